@@ -1,0 +1,27 @@
+# Finds every dependency once. All are Debian packages that `scripts/orbed setup` installs.
+find_package(Threads REQUIRED)
+find_package(Eigen3 3.4 REQUIRED NO_MODULE)
+find_package(yaml-cpp REQUIRED)
+find_package(CLI11 REQUIRED)
+find_package(GTest REQUIRED)
+find_package(PkgConfig REQUIRED)
+
+# LCM 1.3.1 on Debian ships neither a CMake config nor a usable lcm.pc (it requires glib's -dev).
+find_program(LCM_GEN_EXECUTABLE lcm-gen REQUIRED)
+find_library(LCM_LIBRARY lcm REQUIRED)
+find_path(LCM_INCLUDE_DIR lcm/lcm-cpp.hpp REQUIRED)
+add_library(orbed_lcm INTERFACE)
+target_include_directories(orbed_lcm INTERFACE ${LCM_INCLUDE_DIR})
+target_link_libraries(orbed_lcm INTERFACE ${LCM_LIBRARY} Threads::Threads)
+
+find_package(Java 11 COMPONENTS Development)
+find_file(LCM_JAR lcm.jar PATHS /usr/share/java NO_DEFAULT_PATH)
+if(ORBED_BENCHMARKS)
+  find_package(benchmark REQUIRED)
+endif()
+
+find_package(OpenCV REQUIRED COMPONENTS core imgproc imgcodecs highgui)
+find_package(urdfdom REQUIRED)
+# Bullet in double precision only; never link the single-precision libraries beside it.
+pkg_check_modules(BULLET REQUIRED IMPORTED_TARGET bullet-float64)
+find_package(fcl QUIET)

@@ -1,0 +1,30 @@
+# orbed_add_gtest(NAME name SRCS a.cc b.cc LIBS lib1 lib2 [LABELS l1 l2] [TIMEOUT sec])
+#   One gtest executable, registered with ctest as one test (names are per executable, so ctest
+#   output stays short and each library's test is one line).
+function(orbed_add_gtest)
+  cmake_parse_arguments(T "" "NAME;TIMEOUT" "SRCS;LIBS;LABELS" ${ARGN})
+  add_executable(${T_NAME} ${T_SRCS})
+  target_link_libraries(${T_NAME} PRIVATE ${T_LIBS} GTest::gtest_main)
+  set_target_properties(${T_NAME} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/tests)
+  add_test(NAME ${T_NAME} COMMAND ${T_NAME})
+  if(NOT T_TIMEOUT)
+    set(T_TIMEOUT 300)
+  endif()
+  set_tests_properties(${T_NAME} PROPERTIES TIMEOUT ${T_TIMEOUT}
+    ENVIRONMENT "ORBED_SOURCE_DIR=${CMAKE_SOURCE_DIR};ORBED_BIN_DIR=${CMAKE_BINARY_DIR}/bin")
+  if(T_LABELS)
+    set_tests_properties(${T_NAME} PROPERTIES LABELS "${T_LABELS}")
+  endif()
+endfunction()
+
+# orbed_add_process(NAME orbed-foo MAIN main.cc LIBS foo_lib)
+#   A thin main; also registered as two smoke tests: `--help` exits 0, an unknown flag exits != 0.
+function(orbed_add_process)
+  cmake_parse_arguments(P "" "NAME;MAIN" "LIBS" ${ARGN})
+  add_executable(${P_NAME} ${P_MAIN})
+  target_link_libraries(${P_NAME} PRIVATE ${P_LIBS})
+  add_test(NAME ${P_NAME}.help COMMAND ${P_NAME} --help)
+  add_test(NAME ${P_NAME}.unknown_flag COMMAND ${P_NAME} --no-such-flag-xyz)
+  set_tests_properties(${P_NAME}.unknown_flag PROPERTIES WILL_FAIL TRUE)
+  set_tests_properties(${P_NAME}.help ${P_NAME}.unknown_flag PROPERTIES TIMEOUT 20 LABELS smoke)
+endfunction()
