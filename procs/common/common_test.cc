@@ -1,0 +1,217 @@
+// Unit tests of the process scaffold on memq:// (in-process LCM): conversions, validators,
+// typed subscriptions, rejection counting and the heartbeat.
+#include <cmath>
+#include <limits>
+
+#include <gtest/gtest.h>
+#include <orbed/iiwa_command_t.hpp>
+
+#include "procs/common/channels.h"
+#include "procs/common/conversions.h"
+#include "procs/common/flags.h"
+#include "procs/common/process.h"
+#include "procs/common/validation.h"
+
+namespace orbed {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+TEST(Conversions, RotationAboutZByNinetyDegreesHasHandComputedQuaternion) {
+  Eigen::Isometry3d X_AB = Eigen::Isometry3d::Identity();
+  X_AB.linear() = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  X_AB.translation() = Eigen::Vector3d(1.0, -2.0, 0.5);
+  const pose_t pose = ToPose(X_AB);
+  // q = (cos 45°, 0, 0, sin 45°)
+  EXPECT_NEAR(pose.quaternion_wxyz[0], std::sqrt(0.5), 1e-15);
+  EXPECT_NEAR(pose.quaternion_wxyz[1], 0.0, 1e-15);
+  EXPECT_NEAR(pose.quaternion_wxyz[2], 0.0, 1e-15);
+  EXPECT_NEAR(pose.quaternion_wxyz[3], std::sqrt(0.5), 1e-15);
+  EXPECT_EQ(pose.position_m[0], 1.0);
+  EXPECT_EQ(pose.position_m[1], -2.0);
+  EXPECT_EQ(pose.position_m[2], 0.5);
+  // A point on x maps to y.
+  const Eigen::Vector3d p = FromPose(pose) * Eigen::Vector3d(1, 0, 0);
+  EXPECT_NEAR(p.x(), 1.0, 1e-15);
+  EXPECT_NEAR(p.y(), -1.0, 1e-15);
+  EXPECT_NEAR(p.z(), 0.5, 1e-15);
+}
+
+TEST(Conversions, RoundTripAndCanonicalSign) {
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  X.linear() = Eigen::AngleAxisd(3.0, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  X.translation() = Eigen::Vector3d(0.1, 0.2, 0.3);
+  const pose_t pose = ToPose(X);
+  EXPECT_GE(pose.quaternion_wxyz[0], 0.0);
+  EXPECT_TRUE(FromPose(pose).isApprox(X, 1e-14));
+  // -q encodes the same rotation; ToPose picks the same bytes.
+  pose_t flipped = pose;
+  for (double& c : flipped.quaternion_wxyz) c = -c;
+  const pose_t again = ToPose(FromPose(flipped));
+  for (int i = 0; i < 4; ++i) EXPECT_NEAR(again.quaternion_wxyz[i], pose.quaternion_wxyz[i], 1e-15);
+}
+
+TEST(Conversions, MatrixAndVectorLayoutIsRowMajor) {
+  Eigen::Matrix3d m;
+  m << 1, 2, 3, 4, 5, 6, 7, 8, 9;
+  double out[3][3];
+  FromMatrix3(m, out);
+  EXPECT_EQ(out[0][2], 3.0);
+  EXPECT_EQ(out[2][0], 7.0);
+  EXPECT_EQ(ToMatrix3(out), m);
+  const std::vector<double> v{1, 2, 3, 4};
+  EXPECT_EQ(FromVectorX(ToVectorX(v)), v);
+}
+
+TEST(Validation, RejectsNaNInfWrongSizeAndNonUnitQuaternions) {
+  const double good[3] = {1, 2, 3};
+  EXPECT_EQ(CheckFinite(good, 3, "p"), "");
+  const double bad[3] = {1, kNaN, 3};
+  EXPECT_NE(CheckFinite(bad, 3, "p").find("p[1]"), std::string::npos);
+  const double inf[2] = {std::numeric_limits<double>::infinity(), 0};
+  EXPECT_NE(CheckFinite(inf, 2, "v"), "");
+
+  EXPECT_EQ(CheckSize(7, 7, "num_joints"), "");
+  EXPECT_EQ(CheckSize(6, 7, "num_joints"), "num_joints is 6, expected 7");
+  EXPECT_NE(CheckLength(3, 2, 10, "num_x"), "");
+  EXPECT_NE(CheckLength(-1, 0, 10, "num_x"), "");
+  EXPECT_NE(CheckLength(11, 11, 10, "num_x"), "");
+  EXPECT_EQ(CheckLength(2, 2, 10, "num_x"), "");
+
+  const double unit[4] = {0.5, 0.5, 0.5, 0.5};
+  EXPECT_EQ(CheckUnitQuaternion(unit, "q"), "");
+  const double nearly[4] = {1.0 + 5e-7, 0, 0, 0};
+  EXPECT_EQ(CheckUnitQuaternion(nearly, "q"), "");
+  const double half[4] = {0.5, 0, 0, 0};
+  EXPECT_NE(CheckUnitQuaternion(half, "q").find("norm 0.5"), std::string::npos);
+  const double zero[4] = {0, 0, 0, 0};
+  EXPECT_NE(CheckUnitQuaternion(zero, "q"), "");
+  const double nan_q[4] = {kNaN, 0, 0, 0};
+  EXPECT_NE(CheckUnitQuaternion(nan_q, "q"), "");
+
+  pose_t pose{};
+  pose.quaternion_wxyz[0] = 1;
+  EXPECT_EQ(CheckPose(pose, "X_WV"), "");
+  pose.position_m[2] = kNaN;
+  EXPECT_NE(CheckPose(pose, "X_WV").find("X_WV.position_m[2]"), std::string::npos);
+
+  EXPECT_EQ(CheckEnum(2, 0, 3, "mode"), "");
+  EXPECT_EQ(CheckEnum(4, 0, 3, "mode"), "mode is 4, expected 0..3");
+  EXPECT_NE(CheckWithinLimits({0.0, 2.0}, {-1, -1}, {1, 1}, "q"), "");
+  EXPECT_EQ(CheckWithinLimits({0.0, 1.0}, {-1, -1}, {1, 1}, "q"), "");
+  EXPECT_EQ(FirstError({"", "b", "c"}), "b");
+}
+
+TEST(Validation, RejectionCounterCountsPerKey) {
+  RejectionCounter counter;
+  counter.Reject("A/size", "too big");
+  counter.Reject("A/size", "too big again");
+  counter.Reject("B/nan", "nan");
+  EXPECT_EQ(counter.total(), 3);
+  EXPECT_EQ(counter.counts().at("A/size"), 2);
+  EXPECT_EQ(counter.counts().at("B/nan"), 1);
+  EXPECT_EQ(counter.last_reason(), "B/nan: nan");
+}
+
+TEST(Flags, RecvBufSizeIsAddedOrReplaced) {
+  EXPECT_EQ(WithRecvBufSize("udpm://239.255.76.67:7667?ttl=0", 1000),
+            "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=1000");
+  EXPECT_EQ(WithRecvBufSize("udpm://239.255.76.67:7667", 5), "udpm://239.255.76.67:7667?recv_buf_size=5");
+  EXPECT_EQ(WithRecvBufSize("udpm://g:1?recv_buf_size=9&ttl=0", 7), "udpm://g:1?recv_buf_size=7&ttl=0");
+}
+
+TEST(Flags, HelpAndUnknownFlags) {
+  CLI::App app{"test"};
+  CommonFlags flags("orbed-test");
+  AddCommonFlags(&app, &flags);
+  const char* argv[] = {"x", "--seed", "42", "--name", "n1", "--duration-sec", "2.5"};
+  app.parse(7, const_cast<char**>(argv));
+  EXPECT_EQ(flags.seed, 42u);
+  EXPECT_EQ(flags.name, "n1");
+  EXPECT_EQ(flags.duration_sec, 2.5);
+  CLI::App app2{"test"};
+  CommonFlags flags2("orbed-test");
+  AddCommonFlags(&app2, &flags2);
+  const char* bad[] = {"x", "--log-level", "loud"};
+  EXPECT_THROW(app2.parse(3, const_cast<char**>(bad)), CLI::ValidationError);
+}
+
+// A process on memq:// receives its own messages: one valid command, one undecodable payload,
+// one command the handler rejects. The heartbeat must count 3 in, 2 rejected, by reason.
+TEST(Process, CountsMessagesRejectionsAndPublishesHeartbeat) {
+  CommonFlags flags("orbed-test");
+  flags.lcm_url = "memq://";
+  flags.duration_sec = 1.3;
+  Process process(flags);
+  std::vector<process_status_t> heartbeats;
+  int accepted = 0;
+  process.Subscribe<process_status_t>(
+      channels::kProcessStatus,
+      [&](const process_status_t& msg, const std::string&, int64_t) { heartbeats.push_back(msg); });
+  process.Subscribe<iiwa_command_t>(
+      channels::kIiwaCommand, [&](const iiwa_command_t& msg, const std::string& channel, int64_t) {
+        const std::string error = CheckSize(msg.num_joints, 7, "num_joints");
+        if (!error.empty()) {
+          process.Reject(channel + "/num_joints", error);
+          return;
+        }
+        ++accepted;
+      });
+  iiwa_command_t good{};
+  good.num_joints = 7;
+  good.joint_position.assign(7, 0.0);
+  process.lcm().publish(channels::kIiwaCommand, &good);
+  iiwa_command_t wrong{};
+  wrong.num_joints = 3;
+  wrong.joint_position.assign(3, 0.0);
+  process.lcm().publish(channels::kIiwaCommand, &wrong);
+  const uint8_t garbage[5] = {1, 2, 3, 4, 5};
+  process.lcm().publish(channels::kIiwaCommand, garbage, sizeof(garbage));
+
+  EXPECT_EQ(process.Run(), 0);
+  EXPECT_EQ(accepted, 1);
+  EXPECT_EQ(process.rejections().total(), 2);
+  EXPECT_EQ(process.rejections().counts().at("IIWA_COMMAND/decode"), 1);
+  EXPECT_EQ(process.rejections().counts().at("IIWA_COMMAND/num_joints"), 1);
+  // Heartbeats: at start, at 1 s, at stop (the stop one is published after the loop and is not
+  // received). At least the start and the 1 s heartbeat arrive.
+  ASSERT_GE(heartbeats.size(), 2u);
+  const process_status_t& last = heartbeats.back();
+  EXPECT_EQ(last.name, "orbed-test");
+  EXPECT_EQ(last.state, +process_status_t::STATE_RUNNING);
+  EXPECT_EQ(last.rejected_inputs, 2);
+  EXPECT_EQ(last.num_reasons, 2);
+  EXPECT_GE(last.uptime_s, 0.99);
+  // 3 commands + the heartbeats received before the last one.
+  EXPECT_GE(last.messages_in, 3);
+  const process_status_t final_status = process.MakeStatus();
+  EXPECT_EQ(final_status.state, +process_status_t::STATE_STOPPING);
+  EXPECT_EQ(final_status.messages_out, static_cast<int64_t>(heartbeats.size()) + 1);
+}
+
+TEST(Process, TimerFiresAtItsPeriod) {
+  CommonFlags flags("orbed-test");
+  flags.lcm_url = "memq://";
+  flags.duration_sec = 0.5;
+  Process process(flags);
+  int ticks = 0;
+  process.AddTimer(0.1, [&] { ++ticks; });
+  process.Run();
+  // 0.1, 0.2, 0.3, 0.4 (and possibly 0.5) s.
+  EXPECT_GE(ticks, 4);
+  EXPECT_LE(ticks, 5);
+}
+
+TEST(Process, BadUrlThrowsNamingIt) {
+  CommonFlags flags("orbed-test");
+  flags.lcm_url = "nosuchprovider://x";
+  try {
+    Process process(flags);
+    FAIL() << "expected a throw";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("nosuchprovider://x"), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace orbed

@@ -1,0 +1,49 @@
+#pragma once
+/// @file
+/// The flags every orbed process shares, on CLI11:
+///   --lcm-url URL      LCM provider URL (default: $ORBED_LCM_URL, else udpm://239.255.76.67:7667?ttl=0)
+///   --name NAME        process name on PROCESS_STATUS and in log lines
+///   --seed N           seed of every random generator in the process
+///   --duration-sec S   stop cleanly after S seconds (0 = run until SIGINT/SIGTERM)
+///   --log-level L      debug | info | warn | error
+/// Usage in a thin main:
+///   CLI::App app{"what it does"};
+///   orbed::CommonFlags common("orbed-foo");
+///   orbed::AddCommonFlags(&app, &common);
+///   ... process-specific flags ...
+///   CLI11_PARSE(app, argc, argv);   // --help → exit 0, bad flag → exit != 0
+///   orbed::ApplyCommonFlags(common);
+
+#include <cstdint>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+namespace orbed {
+
+/// Multicast group and port of the testbed (LCM's own default group, ttl=0: never leaves the host).
+inline constexpr char kDefaultLcmUrl[] = "udpm://239.255.76.67:7667?ttl=0";
+
+struct CommonFlags {
+  explicit CommonFlags(std::string default_name);
+  std::string lcm_url;
+  std::string name;
+  uint64_t seed = 1;
+  double duration_sec = 0.0;
+  std::string log_level = "info";
+};
+
+/// The URL a process uses when --lcm-url is not given.
+std::string DefaultLcmUrl();
+
+/// Adds `url`'s query parameter recv_buf_size=bytes (replacing one that is there), for processes
+/// that subscribe to large messages (images). LCM's default UDP receive buffer drops ~1 MB
+/// messages outright.
+std::string WithRecvBufSize(const std::string& url, int64_t bytes);
+
+void AddCommonFlags(CLI::App* app, CommonFlags* flags);
+
+/// Sets the log name and level; throws CLI::ValidationError on a bad level.
+void ApplyCommonFlags(const CommonFlags& flags);
+
+}  // namespace orbed

@@ -1,0 +1,160 @@
+#include "procs/common/process.h"
+
+#include <unistd.h>
+
+#include <csignal>
+#include <stdexcept>
+#include <thread>
+
+#include "procs/common/channels.h"
+#include "procs/common/conversions.h"
+#include "procs/common/log.h"
+
+namespace orbed {
+namespace {
+
+std::atomic<bool> g_stop_signalled{false};
+
+extern "C" void HandleStopSignal(int) { g_stop_signalled = true; }
+
+std::chrono::steady_clock::duration Seconds(double s) {
+  return std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+      std::chrono::duration<double>(s));
+}
+
+}  // namespace
+
+void InstallStopSignalHandlers() {
+  struct sigaction action {};
+  action.sa_handler = HandleStopSignal;
+  sigemptyset(&action.sa_mask);
+  action.sa_flags = 0;  // no SA_RESTART: blocking calls return EINTR so loops notice promptly
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
+}
+
+bool StopSignalled() { return g_stop_signalled.load(); }
+void RequestGlobalStop() { g_stop_signalled = true; }
+
+Process::Process(const CommonFlags& flags)
+    : name_(flags.name),
+      seed_(flags.seed),
+      duration_sec_(flags.duration_sec),
+      lcm_(std::make_unique<lcm::LCM>(flags.lcm_url)),
+      start_(std::chrono::steady_clock::now()) {
+  if (!lcm_->good()) {
+    throw std::runtime_error("cannot open LCM at '" + flags.lcm_url +
+                             "' (is there a multicast route? run inside `scripts/orbed launch` or "
+                             "add one: ip route add 224.0.0.0/4 dev lo)");
+  }
+  AddTimer(1.0, [this] { PublishStatus(); });
+}
+
+Process::~Process() = default;
+
+void Process::AddTimer(double period_s, std::function<void()> callback) {
+  if (!(period_s > 0)) throw std::invalid_argument("timer period must be > 0 s");
+  Timer timer;
+  timer.period = Seconds(period_s);
+  timer.next = std::chrono::steady_clock::now() + timer.period;
+  timer.callback = std::move(callback);
+  timers_.push_back(std::move(timer));
+}
+
+void Process::SetLastError(const std::string& error) {
+  std::lock_guard<std::mutex> lock(error_mutex_);
+  last_error_ = error;
+}
+
+void Process::Fail(const std::string& error) {
+  ORBED_LOG(kError) << error;
+  SetLastError(error);
+  failed_ = true;
+  stop_requested_ = true;
+}
+
+double Process::UptimeSeconds() const {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+}
+
+orbed::process_status_t Process::MakeStatus() const {
+  orbed::process_status_t status{};
+  status.utime = NowMicros();
+  status.name = name_;
+  status.pid = static_cast<int32_t>(getpid());
+  if (failed_) {
+    status.state = orbed::process_status_t::STATE_FAILED;
+  } else if (stop_requested_ || StopSignalled()) {
+    status.state = orbed::process_status_t::STATE_STOPPING;
+  } else if (running_) {
+    status.state = orbed::process_status_t::STATE_RUNNING;
+  } else {
+    status.state = orbed::process_status_t::STATE_STARTING;
+  }
+  status.uptime_s = UptimeSeconds();
+  status.messages_in = messages_in_;
+  status.messages_out = messages_out_;
+  status.rejected_inputs = rejections_.total();
+  for (const auto& [reason, count] : rejections_.counts()) {
+    status.reject_reason.push_back(reason);
+    status.reject_count.push_back(count);
+  }
+  status.num_reasons = static_cast<int32_t>(status.reject_reason.size());
+  std::lock_guard<std::mutex> lock(error_mutex_);
+  status.last_error = last_error_.empty() ? rejections_.last_reason() : last_error_;
+  return status;
+}
+
+void Process::PublishStatus() {
+  const orbed::process_status_t status = MakeStatus();
+  Publish(channels::kProcessStatus, status);
+}
+
+int Process::Run() {
+  InstallStopSignalHandlers();
+  running_ = true;
+  ORBED_LOG(kInfo) << "running (pid " << getpid() << ")";
+  PublishStatus();  // the first heartbeat tells the launcher we are ready
+  const auto deadline = duration_sec_ > 0 ? start_ + Seconds(duration_sec_)
+                                          : std::chrono::steady_clock::time_point::max();
+  // Waits are capped so that a stop request is noticed within 50 ms.
+  const auto max_wait = std::chrono::milliseconds(50);
+  while (!stop_requested_ && !StopSignalled()) {
+    auto now = std::chrono::steady_clock::now();
+    if (now >= deadline) {
+      ORBED_LOG(kInfo) << "--duration-sec reached";
+      break;
+    }
+    for (Timer& timer : timers_) {
+      if (now >= timer.next) {
+        timer.callback();
+        now = std::chrono::steady_clock::now();
+        timer.next += timer.period;
+        if (timer.next <= now) {  // fell behind: skip missed ticks rather than bunching them
+          const auto behind = (now - timer.next) / timer.period + 1;
+          timer.next += behind * timer.period;
+        }
+      }
+    }
+    auto next = std::min(deadline, now + max_wait);
+    for (const Timer& timer : timers_) next = std::min(next, timer.next);
+    const auto wait_us =
+        std::chrono::duration_cast<std::chrono::microseconds>(next - now).count();
+    // handleTimeout has millisecond resolution: round up and let the loop catch the rest.
+    const int wait_ms = wait_us <= 0 ? 0 : static_cast<int>((wait_us + 999) / 1000);
+    const int result = lcm_->handleTimeout(wait_ms);
+    if (result < 0 && !StopSignalled()) {
+      SetLastError("LCM handle failed");
+      ORBED_LOG(kWarn) << "LCM handleTimeout failed";
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+  }
+  running_ = false;
+  stop_requested_ = true;
+  PublishStatus();  // says STOPPING (or FAILED)
+  ORBED_LOG(kInfo) << "stopped: " << messages_in_ << " in, " << messages_out_ << " out, "
+                   << rejections_.total() << " rejected";
+  return failed_ ? 1 : 0;
+}
+
+}  // namespace orbed

@@ -1,0 +1,148 @@
+#pragma once
+/// @file
+/// The scaffold every orbed process runs on: one LCM instance, typed subscriptions that decode,
+/// count and reject (a message that fails to decode is a counted rejection, never a silent drop),
+/// periodic timers, the 1 Hz PROCESS_STATUS heartbeat, and a clean stop on SIGINT/SIGTERM or after
+/// --duration-sec.
+///
+/// Threading: Run() is a single-threaded loop. Message handlers and timers are called on the thread
+/// that calls Run(), never concurrently with each other. Counters are atomic, so other threads a
+/// process owns (e.g. the logger's writer) may count too. RequestStop() and the signal handler may
+/// be called from any thread.
+///
+/// Clock: timers and uptime use the monotonic clock; message utimes use the wall clock
+/// (NowMicros()).
+
+#include <atomic>
+#include <chrono>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <lcm/lcm-cpp.hpp>
+#include <orbed/process_status_t.hpp>
+
+#include "procs/common/flags.h"
+#include "procs/common/validation.h"
+
+namespace orbed {
+
+/// Installs SIGINT/SIGTERM handlers that make every Process::Run() return. Idempotent.
+void InstallStopSignalHandlers();
+/// True once SIGINT or SIGTERM arrived (or RequestGlobalStop() was called).
+bool StopSignalled();
+void RequestGlobalStop();
+
+class Process {
+ public:
+  /// Connects to flags.lcm_url; throws std::runtime_error naming the URL if LCM cannot start.
+  explicit Process(const CommonFlags& flags);
+  virtual ~Process();
+  Process(const Process&) = delete;
+  Process& operator=(const Process&) = delete;
+
+  const std::string& name() const { return name_; }
+  uint64_t seed() const { return seed_; }
+  lcm::LCM& lcm() { return *lcm_; }
+
+  /// Subscribes `handler(msg, channel, receive_utime)` to `channel`. Messages that fail to decode
+  /// (wrong type, fingerprint, truncated) are rejected under key "<channel>/decode".
+  template <class Msg>
+  void Subscribe(const std::string& channel,
+                 std::function<void(const Msg&, const std::string&, int64_t)> handler);
+
+  /// Publishes and counts one message out.
+  template <class Msg>
+  void Publish(const std::string& channel, const Msg& msg) {
+    lcm_->publish(channel, &msg);
+    ++messages_out_;
+  }
+
+  /// Calls `callback` every `period_s` seconds on the Run() thread, first at start + period.
+  /// Missed deadlines are skipped, not bunched.
+  void AddTimer(double period_s, std::function<void()> callback);
+
+  /// Records a rejected input with its class `key` and a reason; logs it (rate-limited).
+  void Reject(const std::string& key, const std::string& reason) { rejections_.Reject(key, reason); }
+  /// Records an error that is not a rejected input (shown as last_error on the heartbeat).
+  void SetLastError(const std::string& error);
+
+  /// Runs until a stop signal, RequestStop() or --duration-sec. Returns the process exit code
+  /// (0 unless Fail() was called).
+  int Run();
+  void RequestStop() { stop_requested_ = true; }
+  /// Marks the process failed: the next heartbeat says STATE_FAILED and Run() returns 1.
+  void Fail(const std::string& error);
+
+  /// The heartbeat as it would be published now (for tests and the 1 Hz timer).
+  orbed::process_status_t MakeStatus() const;
+  int64_t messages_in() const { return messages_in_; }
+  int64_t messages_out() const { return messages_out_; }
+  const RejectionCounter& rejections() const { return rejections_; }
+  double UptimeSeconds() const;
+
+ protected:
+  void CountIn() { ++messages_in_; }
+  void CountOut() { ++messages_out_; }
+
+ private:
+  struct Timer {
+    std::chrono::steady_clock::duration period;
+    std::chrono::steady_clock::time_point next;
+    std::function<void()> callback;
+  };
+  // Raw LCM handler: decodes into the typed handler.
+  struct SubscriptionBase {
+    virtual ~SubscriptionBase() = default;
+    virtual void OnRaw(const lcm::ReceiveBuffer* rbuf, const std::string& channel) = 0;
+  };
+  template <class Msg>
+  struct TypedSubscription;
+
+  void PublishStatus();
+
+  std::string name_;
+  uint64_t seed_;
+  double duration_sec_;
+  std::unique_ptr<lcm::LCM> lcm_;
+  std::vector<std::unique_ptr<SubscriptionBase>> subscriptions_;
+  std::vector<Timer> timers_;
+  std::chrono::steady_clock::time_point start_;
+  std::atomic<bool> stop_requested_{false};
+  std::atomic<bool> running_{false};
+  std::atomic<bool> failed_{false};
+  std::atomic<int64_t> messages_in_{0};
+  std::atomic<int64_t> messages_out_{0};
+  RejectionCounter rejections_;
+  mutable std::mutex error_mutex_;
+  std::string last_error_;  // guarded by error_mutex_
+};
+
+template <class Msg>
+struct Process::TypedSubscription : Process::SubscriptionBase {
+  Process* process;
+  std::function<void(const Msg&, const std::string&, int64_t)> handler;
+  void OnRaw(const lcm::ReceiveBuffer* rbuf, const std::string& channel) override {
+    ++process->messages_in_;
+    Msg msg;
+    if (msg.decode(rbuf->data, 0, rbuf->data_size) != static_cast<int>(rbuf->data_size)) {
+      process->Reject(channel + "/decode", "cannot decode " + std::to_string(rbuf->data_size) +
+                                               " bytes as " + Msg::getTypeName());
+      return;
+    }
+    handler(msg, channel, rbuf->recv_utime);
+  }
+};
+
+template <class Msg>
+void Process::Subscribe(const std::string& channel,
+                        std::function<void(const Msg&, const std::string&, int64_t)> handler) {
+  auto sub = std::make_unique<TypedSubscription<Msg>>();
+  sub->process = this;
+  sub->handler = std::move(handler);
+  lcm_->subscribe(channel, &SubscriptionBase::OnRaw, static_cast<SubscriptionBase*>(sub.get()));
+  subscriptions_.push_back(std::move(sub));
+}
+
+}  // namespace orbed
