@@ -118,6 +118,7 @@ TEST(Flags, RecvBufSizeIsAddedOrReplaced) {
             "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=1000");
   EXPECT_EQ(WithRecvBufSize("udpm://239.255.76.67:7667", 5), "udpm://239.255.76.67:7667?recv_buf_size=5");
   EXPECT_EQ(WithRecvBufSize("udpm://g:1?recv_buf_size=9&ttl=0", 7), "udpm://g:1?recv_buf_size=7&ttl=0");
+  EXPECT_EQ(WithRecvBufSize("memq://", 7), "memq://");
 }
 
 TEST(Flags, HelpAndUnknownFlags) {
@@ -211,6 +212,37 @@ TEST(Process, BadUrlThrowsNamingIt) {
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("nosuchprovider://x"), std::string::npos);
   }
+}
+
+}  // namespace
+}  // namespace orbed
+
+#include "procs/common/json.h"
+#include "procs/common/sha256.h"
+
+namespace orbed {
+namespace {
+
+// FIPS 180-4 example vectors.
+TEST(Sha256, KnownVectors) {
+  EXPECT_EQ(Sha256Hex(""), "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855");
+  EXPECT_EQ(Sha256Hex("abc"), "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+  EXPECT_EQ(Sha256Hex("abcdbcdecdefdefgefghfghighijhijkijkljklmklmnlmnomnopnopq"),
+            "248d6a61d20638b8e5c026930c3e6039a33ce45964ff2167f6ecedd419db06c1");
+  EXPECT_EQ(Sha256Hex(std::string(1000000, 'a')),
+            "cdc76e5c9914fb9281a1c7e284d73e67f1809a48a497200e046d39ccc7112cd0");
+}
+
+TEST(Json, WritesEscapedCompactJson) {
+  JsonWriter json;
+  json.BeginObject();
+  json.Key("name").String("a\"b\n");
+  json.Key("v").Array(std::vector<double>{0.1, 2.0, std::nan("")});
+  json.Key("ok").Bool(true);
+  json.Key("n").Int(-3);
+  json.Key("empty").BeginArray().EndArray();
+  json.EndObject();
+  EXPECT_EQ(json.str(), R"({"name":"a\"b\n","v":[0.1,2,null],"ok":true,"n":-3,"empty":[]})");
 }
 
 }  // namespace

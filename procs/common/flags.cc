@@ -17,6 +17,7 @@ std::string DefaultLcmUrl() {
 }
 
 std::string WithRecvBufSize(const std::string& url, int64_t bytes) {
+  if (url.rfind("udpm://", 0) != 0) return url;  // only the UDP provider has a receive buffer
   static const std::regex kExisting("([?&])recv_buf_size=[0-9]+");
   const std::string param = "recv_buf_size=" + std::to_string(bytes);
   if (std::regex_search(url, kExisting)) {

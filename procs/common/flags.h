@@ -38,7 +38,7 @@ std::string DefaultLcmUrl();
 
 /// Adds `url`'s query parameter recv_buf_size=bytes (replacing one that is there), for processes
 /// that subscribe to large messages (images). LCM's default UDP receive buffer drops ~1 MB
-/// messages outright.
+/// messages outright. Other providers (memq://, file://) are returned unchanged.
 std::string WithRecvBufSize(const std::string& url, int64_t bytes);
 
 void AddCommonFlags(CLI::App* app, CommonFlags* flags);

@@ -61,6 +61,18 @@ void Process::AddTimer(double period_s, std::function<void()> callback) {
   timers_.push_back(std::move(timer));
 }
 
+lcm::Subscription* Process::SubscribeRaw(
+    const std::string& channel_regex,
+    std::function<void(const lcm::ReceiveBuffer&, const std::string&)> handler) {
+  auto sub = std::make_unique<RawSubscription>();
+  sub->process = this;
+  sub->handler = std::move(handler);
+  lcm::Subscription* subscription = lcm_->subscribe(
+      channel_regex, &SubscriptionBase::OnRaw, static_cast<SubscriptionBase*>(sub.get()));
+  subscriptions_.push_back(std::move(sub));
+  return subscription;
+}
+
 void Process::SetLastError(const std::string& error) {
   std::lock_guard<std::mutex> lock(error_mutex_);
   last_error_ = error;

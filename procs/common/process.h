@@ -52,6 +52,13 @@ class Process {
   void Subscribe(const std::string& channel,
                  std::function<void(const Msg&, const std::string&, int64_t)> handler);
 
+  /// Subscribes to every channel matching `channel_regex` without decoding (for the logger and
+  /// bridges). The handler gets LCM's receive buffer (data valid only during the call).
+  /// Returns LCM's subscription so the caller can raise its queue capacity.
+  lcm::Subscription* SubscribeRaw(
+      const std::string& channel_regex,
+      std::function<void(const lcm::ReceiveBuffer&, const std::string&)> handler);
+
   /// Publishes and counts one message out.
   template <class Msg>
   void Publish(const std::string& channel, const Msg& msg) {
@@ -99,6 +106,7 @@ class Process {
   };
   template <class Msg>
   struct TypedSubscription;
+  struct RawSubscription;
 
   void PublishStatus();
 
@@ -132,6 +140,15 @@ struct Process::TypedSubscription : Process::SubscriptionBase {
       return;
     }
     handler(msg, channel, rbuf->recv_utime);
+  }
+};
+
+struct Process::RawSubscription : Process::SubscriptionBase {
+  Process* process;
+  std::function<void(const lcm::ReceiveBuffer&, const std::string&)> handler;
+  void OnRaw(const lcm::ReceiveBuffer* rbuf, const std::string& channel) override {
+    ++process->messages_in_;
+    handler(*rbuf, channel);
   }
 };
 

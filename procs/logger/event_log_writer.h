@@ -1,0 +1,50 @@
+#pragma once
+/// @file
+/// Writes the standard LCM event-log format (what lcm-logger writes and lcm-logplayer, lcm-spy
+/// and LCM's LogFile API read). Per event, big-endian:
+///   uint32 sync 0xEDA1DA01 | int64 event number | int64 timestamp [us] |
+///   int32 channel length | int32 data length | channel bytes | data bytes
+/// Buffered; Flush() pushes the buffer to the kernel, so after a SIGKILL the file holds every
+/// event up to the last flush, and at most one partial event after it (which readers skip).
+///
+/// Threading: not thread-safe; the logger calls it from its writer thread only.
+
+#include <cstdint>
+#include <cstdio>
+#include <string>
+
+namespace orbed::logger {
+
+class EventLogWriter {
+ public:
+  /// Opens `path` for writing (truncates). Check ok() / error().
+  explicit EventLogWriter(const std::string& path, size_t buffer_bytes = 1 << 20);
+  ~EventLogWriter();
+  EventLogWriter(const EventLogWriter&) = delete;
+  EventLogWriter& operator=(const EventLogWriter&) = delete;
+
+  bool ok() const { return file_ != nullptr && error_.empty(); }
+  const std::string& error() const { return error_; }
+
+  /// Appends one event; the event number is assigned in order from 0. Returns bytes written
+  /// (header + channel + data), or 0 after an error.
+  size_t Write(int64_t timestamp_us, const std::string& channel, const uint8_t* data,
+               size_t size);
+  /// Pushes buffered bytes to the kernel (fflush). Returns false on an I/O error.
+  bool Flush();
+  /// Flushes and closes; further writes fail.
+  void Close();
+  int64_t events_written() const { return next_event_number_; }
+
+  /// Size of the event header in bytes.
+  static constexpr size_t kHeaderBytes = 4 + 8 + 8 + 4 + 4;
+  static constexpr uint32_t kSyncWord = 0xEDA1DA01;
+
+ private:
+  FILE* file_ = nullptr;
+  std::string path_;
+  std::string error_;
+  int64_t next_event_number_ = 0;
+};
+
+}  // namespace orbed::logger

@@ -1,0 +1,113 @@
+#pragma once
+/// @file
+/// orbed-logger's engine: records LCM traffic to a standard LCM event log.
+///
+/// Threads: the receive thread (Process::Run, LCM's handler) stamps each message with LCM's
+/// receive time and appends it to a bounded in-memory queue, or counts a drop when the queue is
+/// full (by events or bytes) — never a silent loss. The writer thread drains the queue into the
+/// file and flushes every `flush_interval_sec`, so after a SIGKILL the log is valid up to the last
+/// flush. SIGINT/SIGTERM stop the receive loop, the writer drains what is queued, flushes, closes,
+/// and the manifest is rewritten with complete = true.
+///
+/// Outputs: the log file, `manifest.json` beside it (start/stop time, command line, versions,
+/// SHA-256 of the files given with --hash-file, per-channel events and bytes), LOGGER_STATUS at
+/// 1 Hz and the PROCESS_STATUS heartbeat.
+
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <map>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <orbed/logger_status_t.hpp>
+
+#include "procs/common/process.h"
+#include "procs/logger/event_log_writer.h"
+
+namespace orbed::logger {
+
+struct LoggerOptions {
+  /// Folder for the log (created if missing); the file is named by start time (UTC):
+  /// orbed-YYYYMMDDTHHMMSSZ.lcmlog.
+  std::string log_dir = "logs";
+  /// Explicit log path; overrides log_dir + start-time name when set.
+  std::string file;
+  /// Regular expression of the channels to record (LCM's full-match channel regex).
+  std::string channels = ".*";
+  /// Queue bounds: a message that does not fit is dropped and counted.
+  int64_t queue_capacity_events = 100000;
+  int64_t queue_capacity_bytes = 128ll << 20;
+  /// Period of the writer's fflush [s].
+  double flush_interval_sec = 0.25;
+  /// Files whose SHA-256 the manifest records (URDF, scene, launch file, ...).
+  std::vector<std::string> hash_files;
+  /// The command line, for the manifest.
+  std::string command_line;
+  /// Capacity of LCM's own per-subscription queue (LCM's default, 30, drops bursts).
+  int lcm_queue_capacity = 10000;
+  /// Channel of this logger's status messages.
+  std::string status_channel = "LOGGER_STATUS";
+};
+
+/// Per-channel totals (written events).
+struct ChannelStats {
+  int64_t events = 0;
+  int64_t bytes = 0;  // payload bytes
+  int64_t first_utime = 0;
+  int64_t last_utime = 0;
+};
+
+class Logger {
+ public:
+  /// Opens the log; throws std::runtime_error naming the path when it cannot.
+  Logger(const CommonFlags& flags, LoggerOptions options);
+  ~Logger();
+
+  /// Records until stopped; returns the exit code.
+  int Run();
+
+  const std::string& log_path() const { return log_path_; }
+  std::string manifest_path() const;
+  orbed::logger_status_t MakeStatus() const;
+  std::map<std::string, ChannelStats> channel_stats() const;
+  Process& process() { return process_; }
+
+ private:
+  struct Event {
+    int64_t utime;
+    std::string channel;
+    std::vector<uint8_t> data;
+  };
+  void OnMessage(const lcm::ReceiveBuffer& rbuf, const std::string& channel);
+  void WriterLoop();
+  void WriteManifest(bool complete) const;
+
+  LoggerOptions options_;
+  CommonFlags flags_;
+  Process process_;
+  std::string log_path_;
+  int64_t start_utime_;
+  int64_t stop_utime_ = 0;
+
+  mutable std::mutex queue_mutex_;
+  std::condition_variable queue_cv_;
+  std::deque<Event> queue_;       // guarded by queue_mutex_
+  int64_t queue_bytes_ = 0;       // guarded by queue_mutex_
+  int64_t drops_ = 0;             // guarded by queue_mutex_
+  bool writer_stop_ = false;      // guarded by queue_mutex_
+
+  mutable std::mutex stats_mutex_;
+  std::map<std::string, ChannelStats> stats_;  // guarded by stats_mutex_
+  int64_t events_written_ = 0;                  // guarded by stats_mutex_
+  int64_t bytes_written_ = 0;                   // guarded by stats_mutex_
+  int64_t last_flush_utime_ = 0;                // guarded by stats_mutex_
+  std::string write_error_;                     // guarded by stats_mutex_
+
+  std::unique_ptr<EventLogWriter> file_;  // used by the writer thread only, after Run() starts
+  std::thread writer_;
+};
+
+}  // namespace orbed::logger
