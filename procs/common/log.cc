@@ -2,6 +2,7 @@
 
 #include <atomic>
 #include <cstdio>
+#include <cstdlib>
 #include <mutex>
 
 namespace orbed {
@@ -38,8 +39,14 @@ LogLevel GetLogLevel() { return static_cast<LogLevel>(g_level.load()); }
 
 void Log(LogLevel level, const std::string& message) {
   if (static_cast<int>(level) < g_level.load()) return;
+  // Under orbed-launch every output line is already prefixed with the process name.
+  static const bool prefixed = std::getenv("ORBED_LOG_PREFIXED") != nullptr;
   std::lock_guard<std::mutex> lock(g_mutex);
-  std::fprintf(stderr, "[%s] %s %s\n", g_name.c_str(), LevelName(level), message.c_str());
+  if (prefixed) {
+    std::fprintf(stderr, "%s %s\n", LevelName(level), message.c_str());
+  } else {
+    std::fprintf(stderr, "[%s] %s %s\n", g_name.c_str(), LevelName(level), message.c_str());
+  }
   std::fflush(stderr);
 }
 

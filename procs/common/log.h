@@ -1,6 +1,7 @@
 #pragma once
 /// @file
-/// Minimal leveled logging to stderr, one line per call: "[name] LEVEL message". The launcher
+/// Minimal leveled logging to stderr, one line per call: "[name] LEVEL message" ("LEVEL message"
+/// when ORBED_LOG_PREFIXED is set, as orbed-launch does since it prefixes lines itself). The launcher
 /// prefixes each child's output again with its name, so lines stay attributable in a merged
 /// stream. Thread-safe (one mutex around each write).
 

@@ -39,7 +39,7 @@ int main(int argc, char** argv) {
   for (int i = 0; i < argc; ++i) options.command_line += (i ? " " : "") + std::string(argv[i]);
   // The logger records images too: make sure the socket buffer holds a burst of them.
   if (common.lcm_url.find("recv_buf_size=") == std::string::npos) {
-    common.lcm_url = orbed::WithRecvBufSize(common.lcm_url, 16 << 20);
+    common.lcm_url = orbed::WithRecvBufSize(common.lcm_url, 8 << 20);
   }
   try {
     orbed::logger::Logger logger(common, options);

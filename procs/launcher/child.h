@@ -1,0 +1,59 @@
+#pragma once
+/// @file
+/// One child process of orbed-launch: fork/exec in its own process group (so a terminal's Ctrl-C
+/// reaches only the launcher, which then stops children in order) with PR_SET_PDEATHSIG so it dies
+/// if the launcher is killed; stdout and stderr merged into a pipe that the launcher reads and
+/// re-emits line by line with the child's name in front.
+///
+/// Threading: not thread-safe; used from the launcher's loop thread only.
+
+#include <sys/types.h>
+
+#include <map>
+#include <string>
+#include <vector>
+
+namespace orbed::launcher {
+
+class Child {
+ public:
+  Child() = default;
+  ~Child();
+  Child(const Child&) = delete;
+  Child& operator=(const Child&) = delete;
+
+  /// Starts `argv[0]` (resolved: a path with '/' as is, else in `search_dir` if it is there, else
+  /// PATH) with the launcher's environment plus `env`. Returns false with *error set when it
+  /// cannot start (fork failure or a missing executable, detected before fork).
+  bool Start(const std::vector<std::string>& argv, const std::map<std::string, std::string>& env,
+             const std::string& search_dir, std::string* error);
+
+  /// Non-blocking: reaps the child if it exited. Returns true once it has exited.
+  bool Poll();
+  bool running() const { return pid_ > 0 && !exited_; }
+  pid_t pid() const { return pid_; }
+  /// Valid after Poll() returned true.
+  int exit_code() const { return exit_code_; }     // -1 when killed by a signal
+  int term_signal() const { return term_signal_; }  // 0 unless killed by a signal
+  std::string DescribeExit() const;
+
+  /// Sends `signal` to the child's process group.
+  void Signal(int signal);
+
+  /// Reads what the child printed (non-blocking) and writes complete lines to stdout as
+  /// "<prefix><line>". At exit the rest is flushed with Drain(true).
+  void Drain(const std::string& prefix, bool final = false);
+
+ private:
+  pid_t pid_ = -1;
+  int output_fd_ = -1;
+  bool exited_ = false;
+  int exit_code_ = 0;
+  int term_signal_ = 0;
+  std::string partial_line_;
+};
+
+/// Resolves an executable name as Child::Start does; "" if not found.
+std::string ResolveExecutable(const std::string& command, const std::string& search_dir);
+
+}  // namespace orbed::launcher

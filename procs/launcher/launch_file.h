@@ -1,0 +1,81 @@
+#pragma once
+/// @file
+/// The YAML launch file of orbed-launch: groups started in order, processes within a group
+/// started together. Schema (unknown keys are errors, so typos do not pass silently):
+///
+///   name: testbed                      # optional, for messages
+///   groups:
+///     - name: recording
+///       processes:
+///         - name: logger               # unique; passed to the child as --name for heartbeats
+///           command: orbed-logger      # no '/': looked up in the launcher's folder, then PATH
+///           args: [--log-dir, "${ORBED_LOG_DIR}"]
+///           env: {KEY: value}          # added to the launcher's environment
+///           required: true             # its failure stops the testbed, exit != 0 (default true)
+///           respawn: false             # restart when it dies (default false)
+///           stop_signal: SIGINT        # SIGINT | SIGTERM | SIGHUP | SIGQUIT | SIGUSR1 | SIGUSR2 | SIGKILL
+///           stop_timeout_sec: 5        # then SIGKILL (default 5)
+///           ready: heartbeat           # heartbeat (first PROCESS_STATUS) | none (default heartbeat)
+///           ready_timeout_sec: 10      # (default 10)
+///           exit_stops_all: false      # when it exits, stop the testbed with its exit status
+///
+/// ${VAR} in command, args and env values expands from the environment; an unset variable is an
+/// error. Errors throw LaunchFileError with "file:line: what, expected ...".
+
+#include <map>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace orbed::launcher {
+
+class LaunchFileError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+enum class ReadyCheck { kHeartbeat, kNone };
+
+struct ProcessSpec {
+  std::string name;
+  std::string command;
+  std::vector<std::string> args;
+  std::map<std::string, std::string> env;
+  bool required = true;
+  bool respawn = false;
+  int stop_signal = 2;  // SIGINT
+  double stop_timeout_sec = 5.0;
+  ReadyCheck ready = ReadyCheck::kHeartbeat;
+  double ready_timeout_sec = 10.0;
+  bool exit_stops_all = false;
+};
+
+struct GroupSpec {
+  std::string name;
+  std::vector<ProcessSpec> processes;
+};
+
+struct LaunchSpec {
+  std::string name;
+  std::string path;
+  std::vector<GroupSpec> groups;
+};
+
+/// Parses a launch file. `environment` supplies ${VAR} values.
+LaunchSpec LoadLaunchFile(const std::string& path,
+                          const std::map<std::string, std::string>& environment);
+/// The same from YAML text; `path` only names the source in errors.
+LaunchSpec ParseLaunchYaml(const std::string& yaml, const std::string& path,
+                           const std::map<std::string, std::string>& environment);
+
+/// Expands ${VAR}; throws std::invalid_argument naming an unset variable.
+std::string ExpandVariables(const std::string& text,
+                            const std::map<std::string, std::string>& environment);
+
+/// "SIGINT" → 2 etc.; returns -1 for an unknown name.
+int SignalFromName(const std::string& name);
+
+/// The current process environment as a map.
+std::map<std::string, std::string> CurrentEnvironment();
+
+}  // namespace orbed::launcher

@@ -1,0 +1,250 @@
+#include "procs/launcher/launcher.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <csignal>
+#include <cstdio>
+#include <thread>
+
+#include "procs/common/channels.h"
+#include "procs/common/conversions.h"
+#include "procs/common/log.h"
+
+namespace orbed::launcher {
+namespace {
+
+double SecondsSince(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+}  // namespace
+
+Launcher::Launcher(const CommonFlags& flags, LaunchSpec spec, std::string bin_dir)
+    : flags_(flags), spec_(std::move(spec)), bin_dir_(std::move(bin_dir)), process_(flags) {
+  name_width_ = 7;  // "process", the summary's header
+  for (size_t g = 0; g < spec_.groups.size(); ++g) {
+    for (const ProcessSpec& p : spec_.groups[g].processes) {
+      name_width_ = std::max(name_width_, p.name.size());
+    }
+  }
+  for (size_t g = 0; g < spec_.groups.size(); ++g) {
+    for (const ProcessSpec& p : spec_.groups[g].processes) {
+      Managed managed;
+      managed.spec = p;
+      managed.group = g;
+      managed.child = std::make_unique<Child>();
+      managed.prefix = p.name + std::string(name_width_ - p.name.size(), ' ') + " | ";
+      managed_.push_back(std::move(managed));
+    }
+  }
+  process_.Subscribe<orbed::process_status_t>(
+      channels::kProcessStatus,
+      [this](const orbed::process_status_t& status, const std::string&, int64_t recv_utime) {
+        OnHeartbeat(status, recv_utime);
+      });
+  process_.AddTimer(0.02, [this] { Tick(); });
+}
+
+Launcher::~Launcher() = default;
+
+bool Launcher::StartProcess(Managed* m) {
+  std::vector<std::string> argv = {m->spec.command};
+  argv.insert(argv.end(), m->spec.args.begin(), m->spec.args.end());
+  if (m->spec.ready == ReadyCheck::kHeartbeat &&
+      std::find(m->spec.args.begin(), m->spec.args.end(), "--name") == m->spec.args.end()) {
+    argv.push_back("--name");
+    argv.push_back(m->spec.name);
+  }
+  std::map<std::string, std::string> env = m->spec.env;
+  env.emplace("ORBED_LCM_URL", flags_.lcm_url);
+  env["ORBED_LOG_PREFIXED"] = "1";
+  std::string error;
+  m->child = std::make_unique<Child>();
+  if (!m->child->Start(argv, env, bin_dir_, &error)) {
+    m->last_exit = error;
+    ORBED_LOG(kError) << m->spec.name << ": " << error;
+    return false;
+  }
+  m->started = true;
+  m->ready = m->spec.ready == ReadyCheck::kNone;
+  m->finished = false;
+  m->respawn_pending = false;
+  m->started_at = Clock::now();
+  ORBED_LOG(kInfo) << "started " << m->spec.name << " (pid " << m->child->pid() << ")";
+  return true;
+}
+
+void Launcher::StartGroup(size_t group) {
+  starting_group_ = group;
+  group_started_at_ = Clock::now();
+  ORBED_LOG(kInfo) << "starting group '" << spec_.groups[group].name << "'";
+  for (Managed& m : managed_) {
+    if (m.group != group) continue;
+    if (!StartProcess(&m)) {
+      if (m.spec.required) {
+        FailTestbed("required process '" + m.spec.name + "' could not start: " + m.last_exit);
+        return;
+      }
+      m.finished = true;
+      m.ready = true;  // an optional process that cannot start does not hold up the launch
+    }
+  }
+}
+
+void Launcher::OnHeartbeat(const orbed::process_status_t& status, int64_t) {
+  for (Managed& m : managed_) {
+    if (m.spec.name != status.name || !m.child->running() || m.ready) continue;
+    m.ready = true;
+    ORBED_LOG(kInfo) << m.spec.name << " is ready (first heartbeat after "
+                     << SecondsSince(m.started_at) << " s)";
+  }
+}
+
+void Launcher::HandleExit(Managed* m) {
+  m->child->Drain(m->prefix, true);
+  m->last_exit = m->child->DescribeExit();
+  const bool success = m->child->exit_code() == 0 && m->child->term_signal() == 0;
+  if (stopping_) return;
+  if (m->spec.exit_stops_all) {
+    ORBED_LOG(kInfo) << m->spec.name << " " << m->last_exit << ": stopping the testbed";
+    m->finished = true;
+    if (!success && exit_code_ == 0) exit_code_ = m->child->exit_code() > 0 ? m->child->exit_code() : 1;
+    process_.RequestStop();
+    return;
+  }
+  if (m->spec.respawn) {
+    const bool fast = SecondsSince(m->started_at) < 1.0;
+    m->fast_failures = fast ? m->fast_failures + 1 : 0;
+    // Immediately the first time; 0.25, 0.5, ... up to 5 s while it keeps dying at once.
+    const double delay =
+        m->fast_failures <= 1 ? 0.0 : std::min(5.0, 0.25 * (1 << std::min(m->fast_failures - 2, 5)));
+    ORBED_LOG(kWarn) << m->spec.name << " " << m->last_exit << "; respawning"
+                     << (delay > 0 ? " in " + std::to_string(delay) + " s" : "");
+    m->respawn_pending = true;
+    m->respawn_at = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                       std::chrono::duration<double>(delay));
+    return;
+  }
+  m->finished = true;
+  if (m->spec.required && !success) {
+    FailTestbed("required process '" + m->spec.name + "' " + m->last_exit);
+  } else if (!success) {
+    ORBED_LOG(kWarn) << "optional process " << m->spec.name << " " << m->last_exit
+                     << "; continuing without it";
+  } else {
+    ORBED_LOG(kInfo) << m->spec.name << " finished (exit code 0)";
+  }
+}
+
+void Launcher::FailTestbed(const std::string& reason) {
+  ORBED_LOG(kError) << reason;
+  process_.SetLastError(reason);
+  exit_code_ = 1;
+  process_.RequestStop();
+}
+
+void Launcher::Tick() {
+  for (Managed& m : managed_) {
+    if (!m.started) continue;
+    m.child->Drain(m.prefix);
+    if (m.child->running() && m.child->Poll()) HandleExit(&m);
+    if (m.respawn_pending && !stopping_ && Clock::now() >= m.respawn_at) {
+      ++m.restarts;
+      if (!StartProcess(&m)) {
+        m.respawn_pending = true;
+        m.respawn_at = Clock::now() + std::chrono::seconds(1);
+      }
+    }
+  }
+  if (all_started_ || stopping_ || exit_code_ != 0) return;
+  // Readiness of the group being started.
+  bool group_ready = true;
+  for (Managed& m : managed_) {
+    if (m.group != starting_group_ || m.ready) continue;
+    group_ready = false;
+    if (SecondsSince(m.started_at) > m.spec.ready_timeout_sec) {
+      FailTestbed("process '" + m.spec.name + "' sent no heartbeat on PROCESS_STATUS within " +
+                  std::to_string(m.spec.ready_timeout_sec) +
+                  " s (if it is not an orbed process, set `ready: none` in " + spec_.path + ")");
+      return;
+    }
+  }
+  if (!group_ready) return;
+  ORBED_LOG(kInfo) << "group '" << spec_.groups[starting_group_].name << "' ready after "
+                   << SecondsSince(group_started_at_) << " s";
+  if (starting_group_ + 1 < spec_.groups.size()) {
+    StartGroup(starting_group_ + 1);
+  } else {
+    all_started_ = true;
+    ORBED_LOG(kInfo) << "testbed '" << spec_.name << "' is up ("
+                     << SecondsSince(launch_started_at_) << " s)";
+  }
+}
+
+void Launcher::StopEverything() {
+  stopping_ = true;
+  for (size_t g = spec_.groups.size(); g-- > 0;) {
+    std::vector<Managed*> group;
+    for (Managed& m : managed_) {
+      m.respawn_pending = false;
+      if (m.group == g && m.started && m.child->running()) group.push_back(&m);
+    }
+    if (group.empty()) continue;
+    ORBED_LOG(kInfo) << "stopping group '" << spec_.groups[g].name << "'";
+    double timeout = 0;
+    for (Managed* m : group) {
+      m->child->Signal(m->spec.stop_signal);
+      timeout = std::max(timeout, m->spec.stop_timeout_sec);
+    }
+    const auto begin = Clock::now();
+    bool killed = false;
+    for (;;) {
+      bool any_running = false;
+      for (Managed* m : group) {
+        m->child->Drain(m->prefix);
+        if (m->child->running() && !m->child->Poll()) any_running = true;
+        if (!m->child->running()) m->last_exit = m->child->DescribeExit();
+      }
+      if (!any_running) break;
+      if (!killed && SecondsSince(begin) > timeout) {
+        for (Managed* m : group) {
+          if (m->child->running()) {
+            ORBED_LOG(kWarn) << m->spec.name << " did not stop within " << m->spec.stop_timeout_sec
+                             << " s: SIGKILL";
+            m->child->Signal(SIGKILL);
+          }
+        }
+        killed = true;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    for (Managed* m : group) m->child->Drain(m->prefix, true);
+  }
+}
+
+void Launcher::PrintSummary() const {
+  std::fprintf(stdout, "\norbed-launch summary (%s):\n", spec_.name.c_str());
+  std::fprintf(stdout, "  %-*s  %-8s  %s\n", static_cast<int>(name_width_), "process", "restarts",
+               "last state");
+  for (const Managed& m : managed_) {
+    std::fprintf(stdout, "  %-*s  %-8d  %s\n", static_cast<int>(name_width_),
+                 m.spec.name.c_str(), m.restarts,
+                 m.started ? m.last_exit.c_str() : "not started");
+  }
+  std::fflush(stdout);
+}
+
+int Launcher::Run() {
+  launch_started_at_ = Clock::now();
+  ORBED_LOG(kInfo) << "launching '" << spec_.name << "' from " << spec_.path << " on "
+                   << flags_.lcm_url;
+  StartGroup(0);
+  process_.Run();
+  StopEverything();
+  PrintSummary();
+  if (exit_code_ != 0) ORBED_LOG(kError) << "testbed failed: exit code " << exit_code_;
+  return exit_code_;
+}
+
+}  // namespace orbed::launcher

@@ -1,0 +1,83 @@
+#pragma once
+/// @file
+/// orbed-launch's engine: starts a launch file's groups in order, each group's processes together,
+/// and waits for every process to be ready (its first PROCESS_STATUS heartbeat, unless
+/// `ready: none`) before starting the next group; a process that is not ready in time stops the
+/// testbed with an error naming it. While running it re-emits each child's output prefixed with
+/// the child's name, restarts children marked `respawn` (at once, then with a growing back-off if
+/// they keep dying within a second), and stops the testbed when a required child fails or a child
+/// marked `exit_stops_all` exits. On SIGINT/SIGTERM or after --duration-sec it stops the groups in
+/// reverse order: each child gets its stop_signal, then SIGKILL after stop_timeout_sec.
+///
+/// Children get: --name <name> appended (heartbeat-ready processes, unless args have --name),
+/// ORBED_LCM_URL = the launcher's LCM URL, ORBED_LOG_PREFIXED=1 (their log lines then omit the
+/// name), plus the env of their spec.
+///
+/// Exit code: 0, or 1 when a required process failed or was not ready in time, or the exit code of
+/// an `exit_stops_all` process.
+///
+/// Threading: one thread (Process::Run); children are polled every 20 ms.
+
+#include <chrono>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <orbed/process_status_t.hpp>
+
+#include "procs/common/process.h"
+#include "procs/launcher/child.h"
+#include "procs/launcher/launch_file.h"
+
+namespace orbed::launcher {
+
+class Launcher {
+ public:
+  /// `bin_dir` is searched first for commands without '/'.
+  Launcher(const CommonFlags& flags, LaunchSpec spec, std::string bin_dir);
+  ~Launcher();
+
+  int Run();
+
+ private:
+  using Clock = std::chrono::steady_clock;
+  struct Managed {
+    ProcessSpec spec;
+    size_t group = 0;
+    std::unique_ptr<Child> child;
+    std::string prefix;
+    bool started = false;
+    bool ready = false;
+    bool finished = false;  // exited and will not be restarted
+    int restarts = 0;
+    int fast_failures = 0;  // consecutive deaths within 1 s of starting
+    Clock::time_point started_at;
+    Clock::time_point respawn_at;
+    bool respawn_pending = false;
+    std::string last_exit;
+  };
+
+  void Tick();
+  void OnHeartbeat(const orbed::process_status_t& status, int64_t recv_utime);
+  bool StartProcess(Managed* managed);
+  void StartGroup(size_t group);
+  void HandleExit(Managed* managed);
+  void StopEverything();
+  void FailTestbed(const std::string& reason);
+  void PrintSummary() const;
+
+  CommonFlags flags_;
+  LaunchSpec spec_;
+  std::string bin_dir_;
+  Process process_;
+  std::vector<Managed> managed_;
+  size_t starting_group_ = 0;
+  bool all_started_ = false;
+  Clock::time_point group_started_at_;
+  Clock::time_point launch_started_at_;
+  int exit_code_ = 0;
+  bool stopping_ = false;
+  size_t name_width_ = 0;
+};
+
+}  // namespace orbed::launcher

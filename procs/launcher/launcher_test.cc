@@ -1,0 +1,153 @@
+// Unit tests of orbed-launch's launch-file parser and child handling (no LCM needed). The
+// multi-process behaviour (readiness, respawn, ordered stop) is in tests/integration.
+#include <csignal>
+#include <thread>
+
+#include <gtest/gtest.h>
+
+#include "procs/launcher/child.h"
+#include "procs/launcher/launch_file.h"
+
+namespace orbed::launcher {
+namespace {
+
+const std::map<std::string, std::string> kEnv = {{"LOGS", "/tmp/logs"}, {"BIN", "/opt/b"}};
+
+std::string ErrorOf(const std::string& yaml) {
+  try {
+    ParseLaunchYaml(yaml, "test.yaml", kEnv);
+  } catch (const LaunchFileError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(LaunchFile, ParsesGroupsProcessesDefaultsAndVariables) {
+  const LaunchSpec spec = ParseLaunchYaml(R"(
+name: bed
+groups:
+  - name: first
+    processes:
+      - name: logger
+        command: orbed-logger
+        args: [--log-dir, "${LOGS}/x"]
+  - name: second
+    processes:
+      - name: tool
+        command: ${BIN}/tool
+        env: {A: "1", B: "${LOGS}"}
+        respawn: true
+        required: false
+        stop_signal: SIGTERM
+        stop_timeout_sec: 2.5
+        ready: none
+        exit_stops_all: true
+)",
+                                          "test.yaml", kEnv);
+  EXPECT_EQ(spec.name, "bed");
+  ASSERT_EQ(spec.groups.size(), 2u);
+  const ProcessSpec& logger = spec.groups[0].processes.at(0);
+  EXPECT_EQ(logger.command, "orbed-logger");
+  EXPECT_EQ(logger.args, (std::vector<std::string>{"--log-dir", "/tmp/logs/x"}));
+  EXPECT_TRUE(logger.required);
+  EXPECT_FALSE(logger.respawn);
+  EXPECT_EQ(logger.stop_signal, SIGINT);
+  EXPECT_EQ(logger.stop_timeout_sec, 5.0);
+  EXPECT_EQ(logger.ready, ReadyCheck::kHeartbeat);
+  const ProcessSpec& tool = spec.groups[1].processes.at(0);
+  EXPECT_EQ(tool.command, "/opt/b/tool");
+  EXPECT_EQ(tool.env.at("B"), "/tmp/logs");
+  EXPECT_TRUE(tool.respawn);
+  EXPECT_FALSE(tool.required);
+  EXPECT_EQ(tool.stop_signal, SIGTERM);
+  EXPECT_EQ(tool.stop_timeout_sec, 2.5);
+  EXPECT_EQ(tool.ready, ReadyCheck::kNone);
+  EXPECT_TRUE(tool.exit_stops_all);
+}
+
+TEST(LaunchFile, ErrorsNameFileLineKeyAndFix) {
+  EXPECT_EQ(ErrorOf("groups: []"),
+            "test.yaml:1: 'groups' must be a non-empty list of {name, processes}");
+  const std::string typo = ErrorOf(
+      "groups:\n  - name: g\n    processes:\n      - name: a\n        command: x\n        "
+      "respawm: true\n");
+  EXPECT_NE(typo.find("test.yaml:6: unknown key 'respawm' in process 'a'"), std::string::npos) << typo;
+  EXPECT_NE(typo.find("respawn"), std::string::npos);
+  EXPECT_NE(ErrorOf("groups:\n  - name: g\n    processes:\n      - name: a\n").find(
+                "process 'a' needs 'command'"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf("groups:\n  - name: g\n    processes:\n      - {name: a, command: x, "
+                    "stop_signal: SIGFOO}\n")
+                .find("unknown stop_signal 'SIGFOO'"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf("groups:\n  - name: g\n    processes:\n      - {name: a, command: x}\n"
+                    "      - {name: a, command: y}\n")
+                .find("test.yaml:5: process name 'a' is used twice"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf("groups:\n  - name: g\n    processes:\n      - {name: a, command: "
+                    "\"${NOPE}/x\"}\n")
+                .find("variable ${NOPE} is not set"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf("groups:\n  - name: g\n    processes:\n      - {name: a, command: x, "
+                    "respawn: maybe}\n")
+                .find("'respawn' must be true or false"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf("groups: [\n").find("YAML syntax"), std::string::npos);
+}
+
+TEST(LaunchFile, MissingFileIsNamed) {
+  try {
+    LoadLaunchFile("/no/such/launch.yaml", kEnv);
+    FAIL();
+  } catch (const LaunchFileError& e) {
+    EXPECT_NE(std::string(e.what()).find("/no/such/launch.yaml"), std::string::npos);
+  }
+}
+
+TEST(LaunchFile, ExpandVariables) {
+  EXPECT_EQ(ExpandVariables("a${LOGS}b${BIN}", kEnv), "a/tmp/logsb/opt/b");
+  EXPECT_EQ(ExpandVariables("plain $LOGS", kEnv), "plain $LOGS");
+  EXPECT_THROW(ExpandVariables("${LOGS", kEnv), std::invalid_argument);
+}
+
+bool WaitForExit(Child* child, double seconds) {
+  for (int i = 0; i < seconds * 100; ++i) {
+    if (child->Poll()) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return child->Poll();
+}
+
+TEST(Child, ReportsExitCodeAndEnvironment) {
+  Child child;
+  std::string error;
+  ASSERT_TRUE(child.Start({"sh", "-c", "test \"$ORBED_X\" = 42 && exit 3; exit 9"},
+                          {{"ORBED_X", "42"}}, "", &error))
+      << error;
+  ASSERT_TRUE(WaitForExit(&child, 5));
+  EXPECT_EQ(child.exit_code(), 3);
+  EXPECT_EQ(child.DescribeExit(), "exited with code 3");
+}
+
+TEST(Child, SignalReachesTheProcessGroup) {
+  Child child;
+  std::string error;
+  // The shell's child (sleep) is in the same group and must die too, or the pipe stays open.
+  ASSERT_TRUE(child.Start({"sh", "-c", "sleep 30 & wait"}, {}, "", &error)) << error;
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  EXPECT_TRUE(child.running());
+  child.Signal(SIGTERM);
+  ASSERT_TRUE(WaitForExit(&child, 5));
+  EXPECT_EQ(child.term_signal(), SIGTERM);
+}
+
+TEST(Child, MissingExecutableFailsBeforeFork) {
+  Child child;
+  std::string error;
+  EXPECT_FALSE(child.Start({"orbed-no-such-program"}, {}, "/nonexistent", &error));
+  EXPECT_NE(error.find("cannot find executable 'orbed-no-such-program'"), std::string::npos);
+  EXPECT_NE(ResolveExecutable("sh", ""), "");
+}
+
+}  // namespace
+}  // namespace orbed::launcher

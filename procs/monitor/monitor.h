@@ -1,0 +1,44 @@
+#pragma once
+/// @file
+/// orbed-monitor's engine: watches the testbed's health. Keeps the latest PROCESS_STATUS of every
+/// process and the latest LOGGER_STATUS, prints a compact table every `print_period_sec`, and
+/// flags a process as silent when its heartbeat is older than `silent_after_sec`.
+///
+/// Threading: everything on the Process::Run thread.
+
+#include <map>
+#include <string>
+
+#include <orbed/logger_status_t.hpp>
+#include <orbed/process_status_t.hpp>
+
+#include "procs/common/process.h"
+
+namespace orbed::monitor {
+
+struct MonitorOptions {
+  double print_period_sec = 5.0;
+  double silent_after_sec = 3.0;
+};
+
+class Monitor {
+ public:
+  Monitor(const CommonFlags& flags, MonitorOptions options);
+  int Run() { return process_.Run(); }
+  /// The table as it would be printed now (receive-time ages measured against `now_utime`).
+  std::string Table(int64_t now_utime) const;
+  Process& process() { return process_; }
+
+ private:
+  struct Seen {
+    orbed::process_status_t status;
+    int64_t recv_utime = 0;
+  };
+  MonitorOptions options_;
+  Process process_;
+  std::map<std::string, Seen> processes_;
+  bool have_logger_ = false;
+  orbed::logger_status_t logger_{};
+};
+
+}  // namespace orbed::monitor

@@ -1,0 +1,42 @@
+// orbed-monitor on memq://: heartbeats in, a table out; stale heartbeats shown as SILENT.
+#include <gtest/gtest.h>
+
+#include "procs/common/channels.h"
+#include "procs/common/conversions.h"
+#include "procs/monitor/monitor.h"
+
+namespace orbed::monitor {
+namespace {
+
+TEST(Monitor, TabulatesHeartbeatsAndFlagsSilentProcesses) {
+  CommonFlags flags("orbed-monitor");
+  flags.lcm_url = "memq://";
+  flags.duration_sec = 0.2;
+  MonitorOptions options;
+  options.print_period_sec = 10;
+  options.silent_after_sec = 3;
+  Monitor monitor(flags, options);
+  orbed::process_status_t status{};
+  status.name = "sim";
+  status.state = orbed::process_status_t::STATE_RUNNING;
+  status.messages_in = 12;
+  status.rejected_inputs = 2;
+  status.last_error = "IIWA_COMMAND/num_joints: num_joints is 6, expected 7";
+  monitor.process().lcm().publish(channels::kProcessStatus, &status);
+  orbed::process_status_t bad = status;
+  bad.name = "liar";
+  bad.state = 9;
+  monitor.process().lcm().publish(channels::kProcessStatus, &bad);
+  monitor.Run();
+  const int64_t now = NowMicros();
+  const std::string table = monitor.Table(now);
+  EXPECT_NE(table.find("sim"), std::string::npos);
+  EXPECT_NE(table.find("running"), std::string::npos);
+  EXPECT_NE(table.find("num_joints is 6"), std::string::npos);
+  EXPECT_EQ(table.find("liar"), std::string::npos);  // rejected: state out of range
+  EXPECT_EQ(monitor.process().rejections().total(), 1);
+  EXPECT_NE(monitor.Table(now + 10'000'000).find("SILENT"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace orbed::monitor

@@ -1,0 +1,37 @@
+#include "procs/registration_server/registration_server.h"
+
+#include "procs/common/log.h"
+
+namespace orbed::registration {
+
+RegistrationServer::RegistrationServer(const orbed::CommonFlags& flags, const RegistrationServerOptions& options)
+    : Process(flags),
+      options_(options),
+      service_(options.service, [this](const std::string& key, const std::string& reason) { Reject(key, reason); }) {
+  Subscribe<orbed::session_control_t>(
+      options_.session_control_channel,
+      [this](const orbed::session_control_t& msg, const std::string&, int64_t) {
+        if (auto state = service_.HandleSessionControl(msg)) Publish(options_.registration_channel, *state);
+      });
+  Subscribe<orbed::alignment_trial_t>(
+      options_.trial_channel, [this](const orbed::alignment_trial_t& msg, const std::string&, int64_t) {
+        if (auto state = service_.HandleTrial(msg)) Publish(options_.registration_channel, *state);
+      });
+  Subscribe<orbed::landmark_request_t>(
+      options_.landmark_request_channel, [this](const orbed::landmark_request_t& msg, const std::string&, int64_t) {
+        Publish(options_.landmark_channel, service_.HandleLandmarkRequest(msg));
+      });
+  Subscribe<orbed::misalignment_request_t>(
+      options_.misalignment_request_channel,
+      [this](const orbed::misalignment_request_t& msg, const std::string&, int64_t) {
+        Publish(options_.misalignment_channel, service_.HandleMisalignmentRequest(msg));
+      });
+  if (options_.state_period_s > 0.0) {
+    AddTimer(options_.state_period_s, [this]() {
+      if (auto state = service_.PeriodicState()) Publish(options_.registration_channel, *state);
+    });
+  }
+  ORBED_LOG(kInfo) << "serving " << options_.trial_channel << " -> " << options_.registration_channel;
+}
+
+}  // namespace orbed::registration

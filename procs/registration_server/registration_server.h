@@ -1,0 +1,48 @@
+#pragma once
+/// @file
+/// The orbed-registration LCM process: RegistrationService (registration_service.h) on the bus.
+///   Subscribes: SESSION_CONTROL (session_control_t), ALIGNMENT_TRIAL (alignment_trial_t),
+///               LANDMARK_REQUEST (landmark_request_t), MISALIGNMENT_REQUEST (misalignment_request_t).
+///   Publishes:  REGISTRATION (registration_t) after every accepted trial, on COMPUTE, and every
+///               state_period_s as the full state; LANDMARK (landmark_t) and MISALIGNMENT
+///               (misalignment_t) answering each request; PROCESS_STATUS at 1 Hz (Process).
+/// Bad inputs are counted per class on PROCESS_STATUS and logged (Process::Reject); the process
+/// keeps serving. Outputs take their utime from inputs (see registration_service.h), so a replayed
+/// log gives the same REGISTRATION bytes.
+///
+/// Threading: everything runs on the Run() thread (Process).
+
+#include <string>
+
+#include "procs/common/channels.h"
+#include "procs/common/process.h"
+#include "procs/registration_server/registration_service.h"
+
+namespace orbed::registration {
+
+struct RegistrationServerOptions {
+  RegistrationServiceOptions service;
+  /// Period of the full-state REGISTRATION [s]; 0 disables it.
+  double state_period_s = 1.0;
+  std::string session_control_channel = channels::kSessionControl;
+  std::string trial_channel = channels::kAlignmentTrial;
+  std::string registration_channel = channels::kRegistration;
+  std::string landmark_request_channel = channels::kLandmarkRequest;
+  std::string landmark_channel = channels::kLandmark;
+  std::string misalignment_request_channel = channels::kMisalignmentRequest;
+  std::string misalignment_channel = channels::kMisalignment;
+};
+
+class RegistrationServer : public orbed::Process {
+ public:
+  /// Throws std::runtime_error (from Process) when LCM cannot start on flags.lcm_url.
+  RegistrationServer(const orbed::CommonFlags& flags, const RegistrationServerOptions& options);
+
+  const RegistrationService& service() const { return service_; }
+
+ private:
+  RegistrationServerOptions options_;
+  RegistrationService service_;
+};
+
+}  // namespace orbed::registration

@@ -1,0 +1,276 @@
+#include "procs/registration_server/registration_service.h"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+#include "procs/common/conversions.h"
+#include "procs/common/validation.h"
+#include "procs/registration_server/misalignment.h"
+#include "procs/registration_server/se3_mean.h"
+
+namespace orbed::registration {
+namespace {
+
+constexpr size_t kMaxSessionIdLength = 256;
+
+std::string CheckSessionId(const std::string& id, const std::string& what) {
+  if (id.empty()) return what + ": empty session_id";
+  if (id.size() > kMaxSessionIdLength) {
+    return what + ": session_id longer than " + std::to_string(kMaxSessionIdLength) + " characters";
+  }
+  return "";
+}
+
+const char* CommandName(int8_t command) {
+  switch (command) {
+    case orbed::session_control_t::START:
+      return "START";
+    case orbed::session_control_t::RESET:
+      return "RESET";
+    case orbed::session_control_t::COMPUTE:
+      return "COMPUTE";
+    case orbed::session_control_t::STOP:
+      return "STOP";
+  }
+  return "?";
+}
+
+// Rows of an N×3 message array (already sized by the decoder) as Eigen vectors.
+std::string ReadRows(const std::vector<std::vector<double>>& rows, int32_t count, int max,
+                     const std::string& what, std::vector<Eigen::Vector3d>* out) {
+  if (count < 0 || count > max || static_cast<size_t>(count) != rows.size()) {
+    return what + ": count " + std::to_string(count) + " is outside [0, " + std::to_string(max) +
+           "] or does not match the array";
+  }
+  out->clear();
+  for (size_t i = 0; i < rows.size(); ++i) {
+    if (rows[i].size() != 3) return what + "[" + std::to_string(i) + "]: expected 3 values";
+    out->emplace_back(rows[i][0], rows[i][1], rows[i][2]);
+  }
+  return "";
+}
+
+}  // namespace
+
+RegistrationService::RegistrationService(RegistrationServiceOptions options, RejectFn reject)
+    : options_(std::move(options)), reject_(std::move(reject)) {}
+
+void RegistrationService::Reject(const std::string& key, const std::string& reason) const {
+  if (reject_) reject_(key, reason);
+}
+
+std::optional<orbed::registration_t> RegistrationService::HandleSessionControl(
+    const orbed::session_control_t& msg) {
+  const std::string problem = FirstError(
+      {CheckSessionId(msg.session_id, "SESSION_CONTROL"),
+       CheckEnum(msg.command, orbed::session_control_t::START, orbed::session_control_t::STOP,
+                 "SESSION_CONTROL.command"),
+       CheckEnum(msg.display_mode, orbed::alignment_trial_t::MODE_AR,
+                 orbed::alignment_trial_t::MODE_AR_REFLECTIVE, "SESSION_CONTROL.display_mode"),
+       CheckEnum(msg.method, orbed::registration_t::METHOD_CHORDAL, orbed::registration_t::METHOD_ROBUST,
+                 "SESSION_CONTROL.method"),
+       CheckEnum(msg.num_mirrors, 0, 64, "SESSION_CONTROL.num_mirrors")});
+  if (!problem.empty()) {
+    Reject("SESSION_CONTROL/field", problem);
+    return std::nullopt;
+  }
+  if (msg.command == orbed::session_control_t::START) {
+    has_session_ = true;
+    active_ = true;
+    session_id_ = msg.session_id;
+    display_mode_ = msg.display_mode;
+    num_mirrors_ = msg.num_mirrors;
+    method_ = msg.method;
+    trials_.clear();
+    last_utime_ = msg.utime;
+    return std::nullopt;
+  }
+  if (!has_session_ || msg.session_id != session_id_) {
+    Reject("SESSION_CONTROL/session", std::string("SESSION_CONTROL ") + CommandName(msg.command) +
+                                          " for session '" + msg.session_id + "', but the session is '" +
+                                          (has_session_ ? session_id_ : std::string("<none>")) + "'");
+    return std::nullopt;
+  }
+  switch (msg.command) {
+    case orbed::session_control_t::RESET:
+      trials_.clear();
+      last_utime_ = msg.utime;
+      return std::nullopt;
+    case orbed::session_control_t::STOP:
+      active_ = false;
+      last_utime_ = msg.utime;
+      return std::nullopt;
+    default:  // COMPUTE
+      return MakeState(msg.utime, orbed::registration_t::REASON_COMPUTE);
+  }
+}
+
+std::optional<orbed::registration_t> RegistrationService::HandleTrial(const orbed::alignment_trial_t& msg) {
+  if (!active_ || msg.session_id != session_id_) {
+    Reject("ALIGNMENT_TRIAL/session",
+           "trial " + std::to_string(msg.trial_index) + " for session '" + msg.session_id + "', but " +
+               (active_ ? "the active session is '" + session_id_ + "'"
+                        : std::string("no session is active (send SESSION_CONTROL START)")));
+    return std::nullopt;
+  }
+  std::string problem = FirstError(
+      {CheckPose(msg.X_WV, "ALIGNMENT_TRIAL.X_WV"),
+       CheckEnum(msg.display_mode, orbed::alignment_trial_t::MODE_AR, orbed::alignment_trial_t::MODE_AR_REFLECTIVE,
+                 "ALIGNMENT_TRIAL.display_mode"),
+       CheckEnum(msg.num_mirrors, 0, 64, "ALIGNMENT_TRIAL.num_mirrors"),
+       CheckLength(msg.num_joints, msg.joint_position.size(), options_.max_joints, "ALIGNMENT_TRIAL.num_joints"),
+       CheckFinite(msg.joint_position, "ALIGNMENT_TRIAL.joint_position"),
+       CheckFinite(&msg.duration_s, 1, "ALIGNMENT_TRIAL.duration_s")});
+  if (!problem.empty()) {
+    Reject("ALIGNMENT_TRIAL/field", problem);
+    return std::nullopt;
+  }
+  if (msg.display_mode != display_mode_) {
+    Reject("ALIGNMENT_TRIAL/display_mode", "trial " + std::to_string(msg.trial_index) + " has display_mode " +
+                                               std::to_string(msg.display_mode) + " but the session's is " +
+                                               std::to_string(display_mode_));
+    return std::nullopt;
+  }
+  if (msg.duration_s < 0.0) {
+    Reject("ALIGNMENT_TRIAL/field", "ALIGNMENT_TRIAL.duration_s is negative");
+    return std::nullopt;
+  }
+  if (msg.trial_index < 0) {
+    Reject("ALIGNMENT_TRIAL/trial_index", "trial_index " + std::to_string(msg.trial_index) + " is negative");
+    return std::nullopt;
+  }
+  for (const Trial& t : trials_) {
+    if (t.trial_index == msg.trial_index) {
+      Reject("ALIGNMENT_TRIAL/trial_index",
+             "trial_index " + std::to_string(msg.trial_index) + " already received in session '" + session_id_ + "'");
+      return std::nullopt;
+    }
+  }
+  if (static_cast<int>(trials_.size()) >= options_.max_trials_per_session) {
+    Reject("ALIGNMENT_TRIAL/capacity",
+           "session '" + session_id_ + "' already holds " + std::to_string(trials_.size()) + " trials");
+    return std::nullopt;
+  }
+  trials_.push_back({msg.trial_index, QuaternionFromWxyz(msg.X_WV.quaternion_wxyz).normalized(),
+                     ToVector3(msg.X_WV.position_m)});
+  last_utime_ = msg.utime;
+  return MakeState(msg.utime, orbed::registration_t::REASON_TRIAL);
+}
+
+std::optional<orbed::registration_t> RegistrationService::PeriodicState() const {
+  if (!has_session_) return std::nullopt;
+  return MakeState(last_utime_, orbed::registration_t::REASON_PERIODIC);
+}
+
+orbed::registration_t RegistrationService::MakeState(int64_t utime, int8_t reason) const {
+  orbed::registration_t out{};
+  out.utime = utime;
+  out.session_id = session_id_;
+  out.reason = reason;
+  out.method = method_;
+  out.valid = false;
+  out.X_WV_mean = ToPose(Eigen::Isometry3d::Identity());
+  out.num_trials = static_cast<int32_t>(trials_.size());
+  out.num_used = 0;
+  out.num_rejected = 0;
+  if (trials_.empty()) return out;
+
+  std::vector<Eigen::Quaterniond> q;
+  std::vector<Eigen::Vector3d> p;
+  for (const Trial& t : trials_) {
+    q.push_back(t.q_WV);
+    p.push_back(t.p_WV);
+  }
+  Se3MeanOptions options;
+  options.method = static_cast<AveragingMethod>(method_);
+  options.p_VC = options_.p_VC;
+  options.outlier = options_.outlier;
+  const Se3MeanResult mean = ComputeSe3Mean(q, p, options);
+  if (!mean.valid) return out;  // cannot happen for validated trials; left invalid if it does
+
+  Eigen::Isometry3d X_WV_mean = Eigen::Isometry3d::Identity();
+  X_WV_mean.linear() = mean.q_WV_mean.toRotationMatrix();
+  X_WV_mean.translation() = mean.p_WV_mean;
+  out.valid = true;
+  out.X_WV_mean = ToPose(X_WV_mean);
+  out.num_used = mean.dispersion.num_used;
+  for (const RejectedTrial& r : mean.rejected) out.rejected_indices.push_back(trials_[r.index].trial_index);
+  out.num_rejected = static_cast<int32_t>(out.rejected_indices.size());
+  out.rotation_rms_deg = mean.dispersion.rotation_rms_deg;
+  out.rotation_median_deg = mean.dispersion.rotation_median_deg;
+  out.rotation_max_deg = mean.dispersion.rotation_max_deg;
+  FromMatrix3(mean.dispersion.rotation_covariance_rad2, out.rotation_covariance_rad2);
+  out.translation_rms_m = mean.dispersion.translation_rms_m;
+  FromMatrix3(mean.dispersion.translation_covariance_m2, out.translation_covariance_m2);
+  out.iterations = mean.iterations;
+  out.converged = mean.converged;
+  out.unique = mean.unique;
+  out.chordal_eigen_gap = mean.chordal_eigen_gap;
+  return out;
+}
+
+orbed::landmark_t RegistrationService::HandleLandmarkRequest(const orbed::landmark_request_t& msg) {
+  orbed::landmark_t out{};
+  out.utime = msg.utime;
+  out.request_id = msg.request_id;
+  out.name = msg.name;
+  out.valid = false;
+  std::vector<Eigen::Vector3d> origins, directions;
+  std::string problem = ReadRows(msg.origin_W_m, msg.num_rays, options_.max_rays, "LANDMARK_REQUEST.origin_W_m", &origins);
+  if (problem.empty()) {
+    problem = ReadRows(msg.direction_W, msg.num_rays, options_.max_rays, "LANDMARK_REQUEST.direction_W", &directions);
+  }
+  if (problem.empty()) {
+    const TriangulationResult r = TriangulateRays(origins, directions, options_.triangulation);
+    FromVector3(r.p_W, out.p_W_m);
+    out.ray_angle_deg = r.ray_angle_deg;
+    out.gap_m = r.gap_m;
+    out.valid = r.valid;
+    if (!r.valid) problem = "LANDMARK_REQUEST '" + msg.name + "': " + r.reason;
+  }
+  if (!problem.empty()) {
+    out.reason = problem;
+    Reject("LANDMARK_REQUEST/invalid", problem);
+  }
+  return out;
+}
+
+orbed::misalignment_t RegistrationService::HandleMisalignmentRequest(const orbed::misalignment_request_t& msg) {
+  orbed::misalignment_t out{};
+  out.utime = msg.utime;
+  out.request_id = msg.request_id;
+  out.session_id = msg.session_id;
+  out.valid = false;
+  out.num_pairs = 0;
+  std::vector<Eigen::Vector3d> real, virt;
+  std::string problem =
+      ReadRows(msg.p_W_real_m, msg.num_pairs, options_.max_pairs, "MISALIGNMENT_REQUEST.p_W_real_m", &real);
+  if (problem.empty()) {
+    problem = ReadRows(msg.p_W_virtual_m, msg.num_pairs, options_.max_pairs, "MISALIGNMENT_REQUEST.p_W_virtual_m",
+                       &virt);
+  }
+  if (problem.empty()) {
+    const MisalignmentResult r = EvaluateMisalignment(real, virt);
+    if (r.valid) {
+      out.valid = true;
+      out.num_pairs = static_cast<int32_t>(r.error_W_m.size());
+      for (size_t k = 0; k < r.error_W_m.size(); ++k) {
+        out.error_W_m.push_back({r.error_W_m[k].x(), r.error_W_m[k].y(), r.error_W_m[k].z()});
+        out.error_norm_m.push_back(r.error_norm_m[k]);
+      }
+      FromVector3(r.mean_error_W_m, out.mean_error_W_m);
+      out.mean_error_norm_m = r.mean_error_norm_m;
+      out.mean_pair_distance_m = r.mean_pair_distance_m;
+    } else {
+      problem = "MISALIGNMENT_REQUEST: " + r.reason;
+    }
+  }
+  if (!problem.empty()) {
+    out.reason = problem;
+    Reject("MISALIGNMENT_REQUEST/invalid", problem);
+  }
+  return out;
+}
+
+}  // namespace orbed::registration

@@ -1,0 +1,104 @@
+#pragma once
+/// @file
+/// The registration server's message logic without a bus: sessions driven by session_control_t,
+/// alignment trials in, registration_t / landmark_t / misalignment_t out. RegistrationServer
+/// (registration_server.h) wires it to LCM channels; tests drive it directly.
+///
+/// Purity: every output is a function of the inputs handled so far, in order, and nothing else (no
+/// clock, no randomness). Output utimes are input utimes: a REGISTRATION for a trial carries that
+/// trial's utime; a COMPUTE answer the command's utime; the periodic state the utime of the last
+/// input that changed the session; LANDMARK / MISALIGNMENT the request's utime. Replaying a log
+/// therefore reproduces the same bytes.
+///
+/// Sessions: START(session_id, display_mode, num_mirrors, method) opens a session (replacing any
+/// other); trials for it are collected until STOP; RESET drops its trials; COMPUTE asks for the
+/// full state now. The last session's state stays available (periodic state, COMPUTE) after STOP
+/// until the next START.
+///
+/// Frames and units: trials carry X_WV (virtual robot base V in the OR world W) [m]; the mean is
+/// X_WV_mean; rays and landmarks are in W [m]; angles in messages are [deg] where named.
+///
+/// Rejections: a trial or command that fails validation changes nothing; the reject callback gets
+/// a class key ("ALIGNMENT_TRIAL/pose") and a one-line reason. Invalid landmark / misalignment
+/// requests are answered with valid = false and the reason, and also reported as rejections.
+///
+/// Threading: not thread-safe; call from one thread (the Process::Run() thread).
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <orbed/alignment_trial_t.hpp>
+#include <orbed/landmark_request_t.hpp>
+#include <orbed/landmark_t.hpp>
+#include <orbed/misalignment_request_t.hpp>
+#include <orbed/misalignment_t.hpp>
+#include <orbed/registration_t.hpp>
+#include <orbed/session_control_t.hpp>
+
+#include "procs/registration_server/robust.h"
+#include "procs/registration_server/triangulation.h"
+
+namespace orbed::registration {
+
+struct RegistrationServiceOptions {
+  /// Model centroid C in V [m] for averaging translations about it (se3_mean.h); unset = eq. 3.
+  std::optional<Eigen::Vector3d> p_VC;
+  /// Robust-mode rejection (robust.h).
+  OutlierOptions outlier;
+  /// Landmark triangulation (triangulation.h).
+  TriangulationOptions triangulation;
+  /// Bounds that keep a flood of input from growing memory without limit.
+  int max_trials_per_session = 10000;
+  int max_rays = 1000;
+  int max_pairs = 10000;
+  int max_joints = 64;
+};
+
+class RegistrationService {
+ public:
+  using RejectFn = std::function<void(const std::string& key, const std::string& reason)>;
+
+  RegistrationService(RegistrationServiceOptions options, RejectFn reject);
+
+  /// START / RESET / STOP return nothing; COMPUTE returns the full state (reason COMPUTE).
+  std::optional<orbed::registration_t> HandleSessionControl(const orbed::session_control_t& msg);
+  /// An accepted trial returns the new state (reason TRIAL); a rejected one nothing.
+  std::optional<orbed::registration_t> HandleTrial(const orbed::alignment_trial_t& msg);
+  orbed::landmark_t HandleLandmarkRequest(const orbed::landmark_request_t& msg);
+  orbed::misalignment_t HandleMisalignmentRequest(const orbed::misalignment_request_t& msg);
+  /// The full state (reason PERIODIC) once a session has been started, else nothing.
+  std::optional<orbed::registration_t> PeriodicState() const;
+
+  bool has_session() const { return has_session_; }
+  bool session_active() const { return active_; }
+  const std::string& session_id() const { return session_id_; }
+  int num_trials() const { return static_cast<int>(trials_.size()); }
+
+ private:
+  struct Trial {
+    int32_t trial_index;
+    Eigen::Quaterniond q_WV;
+    Eigen::Vector3d p_WV;
+  };
+
+  orbed::registration_t MakeState(int64_t utime, int8_t reason) const;
+  void Reject(const std::string& key, const std::string& reason) const;
+
+  RegistrationServiceOptions options_;
+  RejectFn reject_;
+  bool has_session_ = false;
+  bool active_ = false;
+  std::string session_id_;
+  int8_t display_mode_ = 0;
+  int32_t num_mirrors_ = 0;
+  int8_t method_ = orbed::registration_t::METHOD_KARCHER;
+  std::vector<Trial> trials_;
+  int64_t last_utime_ = 0;
+};
+
+}  // namespace orbed::registration

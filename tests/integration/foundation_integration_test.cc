@@ -1,0 +1,211 @@
+// Multi-process tests of the foundation over real LCM, each run in a private network namespace
+// (ctest wraps this binary in scripts/netns-exec): orbed-launch readiness, respawn and ordered
+// stop; orbed-logger's log played by lcm-logplayer into lcm-logger; a SIGKILLed logger's file.
+#include <signal.h>
+#include <sys/stat.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <lcm/lcm-cpp.hpp>
+#include <orbed/iiwa_status_t.hpp>
+
+#include "tests/integration/testbed_util.h"
+
+namespace orbed::testing {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct LogEvent {
+  std::string channel;
+  std::string data;
+  int64_t timestamp;
+};
+
+std::vector<LogEvent> ReadLog(const std::string& path) {
+  std::vector<LogEvent> events;
+  lcm::LogFile log(path, "r");
+  if (!log.good()) return events;
+  while (const lcm::LogEvent* e = log.readNextEvent()) {
+    events.push_back({e->channel, std::string(static_cast<const char*>(e->data), e->datalen),
+                      e->timestamp});
+  }
+  return events;
+}
+
+std::string FindLog(const std::string& dir) {
+  for (const auto& entry : fs::directory_iterator(dir)) {
+    if (entry.path().extension() == ".lcmlog") return entry.path().string();
+  }
+  return "";
+}
+
+bool Alive(pid_t pid) { return kill(pid, 0) == 0; }
+
+// Launch logger + monitor (respawn: true); both heartbeat; SIGKILL the monitor → a new monitor
+// heartbeats within 1 s; SIGINT the launcher → every child gone, exit 0.
+TEST(Launcher, StartsRespawnsAndStopsInOrder) {
+  const std::string dir = MakeTempDir("launch");
+  const std::string launch_file = dir + "/launch.yaml";
+  std::ofstream(launch_file) << "name: it\n"
+                                "groups:\n"
+                                "  - name: recording\n"
+                                "    processes:\n"
+                                "      - {name: logger, command: orbed-logger, args: [--log-dir, \""
+                             << dir << "/logs\"]}\n"
+                                "  - name: health\n"
+                                "    processes:\n"
+                                "      - {name: monitor, command: orbed-monitor, respawn: true}\n";
+  BusWatcher bus;
+  bus.Start();
+  RunningProcess launcher({BinPath("orbed-launch"), launch_file});
+  ASSERT_TRUE(WaitFor([&] { return !bus.Heartbeats("logger").empty() &&
+                                   !bus.Heartbeats("monitor").empty(); },
+                      15))
+      << "no heartbeat from logger and monitor";
+  const pid_t logger_pid = bus.Heartbeats("logger").front().status.pid;
+  const pid_t monitor_pid = bus.Heartbeats("monitor").front().status.pid;
+  ASSERT_TRUE(Alive(logger_pid));
+  ASSERT_TRUE(Alive(monitor_pid));
+
+  const auto killed_at = std::chrono::steady_clock::now();
+  ASSERT_EQ(kill(monitor_pid, SIGKILL), 0);
+  pid_t new_pid = 0;
+  std::chrono::steady_clock::time_point respawned_at;
+  ASSERT_TRUE(WaitFor(
+      [&] {
+        for (const auto& beat : bus.Heartbeats("monitor")) {
+          if (beat.status.pid != monitor_pid) {
+            new_pid = beat.status.pid;
+            respawned_at = beat.received;
+            return true;
+          }
+        }
+        return false;
+      },
+      5))
+      << "monitor was not respawned";
+  const double respawn_s = std::chrono::duration<double>(respawned_at - killed_at).count();
+  EXPECT_LT(respawn_s, 1.0) << "respawn took " << respawn_s << " s";
+
+  launcher.Signal(SIGINT);
+  ASSERT_TRUE(launcher.Wait(15)) << "launcher did not stop";
+  EXPECT_EQ(launcher.term_signal(), 0);
+  EXPECT_EQ(launcher.exit_code(), 0);
+  EXPECT_FALSE(Alive(logger_pid));
+  EXPECT_FALSE(Alive(new_pid));
+  // The logger stopped cleanly: its manifest says complete.
+  std::ifstream manifest(dir + "/logs/manifest.json");
+  std::stringstream text;
+  text << manifest.rdbuf();
+  EXPECT_NE(text.str().find("\"complete\": true"), std::string::npos);
+}
+
+// A required process that cannot become ready stops the testbed with a non-zero exit.
+TEST(Launcher, RequiredProcessWithoutHeartbeatFailsTheLaunch) {
+  const std::string dir = MakeTempDir("launch_fail");
+  const std::string launch_file = dir + "/launch.yaml";
+  std::ofstream(launch_file) << "groups:\n"
+                                "  - name: g\n"
+                                "    processes:\n"
+                                "      - {name: mute, command: sh, args: [-c, 'sleep 30'], "
+                                "ready_timeout_sec: 1, stop_signal: SIGTERM}\n";
+  const auto begin = std::chrono::steady_clock::now();
+  RunningProcess launcher({BinPath("orbed-launch"), launch_file});
+  ASSERT_TRUE(launcher.Wait(15));
+  EXPECT_EQ(launcher.exit_code(), 1);
+  // It waited for the heartbeat (1 s), then gave up and stopped the silent child.
+  EXPECT_GE(std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count(), 1.0);
+}
+
+std::vector<orbed::iiwa_status_t> PublishTraffic(lcm::LCM* lcm, int count, double rate_hz) {
+  std::vector<orbed::iiwa_status_t> sent;
+  for (int i = 0; i < count; ++i) {
+    orbed::iiwa_status_t status{};
+    status.utime = i;
+    status.num_joints = 7;
+    for (auto* v : {&status.joint_position_measured, &status.joint_velocity_estimated,
+                    &status.joint_position_commanded, &status.joint_position_ipo,
+                    &status.joint_torque_measured, &status.joint_torque_commanded,
+                    &status.joint_torque_external}) {
+      v->assign(7, 0.001 * i);
+    }
+    lcm->publish("IIWA_STATUS", &status);
+    const std::string blob(1000 + i, static_cast<char>(i));
+    lcm->publish("BLOB", blob.data(), static_cast<int>(blob.size()));
+    sent.push_back(status);
+    std::this_thread::sleep_for(std::chrono::duration<double>(1.0 / rate_hz));
+  }
+  return sent;
+}
+
+// orbed-logger's log, played by lcm-logplayer into lcm-logger: same channels and payloads, same
+// order. lcm-logger is the independent oracle.
+TEST(Logger, LogPlaysBackIntoLcmLoggerUnchanged) {
+  const std::string dir = MakeTempDir("replay");
+  const std::string original = dir + "/orbed.lcmlog";
+  {
+    RunningProcess logger({BinPath("orbed-logger"), "--file", original, "--channels",
+                           "IIWA_STATUS|BLOB"});
+    lcm::LCM lcm("");
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));  // logger subscribed
+    PublishTraffic(&lcm, 100, 200.0);
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    logger.Signal(SIGINT);
+    ASSERT_TRUE(logger.Wait(10));
+    EXPECT_EQ(logger.exit_code(), 0);
+  }
+  const std::vector<LogEvent> recorded = ReadLog(original);
+  ASSERT_EQ(recorded.size(), 200u) << "orbed-logger missed messages on loopback";
+
+  const std::string copy = dir + "/copy.lcmlog";
+  {
+    RunningProcess lcm_logger({"/usr/bin/lcm-logger", "-q", "-f", copy});
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    RunningProcess player({"/usr/bin/lcm-logplayer", "-s", "2", original});
+    ASSERT_TRUE(player.Wait(30));
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    lcm_logger.Signal(SIGINT);
+    ASSERT_TRUE(lcm_logger.Wait(10));
+  }
+  const std::vector<LogEvent> replayed = ReadLog(copy);
+  ASSERT_EQ(replayed.size(), recorded.size());
+  for (size_t i = 0; i < recorded.size(); ++i) {
+    EXPECT_EQ(replayed[i].channel, recorded[i].channel) << "event " << i;
+    EXPECT_EQ(replayed[i].data, recorded[i].data) << "event " << i;
+  }
+}
+
+// SIGKILL during recording: the file is valid up to the last flush; cutting it mid-event in
+// addition still reads up to the last whole event.
+TEST(Logger, SigkilledLoggerLeavesAReadableLog) {
+  const std::string dir = MakeTempDir("sigkill");
+  const std::string path = dir + "/killed.lcmlog";
+  RunningProcess logger({BinPath("orbed-logger"), "--file", path, "--channels", "IIWA_STATUS|BLOB",
+                         "--flush-interval-sec", "0.1"});
+  lcm::LCM lcm("");
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  PublishTraffic(&lcm, 60, 200.0);
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));  // several flushes
+  logger.Signal(SIGKILL);
+  ASSERT_TRUE(logger.Wait(5));
+  EXPECT_EQ(logger.term_signal(), SIGKILL);
+
+  std::vector<LogEvent> events = ReadLog(path);
+  EXPECT_EQ(events.size(), 120u);  // everything was flushed before the kill
+  for (const LogEvent& e : events) {
+    if (e.channel != "IIWA_STATUS") continue;
+    orbed::iiwa_status_t status;
+    EXPECT_EQ(status.decode(e.data.data(), 0, e.data.size()), static_cast<int>(e.data.size()));
+  }
+  // Cut in the middle of the last event's payload.
+  const auto size = fs::file_size(path);
+  fs::resize_file(path, size - events.back().data.size() / 2);
+  events = ReadLog(path);
+  EXPECT_EQ(events.size(), 119u);
+}
+
+}  // namespace
+}  // namespace orbed::testing

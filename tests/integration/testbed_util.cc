@@ -1,0 +1,101 @@
+#include "tests/integration/testbed_util.h"
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <csignal>
+#include <cstdlib>
+#include <filesystem>
+#include <stdexcept>
+
+namespace orbed::testing {
+
+std::string BinPath(const std::string& name) {
+  const char* dir = std::getenv("ORBED_BIN_DIR");
+  if (dir == nullptr) throw std::runtime_error("ORBED_BIN_DIR is not set (run through ctest)");
+  return std::string(dir) + "/" + name;
+}
+
+std::string SourcePath(const std::string& relative) {
+  const char* dir = std::getenv("ORBED_SOURCE_DIR");
+  if (dir == nullptr) throw std::runtime_error("ORBED_SOURCE_DIR is not set (run through ctest)");
+  return std::string(dir) + "/" + relative;
+}
+
+std::string MakeTempDir(const std::string& tag) {
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("orbed_" + tag + "_" + std::to_string(getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir.string();
+}
+
+bool WaitFor(const std::function<bool()>& condition, double timeout_s) {
+  const auto deadline = std::chrono::steady_clock::now() +
+                        std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                            std::chrono::duration<double>(timeout_s));
+  while (std::chrono::steady_clock::now() < deadline) {
+    if (condition()) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return condition();
+}
+
+RunningProcess::RunningProcess(const std::vector<std::string>& argv,
+                               const std::map<std::string, std::string>& env)
+    : prefix_(std::filesystem::path(argv.at(0)).filename().string() + " | ") {
+  std::string error;
+  if (!child_.Start(argv, env, "", &error)) throw std::runtime_error(error);
+}
+
+RunningProcess::~RunningProcess() {
+  if (child_.running()) {
+    child_.Signal(SIGKILL);
+    Wait(5);
+  }
+  child_.Drain(prefix_, true);
+}
+
+bool RunningProcess::Wait(double timeout_s) {
+  return WaitFor(
+      [this] {
+        child_.Drain(prefix_);
+        return child_.Poll();
+      },
+      timeout_s);
+}
+
+bool RunningProcess::running() {
+  child_.Drain(prefix_);
+  return !child_.Poll();
+}
+
+BusWatcher::BusWatcher() : lcm_("") {
+  if (!lcm_.good()) throw std::runtime_error("LCM not available (multicast route?)");
+  lcm_.subscribe("PROCESS_STATUS", &BusWatcher::OnStatus, this);
+}
+
+void BusWatcher::Start() {
+  thread_ = std::thread([this] {
+    while (!stop_) lcm_.handleTimeout(20);
+  });
+}
+
+BusWatcher::~BusWatcher() {
+  stop_ = true;
+  if (thread_.joinable()) thread_.join();
+}
+
+void BusWatcher::OnStatus(const lcm::ReceiveBuffer*, const std::string&,
+                          const orbed::process_status_t* msg) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  beats_[msg->name].push_back(Beat{*msg, std::chrono::steady_clock::now()});
+}
+
+std::vector<BusWatcher::Beat> BusWatcher::Heartbeats(const std::string& name) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const auto it = beats_.find(name);
+  return it == beats_.end() ? std::vector<Beat>{} : it->second;
+}
+
+}  // namespace orbed::testing

@@ -1,0 +1,80 @@
+#pragma once
+/// @file
+/// Helpers for multi-process integration tests: run real orbed executables (from ORBED_BIN_DIR)
+/// and watch the real LCM bus. Tests using these run inside a private network namespace (ctest
+/// wraps them in scripts/netns-exec), so the default udpm URL with ttl=0 is private to the test.
+///
+/// Threading: BusWatcher handles LCM on its own thread; its accessors lock.
+
+#include <atomic>
+#include <chrono>
+#include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <lcm/lcm-cpp.hpp>
+#include <orbed/process_status_t.hpp>
+
+#include "procs/launcher/child.h"
+
+namespace orbed::testing {
+
+/// build/bin/<name>, from ORBED_BIN_DIR (set by ctest).
+std::string BinPath(const std::string& name);
+/// The repository root, from ORBED_SOURCE_DIR (set by ctest).
+std::string SourcePath(const std::string& relative);
+/// A fresh empty temporary folder.
+std::string MakeTempDir(const std::string& tag);
+
+/// Polls `condition` every 10 ms until true or `timeout_s` passes; returns its last value.
+bool WaitFor(const std::function<bool()>& condition, double timeout_s);
+
+/// Runs a command as a child (own process group); its output goes to this test's stdout with a
+/// prefix. Destruction SIGKILLs it if still running.
+class RunningProcess {
+ public:
+  explicit RunningProcess(const std::vector<std::string>& argv,
+                          const std::map<std::string, std::string>& env = {});
+  ~RunningProcess();
+  pid_t pid() const { return child_.pid(); }
+  void Signal(int signal) { child_.Signal(signal); }
+  /// Waits for exit; returns false on timeout.
+  bool Wait(double timeout_s);
+  bool running();
+  int exit_code() const { return child_.exit_code(); }
+  int term_signal() const { return child_.term_signal(); }
+
+ private:
+  launcher::Child child_;
+  std::string prefix_;
+};
+
+/// Listens to PROCESS_STATUS (and anything else subscribed) on the default bus.
+class BusWatcher {
+ public:
+  BusWatcher();
+  ~BusWatcher();
+  lcm::LCM& lcm() { return lcm_; }
+  struct Beat {
+    orbed::process_status_t status;
+    std::chrono::steady_clock::time_point received;
+  };
+  /// Every heartbeat of `name` seen so far.
+  std::vector<Beat> Heartbeats(const std::string& name) const;
+  /// Starts the handling thread; subscribe before calling this.
+  void Start();
+
+ private:
+  void OnStatus(const lcm::ReceiveBuffer*, const std::string&, const orbed::process_status_t* msg);
+  lcm::LCM lcm_;
+  mutable std::mutex mutex_;
+  std::map<std::string, std::vector<Beat>> beats_;
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
+
+}  // namespace orbed::testing
