@@ -18,7 +18,7 @@ namespace orbed::logger {
 class EventLogWriter {
  public:
   /// Opens `path` for writing (truncates). Check ok() / error().
-  explicit EventLogWriter(const std::string& path, size_t buffer_bytes = 1 << 20);
+  explicit EventLogWriter(const std::string& path, size_t buffer_bytes = 64 << 10);
   ~EventLogWriter();
   EventLogWriter(const EventLogWriter&) = delete;
   EventLogWriter& operator=(const EventLogWriter&) = delete;
