@@ -87,8 +87,8 @@ void BM_LoggerUnderLoad_VsLcmLogger(benchmark::State& state) {
                                       "--log-level", "warn"});
     // The same receive buffer for both (orbed-logger asks for 8 MB itself).
     const pid_t lcm_logger =
-        Spawn({"/usr/bin/lcm-logger", "-q", "-f", "-c", channels, "-l",
-               "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=8388608", theirs});
+        Spawn({"/usr/bin/lcm-logger", "-q", "-f", "-c", channels,
+               "--lcm-url=udpm://239.255.76.67:7667?ttl=0&recv_buf_size=8388608", theirs});
     const pid_t monitor = Spawn({bin + "/orbed-monitor", "--log-level", "warn"});
     std::this_thread::sleep_for(std::chrono::milliseconds(500));
 
