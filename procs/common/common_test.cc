@@ -138,7 +138,8 @@ TEST(Flags, HelpAndUnknownFlags) {
 }
 
 // A process on memq:// receives its own messages: one valid command, one undecodable payload,
-// one command the handler rejects. The heartbeat must count 3 in, 2 rejected, by reason.
+// one with a hostile length field, one command the handler rejects. The heartbeat must count
+// 4 in, 3 rejected, by reason.
 TEST(Process, CountsMessagesRejectionsAndPublishesHeartbeat) {
   CommonFlags flags("orbed-test");
   flags.lcm_url = "memq://";
@@ -168,11 +169,17 @@ TEST(Process, CountsMessagesRejectionsAndPublishesHeartbeat) {
   process.lcm().publish(channels::kIiwaCommand, &wrong);
   const uint8_t garbage[5] = {1, 2, 3, 4, 5};
   process.lcm().publish(channels::kIiwaCommand, garbage, sizeof(garbage));
+  // Right fingerprint, then num_joints = -1 (big-endian) and nothing else: the generated decoder
+  // would resize a vector to a negative size. It must be a counted rejection, not a crash.
+  std::vector<uint8_t> hostile(8 + 8 + 4, 0xff);
+  const int64_t hash = iiwa_command_t::getHash();
+  for (int i = 0; i < 8; ++i) hostile[i] = static_cast<uint8_t>(hash >> (56 - 8 * i));
+  process.lcm().publish(channels::kIiwaCommand, hostile.data(), hostile.size());
 
   EXPECT_EQ(process.Run(), 0);
   EXPECT_EQ(accepted, 1);
-  EXPECT_EQ(process.rejections().total(), 2);
-  EXPECT_EQ(process.rejections().counts().at("IIWA_COMMAND/decode"), 1);
+  EXPECT_EQ(process.rejections().total(), 3);
+  EXPECT_EQ(process.rejections().counts().at("IIWA_COMMAND/decode"), 2);
   EXPECT_EQ(process.rejections().counts().at("IIWA_COMMAND/num_joints"), 1);
   // Heartbeats: at start, at 1 s, at stop (the stop one is published after the loop and is not
   // received). At least the start and the 1 s heartbeat arrive.
@@ -180,11 +187,11 @@ TEST(Process, CountsMessagesRejectionsAndPublishesHeartbeat) {
   const process_status_t& last = heartbeats.back();
   EXPECT_EQ(last.name, "orbed-test");
   EXPECT_EQ(last.state, +process_status_t::STATE_RUNNING);
-  EXPECT_EQ(last.rejected_inputs, 2);
+  EXPECT_EQ(last.rejected_inputs, 3);
   EXPECT_EQ(last.num_reasons, 2);
   EXPECT_GE(last.uptime_s, 0.99);
-  // 3 commands + the heartbeats received before the last one.
-  EXPECT_GE(last.messages_in, 3);
+  // 4 commands + the heartbeats received before the last one.
+  EXPECT_GE(last.messages_in, 4);
   const process_status_t final_status = process.MakeStatus();
   EXPECT_EQ(final_status.state, +process_status_t::STATE_STOPPING);
   EXPECT_EQ(final_status.messages_out, static_cast<int64_t>(heartbeats.size()) + 1);

@@ -43,7 +43,9 @@ class LogLine {
 }  // namespace orbed
 
 /// Usage: ORBED_LOG(kInfo) << "listening on " << url;  (the stream is not evaluated when filtered)
-#define ORBED_LOG(level)                                            \
-  if (::orbed::LogLevel::level < ::orbed::GetLogLevel()) {          \
-  } else                                                            \
-    ::orbed::internal::LogLine(::orbed::LogLevel::level)
+/// (A one-shot for loop rather than if/else, so that `if (x) ORBED_LOG(kInfo) << ...;` has no
+/// dangling else.)
+#define ORBED_LOG(level)                                                             \
+  for (bool orbed_log_once = ::orbed::LogLevel::level >= ::orbed::GetLogLevel();     \
+       orbed_log_once; orbed_log_once = false)                                       \
+  ::orbed::internal::LogLine(::orbed::LogLevel::level)

@@ -17,6 +17,7 @@
 #include <chrono>
 #include <functional>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -134,7 +135,15 @@ struct Process::TypedSubscription : Process::SubscriptionBase {
   void OnRaw(const lcm::ReceiveBuffer* rbuf, const std::string& channel) override {
     ++process->messages_in_;
     Msg msg;
-    if (msg.decode(rbuf->data, 0, rbuf->data_size) != static_cast<int>(rbuf->data_size)) {
+    int decoded = -1;
+    try {
+      decoded = msg.decode(rbuf->data, 0, rbuf->data_size);
+    } catch (const std::exception&) {
+      // lcm-gen's decoders resize vectors from length fields in the bytes: a negative or huge
+      // length throws (length_error, bad_alloc) instead of failing.
+      decoded = -1;
+    }
+    if (decoded != static_cast<int>(rbuf->data_size)) {
       process->Reject(channel + "/decode", "cannot decode " + std::to_string(rbuf->data_size) +
                                                " bytes as " + Msg::getTypeName());
       return;

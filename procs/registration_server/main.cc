@@ -1,48 +1,94 @@
 /// @file
 /// orbed-registration: the registration server and its offline command line.
 ///
+///   orbed-registration [--lcm-url URL] [--state-period-sec S] [--model-centroid-m X Y Z] ...
+///     The LCM server (registration_server.h).
+///     Subscribes: SESSION_CONTROL, ALIGNMENT_TRIAL, LANDMARK_REQUEST, MISALIGNMENT_REQUEST.
+///     Publishes:  REGISTRATION (per accepted trial, on COMPUTE, and the full state every
+///                 --state-period-sec), LANDMARK, MISALIGNMENT, PROCESS_STATUS (1 Hz).
+///
 ///   orbed-registration mean --input FILE [--robust] [--json] [--model-centroid-m X Y Z]
 ///     Offline SE(3) mean of the trials in FILE (one `qw,qx,qy,qz,tx,ty,tz` per line, '#'
-///     comments); see mean_command.h for the output and exit codes. Touches no network.
+///     comments), on the server's code path; see mean_command.h for output and exit codes.
+///     Touches no network.
 ///
-///   orbed-registration            (no subcommand)
-///     The LCM server process (DESIGN.md §4): subscribes SESSION_CONTROL, ALIGNMENT_TRIAL,
-///     LANDMARK_REQUEST, MISALIGNMENT_REQUEST; publishes REGISTRATION (per trial and 1 Hz),
-///     LANDMARK, MISALIGNMENT, PROCESS_STATUS. Not wired in this build yet.
-///
-/// All logic lives in registration_lib; this file only parses flags.
+/// All logic lives in registration_lib / registration_server_lib; this file only parses flags.
 
+#include <exception>
 #include <iostream>
 #include <vector>
 
 #include <CLI/CLI.hpp>
 
-#include "mean_command.h"
+#include "procs/common/flags.h"
+#include "procs/registration_server/mean_command.h"
+#include "procs/registration_server/registration_server.h"
 
 int main(int argc, char** argv) {
-  CLI::App app{"orbed-registration: SE(3) averaging of alignment trials, landmark triangulation and "
-               "misalignment evaluation"};
+  CLI::App app{"orbed-registration: SE(3) averaging of alignment trials (paper eqs. 2-3), landmark\n"
+               "triangulation and misalignment evaluation. Without a subcommand: the LCM server."};
   app.require_subcommand(0, 1);
 
+  // Server flags.
+  orbed::CommonFlags common("orbed-registration");
+  orbed::AddCommonFlags(&app, &common);
+  orbed::registration::RegistrationServerOptions server;
+  std::vector<double> server_centroid_m;
+  app.add_option("--state-period-sec", server.state_period_s, "Period of the full-state REGISTRATION (0 = off)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--model-centroid-m", server_centroid_m,
+                 "Average translations about this model centroid p_VC (3 numbers, metres, in V)")
+      ->expected(3);
+  app.add_option("--k-mad", server.service.outlier.k_mad, "Robust mode: reject beyond median + k*MAD")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app.add_option("--min-ray-angle-deg", server.service.triangulation.min_ray_angle_deg,
+                 "Landmarks: rays closer than this to parallel are rejected")
+      ->check(CLI::Range(0.0, 89.0))
+      ->capture_default_str();
+  app.add_option("--trial-channel", server.trial_channel)->capture_default_str();
+  app.add_option("--registration-channel", server.registration_channel)->capture_default_str();
+  app.add_option("--session-control-channel", server.session_control_channel)->capture_default_str();
+  app.add_option("--landmark-request-channel", server.landmark_request_channel)->capture_default_str();
+  app.add_option("--landmark-channel", server.landmark_channel)->capture_default_str();
+  app.add_option("--misalignment-request-channel", server.misalignment_request_channel)->capture_default_str();
+  app.add_option("--misalignment-channel", server.misalignment_channel)->capture_default_str();
+
+  // The offline command.
   orbed::registration::MeanCommandOptions mean_options;
-  std::vector<double> centroid_m;
+  std::vector<double> mean_centroid_m;
   CLI::App* mean = app.add_subcommand("mean", "Offline SE(3) mean of a trial file (qw,qx,qy,qz,tx,ty,tz per line)");
   mean->add_option("--input", mean_options.input_path, "Trial file, one qw,qx,qy,qz,tx,ty,tz per line; '-' = stdin")
       ->required();
-  mean->add_flag("--robust", mean_options.robust,
-                 "Reject outlying trials (L1 median + k*MAD) before the Karcher mean");
+  mean->add_flag("--robust", mean_options.robust, "Reject outlying trials (L1 median + k*MAD) before the Karcher mean");
   mean->add_flag("--json", mean_options.json, "Print one JSON object instead of a text report");
-  mean->add_option("--model-centroid-m", centroid_m,
+  mean->add_option("--model-centroid-m", mean_centroid_m,
                    "Average translations about this model centroid p_VC (3 numbers, metres, in V)")
       ->expected(3);
 
   CLI11_PARSE(app, argc, argv);
 
   if (mean->parsed()) {
-    if (centroid_m.size() == 3) mean_options.p_VC = Eigen::Vector3d(centroid_m[0], centroid_m[1], centroid_m[2]);
+    if (mean_centroid_m.size() == 3) {
+      mean_options.p_VC = Eigen::Vector3d(mean_centroid_m[0], mean_centroid_m[1], mean_centroid_m[2]);
+    }
     return orbed::registration::RunMeanCommand(mean_options, std::cout, std::cerr);
   }
-  std::cerr << "orbed-registration: the LCM server is not built into this binary yet; use the `mean` "
-               "subcommand (see --help)\n";
-  return 1;
+
+  try {
+    orbed::ApplyCommonFlags(common);
+  } catch (const CLI::Error& e) {
+    return app.exit(e);
+  }
+  if (server_centroid_m.size() == 3) {
+    server.service.p_VC = Eigen::Vector3d(server_centroid_m[0], server_centroid_m[1], server_centroid_m[2]);
+  }
+  try {
+    orbed::registration::RegistrationServer process(common, server);
+    return process.Run();
+  } catch (const std::exception& e) {
+    std::cerr << "orbed-registration: " << e.what() << "\n";
+    return 1;
+  }
 }

@@ -1,4 +1,4 @@
-#include "mean_command.h"
+#include "procs/registration_server/mean_command.h"
 
 #include <charconv>
 #include <cmath>
@@ -6,7 +6,7 @@
 #include <iostream>
 #include <sstream>
 
-#include "trial_file.h"
+#include "procs/registration_server/trial_file.h"
 
 namespace orbed::registration {
 namespace {

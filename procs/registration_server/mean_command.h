@@ -21,7 +21,7 @@
 
 #include <Eigen/Core>
 
-#include "se3_mean.h"
+#include "procs/registration_server/se3_mean.h"
 
 namespace orbed::registration {
 

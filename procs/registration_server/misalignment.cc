@@ -1,4 +1,4 @@
-#include "misalignment.h"
+#include "procs/registration_server/misalignment.h"
 
 #include <cmath>
 

@@ -1,5 +1,5 @@
 // Oracle: hand-computed Table 1 statistics for two landmark pairs.
-#include "misalignment.h"
+#include "procs/registration_server/misalignment.h"
 
 #include <cmath>
 

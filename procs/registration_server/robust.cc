@@ -1,11 +1,11 @@
-#include "robust.h"
+#include "procs/registration_server/robust.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 
-#include "rotation_mean.h"
-#include "so3.h"
+#include "procs/registration_server/rotation_mean.h"
+#include "procs/registration_server/so3.h"
 
 namespace orbed::registration {
 namespace {

@@ -1,13 +1,13 @@
 // Oracles: medians known in closed form (points on one geodesic / one line, a symmetric square, a
 // dominant weight) and a planted outlier with known truth.
-#include "robust.h"
+#include "procs/registration_server/robust.h"
 
 #include <cmath>
 #include <random>
 
 #include <gtest/gtest.h>
 
-#include "rotation_mean.h"
+#include "procs/registration_server/rotation_mean.h"
 
 namespace orbed::registration {
 namespace {

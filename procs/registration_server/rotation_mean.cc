@@ -1,11 +1,11 @@
-#include "rotation_mean.h"
+#include "procs/registration_server/rotation_mean.h"
 
 #include <cmath>
 #include <string>
 
 #include <Eigen/Eigenvalues>
 
-#include "so3.h"
+#include "procs/registration_server/so3.h"
 
 namespace orbed::registration {
 namespace {

@@ -1,6 +1,6 @@
 // Oracles: closed forms (geodesic midpoints via Eigen's slerp, angles on a common axis,
 // symmetric configurations whose mean is known by symmetry) and Eigen's AngleAxis for logs.
-#include "rotation_mean.h"
+#include "procs/registration_server/rotation_mean.h"
 
 #include <cmath>
 #include <random>

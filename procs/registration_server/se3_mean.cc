@@ -1,9 +1,9 @@
-#include "se3_mean.h"
+#include "procs/registration_server/se3_mean.h"
 
 #include <algorithm>
 #include <cmath>
 
-#include "so3.h"
+#include "procs/registration_server/so3.h"
 
 namespace orbed::registration {
 namespace {

@@ -27,8 +27,8 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
-#include "robust.h"
-#include "rotation_mean.h"
+#include "procs/registration_server/robust.h"
+#include "procs/registration_server/rotation_mean.h"
 
 namespace orbed::registration {
 

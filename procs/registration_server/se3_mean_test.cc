@@ -1,6 +1,6 @@
 // Oracles: hand-computed means and dispersions (angles on one axis, symmetric translations), and a
 // configuration whose centroid-based mean is known by construction.
-#include "se3_mean.h"
+#include "procs/registration_server/se3_mean.h"
 
 #include <cmath>
 

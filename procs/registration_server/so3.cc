@@ -1,4 +1,4 @@
-#include "so3.h"
+#include "procs/registration_server/so3.h"
 
 #include <cmath>
 #include <cstdio>

@@ -1,6 +1,6 @@
 // Oracles: closed-form rotations and quaternions built with std::cos/std::sin and Eigen's own
 // AngleAxis / toRotationMatrix, never with the functions under test.
-#include "so3.h"
+#include "procs/registration_server/so3.h"
 
 #include <cmath>
 #include <limits>

@@ -1,10 +1,10 @@
-#include "trial_file.h"
+#include "procs/registration_server/trial_file.h"
 
 #include <charconv>
 #include <cmath>
 #include <cstdio>
 
-#include "so3.h"
+#include "procs/registration_server/so3.h"
 
 namespace orbed::registration {
 namespace {

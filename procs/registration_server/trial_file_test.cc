@@ -1,12 +1,12 @@
 // The offline trial file and the `mean` command: parsing, line-numbered errors, exit codes, JSON.
-#include "trial_file.h"
+#include "procs/registration_server/trial_file.h"
 
 #include <regex>
 #include <sstream>
 
 #include <gtest/gtest.h>
 
-#include "mean_command.h"
+#include "procs/registration_server/mean_command.h"
 
 namespace orbed::registration {
 namespace {

@@ -1,4 +1,4 @@
-#include "triangulation.h"
+#include "procs/registration_server/triangulation.h"
 
 #include <algorithm>
 #include <cmath>

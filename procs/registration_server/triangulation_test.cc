@@ -1,6 +1,6 @@
 // Oracles: rays constructed through a known point; skew lines whose least-squares point and gap
 // are known in closed form.
-#include "triangulation.h"
+#include "procs/registration_server/triangulation.h"
 
 #include <cmath>
 

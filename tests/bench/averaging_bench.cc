@@ -11,6 +11,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <unistd.h>
 #include <map>
 #include <random>
 #include <string>
@@ -72,6 +73,7 @@ BENCHMARK(BM_RobustRejection)->Arg(3)->Arg(10)->Arg(100)->Arg(1000);
 // The console table, then Karcher / chordal per N from the same run.
 class RatioReporter : public benchmark::ConsoleReporter {
  public:
+  explicit RatioReporter(OutputOptions options) : ConsoleReporter(options) {}
   void ReportRuns(const std::vector<Run>& runs) override {
     ConsoleReporter::ReportRuns(runs);
     for (const Run& run : runs) {
@@ -103,7 +105,9 @@ class RatioReporter : public benchmark::ConsoleReporter {
 int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
-  orbed::registration::RatioReporter reporter;
+  // Colour only on a terminal (ConsoleReporter itself ignores --benchmark_color when given to us).
+  orbed::registration::RatioReporter reporter(isatty(fileno(stdout)) ? benchmark::ConsoleReporter::OO_ColorTabular
+                                                                      : benchmark::ConsoleReporter::OO_Tabular);
   benchmark::RunSpecifiedBenchmarks(&reporter);
   benchmark::Shutdown();
   return 0;

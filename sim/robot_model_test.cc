@@ -1,0 +1,189 @@
+// Tests of the URDF robot model against an independent standard-DH evaluation of the iiwa 7.
+#include "sim/robot_model.h"
+
+#include <cmath>
+#include <cstdlib>
+#include <string>
+
+#include <gtest/gtest.h>
+
+namespace orbed::sim {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+std::string SourcePath(const std::string& rel) {
+  const char* dir = std::getenv("ORBED_SOURCE_DIR");
+  return std::string(dir ? dir : ".") + "/" + rel;
+}
+
+RobotModel LoadIiwa() { return RobotModel::LoadFile(SourcePath(RobotModel::kDefaultUrdfRelativePath)); }
+
+// The iiwa 7 R800 data-sheet DH parameters (DESIGN §4), evaluated by hand:
+// T_{i-1,i} = Rz(theta_i) Tz(d_i) Tx(a_i) Rx(alpha_i).
+Eigen::Matrix4d DhTransform(double theta, double d, double a, double alpha) {
+  const double ct = std::cos(theta), st = std::sin(theta), ca = std::cos(alpha), sa = std::sin(alpha);
+  Eigen::Matrix4d T;
+  T << ct, -st * ca, st * sa, a * ct,
+       st, ct * ca, -ct * sa, a * st,
+       0, sa, ca, d,
+       0, 0, 0, 1;
+  return T;
+}
+
+// DH frames 0..7 (frame 7 = flange).
+std::vector<Eigen::Matrix4d> DhFrames(const Eigen::VectorXd& q) {
+  const double d[7] = {0.34, 0, 0.4, 0, 0.4, 0, 0.126};
+  const double alpha[7] = {-kPi / 2, kPi / 2, kPi / 2, -kPi / 2, -kPi / 2, kPi / 2, 0};
+  std::vector<Eigen::Matrix4d> F{Eigen::Matrix4d::Identity()};
+  for (int i = 0; i < 7; ++i) F.push_back(F.back() * DhTransform(q[i], d[i], 0.0, alpha[i]));
+  return F;
+}
+
+Eigen::VectorXd Deg(std::initializer_list<double> v) {
+  Eigen::VectorXd q(v.size());
+  int i = 0;
+  for (double x : v) q[i++] = x * kPi / 180.0;
+  return q;
+}
+
+TEST(RobotModelTest, LoadsSevenJointsWithDataSheetLimits) {
+  const RobotModel m = LoadIiwa();
+  ASSERT_EQ(m.num_joints(), 7);
+  const double limit_deg[7] = {170, 120, 170, 120, 170, 120, 175};
+  const double speed_deg[7] = {98, 98, 100, 130, 140, 180, 180};
+  for (int i = 0; i < 7; ++i) {
+    EXPECT_NEAR(m.joints()[i].upper_rad * 180 / kPi, limit_deg[i], 1e-9) << i;
+    EXPECT_NEAR(m.joints()[i].lower_rad * 180 / kPi, -limit_deg[i], 1e-9) << i;
+    EXPECT_NEAR(m.joints()[i].velocity_rad_per_s * 180 / kPi, speed_deg[i], 1e-9) << i;
+  }
+  EXPECT_NEAR(m.tool_length_m(), 0.25, 1e-12);
+  EXPECT_EQ(m.links()[m.flange_link()].name, "iiwa_link_ee");
+  EXPECT_EQ(m.links()[m.tool_link()].name, "iiwa_tool");
+}
+
+TEST(RobotModelTest, ZeroPoseFlangeAt1266Upright) {
+  const RobotModel m = LoadIiwa();
+  const Eigen::Isometry3d X_RF = m.CalcFlangePose(Eigen::VectorXd::Zero(7));
+  EXPECT_TRUE(X_RF.translation().isApprox(Eigen::Vector3d(0, 0, 1.266), 1e-12)) << X_RF.translation().transpose();
+  EXPECT_TRUE(X_RF.linear().isApprox(Eigen::Matrix3d::Identity(), 1e-12));
+  const Eigen::Isometry3d X_RT = m.CalcToolTipPose(Eigen::VectorXd::Zero(7));
+  EXPECT_NEAR(X_RT.translation().z(), 1.266 + 0.25, 1e-12);
+}
+
+TEST(RobotModelTest, FlangeAndJointFramesMatchDhOracle) {
+  const RobotModel m = LoadIiwa();
+  const std::vector<Eigen::VectorXd> qs = {
+      Deg({0, 0, 0, 0, 0, 0, 0}),
+      Deg({170, 120, 170, 120, 170, 120, 175}),
+      Deg({-170, -120, -170, -120, -170, -120, -175}),
+      Deg({30, -45, 60, 90, -20, 75, -110}),
+      Deg({-120, 100, -30, -115, 150, -60, 20}),
+      Deg({10, 20, 30, 40, 50, 60, 70}),
+  };
+  for (const auto& q : qs) {
+    const auto F = DhFrames(q);
+    const auto X = m.CalcLinkPoses(q);
+    const Eigen::Matrix4d X_RF = X[m.flange_link()].matrix();
+    EXPECT_TRUE(X_RF.isApprox(F[7], 1e-12)) << "q=" << q.transpose() << "\n" << X_RF << "\n" << F[7];
+    // Link i+1's frame is DH frame i turned by q_{i+1}: same origin, same z (the joint axis).
+    for (int i = 0; i < 7; ++i) {
+      const Eigen::Isometry3d& X_RL = X[m.joints()[i].link];
+      EXPECT_LT((X_RL.translation() - F[i].block<3, 1>(0, 3)).norm(), 1e-12);
+      EXPECT_TRUE(X_RL.linear().col(2).isApprox(F[i].block<3, 1>(0, 2), 1e-12));
+    }
+  }
+}
+
+TEST(RobotModelTest, JacobianMatchesFiniteDifferences) {
+  const RobotModel m = LoadIiwa();
+  const Eigen::VectorXd q = Deg({25, -35, 50, 70, -40, 55, 10});
+  const int tip = m.tool_tip_link();
+  const Eigen::MatrixXd J = m.CalcJacobian(q, tip);
+  const double h = 1e-7;
+  const Eigen::Isometry3d X0 = m.CalcLinkPoses(q)[tip];
+  for (int j = 0; j < 7; ++j) {
+    Eigen::VectorXd qp = q;
+    qp[j] += h;
+    const Eigen::Isometry3d X1 = m.CalcLinkPoses(qp)[tip];
+    const Eigen::Vector3d v = (X1.translation() - X0.translation()) / h;
+    const Eigen::AngleAxisd aa(X1.linear() * X0.linear().transpose());
+    const Eigen::Vector3d w = aa.axis() * aa.angle() / h;
+    EXPECT_TRUE((J.block<3, 1>(3, j) - v).norm() < 1e-6) << j;
+    EXPECT_TRUE((J.block<3, 1>(0, j) - w).norm() < 1e-6) << j;
+  }
+}
+
+TEST(RobotModelTest, SetToolLengthMovesTipAndStretchesShaft) {
+  RobotModel m = LoadIiwa();
+  m.SetToolLength(0.4);
+  const Eigen::VectorXd q = Deg({10, 20, 30, 40, 50, 60, 70});
+  const auto X = m.CalcLinkPoses(q);
+  const Eigen::Isometry3d X_FT = X[m.flange_link()].inverse() * X[m.tool_tip_link()];
+  EXPECT_TRUE(X_FT.translation().isApprox(Eigen::Vector3d(0, 0, 0.4), 1e-12));
+  bool found = false;
+  for (const auto& g : m.links()[m.tool_link()].collision) {
+    if (g.name == "shaft") {
+      found = true;
+      EXPECT_NEAR(g.length_m, 0.35, 1e-12);                    // from 0.05 to 0.40
+      EXPECT_NEAR(g.X_LG.translation().z(), 0.225, 1e-12);
+    }
+    if (g.name == "adaptor") {
+      EXPECT_NEAR(g.length_m, 0.05, 1e-12);
+    }
+  }
+  EXPECT_TRUE(found);
+  EXPECT_THROW(m.SetToolLength(0.04), std::invalid_argument);
+  EXPECT_THROW(m.SetToolLength(std::nan("")), std::invalid_argument);
+}
+
+TEST(RobotModelTest, ValidateJointVectorNamesTheJoint) {
+  const RobotModel m = LoadIiwa();
+  EXPECT_EQ(m.ValidateJointVector(Deg({170, 120, 170, 120, 170, 120, 175})), "");
+  EXPECT_NE(m.ValidateJointVector(Deg({0, 121, 0, 0, 0, 0, 0})).find("iiwa_joint_2"), std::string::npos);
+  EXPECT_NE(m.ValidateJointVector(Deg({0, 0, 0})).find("expected 7"), std::string::npos);
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(7);
+  q[4] = std::nan("");
+  EXPECT_NE(m.ValidateJointVector(q).find("iiwa_joint_5"), std::string::npos);
+}
+
+TEST(RobotModelTest, AdjacencyFollowsJointsAndFixedLinks) {
+  const RobotModel m = LoadIiwa();
+  auto body = [&](const char* n) { return m.links()[m.FindLink(n)].body; };
+  EXPECT_EQ(body("iiwa_link_7"), body("iiwa_tool"));
+  EXPECT_TRUE(m.BodiesAdjacent(body("iiwa_link_6"), body("iiwa_tool")));
+  EXPECT_FALSE(m.BodiesAdjacent(body("iiwa_link_5"), body("iiwa_tool")));
+  EXPECT_EQ(m.BodySeparation(body("iiwa_link_0"), body("iiwa_tool")), 7);
+}
+
+std::string Expect(const std::string& xml) {
+  try {
+    RobotModel::LoadString(xml, "bad.urdf");
+  } catch (const std::runtime_error& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+TEST(RobotModelTest, BadUrdfsAreRejectedWithTheElement) {
+  const std::string head = "<robot name='r'><link name='a'/><link name='iiwa_link_ee'/>";
+  EXPECT_NE(Expect("<robot").find("bad.urdf"), std::string::npos);
+  std::string e = Expect(head + "<joint name='j1' type='continuous'><parent link='a'/><child link='iiwa_link_ee'/>"
+                         "<axis xyz='0 0 1'/></joint></robot>");
+  EXPECT_NE(e.find("bad.urdf: joint 'j1'"), std::string::npos) << e;
+  e = Expect(head + "<joint name='j1' type='revolute'><parent link='a'/><child link='iiwa_link_ee'/>"
+             "<axis xyz='0 0 1'/><limit lower='-1' upper='1' effort='1' velocity='0'/></joint></robot>");
+  EXPECT_NE(e.find("velocity"), std::string::npos) << e;
+  e = Expect("<robot name='r'><link name='a'><collision><geometry><mesh filename='x.stl'/></geometry></collision>"
+             "</link><link name='iiwa_link_ee'/><joint name='j1' type='revolute'><parent link='a'/>"
+             "<child link='iiwa_link_ee'/><limit lower='-1' upper='1' effort='1' velocity='1'/></joint></robot>");
+  EXPECT_NE(e.find("link 'a'"), std::string::npos) << e;
+  EXPECT_NE(Expect("<robot name='r'><link name='a'/><link name='b'/><joint name='j' type='revolute'><parent "
+                   "link='a'/><child link='b'/><limit lower='-1' upper='1' effort='1' velocity='1'/></joint></robot>")
+                .find("iiwa_link_ee"),
+            std::string::npos);
+  EXPECT_THROW(RobotModel::LoadFile("/nonexistent/x.urdf"), std::runtime_error);
+}
+
+}  // namespace
+}  // namespace orbed::sim

@@ -1,0 +1,278 @@
+#include "sim/robot_tool.h"
+
+#include <cmath>
+#include <cstdlib>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "procs/common/json.h"
+#include "sim/collision_world.h"
+#include "sim/robot_model.h"
+#include "sim/scene.h"
+#include "sim/trocar_ik.h"
+#include "sim/trocar_clearance.h"
+
+#ifndef ORBED_BUILD_SOURCE_DIR
+#define ORBED_BUILD_SOURCE_DIR "."
+#endif
+
+namespace orbed::sim {
+namespace {
+
+// A bad argument: reported on one line, exit code 2.
+struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+std::string SourceDir() {
+  const char* env = std::getenv("ORBED_SOURCE_DIR");
+  return env && *env ? std::string(env) : std::string(ORBED_BUILD_SOURCE_DIR);
+}
+
+Eigen::VectorXd ParseJointList(const std::string& text, int expected) {
+  std::vector<double> values;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    size_t used = 0;
+    double v = 0;
+    try {
+      v = std::stod(item, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    while (used < item.size() && std::isspace(static_cast<unsigned char>(item[used]))) ++used;
+    if (item.empty() || used != item.size()) throw UsageError("--q-deg: '" + item + "' is not a number");
+    if (!std::isfinite(v)) throw UsageError("--q-deg: '" + item + "' is not a finite number");
+    values.push_back(v);
+  }
+  if (!text.empty() && text.back() == ',') throw UsageError("--q-deg: trailing comma");
+  if (static_cast<int>(values.size()) != expected) {
+    throw UsageError("--q-deg: expected " + std::to_string(expected) + " comma-separated angles in deg, got " +
+                     std::to_string(values.size()));
+  }
+  return Eigen::Map<Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size()));
+}
+
+RobotModel LoadModel(const std::string& urdf_flag) {
+  const std::string path = urdf_flag.empty() ? SourceDir() + "/" + RobotModel::kDefaultUrdfRelativePath : urdf_flag;
+  try {
+    return RobotModel::LoadFile(path);
+  } catch (const std::exception& e) {
+    throw UsageError(e.what());
+  }
+}
+
+Scene LoadScene(const std::string& path) {
+  try {
+    return LoadSceneFile(path);
+  } catch (const std::exception& e) {
+    throw UsageError(e.what());
+  }
+}
+
+Eigen::VectorXd ValidatedQ(const RobotModel& model, const std::string& q_text) {
+  const Eigen::VectorXd q = DegToRad(ParseJointList(q_text, model.num_joints()));
+  const std::string why = model.ValidateJointVector(q);
+  if (!why.empty()) throw UsageError("--q-deg: " + why);
+  return q;
+}
+
+void WritePose(JsonWriter& j, const Eigen::Isometry3d& X) {
+  j.BeginObject();
+  const Eigen::Vector3d p = X.translation();
+  j.Key("position_m").Array(std::vector<double>{p.x(), p.y(), p.z()});
+  j.Key("rotation").BeginArray();
+  for (int r = 0; r < 3; ++r) {
+    j.Array(std::vector<double>{X.linear()(r, 0), X.linear()(r, 1), X.linear()(r, 2)});
+  }
+  j.EndArray();
+  j.EndObject();
+}
+
+void WriteVec(JsonWriter& j, const Eigen::Vector3d& v) { j.Array(std::vector<double>{v.x(), v.y(), v.z()}); }
+
+void WritePair(JsonWriter& j, const PairDistance& p) {
+  if (!p.valid()) {
+    j.Null();
+    return;
+  }
+  j.BeginObject();
+  j.Key("a").String(p.body_a);
+  j.Key("b").String(p.body_b);
+  j.Key("self").Bool(p.self);
+  j.Key("distance_m").Number(p.distance_m);
+  j.Key("p_WA");
+  WriteVec(j, p.p_WA);
+  j.Key("p_WB");
+  WriteVec(j, p.p_WB);
+  j.EndObject();
+}
+
+void WriteCheck(JsonWriter& j, const RobotModel& model, const CollisionWorld& world, const CollisionResult& r) {
+  j.Key("in_collision").Bool(r.in_collision);
+  j.Key("min_distance_m").Number(r.min_distance_m);
+  j.Key("closest");
+  WritePair(j, r.closest);
+  j.Key("closest_self");
+  WritePair(j, r.closest_self);
+  j.Key("closest_environment");
+  WritePair(j, r.closest_environment);
+  j.Key("link_clearance_m").BeginObject();
+  for (int i = 0; i < model.num_links(); ++i) {
+    if (std::isfinite(r.link_clearance_m[i])) j.Key(model.links()[i].name).Number(r.link_clearance_m[i]);
+  }
+  j.EndObject();
+  j.Key("pairs_checked").BeginObject();
+  j.Key("self").Int(world.num_self_pairs());
+  j.Key("environment").Int(world.num_environment_pairs());
+  j.EndObject();
+}
+
+int RunFk(const std::string& q_text, const std::string& urdf, std::ostream& out) {
+  const RobotModel model = LoadModel(urdf);
+  const Eigen::VectorXd q = ValidatedQ(model, q_text);
+  const auto X_RL = model.CalcLinkPoses(q);
+  JsonWriter j;
+  j.BeginObject();
+  j.Key("frame").String("R");
+  const Eigen::VectorXd q_deg = RadToDeg(q);
+  j.Key("q_deg").Array(std::vector<double>(q_deg.data(), q_deg.data() + q_deg.size()));
+  j.Key("flange");
+  WritePose(j, X_RL[model.flange_link()]);
+  j.Key("tool_tip");
+  WritePose(j, X_RL[model.tool_tip_link()]);
+  j.Key("tool_length_m").Number(model.tool_length_m());
+  j.Key("links").BeginObject();
+  for (int i = 0; i < model.num_links(); ++i) {
+    j.Key(model.links()[i].name);
+    WritePose(j, X_RL[i]);
+  }
+  j.EndObject();
+  j.EndObject();
+  out << j.str() << "\n";
+  return 0;
+}
+
+int RunCheck(const std::string& q_text, const std::string& scene_path, const std::string& urdf, std::ostream& out) {
+  RobotModel model = LoadModel(urdf);
+  const Eigen::VectorXd q = ValidatedQ(model, q_text);
+  Scene scene;
+  const bool has_scene = !scene_path.empty();
+  if (has_scene) {
+    scene = LoadScene(scene_path);
+    model.SetToolLength(scene.tool_length_m);
+  }
+  CollisionWorld world(model, has_scene ? &scene : nullptr);
+  const CollisionResult r = world.Check(q);
+  JsonWriter j;
+  j.BeginObject();
+  j.Key("frame").String(has_scene ? "W" : "R");
+  if (has_scene) {
+    j.Key("scene").String(scene_path);
+  } else {
+    j.Key("scene").Null();
+  }
+  j.Key("within_limits").Bool(true);
+  WriteCheck(j, model, world, r);
+  j.EndObject();
+  out << j.str() << "\n";
+  return 0;
+}
+
+int RunIk(const std::string& scene_path, const std::string& urdf, uint64_t seed, int starts, std::ostream& out) {
+  RobotModel model = LoadModel(urdf);
+  const Scene scene = LoadScene(scene_path);
+  model.SetToolLength(scene.tool_length_m);
+  CollisionWorld world(model, &scene);
+  const ClearanceFunction clearance = MakeTrocarClearanceFunction(model, scene);
+  const TrocarIkTarget target = TrocarTargetInBase(scene);
+  TrocarIkOptions options;
+  options.seed = seed;
+  options.num_seeds = starts;
+  const TrocarIkResult ik = SolveTrocarIk(model, target, options, clearance);
+
+  JsonWriter j;
+  j.BeginObject();
+  j.Key("success").Bool(ik.success);
+  j.Key("message").String(ik.message);
+  j.Key("scene").String(scene_path);
+  if (ik.q_rad.size() > 0) {
+    const Eigen::VectorXd q_deg = RadToDeg(ik.q_rad);
+    j.Key("q_deg").Array(std::vector<double>(q_deg.data(), q_deg.data() + q_deg.size()));
+    j.Key("clearance_m").Number(ik.clearance_m);
+    j.Key("position_error_m").Number(ik.position_error_m);
+    j.Key("angle_error_deg").Number(ik.angle_error_rad * 180.0 / M_PI);
+    const Eigen::Isometry3d X_WT = scene.X_WR * model.CalcToolTipPose(ik.q_rad);
+    j.Key("p_WT");
+    WriteVec(j, X_WT.translation());
+    j.Key("tool_axis_W");
+    WriteVec(j, X_WT.linear().col(2));
+    j.Key("check").BeginObject();
+    WriteCheck(j, model, world, world.Check(ik.q_rad));
+    j.EndObject();
+  } else {
+    j.Key("q_deg").Null();
+  }
+  j.Key("starts").Int(ik.seeds_tried);
+  j.Key("starts_converged").Int(ik.seeds_converged);
+  j.EndObject();
+  out << j.str() << "\n";
+  return ik.success ? 0 : 1;
+}
+
+}  // namespace
+
+int RunRobotTool(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
+  CLI::App app{"orbed-robot: forward kinematics, collision check and trocar IK of the iiwa 7 model (JSON out)"};
+  app.require_subcommand(1);
+  std::string q_text, urdf, scene_path;
+  uint64_t seed = 1;
+  int starts = 48;
+  auto* fk = app.add_subcommand("fk", "flange, tool tip and link poses in the robot base frame R");
+  fk->add_option("--q-deg", q_text, "joint angles q1,...,q7 [deg]")->required();
+  fk->add_option("--urdf", urdf, "robot URDF (default: sim/models/iiwa7.urdf of the source tree)");
+  auto* check = app.add_subcommand("check", "self and scene collision, minimum distance, closest pair");
+  check->add_option("--q-deg", q_text, "joint angles q1,...,q7 [deg]")->required();
+  check->add_option("--scene", scene_path, "scene YAML (without it: self-collision only)");
+  check->add_option("--urdf", urdf, "robot URDF");
+  auto* ik = app.add_subcommand("ik", "collision-free joint vector docking the tool at the scene's trocar");
+  ik->add_option("--scene", scene_path, "scene YAML")->required();
+  ik->add_option("--urdf", urdf, "robot URDF");
+  ik->add_option("--seed", seed, "random seed of the IK starts");
+  ik->add_option("--starts", starts, "number of random IK starts")->check(CLI::Range(1, 100000));
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp&) {
+    out << app.help();
+    return 0;
+  } catch (const CLI::CallForAllHelp&) {
+    out << app.help("", CLI::AppFormatMode::All);
+    return 0;
+  } catch (const CLI::ParseError& e) {
+    std::string msg = e.what();
+    for (auto& c : msg) {
+      if (c == '\n') c = ' ';
+    }
+    err << "orbed-robot: " << msg << " (see --help)\n";
+    return 2;
+  }
+  try {
+    if (*fk) return RunFk(q_text, urdf, out);
+    if (*check) return RunCheck(q_text, scene_path, urdf, out);
+    if (*ik) return RunIk(scene_path, urdf, seed, starts, out);
+  } catch (const UsageError& e) {
+    err << "orbed-robot: " << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    err << "orbed-robot: " << e.what() << "\n";
+    return 2;
+  }
+  return 2;
+}
+
+}  // namespace orbed::sim

@@ -1,0 +1,81 @@
+// Tests of the orbed-robot command line, run in-process.
+#include "sim/robot_tool.h"
+
+#include <cstdlib>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+namespace orbed::sim {
+namespace {
+
+struct ToolRun {
+  int code;
+  std::string out, err;
+};
+
+ToolRun Tool(std::vector<std::string> args) {
+  args.insert(args.begin(), "orbed-robot");
+  std::vector<const char*> argv;
+  for (const auto& a : args) argv.push_back(a.c_str());
+  std::ostringstream out, err;
+  const int code = RunRobotTool(static_cast<int>(argv.size()), argv.data(), out, err);
+  return {code, out.str(), err.str()};
+}
+
+std::string Scene() {
+  const char* dir = std::getenv("ORBED_SOURCE_DIR");
+  return std::string(dir ? dir : ".") + "/sim/models/scenes/trocar_or.yaml";
+}
+
+int Lines(const std::string& s) {
+  int n = 0;
+  for (char c : s) n += c == '\n';
+  return n;
+}
+
+TEST(RobotToolTest, FkPrintsTheFlangeAtTheZeroPose) {
+  const ToolRun r = Tool({"fk", "--q-deg", "0,0,0,0,0,0,0"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.out.rfind("{\"frame\":\"R\"", 0), 0u) << r.out;
+  EXPECT_NE(r.out.find("\"flange\":{\"position_m\":[0,0,1.266],\"rotation\":[[1,0,0],[0,1,0],[0,0,1]]}"),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("\"links\":{\"iiwa_link_0\""), std::string::npos);
+}
+
+TEST(RobotToolTest, CheckAndIkOnTheScene) {
+  ToolRun r = Tool({"check", "--q-deg", "0,0,0,0,0,0,0", "--scene", Scene()});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("\"in_collision\":false"), std::string::npos) << r.out;
+  r = Tool({"check", "--q-deg=0,120,0,-120,0,0,0"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("\"in_collision\":true"), std::string::npos) << r.out;
+  r = Tool({"ik", "--scene", Scene()});
+  ASSERT_EQ(r.code, 0) << r.err << r.out;
+  EXPECT_NE(r.out.find("\"success\":true"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\"q_deg\":["), std::string::npos) << r.out;
+}
+
+TEST(RobotToolTest, BadArgumentsGiveOneLineAndExitTwo) {
+  for (const auto& args : std::vector<std::vector<std::string>>{
+           {"fk", "--q-deg", "1,2,3"},
+           {"fk", "--q-deg", "0,0,0,0,0,0,abc"},
+           {"fk", "--q-deg", "0,121,0,0,0,0,0"},
+           {"fk", "--q-deg", "0,nan,0,0,0,0,0"},
+           {"fk"},
+           {"check", "--q-deg", "0,0,0,0,0,0,0", "--scene", "/nonexistent.yaml"},
+           {"ik"},
+           {"fk", "--q-deg", "0,0,0,0,0,0,0", "--urdf", "/nonexistent.urdf"},
+           {"frobnicate"}}) {
+    const ToolRun r = Tool(args);
+    EXPECT_EQ(r.code, 2) << args[0];
+    EXPECT_EQ(Lines(r.err), 1) << r.err;
+    EXPECT_TRUE(r.out.empty()) << r.out;
+  }
+}
+
+}  // namespace
+}  // namespace orbed::sim

@@ -1,0 +1,75 @@
+#pragma once
+/// @file
+/// The operating-room scene around the robot, loaded from YAML (sim/models/scenes/*.yaml): the robot
+/// base pose X_WR, the tool length, the trocar (docking point and insertion direction) and the
+/// obstacles (table, patient mannequin, carts, other arms...) as boxes, cylinders and spheres.
+///
+/// Frames: W is the OR world frame (floor at z = 0, z up). Each object O has its pose X_WO; a box is
+/// centred on O with full side lengths size_m along O's axes; a cylinder is centred on O with its
+/// axis along O's z; a sphere is centred on O. Orientations in the file are URDF-style fixed-axis
+/// roll-pitch-yaw in degrees: R = Rz(yaw) Ry(pitch) Rx(roll). Units: m, deg in the file.
+///
+/// File format (every key is checked; unknown keys are errors, so typos are caught):
+///   name: trocar_or                      # optional
+///   robot:
+///     base_pose: {position_m: [x, y, z], rpy_deg: [r, p, y]}   # X_WR
+///     tool_length_m: 0.25                # flange F to tool tip T, > 0
+///   trocar:
+///     position_m: [x, y, z]              # p_WT*, where the tool tip docks onto the cannula
+///     insertion_direction: [x, y, z]     # unit vector in W (normalised if within 1 % of unit)
+///   objects:
+///     - name: operating_table
+///       shape: box                       # box | cylinder | sphere
+///       size_m: [lx, ly, lz]             # box
+///       radius_m: 0.1                    # cylinder, sphere
+///       length_m: 1.6                    # cylinder
+///       pose: {position_m: [...], rpy_deg: [...]}   # X_WO; rpy_deg optional (default 0)
+///       ignore_links: [iiwa_link_0]      # optional: robot links never checked against it (a mount)
+///
+/// Threading: plain data; the loaders are reentrant.
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+namespace orbed::sim {
+
+struct SceneObject {
+  enum class Shape { kBox, kCylinder, kSphere };
+  std::string name;
+  Shape shape{Shape::kBox};
+  Eigen::Isometry3d X_WO{Eigen::Isometry3d::Identity()};
+  Eigen::Vector3d size_m{Eigen::Vector3d::Zero()};  ///< box: full side lengths
+  double radius_m{0};                                ///< cylinder, sphere
+  double length_m{0};                                ///< cylinder
+  std::vector<std::string> ignore_links;
+};
+
+struct Trocar {
+  Eigen::Vector3d p_WT{Eigen::Vector3d::Zero()};                    ///< docking point [m]
+  Eigen::Vector3d insertion_direction_W{-Eigen::Vector3d::UnitZ()};  ///< unit vector
+};
+
+struct Scene {
+  std::string name;
+  std::string source;  ///< file name or the name passed to the loader
+  Eigen::Isometry3d X_WR{Eigen::Isometry3d::Identity()};
+  double tool_length_m{0.25};
+  Trocar trocar;
+  std::vector<SceneObject> objects;
+};
+
+/// Loads a scene file. Throws std::runtime_error naming the file, the line, the key and what was
+/// expected, e.g. "or.yaml:12: objects[1].size_m: expected a list of 3 numbers > 0".
+Scene LoadSceneFile(const std::string& path);
+/// The same from YAML text; `source_name` is used in error messages.
+Scene LoadSceneString(const std::string& yaml_text, const std::string& source_name);
+
+/// R = Rz(yaw) Ry(pitch) Rx(roll), angles in degrees.
+Eigen::Matrix3d RotationFromRpyDeg(const Eigen::Vector3d& rpy_deg);
+
+/// The scene shipped in the source tree for the trocar-placement experiment, relative to the root.
+inline constexpr const char* kDefaultSceneRelativePath = "sim/models/scenes/trocar_or.yaml";
+
+}  // namespace orbed::sim

@@ -1,0 +1,204 @@
+/// @file
+/// FK + full collision check (self + scene) per query of the iiwa 7 in the shipped trocar scene:
+/// orbed's Bullet CollisionWorld (with and without its bound-ordered pruning) beside FCL answering
+/// the same query — the same pairs, the same primitives (capsules, cylinders, spheres, boxes), the
+/// minimum signed distance, the closest pair and per-link clearance — in the same run. The joint
+/// vectors are a fixed pool of 1024 seeded random vectors within the limits.
+///
+/// Counters: `pairs` = exact pair distances computed per query; `max_diff_vs_bullet_m` = the
+/// largest |min distance (FCL) - min distance (Bullet)| over the pool (agreement check).
+/// Run: build-*/bench/collision_bench (needs $ORBED_SOURCE_DIR or runs from the source root).
+#include <cmath>
+#include <cstdlib>
+#include <limits>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <benchmark/benchmark.h>
+#include <fcl/narrowphase/collision_object.h>
+#include <fcl/narrowphase/distance.h>
+
+#include "sim/collision_world.h"
+#include "sim/robot_model.h"
+#include "sim/scene.h"
+
+namespace orbed::sim {
+namespace {
+
+std::string SourcePath(const std::string& rel) {
+  const char* dir = std::getenv("ORBED_SOURCE_DIR");
+  return std::string(dir ? dir : ".") + "/" + rel;
+}
+
+struct Fixture {
+  RobotModel model = RobotModel::LoadFile(SourcePath(RobotModel::kDefaultUrdfRelativePath));
+  Scene scene = LoadSceneFile(SourcePath(kDefaultSceneRelativePath));
+  std::vector<Eigen::VectorXd> pool;
+  Fixture() {
+    model.SetToolLength(scene.tool_length_m);
+    std::mt19937_64 rng(42);
+    std::uniform_real_distribution<double> u(0, 1);
+    for (int n = 0; n < 1024; ++n) {
+      Eigen::VectorXd q(model.num_joints());
+      for (int i = 0; i < q.size(); ++i) {
+        q[i] = model.joints()[i].lower_rad + u(rng) * (model.joints()[i].upper_rad - model.joints()[i].lower_rad);
+      }
+      pool.push_back(q);
+    }
+  }
+};
+
+Fixture& F() {
+  static Fixture f;
+  return f;
+}
+
+std::shared_ptr<fcl::CollisionGeometryd> ToFcl(const CollisionPrimitive& g) {
+  using K = CollisionPrimitive::Kind;
+  switch (g.kind) {
+    case K::kSphere: return std::make_shared<fcl::Sphered>(g.radius_m);
+    case K::kCapsule: return std::make_shared<fcl::Capsuled>(g.radius_m, g.length_m);
+    case K::kCylinder: return std::make_shared<fcl::Cylinderd>(g.radius_m, g.length_m);
+    case K::kBox: return std::make_shared<fcl::Boxd>(g.size_m.x(), g.size_m.y(), g.size_m.z());
+  }
+  return nullptr;
+}
+
+CollisionPrimitive ObjectPrimitive(const SceneObject& o) {
+  CollisionPrimitive g;
+  switch (o.shape) {
+    case SceneObject::Shape::kBox: g.kind = CollisionPrimitive::Kind::kBox; g.size_m = o.size_m; break;
+    case SceneObject::Shape::kCylinder:
+      g.kind = CollisionPrimitive::Kind::kCylinder;
+      g.radius_m = o.radius_m;
+      g.length_m = o.length_m;
+      break;
+    case SceneObject::Shape::kSphere: g.kind = CollisionPrimitive::Kind::kSphere; g.radius_m = o.radius_m; break;
+  }
+  return g;
+}
+
+// The same query on FCL: every checked pair, every primitive pair, signed distance.
+class FclChecker {
+ public:
+  explicit FclChecker(const CollisionWorld& world, const Scene& scene) : model_(world.model()), X_WR_(scene.X_WR) {
+    links_.resize(model_.num_links());
+    for (int l = 0; l < model_.num_links(); ++l) {
+      for (const auto& g : world.LinkPrimitives(l)) {
+        links_[l].push_back({std::make_unique<fcl::CollisionObjectd>(ToFcl(g)), g.X_LG});
+      }
+    }
+    for (const auto& o : scene.objects) {
+      std::vector<Child> v;
+      auto obj = std::make_unique<fcl::CollisionObjectd>(ToFcl(ObjectPrimitive(o)));
+      obj->setTransform(o.X_WO);
+      v.push_back({std::move(obj), Eigen::Isometry3d::Identity()});
+      objects_.push_back(std::move(v));
+    }
+    pairs_ = world.CheckedPairs();
+    request_.enable_signed_distance = true;
+    request_.enable_nearest_points = true;
+    request_.gjk_solver_type = fcl::GST_LIBCCD;
+  }
+
+  // Returns the minimum signed distance; fills per-link clearance and the closest pair.
+  double Check(const Eigen::VectorXd& q, std::vector<double>* clearance, int* closest_pair) {
+    model_.CalcLinkPoses(q, &X_RL_);
+    for (int l = 0; l < model_.num_links(); ++l) {
+      const Eigen::Isometry3d X_WL = X_WR_ * X_RL_[l];
+      for (auto& c : links_[l]) c.object->setTransform(X_WL * c.X_LG);
+    }
+    clearance->assign(model_.num_links(), std::numeric_limits<double>::infinity());
+    double best = std::numeric_limits<double>::infinity();
+    for (size_t p = 0; p < pairs_.size(); ++p) {
+      const auto& pair = pairs_[p];
+      const auto& A = links_[pair.link_a];
+      const auto& B = pair.link_b >= 0 ? links_[pair.link_b] : objects_[pair.object_b];
+      double d = std::numeric_limits<double>::infinity();
+      for (const auto& a : A) {
+        for (const auto& b : B) {
+          fcl::DistanceResultd result;
+          fcl::distance(a.object.get(), b.object.get(), request_, result);
+          d = std::min(d, result.min_distance);
+        }
+      }
+      (*clearance)[pair.link_a] = std::min((*clearance)[pair.link_a], d);
+      if (pair.link_b >= 0) (*clearance)[pair.link_b] = std::min((*clearance)[pair.link_b], d);
+      if (d < best) {
+        best = d;
+        *closest_pair = static_cast<int>(p);
+      }
+    }
+    return best;
+  }
+
+ private:
+  struct Child {
+    std::unique_ptr<fcl::CollisionObjectd> object;
+    Eigen::Isometry3d X_LG;
+  };
+  const RobotModel& model_;
+  Eigen::Isometry3d X_WR_;
+  std::vector<std::vector<Child>> links_;
+  std::vector<std::vector<Child>> objects_;
+  std::vector<CollisionWorld::CheckedPair> pairs_;
+  fcl::DistanceRequestd request_;
+  std::vector<Eigen::Isometry3d> X_RL_;
+};
+
+void BM_Fk(benchmark::State& state) {
+  const auto& f = F();
+  std::vector<Eigen::Isometry3d> X;
+  size_t i = 0;
+  for (auto _ : state) {
+    f.model.CalcLinkPoses(f.pool[i++ & 1023], &X);
+    benchmark::DoNotOptimize(X.data());
+  }
+}
+BENCHMARK(BM_Fk);
+
+void BulletCheck(benchmark::State& state, bool prune) {
+  auto& f = F();
+  CollisionWorld::Options options;
+  options.prune = prune;
+  CollisionWorld world(f.model, &f.scene, options);
+  size_t i = 0;
+  double pairs = 0;
+  for (auto _ : state) {
+    const CollisionResult r = world.Check(f.pool[i++ & 1023]);
+    pairs += r.pairs_computed;
+    benchmark::DoNotOptimize(r.min_distance_m);
+  }
+  state.counters["pairs"] = pairs / static_cast<double>(state.iterations());
+  state.counters["checked_pairs"] = world.num_self_pairs() + world.num_environment_pairs();
+}
+void BM_BulletFkAndCheck(benchmark::State& state) { BulletCheck(state, true); }
+void BM_BulletFkAndCheckNoPruning(benchmark::State& state) { BulletCheck(state, false); }
+BENCHMARK(BM_BulletFkAndCheck);
+BENCHMARK(BM_BulletFkAndCheckNoPruning);
+
+void BM_FclFkAndCheck(benchmark::State& state) {
+  auto& f = F();
+  CollisionWorld world(f.model, &f.scene);
+  FclChecker fcl_checker(world, f.scene);
+  std::vector<double> clearance;
+  int closest = -1;
+  double max_diff = 0;
+  for (const auto& q : f.pool) {
+    max_diff = std::max(max_diff, std::abs(fcl_checker.Check(q, &clearance, &closest) - world.Check(q).min_distance_m));
+  }
+  size_t i = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(fcl_checker.Check(f.pool[i++ & 1023], &clearance, &closest));
+  }
+  state.counters["pairs"] = world.num_self_pairs() + world.num_environment_pairs();
+  state.counters["max_diff_vs_bullet_m"] = max_diff;
+}
+BENCHMARK(BM_FclFkAndCheck);
+
+}  // namespace
+}  // namespace orbed::sim
+
+BENCHMARK_MAIN();
