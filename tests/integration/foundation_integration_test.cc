@@ -9,7 +9,7 @@
 
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
-#include <orbed/iiwa_status_t.hpp>
+#include <orbed/all_types.hpp>
 
 #include "tests/integration/testbed_util.h"
 
@@ -101,6 +101,28 @@ TEST(Launcher, StartsRespawnsAndStopsInOrder) {
   std::stringstream text;
   text << manifest.rdbuf();
   EXPECT_NE(text.str().find("\"complete\": true"), std::string::npos);
+
+  // What lcm-spy would show: every recorded message decodes as one of the contract's types
+  // (lcm-spy matches the same 8-byte fingerprint), except LCM's own self-test packet.
+  std::map<int64_t, std::string> fingerprints;
+#define ORBED_FINGERPRINT(type) fingerprints[orbed::type::getHash()] = #type;
+  ORBED_FOR_EACH_LCM_TYPE(ORBED_FINGERPRINT)
+#undef ORBED_FINGERPRINT
+  const std::vector<LogEvent> events = ReadLog(FindLog(dir + "/logs"));
+  ASSERT_FALSE(events.empty());
+  int undecodable = 0;
+  for (const LogEvent& e : events) {
+    if (e.channel == "LCM_SELF_TEST") continue;
+    int64_t hash = 0;
+    for (int i = 0; i < 8 && i < static_cast<int>(e.data.size()); ++i) {
+      hash = (hash << 8) | static_cast<uint8_t>(e.data[i]);
+    }
+    if (fingerprints.count(hash) == 0) {
+      ++undecodable;
+      ADD_FAILURE() << "undecodable message on " << e.channel;
+    }
+  }
+  EXPECT_EQ(undecodable, 0);
 }
 
 // A required process that cannot become ready stops the testbed with a non-zero exit.
