@@ -204,7 +204,8 @@ int RunIk(const std::string& scene_path, const std::string& urdf, uint64_t seed,
   if (ik.q_rad.size() > 0) {
     const Eigen::VectorXd q_deg = RadToDeg(ik.q_rad);
     j.Key("q_deg").Array(std::vector<double>(q_deg.data(), q_deg.data() + q_deg.size()));
-    j.Key("clearance_m").Number(ik.clearance_m);
+    j.Key("clearance_m").Number(MakeTrocarArmClearanceFunction(model, scene)(ik.q_rad));
+    j.Key("objective").Number(ik.clearance_m);
     j.Key("position_error_m").Number(ik.position_error_m);
     j.Key("angle_error_deg").Number(ik.angle_error_rad * 180.0 / M_PI);
     const Eigen::Isometry3d X_WT = scene.X_WR * model.CalcToolTipPose(ik.q_rad);

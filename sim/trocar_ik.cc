@@ -188,7 +188,7 @@ TrocarIkResult SolveTrocarIk(const RobotModel& model, const TrocarIkTarget& targ
     return result;
   }
   result.success = true;
-  os << "clearance " << best.clearance << " m; " << result.seeds_converged << " of " << result.seeds_tried
+  os << "clearance objective " << best.clearance << " m; " << result.seeds_converged << " of " << result.seeds_tried
      << " starts converged";
   result.message = os.str();
   return result;
