@@ -1,5 +1,6 @@
 #include "procs/common/process.h"
 
+#include <poll.h>
 #include <unistd.h>
 
 #include <csignal>
@@ -150,11 +151,18 @@ int Process::Run() {
     }
     auto next = std::min(deadline, now + max_wait);
     for (const Timer& timer : timers_) next = std::min(next, timer.next);
-    const auto wait_us =
-        std::chrono::duration_cast<std::chrono::microseconds>(next - now).count();
-    // handleTimeout has millisecond resolution: round up and let the loop catch the rest.
-    const int wait_ms = wait_us <= 0 ? 0 : static_cast<int>((wait_us + 999) / 1000);
-    const int result = lcm_->handleTimeout(wait_ms);
+    const auto wait_ns =
+        std::chrono::duration_cast<std::chrono::nanoseconds>(next - now).count();
+    // Wait on LCM's file descriptor with ppoll (nanosecond timeout) rather than handleTimeout,
+    // whose millisecond rounding would make a 1 kHz timer drift late and skip ticks.
+    pollfd fd{lcm_->getFileno(), POLLIN, 0};
+    timespec timeout{};
+    if (wait_ns > 0) {
+      timeout.tv_sec = static_cast<time_t>(wait_ns / 1000000000);
+      timeout.tv_nsec = static_cast<long>(wait_ns % 1000000000);
+    }
+    const int ready = ppoll(&fd, 1, &timeout, nullptr);
+    const int result = ready > 0 ? lcm_->handleTimeout(0) : 0;
     if (result < 0 && !StopSignalled()) {
       SetLastError("LCM handle failed");
       ORBED_LOG(kWarn) << "LCM handleTimeout failed";

@@ -22,42 +22,17 @@
 #include <orbed/image_t.hpp>
 #include <orbed/iiwa_status_t.hpp>
 
+#include "tests/bench/bench_util.h"
+
 namespace {
+
+using orbed::bench::BinDir;
+using orbed::bench::Spawn;
+using orbed::bench::StopAndMeasure;
+using orbed::bench::Usage;
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
-
-struct Usage {
-  double cpu_s = 0;
-  double peak_rss_mb = 0;
-  int exit_code = -1;
-};
-
-pid_t Spawn(const std::vector<std::string>& argv) {
-  const pid_t pid = fork();
-  if (pid == 0) {
-    std::vector<char*> args;
-    for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
-    args.push_back(nullptr);
-    freopen("/dev/null", "w", stdout);
-    execv(args[0], args.data());
-    _exit(127);
-  }
-  return pid;
-}
-
-Usage StopAndMeasure(pid_t pid) {
-  kill(pid, SIGINT);
-  int status = 0;
-  rusage usage{};
-  wait4(pid, &status, 0, &usage);
-  Usage u;
-  u.cpu_s = usage.ru_utime.tv_sec + usage.ru_utime.tv_usec * 1e-6 + usage.ru_stime.tv_sec +
-            usage.ru_stime.tv_usec * 1e-6;
-  u.peak_rss_mb = usage.ru_maxrss / 1024.0;
-  u.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return u;
-}
 
 int64_t CountEvents(const std::string& path, const std::string& prefix) {
   lcm::LogFile log(path, "r");
@@ -72,7 +47,7 @@ int64_t CountEvents(const std::string& path, const std::string& prefix) {
 void BM_LoggerUnderLoad_VsLcmLogger(benchmark::State& state) {
   const char* seconds_env = std::getenv("ORBED_BENCH_SECONDS");
   const double seconds = seconds_env ? std::atof(seconds_env) : 30.0;
-  const std::string bin = std::getenv("ORBED_BIN_DIR") ? std::getenv("ORBED_BIN_DIR") : "build/bin";
+  const std::string bin = BinDir();
   const fs::path dir = fs::temp_directory_path() / ("orbed_logger_bench_" + std::to_string(getpid()));
   fs::create_directories(dir);
   const std::string ours = (dir / "orbed.lcmlog").string();

@@ -1,0 +1,253 @@
+#include "sim/iiwa_sim.h"
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <stdexcept>
+
+#include <orbed/collision_status_t.hpp>
+#include <orbed/iiwa_status_t.hpp>
+#include <orbed/plan_check_reply_t.hpp>
+#include <orbed/robot_state_t.hpp>
+
+#include "procs/common/conversions.h"
+#include "procs/common/log.h"
+#include "procs/common/validation.h"
+
+#ifndef ORBED_BUILD_SOURCE_DIR
+#define ORBED_BUILD_SOURCE_DIR "."
+#endif
+
+namespace orbed::sim {
+namespace {
+
+static_assert(static_cast<int>(MotionState::kIdle) == orbed::robot_state_t::MOTION_IDLE &&
+                  static_cast<int>(MotionState::kMoving) == orbed::robot_state_t::MOTION_MOVING &&
+                  static_cast<int>(MotionState::kStoppedAtLimit) == orbed::robot_state_t::MOTION_STOPPED_AT_LIMIT &&
+                  static_cast<int>(MotionState::kStoppedBeforeCollision) ==
+                      orbed::robot_state_t::MOTION_STOPPED_BEFORE_COLLISION &&
+                  static_cast<int>(MotionState::kInCollision) == orbed::robot_state_t::MOTION_IN_COLLISION,
+              "MotionState must number as robot_state_t::MOTION_*");
+
+std::string Fixed(double value, int digits) {
+  char text[64];
+  std::snprintf(text, sizeof(text), "%.*f", digits, value);
+  return text;
+}
+
+// Resolves default paths and checks every number before anything is loaded.
+IiwaSimOptions Resolved(IiwaSimOptions options) {
+  if (options.urdf_path.empty()) options.urdf_path = SourceTreePath(RobotModel::kDefaultUrdfRelativePath);
+  if (options.scene_path.empty()) options.scene_path = SourceTreePath(kDefaultSceneRelativePath);
+  if (!(options.period_sec > 0) || !std::isfinite(options.period_sec)) {
+    throw std::invalid_argument("--period-sec must be a finite number > 0");
+  }
+  if (!(options.stale_command_sec >= 0) || !std::isfinite(options.stale_command_sec)) {
+    throw std::invalid_argument("--stale-command-sec must be a finite number >= 0 (0 disables the check)");
+  }
+  if (!(options.stop_margin_m >= 0) || !std::isfinite(options.stop_margin_m)) {
+    throw std::invalid_argument("--stop-margin-m must be a finite number >= 0");
+  }
+  if (!(options.report_distance_m >= 0) || !std::isfinite(options.report_distance_m)) {
+    throw std::invalid_argument("--report-distance-m must be a finite number >= 0");
+  }
+  return options;
+}
+
+Eigen::VectorXd InitialQ(const RobotModel& model, const std::vector<double>& q_deg) {
+  if (q_deg.empty()) return Eigen::VectorXd::Zero(model.num_joints());
+  if (static_cast<int>(q_deg.size()) != model.num_joints()) {
+    throw std::invalid_argument("--initial-q-deg: expected " + std::to_string(model.num_joints()) +
+                                " angles in deg, got " + std::to_string(q_deg.size()));
+  }
+  const Eigen::VectorXd q = DegToRad(ToVectorX(q_deg));
+  const std::string why = model.ValidateJointVector(q);
+  if (!why.empty()) throw std::invalid_argument("--initial-q-deg: " + why);
+  return q;
+}
+
+orbed::contact_t ToContact(const PairDistance& pair) {
+  orbed::contact_t c{};
+  c.body_a = pair.body_a;
+  c.body_b = pair.body_b;
+  c.distance_m = pair.distance_m;
+  FromVector3(pair.p_WA, c.p_WA_m);
+  FromVector3(pair.p_WB, c.p_WB_m);
+  FromVector3(pair.normal_W, c.normal_W);
+  return c;
+}
+
+}  // namespace
+
+std::string SourceTreePath(const std::string& relative) {
+  const char* env = std::getenv("ORBED_SOURCE_DIR");
+  const std::string root = env && *env ? std::string(env) : std::string(ORBED_BUILD_SOURCE_DIR);
+  return root + "/" + relative;
+}
+
+IiwaSim::IiwaSim(const orbed::CommonFlags& flags, const IiwaSimOptions& options)
+    : options_(Resolved(options)), scene_(LoadSceneFile(options_.scene_path)) {
+  RobotModel model = RobotModel::LoadFile(options_.urdf_path);
+  model.SetToolLength(scene_.tool_length_m);
+  ManualArmOptions arm_options;
+  arm_options.stop_margin_m = options_.stop_margin_m;
+  arm_options.report_distance_m = options_.report_distance_m;
+  arm_ = std::make_unique<ManualArm>(model, &scene_, InitialQ(model, options_.initial_q_deg), arm_options);
+  for (int i = 0; i < model.num_links(); ++i) {
+    if (!arm_->world().LinkPrimitives(i).empty() && std::isfinite(arm_->collision().link_clearance_m[i])) {
+      reported_links_.push_back(i);
+    }
+  }
+  if (arm_->collision().in_collision) {
+    ORBED_LOG(kWarn) << "the initial joint vector is in collision: " << arm_->stop_reason();
+  }
+
+  process_ = std::make_unique<orbed::Process>(flags);
+  process_->Subscribe<orbed::iiwa_command_t>(
+      options_.iiwa_command_channel,
+      [this](const orbed::iiwa_command_t& msg, const std::string& channel, int64_t) { OnCommand(msg, channel); });
+  process_->Subscribe<orbed::plan_check_request_t>(
+      options_.plan_check_request_channel,
+      [this](const orbed::plan_check_request_t& msg, const std::string& channel, int64_t) {
+        OnPlanCheck(msg, channel);
+      });
+  process_->AddTimer(options_.period_sec, [this] { Tick(); });
+  ORBED_LOG(kInfo) << "robot " << options_.urdf_path << " (" << model.num_joints() << " joints), scene "
+                   << options_.scene_path << ", tick " << options_.period_sec * 1e3 << " ms";
+}
+
+IiwaSim::~IiwaSim() = default;
+
+void IiwaSim::OnCommand(const orbed::iiwa_command_t& msg, const std::string& channel) {
+  const int n = arm_->num_joints();
+  std::string error = CheckSize(msg.num_joints, n, "num_joints");
+  if (!error.empty()) {
+    process_->Reject(channel + "/num_joints", error);
+    return;
+  }
+  if (!(msg.num_torques == 0 || msg.num_torques == msg.num_joints) ||
+      static_cast<size_t>(msg.num_torques) != msg.joint_torque.size()) {
+    process_->Reject(channel + "/num_torques", "num_torques is " + std::to_string(msg.num_torques) +
+                                                   " with " + std::to_string(msg.joint_torque.size()) +
+                                                   " torques, expected 0 or num_joints (" + std::to_string(n) + ")");
+    return;
+  }
+  error = FirstError(
+      {CheckFinite(msg.joint_position, "joint_position"), CheckFinite(msg.joint_torque, "joint_torque")});
+  if (!error.empty()) {
+    process_->Reject(channel + "/non_finite", error);
+    return;
+  }
+  if (options_.stale_command_sec > 0) {
+    // In double: a wild utime (e.g. INT64_MIN) must not overflow the subtraction.
+    const double age_s = (static_cast<double>(NowMicros()) - static_cast<double>(msg.utime)) * 1e-6;
+    if (std::abs(age_s) > options_.stale_command_sec) {
+      process_->Reject(channel + "/stale", "utime " + std::to_string(msg.utime) + " is " +
+                                               Fixed(std::abs(age_s), 3) + " s " +
+                                               (age_s > 0 ? "older than" : "ahead of") + " the wall clock (limit " +
+                                               Fixed(options_.stale_command_sec, 3) + " s)");
+      return;
+    }
+  }
+  arm_->SetCommand(ToVectorX(msg.joint_position));
+}
+
+void IiwaSim::OnPlanCheck(const orbed::plan_check_request_t& msg, const std::string& channel) {
+  orbed::plan_check_reply_t reply{};
+  reply.request_id = msg.request_id;
+  const int n = arm_->num_joints();
+  std::string key;
+  std::string error = CheckSize(msg.num_joints, n, "num_joints");
+  if (!error.empty()) {
+    key = "num_joints";
+  } else if (!(error = CheckFinite(msg.joint_position, "joint_position")).empty()) {
+    key = "non_finite";
+  }
+  if (!error.empty()) {
+    process_->Reject(channel + "/" + key, error);
+    reply.utime = NowMicros();
+    reply.request_valid = false;
+    reply.min_distance_m = std::nan("");
+    reply.reason = "invalid request: " + error;
+    process_->Publish(options_.plan_check_reply_channel, reply);
+    return;
+  }
+  const Eigen::VectorXd q = ToVectorX(msg.joint_position);
+  const std::string limits = arm_->model().ValidateJointVector(q);
+  const CollisionResult r = arm_->Check(q);
+  reply.request_valid = true;
+  reply.within_limits = limits.empty();
+  reply.in_collision = r.in_collision;
+  reply.feasible = reply.within_limits && !reply.in_collision;
+  reply.min_distance_m = r.min_distance_m;
+  for (const PairDistance& pair : r.contacts) reply.pairs.push_back(ToContact(pair));
+  if (reply.pairs.empty() && r.closest.valid()) reply.pairs.push_back(ToContact(r.closest));
+  reply.num_pairs = static_cast<int32_t>(reply.pairs.size());
+  if (!limits.empty()) reply.reason = "outside the limits: " + limits;
+  if (r.in_collision) {
+    if (!reply.reason.empty()) reply.reason += "; ";
+    reply.reason += "in collision: " + r.closest.body_a + " vs " + r.closest.body_b + " penetrate by " +
+                    Fixed(-r.closest.distance_m, 4) + " m";
+  }
+  reply.utime = NowMicros();
+  process_->Publish(options_.plan_check_reply_channel, reply);
+}
+
+void IiwaSim::Tick() {
+  arm_->Step(options_.period_sec);
+  PublishAll(NowMicros());
+}
+
+void IiwaSim::PublishAll(int64_t utime) {
+  const RobotModel& model = arm_->model();
+  const int n = model.num_joints();
+  const std::vector<double> q = FromVectorX(arm_->q_rad());
+
+  orbed::iiwa_status_t status{};
+  status.utime = utime;
+  status.num_joints = n;
+  status.joint_position_measured = q;
+  status.joint_velocity_estimated = FromVectorX(arm_->velocity_rad_per_s());
+  status.joint_position_commanded = FromVectorX(arm_->command_rad());
+  status.joint_position_ipo = q;
+  status.joint_torque_measured.assign(n, 0.0);
+  status.joint_torque_commanded.assign(n, 0.0);
+  status.joint_torque_external.assign(n, 0.0);
+  process_->Publish(options_.iiwa_status_channel, status);
+
+  model.CalcLinkPoses(arm_->q_rad(), &X_RL_);
+  orbed::robot_state_t state{};
+  state.utime = utime;
+  state.robot_name = options_.robot_name;
+  state.X_WR = ToPose(scene_.X_WR);
+  state.X_RF = ToPose(X_RL_[model.flange_link()]);
+  state.X_RT = ToPose(X_RL_[model.tool_tip_link()]);
+  state.num_joints = n;
+  state.joint_position = q;
+  for (int hit : arm_->LimitHits()) state.joint_limit_hit.push_back(static_cast<int8_t>(hit));
+  state.num_links = model.num_links();
+  for (int i = 0; i < model.num_links(); ++i) {
+    state.link_names.push_back(model.links()[i].name);
+    state.X_RL.push_back(ToPose(X_RL_[i]));
+  }
+  state.motion_state = static_cast<int8_t>(arm_->state());
+  state.stop_reason = arm_->stop_reason();
+  process_->Publish(options_.robot_state_channel, state);
+
+  const CollisionResult& r = arm_->collision();
+  orbed::collision_status_t collision{};
+  collision.utime = utime;
+  collision.in_collision = r.in_collision;
+  collision.min_distance_m = r.min_distance_m;
+  for (const PairDistance& pair : r.contacts) collision.contacts.push_back(ToContact(pair));
+  collision.num_contacts = static_cast<int32_t>(collision.contacts.size());
+  for (int i : reported_links_) {
+    collision.link_names.push_back(model.links()[i].name);
+    collision.link_clearance_m.push_back(r.link_clearance_m[i]);
+  }
+  collision.num_links = static_cast<int32_t>(collision.link_names.size());
+  collision.check_duration_us = static_cast<int64_t>(std::llround(arm_->collision_check_us()));
+  process_->Publish(options_.collision_status_channel, collision);
+}
+
+}  // namespace orbed::sim

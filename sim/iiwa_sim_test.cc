@@ -1,0 +1,283 @@
+// orbed-iiwa-sim in-process on memq:// (the sim's own LCM instance delivers what the test publishes
+// on it): bad commands rejected and counted per class, plan checks answered (invalid ones too), a
+// command beyond a limit stops on the limit, every tick's step within the iiwa 7's published joint
+// speeds (DESIGN §4) x the period, and the published frames against the scene file and the DH facts.
+#include "sim/iiwa_sim.h"
+
+#include <cmath>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <orbed/collision_status_t.hpp>
+#include <orbed/iiwa_status_t.hpp>
+#include <orbed/plan_check_reply_t.hpp>
+#include <orbed/robot_state_t.hpp>
+
+#include "procs/common/conversions.h"
+
+namespace orbed::sim {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+const double kSpeedDegPerS[7] = {98, 98, 100, 130, 140, 180, 180};  // DESIGN §4
+
+// Everything the sim publishes, as received on the same memq instance.
+struct Collector {
+  std::vector<orbed::iiwa_status_t> status;
+  std::vector<orbed::robot_state_t> state;
+  std::vector<orbed::collision_status_t> collision;
+  std::map<int64_t, orbed::plan_check_reply_t> replies;
+  void OnStatus(const lcm::ReceiveBuffer*, const std::string&, const orbed::iiwa_status_t* m) { status.push_back(*m); }
+  void OnState(const lcm::ReceiveBuffer*, const std::string&, const orbed::robot_state_t* m) { state.push_back(*m); }
+  void OnCollision(const lcm::ReceiveBuffer*, const std::string&, const orbed::collision_status_t* m) {
+    collision.push_back(*m);
+  }
+  void OnReply(const lcm::ReceiveBuffer*, const std::string&, const orbed::plan_check_reply_t* m) {
+    replies[m->request_id] = *m;
+  }
+  void Attach(lcm::LCM& lcm) {
+    lcm.subscribe("IIWA_STATUS", &Collector::OnStatus, this);
+    lcm.subscribe("ROBOT_STATE", &Collector::OnState, this);
+    lcm.subscribe("COLLISION_STATUS", &Collector::OnCollision, this);
+    lcm.subscribe("PLAN_CHECK_REPLY", &Collector::OnReply, this);
+  }
+};
+
+CommonFlags MemqFlags(double duration_sec) {
+  CommonFlags flags("orbed-iiwa-sim");
+  flags.lcm_url = "memq://";
+  flags.duration_sec = duration_sec;
+  return flags;
+}
+
+orbed::iiwa_command_t Command(const std::vector<double>& q_deg) {
+  orbed::iiwa_command_t cmd{};
+  cmd.utime = NowMicros();
+  cmd.num_joints = static_cast<int32_t>(q_deg.size());
+  for (double q : q_deg) cmd.joint_position.push_back(q * kDeg);
+  cmd.num_torques = 0;
+  return cmd;
+}
+
+orbed::plan_check_request_t Request(int64_t id, const std::vector<double>& q_deg) {
+  orbed::plan_check_request_t req{};
+  req.utime = NowMicros();
+  req.request_id = id;
+  req.num_joints = static_cast<int32_t>(q_deg.size());
+  for (double q : q_deg) req.joint_position.push_back(q * kDeg);
+  return req;
+}
+
+TEST(IiwaSim, RejectsBadCommandsPerReasonAndKeepsRunning) {
+  IiwaSim sim(MemqFlags(0.3), IiwaSimOptions{});
+  Collector got;
+  got.Attach(sim.process().lcm());
+  lcm::LCM& lcm = sim.process().lcm();
+
+  orbed::iiwa_command_t six = Command({10, 0, 0, 0, 0, 0});
+  lcm.publish("IIWA_COMMAND", &six);
+  orbed::iiwa_command_t nan = Command({10, 0, 0, 0, 0, 0, 0});
+  nan.joint_position[3] = std::nan("");
+  lcm.publish("IIWA_COMMAND", &nan);
+  orbed::iiwa_command_t inf_torque = Command({10, 0, 0, 0, 0, 0, 0});
+  inf_torque.num_torques = 7;
+  inf_torque.joint_torque.assign(7, 0.0);
+  inf_torque.joint_torque[6] = INFINITY;
+  lcm.publish("IIWA_COMMAND", &inf_torque);
+  orbed::iiwa_command_t stale = Command({10, 0, 0, 0, 0, 0, 0});
+  stale.utime -= 5'000'000;  // 5 s old, limit 1 s
+  lcm.publish("IIWA_COMMAND", &stale);
+  orbed::iiwa_command_t future = Command({10, 0, 0, 0, 0, 0, 0});
+  future.utime += 60'000'000;
+  lcm.publish("IIWA_COMMAND", &future);
+  orbed::iiwa_command_t torques = Command({10, 0, 0, 0, 0, 0, 0});
+  torques.num_torques = 3;
+  torques.joint_torque.assign(3, 0.0);
+  lcm.publish("IIWA_COMMAND", &torques);
+  lcm.publish("IIWA_COMMAND", "garbage", 7);
+  // One good command: 2 deg on joint 1 (at 98 deg/s it arrives in ~4 ticks).
+  orbed::iiwa_command_t good = Command({2, 0, 0, 0, 0, 0, 0});
+  lcm.publish("IIWA_COMMAND", &good);
+
+  EXPECT_EQ(sim.Run(), 0);
+  const std::map<std::string, int64_t> counts = sim.process().rejections().counts();
+  EXPECT_EQ(counts.at("IIWA_COMMAND/num_joints"), 1);
+  EXPECT_EQ(counts.at("IIWA_COMMAND/non_finite"), 2);
+  EXPECT_EQ(counts.at("IIWA_COMMAND/stale"), 2);
+  EXPECT_EQ(counts.at("IIWA_COMMAND/num_torques"), 1);
+  EXPECT_EQ(counts.at("IIWA_COMMAND/decode"), 1);
+  EXPECT_EQ(sim.process().rejections().total(), 7);
+  const orbed::process_status_t heartbeat = sim.process().MakeStatus();
+  EXPECT_EQ(heartbeat.rejected_inputs, 7);
+  EXPECT_EQ(heartbeat.num_reasons, 5);
+
+  // Still ticking, and the good command was executed.
+  ASSERT_GT(got.status.size(), 20u);
+  const orbed::iiwa_status_t& last = got.status.back();
+  EXPECT_NEAR(last.joint_position_measured[0], 2 * kDeg, 1e-12);
+  EXPECT_NEAR(last.joint_position_commanded[0], 2 * kDeg, 1e-15);
+  for (int i = 1; i < 7; ++i) EXPECT_EQ(last.joint_position_measured[i], 0.0);
+}
+
+// Replies for a free pose, an elbow in the patient, an out-of-limit pose and malformed requests.
+TEST(IiwaSim, AnswersPlanChecksIncludingInvalidOnes) {
+  IiwaSim sim(MemqFlags(0.2), IiwaSimOptions{});
+  Collector got;
+  got.Attach(sim.process().lcm());
+  lcm::LCM& lcm = sim.process().lcm();
+  const orbed::plan_check_request_t upright = Request(11, {0, 0, 0, 0, 0, 0, 0});
+  // Joint 2 at 110 deg tips the upper arm toward the table (+y in W): the elbow (joint 4 axis,
+  // 0.4 m from the shoulder at z = 0.75 + 0.34) lands at y = -0.55 + 0.4 sin 110 = -0.174,
+  // z = 1.09 + 0.4 cos 110 = 0.953, x = 0.25: inside the patient torso box
+  // (|x| < 0.325, |y| < 0.21, 0.80 < z < 1.02 from the scene file).
+  const orbed::plan_check_request_t elbow_in_patient = Request(12, {0, 110, 0, 0, 0, 0, 0});
+  const orbed::plan_check_request_t beyond_limit = Request(13, {0, 0, 0, 130, 0, 0, 0});
+  const orbed::plan_check_request_t six = Request(14, {0, 0, 0, 0, 0, 0});
+  orbed::plan_check_request_t nan_request = Request(15, {0, 0, 0, 0, 0, 0, 0});
+  nan_request.joint_position[2] = std::nan("");
+  const std::vector<orbed::plan_check_request_t> requests{upright, elbow_in_patient, beyond_limit, six, nan_request};
+  for (const orbed::plan_check_request_t& req : requests) {
+    lcm.publish("PLAN_CHECK_REQUEST", &req);
+  }
+  sim.Run();
+  ASSERT_EQ(got.replies.size(), 5u);
+
+  const orbed::plan_check_reply_t& free = got.replies.at(11);
+  EXPECT_TRUE(free.request_valid);
+  EXPECT_TRUE(free.within_limits);
+  EXPECT_FALSE(free.in_collision);
+  EXPECT_TRUE(free.feasible);
+  EXPECT_GT(free.min_distance_m, 0.0);
+  EXPECT_EQ(free.reason, "");
+  EXPECT_EQ(free.num_pairs, static_cast<int32_t>(free.pairs.size()));
+
+  const orbed::plan_check_reply_t& hit = got.replies.at(12);
+  EXPECT_TRUE(hit.request_valid);
+  EXPECT_TRUE(hit.within_limits);
+  EXPECT_TRUE(hit.in_collision);
+  EXPECT_FALSE(hit.feasible);
+  EXPECT_LT(hit.min_distance_m, 0.0);
+  bool torso = false;
+  for (const auto& pair : hit.pairs) torso |= pair.body_b == "patient_torso" && pair.distance_m < 0;
+  EXPECT_TRUE(torso) << hit.reason;
+  EXPECT_NE(hit.reason.find("patient_torso"), std::string::npos) << hit.reason;
+
+  const orbed::plan_check_reply_t& limit = got.replies.at(13);
+  EXPECT_TRUE(limit.request_valid);
+  EXPECT_FALSE(limit.within_limits);
+  EXPECT_FALSE(limit.feasible);
+  EXPECT_NE(limit.reason.find("iiwa_joint_4"), std::string::npos) << limit.reason;
+
+  for (int64_t id : {14, 15}) {
+    const orbed::plan_check_reply_t& bad = got.replies.at(id);
+    EXPECT_FALSE(bad.request_valid) << id;
+    EXPECT_FALSE(bad.feasible) << id;
+    EXPECT_NE(bad.reason, "") << id;
+  }
+  EXPECT_EQ(sim.process().rejections().counts().at("PLAN_CHECK_REQUEST/num_joints"), 1);
+  EXPECT_EQ(sim.process().rejections().counts().at("PLAN_CHECK_REQUEST/non_finite"), 1);
+}
+
+// Joint 7 commanded to 200 deg (limit 175) and joint 1 to -30 deg: joint 7 sets the pace
+// (175/180 s vs 30/98 s); the arm ends exactly on the joint 7 limit and says so.
+TEST(IiwaSim, CommandBeyondALimitStopsAtTheLimitWithinTheJointSpeeds) {
+  IiwaSimOptions options;
+  options.period_sec = 0.005;
+  IiwaSim sim(MemqFlags(2.0), options);
+  Collector got;
+  got.Attach(sim.process().lcm());
+  const orbed::iiwa_command_t cmd = Command({-30, 0, 0, 0, 0, 0, 200});
+  sim.process().lcm().publish("IIWA_COMMAND", &cmd);
+  sim.Run();
+
+  ASSERT_GT(got.status.size(), 250u);  // ~400 ticks in 2 s; 195 are needed to arrive
+  ASSERT_EQ(got.state.size(), got.status.size());
+  ASSERT_EQ(got.collision.size(), got.status.size());
+  double peak_step7 = 0;
+  for (size_t k = 1; k < got.status.size(); ++k) {
+    for (int i = 0; i < 7; ++i) {
+      const double step =
+          std::abs(got.status[k].joint_position_measured[i] - got.status[k - 1].joint_position_measured[i]);
+      EXPECT_LE(step, kSpeedDegPerS[i] * kDeg * options.period_sec * (1 + 1e-9))
+          << "tick " << k << " joint " << i + 1;
+      if (i == 6) peak_step7 = std::max(peak_step7, step);
+    }
+    EXPECT_EQ(got.state[k].utime, got.status[k].utime);
+    EXPECT_EQ(got.collision[k].utime, got.status[k].utime);
+  }
+  // The bound is met, not merely respected: joint 7 ran at its full 180 deg/s.
+  EXPECT_NEAR(peak_step7, 180 * kDeg * options.period_sec, 1e-12);
+
+  const orbed::iiwa_status_t& last = got.status.back();
+  EXPECT_NEAR(last.joint_position_measured[6], 175 * kDeg, 1e-12);
+  EXPECT_NEAR(last.joint_position_measured[0], -30 * kDeg, 1e-12);
+  EXPECT_NEAR(last.joint_position_commanded[6], 200 * kDeg, 1e-15);
+  EXPECT_EQ(last.joint_velocity_estimated[6], 0.0);
+  const orbed::robot_state_t& state = got.state.back();
+  EXPECT_EQ(state.motion_state, +orbed::robot_state_t::MOTION_STOPPED_AT_LIMIT);
+  EXPECT_NE(state.stop_reason.find("iiwa_joint_7"), std::string::npos) << state.stop_reason;
+  EXPECT_EQ(state.joint_limit_hit, (std::vector<int8_t>{0, 0, 0, 0, 0, 0, 1}));
+  // While under way it said MOVING.
+  EXPECT_EQ(got.state[5].motion_state, +orbed::robot_state_t::MOTION_MOVING);
+  EXPECT_FALSE(got.collision.back().in_collision);
+}
+
+// The published frames against independent facts: X_WR from the scene file (position
+// (0.25, -0.55, 0.75), yaw 90 deg), the upright flange at z = 0.34 + 0.4 + 0.4 + 0.126 = 1.266 m
+// in R (DESIGN's DH d), the tool tip 0.25 m (scene tool_length_m) above it.
+TEST(IiwaSim, PublishesTrueFramesAndClearances) {
+  IiwaSim sim(MemqFlags(0.1), IiwaSimOptions{});
+  Collector got;
+  got.Attach(sim.process().lcm());
+  sim.Run();
+  ASSERT_FALSE(got.state.empty());
+  const orbed::robot_state_t& s = got.state.front();
+  EXPECT_EQ(s.robot_name, "iiwa7");
+  EXPECT_NEAR(s.X_WR.position_m[0], 0.25, 1e-12);
+  EXPECT_NEAR(s.X_WR.position_m[1], -0.55, 1e-12);
+  EXPECT_NEAR(s.X_WR.position_m[2], 0.75, 1e-12);
+  EXPECT_NEAR(s.X_WR.quaternion_wxyz[0], std::cos(M_PI / 4), 1e-12);
+  EXPECT_NEAR(s.X_WR.quaternion_wxyz[3], std::sin(M_PI / 4), 1e-12);
+  EXPECT_NEAR(s.X_RF.position_m[2], 1.266, 1e-9);
+  EXPECT_NEAR(s.X_RT.position_m[2], 1.516, 1e-9);
+  EXPECT_EQ(s.num_links, static_cast<int32_t>(s.link_names.size()));
+  EXPECT_EQ(s.link_names.front(), "iiwa_link_0");
+  EXPECT_EQ(s.motion_state, +orbed::robot_state_t::MOTION_IDLE);
+  ASSERT_FALSE(got.collision.empty());
+  const orbed::collision_status_t& c = got.collision.front();
+  EXPECT_FALSE(c.in_collision);
+  EXPECT_GT(c.min_distance_m, 0.0);
+  EXPECT_GE(c.num_links, 8);
+  EXPECT_EQ(c.num_links, static_cast<int32_t>(c.link_clearance_m.size()));
+  double smallest = INFINITY;
+  for (double d : c.link_clearance_m) smallest = std::min(smallest, d);
+  EXPECT_DOUBLE_EQ(smallest, c.min_distance_m);
+  for (const auto& contact : c.contacts) EXPECT_LT(contact.distance_m, 0.05);
+}
+
+TEST(IiwaSim, BadOptionsAndFilesAreNamed) {
+  IiwaSimOptions bad_q;
+  bad_q.initial_q_deg = {0, 0, 0, 0, 0, 0};
+  try {
+    IiwaSim sim(MemqFlags(0.1), bad_q);
+    FAIL() << "accepted 6 initial angles";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("--initial-q-deg"), std::string::npos) << e.what();
+  }
+  IiwaSimOptions no_file;
+  no_file.scene_path = "/nonexistent/scene.yaml";
+  try {
+    IiwaSim sim(MemqFlags(0.1), no_file);
+    FAIL() << "accepted a missing scene";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/scene.yaml"), std::string::npos) << e.what();
+  }
+  IiwaSimOptions period;
+  period.period_sec = 0;
+  EXPECT_THROW(IiwaSim(MemqFlags(0.1), period), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace orbed::sim
