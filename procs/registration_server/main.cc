@@ -22,6 +22,7 @@
 
 #include "procs/common/flags.h"
 #include "procs/registration_server/mean_command.h"
+#include "procs/registration_server/send_command.h"
 #include "procs/registration_server/registration_server.h"
 
 int main(int argc, char** argv) {
@@ -67,7 +68,27 @@ int main(int argc, char** argv) {
                    "Average translations about this model centroid p_VC (3 numbers, metres, in V)")
       ->expected(3);
 
+  // Feed a trial file to a running server.
+  orbed::registration::SendCommandOptions send_options;
+  CLI::App* send = app.add_subcommand(
+      "send", "Send a trial file to a running orbed-registration as one session and print its mean");
+  send->add_option("--input", send_options.input_path, "Trial file, one qw,qx,qy,qz,tx,ty,tz per line; '-' = stdin")
+      ->required();
+  send->add_option("--session-id", send_options.session_id, "Session id to use")->capture_default_str();
+  send->add_flag("--robust", send_options.robust, "Ask for the robust mean");
+  send->add_option("--timeout-sec", send_options.timeout_s, "How long to wait for the answer")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+
   CLI11_PARSE(app, argc, argv);
+
+  if (send->parsed()) {
+    send_options.lcm_url = common.lcm_url;
+    send_options.session_control_channel = server.session_control_channel;
+    send_options.trial_channel = server.trial_channel;
+    send_options.registration_channel = server.registration_channel;
+    return orbed::registration::RunSendCommand(send_options, std::cout, std::cerr);
+  }
 
   if (mean->parsed()) {
     if (mean_centroid_m.size() == 3) {

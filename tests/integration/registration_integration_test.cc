@@ -2,6 +2,10 @@
 // the closed-form SE(3) mean out; a landmark from two rays; a bad trial counted; the same inputs
 // replayed into a fresh server give the same REGISTRATION bytes.
 #include <signal.h>
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <regex>
 
 #include <cmath>
 
@@ -179,6 +183,51 @@ TEST(Registration, ThreeTrialsInClosedFormMeanOutAndReplaysBitForBit) {
   const std::vector<std::string> second_run = RunSession(&lcm, &collector);
   ASSERT_EQ(second_run.size(), first_run.size());
   for (size_t i = 0; i < first_run.size(); ++i) EXPECT_EQ(second_run[i], first_run[i]) << i;
+}
+
+std::string Capture(const std::string& command, int* exit_code) {
+  std::string out;
+  FILE* pipe = popen(command.c_str(), "r");
+  char buffer[4096];
+  while (size_t n = fread(buffer, 1, sizeof(buffer), pipe)) out.append(buffer, n);
+  *exit_code = WEXITSTATUS(pclose(pipe));
+  return out;
+}
+
+// The numbers of a JSON text, in order.
+std::vector<double> Numbers(const std::string& text) {
+  std::vector<double> numbers;
+  const std::regex number(R"(-?[0-9]+(\.[0-9]+)?([eE][-+]?[0-9]+)?)");
+  for (auto it = std::sregex_iterator(text.begin(), text.end(), number); it != std::sregex_iterator();
+       ++it) {
+    numbers.push_back(std::stod(it->str()));
+  }
+  return numbers;
+}
+
+// `orbed-registration send` feeds a trial file through the bus to a running server; its answer
+// must equal the offline `mean --json` of the same file (one code path): same keys and flags,
+// numbers within 1e-12 (the server's pose goes through a rotation matrix, the offline mean not).
+TEST(Registration, LiveServerAgreesWithTheOfflineMean) {
+  BusWatcher bus;
+  bus.Start();
+  RunningProcess server({BinPath("orbed-registration"), "--name", "registration-send"});
+  ASSERT_TRUE(WaitFor([&] { return !bus.Heartbeats("registration-send").empty(); }, 10));
+  const std::string trials = SourcePath("procs/registration_server/testdata/robust_trials.txt");
+  int offline_code = -1, live_code = -1;
+  const std::string offline = Capture(
+      BinPath("orbed-registration") + " mean --robust --json --input " + trials + " 2>/dev/null",
+      &offline_code);
+  const std::string live = Capture(
+      BinPath("orbed-registration") + " send --robust --input " + trials, &live_code);
+  EXPECT_EQ(offline_code, 0);
+  EXPECT_EQ(live_code, 0);
+  EXPECT_NE(offline.find("\"rejected\":[10]"), std::string::npos) << offline;
+  const std::regex numbers_out(R"(-?[0-9]+(\.[0-9]+)?([eE][-+]?[0-9]+)?)");
+  EXPECT_EQ(std::regex_replace(live, numbers_out, "#"), std::regex_replace(offline, numbers_out, "#"));
+  const std::vector<double> a = Numbers(live), b = Numbers(offline);
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t i = 0; i < a.size(); ++i) EXPECT_NEAR(a[i], b[i], 1e-12) << "number " << i;
 }
 
 }  // namespace
