@@ -32,6 +32,8 @@ const char* CommandName(int8_t command) {
       return "COMPUTE";
     case orbed::session_control_t::STOP:
       return "STOP";
+    case orbed::session_control_t::REQUEST_TRIAL:
+      return "REQUEST_TRIAL";
   }
   return "?";
 }
@@ -64,8 +66,8 @@ std::optional<orbed::registration_t> RegistrationService::HandleSessionControl(
     const orbed::session_control_t& msg) {
   const std::string problem = FirstError(
       {CheckSessionId(msg.session_id, "SESSION_CONTROL"),
-       CheckEnum(msg.command, orbed::session_control_t::START, orbed::session_control_t::STOP,
-                 "SESSION_CONTROL.command"),
+       CheckEnum(msg.command, orbed::session_control_t::START,
+                 orbed::session_control_t::REQUEST_TRIAL, "SESSION_CONTROL.command"),
        CheckEnum(msg.display_mode, orbed::alignment_trial_t::MODE_AR,
                  orbed::alignment_trial_t::MODE_AR_REFLECTIVE, "SESSION_CONTROL.display_mode"),
        CheckEnum(msg.method, orbed::registration_t::METHOD_CHORDAL, orbed::registration_t::METHOD_ROBUST,
@@ -75,6 +77,8 @@ std::optional<orbed::registration_t> RegistrationService::HandleSessionControl(
     Reject("SESSION_CONTROL/field", problem);
     return std::nullopt;
   }
+  // A trial request is for the user, not for the server.
+  if (msg.command == orbed::session_control_t::REQUEST_TRIAL) return std::nullopt;
   if (msg.command == orbed::session_control_t::START) {
     has_session_ = true;
     active_ = true;
