@@ -1,0 +1,147 @@
+#include "hmd_emulator/head_trajectory.h"
+
+#include <cmath>
+#include <stdexcept>
+
+#include "hmd_emulator/yaml_fields.h"
+
+namespace orbed::hmd {
+
+HeadTrajectoryConfig ParseHeadTrajectory(const YAML::Node& node, const std::string& source,
+                                         const std::string& key) {
+  const YamlFields f(source);
+  f.CheckKeys(node, key, {"speed_m_per_s", "look_at_m", "loop", "waypoints"});
+  HeadTrajectoryConfig c;
+  c.speed_m_per_s = f.Number(f.Required(node, "speed_m_per_s", key + ".speed_m_per_s"), key + ".speed_m_per_s",
+                             1e-3, 10.0, "m/s");
+  c.p_W_look_at = f.Vector3(f.Required(node, "look_at_m", key + ".look_at_m"), key + ".look_at_m", "m");
+  c.loop = f.BoolOr(node, "loop", key, false);
+  const YAML::Node wps = f.Required(node, "waypoints", key + ".waypoints");
+  if (!wps.IsSequence() || wps.size() == 0) f.Fail(wps, key + ".waypoints", "expected a list of >= 1 waypoints");
+  for (std::size_t i = 0; i < wps.size(); ++i) {
+    const std::string k = key + ".waypoints[" + std::to_string(i) + "]";
+    const YAML::Node w = wps[i];
+    f.CheckKeys(w, k, {"name", "position_m", "dwell_s", "look_at_m"});
+    HeadWaypoint wp;
+    wp.name = w["name"] ? w["name"].as<std::string>() : "waypoint" + std::to_string(i);
+    wp.p_WH = f.Vector3(f.Required(w, "position_m", k + ".position_m"), k + ".position_m", "m");
+    wp.dwell_s = f.NumberOr(w, "dwell_s", k, 0.0, 0.0, 3600.0, "s");
+    if (w["look_at_m"]) wp.p_W_look_at = f.Vector3(w["look_at_m"], k + ".look_at_m", "m");
+    c.waypoints.push_back(wp);
+  }
+  try {
+    HeadTrajectory check(c);
+  } catch (const std::invalid_argument& e) {
+    f.Fail(node, key, e.what());
+  }
+  return c;
+}
+
+HeadTrajectoryConfig LoadHeadTrajectoryFile(const std::string& path) {
+  const YAML::Node root = YamlFields::LoadFile(path);
+  const YamlFields f(path);
+  return ParseHeadTrajectory(f.Required(root, "head_trajectory", "head_trajectory"), path);
+}
+
+Eigen::Isometry3d LookAt(const Eigen::Vector3d& p_WH, const Eigen::Vector3d& p_WT) {
+  const Eigen::Vector3d d = p_WT - p_WH;
+  if (!(d.norm() > 1e-3)) throw std::invalid_argument("look-at target within 1 mm of the head");
+  const Eigen::Vector3d z = d.normalized();
+  const Eigen::Vector3d x_raw = z.cross(Eigen::Vector3d::UnitZ());
+  if (!(x_raw.norm() > 1e-6)) throw std::invalid_argument("look-at target straight above or below the head");
+  const Eigen::Vector3d x = x_raw.normalized();
+  const Eigen::Vector3d y = z.cross(x);
+  Eigen::Isometry3d X_WH = Eigen::Isometry3d::Identity();
+  X_WH.linear().col(0) = x;
+  X_WH.linear().col(1) = y;
+  X_WH.linear().col(2) = z;
+  X_WH.translation() = p_WH;
+  return X_WH;
+}
+
+HeadTrajectory::HeadTrajectory(HeadTrajectoryConfig config) : config_(std::move(config)) {
+  const auto& w = config_.waypoints;
+  if (w.empty()) throw std::invalid_argument("head trajectory: needs at least one waypoint");
+  if (!(config_.speed_m_per_s > 0) || !std::isfinite(config_.speed_m_per_s)) {
+    throw std::invalid_argument("head trajectory: speed_m_per_s must be > 0");
+  }
+  const int n = static_cast<int>(w.size());
+  for (int i = 0; i < n; ++i) {
+    if (!(w[i].dwell_s >= 0)) throw std::invalid_argument("head trajectory: dwell_s must be >= 0");
+    LookAt(w[i].p_WH, Target(i));  // throws when the target is degenerate
+  }
+  const int num_segments = config_.loop ? n : n - 1;
+  double t = 0, s = 0;
+  for (int i = 0; i < n; ++i) {
+    arrive_s_.push_back(t);
+    cum_len_m_.push_back(s);
+    t += w[i].dwell_s;
+    if (i < num_segments) {
+      const double len = (w[(i + 1) % n].p_WH - w[i].p_WH).norm();
+      seg_len_m_.push_back(len);
+      t += len / config_.speed_m_per_s;
+      s += len;
+    }
+  }
+  duration_s_ = t;
+  length_m_ = s;
+}
+
+Eigen::Vector3d HeadTrajectory::Target(int i) const {
+  const auto& wp = config_.waypoints[i];
+  return wp.p_W_look_at ? *wp.p_W_look_at : config_.p_W_look_at;
+}
+
+int HeadTrajectory::FindWaypoint(const std::string& name) const {
+  for (std::size_t i = 0; i < config_.waypoints.size(); ++i) {
+    if (config_.waypoints[i].name == name) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+Eigen::Isometry3d HeadTrajectory::X_WH(double t_s) const {
+  const auto& w = config_.waypoints;
+  const int n = static_cast<int>(w.size());
+  double t = std::max(0.0, t_s);
+  if (config_.loop && duration_s_ > 0) t = std::fmod(t, duration_s_);
+  for (int i = 0; i < n; ++i) {
+    const double leave = arrive_s_[i] + w[i].dwell_s;
+    if (t <= leave) return LookAt(w[i].p_WH, Target(i));
+    if (i < static_cast<int>(seg_len_m_.size())) {
+      const double walk = seg_len_m_[i] / config_.speed_m_per_s;
+      if (t <= leave + walk) {
+        const double a = walk > 0 ? (t - leave) / walk : 1.0;
+        const int j = (i + 1) % n;
+        const Eigen::Vector3d p = (1 - a) * w[i].p_WH + a * w[j].p_WH;
+        const Eigen::Vector3d target = (1 - a) * Target(i) + a * Target(j);
+        return LookAt(p, target);
+      }
+    }
+  }
+  // Past the end of a non-looping path (or rounding at the loop's end): the last / first waypoint.
+  const int last = config_.loop ? 0 : n - 1;
+  return LookAt(w[last].p_WH, Target(last));
+}
+
+double HeadTrajectory::PathLength(double t_s) const {
+  const auto& w = config_.waypoints;
+  const int n = static_cast<int>(w.size());
+  double t = std::max(0.0, t_s);
+  double laps = 0;
+  if (config_.loop && duration_s_ > 0) {
+    laps = std::floor(t / duration_s_);
+    t -= laps * duration_s_;
+  }
+  double s = laps * length_m_;
+  for (int i = 0; i < n; ++i) {
+    const double leave = arrive_s_[i] + w[i].dwell_s;
+    if (t <= leave) return s + cum_len_m_[i];
+    if (i < static_cast<int>(seg_len_m_.size())) {
+      const double walk = seg_len_m_[i] / config_.speed_m_per_s;
+      if (t <= leave + walk) return s + cum_len_m_[i] + (t - leave) * config_.speed_m_per_s;
+    }
+  }
+  return s + length_m_;
+}
+
+}  // namespace orbed::hmd

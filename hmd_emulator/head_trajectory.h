@@ -1,0 +1,94 @@
+#pragma once
+/// @file
+/// The wearer's head path through the OR: waypoints walked at a constant speed, a dwell (standing
+/// still) at each, and the head always turned toward a look-at target (the robot by default).
+///
+/// Frames: W is the OR world (floor z = 0, z up; sim/scene.h). H is the head: origin at the midpoint
+/// between the eyes (the cyclopean eye), axes like the camera C: z forward along the line of sight,
+/// x to the wearer's right, y down. "Looking at" p_WT means z_H points from p_WH to p_WT with x_H
+/// horizontal (roll 0), so y_H points down. Units: m, s.
+///
+/// Timing: the head starts at waypoint 0 at t = 0, dwells there, walks the straight segment to the
+/// next waypoint at speed_m_per_s, dwells, and so on. The look-at target is the waypoint's own
+/// (look_at_m) or the trajectory's, and is interpolated linearly along a segment so the head turns
+/// smoothly. After the last waypoint the head stays there, or, with loop: true, walks back to
+/// waypoint 0 and starts again (period duration_s()).
+///
+/// YAML (a `head_trajectory:` mapping in a scenario or config file; unknown keys are errors):
+///   head_trajectory:
+///     speed_m_per_s: 0.8          # > 0
+///     look_at_m: [0.25, -0.45, 1.25]
+///     loop: false                 # optional
+///     waypoints:                  # >= 1
+///       - {name: bedside, position_m: [1.6, -1.2, 1.7], dwell_s: 2.0}
+///       - {name: head_end, position_m: [-0.9, -1.4, 1.7], dwell_s: 1.0, look_at_m: [x, y, z]}
+///
+/// Threading: immutable after construction; const methods are thread-safe.
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+#include <yaml-cpp/yaml.h>
+
+namespace orbed::hmd {
+
+struct HeadWaypoint {
+  std::string name;
+  Eigen::Vector3d p_WH{Eigen::Vector3d::Zero()};  ///< head position [m]
+  double dwell_s{0.0};                             ///< time standing here [s], >= 0
+  std::optional<Eigen::Vector3d> p_W_look_at;      ///< overrides the trajectory's target
+};
+
+struct HeadTrajectoryConfig {
+  double speed_m_per_s{0.8};
+  Eigen::Vector3d p_W_look_at{Eigen::Vector3d::Zero()};
+  bool loop{false};
+  std::vector<HeadWaypoint> waypoints;
+};
+
+/// Reads a `head_trajectory` mapping (the node itself, not its parent). `yaml` names the source in
+/// errors; `key` is the node's dotted path (e.g. "head_trajectory").
+HeadTrajectoryConfig ParseHeadTrajectory(const YAML::Node& node, const std::string& source,
+                                         const std::string& key = "head_trajectory");
+/// Loads the `head_trajectory:` mapping of a YAML file.
+HeadTrajectoryConfig LoadHeadTrajectoryFile(const std::string& path);
+
+/// The head frame H of a viewer at p_WH looking at p_WT: z_H toward the target, x_H horizontal
+/// (to the right), y_H down. Throws std::invalid_argument when the target is within 1 mm or
+/// straight above/below (roll undefined).
+Eigen::Isometry3d LookAt(const Eigen::Vector3d& p_WH, const Eigen::Vector3d& p_WT);
+
+class HeadTrajectory {
+ public:
+  /// Validates (>= 1 waypoint, speed > 0, dwell >= 0, targets not at/above/below a waypoint).
+  explicit HeadTrajectory(HeadTrajectoryConfig config);
+
+  /// X_WH_true at time t [s]; t < 0 gives the start; beyond the end the last pose (or, when looping,
+  /// t modulo duration_s()).
+  Eigen::Isometry3d X_WH(double t_s) const;
+  /// The path length walked up to time t [m] (counting every lap when looping).
+  double PathLength(double t_s) const;
+  /// One pass: dwell + walk times [s], and its path length [m] (including the closing segment when
+  /// looping).
+  double duration_s() const { return duration_s_; }
+  double length_m() const { return length_m_; }
+  /// Times at which the head arrives at and leaves waypoint i (first pass) [s].
+  double ArrivalTime(int i) const { return arrive_s_.at(i); }
+  double DepartureTime(int i) const { return arrive_s_.at(i) + config_.waypoints.at(i).dwell_s; }
+  /// Index of the waypoint with this name, or -1.
+  int FindWaypoint(const std::string& name) const;
+  const HeadTrajectoryConfig& config() const { return config_; }
+
+ private:
+  Eigen::Vector3d Target(int i) const;
+  HeadTrajectoryConfig config_;
+  std::vector<double> arrive_s_;  // per waypoint; plus the loop's return to 0 at the end
+  std::vector<double> seg_len_m_;  // segment i: waypoint i -> i+1 (or -> 0 when looping)
+  std::vector<double> cum_len_m_;  // path length at arrival at waypoint i
+  double duration_s_{0};
+  double length_m_{0};
+};
+
+}  // namespace orbed::hmd

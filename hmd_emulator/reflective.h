@@ -1,0 +1,118 @@
+#pragma once
+/// @file
+/// The reflective-AR display (paper Sec. II-B) and the AR view: the virtual robot at X_WV drawn as
+/// a hologram over a camera frame.
+///
+/// What is in the picture (the physical mechanism the alignment study relies on):
+///   * The captured frame shows the REAL robot (at X_WR) as the camera truly saw it, from X_WC_true.
+///   * The device only knows its SLAM estimate X_WC_est of that capture pose (image_t carries it).
+///     The hologram is drawn with what the device knows: the virtual robot at X_WV, joint vector q of
+///     capture time, projected with the observer geometry P_o = K_o [R_CW | p_CW] of X_WC_est.
+///   * So with X_WV = X_WR the overlay still misses the real robot by the SLAM error at capture
+///     time (X_WC_true vs X_WC_est); an emulated user aligning in this image inherits that error.
+///   The content is independent of D, as the paper states ("does not affect the rendering content").
+///
+/// The reversed frustum (where and how the image is shown in the AR scene):
+///   X_CM = [R_x(π) | (0, 0, D)]   (M: C turned π about x, moved D along the principal ray, so M
+///                                   sits at the gaze hit on the robot and looks back toward C)
+///   X_WM = X_WC_est · X_CM,  K_m = diag(1, −1, 1) · K_o,  P_m = K_m [R_MW | p_MW].
+/// An eye at M looking into a planar mirror at z_C = D/2 (facing M) sees exactly the rays the camera
+/// captured: the mirror reflects M onto C. The display is that mirror: pixel (u, v) is shown at
+///   p_M = s · ((u − cx)/fx, −(v − cy)/fy, 1),   s = D/2 by default (DisplayPanelPoint),
+/// which lies on the capture ray of (u, v) seen from C, and which P_m maps to (u, v − 2 cy): K_m's
+/// y-flip only negates the row axis (the y-up convention of graphics engines), so the composed image
+/// is stored un-flipped, row 0 at the top, like the captured frame. D and s place and scale the
+/// panel; they never change its pixels.
+///
+/// Frames: W world, C camera (z forward, x right, y down), M reversed frustum, V virtual robot base.
+/// Units: m, rad, px; utime in µs.
+/// Threading: a Compositor owns a Renderer and scratch geometry; use one per thread.
+
+#include <cstdint>
+#include <memory>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <opencv2/core.hpp>
+
+#include "hmd_emulator/camera_model.h"
+#include "hmd_emulator/renderer.h"
+#include "hmd_emulator/scene_geometry.h"
+#include "sim/robot_model.h"
+
+namespace orbed::hmd {
+
+/// A camera frame as the device holds it.
+struct CapturedFrame {
+  cv::Mat bgr;                       ///< CV_8UC3, rendered from the TRUE capture pose
+  Intrinsics intrinsics;             ///< K_o of the frame
+  Eigen::Isometry3d X_WC_est{Eigen::Isometry3d::Identity()};  ///< SLAM estimate at capture
+  Eigen::VectorXd q_rad;             ///< robot joint vector at capture (IIWA_STATUS) [rad]
+  std::int64_t utime{0};             ///< capture time [µs]
+};
+
+/// Imaging geometry of one reflective display (what reflective_view_t carries).
+struct ReflectiveGeometry {
+  Eigen::Matrix3d K_o{Eigen::Matrix3d::Identity()};   ///< observer (capture) intrinsics [px]
+  Eigen::Matrix3d K_m{Eigen::Matrix3d::Identity()};   ///< diag(1, −1, 1) · K_o [px]
+  Eigen::Isometry3d X_WC{Eigen::Isometry3d::Identity()};  ///< capture pose used (the estimate)
+  Eigen::Isometry3d X_WM{Eigen::Isometry3d::Identity()};  ///< reversed frustum, X_WC · X_CM(D)
+  double distance_m{0};                                ///< D [m]
+  CameraMatrix P_o{CameraMatrix::Zero()};              ///< K_o [R_CW | p_CW]: draws the content
+  CameraMatrix P_m{CameraMatrix::Zero()};              ///< K_m [R_MW | p_MW] (paper eq. for P_m)
+};
+
+/// The geometry for a frame captured at X_WC with gaze distance D. Throws std::invalid_argument
+/// unless D is finite and > 0.
+ReflectiveGeometry MakeReflectiveGeometry(const Intrinsics& intrinsics, const Eigen::Isometry3d& X_WC,
+                                          double D_m);
+
+/// Where the display shows pixel (u, v), in W: p_M = s ((u − cx)/fx, −(v − cy)/fy, 1) with
+/// s = `depth_in_M_m` (default, when <= 0: D/2, the mirror plane).
+Eigen::Vector3d DisplayPanelPoint(const ReflectiveGeometry& geometry, double u_px, double v_px,
+                                  double depth_in_M_m = 0);
+
+struct ReflectiveView {
+  cv::Mat bgr;                 ///< the composed image, CV_8UC3, the frame's size, row 0 at the top
+  ReflectiveGeometry geometry;
+  Eigen::Isometry3d X_WV{Eigen::Isometry3d::Identity()};  ///< virtual robot base used
+  std::int64_t source_utime{0};                          ///< the frame's capture time [µs]
+};
+
+/// Draws the virtual robot over camera frames. Holds a reference to `robot` (must outlive it).
+class Compositor {
+ public:
+  explicit Compositor(const sim::RobotModel& robot, const OverlayStyle& style = {},
+                      const TessellationOptions& tessellation = {});
+
+  /// Reflective display: `frame` + the virtual robot at (frame.q_rad, X_WV) drawn with P_o of
+  /// frame.X_WC_est, and the geometry for D. `body_id` (optional, CV_32S) receives the overlay's
+  /// body indices into virtual_geometry().bodies(), -1 elsewhere. Throws std::invalid_argument on an
+  /// empty or mis-sized frame, a wrong q size or a bad D.
+  void ComposeReflective(const CapturedFrame& frame, double D_m, const Eigen::Isometry3d& X_WV,
+                         ReflectiveView* view, cv::Mat* body_id = nullptr);
+
+  /// AR view: the virtual robot at (q, X_WV) over a live frame, drawn from the current estimate
+  /// X_WC_est. `out` may alias `live_bgr`'s buffer only if it is the same Mat object.
+  void ComposeArView(const cv::Mat& live_bgr, const Intrinsics& intrinsics,
+                     const Eigen::Isometry3d& X_WC_est, const Eigen::VectorXd& q_rad,
+                     const Eigen::Isometry3d& X_WV, cv::Mat* out, cv::Mat* body_id = nullptr);
+
+  /// The virtual robot's bodies (names "virtual/<link>"), posed at the last call.
+  const SceneGeometry& virtual_geometry() const { return virtual_robot_; }
+
+ private:
+  void Overlay(const Intrinsics& intrinsics, const Eigen::Isometry3d& X_WC,
+               const Eigen::VectorXd& q_rad, const Eigen::Isometry3d& X_WV, cv::Mat* image,
+               cv::Mat* body_id);
+
+  const sim::RobotModel& robot_;
+  OverlayStyle style_;
+  TessellationOptions tessellation_;
+  SceneGeometry virtual_robot_;
+  int handle_{0};
+  Mesh mesh_;
+  std::unique_ptr<Renderer> renderer_;  // rebuilt when the intrinsics change
+};
+
+}  // namespace orbed::hmd

@@ -1,0 +1,207 @@
+#include "hmd_emulator/slam_model.h"
+
+#include <cmath>
+#include <stdexcept>
+
+#include "hmd_emulator/yaml_fields.h"
+#include "sim/scene.h"
+
+namespace orbed::hmd {
+namespace {
+
+constexpr double kDegToRad = M_PI / 180.0;
+
+// The rigid motion that rotates by yaw_rad about the vertical axis through p_W, then translates by t_W.
+Eigen::Isometry3d YawAboutPoint(const Eigen::Vector3d& p_W, double yaw_rad, const Eigen::Vector3d& t_W) {
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  X.linear() = Eigen::AngleAxisd(yaw_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  X.translation() = p_W - X.linear() * p_W + t_W;
+  return X;
+}
+
+double YawOf(const Eigen::Isometry3d& X) { return std::atan2(X.linear()(1, 0), X.linear()(0, 0)); }
+
+Eigen::Matrix3d ExpRotation(const Eigen::Vector3d& w) {
+  const double angle = w.norm();
+  if (angle < 1e-15) return Eigen::Matrix3d::Identity();
+  return Eigen::AngleAxisd(angle, w / angle).toRotationMatrix();
+}
+
+}  // namespace
+
+const char* TrackingStateName(TrackingState state) {
+  switch (state) {
+    case TrackingState::kTracking: return "tracking";
+    case TrackingState::kLimited: return "limited";
+    case TrackingState::kLost: return "lost";
+    case TrackingState::kRelocalized: return "relocalized";
+  }
+  return "unknown";
+}
+
+SlamConfig ParseSlamConfig(const YAML::Node& node, const std::string& source, const std::string& key) {
+  const YamlFields f(source);
+  f.CheckKeys(node, key, {"seed", "rate_hz", "head_to_camera", "jitter", "drift", "tracking_loss"});
+  SlamConfig c;
+  c.seed = static_cast<std::uint64_t>(f.IntegerOr(node, "seed", key, 1, 0, (1LL << 62)));
+  c.rate_hz = f.NumberOr(node, "rate_hz", key, c.rate_hz, 1.0, 1000.0, "Hz");
+  if (node["head_to_camera"]) {
+    const std::string k = key + ".head_to_camera";
+    const YAML::Node h = node["head_to_camera"];
+    f.CheckKeys(h, k, {"position_m", "rpy_deg"});
+    c.X_HC.translation() = f.Vector3(f.Required(h, "position_m", k + ".position_m"), k + ".position_m", "m");
+    if (h["rpy_deg"]) c.X_HC.linear() = sim::RotationFromRpyDeg(f.Vector3(h["rpy_deg"], k + ".rpy_deg", "deg"));
+  }
+  const YAML::Node j = f.Section(node, "jitter", key + ".jitter");
+  const std::string kj = key + ".jitter";
+  f.CheckKeys(j, kj, {"translation_std_m", "rotation_std_deg"});
+  c.jitter_translation_std_m = f.NumberOr(j, "translation_std_m", kj, c.jitter_translation_std_m, 0, 0.1, "m");
+  c.jitter_rotation_std_deg = f.NumberOr(j, "rotation_std_deg", kj, c.jitter_rotation_std_deg, 0, 5, "deg");
+  const YAML::Node d = f.Section(node, "drift", key + ".drift");
+  const std::string kd = key + ".drift";
+  f.CheckKeys(d, kd, {"fraction_of_distance", "yaw_deg_per_m", "direction_correlation_m", "band_fraction"});
+  c.drift_fraction_of_distance = f.NumberOr(d, "fraction_of_distance", kd, c.drift_fraction_of_distance, 0, 0.2);
+  c.drift_yaw_deg_per_m = f.NumberOr(d, "yaw_deg_per_m", kd, c.drift_yaw_deg_per_m, 0, 10, "deg/m");
+  c.drift_direction_correlation_m =
+      f.NumberOr(d, "direction_correlation_m", kd, c.drift_direction_correlation_m, 0.01, 1e6, "m");
+  if (d["band_fraction"]) {
+    const YAML::Node b = d["band_fraction"];
+    if (!b.IsSequence() || b.size() != 2) f.Fail(b, kd + ".band_fraction", "expected [min, max] with 0 <= min <= max");
+    c.drift_band_min_fraction = f.Number(b[0], kd + ".band_fraction[0]", 0, 0.2);
+    c.drift_band_max_fraction = f.Number(b[1], kd + ".band_fraction[1]", c.drift_band_min_fraction, 0.2);
+  }
+  const YAML::Node t = f.Section(node, "tracking_loss", key + ".tracking_loss");
+  const std::string kt = key + ".tracking_loss";
+  f.CheckKeys(t, kt, {"rate_per_min", "limited_mean_s", "limited_drift_multiplier", "lost_probability",
+                      "lost_mean_s", "relocalization_correction", "jump_translation_std_m", "jump_yaw_std_deg"});
+  c.tracking_loss_rate_per_min = f.NumberOr(t, "rate_per_min", kt, c.tracking_loss_rate_per_min, 0, 600, "1/min");
+  c.limited_mean_s = f.NumberOr(t, "limited_mean_s", kt, c.limited_mean_s, 1e-3, 600, "s");
+  c.limited_drift_multiplier = f.NumberOr(t, "limited_drift_multiplier", kt, c.limited_drift_multiplier, 0, 100);
+  c.lost_probability = f.NumberOr(t, "lost_probability", kt, c.lost_probability, 0, 1);
+  c.lost_mean_s = f.NumberOr(t, "lost_mean_s", kt, c.lost_mean_s, 1e-3, 600, "s");
+  c.relocalization_correction = f.NumberOr(t, "relocalization_correction", kt, c.relocalization_correction, 0, 1);
+  c.jump_translation_std_m = f.NumberOr(t, "jump_translation_std_m", kt, c.jump_translation_std_m, 0, 1, "m");
+  c.jump_yaw_std_deg = f.NumberOr(t, "jump_yaw_std_deg", kt, c.jump_yaw_std_deg, 0, 45, "deg");
+  return c;
+}
+
+SlamConfig LoadSlamConfigFile(const std::string& path) {
+  const YAML::Node root = YamlFields::LoadFile(path);
+  const YamlFields f(path);
+  f.CheckKeys(root, "", {"slam"});
+  return ParseSlamConfig(f.Required(root, "slam", "slam"), path);
+}
+
+SlamModel::SlamModel(const SlamConfig& config) : config_(config), rng_(config.seed) {}
+
+void SlamModel::Drift(const Eigen::Vector3d& p_WH, double ds_m, double multiplier) {
+  if (!(ds_m > 0) || multiplier == 0) return;
+  const double L = config_.drift_direction_correlation_m;
+  // Brownian motion on the unit sphere: two tangent components of variance ds/L each give
+  // E[u(s)·u(0)] = exp(−s/L); the scalar phase with variance 2 ds/L gives E[cos Δφ] = exp(−s/L).
+  drift_dir_ = (drift_dir_ + std::sqrt(ds_m / L) * rng_.Normal3()).normalized();
+  yaw_phase_rad_ += std::sqrt(2.0 * ds_m / L) * rng_.Normal();
+  const Eigen::Vector3d dt_W = multiplier * config_.drift_fraction_of_distance * ds_m * drift_dir_;
+  const double dyaw = multiplier * config_.drift_yaw_deg_per_m * kDegToRad * ds_m * std::cos(yaw_phase_rad_);
+  E_ = YawAboutPoint(p_WH, dyaw, dt_W) * E_;
+}
+
+void SlamModel::AdvanceState(double dt_s) {
+  switch (state_) {
+    case TrackingState::kRelocalized:
+      state_ = TrackingState::kTracking;
+      [[fallthrough]];
+    case TrackingState::kTracking: {
+      const double rate_per_s = config_.tracking_loss_rate_per_min / 60.0;
+      if (rate_per_s > 0 && rng_.Uniform() < 1.0 - std::exp(-rate_per_s * dt_s)) {
+        state_ = TrackingState::kLimited;
+        state_left_s_ = rng_.Exponential(config_.limited_mean_s);
+        lost_follows_ = rng_.Uniform() < config_.lost_probability;
+      }
+      break;
+    }
+    case TrackingState::kLimited:
+      state_left_s_ -= dt_s;
+      if (state_left_s_ <= 0) {
+        if (lost_follows_) {
+          state_ = TrackingState::kLost;
+          state_left_s_ = rng_.Exponential(config_.lost_mean_s);
+        } else {
+          state_ = TrackingState::kRelocalized;
+        }
+      }
+      break;
+    case TrackingState::kLost:
+      state_left_s_ -= dt_s;
+      if (state_left_s_ <= 0) state_ = TrackingState::kRelocalized;
+      break;
+  }
+}
+
+SlamSample SlamModel::Step(const Eigen::Isometry3d& X_WH_true, double t_s) {
+  const Eigen::Vector3d p_WH = X_WH_true.translation();
+  if (!started_) {
+    started_ = true;
+    last_t_s_ = t_s;
+    last_p_WH_ = p_WH;
+    drift_dir_ = rng_.Normal3().normalized();
+    yaw_phase_rad_ = rng_.Uniform(0, 2 * M_PI);
+  }
+  if (!(t_s >= last_t_s_)) throw std::invalid_argument("SlamModel::Step: time went backwards");
+  const double dt = t_s - last_t_s_;
+  const double ds = (p_WH - last_p_WH_).norm();
+  path_m_ += ds;
+
+  const TrackingState before = state_;
+  if (seq_ > 0) AdvanceState(dt);
+  if (state_ == TrackingState::kRelocalized && before != TrackingState::kRelocalized) {
+    // Re-matched to the stored map: shrink the accumulated error about the head, then jump.
+    const double keep = 1.0 - config_.relocalization_correction;
+    const Eigen::Vector3d e_head = E_ * p_WH - p_WH;  // the head's position error before
+    const Eigen::Isometry3d shrunk =
+        YawAboutPoint(p_WH, keep * YawOf(E_), keep * e_head);
+    const Eigen::Isometry3d jump =
+        YawAboutPoint(p_WH, config_.jump_yaw_std_deg * kDegToRad * rng_.Normal(),
+                      config_.jump_translation_std_m * rng_.Normal3());
+    E_ = jump * shrunk;
+  } else if (state_ != TrackingState::kLost) {
+    Drift(p_WH, ds, state_ == TrackingState::kLimited ? config_.limited_drift_multiplier : 1.0);
+  }
+
+  SlamSample s;
+  s.t_s = t_s;
+  s.seq = seq_++;
+  s.path_m = path_m_;
+  s.X_WH_true = X_WH_true;
+  s.X_WC_true = X_WH_true * config_.X_HC;
+  s.X_WWmap = E_;
+  s.state = state_;
+  if (state_ == TrackingState::kLost) {
+    s.X_WH_est = frozen_X_WH_est_;  // the device holds its last pose while lost
+  } else {
+    Eigen::Isometry3d J_H = Eigen::Isometry3d::Identity();
+    J_H.linear() = ExpRotation(config_.jitter_rotation_std_deg * kDegToRad * rng_.Normal3());
+    J_H.translation() = config_.jitter_translation_std_m * rng_.Normal3();
+    s.X_WH_est = E_.inverse() * X_WH_true * J_H;
+    frozen_X_WH_est_ = s.X_WH_est;
+  }
+  s.X_WC_est = s.X_WH_est * config_.X_HC;
+  last_t_s_ = t_s;
+  last_p_WH_ = p_WH;
+  return s;
+}
+
+std::vector<SlamSample> SimulateWalk(const HeadTrajectory& trajectory, const SlamConfig& config, double t_end_s) {
+  SlamModel model(config);
+  std::vector<SlamSample> samples;
+  const double dt = 1.0 / config.rate_hz;
+  const long long n = static_cast<long long>(std::floor(t_end_s / dt + 1e-9)) + 1;
+  samples.reserve(static_cast<std::size_t>(std::max(0LL, n)));
+  for (long long k = 0; k < n; ++k) {
+    const double t = k * dt;
+    samples.push_back(model.Step(trajectory.X_WH(t), t));
+  }
+  return samples;
+}
+
+}  // namespace orbed::hmd

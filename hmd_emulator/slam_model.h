@@ -1,0 +1,147 @@
+#pragma once
+/// @file
+/// The headset's SLAM (inside-out tracking) as an error model around the true head pose: what the
+/// device believes (X_WH_est, X_WC_est) given where the head truly is (X_WH_true), sample by sample
+/// at 60 Hz, with white jitter, drift that grows with the path walked, and occasional tracking loss
+/// followed by a relocalization jump.
+///
+/// Frames and the one relation everything else uses. W is the true OR world; W' is the device's
+/// SLAM map, which the device takes for W (the map is initialised on W: they coincide at the first
+/// sample). The map error is the pose of the map in the true world, E = X_WW'. The device reports
+///     X_WH_est = E⁻¹ · X_WH_true · J_H,        X_WC_est = X_WH_est · X_HC,
+/// J_H being the white jitter of this sample (in H). A hologram the device places at X_WV (map
+/// coordinates: every pose the device or its user chooses is one) is drawn with the estimated
+/// head pose, i.e. at X_HV = X_WH_est⁻¹ · X_WV relative to the head, and since the head is truly at
+/// X_WH_true it appears in the true world at
+///     X_WV_apparent = X_WH_true · X_WH_est⁻¹ · X_WV                           (ApparentPose)
+/// (= E · X_WV without jitter). Consequences the tests check: head-locked content
+/// (X_WV = X_WH_est · X_HV) appears exactly at X_WH_true · X_HV, whatever the error; a purely
+/// translational error shifts every hologram by p_WH_true − p_WH_est; the device's projection of a
+/// hologram with its believed camera pose equals the true camera's projection of the apparent one.
+///
+/// The error model (parameters in SlamConfig, loaded from config/slam.yaml):
+///  - Drift: visual-inertial odometry leaves 4 directions unobservable (position and yaw about
+///    gravity; roll and pitch are fixed by gravity), so E is a translation plus a rotation about the
+///    world z axis. Each sample adds to E a translation of drift_fraction_of_distance · ds along a
+///    unit direction u and a yaw of drift_yaw_deg_per_m · ds · cos φ about the current head
+///    position (ds = the head's true displacement this sample [m]). u and φ are random walks whose
+///    correlation decays as exp(−s / drift_direction_correlation_m) with the path s, so over short
+///    paths the translation error grows at drift_fraction_of_distance per metre and over long ones
+///    it wanders like a random walk. While standing still there is no drift (jitter only).
+///  - Jitter: J_H = (exp(ω), v), ω ~ N(0, σ_r² I), v ~ N(0, σ_t² I), independent per sample.
+///  - Tracking loss: a Poisson process at tracking_loss_rate_per_min (while TRACKING). The state goes
+///    LIMITED for an exponential time (mean limited_mean_s), drifting limited_drift_multiplier times
+///    faster; with probability lost_probability it then goes LOST for an exponential time (mean
+///    lost_mean_s), during which the device freezes its last estimate. Then one sample is
+///    RELOCALIZED: the accumulated error is shrunk by relocalization_correction (re-matching to the
+///    stored map; 1 removes it), about the head, and a random jump (σ jump_translation_std_m, yaw
+///    σ jump_yaw_std_deg) is applied; then TRACKING again.
+///
+/// TrackingState values equal orbed::hmd_pose_t's TRACKING/LIMITED/LOST/RELOCALIZED constants.
+/// Units: m, s, rad inside (deg only in names that say so). Threading: a SlamModel is
+/// single-threaded (it owns its random stream); configs are plain data.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+#include <yaml-cpp/yaml.h>
+
+#include "hmd_emulator/head_trajectory.h"
+#include "hmd_emulator/random.h"
+
+namespace orbed::hmd {
+
+enum class TrackingState : std::int8_t { kTracking = 0, kLimited = 1, kLost = 2, kRelocalized = 3 };
+const char* TrackingStateName(TrackingState state);
+
+struct SlamConfig {
+  std::uint64_t seed{1};
+  double rate_hz{60.0};
+  /// X_HC: the photo/video camera in the head frame.
+  Eigen::Isometry3d X_HC{Eigen::Isometry3d::Identity()};
+  double jitter_translation_std_m{0.0005};
+  double jitter_rotation_std_deg{0.02};
+  double drift_fraction_of_distance{0.01};
+  double drift_yaw_deg_per_m{0.05};
+  double drift_direction_correlation_m{10.0};
+  /// The band the drift per metre is expected in (documentation and tests; not used by the model).
+  double drift_band_min_fraction{0.003};
+  double drift_band_max_fraction{0.014};
+  double tracking_loss_rate_per_min{0.5};
+  double limited_mean_s{1.0};
+  double limited_drift_multiplier{4.0};
+  double lost_probability{0.2};
+  double lost_mean_s{2.0};
+  double relocalization_correction{0.5};
+  double jump_translation_std_m{0.01};
+  double jump_yaw_std_deg{0.5};
+};
+
+/// Reads the `slam:` mapping (the node itself). Every key is optional (defaults above) and checked;
+/// errors name `source`, the line and the key.
+SlamConfig ParseSlamConfig(const YAML::Node& node, const std::string& source, const std::string& key = "slam");
+/// Loads the `slam:` mapping of a YAML file (e.g. hmd_emulator/config/slam.yaml).
+SlamConfig LoadSlamConfigFile(const std::string& path);
+/// The shipped defaults, relative to the repository root.
+inline constexpr const char* kDefaultSlamConfigRelativePath = "hmd_emulator/config/slam.yaml";
+
+/// One 60 Hz sample. seq starts at 0.
+struct SlamSample {
+  double t_s{0};
+  std::int64_t seq{0};
+  double path_m{0};  ///< true path walked so far [m]
+  Eigen::Isometry3d X_WH_true{Eigen::Isometry3d::Identity()};
+  Eigen::Isometry3d X_WC_true{Eigen::Isometry3d::Identity()};
+  Eigen::Isometry3d X_WH_est{Eigen::Isometry3d::Identity()};
+  Eigen::Isometry3d X_WC_est{Eigen::Isometry3d::Identity()};
+  /// The drift part of the map error E = X_WW' (without this sample's jitter).
+  Eigen::Isometry3d X_WWmap{Eigen::Isometry3d::Identity()};
+  TrackingState state{TrackingState::kTracking};
+};
+
+/// X_WV_apparent = X_WH_true · X_WH_est⁻¹ · X_WV: where a hologram placed at X_WV in map
+/// coordinates appears in the true world when the device draws it with X_WH_est.
+inline Eigen::Isometry3d ApparentPose(const Eigen::Isometry3d& X_WH_true, const Eigen::Isometry3d& X_WH_est,
+                                      const Eigen::Isometry3d& X_WV) {
+  return X_WH_true * X_WH_est.inverse() * X_WV;
+}
+
+class SlamModel {
+ public:
+  explicit SlamModel(const SlamConfig& config);
+
+  /// Advances to the next sample with the head truly at X_WH_true at time t_s (non-decreasing).
+  /// The first call initialises the map on W (E = I).
+  SlamSample Step(const Eigen::Isometry3d& X_WH_true, double t_s);
+
+  const SlamConfig& config() const { return config_; }
+  /// The current drift part of the map error E = X_WW'.
+  const Eigen::Isometry3d& X_WWmap() const { return E_; }
+
+ private:
+  void Drift(const Eigen::Vector3d& p_WH, double ds_m, double multiplier);
+  void AdvanceState(double dt_s);
+
+  SlamConfig config_;
+  Random rng_;
+  bool started_{false};
+  std::int64_t seq_{0};
+  double last_t_s_{0};
+  double path_m_{0};
+  Eigen::Vector3d last_p_WH_{Eigen::Vector3d::Zero()};
+  Eigen::Isometry3d E_{Eigen::Isometry3d::Identity()};
+  Eigen::Vector3d drift_dir_{Eigen::Vector3d::UnitX()};
+  double yaw_phase_rad_{0};
+  TrackingState state_{TrackingState::kTracking};
+  double state_left_s_{0};
+  bool lost_follows_{false};
+  Eigen::Isometry3d frozen_X_WH_est_{Eigen::Isometry3d::Identity()};
+};
+
+/// Samples a trajectory at config.rate_hz from t = 0 to t_end_s (inclusive of 0): one SlamModel
+/// with config's seed.
+std::vector<SlamSample> SimulateWalk(const HeadTrajectory& trajectory, const SlamConfig& config, double t_end_s);
+
+}  // namespace orbed::hmd

@@ -1,0 +1,280 @@
+// Head trajectory and SLAM error model. Oracles: geometry worked out by hand, the KITTI-style
+// relative pose error (Geiger et al. 2012) over 1 m segments against the configured drift, and
+// the physical consequences of the hologram relation (head-locked content is unaffected by any
+// tracking error; a translational map error shifts every hologram by p_true − p_est; the device's
+// camera overlay lands where the true camera sees the apparent hologram).
+#include "hmd_emulator/slam_model.h"
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "hmd_emulator/camera_model.h"
+#include "hmd_emulator/stats.h"
+#include "hmd_emulator/yaml_fields.h"
+#include "orbed/hmd_pose_t.hpp"
+
+namespace orbed::hmd {
+namespace {
+
+std::string SourcePath(const std::string& relative) {
+  const char* root = std::getenv("ORBED_SOURCE_DIR");
+  return std::string(root ? root : ".") + "/" + relative;
+}
+
+static_assert(static_cast<int>(TrackingState::kTracking) == orbed::hmd_pose_t::TRACKING);
+static_assert(static_cast<int>(TrackingState::kLimited) == orbed::hmd_pose_t::LIMITED);
+static_assert(static_cast<int>(TrackingState::kLost) == orbed::hmd_pose_t::LOST);
+static_assert(static_cast<int>(TrackingState::kRelocalized) == orbed::hmd_pose_t::RELOCALIZED);
+
+TEST(HeadTrajectory, LookAtAxes) {
+  // Looking along +x_W from (1, 2, 1.7): right is −y_W, down is −z_W.
+  const Eigen::Isometry3d X_WH = LookAt({1, 2, 1.7}, {5, 2, 1.7});
+  EXPECT_TRUE(X_WH.linear().col(2).isApprox(Eigen::Vector3d(1, 0, 0), 1e-12));
+  EXPECT_TRUE(X_WH.linear().col(0).isApprox(Eigen::Vector3d(0, -1, 0), 1e-12));
+  EXPECT_TRUE(X_WH.linear().col(1).isApprox(Eigen::Vector3d(0, 0, -1), 1e-12));
+  EXPECT_TRUE(X_WH.translation().isApprox(Eigen::Vector3d(1, 2, 1.7)));
+  EXPECT_THROW(LookAt({0, 0, 1}, {0, 0, 3}), std::invalid_argument);
+}
+
+TEST(HeadTrajectory, TimingAndPath) {
+  HeadTrajectoryConfig c;
+  c.speed_m_per_s = 0.5;
+  c.p_W_look_at = Eigen::Vector3d(0, 5, 1.0);
+  c.waypoints = {{"a", {0, 0, 1.7}, 1.0, {}}, {"b", {2, 0, 1.7}, 3.0, {}}};
+  const HeadTrajectory t(c);
+  // Dwell 1 s, walk 2 m at 0.5 m/s = 4 s, dwell 3 s.
+  EXPECT_DOUBLE_EQ(t.duration_s(), 8.0);
+  EXPECT_DOUBLE_EQ(t.length_m(), 2.0);
+  EXPECT_DOUBLE_EQ(t.ArrivalTime(1), 5.0);
+  EXPECT_DOUBLE_EQ(t.DepartureTime(1), 8.0);
+  EXPECT_TRUE(t.X_WH(3.0).translation().isApprox(Eigen::Vector3d(1, 0, 1.7)));  // halfway
+  EXPECT_DOUBLE_EQ(t.PathLength(3.0), 1.0);
+  EXPECT_TRUE(t.X_WH(100).translation().isApprox(Eigen::Vector3d(2, 0, 1.7)));
+  // Always facing the target.
+  const Eigen::Isometry3d X = t.X_WH(4.0);
+  EXPECT_NEAR(X.linear().col(2).dot((c.p_W_look_at - X.translation()).normalized()), 1.0, 1e-12);
+  EXPECT_EQ(t.FindWaypoint("b"), 1);
+  EXPECT_EQ(t.FindWaypoint("zz"), -1);
+  // Looping: the closing segment back to "a" (2 m) is walked too.
+  c.loop = true;
+  const HeadTrajectory loop(c);
+  EXPECT_DOUBLE_EQ(loop.duration_s(), 12.0);
+  EXPECT_DOUBLE_EQ(loop.PathLength(24.0 + 5.0), 2 * 4.0 + 2.0);
+}
+
+// A closed walk around the robot (a 3 m × 2 m rectangle at head height), looped.
+HeadTrajectoryConfig RectangleWalk() {
+  HeadTrajectoryConfig c;
+  c.speed_m_per_s = 0.8;
+  c.p_W_look_at = Eigen::Vector3d(0.25, -0.45, 1.25);
+  c.loop = true;
+  c.waypoints = {{"p0", {-1.25, -1.45, 1.7}, 0, {}},
+                 {"p1", {1.75, -1.45, 1.7}, 0, {}},
+                 {"p2", {1.75, 0.55, 1.7}, 0, {}},
+                 {"p3", {-1.25, 0.55, 1.7}, 0, {}}};
+  return c;
+}
+
+struct RpeStats {
+  std::vector<double> per_metre;
+};
+
+// Relative pose error over segments of >= 1 m of true path, only over segments tracked throughout.
+RpeStats RelativePoseErrorPerMetre(const std::vector<SlamSample>& s) {
+  RpeStats out;
+  std::size_t a = 0;
+  while (a < s.size()) {
+    std::size_t b = a;
+    bool tracked = true;
+    while (b < s.size() && s[b].path_m - s[a].path_m < 1.0) {
+      tracked = tracked && s[b].state == TrackingState::kTracking;
+      ++b;
+    }
+    if (b >= s.size()) break;
+    tracked = tracked && s[b].state == TrackingState::kTracking;
+    if (tracked) {
+      const Eigen::Isometry3d d_true = s[a].X_WH_true.inverse() * s[b].X_WH_true;
+      const Eigen::Isometry3d d_est = s[a].X_WH_est.inverse() * s[b].X_WH_est;
+      const double err = (d_est.inverse() * d_true).translation().norm();
+      out.per_metre.push_back(err / (s[b].path_m - s[a].path_m));
+    }
+    a = b;
+  }
+  return out;
+}
+
+TEST(SlamModel, DriftPerMetreStaysInConfiguredBand) {
+  const SlamConfig shipped = LoadSlamConfigFile(SourcePath(kDefaultSlamConfigRelativePath));
+  const HeadTrajectory walk(RectangleWalk());
+  for (const double fraction : {shipped.drift_fraction_of_distance, 0.005}) {
+    SlamConfig c = shipped;
+    c.drift_fraction_of_distance = fraction;
+    c.seed = 7;
+    // 300 s at 0.8 m/s: 240 m, 24 laps.
+    const std::vector<SlamSample> s = SimulateWalk(walk, c, 300.0);
+    EXPECT_NEAR(s.back().path_m, 240.0, 0.5);
+    const RpeStats rpe = RelativePoseErrorPerMetre(s);
+    ASSERT_GT(rpe.per_metre.size(), 150u);
+    const double mean = stats::Mean(rpe.per_metre);
+    std::printf("configured drift %.4f, measured relative pose error %.4f per metre over %zu segments\n", fraction,
+                mean, rpe.per_metre.size());
+    EXPECT_GE(mean, c.drift_band_min_fraction) << "fraction " << fraction;
+    EXPECT_LE(mean, c.drift_band_max_fraction) << "fraction " << fraction;
+    // Closed form for a drift direction decorrelating as exp(−s/L): the RMS drift over ℓ = 1 m is
+    // f · √(2 L² (ℓ/L − 1 + e^(−ℓ/L))) = 0.9835 f for L = 10 m; the mean of the norm is a little
+    // below the RMS, jitter and yaw add < 0.1 % of distance.
+    EXPECT_GT(mean, 0.85 * fraction);
+    EXPECT_LT(mean, 1.05 * fraction);
+  }
+  // The shipped default is inside the documented band.
+  EXPECT_GE(shipped.drift_fraction_of_distance, shipped.drift_band_min_fraction);
+  EXPECT_LE(shipped.drift_fraction_of_distance, shipped.drift_band_max_fraction);
+}
+
+TEST(SlamModel, NoDriftWhileStandingAndMapStartsOnWorld) {
+  SlamConfig c;
+  c.tracking_loss_rate_per_min = 0;
+  HeadTrajectoryConfig stand;
+  stand.speed_m_per_s = 1;
+  stand.p_W_look_at = Eigen::Vector3d(0, 0, 1.2);
+  stand.waypoints = {{"here", {1.5, -1, 1.7}, 30.0, {}}};
+  const std::vector<SlamSample> s = SimulateWalk(HeadTrajectory(stand), c, 20.0);
+  for (const auto& x : s) {
+    EXPECT_TRUE(x.X_WWmap.isApprox(Eigen::Isometry3d::Identity(), 1e-12));
+    EXPECT_LT((x.X_WH_est.translation() - x.X_WH_true.translation()).norm(), 6 * c.jitter_translation_std_m);
+  }
+}
+
+TEST(SlamModel, TrackingLossFreezesAndRelocalizes) {
+  SlamConfig c;
+  c.seed = 3;
+  c.tracking_loss_rate_per_min = 20;  // frequent, to see every state
+  c.lost_probability = 0.5;
+  const std::vector<SlamSample> s = SimulateWalk(HeadTrajectory(RectangleWalk()), c, 120.0);
+  int counts[4] = {0, 0, 0, 0};
+  for (std::size_t k = 1; k < s.size(); ++k) {
+    ++counts[static_cast<int>(s[k].state)];
+    if (s[k].state == TrackingState::kLost) {
+      // The device holds its last pose while lost.
+      EXPECT_TRUE(s[k].X_WH_est.isApprox(s[k - 1].X_WH_est, 1e-15));
+    }
+    if (s[k].state == TrackingState::kRelocalized) {
+      // One sample only, and always after a degraded state.
+      EXPECT_NE(s[k - 1].state, TrackingState::kTracking);
+      if (k + 1 < s.size()) {
+        EXPECT_NE(s[k + 1].state, TrackingState::kRelocalized);
+      }
+    }
+    EXPECT_EQ(s[k].seq, static_cast<std::int64_t>(k));
+  }
+  EXPECT_GT(counts[0], 0);
+  EXPECT_GT(counts[1], 0);
+  EXPECT_GT(counts[2], 0);
+  EXPECT_GT(counts[3], 10);  // ~20/min over 2 min, most episodes end in a relocalization
+}
+
+// The hologram relation X_WV_apparent = X_WH_true · X_WH_est⁻¹ · X_WV and its consequences.
+TEST(SlamModel, HologramRelation) {
+  SlamConfig c;
+  c.seed = 11;
+  c.drift_fraction_of_distance = 0.014;
+  c.drift_yaw_deg_per_m = 0.5;
+  c.tracking_loss_rate_per_min = 2;
+  const std::vector<SlamSample> s = SimulateWalk(HeadTrajectory(RectangleWalk()), c, 60.0);
+  const SlamSample& x = s.back();
+  ASSERT_GT((x.X_WH_true.translation() - x.X_WH_est.translation()).norm(), 0.01);  // a real error
+
+  // (1) Head-locked content (placed relative to the estimated head) is exactly where it should be
+  //     relative to the true head, whatever the tracking error.
+  Eigen::Isometry3d X_HV = Eigen::Isometry3d::Identity();
+  X_HV.translation() = Eigen::Vector3d(0.1, 0.05, 1.2);
+  X_HV.linear() = Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  const Eigen::Isometry3d head_locked = ApparentPose(x.X_WH_true, x.X_WH_est, x.X_WH_est * X_HV);
+  EXPECT_TRUE(head_locked.isApprox(x.X_WH_true * X_HV, 1e-12));
+
+  // (2) The device's overlay in its own camera image (drawn with X_WC_est) falls where the true
+  //     camera sees the apparent hologram.
+  const Intrinsics in = Intrinsics::HoloLensPv();
+  Eigen::Isometry3d X_WV = Eigen::Isometry3d::Identity();
+  X_WV.translation() = Eigen::Vector3d(0.25, -0.55, 0.75);
+  const Eigen::Isometry3d apparent = ApparentPose(x.X_WH_true, x.X_WH_est, X_WV);
+  const CameraMatrix P_est = MakeCameraMatrix(in.K(), x.X_WC_est);
+  const CameraMatrix P_true = MakeCameraMatrix(in.K(), x.X_WC_true);
+  for (const Eigen::Vector3d& p_V : {Eigen::Vector3d(0, 0, 0.5), Eigen::Vector3d(0.1, -0.2, 1.1)}) {
+    Eigen::Vector2d u_device, u_true;
+    ASSERT_TRUE(Project(P_est, X_WV * p_V, &u_device));
+    ASSERT_TRUE(Project(P_true, apparent * p_V, &u_true));
+    EXPECT_LT((u_device - u_true).norm(), 1e-6);
+  }
+
+  // (3) With a purely translational error (no yaw drift, no jitter, no relocalization), every
+  //     hologram point is shifted by the same p_WH_true − p_WH_est.
+  SlamConfig t = c;
+  t.drift_yaw_deg_per_m = 0;
+  t.jitter_rotation_std_deg = 0;
+  t.jitter_translation_std_m = 0;
+  t.tracking_loss_rate_per_min = 0;
+  const SlamSample y = SimulateWalk(HeadTrajectory(RectangleWalk()), t, 60.0).back();
+  const Eigen::Vector3d shift = y.X_WH_true.translation() - y.X_WH_est.translation();
+  ASSERT_GT(shift.norm(), 0.01);
+  const Eigen::Isometry3d moved = ApparentPose(y.X_WH_true, y.X_WH_est, X_WV);
+  for (const Eigen::Vector3d& p_V : {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0.3, 0.2, 1.3)}) {
+    EXPECT_LT((moved * p_V - X_WV * p_V - shift).norm(), 1e-12);
+  }
+  EXPECT_TRUE(moved.linear().isApprox(X_WV.linear(), 1e-12));
+}
+
+TEST(SlamModel, SameSeedSameWalk) {
+  SlamConfig c;
+  c.seed = 5;
+  const HeadTrajectory walk(RectangleWalk());
+  const auto a = SimulateWalk(walk, c, 10.0);
+  const auto b = SimulateWalk(walk, c, 10.0);
+  ASSERT_EQ(a.size(), b.size());
+  EXPECT_TRUE(a.back().X_WH_est.isApprox(b.back().X_WH_est, 0));
+  c.seed = 6;
+  EXPECT_FALSE(SimulateWalk(walk, c, 10.0).back().X_WH_est.isApprox(a.back().X_WH_est, 1e-9));
+}
+
+TEST(SlamConfig, ShippedFilesLoad) {
+  const SlamConfig c = LoadSlamConfigFile(SourcePath(kDefaultSlamConfigRelativePath));
+  EXPECT_DOUBLE_EQ(c.rate_hz, 60.0);
+  EXPECT_DOUBLE_EQ(c.drift_fraction_of_distance, 0.01);
+  EXPECT_NEAR(c.X_HC.translation().z(), 0.06, 1e-12);
+  const HeadTrajectoryConfig w = LoadHeadTrajectoryFile(SourcePath("hmd_emulator/config/viraal_walk.yaml"));
+  EXPECT_EQ(w.waypoints.size(), 2u);
+}
+
+TEST(SlamConfig, ErrorsNameFileKeyAndExpectation) {
+  auto parse = [](const std::string& text) {
+    return ParseSlamConfig(YamlFields::LoadString(text, "bad.yaml")["slam"], "bad.yaml");
+  };
+  try {
+    parse("slam:\n  drift:\n    fraction_of_distance: -1\n");
+    FAIL() << "expected an error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "bad.yaml:3: slam.drift.fraction_of_distance: expected a number in [0, 0.2], got '-1'");
+  }
+  try {
+    parse("slam:\n  jiter: {}\n");
+    FAIL() << "expected an error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("bad.yaml:2: slam.jiter: unknown key; expected one of:"), std::string::npos)
+        << e.what();
+  }
+  try {
+    ParseHeadTrajectory(YamlFields::LoadString("speed_m_per_s: 1\nlook_at_m: [0, 0]\nwaypoints: []\n", "w.yaml"),
+                        "w.yaml");
+    FAIL() << "expected an error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), "w.yaml:2: head_trajectory.look_at_m: expected a list of 3 numbers [m]");
+  }
+}
+
+}  // namespace
+}  // namespace orbed::hmd

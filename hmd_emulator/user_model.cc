@@ -1,0 +1,352 @@
+#include "hmd_emulator/user_model.h"
+
+#include <cmath>
+#include <stdexcept>
+
+#include "hmd_emulator/random.h"
+#include "hmd_emulator/yaml_fields.h"
+#include "sim/scene.h"
+
+namespace orbed::hmd {
+namespace {
+
+constexpr double kArcminToRad = M_PI / (180.0 * 60.0);
+constexpr double kDegToRad = M_PI / 180.0;
+
+Eigen::Matrix3d Skew(const Eigen::Vector3d& w) {
+  Eigen::Matrix3d S;
+  S << 0, -w.z(), w.y(), w.z(), 0, -w.x(), -w.y(), w.x(), 0;
+  return S;
+}
+
+// d(point)/d(ξ) for the nudge x' = c + exp(ω)(x − c) + v at ξ = 0: [−[x − c]×, I].
+Eigen::Matrix<double, 3, 6> PointJacobian(const Eigen::Vector3d& x, const Eigen::Vector3d& c) {
+  Eigen::Matrix<double, 3, 6> J;
+  J.leftCols<3>() = -Skew(x - c);
+  J.rightCols<3>() = Eigen::Matrix3d::Identity();
+  return J;
+}
+
+Eigen::Vector3d Centroid(const std::vector<Eigen::Vector3d>& p) {
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  for (const auto& x : p) c += x;
+  return p.empty() ? c : Eigen::Vector3d(c / static_cast<double>(p.size()));
+}
+
+// Pixel of p_W through the camera at X_WC with K, and du/dp_W (2×3). False behind the camera.
+bool ProjectWithJacobian(const Intrinsics& in, const Eigen::Isometry3d& X_CW, const Eigen::Vector3d& p_W,
+                         Eigen::Vector2d* uv, Eigen::Matrix<double, 2, 3>* J) {
+  const Eigen::Vector3d y = X_CW * p_W;
+  if (!(y.z() > 1e-6)) return false;
+  const double iz = 1.0 / y.z();
+  *uv = Eigen::Vector2d(in.fx_px * y.x() * iz + in.cx_px, in.fy_px * y.y() * iz + in.cy_px);
+  Eigen::Matrix<double, 2, 3> du_dy;
+  du_dy << in.fx_px * iz, 0, -in.fx_px * y.x() * iz * iz, 0, in.fy_px * iz, -in.fy_px * y.y() * iz * iz;
+  *J = du_dy * X_CW.linear();
+  return true;
+}
+
+bool InImage(const Intrinsics& in, const Eigen::Vector2d& uv) {
+  return uv.x() >= 0 && uv.y() >= 0 && uv.x() <= in.width_px - 1 && uv.y() <= in.height_px - 1;
+}
+
+}  // namespace
+
+UserConfig ParseUserConfig(const YAML::Node& node, const std::string& source, const std::string& key) {
+  const YamlFields f(source);
+  f.CheckKeys(node, key, {"seed", "start_offset", "direct_view", "reflective_display", "belief", "nudging", "time"});
+  UserConfig c;
+  c.seed = static_cast<std::uint64_t>(f.IntegerOr(node, "seed", key, 1, 0, (1LL << 62)));
+  if (node["start_offset"]) {
+    const std::string k = key + ".start_offset";
+    const YAML::Node s = node["start_offset"];
+    f.CheckKeys(s, k, {"position_m", "rpy_deg"});
+    c.X_RV_start.translation() = f.Vector3(f.Required(s, "position_m", k + ".position_m"), k + ".position_m", "m");
+    if (s["rpy_deg"]) c.X_RV_start.linear() = sim::RotationFromRpyDeg(f.Vector3(s["rpy_deg"], k + ".rpy_deg", "deg"));
+  }
+  const double inf = INFINITY;
+  {
+    const std::string k = key + ".direct_view";
+    const YAML::Node d = f.Section(node, "direct_view", k);
+    f.CheckKeys(d, k, {"lateral_noise_arcmin", "lateral_bias_arcmin", "depth_bias_fraction_std",
+                       "depth_user_bias_fraction_std", "depth_noise_fraction_std", "user_scale_log_sigma",
+                       "size_blind"});
+    c.size_blind = f.BoolOr(d, "size_blind", k, c.size_blind);
+    c.lateral_noise_arcmin = f.NumberOr(d, "lateral_noise_arcmin", k, c.lateral_noise_arcmin, 0, 600, "arcmin");
+    c.lateral_bias_arcmin = f.NumberOr(d, "lateral_bias_arcmin", k, c.lateral_bias_arcmin, 0, 600, "arcmin");
+    c.depth_bias_fraction_std = f.NumberOr(d, "depth_bias_fraction_std", k, c.depth_bias_fraction_std, 0, 1);
+    c.depth_user_bias_fraction_std =
+        f.NumberOr(d, "depth_user_bias_fraction_std", k, c.depth_user_bias_fraction_std, 0, 1);
+    c.depth_noise_fraction_std = f.NumberOr(d, "depth_noise_fraction_std", k, c.depth_noise_fraction_std, 0, 1);
+    c.user_scale_log_sigma = f.NumberOr(d, "user_scale_log_sigma", k, c.user_scale_log_sigma, 0, 3);
+  }
+  {
+    const std::string k = key + ".reflective_display";
+    const YAML::Node d = f.Section(node, "reflective_display", k);
+    f.CheckKeys(d, k, {"noise_px", "bias_px"});
+    c.display_noise_px = f.NumberOr(d, "noise_px", k, c.display_noise_px, 0, 1000, "px");
+    c.display_bias_px = f.NumberOr(d, "bias_px", k, c.display_bias_px, 0, 1000, "px");
+  }
+  {
+    const std::string k = key + ".belief";
+    const YAML::Node d = f.Section(node, "belief", k);
+    f.CheckKeys(d, k, {"lateral_arcmin", "depth_fraction", "display_px"});
+    c.assumed_lateral_arcmin = f.NumberOr(d, "lateral_arcmin", k, c.assumed_lateral_arcmin, 1e-3, 600, "arcmin");
+    c.assumed_depth_fraction = f.NumberOr(d, "depth_fraction", k, c.assumed_depth_fraction, 1e-5, 1);
+    c.assumed_display_px = f.NumberOr(d, "display_px", k, c.assumed_display_px, 1e-3, 1000, "px");
+  }
+  {
+    const std::string k = key + ".nudging";
+    const YAML::Node d = f.Section(node, "nudging", k);
+    f.CheckKeys(d, k, {"gain", "motor_noise_fraction", "max_nudges", "stop_lateral_arcmin", "stop_depth_fraction",
+                       "stop_display_px", "min_step_m", "min_step_deg"});
+    c.gain = f.NumberOr(d, "gain", k, c.gain, 0.01, 1.5);
+    c.motor_noise_fraction = f.NumberOr(d, "motor_noise_fraction", k, c.motor_noise_fraction, 0, 1);
+    c.max_nudges = static_cast<int>(f.IntegerOr(d, "max_nudges", k, c.max_nudges, 1, 10000));
+    c.stop_lateral_arcmin = f.NumberOr(d, "stop_lateral_arcmin", k, c.stop_lateral_arcmin, 0, 600, "arcmin");
+    c.stop_depth_fraction = f.NumberOr(d, "stop_depth_fraction", k, c.stop_depth_fraction, 0, 1);
+    c.stop_display_px = f.NumberOr(d, "stop_display_px", k, c.stop_display_px, 0, 1000, "px");
+    c.min_step_m = f.NumberOr(d, "min_step_m", k, c.min_step_m, 0, 1, "m");
+    c.min_step_deg = f.NumberOr(d, "min_step_deg", k, c.min_step_deg, 0, 45, "deg");
+  }
+  {
+    const std::string k = key + ".time";
+    const YAML::Node d = f.Section(node, "time", k);
+    f.CheckKeys(d, k, {"look_s", "display_look_s", "nudge_s"});
+    c.look_time_s = f.NumberOr(d, "look_s", k, c.look_time_s, 0, inf, "s");
+    c.display_look_time_s = f.NumberOr(d, "display_look_s", k, c.display_look_time_s, 0, inf, "s");
+    c.nudge_time_s = f.NumberOr(d, "nudge_s", k, c.nudge_time_s, 0, inf, "s");
+  }
+  return c;
+}
+
+UserConfig LoadUserConfigFile(const std::string& path) {
+  const YAML::Node root = YamlFields::LoadFile(path);
+  const YamlFields f(path);
+  f.CheckKeys(root, "", {"user"});
+  return ParseUserConfig(f.Required(root, "user", "user"), path);
+}
+
+std::vector<Eigen::Vector3d> RobotModelPoints(const sim::RobotModel& model, const Eigen::VectorXd& q_rad) {
+  const std::vector<Eigen::Isometry3d> X_RL = model.CalcLinkPoses(q_rad);
+  std::vector<Eigen::Vector3d> points;
+  auto add = [&points](const Eigen::Vector3d& p) {
+    for (const auto& x : points) {
+      if ((x - p).norm() < 1e-3) return;  // one point per place (capsule caps repeat link origins)
+    }
+    points.push_back(p);
+  };
+  for (int i = 0; i < model.num_links(); ++i) {
+    add(X_RL[i].translation());
+    for (const auto& g : model.links()[i].collision) {
+      const Eigen::Isometry3d X_RG = X_RL[i] * g.X_LG;
+      add(X_RG.translation());
+      if (g.kind == sim::CollisionPrimitive::Kind::kCylinder || g.kind == sim::CollisionPrimitive::Kind::kCapsule) {
+        const Eigen::Vector3d half = 0.5 * g.length_m * X_RG.linear().col(2);
+        add(X_RG.translation() + half);
+        add(X_RG.translation() - half);
+      }
+    }
+  }
+  return points;
+}
+
+EmulatedUser::EmulatedUser(const UserConfig& config) : config_(config) {
+  Random person(config.seed);
+  depth_scale_ = person.LogNormalUnitMedian(config.user_scale_log_sigma);
+  depth_user_bias_ = config.depth_user_bias_fraction_std * person.Normal();
+}
+
+AlignmentResult EmulatedUser::Align(const ViewingContext& ctx, const std::vector<Eigen::Vector3d>& p_RQ,
+                                    const Eigen::Isometry3d& X_WV_start, std::uint64_t trial_seed) const {
+  if (p_RQ.empty()) throw std::invalid_argument("EmulatedUser::Align: no model points");
+  const UserConfig& c = config_;
+  Random rng(trial_seed);
+
+  // Biases held through the trial.
+  const Eigen::Vector2d alpha_rad(c.lateral_bias_arcmin * kArcminToRad * rng.Normal(),
+                                  c.lateral_bias_arcmin * kArcminToRad * rng.Normal());
+  const double beta = depth_scale_ * (depth_user_bias_ + c.depth_bias_fraction_std * rng.Normal());
+  std::vector<Eigen::Vector2d> display_bias_px;
+  for (std::size_t j = 0; j < ctx.displays.size(); ++j) {
+    display_bias_px.emplace_back(c.display_bias_px * rng.Normal(), c.display_bias_px * rng.Normal());
+  }
+
+  // The scene as it is: real points, the eye, the hologram's apparent-pose map A.
+  const Eigen::Isometry3d A = ctx.X_WH_true * ctx.X_WH_est.inverse();
+  const Eigen::Vector3d p_W_eye = ctx.X_WH_true.translation();
+  const std::size_t n = p_RQ.size();
+  std::vector<Eigen::Vector3d> r(n);
+  for (std::size_t k = 0; k < n; ++k) r[k] = ctx.X_WR * p_RQ[k];
+  const Eigen::Vector3d p_RC = Centroid(p_RQ);
+  const Eigen::Vector3d real_c = ctx.X_WR * p_RC;
+
+  // Each display's captured image of the real robot (true camera pose), and its overlay camera.
+  struct DisplayState {
+    Eigen::Isometry3d X_CW_est;
+    std::vector<bool> seen;
+    std::vector<Eigen::Vector2d> u_real;
+  };
+  std::vector<DisplayState> displays;
+  for (const auto& d : ctx.displays) {
+    DisplayState s;
+    s.X_CW_est = d.X_WC_est.inverse();
+    const CameraMatrix P_true = MakeCameraMatrix(d.intrinsics.K(), d.X_WC_true);
+    s.seen.assign(n, false);
+    s.u_real.assign(n, Eigen::Vector2d::Zero());
+    for (std::size_t k = 0; k < n; ++k) {
+      Eigen::Vector2d uv;
+      if (Project(P_true, r[k], &uv) && InImage(d.intrinsics, uv)) {
+        s.seen[k] = true;
+        s.u_real[k] = uv;
+      }
+    }
+    displays.push_back(std::move(s));
+  }
+
+  const double w_lat = 1.0 / std::pow(c.assumed_lateral_arcmin * kArcminToRad, 2);  // × 1/ρ²
+  const double w_depth = 1.0 / std::pow(c.assumed_depth_fraction, 2);              // × 1/ρ²
+  const double w_px = 1.0 / std::pow(c.assumed_display_px, 2);
+
+  AlignmentResult result;
+  Eigen::Isometry3d X_WV = X_WV_start;
+  while (true) {
+    // Look.
+    result.duration_s += c.look_time_s + c.display_look_time_s * static_cast<double>(displays.size());
+    const Eigen::Vector3d c_W = X_WV * p_RC;  // the nudge's pivot, map coordinates
+    // Unknowns: the nudge ξ (6) and, when the person is blind to small size differences, the
+    // apparent image scale σ of the hologram about the real robot's centroid (a nuisance they
+    // cannot act on: index 6).
+    Eigen::Matrix<double, 7, 7> H = Eigen::Matrix<double, 7, 7>::Zero();
+    Eigen::Matrix<double, 7, 1> g = Eigen::Matrix<double, 7, 1>::Zero();
+    double depth2 = 0, px2 = 0;
+    int num_px = 0;
+    // Per point: perceived lateral discrepancy and its size-nuisance direction, over ρ [rad].
+    std::vector<Eigen::Vector2d> lateral_rad, size_dir_rad;
+    for (std::size_t k = 0; k < n; ++k) {
+      const Eigen::Vector3d x = X_WV * p_RQ[k];
+      const Eigen::Vector3d h = A * x;
+      const Eigen::Vector3d ray = r[k] - p_W_eye;
+      const double rho = ray.norm();
+      if (!(rho > 1e-3)) continue;
+      const Eigen::Vector3d nr = ray / rho;
+      Eigen::Vector3d a = nr.cross(Eigen::Vector3d::UnitZ());
+      a = a.norm() > 1e-6 ? Eigen::Vector3d(a.normalized()) : nr.unitOrthogonal();
+      const Eigen::Vector3d b = nr.cross(a);
+      const Eigen::Vector3d d = h - r[k];
+      const Eigen::Vector3d perceived(
+          a.dot(d) + rho * (alpha_rad.x() + c.lateral_noise_arcmin * kArcminToRad * rng.Normal()),
+          b.dot(d) + rho * (alpha_rad.y() + c.lateral_noise_arcmin * kArcminToRad * rng.Normal()),
+          nr.dot(d) + rho * (beta + depth_scale_ * c.depth_noise_fraction_std * rng.Normal()));
+      depth2 += perceived.z() * perceived.z() / (rho * rho);
+      Eigen::Matrix3d B;
+      B.row(0) = a.transpose();
+      B.row(1) = b.transpose();
+      B.row(2) = nr.transpose();
+      Eigen::Matrix<double, 3, 7> J = Eigen::Matrix<double, 3, 7>::Zero();
+      J.leftCols<6>() = B * A.linear() * PointJacobian(x, c_W);
+      if (c.size_blind) {
+        // A uniform scale of what is seen about the centroid's line of sight moves each point
+        // across its ray by σ · (r − c) (the perspective signature of a shift along that line).
+        J(0, 6) = a.dot(r[k] - real_c);
+        J(1, 6) = b.dot(r[k] - real_c);
+      }
+      lateral_rad.emplace_back(perceived.x() / rho, perceived.y() / rho);
+      size_dir_rad.emplace_back(J(0, 6) / rho, J(1, 6) / rho);
+      const Eigen::Vector3d w = Eigen::Vector3d(w_lat, w_lat, w_depth) / (rho * rho);
+      H += J.transpose() * w.asDiagonal() * J;
+      g += J.transpose() * w.asDiagonal() * perceived;
+    }
+    for (std::size_t j = 0; j < displays.size(); ++j) {
+      const DisplayState& s = displays[j];
+      for (std::size_t k = 0; k < n; ++k) {
+        if (!s.seen[k]) continue;
+        const Eigen::Vector3d x = X_WV * p_RQ[k];
+        Eigen::Vector2d u_virtual;
+        Eigen::Matrix<double, 2, 3> du_dx;
+        if (!ProjectWithJacobian(ctx.displays[j].intrinsics, s.X_CW_est, x, &u_virtual, &du_dx)) continue;
+        const Eigen::Vector2d perceived = u_virtual - s.u_real[k] + display_bias_px[j] +
+                                          c.display_noise_px * Eigen::Vector2d(rng.Normal(), rng.Normal());
+        px2 += perceived.squaredNorm();
+        ++num_px;
+        Eigen::Matrix<double, 2, 7> J = Eigen::Matrix<double, 2, 7>::Zero();
+        J.leftCols<6>() = du_dx * PointJacobian(x, c_W);
+        H += w_px * J.transpose() * J;
+        g += w_px * J.transpose() * perceived;
+      }
+    }
+    // Decide the nudge: one Gauss–Newton step on the perceived discrepancies (tiny damping keeps an
+    // unobservable direction, if any, still).
+    const double damping = 1e-12 * std::max(1.0, H.trace() / 7.0);
+    if (!c.size_blind) H(6, 6) = 1.0;  // σ fixed at 0
+    const Eigen::Matrix<double, 7, 1> solution =
+        -(H + damping * Eigen::Matrix<double, 7, 7>::Identity()).ldlt().solve(g);
+    const Eigen::Matrix<double, 6, 1> xi = solution.head<6>();
+
+    // What the person judges: lateral discrepancies net of the size difference they do not see.
+    const double sigma = -solution[6];  // the image scale that best explains what they see
+    double lat2 = 0;
+    for (std::size_t k = 0; k < lateral_rad.size(); ++k) {
+      lat2 += (lateral_rad[k] - sigma * size_dir_rad[k]).squaredNorm();
+    }
+    const double num_direct = std::max<double>(1.0, static_cast<double>(lateral_rad.size()));
+    result.perceived_lateral_arcmin = std::sqrt(lat2 / num_direct) / kArcminToRad;
+    result.perceived_depth_fraction = std::sqrt(depth2 / num_direct);
+    result.perceived_display_px = num_px > 0 ? std::sqrt(px2 / num_px) : 0.0;
+    result.display_points_seen = num_px;
+
+    const bool satisfied = result.perceived_lateral_arcmin <= c.stop_lateral_arcmin &&
+                           result.perceived_depth_fraction <= c.stop_depth_fraction &&
+                           (num_px == 0 || result.perceived_display_px <= c.stop_display_px);
+    if (satisfied) {
+      result.stop_reason = "aligned";
+      break;
+    }
+    if (result.nudges >= c.max_nudges) {
+      result.stop_reason = "max_nudges";
+      break;
+    }
+    const Eigen::Vector3d omega = xi.head<3>();
+    const Eigen::Vector3d v = xi.tail<3>();
+    if (v.norm() < c.min_step_m && omega.norm() < c.min_step_deg * kDegToRad) {
+      result.stop_reason = "no_visible_improvement";
+      break;
+    }
+    // Carry it out: a fraction of it, with motor noise on each component.
+    Eigen::Matrix<double, 6, 1> applied;
+    for (int i = 0; i < 6; ++i) applied[i] = c.gain * xi[i] * (1.0 + c.motor_noise_fraction * rng.Normal());
+    const Eigen::Vector3d w_applied = applied.head<3>();
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    if (w_applied.norm() > 0) T.linear() = Eigen::AngleAxisd(w_applied.norm(), w_applied.normalized()).toRotationMatrix();
+    T.translation() = c_W + applied.tail<3>() - T.linear() * c_W;
+    X_WV = T * X_WV;
+    X_WV.linear() = Eigen::Quaterniond(X_WV.linear()).normalized().toRotationMatrix();
+    ++result.nudges;
+    result.duration_s += c.nudge_time_s;
+  }
+  result.X_WV = X_WV;
+  return result;
+}
+
+PoseError EvaluatePose(const Eigen::Isometry3d& X_WV_cmp, const Eigen::Isometry3d& X_WR,
+                       const std::vector<Eigen::Vector3d>& p_RQ, const Eigen::Vector3d& p_W_eye) {
+  PoseError e;
+  if (p_RQ.empty()) return e;
+  const Eigen::Vector3d p_RC = Centroid(p_RQ);
+  const Eigen::Vector3d real_c = X_WR * p_RC;
+  e.centroid_error_W_m = X_WV_cmp * p_RC - real_c;
+  e.translation_error_m = e.centroid_error_W_m.norm();
+  const Eigen::Vector3d ray = real_c - p_W_eye;
+  const Eigen::Vector3d nr = ray.norm() > 0 ? Eigen::Vector3d(ray.normalized()) : Eigen::Vector3d::UnitZ();
+  e.along_ray_m = std::abs(e.centroid_error_W_m.dot(nr));
+  e.lateral_m = (e.centroid_error_W_m - e.centroid_error_W_m.dot(nr) * nr).norm();
+  e.base_translation_error_m = (X_WV_cmp.translation() - X_WR.translation()).norm();
+  e.rotation_error_deg =
+      Eigen::AngleAxisd(X_WR.linear().transpose() * X_WV_cmp.linear()).angle() / kDegToRad;
+  double sum = 0;
+  for (const auto& p : p_RQ) sum += (X_WV_cmp * p - X_WR * p).norm();
+  e.mean_point_error_m = sum / static_cast<double>(p_RQ.size());
+  return e;
+}
+
+}  // namespace orbed::hmd

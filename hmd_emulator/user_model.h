@@ -1,0 +1,179 @@
+#pragma once
+/// @file
+/// The emulated ViRAAl user (paper Sec. II-A, III-B): a person wearing the headset who nudges the
+/// virtual robot V until it looks aligned with the real robot R in everything they can see, and
+/// returns the pose they settled on (an alignment trial).
+///
+/// Frames (DESIGN.md §2; the SLAM relation of slam_model.h). W is the true world, the user's chosen
+/// X_WV is in map coordinates (the device's W'). The real robot is at X_WR (truth) at joint vector q;
+/// the virtual robot is the same model at the same q at X_WV. Model points p_RQ (= p_VQ) come from
+/// forward kinematics (RobotModelPoints). The head is truly at X_WH_true; the device believes
+/// X_WH_est, so the hologram appears at A · X_WV with A = X_WH_true · X_WH_est⁻¹ (ApparentPose).
+///
+/// What the person perceives, per look (one look before each nudge):
+///  - Direct view (see-through display, from the eye at X_WH_true's origin). For each model point,
+///    the discrepancy d = h − r between where the hologram point appears (h = A·X_WV·p) and the real
+///    point (r = X_WR·p), split along the viewing ray n (eye → r, distance ρ) and across it:
+///      lateral (2 components):  a·d + ρ·(α_trial + σ_lat·N)        [angular acuity, small]
+///      along the ray:           n·d + ρ·(β_trial + s·σ_depth·N)     [depth matching, poor]
+///    α_trial (per trial, 2D) and β_trial = s·(β_user + σ_β·N) (per trial) are biases held during a
+///    trial: a person misjudges the depth of a virtual object consistently, as a fraction of the
+///    viewing distance (AR depth-matching studies), more or less so depending on who they are:
+///    s (log-normal, median 1) and β_user are drawn once per person from the user seed, so the
+///    errors are heavy-tailed from person to person.
+///  - Each reflective display: the frame was captured earlier with the camera truly at X_WC_true and
+///    is stamped with the device's estimate X_WC_est; the overlay projects the virtual robot with
+///    the estimate, so the display carries the SLAM error of its capture time. The reversed frustum
+///    P_m (camera_model.h) only re-places and y-flips that image (the paper: D "does not affect the
+///    rendering content"; the flip is an isometry of the image), so the 2D discrepancy the person
+///    sees is, up to the sign of v, Δu = Π(K, X_WC_est, X_WV·p) − Π(K, X_WC_true, X_WR·p) [px] for
+///    the points inside the captured frame, perceived with a per-trial common offset (σ bias) and
+///    per-point pixel noise.
+/// How the person acts: they combine everything by weighted least squares over the 6 DOF of a
+/// nudge (a twist ξ = (ω, v) of the hologram about its centroid, in map coordinates), weighting each
+/// perceived component by the reliability they believe it has (assumed_* parameters), take one
+/// Gauss–Newton step, and carry out a fraction `gain` of it with motor noise. Size blindness
+/// (size_blind): moving the hologram a distance t along the line of sight also rescales its image
+/// by ~t/ρ (1.2 % for 24 mm at 2 m), below what people discriminate in size (a few per cent), so the
+/// person's fit carries a nuisance image scale σ about the centroid's line of sight, which they
+/// cannot act on: depth in the direct view then rests on depth perception alone. They stop when every
+/// perceived discrepancy is below their thresholds (lateral [arcmin], depth [fraction of ρ],
+/// display [px]), when the step they would take is too small to bother (min_step_*), or after
+/// max_nudges. Nothing about "the mirror helps" is written in: the display's image plane, seen from
+/// another viewpoint, contains the direct view's ray direction, so it constrains the depth that the
+/// direct view leaves ambiguous, with its own (SLAM) error.
+///
+/// Every parameter is in UserConfig, loaded from hmd_emulator/config/user.yaml (sources beside each
+/// default there). Units: m, rad inside; arcmin/deg/px/fraction only where the name says so.
+/// Threading: an EmulatedUser is immutable after construction; Align is const and draws its
+/// randomness from the trial seed, so trials may run on several threads.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+#include <yaml-cpp/yaml.h>
+
+#include "hmd_emulator/camera_model.h"
+#include "sim/robot_model.h"
+
+namespace orbed::hmd {
+
+struct UserConfig {
+  std::uint64_t seed{1};  ///< the person
+  // Direct view (see-through display).
+  double lateral_noise_arcmin{1.5};
+  double lateral_bias_arcmin{1.0};
+  double depth_bias_fraction_std{0.012};
+  double depth_user_bias_fraction_std{0.006};
+  double depth_noise_fraction_std{0.004};
+  double user_scale_log_sigma{0.5};
+  /// The person does not see small differences in the hologram's overall size: the perspective
+  /// scale change that a shift along the line of sight causes is not taken as misalignment.
+  bool size_blind{true};
+  // Reflective display.
+  double display_noise_px{2.0};
+  double display_bias_px{1.5};
+  // What the person believes their perception is worth (weights of the least squares).
+  double assumed_lateral_arcmin{2.0};
+  double assumed_depth_fraction{0.02};
+  double assumed_display_px{3.0};
+  // Nudging.
+  double gain{0.6};
+  double motor_noise_fraction{0.15};
+  int max_nudges{40};
+  double stop_lateral_arcmin{3.0};
+  double stop_depth_fraction{0.01};
+  double stop_display_px{4.0};
+  double min_step_m{0.001};
+  double min_step_deg{0.1};
+  // Time.
+  double look_time_s{2.0};
+  double display_look_time_s{4.0};
+  double nudge_time_s{5.5};
+  // The virtual robot's known starting offset from the real base, X_RV0 (used by StartPose).
+  Eigen::Isometry3d X_RV_start{Eigen::Isometry3d::Identity()};
+};
+
+/// Reads the `user:` mapping; every key optional (defaults above) and checked.
+UserConfig ParseUserConfig(const YAML::Node& node, const std::string& source, const std::string& key = "user");
+/// Loads the `user:` mapping of a YAML file (e.g. hmd_emulator/config/user.yaml).
+UserConfig LoadUserConfigFile(const std::string& path);
+inline constexpr const char* kDefaultUserConfigRelativePath = "hmd_emulator/config/user.yaml";
+
+/// Points on the robot in its base frame R at joint vector q: each link origin and the centre and
+/// axis end points of each collision primitive. Throws std::invalid_argument on a wrong q size.
+std::vector<Eigen::Vector3d> RobotModelPoints(const sim::RobotModel& model, const Eigen::VectorXd& q_rad);
+
+/// One reflective display as it stands during the trial: the frame it shows was captured with the
+/// camera truly at X_WC_true and stamped X_WC_est (the estimate at capture time).
+struct ReflectiveDisplayView {
+  Intrinsics intrinsics;
+  Eigen::Isometry3d X_WC_true{Eigen::Isometry3d::Identity()};
+  Eigen::Isometry3d X_WC_est{Eigen::Isometry3d::Identity()};
+  double D_m{1.5};  ///< gaze distance of the reversed frustum (places the display; no effect here)
+};
+
+/// Everything that decides what the person sees during one trial.
+struct ViewingContext {
+  Eigen::Isometry3d X_WR{Eigen::Isometry3d::Identity()};        ///< real robot base (truth)
+  Eigen::Isometry3d X_WH_true{Eigen::Isometry3d::Identity()};   ///< head while aligning
+  Eigen::Isometry3d X_WH_est{Eigen::Isometry3d::Identity()};    ///< the device's estimate then
+  std::vector<ReflectiveDisplayView> displays;                  ///< empty: AR only
+};
+
+struct AlignmentResult {
+  Eigen::Isometry3d X_WV{Eigen::Isometry3d::Identity()};  ///< chosen pose, map coordinates
+  double duration_s{0};
+  int nudges{0};
+  /// "aligned" (thresholds met), "no_visible_improvement" (step below min_step), "max_nudges".
+  std::string stop_reason;
+  /// At the last look: RMS of the perceived lateral [arcmin] and depth [fraction of ρ] discrepancy in
+  /// the direct view, and of the display discrepancy [px] (0 without displays).
+  double perceived_lateral_arcmin{0};
+  double perceived_depth_fraction{0};
+  double perceived_display_px{0};
+  int display_points_seen{0};  ///< model points inside the captured frame(s) at the last look
+};
+
+class EmulatedUser {
+ public:
+  /// Draws the person (depth-error scale and personal depth bias) from config.seed.
+  explicit EmulatedUser(const UserConfig& config);
+
+  /// One trial from X_WV_start (map coordinates). p_RQ: model points (RobotModelPoints), the same on
+  /// the real and the virtual robot. trial_seed: the trial's own randomness.
+  AlignmentResult Align(const ViewingContext& context, const std::vector<Eigen::Vector3d>& p_RQ,
+                        const Eigen::Isometry3d& X_WV_start, std::uint64_t trial_seed) const;
+
+  /// X_WV_start = X_WR_nominal · X_RV_start: the virtual robot shown at its known offset.
+  Eigen::Isometry3d StartPose(const Eigen::Isometry3d& X_WR_nominal) const { return X_WR_nominal * config_.X_RV_start; }
+
+  const UserConfig& config() const { return config_; }
+  double depth_scale() const { return depth_scale_; }                ///< s
+  double depth_user_bias_fraction() const { return depth_user_bias_; }  ///< β_user
+
+ private:
+  UserConfig config_;
+  double depth_scale_{1};
+  double depth_user_bias_{0};
+};
+
+/// The error of a virtual robot pose X_WV_cmp (map coordinates, or an apparent pose) against the
+/// real one, on the model points: the centroid's displacement e [m] split along the viewing ray from
+/// p_W_eye to the real centroid and across it, the base origin's displacement, the rotation angle,
+/// and the mean point displacement.
+struct PoseError {
+  Eigen::Vector3d centroid_error_W_m{Eigen::Vector3d::Zero()};
+  double translation_error_m{0};       ///< ‖e‖ at the model centroid
+  double along_ray_m{0};               ///< |e · n|
+  double lateral_m{0};                 ///< ‖e − (e · n) n‖
+  double base_translation_error_m{0};  ///< ‖p_WV − p_WR‖
+  double rotation_error_deg{0};
+  double mean_point_error_m{0};
+};
+PoseError EvaluatePose(const Eigen::Isometry3d& X_WV_cmp, const Eigen::Isometry3d& X_WR,
+                       const std::vector<Eigen::Vector3d>& p_RQ, const Eigen::Vector3d& p_W_eye);
+
+}  // namespace orbed::hmd

@@ -1,0 +1,187 @@
+// The emulated ViRAAl user. Oracles: the truth (a perfect perceiver with perfect tracking ends at
+// X_WR), the geometry of the viewing ray, and the statistical claims of the paper's Table 1 tested
+// with the rank test of stats.h (whose own oracles are hand computations).
+#include "hmd_emulator/user_model.h"
+
+#include <cmath>
+#include <cstdlib>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "hmd_emulator/stats.h"
+#include "hmd_emulator/user_study.h"
+#include "hmd_emulator/yaml_fields.h"
+#include "sim/scene.h"
+
+namespace orbed::hmd {
+namespace {
+
+std::string SourceDir() {
+  const char* root = std::getenv("ORBED_SOURCE_DIR");
+  return root ? root : ".";
+}
+
+sim::RobotModel Robot() { return sim::RobotModel::LoadFile(SourceDir() + "/" + sim::RobotModel::kDefaultUrdfRelativePath); }
+
+TEST(RobotModelPoints, OnTheUprightArm) {
+  const sim::RobotModel robot = Robot();
+  const std::vector<Eigen::Vector3d> p = RobotModelPoints(robot, Eigen::VectorXd::Zero(7));
+  ASSERT_GE(p.size(), 15u);
+  double z_max = 0;
+  for (const auto& x : p) {
+    // Upright (q = 0): every axis point within the links' 0.2 m of the vertical axis, above the base.
+    EXPECT_LT(std::hypot(x.x(), x.y()), 0.2);
+    EXPECT_GE(x.z(), -1e-9);
+    z_max = std::max(z_max, x.z());
+  }
+  // The flange is at d1 + d3 + d5 + d7 = 0.34 + 0.4 + 0.4 + 0.126 = 1.266 m (DH), the tool beyond.
+  EXPECT_GE(z_max, 1.266 - 1e-6);
+  EXPECT_THROW(RobotModelPoints(robot, Eigen::VectorXd::Zero(3)), std::invalid_argument);
+}
+
+// A person who perceives perfectly, with perfect tracking, ends where the real robot is.
+TEST(EmulatedUser, PerfectPerceiverFindsTheTruth) {
+  const sim::RobotModel robot = Robot();
+  const std::vector<Eigen::Vector3d> p_RQ = RobotModelPoints(robot, sim::DegToRad((Eigen::VectorXd(7) << 0, 20, 0, -70, 0, 60, 0).finished()));
+  UserConfig c;
+  c.lateral_noise_arcmin = c.lateral_bias_arcmin = 0;
+  c.depth_bias_fraction_std = c.depth_user_bias_fraction_std = c.depth_noise_fraction_std = 0;
+  c.display_noise_px = c.display_bias_px = 0;
+  c.motor_noise_fraction = 0;
+  c.stop_lateral_arcmin = 0.05;
+  c.stop_depth_fraction = 1e-4;
+  c.stop_display_px = 0.05;
+  c.min_step_m = 1e-5;
+  c.min_step_deg = 1e-4;
+  c.X_RV_start.translation() = Eigen::Vector3d(0.10, -0.08, 0.05);
+  c.X_RV_start.linear() = Eigen::AngleAxisd(0.07, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  const EmulatedUser user(c);
+
+  ViewingContext ctx;
+  ctx.X_WR.translation() = Eigen::Vector3d(0.25, -0.55, 0.75);
+  ctx.X_WR.linear() = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  ctx.X_WH_true = LookAt({-0.75, -1.4, 1.7}, {0.25, -0.45, 1.25});
+  ctx.X_WH_est = ctx.X_WH_true;
+  for (const bool with_display : {false, true}) {
+    if (with_display) {
+      ReflectiveDisplayView d;
+      d.X_WC_true = d.X_WC_est = LookAt({1.45, -1.2, 1.7}, {0.25, -0.45, 1.25});
+      ctx.displays.push_back(d);
+    }
+    const AlignmentResult r = user.Align(ctx, p_RQ, user.StartPose(ctx.X_WR), 42);
+    EXPECT_EQ(r.stop_reason, "aligned");
+    const PoseError e = EvaluatePose(r.X_WV, ctx.X_WR, p_RQ, ctx.X_WH_true.translation());
+    EXPECT_LT(e.translation_error_m, 0.5e-3) << "display " << with_display;
+    EXPECT_LT(e.rotation_error_deg, 0.05);
+    EXPECT_GT(r.nudges, 3);
+    EXPECT_GT(r.duration_s, 0);
+    if (with_display) {
+      EXPECT_GT(r.display_points_seen, 5);
+    }
+  }
+}
+
+// With tracking perfect and only a depth misjudgement β, the person's error is along the ray and
+// about β · ρ (ρ ≈ 1.6 m to the robot's middle).
+TEST(EmulatedUser, DepthMisjudgementMovesAlongTheRay) {
+  const sim::RobotModel robot = Robot();
+  const std::vector<Eigen::Vector3d> p_RQ = RobotModelPoints(robot, sim::DegToRad((Eigen::VectorXd(7) << 0, 20, 0, -70, 0, 60, 0).finished()));
+  UserConfig c;
+  c.lateral_noise_arcmin = c.lateral_bias_arcmin = 0;
+  c.depth_bias_fraction_std = c.depth_noise_fraction_std = 0;
+  c.user_scale_log_sigma = 0;
+  c.depth_user_bias_fraction_std = 0.02;
+  c.motor_noise_fraction = 0;
+  c.min_step_m = 1e-5;
+  c.min_step_deg = 1e-4;
+  c.stop_depth_fraction = 1e-4;
+  c.stop_lateral_arcmin = 0.05;
+  ViewingContext ctx;
+  ctx.X_WR.translation() = Eigen::Vector3d(0.25, -0.55, 0.75);
+  ctx.X_WH_true = ctx.X_WH_est = LookAt({-0.75, -1.4, 1.7}, {0.25, -0.45, 1.25});
+  for (std::uint64_t seed = 1; seed <= 5; ++seed) {
+    c.seed = seed;
+    const EmulatedUser user(c);
+    const AlignmentResult r = user.Align(ctx, p_RQ, user.StartPose(ctx.X_WR), seed);
+    const PoseError e = EvaluatePose(r.X_WV, ctx.X_WR, p_RQ, ctx.X_WH_true.translation());
+    const double rho = (ctx.X_WR * (Eigen::Vector3d::Zero()) - ctx.X_WH_true.translation()).norm();
+    EXPECT_LT(e.lateral_m, 0.15 * e.along_ray_m + 0.5e-3) << "seed " << seed;
+    // β · ρ with ρ between the nearest and the farthest model point (1.2 .. 2.2 m).
+    const double beta = std::abs(user.depth_user_bias_fraction());
+    EXPECT_GT(e.along_ray_m, beta * 1.0 - 1e-3) << rho;
+    EXPECT_LT(e.along_ray_m, beta * 2.3 + 1e-3);
+  }
+}
+
+// The paper's Table 1 claim, emerging from the mechanism: 200 seeded trials per mode.
+TEST(EmulatedUser, ReflectiveDisplayReducesErrorSignificantly) {
+  StudyOptions o;
+  o.source_dir = SourceDir();
+  o.trials_per_mode = 200;
+  const std::vector<StudyMode> modes = RunStudy(o);
+  ASSERT_EQ(modes.size(), 2u);
+  ASSERT_EQ(modes[0].name, "ar");
+  ASSERT_EQ(modes[1].name, "ar_reflective");
+  std::vector<double> reg[2], aug[2], along_ar, lateral_ar;
+  for (int m = 0; m < 2; ++m) {
+    for (const auto& t : modes[m].trials) {
+      reg[m].push_back(t.registration.translation_error_m);
+      aug[m].push_back(t.augmentation.translation_error_m);
+      if (m == 0) {
+        along_ar.push_back(t.augmentation.along_ray_m);
+        lateral_ar.push_back(t.augmentation.lateral_m);
+      }
+    }
+  }
+  // Lower mean error with the reflective display, significant by the rank test (one-sided).
+  EXPECT_LT(stats::Mean(reg[1]), stats::Mean(reg[0]));
+  const stats::MannWhitneyResult mw = stats::MannWhitneyU(reg[1], reg[0]);
+  ASSERT_TRUE(mw.valid);
+  EXPECT_LT(mw.p_x_less, 0.01);
+  EXPECT_LT(stats::Mean(aug[1]), stats::Mean(aug[0]));
+  EXPECT_LT(stats::MannWhitneyU(aug[1], aug[0]).p_x_less, 0.01);
+  // Without the display, what the person leaves is mostly along the line of sight.
+  EXPECT_GT(stats::Mean(along_ar), 3.0 * stats::Mean(lateral_ar));
+  int along_dominates = 0;
+  for (std::size_t i = 0; i < along_ar.size(); ++i) along_dominates += along_ar[i] > lateral_ar[i];
+  EXPECT_GT(along_dominates, 0.8 * along_ar.size());
+  // Order of magnitude of Table 1 (30.2 ± 23.9 mm AR, 16.5 ± 11.0 mm with the display): within a
+  // factor of two.
+  EXPECT_GT(stats::Mean(reg[0]), 0.015);
+  EXPECT_LT(stats::Mean(reg[0]), 0.060);
+  EXPECT_GT(stats::Mean(reg[1]), 0.008);
+  EXPECT_LT(stats::Mean(reg[1]), 0.033);
+}
+
+TEST(EmulatedUser, SeedIsAPersonAndTrialsAreReproducible) {
+  UserConfig c;
+  c.seed = 1;
+  const EmulatedUser a(c);
+  c.seed = 2;
+  const EmulatedUser b(c);
+  EXPECT_NE(a.depth_scale(), b.depth_scale());
+  EXPECT_NE(a.depth_user_bias_fraction(), b.depth_user_bias_fraction());
+  const std::vector<Eigen::Vector3d> p_RQ = RobotModelPoints(Robot(), Eigen::VectorXd::Zero(7));
+  ViewingContext ctx;
+  ctx.X_WH_true = ctx.X_WH_est = LookAt({1.5, -1.2, 1.7}, {0, 0, 1.0});
+  const AlignmentResult r1 = a.Align(ctx, p_RQ, a.StartPose(ctx.X_WR), 9);
+  const AlignmentResult r2 = a.Align(ctx, p_RQ, a.StartPose(ctx.X_WR), 9);
+  EXPECT_TRUE(r1.X_WV.isApprox(r2.X_WV, 0));
+  EXPECT_EQ(r1.nudges, r2.nudges);
+}
+
+TEST(UserConfig, ShippedFileAndErrors) {
+  const UserConfig c = LoadUserConfigFile(SourceDir() + "/" + kDefaultUserConfigRelativePath);
+  EXPECT_DOUBLE_EQ(c.depth_bias_fraction_std, 0.012);
+  EXPECT_NEAR(c.X_RV_start.translation().x(), 0.10, 1e-12);
+  try {
+    ParseUserConfig(YamlFields::LoadString("user:\n  nudging:\n    gain: fast\n", "u.yaml")["user"], "u.yaml");
+    FAIL() << "expected an error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), "u.yaml:3: user.nudging.gain: expected a number in [0.01, 1.5], got 'fast'");
+  }
+}
+
+}  // namespace
+}  // namespace orbed::hmd

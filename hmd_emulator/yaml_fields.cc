@@ -1,0 +1,138 @@
+#include "hmd_emulator/yaml_fields.h"
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace orbed::hmd {
+namespace {
+
+std::string Range(double lo, double hi, const std::string& unit) {
+  std::ostringstream s;
+  s << "a number";
+  const bool has_lo = std::isfinite(lo), has_hi = std::isfinite(hi);
+  if (has_lo && has_hi) {
+    s << " in [" << lo << ", " << hi << "]";
+  } else if (has_lo) {
+    s << " >= " << lo;
+  } else if (has_hi) {
+    s << " <= " << hi;
+  }
+  if (!unit.empty()) s << " [" << unit << "]";
+  return s.str();
+}
+
+}  // namespace
+
+YAML::Node YamlFields::LoadFile(const std::string& path) {
+  try {
+    return YAML::LoadFile(path);
+  } catch (const YAML::BadFile&) {
+    throw std::runtime_error(path + ": cannot open the file (expected a readable YAML file)");
+  } catch (const YAML::Exception& e) {
+    throw std::runtime_error(path + ":" + std::to_string(e.mark.line + 1) + ": not valid YAML: " + e.msg);
+  }
+}
+
+YAML::Node YamlFields::LoadString(const std::string& text, const std::string& source) {
+  try {
+    return YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    throw std::runtime_error(source + ":" + std::to_string(e.mark.line + 1) + ": not valid YAML: " + e.msg);
+  }
+}
+
+void YamlFields::Fail(const YAML::Node& node, const std::string& key, const std::string& expected) const {
+  std::string where = source_;
+  if (node.IsDefined() && node.Mark().line >= 0) where += ":" + std::to_string(node.Mark().line + 1);
+  throw std::runtime_error(where + ": " + key + ": " + expected);
+}
+
+void YamlFields::CheckKeys(const YAML::Node& map, const std::string& key,
+                           const std::set<std::string>& allowed) const {
+  if (!map.IsMap()) Fail(map, key.empty() ? "(top level)" : key, "expected a mapping");
+  for (const auto& kv : map) {
+    const std::string name = kv.first.as<std::string>();
+    if (allowed.count(name)) continue;
+    std::string list;
+    for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+    Fail(kv.first, Join(key, name), "unknown key; expected one of: " + list);
+  }
+}
+
+YAML::Node YamlFields::Required(const YAML::Node& map, const std::string& name, const std::string& key) const {
+  const YAML::Node child = map[name];
+  if (!child.IsDefined() || child.IsNull()) Fail(map, key, "missing (required)");
+  return child;
+}
+
+YAML::Node YamlFields::Section(const YAML::Node& map, const std::string& name, const std::string& key) const {
+  const YAML::Node child = map[name];
+  if (!child.IsDefined() || child.IsNull()) return YAML::Node(YAML::NodeType::Map);
+  if (!child.IsMap()) Fail(child, key, "expected a mapping");
+  return child;
+}
+
+double YamlFields::Number(const YAML::Node& node, const std::string& key, double lo, double hi,
+                          const std::string& unit) const {
+  const std::string expected = Range(lo, hi, unit);
+  if (!node.IsScalar()) Fail(node, key, "expected " + expected);
+  double v = 0.0;
+  try {
+    v = node.as<double>();
+  } catch (const YAML::Exception&) {
+    Fail(node, key, "expected " + expected + ", got '" + node.Scalar() + "'");
+  }
+  if (!std::isfinite(v) || v < lo || v > hi) Fail(node, key, "expected " + expected + ", got '" + node.Scalar() + "'");
+  return v;
+}
+
+double YamlFields::NumberOr(const YAML::Node& map, const std::string& name, const std::string& prefix,
+                            double fallback, double lo, double hi, const std::string& unit) const {
+  const YAML::Node child = map[name];
+  if (!child.IsDefined()) return fallback;
+  return Number(child, Join(prefix, name), lo, hi, unit);
+}
+
+long long YamlFields::Integer(const YAML::Node& node, const std::string& key, long long lo, long long hi) const {
+  const std::string expected = "an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+  if (!node.IsScalar()) Fail(node, key, "expected " + expected);
+  long long v = 0;
+  try {
+    v = node.as<long long>();
+  } catch (const YAML::Exception&) {
+    Fail(node, key, "expected " + expected + ", got '" + node.Scalar() + "'");
+  }
+  if (v < lo || v > hi) Fail(node, key, "expected " + expected + ", got '" + node.Scalar() + "'");
+  return v;
+}
+
+long long YamlFields::IntegerOr(const YAML::Node& map, const std::string& name, const std::string& prefix,
+                                long long fallback, long long lo, long long hi) const {
+  const YAML::Node child = map[name];
+  if (!child.IsDefined()) return fallback;
+  return Integer(child, Join(prefix, name), lo, hi);
+}
+
+bool YamlFields::BoolOr(const YAML::Node& map, const std::string& name, const std::string& prefix,
+                        bool fallback) const {
+  const YAML::Node child = map[name];
+  if (!child.IsDefined()) return fallback;
+  try {
+    return child.as<bool>();
+  } catch (const YAML::Exception&) {
+    Fail(child, Join(prefix, name), "expected true or false, got '" + child.Scalar() + "'");
+  }
+}
+
+Eigen::Vector3d YamlFields::Vector3(const YAML::Node& node, const std::string& key, const std::string& unit) const {
+  const std::string expected = "a list of 3 numbers [" + unit + "]";
+  if (!node.IsSequence() || node.size() != 3) Fail(node, key, "expected " + expected);
+  Eigen::Vector3d v;
+  for (int i = 0; i < 3; ++i) {
+    v[i] = Number(node[i], key + "[" + std::to_string(i) + "]", -INFINITY, INFINITY, unit);
+  }
+  return v;
+}
+
+}  // namespace orbed::hmd
