@@ -11,6 +11,8 @@
 #include <BulletCollision/NarrowPhaseCollision/btPointCollector.h>
 #include <BulletCollision/NarrowPhaseCollision/btVoronoiSimplexSolver.h>
 
+#include "sim/distance_closed_form.h"
+
 namespace orbed::sim {
 namespace {
 
@@ -70,7 +72,7 @@ double PointDistance(const CollisionPrimitive& g, const Eigen::Vector3d& p) {
       return (p - c).norm() - g.radius_m;
     }
     case Kind::kCylinder: {
-      const Eigen::Vector2d q(std::hypot(p.x(), p.y()) - g.radius_m, std::abs(p.z()) - 0.5 * g.length_m);
+      const Eigen::Vector2d q(std::sqrt(p.x() * p.x() + p.y() * p.y()) - g.radius_m, std::abs(p.z()) - 0.5 * g.length_m);
       return q.cwiseMax(0.0).norm() + std::min(q.maxCoeff(), 0.0);
     }
     case Kind::kBox: {
@@ -115,13 +117,41 @@ std::vector<CollisionPrimitive> FuseCapsules(const std::vector<CollisionPrimitiv
   return out;
 }
 
+// The fast path's view of a Bullet shape: its core and margin as Bullet itself stores them.
+CoreShape CoreOf(const CollisionPrimitive& g, const btConvexShape& shape) {
+  CoreShape c;
+  c.margin_m = shape.getMargin();
+  switch (g.kind) {
+    case Kind::kSphere:
+      c.kind = CoreShape::Kind::kPoint;
+      break;
+    case Kind::kCapsule:
+      c.kind = CoreShape::Kind::kSegment;
+      c.half_length_m = static_cast<const btCapsuleShape&>(shape).getHalfHeight();
+      break;
+    case Kind::kBox: {
+      c.kind = CoreShape::Kind::kBox;
+      const btVector3& e = static_cast<const btBoxShape&>(shape).getHalfExtentsWithoutMargin();
+      c.half_extents_m = Eigen::Vector3d(e.x(), e.y(), e.z());
+      break;
+    }
+    case Kind::kCylinder: {
+      c.kind = CoreShape::Kind::kCylinder;
+      const btVector3& e = static_cast<const btCylinderShape&>(shape).getHalfExtentsWithoutMargin();
+      c.half_extents_m = Eigen::Vector3d(e.x(), e.x(), e.z());  // btCylinderShapeZ: radius x, half height z
+      break;
+    }
+  }
+  return c;
+}
+
 struct Child {
   CollisionPrimitive prim;
   std::unique_ptr<btConvexShape> shape;
+  CoreShape core;
   double bound_radius_m{0};
   Eigen::Isometry3d X_WC{Eigen::Isometry3d::Identity()};  // updated every query
   Eigen::Isometry3d X_CW{Eigen::Isometry3d::Identity()};  // inverse, kept for static (scene) children
-  btTransform bt_X_WC;
 };
 
 struct Body {
@@ -131,6 +161,10 @@ struct Body {
   std::vector<Child> children;
   std::unique_ptr<btCompoundShape> compound;
   std::unique_ptr<btCollisionObject> object_bt;
+  // Pose bookkeeping for the pair cache: `epoch` changes whenever X_WL differs (bitwise) from the
+  // previous query's; scene bodies never change.
+  Eigen::Isometry3d X_WL{Eigen::Isometry3d::Identity()};
+  long epoch{0};
 };
 
 struct Pair {
@@ -139,9 +173,18 @@ struct Pair {
   bool self;
 };
 
-// One exact signed distance between two posed convex shapes.
+// The last exact result of a pair and the body epochs (and path) it was computed at: when neither
+// body moved, the same inputs give the same output, so it is reused (the base link and the scene).
+struct PairCache {
+  long epoch_a{-1};
+  long epoch_b{-1};
+  bool fast_path{false};
+  SignedDistance distance;
+};
+
+// One exact signed distance between two posed convex shapes by GJK (EPA when the cores overlap).
 void GjkDistance(const btConvexShape* a, const btTransform& X_WA, const btConvexShape* b, const btTransform& X_WB,
-                 PairDistance* out) {
+                 SignedDistance* out) {
   btVoronoiSimplexSolver simplex;
   btGjkEpaPenetrationDepthSolver epa;
   btGjkPairDetector gjk(a, b, &simplex, &epa);
@@ -156,12 +199,28 @@ void GjkDistance(const btConvexShape* a, const btTransform& X_WA, const btConvex
     // of unknown depth rather than a false clearance.
     out->distance_m = -0.0;
     out->p_WA = out->p_WB = ToEigen(X_WA.getOrigin());
+    out->normal_W = Eigen::Vector3d::UnitZ();
     return;
   }
   out->distance_m = result.m_distance;
   out->p_WB = ToEigen(result.m_pointInWorld);
   out->normal_W = ToEigen(result.m_normalOnBInWorld);
   out->p_WA = out->p_WB + out->normal_W * result.m_distance;
+}
+
+// The signed distance of one primitive pair: the closed forms where they apply (fast_path), else
+// Bullet's GJK/EPA. Returns true if GJK/EPA was used.
+bool ChildDistance(const Child& a, const Child& b, bool fast_path, SignedDistance* out) {
+  if (fast_path && ClosedFormDistance(a.core, a.X_WC, b.core, b.X_WC, out)) return false;
+  GjkDistance(a.shape.get(), ToBt(a.X_WC), b.shape.get(), ToBt(b.X_WC), out);
+  return true;
+}
+
+// Lower bound on the distance of two children: bounding spheres for self pairs, the exact scene
+// shape against the robot child's bounding sphere otherwise.
+double ChildLowerBound(const Child& ca, const Child& cb, bool self) {
+  if (self) return (ca.X_WC.translation() - cb.X_WC.translation()).norm() - ca.bound_radius_m - cb.bound_radius_m;
+  return PointDistance(cb.prim, cb.X_CW * ca.X_WC.translation()) - ca.bound_radius_m;
 }
 
 }  // namespace
@@ -175,9 +234,11 @@ struct CollisionWorld::Impl {
   std::vector<int> body_of_link;  // robot link -> body index or -1
   std::vector<std::string> object_names;
   std::vector<Pair> pairs;
-  // Scratch for queries.
+  // Scratch for queries (sized once, reused).
   std::vector<double> lower_bound;
-  std::vector<int> order;
+  std::vector<char> done;
+  std::vector<int> seed;  // per link, then self group, then environment group: the pair of least bound
+  std::vector<PairCache> cache;  // per pair
 
   ~Impl() {
     for (auto& b : bodies) world.removeCollisionObject(b.object_bt.get());
@@ -187,15 +248,16 @@ struct CollisionWorld::Impl {
     body.compound = std::make_unique<btCompoundShape>(/*enableDynamicAabbTree=*/false);
     for (auto& c : body.children) {
       c.shape = MakeShape(c.prim);
+      c.core = CoreOf(c.prim, *c.shape);
       c.bound_radius_m = BoundingRadius(c.prim);
       body.compound->addChildShape(ToBt(c.prim.X_LG), c.shape.get());
       c.X_WC = X_WB * c.prim.X_LG;
       c.X_CW = c.X_WC.inverse();
-      c.bt_X_WC = ToBt(c.X_WC);
     }
     body.object_bt = std::make_unique<btCollisionObject>();
     body.object_bt->setCollisionShape(body.compound.get());
     body.object_bt->setWorldTransform(ToBt(X_WB));
+    body.X_WL = X_WB;
     world.addCollisionObject(body.object_bt.get());
     bodies.push_back(std::move(body));
   }
@@ -310,84 +372,124 @@ CollisionResult CollisionWorld::CheckPoses(const std::vector<Eigen::Isometry3d>&
   for (auto& body : im.bodies) {
     if (body.link < 0) continue;
     const Eigen::Isometry3d X_WL = X_WR_ * X_RL[body.link];
+    if (X_WL.matrix() == body.X_WL.matrix()) continue;  // unmoved (e.g. the base): children as they are
+    ++body.epoch;
+    body.X_WL = X_WL;
     body.object_bt->setWorldTransform(ToBt(X_WL));
-    for (auto& c : body.children) {
-      c.X_WC = X_WL * c.prim.X_LG;
-      c.bt_X_WC = ToBt(c.X_WC);
-    }
+    for (auto& c : body.children) c.X_WC = X_WL * c.prim.X_LG;
   }
+  if (im.cache.size() != im.pairs.size()) im.cache.assign(im.pairs.size(), PairCache{});
 
   CollisionResult result;
   result.link_clearance_m.assign(model_.num_links(), kInf);
-  const size_t n = im.pairs.size();
-  im.lower_bound.resize(n);
-  im.order.resize(n);
-  for (size_t i = 0; i < n; ++i) {
+  const bool prune = options_.prune, fast = options_.fast_path;
+  const double report = options_.report_distance_m;
+
+  // The exact distance of pair i, folded into the result.
+  auto compute = [&](int i) {
     const Pair& p = im.pairs[i];
     const Body& A = im.bodies[p.a];
     const Body& B = im.bodies[p.b];
-    double lb = kInf;
-    for (const Child& ca : A.children) {
-      for (const Child& cb : B.children) {
-        double d;
-        if (p.self) {
-          d = (ca.X_WC.translation() - cb.X_WC.translation()).norm() - ca.bound_radius_m - cb.bound_radius_m;
-        } else {
-          d = PointDistance(cb.prim, cb.X_CW * ca.X_WC.translation()) - ca.bound_radius_m;
+    PairCache& cache = im.cache[i];
+    SignedDistance& best = cache.distance;
+    if (cache.epoch_a != A.epoch || cache.epoch_b != B.epoch || cache.fast_path != fast) {
+      best.distance_m = kInf;
+      const bool single = A.children.size() == 1 && B.children.size() == 1;
+      for (const Child& ca : A.children) {
+        for (const Child& cb : B.children) {
+          // Within a pair only the least distance is kept: a child pair whose bound is not below the
+          // best so far cannot replace it (ties keep the earlier one either way).
+          if (prune && !single && ChildLowerBound(ca, cb, p.self) >= best.distance_m) continue;
+          SignedDistance d;
+          result.primitive_pairs_gjk += ChildDistance(ca, cb, fast, &d);
+          if (d.distance_m < best.distance_m) best = d;
         }
-        lb = std::min(lb, d);
       }
-    }
-    im.lower_bound[i] = lb;
-    im.order[i] = static_cast<int>(i);
-  }
-  if (options_.prune) {
-    std::sort(im.order.begin(), im.order.end(),
-              [&](int x, int y) { return im.lower_bound[x] < im.lower_bound[y]; });
-  }
-
-  for (int idx : im.order) {
-    const Pair& p = im.pairs[idx];
-    if (p.self && !options_.check_self) continue;
-    const Body& A = im.bodies[p.a];
-    const Body& B = im.bodies[p.b];
-    const double lb = im.lower_bound[idx];
-    if (options_.prune) {
-      // Skip only what cannot lower link A's or B's clearance, its group's closest pair (and so the
-      // overall minimum) or enter the report list.
-      const double clear_b = p.self ? result.link_clearance_m[B.link] : -kInf;
-      const double group_min = p.self ? result.closest_self.distance_m : result.closest_environment.distance_m;
-      if (lb >= result.link_clearance_m[A.link] && lb >= clear_b && lb >= group_min &&
-          lb >= options_.report_distance_m) {
-        continue;
-      }
-    }
-    PairDistance best;
-    for (const Child& ca : A.children) {
-      for (const Child& cb : B.children) {
-        PairDistance d;
-        GjkDistance(ca.shape.get(), ca.bt_X_WC, cb.shape.get(), cb.bt_X_WC, &d);
-        if (d.distance_m < best.distance_m) best = d;
-      }
+      cache.epoch_a = A.epoch;
+      cache.epoch_b = B.epoch;
+      cache.fast_path = fast;
     }
     ++result.pairs_computed;
-    best.link_a = A.link;
-    best.link_b = B.link;
-    best.object_b = B.object;
-    best.self = p.self;
-    double& ca = result.link_clearance_m[A.link];
-    ca = std::min(ca, best.distance_m);
+    const double dist = best.distance_m;
+    double& clear_a = result.link_clearance_m[A.link];
+    clear_a = std::min(clear_a, dist);
     if (p.self) {
-      double& cb = result.link_clearance_m[B.link];
-      cb = std::min(cb, best.distance_m);
+      double& clear_b = result.link_clearance_m[B.link];
+      clear_b = std::min(clear_b, dist);
     }
     PairDistance& group = p.self ? result.closest_self : result.closest_environment;
-    if (best.distance_m < group.distance_m) group = best;
-    if (best.distance_m < result.min_distance_m) {
-      result.min_distance_m = best.distance_m;
-      result.closest = best;
+    const bool closer_in_group = dist < group.distance_m, closest = dist < result.min_distance_m;
+    if (!closer_in_group && !closest && !(dist < report)) return;
+    PairDistance pd;
+    pd.link_a = A.link;
+    pd.link_b = B.link;
+    pd.object_b = B.object;
+    pd.self = p.self;
+    pd.distance_m = dist;
+    pd.p_WA = best.p_WA;
+    pd.p_WB = best.p_WB;
+    pd.normal_W = best.normal_W;
+    if (closer_in_group) group = pd;
+    if (closest) {
+      result.min_distance_m = dist;
+      result.closest = pd;
     }
-    if (best.distance_m < options_.report_distance_m) result.contacts.push_back(best);
+    if (dist < report) result.contacts.push_back(pd);
+  };
+
+  const int n = static_cast<int>(im.pairs.size());
+  if (!prune) {
+    for (int i = 0; i < n; ++i) {
+      if (im.pairs[i].self && !options_.check_self) continue;
+      compute(i);
+    }
+  } else {
+    // Bounds, and per link and per group the pair of least bound: computed first, these make the
+    // clearances tight early (they are usually the final ones), so the pass in pair order that
+    // follows skips nearly everything else without sorting.
+    const int num_links = model_.num_links();
+    im.lower_bound.resize(n);
+    im.done.assign(n, 0);
+    im.seed.assign(num_links + 2, -1);
+    auto offer = [&](int slot, int i, double lb) {
+      int& s = im.seed[slot];
+      if (s < 0 || lb < im.lower_bound[s]) s = i;
+    };
+    for (int i = 0; i < n; ++i) {
+      const Pair& p = im.pairs[i];
+      if (p.self && !options_.check_self) {
+        im.done[i] = 1;
+        continue;
+      }
+      const Body& A = im.bodies[p.a];
+      const Body& B = im.bodies[p.b];
+      double lb = kInf;
+      for (const Child& ca : A.children) {
+        for (const Child& cb : B.children) lb = std::min(lb, ChildLowerBound(ca, cb, p.self));
+      }
+      im.lower_bound[i] = lb;
+      offer(A.link, i, lb);
+      if (p.self) offer(B.link, i, lb);
+      offer(num_links + (p.self ? 0 : 1), i, lb);
+    }
+    for (int i : im.seed) {
+      if (i < 0 || im.done[i]) continue;
+      im.done[i] = 1;
+      compute(i);
+    }
+    for (int i = 0; i < n; ++i) {
+      if (im.done[i]) continue;
+      const Pair& p = im.pairs[i];
+      const double lb = im.lower_bound[i];
+      // Skip only what cannot lower link A's or B's clearance, its group's closest pair (and so the
+      // overall minimum) or enter the report list.
+      const double clear_b = p.self ? result.link_clearance_m[im.bodies[p.b].link] : -kInf;
+      const double group_min = p.self ? result.closest_self.distance_m : result.closest_environment.distance_m;
+      if (lb >= result.link_clearance_m[im.bodies[p.a].link] && lb >= clear_b && lb >= group_min && lb >= report) {
+        continue;
+      }
+      compute(i);
+    }
   }
   std::sort(result.contacts.begin(), result.contacts.end(),
             [](const PairDistance& x, const PairDistance& y) { return x.distance_m < y.distance_m; });
@@ -423,12 +525,25 @@ std::vector<CollisionPrimitive> CollisionWorld::LinkPrimitives(int link) const {
 }
 
 PairDistance CollisionWorld::PrimitiveDistance(const CollisionPrimitive& a, const Eigen::Isometry3d& X_WA,
-                                               const CollisionPrimitive& b, const Eigen::Isometry3d& X_WB) {
-  const auto sa = MakeShape(a);
-  const auto sb = MakeShape(b);
-  PairDistance d;
-  GjkDistance(sa.get(), ToBt(X_WA), sb.get(), ToBt(X_WB), &d);
-  return d;
+                                               const CollisionPrimitive& b, const Eigen::Isometry3d& X_WB,
+                                               bool fast_path) {
+  Child ca, cb;
+  ca.prim = a;
+  cb.prim = b;
+  ca.shape = MakeShape(a);
+  cb.shape = MakeShape(b);
+  ca.core = CoreOf(a, *ca.shape);
+  cb.core = CoreOf(b, *cb.shape);
+  ca.X_WC = X_WA;
+  cb.X_WC = X_WB;
+  SignedDistance d;
+  ChildDistance(ca, cb, fast_path, &d);
+  PairDistance out;
+  out.distance_m = d.distance_m;
+  out.p_WA = d.p_WA;
+  out.p_WB = d.p_WB;
+  out.normal_W = d.normal_W;
+  return out;
 }
 
 }  // namespace orbed::sim

@@ -2,11 +2,14 @@
 // sphere-sphere, and hand-computed robot poses.
 #include "sim/collision_world.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
-#include <random>
 #include <iostream>
+#include <map>
+#include <random>
 #include <string>
+#include <tuple>
 
 #include <gtest/gtest.h>
 
@@ -295,6 +298,246 @@ TEST(CollisionWorldTest, ResultsAreFreshAndPruningChangesNothing) {
   EXPECT_EQ(world.Check(down).min_distance_m, d1);
   EXPECT_EQ(pruned.num_self_pairs(), 27);
   EXPECT_THROW(world.Check(Eigen::VectorXd::Zero(6)), std::invalid_argument);
+}
+
+// --- The closed-form fast path against Bullet's GJK/EPA (Options::fast_path = false) ---
+
+// Bullet's margin of a primitive: the radius of a sphere or capsule, kMarginM for boxes and
+// cylinders. A pair whose distance exceeds -(margin_a + margin_b) has disjoint cores, so GJK (not
+// EPA) decides it.
+double Margin(const CollisionPrimitive& g) {
+  return g.kind == Kind::kSphere || g.kind == Kind::kCapsule ? g.radius_m : CollisionWorld::kMarginM;
+}
+
+// Both paths exact: sphere, capsule and box pairs with disjoint cores (GJK on polytope cores stops
+// at a relative 1e-12).
+constexpr double kExactTolM = 1e-9;
+// EPA on overlapping cores (sphere/capsule/box; measured ~1e-12, the fast path is exact there).
+constexpr double kEpaTolM = 1e-6;
+// GJK on a cylinder's curved side stops early and over-estimates the distance by up to ~3e-5 m;
+// the fast path's sphere/capsule-cylinder distances are checked against an independent reference.
+constexpr double kGjkCylinderTolM = 5e-5;
+
+// Reference signed distance from a point (in the cylinder frame) to Bullet's rounded cylinder.
+double PointRoundedCylinder(const Eigen::Vector3d& p, double radius, double length) {
+  const double r = radius - CollisionWorld::kMarginM, h = 0.5 * length - CollisionWorld::kMarginM;
+  const double side = std::sqrt(p.x() * p.x() + p.y() * p.y()) - r, cap = std::abs(p.z()) - h;
+  const double outside = std::sqrt(std::pow(std::max(side, 0.0), 2) + std::pow(std::max(cap, 0.0), 2));
+  return outside + std::min(std::max(side, cap), 0.0) - CollisionWorld::kMarginM;
+}
+
+// Reference distance of a sphere or capsule A to a cylinder B: the point distance minimised along
+// A's axis by golden-section search (convex), to ~1e-15.
+double ReferenceToCylinder(const CollisionPrimitive& a, const Eigen::Isometry3d& XA, const CollisionPrimitive& b,
+                           const Eigen::Isometry3d& XB) {
+  const double h = a.kind == Kind::kCapsule ? 0.5 * a.length_m : 0.0;
+  const Eigen::Vector3d c = XB.inverse() * XA.translation(), z = XB.linear().transpose() * XA.linear().col(2);
+  auto f = [&](double t) { return PointRoundedCylinder(c + t * z, b.radius_m, b.length_m); };
+  double lo = -h, hi = h;
+  const double g = 0.5 * (std::sqrt(5.0) - 1);
+  for (int i = 0; i < 200 && hi - lo > 1e-15; ++i) {
+    const double x1 = hi - g * (hi - lo), x2 = lo + g * (hi - lo);
+    (f(x1) < f(x2) ? hi : lo) = f(x1) < f(x2) ? x2 : x1;
+  }
+  return std::min({f(lo), f(hi), f(-h), f(h)}) - a.radius_m;
+}
+
+TEST(CollisionWorldTest, FastPathMatchesGjkForEveryPrimitivePair) {
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(0, 1);
+  auto random_primitive = [&](Kind kind) {
+    CollisionPrimitive g;
+    g.kind = kind;
+    g.radius_m = 0.01 + 0.1 * u(rng);
+    g.length_m = 0.02 + 0.3 * u(rng);
+    g.size_m = Eigen::Vector3d(0.02 + 0.5 * u(rng), 0.02 + 0.5 * u(rng), 0.02 + 0.5 * u(rng));
+    return g;
+  };
+  auto round = [](Kind k) { return k == Kind::kSphere || k == Kind::kCapsule; };
+  const Kind kinds[] = {Kind::kSphere, Kind::kCapsule, Kind::kBox, Kind::kCylinder};
+  int exact = 0, epa = 0, cylinder = 0;
+  double max_exact = 0, max_epa = 0, max_ref = 0, max_gjk_cyl = 0, max_point = 0;
+  for (Kind ka : kinds) {
+    for (Kind kb : kinds) {
+      for (int i = 0; i < 1500; ++i) {
+        const CollisionPrimitive a = random_primitive(ka), b = random_primitive(kb);
+        const Eigen::Isometry3d XA = RandomPose(rng, 0.25), XB = RandomPose(rng, 0.25);
+        const PairDistance fast = CollisionWorld::PrimitiveDistance(a, XA, b, XB, true);
+        const PairDistance gjk = CollisionWorld::PrimitiveDistance(a, XA, b, XB, false);
+        const std::string what = std::to_string(static_cast<int>(ka)) + std::to_string(static_cast<int>(kb)) + " #" +
+                                 std::to_string(i) + " fast " + std::to_string(fast.distance_m) + " gjk " +
+                                 std::to_string(gjk.distance_m);
+        const double diff = std::abs(fast.distance_m - gjk.distance_m);
+        // The fast path's witnesses are consistent with its distance.
+        EXPECT_NEAR((fast.p_WA - (fast.p_WB + fast.normal_W * fast.distance_m)).norm(), 0.0, 1e-12) << what;
+        EXPECT_NEAR(fast.normal_W.norm(), 1.0, 1e-12) << what;
+        const bool disjoint_cores = fast.distance_m > -(Margin(a) + Margin(b)) + 1e-6;
+        const bool with_cylinder = ka == Kind::kCylinder || kb == Kind::kCylinder;
+        if (with_cylinder && (round(ka) || round(kb))) {
+          // Sphere/capsule against a cylinder: the fast path is exact, GJK over-estimates a little.
+          const double ref = round(ka) ? ReferenceToCylinder(a, XA, b, XB) : ReferenceToCylinder(b, XB, a, XA);
+          if (disjoint_cores || ka == Kind::kSphere || kb == Kind::kSphere) {
+            EXPECT_NEAR(fast.distance_m, ref, kExactTolM) << what;
+            max_ref = std::max(max_ref, std::abs(fast.distance_m - ref));
+          }
+          if (disjoint_cores) {
+            ++cylinder;
+            EXPECT_LE(fast.distance_m, gjk.distance_m + 1e-12) << what;
+            EXPECT_LE(diff, kGjkCylinderTolM) << what;
+            max_gjk_cyl = std::max(max_gjk_cyl, diff);
+          }
+        } else if (disjoint_cores) {
+          ++exact;
+          EXPECT_LE(diff, kExactTolM) << what;
+          max_exact = std::max(max_exact, diff);
+          if (fast.distance_m > 1e-3 && !with_cylinder) {  // closest points unique in random poses
+            const double point_diff = std::max((fast.p_WA - gjk.p_WA).norm(), (fast.p_WB - gjk.p_WB).norm());
+            EXPECT_LE(point_diff, 1e-6) << what;
+            max_point = std::max(max_point, point_diff);
+          }
+        } else {
+          ++epa;
+          EXPECT_LE(diff, kEpaTolM) << what;
+          max_epa = std::max(max_epa, diff);
+        }
+      }
+    }
+  }
+  EXPECT_GT(exact, 10000);
+  EXPECT_GT(epa, 1000);
+  EXPECT_GT(cylinder, 5000);
+  std::cout << "fast vs GJK: " << exact << " disjoint-core pairs, max |diff| " << max_exact << " m (closest points "
+            << max_point << " m); " << epa << " overlapping-core pairs, max |diff| " << max_epa << " m; " << cylinder
+            << " sphere/capsule-cylinder pairs: fast vs reference " << max_ref << " m, GJK over-estimates by up to "
+            << max_gjk_cyl << " m\n";
+}
+
+TEST(CollisionWorldTest, SegmentBoxPenetrationIsExact) {
+  // A capsule (r 0.05) through a box (half extents 0.3, 0.2, 0.1) with its axis 0.03 m below the
+  // top face and parallel to x: the least way out is up, depth 0.03 + 0.05.
+  CollisionPrimitive cap = Capsule(0.05, 0.2);
+  CollisionPrimitive box;
+  box.kind = Kind::kBox;
+  box.size_m = Eigen::Vector3d(0.6, 0.4, 0.2);
+  Eigen::Isometry3d XA = Eigen::Isometry3d::Identity();
+  XA.linear() = Eigen::AngleAxisd(kPi / 2, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  XA.translation() = Eigen::Vector3d(0.05, 0.02, 0.07);
+  const PairDistance d = CollisionWorld::PrimitiveDistance(cap, XA, box, Eigen::Isometry3d::Identity());
+  EXPECT_NEAR(d.distance_m, -0.08, 1e-12);
+  EXPECT_NEAR(d.normal_W.z(), 1.0, 1e-12);
+  EXPECT_NEAR(d.p_WB.z(), 0.1, 1e-12);
+  EXPECT_NEAR(d.p_WA.z(), 0.02, 1e-12);
+  EXPECT_NEAR(CollisionWorld::PrimitiveDistance(cap, XA, box, Eigen::Isometry3d::Identity(), false).distance_m, -0.08,
+              1e-9);
+}
+
+TEST(CollisionWorldTest, FastPathMatchesGjkOverRandomConfigurations) {
+  RobotModel m = LoadIiwa();
+  const Scene scene = LoadSceneFile(SourcePath(kDefaultSceneRelativePath));
+  m.SetToolLength(scene.tool_length_m);
+  // Every pair reported (so every pair is compared), and the default options (pruned).
+  CollisionWorld::Options all;
+  all.report_distance_m = 1e9;
+  CollisionWorld::Options all_gjk = all, def_gjk;
+  all_gjk.fast_path = def_gjk.fast_path = false;
+  CollisionWorld fast_all(m, &scene, all), gjk_all(m, &scene, all_gjk);
+  CollisionWorld fast(m, &scene), gjk(m, &scene, def_gjk);
+  // Per pair: the largest margin sum over its child pairs (disjoint-core test) and whether a
+  // sphere/capsule meets a cylinder (where GJK is the inexact side).
+  struct PairInfo {
+    double margin_sum{0};
+    bool round_vs_cylinder{false};
+  };
+  std::map<std::tuple<int, int, int>, PairInfo> info;
+  for (const auto& p : fast.CheckedPairs()) {
+    std::vector<CollisionPrimitive> bs = p.link_b >= 0 ? fast.LinkPrimitives(p.link_b) : std::vector<CollisionPrimitive>(1);
+    if (p.link_b < 0) {
+      const SceneObject& o = scene.objects[p.object_b];
+      bs[0].kind = o.shape == SceneObject::Shape::kBox        ? Kind::kBox
+                   : o.shape == SceneObject::Shape::kCylinder ? Kind::kCylinder
+                                                              : Kind::kSphere;
+      bs[0].radius_m = o.radius_m;
+    }
+    PairInfo& pi = info[{p.link_a, p.link_b, p.object_b}];
+    for (const auto& ga : fast.LinkPrimitives(p.link_a)) {
+      for (const auto& gb : bs) {
+        pi.margin_sum = std::max(pi.margin_sum, Margin(ga) + Margin(gb));
+        const bool ra = ga.kind == Kind::kSphere || ga.kind == Kind::kCapsule;
+        const bool rb = gb.kind == Kind::kSphere || gb.kind == Kind::kCapsule;
+        pi.round_vs_cylinder |= (ra && gb.kind == Kind::kCylinder) || (rb && ga.kind == Kind::kCylinder);
+      }
+    }
+  }
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> u(0, 1);
+  int exact = 0, epa = 0, cylinder = 0, fast_gjk_prims = 0, gjk_gjk_prims = 0, clearances = 0, clearances_1e9 = 0;
+  double max_exact = 0, max_epa = 0, max_cyl = 0, max_clear = 0;
+  for (int n = 0; n < 3000; ++n) {
+    Eigen::VectorXd q(7);
+    for (int i = 0; i < 7; ++i) q[i] = m.joints()[i].lower_rad + u(rng) * (m.joints()[i].upper_rad - m.joints()[i].lower_rad);
+    // Per pair: fast vs GJK.
+    const CollisionResult fa = fast_all.Check(q), ga = gjk_all.Check(q);
+    ASSERT_EQ(fa.contacts.size(), ga.contacts.size());
+    std::map<std::tuple<int, int, int>, const PairDistance*> gjk_pair;
+    for (const auto& c : ga.contacts) gjk_pair[{c.link_a, c.link_b, c.object_b}] = &c;
+    for (const auto& c : fa.contacts) {
+      const auto key = std::make_tuple(c.link_a, c.link_b, c.object_b);
+      ASSERT_EQ(gjk_pair.count(key), 1u);
+      const double g = gjk_pair[key]->distance_m, diff = std::abs(c.distance_m - g);
+      const PairInfo& pi = info[key];
+      if (pi.round_vs_cylinder) {
+        ++cylinder;
+        max_cyl = std::max(max_cyl, diff);
+        EXPECT_LE(diff, kGjkCylinderTolM) << c.body_a << "/" << c.body_b << " q#" << n;
+      } else if (c.distance_m > -pi.margin_sum + 1e-6) {
+        ++exact;
+        max_exact = std::max(max_exact, diff);
+        EXPECT_LE(diff, kExactTolM) << c.body_a << "/" << c.body_b << " q#" << n;
+      } else {
+        ++epa;
+        max_epa = std::max(max_epa, diff);
+        EXPECT_LE(diff, kEpaTolM) << c.body_a << "/" << c.body_b << " q#" << n;
+      }
+    }
+    // The pruned default query equals the all-pairs one bit for bit (same path, fewer pairs).
+    const CollisionResult f = fast.Check(q), g = gjk.Check(q);
+    fast_gjk_prims += f.primitive_pairs_gjk;
+    gjk_gjk_prims += g.primitive_pairs_gjk;
+    EXPECT_EQ(f.min_distance_m, fa.min_distance_m) << "q#" << n;
+    EXPECT_EQ(f.closest.body_a + "/" + f.closest.body_b, fa.closest.body_a + "/" + fa.closest.body_b) << "q#" << n;
+    EXPECT_EQ(f.closest_self.distance_m, fa.closest_self.distance_m) << "q#" << n;
+    EXPECT_EQ(f.closest_environment.distance_m, fa.closest_environment.distance_m) << "q#" << n;
+    for (int i = 0; i < m.num_links(); ++i) EXPECT_EQ(f.link_clearance_m[i], fa.link_clearance_m[i]) << "q#" << n;
+    // Fast vs GJK on the query result: the same closest pair (unless the runner-up is within GJK's
+    // cylinder error) and the same clearances within the per-pair tolerances.
+    EXPECT_EQ(f.in_collision, g.in_collision) << "q#" << n;
+    EXPECT_NEAR(f.min_distance_m, g.min_distance_m, kGjkCylinderTolM) << "q#" << n;
+    if (fa.contacts.size() < 2 || fa.contacts[1].distance_m - fa.contacts[0].distance_m > 2 * kGjkCylinderTolM) {
+      EXPECT_EQ(f.closest.body_a + "/" + f.closest.body_b, g.closest.body_a + "/" + g.closest.body_b) << "q#" << n;
+    }
+    for (int i = 0; i < m.num_links(); ++i) {
+      const double gi = g.link_clearance_m[i], fi = f.link_clearance_m[i];
+      if (std::isinf(gi)) {
+        EXPECT_EQ(fi, gi);
+        continue;
+      }
+      ++clearances;
+      const double diff = std::abs(fi - gi);
+      clearances_1e9 += diff <= kExactTolM;
+      max_clear = std::max(max_clear, diff);
+      EXPECT_LE(diff, kGjkCylinderTolM) << m.links()[i].name << " q#" << n;
+    }
+    EXPECT_EQ(f.contacts.size(), g.contacts.size()) << "q#" << n;
+  }
+  EXPECT_GT(exact, 100000);
+  EXPECT_GT(epa, 100);
+  EXPECT_LT(fast_gjk_prims, gjk_gjk_prims / 5);
+  std::cout << "3000 configurations, fast vs GJK per pair: " << exact << " exact-both pairs max |diff| " << max_exact
+            << " m; " << epa << " overlapping-core (EPA) pairs max " << max_epa << " m; " << cylinder
+            << " sphere/capsule-cylinder pairs max " << max_cyl << " m (GJK's error). Per-link clearance: "
+            << clearances_1e9 << " of " << clearances << " within 1e-9 m, max " << max_clear
+            << " m. GJK primitive pairs per query: " << fast_gjk_prims / 3000.0 << " (fast path) vs "
+            << gjk_gjk_prims / 3000.0 << " (GJK only)\n";
 }
 
 TEST(CollisionWorldTest, UnknownIgnoredLinkIsAnError) {

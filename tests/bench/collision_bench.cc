@@ -1,12 +1,14 @@
 /// @file
-/// FK + full collision check (self + scene) per query of the iiwa 7 in the shipped trocar scene:
-/// orbed's Bullet CollisionWorld (with and without its bound-ordered pruning) beside FCL answering
-/// the same query — the same pairs, the same primitives (capsules, cylinders, spheres, boxes), the
-/// minimum signed distance, the closest pair and per-link clearance — in the same run. The joint
-/// vectors are a fixed pool of 1024 seeded random vectors within the limits.
+/// FK + full collision check (self + scene) per query of the iiwa 7 in the shipped trocar scene, in
+/// one run: orbed's Bullet CollisionWorld with its closed-form fast path (the default), the same
+/// with GJK/EPA for every primitive pair (fast_path = false), both without bound pruning, and FCL
+/// answering the same query — the same pairs, the same primitives (capsules, cylinders, spheres,
+/// boxes), the minimum signed distance, the closest pair and per-link clearance. The joint vectors
+/// are a fixed pool of 1024 seeded random vectors within the limits.
 ///
-/// Counters: `pairs` = exact pair distances computed per query; `max_diff_vs_bullet_m` = the
-/// largest |min distance (FCL) - min distance (Bullet)| over the pool (agreement check).
+/// Counters: `pairs` = exact pair distances computed per query; `gjk_prims` = primitive pairs of
+/// those that went to GJK/EPA; `max_diff_vs_bullet_m` = the largest |min distance (FCL) - min
+/// distance (Bullet fast path)| over the pool (agreement check).
 /// Run: build-*/bench/collision_bench (needs $ORBED_SOURCE_DIR or runs from the source root).
 #include <cmath>
 #include <cstdlib>
@@ -159,25 +161,34 @@ void BM_Fk(benchmark::State& state) {
 }
 BENCHMARK(BM_Fk);
 
-void BulletCheck(benchmark::State& state, bool prune) {
+void BulletCheck(benchmark::State& state, bool prune, bool fast_path) {
   auto& f = F();
   CollisionWorld::Options options;
   options.prune = prune;
+  options.fast_path = fast_path;
   CollisionWorld world(f.model, &f.scene, options);
   size_t i = 0;
-  double pairs = 0;
+  double pairs = 0, gjk = 0;
   for (auto _ : state) {
     const CollisionResult r = world.Check(f.pool[i++ & 1023]);
     pairs += r.pairs_computed;
+    gjk += r.primitive_pairs_gjk;
     benchmark::DoNotOptimize(r.min_distance_m);
   }
   state.counters["pairs"] = pairs / static_cast<double>(state.iterations());
+  state.counters["gjk_prims"] = gjk / static_cast<double>(state.iterations());
   state.counters["checked_pairs"] = world.num_self_pairs() + world.num_environment_pairs();
 }
-void BM_BulletFkAndCheck(benchmark::State& state) { BulletCheck(state, true); }
-void BM_BulletFkAndCheckNoPruning(benchmark::State& state) { BulletCheck(state, false); }
+// Closed forms where exact, GJK/EPA for the rest (the default).
+void BM_BulletFkAndCheck(benchmark::State& state) { BulletCheck(state, true, true); }
+// GJK/EPA for every primitive pair (the reference path).
+void BM_BulletFkAndCheckGjkOnly(benchmark::State& state) { BulletCheck(state, true, false); }
+void BM_BulletFkAndCheckNoPruning(benchmark::State& state) { BulletCheck(state, false, true); }
+void BM_BulletFkAndCheckGjkOnlyNoPruning(benchmark::State& state) { BulletCheck(state, false, false); }
 BENCHMARK(BM_BulletFkAndCheck);
+BENCHMARK(BM_BulletFkAndCheckGjkOnly);
 BENCHMARK(BM_BulletFkAndCheckNoPruning);
+BENCHMARK(BM_BulletFkAndCheckGjkOnlyNoPruning);
 
 void BM_FclFkAndCheck(benchmark::State& state) {
   auto& f = F();

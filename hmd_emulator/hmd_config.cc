@@ -1,0 +1,113 @@
+#include "hmd_emulator/hmd_config.h"
+
+#include <cstdlib>
+#include <limits>
+#include <stdexcept>
+
+#include "hmd_emulator/yaml_fields.h"
+
+#ifndef ORBED_BUILD_SOURCE_DIR
+#define ORBED_BUILD_SOURCE_DIR "."
+#endif
+
+namespace orbed::hmd {
+namespace {
+
+std::string Text(const YamlFields& f, const YAML::Node& map, const std::string& name, const std::string& key,
+                 const std::string& fallback) {
+  const YAML::Node node = map[name];
+  if (!node.IsDefined() || node.IsNull()) return fallback;
+  if (!node.IsScalar()) f.Fail(node, key + "." + name, "expected a string");
+  return node.as<std::string>();
+}
+
+}  // namespace
+
+std::string HmdSourcePath(const std::string& relative) {
+  const char* env = std::getenv("ORBED_SOURCE_DIR");
+  const std::string root = env && *env ? std::string(env) : std::string(ORBED_BUILD_SOURCE_DIR);
+  return root + "/" + relative;
+}
+
+std::vector<std::string> DefaultHmdConfigRelativePaths() {
+  return {kDefaultSlamConfigRelativePath, kDefaultUserConfigRelativePath, "hmd_emulator/config/viraal_walk.yaml",
+          "hmd_emulator/config/hmd.yaml"};
+}
+
+HmdConfig ParseHmdConfig(const YAML::Node& node, const std::string& source, const std::string& key) {
+  const YamlFields f(source);
+  f.CheckKeys(node, key,
+              {"name", "gaze_hz", "reflective_hz", "ar_view_hz", "align_waypoint", "settle_s", "max_wait_s",
+               "recapture_period_s", "gaze_fallback_distance_m", "max_gaze_distance_m", "displays"});
+  HmdConfig c;
+  c.name = Text(f, node, "name", key, c.name);
+  c.gaze_hz = f.NumberOr(node, "gaze_hz", key, c.gaze_hz, 0.1, 120, "Hz");
+  c.reflective_hz = f.NumberOr(node, "reflective_hz", key, c.reflective_hz, 0.1, 120, "Hz");
+  c.ar_view_hz = f.NumberOr(node, "ar_view_hz", key, c.ar_view_hz, 0.1, 120, "Hz");
+  c.align_waypoint = Text(f, node, "align_waypoint", key, c.align_waypoint);
+  c.settle_s = f.NumberOr(node, "settle_s", key, c.settle_s, 0, 600, "s");
+  c.max_wait_s = f.NumberOr(node, "max_wait_s", key, c.max_wait_s, 0, 3600, "s");
+  c.recapture_period_s = f.NumberOr(node, "recapture_period_s", key, c.recapture_period_s, 0, 3600, "s");
+  c.gaze_fallback_distance_m =
+      f.NumberOr(node, "gaze_fallback_distance_m", key, c.gaze_fallback_distance_m, 0.05, 100, "m");
+  c.max_gaze_distance_m = f.NumberOr(node, "max_gaze_distance_m", key, c.max_gaze_distance_m, 0.1, 1000, "m");
+  const YAML::Node displays = node["displays"];
+  if (displays.IsDefined() && !displays.IsNull()) {
+    if (!displays.IsSequence() || displays.size() == 0 || displays.size() > 16) {
+      f.Fail(displays, key + ".displays", "expected a list of 1 to 16 {capture_waypoint: NAME}");
+    }
+    for (std::size_t i = 0; i < displays.size(); ++i) {
+      const std::string k = key + ".displays[" + std::to_string(i) + "]";
+      f.CheckKeys(displays[i], k, {"capture_waypoint"});
+      DisplayPlacement d;
+      d.capture_waypoint = Text(f, displays[i], "capture_waypoint", k, "");
+      if (d.capture_waypoint.empty()) f.Fail(displays[i], k + ".capture_waypoint", "missing (a waypoint name)");
+      c.displays.push_back(d);
+    }
+  }
+  return c;
+}
+
+HmdConfigSet LoadHmdConfigs(const std::vector<std::string>& paths) {
+  HmdConfigSet set;
+  std::string walk_source, hmd_source = "(defaults)";
+  for (const std::string& path : paths) {
+    const YAML::Node root = YamlFields::LoadFile(path);
+    const YamlFields f(path);
+    if (root.IsNull()) continue;  // an empty file sets nothing
+    f.CheckKeys(root, "", {"slam", "user", "head_trajectory", "hmd"});
+    if (root["slam"]) set.slam = ParseSlamConfig(root["slam"], path);
+    if (root["user"]) set.user = ParseUserConfig(root["user"], path);
+    if (root["head_trajectory"]) {
+      set.walk = ParseHeadTrajectory(root["head_trajectory"], path);
+      walk_source = path;
+    }
+    if (root["hmd"]) {
+      set.hmd = ParseHmdConfig(root["hmd"], path);
+      hmd_source = path;
+    }
+    set.sources.push_back(path);
+  }
+  if (set.walk.waypoints.empty()) {
+    throw std::runtime_error("no head_trajectory: none of the config files (" + std::to_string(paths.size()) +
+                             ") has a `head_trajectory:` mapping; add one (see hmd_emulator/config/viraal_walk.yaml)");
+  }
+  HeadTrajectory walk(set.walk);  // validates the walk
+  auto check = [&](const std::string& name, const std::string& what) {
+    if (walk.FindWaypoint(name) < 0) {
+      std::string names;
+      for (const auto& w : set.walk.waypoints) names += (names.empty() ? "" : ", ") + w.name;
+      throw std::runtime_error(hmd_source + ": " + what + ": the walk (" + walk_source + ") has no waypoint '" +
+                               name + "'; it has: " + names);
+    }
+  };
+  if (set.hmd.displays.empty()) set.hmd.displays.push_back({set.walk.waypoints.front().name});
+  if (set.hmd.align_waypoint.empty()) set.hmd.align_waypoint = set.walk.waypoints.back().name;
+  check(set.hmd.align_waypoint, "hmd.align_waypoint");
+  for (std::size_t i = 0; i < set.hmd.displays.size(); ++i) {
+    check(set.hmd.displays[i].capture_waypoint, "hmd.displays[" + std::to_string(i) + "].capture_waypoint");
+  }
+  return set;
+}
+
+}  // namespace orbed::hmd

@@ -1,0 +1,87 @@
+#pragma once
+/// @file
+/// The configuration of the orbed-hmd process, read from one or more YAML files. Each file may hold
+/// any of four top-level mappings (unknown top-level keys are errors naming the file):
+///   slam:            the SLAM error model          (slam_model.h,      config/slam.yaml)
+///   user:            the emulated ViRAAl user      (user_model.h,      config/user.yaml)
+///   head_trajectory: the wearer's walk             (head_trajectory.h, config/viraal_walk.yaml)
+///   hmd:             the process itself (below)    (this file,         config/hmd.yaml)
+/// Files are applied in order; a mapping in a later file replaces the same mapping from an earlier
+/// one as a whole (its missing keys take the compiled-in defaults, which equal the shipped files).
+/// orbed-hmd loads the four shipped files first, then every --config file.
+///
+/// The `hmd:` mapping (every key optional, every key checked):
+///   hmd:
+///     name: hololens1              # hmd_name on HMD_POSE and GAZE_RAY
+///     gaze_hz: 10                  # GAZE_RAY rate [Hz]
+///     reflective_hz: 30            # REFLECTIVE_VIEW rate per display [Hz]
+///     ar_view_hz: 5                # AR_VIEW rate [Hz]
+///     align_waypoint: head_end     # where the emulated user aligns ("" = the walk's last waypoint)
+///     settle_s: 0.5                # standing time at the alignment waypoint before aligning [s]
+///     max_wait_s: 30               # longest wait for tracking to recover before aligning [s]
+///     recapture_period_s: 0.5      # a display re-captures at most this often after the robot moved [s]
+///     gaze_fallback_distance_m: 1.5  # D when the gaze ray hits nothing [m]
+///     max_gaze_distance_m: 10      # ray-casting range [m]
+///     displays:                    # reflective displays, in order: where each captures its frame
+///       - {capture_waypoint: foot_end}
+///       - {capture_waypoint: head_end}
+/// Display i is placed at (captures its frame from) the camera pose at the arrival at its waypoint of
+/// the walk: live, and in every emulated trial that uses >= i + 1 displays.
+///
+/// Threading: plain data; the loaders are reentrant.
+
+#include <string>
+#include <vector>
+
+#include <yaml-cpp/yaml.h>
+
+#include "hmd_emulator/head_trajectory.h"
+#include "hmd_emulator/slam_model.h"
+#include "hmd_emulator/user_model.h"
+
+namespace orbed::hmd {
+
+struct DisplayPlacement {
+  std::string capture_waypoint;  ///< a waypoint name of the walk
+};
+
+struct HmdConfig {
+  std::string name{"hololens1"};
+  double gaze_hz{10.0};
+  double reflective_hz{30.0};
+  double ar_view_hz{5.0};
+  std::string align_waypoint;  ///< "" = the walk's last waypoint
+  double settle_s{0.5};
+  double max_wait_s{30.0};
+  double recapture_period_s{0.5};
+  double gaze_fallback_distance_m{1.5};
+  double max_gaze_distance_m{10.0};
+  /// Empty after parsing a file without `displays` = one display at the walk's first waypoint.
+  std::vector<DisplayPlacement> displays;
+};
+
+/// Reads the `hmd:` mapping (the node itself); errors name `source`, the line and the key.
+HmdConfig ParseHmdConfig(const YAML::Node& node, const std::string& source, const std::string& key = "hmd");
+
+/// Everything orbed-hmd is configured by.
+struct HmdConfigSet {
+  SlamConfig slam;
+  UserConfig user;
+  HeadTrajectoryConfig walk;
+  HmdConfig hmd;
+  std::vector<std::string> sources;  ///< files read, in order
+};
+
+/// Loads `paths` in order (see the file comment) over the compiled-in defaults, then resolves and
+/// checks the cross references: an empty display list becomes one display at the walk's first
+/// waypoint, an empty align_waypoint the walk's last; every waypoint named must exist in the walk
+/// (std::runtime_error naming the file that set it). A walk must come from some file.
+HmdConfigSet LoadHmdConfigs(const std::vector<std::string>& paths);
+
+/// The shipped files, relative to the repository root, in load order.
+std::vector<std::string> DefaultHmdConfigRelativePaths();
+
+/// `relative` under $ORBED_SOURCE_DIR if set, else under the source tree this library was built from.
+std::string HmdSourcePath(const std::string& relative);
+
+}  // namespace orbed::hmd

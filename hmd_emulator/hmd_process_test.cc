@@ -1,0 +1,469 @@
+// orbed-hmd in-process on memq:// (the process's own LCM instance delivers what the test publishes
+// on it), images made inline (options.threaded = false) so every step is deterministic:
+//   - SESSION_CONTROL START + REQUEST_TRIAL with the robot known → one ALIGNMENT_TRIAL per request,
+//     with the session, the per-session index, the mode, num_mirrors and the robot's q; the chosen
+//     X_WV is closer to the true X_WR than the start offset written in user.yaml;
+//   - every bad input is rejected and counted under its own key, and produces no trial;
+//   - HMD_POSE and HMD_POSE_TRUTH share seq and utime, seq counts from 0, the first true head pose
+//     is the walk's first waypoint (viraal_walk.yaml);
+//   - HMD_CAMERA is a 1280×720 JPEG with the HoloLens PV intrinsics stamped with the estimated
+//     pose of the sample it was rendered at; REFLECTIVE_VIEW's K_m = diag(1, −1, 1)·K_o and X_WM is
+//     the camera turned π about x and moved D along its principal ray (computed here by hand);
+//   - the interactive mode's keys move the hologram by the shown steps and Enter submits a trial.
+#include "hmd_emulator/hmd_process.h"
+
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <orbed/gaze_ray_t.hpp>
+#include <orbed/hmd_pose_t.hpp>
+#include <orbed/image_t.hpp>
+#include <orbed/reflective_view_t.hpp>
+
+#include "hmd_emulator/renderer.h"
+#include "procs/common/conversions.h"
+
+namespace orbed::hmd {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+using SC = orbed::session_control_t;
+using AT = orbed::alignment_trial_t;
+
+// The shipped scene's X_WR (sim/models/scenes/trocar_or.yaml), read back through the scene loader.
+Eigen::Isometry3d SceneX_WR() { return sim::LoadSceneFile(HmdSourcePath(sim::kDefaultSceneRelativePath)).X_WR; }
+
+struct Collector {
+  std::vector<orbed::alignment_trial_t> trials;
+  std::vector<orbed::hmd_pose_t> est, truth;
+  std::vector<orbed::image_t> camera, ar;
+  std::vector<orbed::reflective_view_t> reflective;
+  std::vector<orbed::gaze_ray_t> gaze;
+  std::vector<orbed::session_control_t> control;
+  void OnTrial(const lcm::ReceiveBuffer*, const std::string&, const orbed::alignment_trial_t* m) { trials.push_back(*m); }
+  void OnPose(const lcm::ReceiveBuffer*, const std::string&, const orbed::hmd_pose_t* m) { est.push_back(*m); }
+  void OnTruth(const lcm::ReceiveBuffer*, const std::string&, const orbed::hmd_pose_t* m) { truth.push_back(*m); }
+  void OnCamera(const lcm::ReceiveBuffer*, const std::string&, const orbed::image_t* m) { camera.push_back(*m); }
+  void OnAr(const lcm::ReceiveBuffer*, const std::string&, const orbed::image_t* m) { ar.push_back(*m); }
+  void OnReflective(const lcm::ReceiveBuffer*, const std::string&, const orbed::reflective_view_t* m) {
+    reflective.push_back(*m);
+  }
+  void OnGaze(const lcm::ReceiveBuffer*, const std::string&, const orbed::gaze_ray_t* m) { gaze.push_back(*m); }
+  void OnControl(const lcm::ReceiveBuffer*, const std::string&, const orbed::session_control_t* m) {
+    control.push_back(*m);
+  }
+  void Attach(lcm::LCM& lcm) {
+    lcm.subscribe("ALIGNMENT_TRIAL", &Collector::OnTrial, this);
+    lcm.subscribe("HMD_POSE", &Collector::OnPose, this);
+    lcm.subscribe("HMD_POSE_TRUTH", &Collector::OnTruth, this);
+    lcm.subscribe("HMD_CAMERA", &Collector::OnCamera, this);
+    lcm.subscribe("AR_VIEW", &Collector::OnAr, this);
+    lcm.subscribe("REFLECTIVE_VIEW", &Collector::OnReflective, this);
+    lcm.subscribe("GAZE_RAY", &Collector::OnGaze, this);
+    lcm.subscribe("SESSION_CONTROL", &Collector::OnControl, this);
+  }
+};
+
+CommonFlags MemqFlags(double duration_sec) {
+  CommonFlags flags("orbed-hmd");
+  flags.lcm_url = "memq://";
+  flags.duration_sec = duration_sec;
+  flags.log_level = "warn";
+  return flags;
+}
+
+HmdOptions Inline() {
+  HmdOptions o;
+  o.threaded = false;
+  return o;
+}
+
+const std::vector<double> kQDeg{0, 30, 0, -60, 0, 45, 0};
+
+orbed::iiwa_status_t Status(const std::vector<double>& q_deg) {
+  orbed::iiwa_status_t m{};
+  m.utime = NowMicros();
+  m.num_joints = static_cast<int32_t>(q_deg.size());
+  for (double q : q_deg) m.joint_position_measured.push_back(q * kDeg);
+  m.joint_velocity_estimated.assign(q_deg.size(), 0.0);
+  m.joint_position_commanded = m.joint_position_measured;
+  m.joint_position_ipo = m.joint_position_measured;
+  m.joint_torque_measured.assign(q_deg.size(), 0.0);
+  m.joint_torque_commanded.assign(q_deg.size(), 0.0);
+  m.joint_torque_external.assign(q_deg.size(), 0.0);
+  return m;
+}
+
+orbed::robot_state_t State(const Eigen::Isometry3d& X_WR) {
+  orbed::robot_state_t m{};
+  m.utime = NowMicros();
+  m.robot_name = "iiwa7";
+  m.X_WR = ToPose(X_WR);
+  m.X_RF = ToPose(Eigen::Isometry3d::Identity());
+  m.X_RT = m.X_RF;
+  return m;
+}
+
+orbed::session_control_t Control(const std::string& id, int8_t command, int8_t mode = +AT::MODE_AR, int32_t mirrors = 0) {
+  orbed::session_control_t m{};
+  m.utime = NowMicros();
+  m.session_id = id;
+  m.command = command;
+  m.display_mode = mode;
+  m.num_mirrors = mirrors;
+  m.method = +orbed::registration_t::METHOD_KARCHER;
+  return m;
+}
+
+void Drain(lcm::LCM& lcm) {
+  while (lcm.handleTimeout(0) > 0) {
+  }
+}
+
+TEST(HmdProcess, AnswersEachRequestTrialWithOneAlignmentTrial) {
+  HmdProcess hmd(MemqFlags(0.5), Inline());
+  Collector got;
+  lcm::LCM& lcm = hmd.process().lcm();
+  got.Attach(lcm);
+  const Eigen::Isometry3d X_WR = SceneX_WR();
+  const orbed::iiwa_status_t status = Status(kQDeg);
+  const orbed::robot_state_t state = State(X_WR);
+  const auto start = Control("s-refl", +SC::START, +AT::MODE_AR_REFLECTIVE, 1);
+  const auto request = Control("s-refl", +SC::REQUEST_TRIAL);
+  lcm.publish("IIWA_STATUS", &status);
+  lcm.publish("ROBOT_STATE", &state);
+  lcm.publish("SESSION_CONTROL", &start);
+  lcm.publish("SESSION_CONTROL", &request);
+  lcm.publish("SESSION_CONTROL", &request);
+  const auto start_ar = Control("s-ar", +SC::START, +AT::MODE_AR, 0);
+  const auto request_ar = Control("s-ar", +SC::REQUEST_TRIAL);
+  lcm.publish("SESSION_CONTROL", &start_ar);
+  lcm.publish("SESSION_CONTROL", &request_ar);
+  EXPECT_EQ(hmd.Run(), 0);
+
+  ASSERT_EQ(got.trials.size(), 3u);
+  // The start offset of user.yaml: (0.10, -0.08, 0.05) m from the real base, i.e. 0.138 m.
+  const double start_offset_m = std::sqrt(0.10 * 0.10 + 0.08 * 0.08 + 0.05 * 0.05);
+  for (size_t i = 0; i < got.trials.size(); ++i) {
+    const auto& t = got.trials[i];
+    const bool refl = i < 2;
+    EXPECT_EQ(t.session_id, refl ? "s-refl" : "s-ar");
+    EXPECT_EQ(t.trial_index, refl ? static_cast<int>(i) : 0);
+    EXPECT_EQ(t.display_mode, refl ? +AT::MODE_AR_REFLECTIVE : +AT::MODE_AR);
+    EXPECT_EQ(t.num_mirrors, refl ? 1 : 0);
+    ASSERT_EQ(t.num_joints, 7);
+    for (int j = 0; j < 7; ++j) EXPECT_NEAR(t.joint_position[j], kQDeg[j] * kDeg, 1e-12);
+    EXPECT_EQ(t.user_id, "emulated-seed-1");
+    EXPECT_GT(t.duration_s, 5.0);  // at least a look and a nudge (user.yaml: 2 s + 5.5 s)
+    EXPECT_TRUE(CheckPose(t.X_WV, "X_WV").empty());
+    const Eigen::Isometry3d X_WV = FromPose(t.X_WV);
+    EXPECT_LT((X_WV.translation() - X_WR.translation()).norm(), start_offset_m) << "trial " << i;
+  }
+  // Different trials of a session are different draws (their own SLAM walk and trial seed).
+  EXPECT_NE(got.trials[0].X_WV.position_m[0], got.trials[1].X_WV.position_m[0]);
+  EXPECT_EQ(hmd.process().rejections().total(), 0);
+  // After the trials the hologram is drawn where the user put it last.
+  EXPECT_TRUE(hmd.CurrentX_WV().isApprox(FromPose(got.trials.back().X_WV)));
+}
+
+TEST(HmdProcess, SameSeedSameSessionGivesTheSameTrial) {
+  std::vector<orbed::alignment_trial_t> runs;
+  for (int k = 0; k < 2; ++k) {
+    HmdProcess hmd(MemqFlags(0.2), Inline());
+    Collector got;
+    got.Attach(hmd.process().lcm());
+    const auto status = Status(kQDeg);
+    const auto state = State(SceneX_WR());
+    const auto start = Control("same", +SC::START, +AT::MODE_AR_REFLECTIVE, 1);
+    const auto request = Control("same", +SC::REQUEST_TRIAL);
+    hmd.process().lcm().publish("IIWA_STATUS", &status);
+    hmd.process().lcm().publish("ROBOT_STATE", &state);
+    hmd.process().lcm().publish("SESSION_CONTROL", &start);
+    hmd.process().lcm().publish("SESSION_CONTROL", &request);
+    hmd.Run();
+    ASSERT_EQ(got.trials.size(), 1u);
+    runs.push_back(got.trials[0]);
+  }
+  for (int i = 0; i < 3; ++i) EXPECT_EQ(runs[0].X_WV.position_m[i], runs[1].X_WV.position_m[i]);
+  EXPECT_EQ(runs[0].duration_s, runs[1].duration_s);
+}
+
+TEST(HmdProcess, RejectsBadInputsPerReasonAndKeepsRunning) {
+  HmdProcess hmd(MemqFlags(0.4), Inline());
+  Collector got;
+  lcm::LCM& lcm = hmd.process().lcm();
+  got.Attach(lcm);
+
+  // A trial before the robot is known, and for a session that was never started.
+  const auto start = Control("s", +SC::START, +AT::MODE_AR_REFLECTIVE, 1);
+  const auto request = Control("s", +SC::REQUEST_TRIAL);
+  const auto request_other = Control("other", +SC::REQUEST_TRIAL);
+  lcm.publish("SESSION_CONTROL", &start);
+  lcm.publish("SESSION_CONTROL", &request);        // no_robot_state
+  lcm.publish("SESSION_CONTROL", &request_other);  // unknown_session
+  auto bad_command = Control("s", 9);
+  auto empty_id = Control("", +SC::START);
+  auto bad_mode = Control("t", +SC::START, 7, 0);
+  auto ar_with_mirror = Control("t", +SC::START, +AT::MODE_AR, 1);
+  auto too_many_mirrors = Control("t", +SC::START, +AT::MODE_AR_REFLECTIVE, 99);
+  for (const auto* m : {&bad_command, &empty_id, &bad_mode, &ar_with_mirror, &too_many_mirrors}) {
+    lcm.publish("SESSION_CONTROL", m);
+  }
+  auto six = Status({0, 30, 0, -60, 0, 45});
+  auto nan = Status(kQDeg);
+  nan.joint_position_measured[3] = std::nan("");
+  auto beyond = Status({0, 130, 0, -60, 0, 45, 0});  // joint 2 limit is ±120 deg
+  lcm.publish("IIWA_STATUS", &six);
+  lcm.publish("IIWA_STATUS", &nan);
+  lcm.publish("IIWA_STATUS", &beyond);
+  auto bad_pose = State(SceneX_WR());
+  bad_pose.X_WR.quaternion_wxyz[0] = 0.5;
+  lcm.publish("ROBOT_STATE", &bad_pose);
+  orbed::registration_t reg{};
+  reg.session_id = "s";
+  reg.valid = true;
+  reg.X_WV_mean.position_m[0] = std::nan("");
+  reg.X_WV_mean.quaternion_wxyz[0] = 1;
+  lcm.publish("REGISTRATION", &reg);
+  const char garbage[5] = {1, 2, 3, 4, 5};
+  lcm.publish("IIWA_STATUS", garbage, sizeof(garbage));
+  // Still no valid robot: the request is refused again.
+  lcm.publish("SESSION_CONTROL", &request);
+  EXPECT_EQ(hmd.Run(), 0);
+
+  EXPECT_TRUE(got.trials.empty());
+  const std::map<std::string, int64_t> counts = hmd.process().rejections().counts();
+  auto count = [&counts](const std::string& key) {
+    const auto it = counts.find(key);
+    return it == counts.end() ? 0 : it->second;
+  };
+  EXPECT_EQ(count("SESSION_CONTROL/no_robot_state"), 2);
+  EXPECT_EQ(count("SESSION_CONTROL/unknown_session"), 1);
+  EXPECT_EQ(count("SESSION_CONTROL/command"), 1);
+  EXPECT_EQ(count("SESSION_CONTROL/session_id"), 1);
+  EXPECT_EQ(count("SESSION_CONTROL/display_mode"), 1);
+  EXPECT_EQ(count("SESSION_CONTROL/num_mirrors"), 2);
+  EXPECT_EQ(count("IIWA_STATUS/num_joints"), 1);
+  EXPECT_EQ(count("IIWA_STATUS/non_finite"), 1);
+  EXPECT_EQ(count("IIWA_STATUS/limits"), 1);
+  EXPECT_EQ(count("IIWA_STATUS/decode"), 1);
+  EXPECT_EQ(count("ROBOT_STATE/pose"), 1);
+  EXPECT_EQ(count("REGISTRATION/pose"), 1);
+  EXPECT_EQ(hmd.process().rejections().total(), 14);
+  // The heartbeat carries them too, and the process kept publishing poses throughout.
+  EXPECT_EQ(hmd.process().MakeStatus().rejected_inputs, 14);
+  EXPECT_GT(got.est.size(), 10u);
+}
+
+TEST(HmdProcess, PoseAndTruthShareSeqAndStartAtTheFirstWaypoint) {
+  HmdProcess hmd(MemqFlags(0.5), Inline());
+  Collector got;
+  got.Attach(hmd.process().lcm());
+  EXPECT_EQ(hmd.Run(), 0);
+  Drain(hmd.process().lcm());
+  ASSERT_GE(got.est.size(), 20u);  // 60 Hz for 0.5 s: ~30
+  ASSERT_EQ(got.est.size(), got.truth.size());
+  for (size_t i = 0; i < got.est.size(); ++i) {
+    EXPECT_EQ(got.est[i].seq, static_cast<int64_t>(i));
+    EXPECT_EQ(got.truth[i].seq, got.est[i].seq);
+    EXPECT_EQ(got.truth[i].utime, got.est[i].utime);
+    EXPECT_EQ(got.est[i].hmd_name, "hololens1");
+    EXPECT_TRUE(CheckPose(got.est[i].X_WH, "X_WH").empty());
+    EXPECT_GE(got.est[i].tracking_state, +orbed::hmd_pose_t::TRACKING);
+    EXPECT_LE(got.est[i].tracking_state, +orbed::hmd_pose_t::RELOCALIZED);
+  }
+  // viraal_walk.yaml: the wearer starts at foot_end, (1.45, -1.20, 1.70) m, dwelling 2 s.
+  const Eigen::Vector3d p_WH = ToVector3(got.truth.front().X_WH.position_m);
+  EXPECT_NEAR(p_WH.x(), 1.45, 1e-9);
+  EXPECT_NEAR(p_WH.y(), -1.20, 1e-9);
+  EXPECT_NEAR(p_WH.z(), 1.70, 1e-9);
+  // The map starts on W: the estimate is the truth up to jitter (slam.yaml: 0.5 mm std).
+  EXPECT_LT((ToVector3(got.est.front().X_WH.position_m) - p_WH).norm(), 0.005);
+  // Gaze rays at 10 Hz from the head: unit direction, hit at the robot's middle distance (~2 m).
+  ASSERT_GE(got.gaze.size(), 3u);
+  EXPECT_NEAR(ToVector3(got.gaze.back().direction_W).norm(), 1.0, 1e-9);
+}
+
+TEST(HmdProcess, CameraReflectiveAndArViewCarryTheirGeometry) {
+  HmdOptions options = Inline();
+  options.displays = 1;
+  HmdProcess hmd(MemqFlags(0), options);
+  Collector got;
+  lcm::LCM& lcm = hmd.process().lcm();
+  got.Attach(lcm);
+  const auto status = Status(kQDeg);
+  const auto state = State(SceneX_WR());
+  lcm.publish("IIWA_STATUS", &status);
+  lcm.publish("ROBOT_STATE", &state);
+  Drain(lcm);
+  hmd.PublishPose();
+  hmd.RequestCamera();     // display 0 captures at the first waypoint, i.e. this frame
+  hmd.RequestReflective();
+  hmd.RequestArView();
+  hmd.PublishGaze();
+  Drain(lcm);
+
+  ASSERT_EQ(got.est.size(), 1u);
+  ASSERT_EQ(got.camera.size(), 1u);
+  const orbed::image_t& cam = got.camera[0];
+  EXPECT_EQ(cam.pixel_format, +orbed::image_t::FORMAT_JPEG);
+  EXPECT_EQ(cam.width, 1280);
+  EXPECT_EQ(cam.height, 720);
+  EXPECT_DOUBLE_EQ(cam.fx_px, 1545.4);
+  EXPECT_DOUBLE_EQ(cam.fy_px, 1551.2);
+  EXPECT_DOUBLE_EQ(cam.cx_px, 597.2);
+  EXPECT_DOUBLE_EQ(cam.cy_px, 322.1);
+  // Stamped with the ESTIMATED camera pose of the sample it was rendered at, and its utime.
+  EXPECT_EQ(cam.pose_utime, got.est[0].utime);
+  EXPECT_EQ(cam.utime, got.est[0].utime);
+  for (int i = 0; i < 3; ++i) EXPECT_EQ(cam.X_WC.position_m[i], got.est[0].X_WC.position_m[i]);
+  const cv::Mat frame = DecodeJpeg(cam.data);
+  ASSERT_EQ(frame.cols, 1280);
+  ASSERT_EQ(frame.rows, 720);
+
+  ASSERT_EQ(got.reflective.size(), 1u);
+  const orbed::reflective_view_t& rv = got.reflective[0];
+  EXPECT_EQ(rv.display_id, 0);
+  EXPECT_EQ(rv.source_utime, cam.utime);
+  const double K_m[3][3] = {{1545.4, 0, 597.2}, {0, -1551.2, -322.1}, {0, 0, 1}};
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) EXPECT_DOUBLE_EQ(rv.K_m[r][c], K_m[r][c]) << r << "," << c;
+  }
+  // X_WM: the camera turned π about its x axis and moved D along its principal ray.
+  const Eigen::Isometry3d X_WC = FromPose(rv.image.X_WC);
+  const Eigen::Isometry3d X_WM = FromPose(rv.X_WM);
+  EXPECT_GT(rv.distance_m, 0.5);
+  EXPECT_LT(rv.distance_m, 5.0);
+  EXPECT_LT((X_WM.translation() - (X_WC.translation() + rv.distance_m * X_WC.linear().col(2))).norm(), 1e-9);
+  EXPECT_LT((X_WM.linear().col(0) - X_WC.linear().col(0)).norm(), 1e-9);
+  EXPECT_LT((X_WM.linear().col(1) + X_WC.linear().col(1)).norm(), 1e-9);
+  EXPECT_LT((X_WM.linear().col(2) + X_WC.linear().col(2)).norm(), 1e-9);
+  const cv::Mat mirror = DecodeJpeg(rv.image.data);
+  ASSERT_EQ(mirror.cols, 1280);
+  ASSERT_EQ(mirror.rows, 720);
+
+  // The AR view is the camera frame with the hologram drawn over it: same size, not the same picture.
+  ASSERT_EQ(got.ar.size(), 1u);
+  const cv::Mat ar = DecodeJpeg(got.ar[0].data);
+  ASSERT_EQ(ar.cols, 1280);
+  cv::Mat diff;
+  cv::absdiff(ar, frame, diff);
+  EXPECT_GT(cv::countNonZero(diff.reshape(1) > 40), 2000);
+
+  // The gaze from the foot end looks at the robot's middle: it hits the real world ~2 m away.
+  ASSERT_EQ(got.gaze.size(), 1u);
+  EXPECT_TRUE(got.gaze[0].valid);
+  EXPECT_GT(got.gaze[0].hit_distance_m, 0.5);
+  EXPECT_LT(got.gaze[0].hit_distance_m, 4.0);
+
+  // A second frame with nothing changed reuses the same JPEG bytes.
+  hmd.PublishPose();
+  hmd.RequestCamera();
+  Drain(lcm);
+  ASSERT_EQ(got.camera.size(), 2u);
+  EXPECT_EQ(got.camera[1].data, got.camera[0].data);
+  EXPECT_EQ(got.camera[1].pose_utime, got.est[1].utime);
+}
+
+TEST(HmdProcess, ThreadedPipelinePublishesTheSame) {
+  HmdProcess hmd(MemqFlags(0.6), HmdOptions{});
+  Collector got;
+  got.Attach(hmd.process().lcm());
+  EXPECT_EQ(hmd.Run(), 0);
+  hmd.Flush();
+  Drain(hmd.process().lcm());
+  EXPECT_GE(got.camera.size(), 8u);  // 30 Hz for 0.6 s: ~18
+  EXPECT_GE(got.reflective.size(), 8u);
+  EXPECT_GE(got.ar.size(), 1u);
+}
+
+TEST(HmdProcess, InteractiveKeysMoveTheHologramAndEnterSubmits) {
+  HmdOptions options = Inline();
+  options.interactive = true;  // no window unless Run() is called
+  HmdProcess hmd(MemqFlags(0), options);
+  Collector got;
+  lcm::LCM& lcm = hmd.process().lcm();
+  got.Attach(lcm);
+  const Eigen::Isometry3d X_WV0 = hmd.CurrentX_WV();
+  hmd.HandleKey('d');  // +x by the default 5 mm
+  EXPECT_NEAR((hmd.CurrentX_WV().translation() - X_WV0.translation()).x(), 0.005, 1e-12);
+  hmd.HandleKey(']');  // 10 mm steps
+  hmd.HandleKey('w');
+  EXPECT_NEAR((hmd.CurrentX_WV().translation() - X_WV0.translation()).y(), 0.010, 1e-12);
+  hmd.HandleKey('l');  // yaw +0.5 deg about z_W
+  const Eigen::Matrix3d R = X_WV0.linear().transpose() * hmd.CurrentX_WV().linear();
+  EXPECT_NEAR(Eigen::AngleAxisd(R).angle(), 0.5 * kDeg, 1e-12);
+  const Eigen::Matrix3d dR = hmd.CurrentX_WV().linear() * X_WV0.linear().transpose();
+  EXPECT_NEAR(Eigen::AngleAxisd(dR).axis().z(), 1.0, 1e-9);
+
+  hmd.HandleKey(13);  // no robot yet: nothing is submitted
+  Drain(lcm);
+  EXPECT_TRUE(got.trials.empty());
+  const auto status = Status(kQDeg);
+  const auto state = State(SceneX_WR());
+  lcm.publish("IIWA_STATUS", &status);
+  lcm.publish("ROBOT_STATE", &state);
+  Drain(lcm);
+  hmd.HandleKey(13);
+  Drain(lcm);
+  ASSERT_EQ(got.trials.size(), 1u);
+  ASSERT_EQ(got.control.size(), 1u);  // the local session's START
+  EXPECT_EQ(got.control[0].command, +SC::START);
+  EXPECT_EQ(got.trials[0].session_id, got.control[0].session_id);
+  EXPECT_EQ(got.trials[0].trial_index, 0);
+  EXPECT_EQ(got.trials[0].display_mode, +AT::MODE_AR_REFLECTIVE);
+  EXPECT_EQ(got.trials[0].user_id, "interactive");
+  EXPECT_TRUE(FromPose(got.trials[0].X_WV).isApprox(hmd.CurrentX_WV(), 1e-12));
+  hmd.HandleKey(13);  // the echoed START did not reset the index
+  Drain(lcm);
+  ASSERT_EQ(got.trials.size(), 2u);
+  EXPECT_EQ(got.trials[1].trial_index, 1);
+
+  // The window: two 800×450 panels over a status bar; the help overlay changes the picture.
+  const cv::Mat without_help = hmd.CurrentWindowImage();
+  EXPECT_EQ(without_help.cols, 1600);
+  EXPECT_GT(without_help.rows, 450);
+  hmd.HandleKey('h');
+  const cv::Mat with_help = hmd.CurrentWindowImage();
+  cv::Mat diff;
+  cv::absdiff(with_help, without_help, diff);
+  EXPECT_GT(cv::countNonZero(diff.reshape(1)), 1000);
+}
+
+TEST(HmdConfig, ErrorsNameTheFileAndTheKey) {
+  const std::string dir = ::testing::TempDir();
+  const std::string bad_waypoint = dir + "/hmd_bad_waypoint.yaml";
+  std::ofstream(bad_waypoint) << "hmd:\n  displays:\n    - {capture_waypoint: nowhere}\n";
+  std::vector<std::string> paths;
+  for (const auto& rel : DefaultHmdConfigRelativePaths()) paths.push_back(HmdSourcePath(rel));
+  paths.push_back(bad_waypoint);
+  try {
+    LoadHmdConfigs(paths);
+    FAIL() << "expected an error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("hmd_bad_waypoint.yaml"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("nowhere"), std::string::npos) << e.what();
+  }
+  const std::string unknown = dir + "/hmd_unknown_key.yaml";
+  std::ofstream(unknown) << "hmd:\n  gaze_hz: 10\nslamm: {}\n";
+  paths.back() = unknown;
+  try {
+    LoadHmdConfigs(paths);
+    FAIL() << "expected an error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("slamm"), std::string::npos) << e.what();
+  }
+  // The shipped files: two displays placed, alignment at head_end.
+  paths.pop_back();
+  const HmdConfigSet set = LoadHmdConfigs(paths);
+  ASSERT_EQ(set.hmd.displays.size(), 2u);
+  EXPECT_EQ(set.hmd.displays[0].capture_waypoint, "foot_end");
+  EXPECT_EQ(set.hmd.align_waypoint, "head_end");
+}
+
+}  // namespace
+}  // namespace orbed::hmd

@@ -1,0 +1,123 @@
+#include "hmd_emulator/interactive.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include <opencv2/imgproc.hpp>
+
+namespace orbed::hmd {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+void Rotate(const Eigen::Vector3d& axis_W, double angle_rad, Eigen::Isometry3d* X_WV) {
+  X_WV->linear() = Eigen::AngleAxisd(angle_rad, axis_W).toRotationMatrix() * X_WV->linear();
+}
+
+void Text(cv::Mat* image, const std::string& text, cv::Point at, double scale, cv::Scalar color, int thickness = 1) {
+  cv::putText(*image, text, at, cv::FONT_HERSHEY_SIMPLEX, scale, color, thickness, cv::LINE_AA);
+}
+
+cv::Mat Panel(const cv::Mat& image, int width, int height, const std::string& title, const std::string& empty_text) {
+  cv::Mat panel(height, width, CV_8UC3, cv::Scalar(40, 40, 40));
+  if (!image.empty() && image.type() == CV_8UC3) {
+    cv::resize(image, panel, cv::Size(width, height), 0, 0, cv::INTER_AREA);
+  } else {
+    Text(&panel, empty_text, cv::Point(20, height / 2), 0.7, cv::Scalar(200, 200, 200));
+  }
+  cv::rectangle(panel, cv::Rect(0, 0, width, 28), cv::Scalar(25, 25, 25), cv::FILLED);
+  Text(&panel, title, cv::Point(10, 20), 0.58, cv::Scalar(235, 235, 235));
+  return panel;
+}
+
+}  // namespace
+
+KeyAction ApplyKey(int key, int num_displays, InteractiveState* s, Eigen::Isometry3d* X_WV) {
+  const double t = s->step_m, r = s->step_deg * kDeg;
+  switch (key & 0xFF) {
+    case 'a': X_WV->translation().x() -= t; return KeyAction::kMoved;
+    case 'd': X_WV->translation().x() += t; return KeyAction::kMoved;
+    case 'w': X_WV->translation().y() += t; return KeyAction::kMoved;
+    case 's': X_WV->translation().y() -= t; return KeyAction::kMoved;
+    case 'r': X_WV->translation().z() += t; return KeyAction::kMoved;
+    case 'f': X_WV->translation().z() -= t; return KeyAction::kMoved;
+    case 'j': Rotate(Eigen::Vector3d::UnitZ(), -r, X_WV); return KeyAction::kMoved;
+    case 'l': Rotate(Eigen::Vector3d::UnitZ(), r, X_WV); return KeyAction::kMoved;
+    case 'i': Rotate(Eigen::Vector3d::UnitY(), r, X_WV); return KeyAction::kMoved;
+    case 'k': Rotate(Eigen::Vector3d::UnitY(), -r, X_WV); return KeyAction::kMoved;
+    case 'u': Rotate(Eigen::Vector3d::UnitX(), -r, X_WV); return KeyAction::kMoved;
+    case 'o': Rotate(Eigen::Vector3d::UnitX(), r, X_WV); return KeyAction::kMoved;
+    case '[': s->step_m = std::max(0.0005, s->step_m / 2); return KeyAction::kStep;
+    case ']': s->step_m = std::min(0.1, s->step_m * 2); return KeyAction::kStep;
+    case '-': s->step_deg = std::max(0.05, s->step_deg / 2); return KeyAction::kStep;
+    case '=': s->step_deg = std::min(10.0, s->step_deg * 2); return KeyAction::kStep;
+    case 'h': s->show_help = !s->show_help; return KeyAction::kHelp;
+    case '0': return KeyAction::kReset;
+    case 'n':
+      s->shown_display = num_displays > 0 ? (s->shown_display + 1) % num_displays : 0;
+      return KeyAction::kNextDisplay;
+    case 'c': return KeyAction::kRecapture;
+    case 10:
+    case 13: return KeyAction::kSubmit;
+    case 'q':
+    case 27: return KeyAction::kQuit;
+    default: return KeyAction::kNone;
+  }
+}
+
+std::vector<std::string> InteractiveHelpLines() {
+  return {
+      "a / d    move the virtual robot along -x / +x (world)",
+      "w / s    along +y / -y          r / f    along +z / -z",
+      "j / l    yaw -/+ (about z)      i / k    pitch +/- (about y)",
+      "u / o    roll -/+ (about x)     (about the world axes through V's origin)",
+      "[ / ]    translation step /2, x2          - / =    rotation step /2, x2",
+      "0        back to the start pose           n        next reflective display",
+      "c        re-capture the shown display from where you stand",
+      "Enter    submit the alignment trial (ALIGNMENT_TRIAL)",
+      "h        this help on/off                 q / Esc  quit",
+  };
+}
+
+cv::Mat WindowImage(const cv::Mat& ar_view, const cv::Mat& reflective, const InteractiveState& state,
+                    const std::vector<std::string>& status_lines, int panel_width_px) {
+  const int w = std::max(160, panel_width_px);
+  const int h = w * 9 / 16;
+  const int bar_h = 34 + 24 * static_cast<int>(status_lines.size());
+  cv::Mat window(h + bar_h, 2 * w, CV_8UC3, cv::Scalar(30, 30, 30));
+  Panel(ar_view, w, h, "AR view: the hologram over the live camera frame", "waiting for the camera")
+      .copyTo(window(cv::Rect(0, 0, w, h)));
+  char title[96];
+  std::snprintf(title, sizeof(title), "reflective display %d (mirror view of a captured frame)", state.shown_display);
+  Panel(reflective, w, h, title, "no reflective display (--displays 0) or no frame yet")
+      .copyTo(window(cv::Rect(w, 0, w, h)));
+  cv::line(window, cv::Point(w, 0), cv::Point(w, h), cv::Scalar(90, 90, 90), 2);
+
+  char steps[160];
+  std::snprintf(steps, sizeof(steps),
+                "step: %.1f mm  %.2f deg   ([ ] and - = change them)   h: help   Enter: submit   q: quit",
+                state.step_m * 1e3, state.step_deg);
+  Text(&window, steps, cv::Point(12, h + 24), 0.6, cv::Scalar(120, 230, 255));
+  for (std::size_t i = 0; i < status_lines.size(); ++i) {
+    Text(&window, status_lines[i], cv::Point(12, h + 48 + 24 * static_cast<int>(i)), 0.55, cv::Scalar(225, 225, 225));
+  }
+
+  if (state.show_help) {
+    const std::vector<std::string> lines = InteractiveHelpLines();
+    const int box_w = std::min(2 * w - 40, 760), box_h = 50 + 26 * static_cast<int>(lines.size());
+    const cv::Rect box((2 * w - box_w) / 2, std::max(10, (h - box_h) / 2), box_w, box_h);
+    cv::Mat roi = window(box & cv::Rect(0, 0, window.cols, window.rows));
+    cv::Mat dark(roi.size(), CV_8UC3, cv::Scalar(20, 20, 20));
+    cv::addWeighted(roi, 0.2, dark, 0.8, 0, roi);
+    cv::rectangle(window, box, cv::Scalar(120, 230, 255), 1);
+    Text(&window, "keys", cv::Point(box.x + 16, box.y + 30), 0.7, cv::Scalar(120, 230, 255), 2);
+    for (std::size_t i = 0; i < lines.size(); ++i) {
+      Text(&window, lines[i], cv::Point(box.x + 16, box.y + 58 + 26 * static_cast<int>(i)), 0.55,
+           cv::Scalar(240, 240, 240));
+    }
+  }
+  return window;
+}
+
+}  // namespace orbed::hmd

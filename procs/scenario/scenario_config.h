@@ -1,0 +1,61 @@
+#pragma once
+/// @file
+/// The ViRAAl scenario file (procs/scenario/viraal.yaml): which display modes to run and in which
+/// order, how many trials per mode, the joint configurations the robot takes for the trials, and
+/// the landmarks of the paper's misalignment protocol. Every key is checked; unknown keys and bad
+/// values are errors naming the file, the line and what was expected.
+///
+///   trials: 3                              # per mode, >= 1 (trial i uses configuration i mod K)
+///   modes: [ar_reflective, ar]             # run order; each of ar_reflective | ar, no repeats
+///   reflective_mirrors: 1                  # num_mirrors of the ar_reflective mode, >= 1
+///   method: karcher                        # chordal | karcher | robust (registration_t.METHOD_*)
+///   configurations_deg:                    # K >= 1 joint vectors q1..q7 [deg], pairwise distinct
+///     - [0, 30, 0, -60, 0, 45, 0]
+///   landmarks: [iiwa_link_4, iiwa_link_6, iiwa_link_ee]   # link origins, >= 1 (paper: 3)
+///
+/// Joint limits and collisions are not checked here (no model): ViraalScenario checks the limits
+/// against the URDF and asks orbed-iiwa-sim (PLAN_CHECK_REQUEST) about collisions before use.
+///
+/// Threading: plain data; the loaders are reentrant.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace orbed::scenario {
+
+/// One display mode of the experiment.
+struct ModeSpec {
+  std::string name;        ///< "ar_reflective" or "ar"
+  int8_t display_mode{0};  ///< alignment_trial_t::MODE_*
+  int32_t num_mirrors{0};
+};
+
+struct ScenarioConfig {
+  int trials{3};
+  std::vector<ModeSpec> modes;
+  int8_t method{1};  ///< registration_t::METHOD_KARCHER
+  std::vector<std::vector<double>> configurations_deg;
+  std::vector<std::string> landmarks;
+};
+
+/// The file shipped in the source tree, relative to the repository root.
+inline constexpr const char* kDefaultScenarioRelativePath = "procs/scenario/viraal.yaml";
+
+/// Loads and checks a scenario file; throws std::runtime_error "file:line: key: what, expected ...".
+ScenarioConfig LoadScenarioFile(const std::string& path);
+ScenarioConfig LoadScenarioString(const std::string& yaml_text, const std::string& source_name);
+
+/// "ar_reflective" / "ar" → a ModeSpec (the reflective mode with `reflective_mirrors` displays);
+/// throws std::invalid_argument naming the accepted names otherwise.
+ModeSpec ModeFromName(const std::string& name, int reflective_mirrors);
+
+/// "q1,q2,...,q7" [deg] → numbers; throws std::invalid_argument naming `what` on a bad list.
+std::vector<double> ParseJointList(const std::string& text, const std::string& what);
+
+/// Checks counts, joint-vector sizes (7), finiteness and pairwise distinctness (some joint differs
+/// by more than 1 deg); throws std::invalid_argument with the reason. Used after flags override
+/// the file.
+void ValidateScenarioConfig(const ScenarioConfig& config, int num_joints);
+
+}  // namespace orbed::scenario

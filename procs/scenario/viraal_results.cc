@@ -1,0 +1,229 @@
+#include "procs/scenario/viraal_results.h"
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <functional>
+#include <sstream>
+#include <stdexcept>
+
+#include "procs/common/json.h"
+
+namespace orbed::scenario {
+namespace {
+
+// Paper, Table 1 and Sec. III-B: misalignment ‖t̄‖₂ and ‖σ_t‖₂ [mm] over 10 trials x 4 users.
+constexpr double kPaperReflectiveMm = 16.5, kPaperReflectiveStdMm = 11.0;
+constexpr double kPaperArMm = 30.2, kPaperArStdMm = 23.9;
+constexpr double kPaperReflectiveMeanMm = 11.3, kPaperReflectiveMeanStdMm = 1.01;
+
+void WritePose(JsonWriter* json, const Eigen::Isometry3d& X) {
+  const Eigen::Quaterniond q(X.linear());
+  // w >= 0, as ToPose does, so equal rotations print equally.
+  const double s = q.w() < 0 ? -1.0 : 1.0;
+  json->BeginObject();
+  json->Key("position_m").Array(std::vector<double>{X.translation().x(), X.translation().y(), X.translation().z()});
+  json->Key("quaternion_wxyz").Array(std::vector<double>{s * q.w(), s * q.x(), s * q.y(), s * q.z()});
+  json->EndObject();
+}
+
+void WriteMeasures(JsonWriter* json, const ErrorMeasures& e) {
+  json->Key("translation_error_mm").Number(e.translation_error_mm);
+  json->Key("rotation_error_deg").Number(e.rotation_error_deg);
+  json->Key("misalignment_mm").Number(e.misalignment_mm);
+  json->Key("base_translation_error_mm").Number(e.base_translation_error_mm);
+  json->Key("flange_translation_error_mm").Number(e.flange_translation_error_mm);
+  json->Key("misalignment_axes_mm")
+      .Array(std::vector<double>{e.misalignment_axes_mm.x(), e.misalignment_axes_mm.y(), e.misalignment_axes_mm.z()});
+  json->Key("misalignment_mean_pair_distance_mm").Number(e.misalignment_mean_pair_distance_mm);
+}
+
+// The measures that get trial statistics, by name.
+const std::vector<std::pair<std::string, std::function<double(const ErrorMeasures&)>>>& StatMeasures() {
+  static const std::vector<std::pair<std::string, std::function<double(const ErrorMeasures&)>>> measures = {
+      {"translation_error_mm", [](const ErrorMeasures& e) { return e.translation_error_mm; }},
+      {"rotation_error_deg", [](const ErrorMeasures& e) { return e.rotation_error_deg; }},
+      {"misalignment_mm", [](const ErrorMeasures& e) { return e.misalignment_mm; }},
+      {"base_translation_error_mm", [](const ErrorMeasures& e) { return e.base_translation_error_mm; }},
+      {"flange_translation_error_mm", [](const ErrorMeasures& e) { return e.flange_translation_error_mm; }}};
+  return measures;
+}
+
+std::string Fixed(double value, int digits) {
+  char text[64];
+  std::snprintf(text, sizeof(text), "%.*f", digits, value);
+  return text;
+}
+
+std::string PadLeft(const std::string& text, size_t width) {
+  return text.size() >= width ? text : std::string(width - text.size(), ' ') + text;
+}
+std::string PadRight(const std::string& text, size_t width) {
+  return text.size() >= width ? text : text + std::string(width - text.size(), ' ');
+}
+
+}  // namespace
+
+MeanStd ComputeMeanStd(const std::vector<double>& values) {
+  MeanStd out;
+  if (values.empty()) return out;
+  for (double v : values) out.mean += v;
+  out.mean /= static_cast<double>(values.size());
+  if (values.size() < 2) return out;
+  double ss = 0;
+  for (double v : values) ss += (v - out.mean) * (v - out.mean);
+  out.std = std::sqrt(ss / static_cast<double>(values.size() - 1));
+  return out;
+}
+
+std::string ResultsJson(const RunResults& r) {
+  JsonWriter json(2);
+  json.BeginObject();
+  json.Key("run_id").String(r.run_id);
+  json.Key("status").String(r.ok ? "ok" : "failed");
+  json.Key("error").String(r.error);
+  json.Key("seed").Int(static_cast<int64_t>(r.seed));
+  json.Key("started_utime").Int(r.started_utime);
+  json.Key("duration_s").Number(r.duration_s);
+  json.Key("translation_error_point")
+      .String("robot centroid: mean of the link origins from the base to the flange at the trial's q "
+              "(for a mean: averaged over the session's configurations)");
+  json.Key("misalignment_definition")
+      .String("paper Table 1: norm of the mean absolute per-axis error over the landmark pairs, "
+              "||t_bar||_2 (orbed-registration MISALIGNMENT mean_error_norm_m); for a mean: the pairs of "
+              "all the session's configurations");
+  json.Key("landmarks").BeginArray();
+  for (const std::string& name : r.landmarks) json.String(name);
+  json.EndArray();
+  json.Key("configurations_deg").BeginArray();
+  for (const auto& q : r.configurations_deg) json.Array(q);
+  json.EndArray();
+  json.Key("X_WR");
+  if (r.X_WR) {
+    WritePose(&json, *r.X_WR);
+  } else {
+    json.Null();
+  }
+  json.Key("rejected_inputs").Int(r.rejected_inputs);
+  json.Key("paper_reference").BeginObject();
+  json.Key("source").String("Fotouhi et al., RA-L 2020, Table 1 and Sec. III-B (10 trials x 4 users)");
+  json.Key("ar_reflective").BeginObject();
+  json.Key("misalignment_mm").Number(kPaperReflectiveMm).Key("std_mm").Number(kPaperReflectiveStdMm);
+  json.EndObject();
+  json.Key("ar").BeginObject();
+  json.Key("misalignment_mm").Number(kPaperArMm).Key("std_mm").Number(kPaperArStdMm);
+  json.EndObject();
+  json.Key("ar_reflective_mean").BeginObject();
+  json.Key("misalignment_mm").Number(kPaperReflectiveMeanMm).Key("std_mm").Number(kPaperReflectiveMeanStdMm);
+  json.EndObject();
+  json.EndObject();
+
+  json.Key("sessions").BeginArray();
+  for (const SessionResult& s : r.sessions) {
+    json.BeginObject();
+    json.Key("mode").String(s.mode);
+    json.Key("session_id").String(s.session_id);
+    json.Key("display_mode").Int(s.display_mode);
+    json.Key("num_mirrors").Int(s.num_mirrors);
+    json.Key("trials").BeginArray();
+    for (const TrialResult& t : s.trials) {
+      json.BeginObject();
+      json.Key("index").Int(t.index);
+      json.Key("q_deg").Array(t.q_deg);
+      WriteMeasures(&json, t.errors);
+      json.Key("user_duration_s").Number(t.user_duration_s);
+      json.Key("user_id").String(t.user_id);
+      json.Key("X_WV");
+      WritePose(&json, t.X_WV);
+      json.Key("X_WR");
+      WritePose(&json, t.X_WR);
+      json.EndObject();
+    }
+    json.EndArray();
+    json.Key("trial_statistics").BeginObject();
+    for (const auto& [name, get] : StatMeasures()) {
+      std::vector<double> values;
+      for (const TrialResult& t : s.trials) values.push_back(get(t.errors));
+      const MeanStd stats = ComputeMeanStd(values);
+      json.Key(name).BeginObject().Key("mean").Number(stats.mean).Key("std").Number(stats.std).EndObject();
+    }
+    json.EndObject();
+    json.Key("mean");
+    if (s.mean) {
+      const MeanResult& m = *s.mean;
+      json.BeginObject();
+      WriteMeasures(&json, m.errors);
+      json.Key("X_WV");
+      WritePose(&json, m.X_WV);
+      json.Key("num_used").Int(m.num_used);
+      json.Key("rejected_indices").Array(m.rejected_indices);
+      json.Key("rotation_rms_deg").Number(m.rotation_rms_deg);
+      json.Key("translation_rms_mm").Number(m.translation_rms_mm);
+      json.Key("iterations").Int(m.iterations);
+      json.Key("converged").Bool(m.converged);
+      json.Key("unique").Bool(m.unique);
+      json.EndObject();
+    } else {
+      json.Null();
+    }
+    json.EndObject();
+  }
+  json.EndArray();
+  json.EndObject();
+  return json.str() + "\n";
+}
+
+std::string ResultsTable(const RunResults& r) {
+  std::ostringstream out;
+  const auto row = [&](const std::string& mode, const std::string& what, const std::string& q,
+                       const ErrorMeasures& e) {
+    out << PadRight(mode, 15) << PadRight(what, 8) << PadRight(q, 44) << PadLeft(Fixed(e.translation_error_mm, 1), 9)
+        << PadLeft(Fixed(e.rotation_error_deg, 2), 9) << PadLeft(Fixed(e.misalignment_mm, 1), 10)
+        << PadLeft(Fixed(e.base_translation_error_mm, 1), 9) << "\n";
+  };
+  out << "ViRAAl run " << r.run_id << " (" << (r.ok ? "ok" : "FAILED: " + r.error) << ")\n";
+  out << PadRight("mode", 15) << PadRight("trial", 8) << PadRight("q [deg]", 44) << PadLeft("t [mm]", 9)
+      << PadLeft("R [deg]", 9) << PadLeft("mis [mm]", 10) << PadLeft("base[mm]", 9) << "\n";
+  for (const SessionResult& s : r.sessions) {
+    std::vector<double> misalignment;
+    for (const TrialResult& t : s.trials) {
+      std::string q = "(";
+      for (size_t i = 0; i < t.q_deg.size(); ++i) q += (i ? ", " : "") + Fixed(t.q_deg[i], 0);
+      row(s.mode, std::to_string(t.index), q + ")", t.errors);
+      misalignment.push_back(t.errors.misalignment_mm);
+    }
+    if (s.mean) row(s.mode, "mean", "SE(3) mean of " + std::to_string(s.mean->num_used) + " trials", s.mean->errors);
+    const MeanStd stats = ComputeMeanStd(misalignment);
+    out << PadRight("", 23) << "trial misalignment " << Fixed(stats.mean, 1) << " +/- " << Fixed(stats.std, 1)
+        << " mm";
+    if (s.mode == "ar_reflective") {
+      out << "   (paper: " << Fixed(kPaperReflectiveMm, 1) << " +/- " << Fixed(kPaperReflectiveStdMm, 1)
+          << " mm; its mean " << Fixed(kPaperReflectiveMeanMm, 1) << " +/- " << Fixed(kPaperReflectiveMeanStdMm, 2)
+          << " mm)";
+    } else if (s.mode == "ar") {
+      out << "   (paper: " << Fixed(kPaperArMm, 1) << " +/- " << Fixed(kPaperArStdMm, 1) << " mm)";
+    }
+    out << "\n";
+  }
+  out << "t = translation error at the robot centroid, R = rotation error, mis = landmark misalignment "
+         "||t_bar||_2 (paper Table 1), base = translation error at the base origin\n";
+  return out.str();
+}
+
+std::string WriteResultsFile(const std::string& dir, const std::string& text) {
+  const std::string path = (dir.empty() ? std::string(".") : dir) + "/results.json";
+  const std::string temporary = path + ".tmp";
+  {
+    std::ofstream out(temporary, std::ios::trunc);
+    if (!out) throw std::runtime_error("cannot write " + temporary);
+    out << text;
+    out.flush();
+    if (!out) throw std::runtime_error("cannot write " + temporary);
+  }
+  if (std::rename(temporary.c_str(), path.c_str()) != 0) {
+    throw std::runtime_error("cannot rename " + temporary + " to " + path);
+  }
+  return path;
+}
+
+}  // namespace orbed::scenario

@@ -1,0 +1,116 @@
+#pragma once
+/// @file
+/// The results of a ViRAAl run and their two renderings: results.json (documented in README.md)
+/// and the text table orbed-scenario prints at the end.
+///
+/// Units: as named (mm, deg, s); poses X_WR (truth) and X_WV (chosen / mean) as
+/// {"position_m":[x,y,z],"quaternion_wxyz":[w,x,y,z]} in the world W.
+///
+/// results.json, top level:
+///   "run_id", "status" ("ok" | "failed"), "error" (one line, "" when ok), "seed",
+///   "started_utime" [µs since the epoch], "duration_s" (wall clock of the run),
+///   "translation_error_point" (what "translation_error_mm" measures), "misalignment_definition",
+///   "landmarks" (link names), "X_WR" (truth at the first trial), "configurations_deg",
+///   "rejected_inputs" (count of invalid messages the scenario refused),
+///   "paper_reference" (Table 1 / Sec. III-B figures, mm),
+///   "sessions": [ {"mode", "session_id", "display_mode", "num_mirrors",
+///                  "trials": [ {"index", "q_deg", "translation_error_mm", "rotation_error_deg",
+///                               "misalignment_mm", "base_translation_error_mm",
+///                               "flange_translation_error_mm", "misalignment_axes_mm" [t̄x,t̄y,t̄z],
+///                               "misalignment_mean_pair_distance_mm", "user_duration_s",
+///                               "user_id", "X_WV", "X_WR"} ],
+///                  "trial_statistics": {"<measure>": {"mean", "std"}} over the trials (std with
+///                                      N − 1; 0 for one trial),
+///                  "mean": {"translation_error_mm", "rotation_error_deg", "misalignment_mm",
+///                           "base_translation_error_mm", "flange_translation_error_mm",
+///                           "misalignment_axes_mm", "misalignment_mean_pair_distance_mm",
+///                           "X_WV", "num_used", "rejected_indices", "rotation_rms_deg",
+///                           "translation_rms_mm", "iterations", "converged", "unique"} } ]
+/// A failed run still writes what it had: the sessions and trials finished so far ("mean" is null
+/// for a session that did not get one).
+///
+/// Threading: plain data and pure functions.
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+namespace orbed::scenario {
+
+/// The error measures of one pose against the truth (see viraal_errors.h for the definitions).
+struct ErrorMeasures {
+  double translation_error_mm{0};  ///< at the robot's centroid
+  double rotation_error_deg{0};
+  double misalignment_mm{0};       ///< paper Table 1: ‖t̄‖₂ over the landmark pairs
+  double base_translation_error_mm{0};
+  double flange_translation_error_mm{0};
+  Eigen::Vector3d misalignment_axes_mm{Eigen::Vector3d::Zero()};  ///< t̄ = mean |virtual − real| per axis
+  double misalignment_mean_pair_distance_mm{0};                   ///< mean of the pair distances
+};
+
+struct TrialResult {
+  int index{0};
+  std::vector<double> q_deg;
+  ErrorMeasures errors;
+  double user_duration_s{0};  ///< the trial's duration_s (emulated time for orbed-hmd)
+  std::string user_id;
+  Eigen::Isometry3d X_WV{Eigen::Isometry3d::Identity()};
+  Eigen::Isometry3d X_WR{Eigen::Isometry3d::Identity()};
+};
+
+struct MeanResult {
+  ErrorMeasures errors;
+  Eigen::Isometry3d X_WV{Eigen::Isometry3d::Identity()};
+  int num_used{0};
+  std::vector<int> rejected_indices;
+  double rotation_rms_deg{0};
+  double translation_rms_mm{0};
+  int iterations{0};
+  bool converged{false};
+  bool unique{false};
+};
+
+struct SessionResult {
+  std::string mode;
+  std::string session_id;
+  int display_mode{0};
+  int num_mirrors{0};
+  std::vector<TrialResult> trials;
+  std::optional<MeanResult> mean;
+};
+
+struct RunResults {
+  std::string run_id;
+  bool ok{false};
+  std::string error;
+  uint64_t seed{0};
+  int64_t started_utime{0};
+  double duration_s{0};
+  std::vector<std::string> landmarks;
+  std::vector<std::vector<double>> configurations_deg;
+  std::optional<Eigen::Isometry3d> X_WR;
+  int64_t rejected_inputs{0};
+  std::vector<SessionResult> sessions;
+};
+
+/// Sample mean and standard deviation (N − 1 denominator; 0 for fewer than two values).
+struct MeanStd {
+  double mean{0};
+  double std{0};
+};
+MeanStd ComputeMeanStd(const std::vector<double>& values);
+
+/// results.json text (pretty-printed, 2 spaces).
+std::string ResultsJson(const RunResults& results);
+
+/// The end-of-run table: one row per trial and per mean, then the paper's figures for comparison.
+std::string ResultsTable(const RunResults& results);
+
+/// Writes `text` to `dir`/results.json through a temporary file and a rename (a reader never sees a
+/// half-written file); returns the path. Throws std::runtime_error naming the path on failure.
+std::string WriteResultsFile(const std::string& dir, const std::string& text);
+
+}  // namespace orbed::scenario
