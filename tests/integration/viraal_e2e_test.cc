@@ -1,0 +1,71 @@
+// The ViRAAl run end to end, as `scripts/orbed run` does it: orbed-launch with
+// scripts/launch/viraal.yaml (logger, sim, registration, monitor, orbed-hmd, orbed-scenario) in a
+// private network namespace. The scenario ends the run; the launcher must exit 0 and leave a log,
+// a complete manifest and a results.json with 2 sessions × 3 trials and 2 means.
+#include <cmath>
+#include <filesystem>
+#include <set>
+
+#include <gtest/gtest.h>
+#include <lcm/lcm-cpp.hpp>
+#include <yaml-cpp/yaml.h>
+
+#include "tests/integration/testbed_util.h"
+
+namespace orbed::testing {
+namespace {
+
+namespace fs = std::filesystem;
+
+void ExpectErrors(const YAML::Node& node, const std::string& where) {
+  for (const char* key : {"translation_error_mm", "rotation_error_deg", "misalignment_mm"}) {
+    ASSERT_TRUE(node[key]) << where << " lacks " << key;
+    const double value = node[key].as<double>();
+    EXPECT_TRUE(std::isfinite(value) && value >= 0) << where << "." << key << " = " << value;
+  }
+  // An emulated person is not perfect, and not absurd: within a metre and 10 degrees.
+  EXPECT_LT(node["translation_error_mm"].as<double>(), 1000.0) << where;
+  EXPECT_LT(node["rotation_error_deg"].as<double>(), 10.0) << where;
+}
+
+TEST(ViraalRun, LaunchFileRunsTheStudyAndWritesResults) {
+  const std::string log_dir = MakeTempDir("viraal_e2e");
+  RunningProcess launcher({BinPath("orbed-launch"), SourcePath("scripts/launch/viraal.yaml"),
+                           "--duration-sec", "240"},
+                          {{"ORBED_LOG_DIR", log_dir}});
+  ASSERT_TRUE(launcher.Wait(240)) << "the run did not finish";
+  EXPECT_EQ(launcher.term_signal(), 0);
+  ASSERT_EQ(launcher.exit_code(), 0);
+
+  // results.json is JSON, which YAML reads.
+  const YAML::Node results = YAML::LoadFile(log_dir + "/results.json");
+  EXPECT_EQ(results["status"].as<std::string>(), "ok");
+  const YAML::Node sessions = results["sessions"];
+  ASSERT_EQ(sessions.size(), 2u);
+  std::set<std::string> modes;
+  for (const auto& session : sessions) {
+    const std::string mode = session["mode"].as<std::string>();
+    modes.insert(mode);
+    ASSERT_EQ(session["trials"].size(), 3u) << mode;
+    for (size_t i = 0; i < 3; ++i) {
+      EXPECT_EQ(session["trials"][i]["index"].as<int>(), static_cast<int>(i));
+      EXPECT_EQ(session["trials"][i]["q_deg"].size(), 7u);
+      ExpectErrors(session["trials"][i], mode + " trial " + std::to_string(i));
+    }
+    ExpectErrors(session["mean"], mode + " mean");
+  }
+  EXPECT_EQ(modes, (std::set<std::string>{"ar", "ar_reflective"}));
+
+  // The log beside it is whole and holds the study's messages.
+  const YAML::Node manifest = YAML::LoadFile(log_dir + "/manifest.json");
+  EXPECT_TRUE(manifest["complete"].as<bool>());
+  EXPECT_EQ(manifest["drops"].as<int>(), 0);
+  for (const char* channel : {"ALIGNMENT_TRIAL", "REGISTRATION", "HMD_POSE", "HMD_CAMERA",
+                              "REFLECTIVE_VIEW", "IIWA_STATUS", "SESSION_CONTROL"}) {
+    EXPECT_TRUE(manifest["channels"][channel]) << channel << " missing from the log";
+  }
+  EXPECT_EQ(manifest["channels"]["ALIGNMENT_TRIAL"]["events"].as<int>(), 6);
+}
+
+}  // namespace
+}  // namespace orbed::testing
