@@ -14,8 +14,12 @@ add_library(orbed_lcm INTERFACE)
 target_include_directories(orbed_lcm INTERFACE ${LCM_INCLUDE_DIR})
 target_link_libraries(orbed_lcm INTERFACE ${LCM_LIBRARY} Threads::Threads)
 
-find_package(Java 11 COMPONENTS Development)
-find_file(LCM_JAR lcm.jar PATHS /usr/share/java NO_DEFAULT_PATH)
+# The lcm-spy jar and the tests' tools are part of the product: missing ones are errors, not
+# silently skipped tests (scripts/orbed setup installs them all).
+find_package(Java 11 REQUIRED COMPONENTS Development)
+find_file(LCM_JAR lcm.jar PATHS /usr/share/java NO_DEFAULT_PATH REQUIRED)
+find_program(CHECK_URDF_EXECUTABLE check_urdf REQUIRED)
+find_program(XVFB_RUN_EXECUTABLE xvfb-run REQUIRED)
 if(ORBED_BENCHMARKS)
   find_package(benchmark REQUIRED)
 endif()

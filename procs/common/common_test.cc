@@ -2,6 +2,7 @@
 // typed subscriptions, rejection counting and the heartbeat.
 #include <cmath>
 #include <limits>
+#include <thread>
 
 #include <gtest/gtest.h>
 #include <orbed/iiwa_command_t.hpp>
@@ -71,6 +72,10 @@ TEST(Validation, RejectsNaNInfWrongSizeAndNonUnitQuaternions) {
   const double inf[2] = {std::numeric_limits<double>::infinity(), 0};
   EXPECT_NE(CheckFinite(inf, 2, "v"), "");
 
+  const double huge[2] = {1.0, 1e308};
+  EXPECT_NE(CheckBounded(huge, 2, 1e4, "p").find("p[1]"), std::string::npos);
+  EXPECT_EQ(CheckBounded(good, 3, 1e4, "p"), "");
+  EXPECT_NE(CheckBounded(bad, 3, 1e4, "p"), "");
   EXPECT_EQ(CheckSize(7, 7, "num_joints"), "");
   EXPECT_EQ(CheckSize(6, 7, "num_joints"), "num_joints is 6, expected 7");
   EXPECT_NE(CheckLength(3, 2, 10, "num_x"), "");
@@ -208,6 +213,52 @@ TEST(Process, TimerFiresAtItsPeriod) {
   // 0.1, 0.2, 0.3, 0.4 (and possibly 0.5) s.
   EXPECT_GE(ticks, 4);
   EXPECT_LE(ticks, 5);
+}
+
+// One 0.25 s stall in a 0.1 s timer: the missed ticks run back to back afterwards, so 1 s still
+// holds 9 or 10 ticks (skipping would leave 7 or 8).
+TEST(Process, TimerCatchesUpAfterAShortStall) {
+  CommonFlags flags("orbed-test");
+  flags.lcm_url = "memq://";
+  flags.duration_sec = 1.05;
+  Process process(flags);
+  int ticks = 0;
+  process.AddTimer(0.1, [&] {
+    if (++ticks == 2) std::this_thread::sleep_for(std::chrono::milliseconds(250));
+  });
+  process.Run();
+  EXPECT_GE(ticks, 9);
+  EXPECT_LE(ticks, 10);
+}
+
+TEST(Process, ExceptionsInTimersAndHandlersAreCountedNotFatal) {
+  CommonFlags flags("orbed-test");
+  flags.lcm_url = "memq://";
+  flags.duration_sec = 0.35;
+  Process process(flags);
+  int ticks = 0;
+  process.AddTimer(0.1, [&] {
+    ++ticks;
+    throw std::runtime_error("bad tick");
+  });
+  process.Subscribe<iiwa_command_t>(channels::kIiwaCommand,
+                                    [&](const iiwa_command_t&, const std::string&, int64_t) {
+                                      throw std::out_of_range("bad message");
+                                    });
+  iiwa_command_t cmd{};
+  process.lcm().publish(channels::kIiwaCommand, &cmd);
+  EXPECT_EQ(process.Run(), 0);
+  EXPECT_EQ(ticks, 3);  // it kept ticking after the first exception
+  EXPECT_EQ(process.rejections().counts().at("IIWA_COMMAND/handler"), 1);
+  EXPECT_EQ(process.rejections().counts().at("timer/1"), 3);  // timer 0 is the heartbeat
+}
+
+TEST(Process, MalformedChannelRegexIsAnErrorNotACrash) {
+  CommonFlags flags("orbed-test");
+  flags.lcm_url = "memq://";
+  Process process(flags);
+  EXPECT_THROW(process.SubscribeRaw("(", [](const lcm::ReceiveBuffer&, const std::string&) {}),
+               std::invalid_argument);
 }
 
 TEST(Process, BadUrlThrowsNamingIt) {

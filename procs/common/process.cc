@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <csignal>
+#include <regex>
 #include <stdexcept>
 #include <thread>
 
@@ -37,12 +38,31 @@ void InstallStopSignalHandlers() {
 bool StopSignalled() { return g_stop_signalled.load(); }
 void RequestGlobalStop() { g_stop_signalled = true; }
 
+namespace {
+
+// Every process hears every datagram on the group, images included: without a large socket buffer
+// a busy moment drops small messages too. 8 MB unless the URL says otherwise.
+constexpr int64_t kDefaultRecvBufBytes = 8 << 20;
+
+// How far (in periods) a timer may fall behind and still catch up tick by tick.
+constexpr int kMaxCatchUpPeriods = 5;
+
+std::string UrlWithReceiveBuffer(const std::string& url) {
+  if (url.find("recv_buf_size=") != std::string::npos) return url;
+  return WithRecvBufSize(url, kDefaultRecvBufBytes);
+}
+
+}  // namespace
+
 Process::Process(const CommonFlags& flags)
     : name_(flags.name),
       seed_(flags.seed),
       duration_sec_(flags.duration_sec),
-      lcm_(std::make_unique<lcm::LCM>(flags.lcm_url)),
+      lcm_(std::make_unique<lcm::LCM>(UrlWithReceiveBuffer(flags.lcm_url))),
       start_(std::chrono::steady_clock::now()) {
+  // Before any slow set-up (models, meshes, hashes), so that a stop request during it is a clean
+  // stop (Run() returns at once) rather than the default action.
+  InstallStopSignalHandlers();
   if (!lcm_->good()) {
     throw std::runtime_error("cannot open LCM at '" + flags.lcm_url +
                              "' (is there a multicast route? run inside `scripts/orbed launch` or "
@@ -65,6 +85,15 @@ void Process::AddTimer(double period_s, std::function<void()> callback) {
 lcm::Subscription* Process::SubscribeRaw(
     const std::string& channel_regex,
     std::function<void(const lcm::ReceiveBuffer&, const std::string&)> handler) {
+  // LCM 1.3.1 hands back a subscription even when it cannot compile the regex, and crashes on its
+  // first use: check the expression first (ECMAScript is close enough to LCM's PCRE to catch
+  // malformed ones).
+  try {
+    std::regex check(channel_regex);
+  } catch (const std::regex_error& e) {
+    throw std::invalid_argument("invalid channel regular expression '" + channel_regex +
+                                "': " + e.what());
+  }
   auto sub = std::make_unique<RawSubscription>();
   sub->process = this;
   sub->handler = std::move(handler);
@@ -138,12 +167,20 @@ int Process::Run() {
       ORBED_LOG(kInfo) << "--duration-sec reached";
       break;
     }
-    for (Timer& timer : timers_) {
+    for (size_t i = 0; i < timers_.size(); ++i) {
+      Timer& timer = timers_[i];
       if (now >= timer.next) {
-        timer.callback();
+        try {
+          timer.callback();
+        } catch (const std::exception& e) {
+          // A bug or a bad input surfacing in a periodic task must not end the process.
+          Reject("timer/" + std::to_string(i), std::string("exception: ") + e.what());
+        }
         now = std::chrono::steady_clock::now();
         timer.next += timer.period;
-        if (timer.next <= now) {  // fell behind: skip missed ticks rather than bunching them
+        // A few periods late (a busy moment): the missed ticks run back to back, so a 200 Hz
+        // stream keeps its average rate. Further behind (a stall): they are skipped, not bunched.
+        if (now - timer.next > kMaxCatchUpPeriods * timer.period) {
           const auto behind = (now - timer.next) / timer.period + 1;
           timer.next += behind * timer.period;
         }

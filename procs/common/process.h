@@ -37,7 +37,8 @@ void RequestGlobalStop();
 
 class Process {
  public:
-  /// Connects to flags.lcm_url; throws std::runtime_error naming the URL if LCM cannot start.
+  /// Connects to flags.lcm_url (adding recv_buf_size=8 MB unless the URL sets it); throws
+  /// std::runtime_error naming the URL if LCM cannot start. Installs the SIGINT/SIGTERM handlers.
   explicit Process(const CommonFlags& flags);
   virtual ~Process();
   Process(const Process&) = delete;
@@ -55,7 +56,8 @@ class Process {
 
   /// Subscribes to every channel matching `channel_regex` without decoding (for the logger and
   /// bridges). The handler gets LCM's receive buffer (data valid only during the call).
-  /// Returns LCM's subscription so the caller can raise its queue capacity.
+  /// Returns LCM's subscription so the caller can raise its queue capacity. Throws
+  /// std::invalid_argument for a malformed regular expression.
   lcm::Subscription* SubscribeRaw(
       const std::string& channel_regex,
       std::function<void(const lcm::ReceiveBuffer&, const std::string&)> handler);
@@ -68,7 +70,9 @@ class Process {
   }
 
   /// Calls `callback` every `period_s` seconds on the Run() thread, first at start + period.
-  /// Missed deadlines are skipped, not bunched.
+  /// Up to 5 missed ticks run back to back (the average rate holds through a busy moment); beyond
+  /// that they are skipped. An exception from a callback is a counted rejection ("timer/<i>").
+  /// Exceptions from message handlers likewise ("<channel>/handler"): the process keeps running.
   void AddTimer(double period_s, std::function<void()> callback);
 
   /// Records a rejected input with its class `key` and a reason; logs it (rate-limited).
@@ -89,10 +93,6 @@ class Process {
   int64_t messages_out() const { return messages_out_; }
   const RejectionCounter& rejections() const { return rejections_; }
   double UptimeSeconds() const;
-
- protected:
-  void CountIn() { ++messages_in_; }
-  void CountOut() { ++messages_out_; }
 
  private:
   struct Timer {
@@ -148,7 +148,11 @@ struct Process::TypedSubscription : Process::SubscriptionBase {
                                                " bytes as " + Msg::getTypeName());
       return;
     }
-    handler(msg, channel, rbuf->recv_utime);
+    try {
+      handler(msg, channel, rbuf->recv_utime);
+    } catch (const std::exception& e) {
+      process->Reject(channel + "/handler", std::string("exception: ") + e.what());
+    }
   }
 };
 
@@ -157,7 +161,11 @@ struct Process::RawSubscription : Process::SubscriptionBase {
   std::function<void(const lcm::ReceiveBuffer&, const std::string&)> handler;
   void OnRaw(const lcm::ReceiveBuffer* rbuf, const std::string& channel) override {
     ++process->messages_in_;
-    handler(*rbuf, channel);
+    try {
+      handler(*rbuf, channel);
+    } catch (const std::exception& e) {
+      process->Reject(channel + "/handler", std::string("exception: ") + e.what());
+    }
   }
 };
 

@@ -22,6 +22,19 @@ std::string CheckFinite(const std::vector<double>& values, const std::string& wh
   return CheckFinite(values.data(), static_cast<int>(values.size()), what);
 }
 
+std::string CheckBounded(const double* values, int count, double max_abs, const std::string& what) {
+  const std::string finite = CheckFinite(values, count, what);
+  if (!finite.empty()) return finite;
+  for (int i = 0; i < count; ++i) {
+    if (std::abs(values[i]) > max_abs) {
+      std::ostringstream out;
+      out << what << "[" << i << "] is " << values[i] << ", expected |x| <= " << max_abs;
+      return out.str();
+    }
+  }
+  return "";
+}
+
 std::string CheckSize(int64_t actual, int64_t expected, const std::string& what) {
   if (actual == expected) return "";
   std::ostringstream out;

@@ -23,6 +23,9 @@ inline constexpr double kUnitQuaternionTolerance = 1e-6;
 
 std::string CheckFinite(const double* values, int count, const std::string& what);
 std::string CheckFinite(const std::vector<double>& values, const std::string& what);
+/// Finite and |value| <= max_abs: bounds finite-but-absurd input (1e308) that would overflow
+/// sums downstream.
+std::string CheckBounded(const double* values, int count, double max_abs, const std::string& what);
 /// `actual` must equal `expected` (e.g. num_joints vs the arm's joint count).
 std::string CheckSize(int64_t actual, int64_t expected, const std::string& what);
 /// A length field must match the array it describes and lie in [0, max].

@@ -25,6 +25,7 @@ std::string Where(const std::string& path, const YAML::Node& node) {
 void CheckKeys(const std::string& path, const YAML::Node& map, const std::set<std::string>& allowed,
                const std::string& context) {
   for (const auto& item : map) {
+    if (!item.first.IsScalar()) Fail(path, item.first, "a key in " + context + " must be a plain word");
     const std::string key = item.first.as<std::string>();
     if (allowed.count(key) == 0) {
       std::string list;
@@ -86,6 +87,7 @@ ProcessSpec ParseProcess(const std::string& path, const YAML::Node& node,
   if (const YAML::Node env = node["env"]) {
     if (!env.IsMap()) Fail(path, env, "'env' of " + context + " must be a map of strings");
     for (const auto& item : env) {
+      if (!item.first.IsScalar()) Fail(path, item.first, "env names must be plain words");
       if (!item.second.IsScalar()) Fail(path, item.second, "env values must be strings");
       spec.env[item.first.as<std::string>()] = expand(item.second.as<std::string>(), item.second);
     }
@@ -160,8 +162,21 @@ std::map<std::string, std::string> CurrentEnvironment() {
   return env;
 }
 
+LaunchSpec ParseLaunchYamlUnchecked(const std::string& yaml, const std::string& path,
+                                    const std::map<std::string, std::string>& environment);
+
 LaunchSpec ParseLaunchYaml(const std::string& yaml, const std::string& path,
                            const std::map<std::string, std::string>& environment) {
+  try {
+    return ParseLaunchYamlUnchecked(yaml, path, environment);
+  } catch (const YAML::Exception& e) {
+    // Anything the explicit checks did not anticipate (a map used as a key, ...).
+    throw LaunchFileError(path + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
+  }
+}
+
+LaunchSpec ParseLaunchYamlUnchecked(const std::string& yaml, const std::string& path,
+                                    const std::map<std::string, std::string>& environment) {
   YAML::Node root;
   try {
     root = YAML::Load(yaml);

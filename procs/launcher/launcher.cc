@@ -93,6 +93,11 @@ void Launcher::StartGroup(size_t group) {
 }
 
 void Launcher::OnHeartbeat(const orbed::process_status_t& status, int64_t) {
+  // A process saying it is stopping (e.g. the last heartbeat of a dying instance) is not ready.
+  if (status.state != orbed::process_status_t::STATE_STARTING &&
+      status.state != orbed::process_status_t::STATE_RUNNING) {
+    return;
+  }
   for (Managed& m : managed_) {
     if (m.spec.name != status.name || !m.child->running() || m.ready) continue;
     m.ready = true;
@@ -129,6 +134,9 @@ void Launcher::HandleExit(Managed* m) {
   m->finished = true;
   if (m->spec.required && !success) {
     FailTestbed("required process '" + m->spec.name + "' " + m->last_exit);
+  } else if (m->spec.required && !m->ready) {
+    FailTestbed("required process '" + m->spec.name + "' " + m->last_exit +
+                " before its first heartbeat");
   } else if (!success) {
     ORBED_LOG(kWarn) << "optional process " << m->spec.name << " " << m->last_exit
                      << "; continuing without it";
@@ -162,8 +170,11 @@ void Launcher::Tick() {
   bool group_ready = true;
   for (Managed& m : managed_) {
     if (m.group != starting_group_ || m.ready) continue;
+    if (m.finished && !m.spec.required) continue;  // an optional process that is gone already
     group_ready = false;
-    if (SecondsSince(m.started_at) > m.spec.ready_timeout_sec) {
+    // Measured from the group's start, not the last respawn: a child that keeps dying before
+    // its first heartbeat must still time out.
+    if (SecondsSince(group_started_at_) > m.spec.ready_timeout_sec) {
       FailTestbed("process '" + m.spec.name + "' sent no heartbeat on PROCESS_STATUS within " +
                   std::to_string(m.spec.ready_timeout_sec) +
                   " s (if it is not an orbed process, set `ready: none` in " + spec_.path + ")");
@@ -219,7 +230,16 @@ void Launcher::StopEverything() {
       }
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
     }
-    for (Managed* m : group) m->child->Drain(m->prefix, true);
+    for (Managed* m : group) {
+      m->child->Drain(m->prefix, true);
+      // Stopped by its own stop signal (or our SIGKILL) is a normal end; an exit code other than
+      // 0 from a required process is a failure (e.g. the logger could not write its log).
+      if (m->spec.required && m->child->exit_code() > 0 && exit_code_ == 0) {
+        ORBED_LOG(kError) << "required process '" << m->spec.name << "' " << m->last_exit
+                          << " while stopping";
+        exit_code_ = 1;
+      }
+    }
   }
 }
 

@@ -93,6 +93,15 @@ TEST(LaunchFile, ErrorsNameFileLineKeyAndFix) {
                 .find("'respawn' must be true or false"),
             std::string::npos);
   EXPECT_NE(ErrorOf("groups: [\n").find("YAML syntax"), std::string::npos);
+  // Hostile structure: maps and lists where words belong.
+  EXPECT_NE(ErrorOf("groups:\n  - name: g\n    processes:\n      - {name: a, command: x, [1, 2]: 3}\n")
+                .find("must be a plain word"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf("groups:\n  - name: g\n    processes:\n      - {name: a, command: x, env: {[1]: b}}\n")
+                .find("env names must be plain words"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf("groups:\n  - name: [g]\n    processes: []\n"), "");
+  EXPECT_NE(ErrorOf("{[a]: 1}"), "");
 }
 
 TEST(LaunchFile, MissingFileIsNamed) {

@@ -47,6 +47,14 @@ Logger::Logger(const CommonFlags& flags, LoggerOptions options)
   if (!(options_.flush_interval_sec > 0)) {
     throw std::invalid_argument("flush interval must be > 0 s");
   }
+  // Subscribe first: a malformed --channels regex throws before any file is created.
+  lcm::Subscription* subscription = process_.SubscribeRaw(
+      options_.channels,
+      [this](const lcm::ReceiveBuffer& rbuf, const std::string& channel) {
+        OnMessage(rbuf, channel);
+      });
+  subscription->setQueueCapacity(options_.lcm_queue_capacity);
+
   log_path_ = ChooseLogPath(options_, start_utime_);
   const fs::path parent = fs::path(log_path_).parent_path();
   std::error_code ec;
@@ -54,13 +62,12 @@ Logger::Logger(const CommonFlags& flags, LoggerOptions options)
   if (ec) throw std::runtime_error("cannot create " + parent.string() + ": " + ec.message());
   file_ = std::make_unique<EventLogWriter>(log_path_);
   if (!file_->ok()) throw std::runtime_error(file_->error());
-
-  lcm::Subscription* subscription = process_.SubscribeRaw(
-      options_.channels,
-      [this](const lcm::ReceiveBuffer& rbuf, const std::string& channel) {
-        OnMessage(rbuf, channel);
-      });
-  subscription->setQueueCapacity(options_.lcm_queue_capacity);
+  // The files do not change while we record: hash them once.
+  for (const std::string& path : options_.hash_files) {
+    std::string error;
+    const std::string hash = Sha256FileHex(path, &error);
+    file_hashes_.push_back({path, hash, hash.empty() ? error : ""});
+  }
   process_.AddTimer(1.0, [this] { process_.Publish(options_.status_channel, MakeStatus()); });
   process_.AddTimer(5.0, [this] { WriteManifest(false); });
 }
@@ -77,6 +84,7 @@ Logger::~Logger() {
 }
 
 std::string Logger::manifest_path() const {
+  if (!options_.manifest.empty()) return options_.manifest;
   return (fs::path(log_path_).parent_path() / "manifest.json").string();
 }
 
@@ -120,7 +128,13 @@ void Logger::WriterLoop() {
           file_->Write(event.utime, event.channel, event.data.data(), event.data.size());
       std::lock_guard<std::mutex> lock(stats_mutex_);
       if (written == 0) {
-        write_error_ = file_->error();
+        // Disk full or gone: every later event is lost too. Say so once, count the losses as
+        // drops, and stop the logger (its exit code and heartbeat say FAILED).
+        if (write_error_.empty()) {
+          write_error_ = file_->error();
+          process_.Fail("log write failed: " + write_error_);
+        }
+        ++lost_events_;
         continue;
       }
       ++events_written_;
@@ -133,8 +147,12 @@ void Logger::WriterLoop() {
     }
     batch.clear();
     if (stop || Clock::now() >= next_flush) {
-      file_->Flush();
+      const bool flushed = file_->Flush();
       std::lock_guard<std::mutex> lock(stats_mutex_);
+      if (!flushed && write_error_.empty()) {
+        write_error_ = file_->error();
+        process_.Fail("log flush failed: " + write_error_);
+      }
       last_flush_utime_ = NowMicros();
       next_flush = Clock::now() + flush_period;
     }
@@ -177,8 +195,13 @@ orbed::logger_status_t Logger::MakeStatus() const {
     status.bytes_written = bytes_written_;
     status.last_flush_utime = last_flush_utime_;
   }
+  int64_t lost = 0;
+  {
+    std::lock_guard<std::mutex> lock(stats_mutex_);
+    lost = lost_events_;
+  }
   std::lock_guard<std::mutex> lock(queue_mutex_);
-  status.drops = drops_;
+  status.drops = drops_ + lost;
   status.queue_depth = static_cast<int32_t>(queue_.size());
   status.queue_capacity = static_cast<int32_t>(options_.queue_capacity_events);
   return status;
@@ -211,15 +234,13 @@ void Logger::WriteManifest(bool complete) const {
   json.Key("lcm_url").String(flags_.lcm_url);
   json.Key("channels_regex").String(options_.channels);
   json.Key("files").BeginArray();
-  for (const std::string& path : options_.hash_files) {
-    std::string error;
-    const std::string hash = Sha256FileHex(path, &error);
+  for (const FileHash& file : file_hashes_) {
     json.BeginObject();
-    json.Key("path").String(path);
-    if (hash.empty()) {
-      json.Key("error").String(error);
+    json.Key("path").String(file.path);
+    if (file.sha256.empty()) {
+      json.Key("error").String(file.error);
     } else {
-      json.Key("sha256").String(hash);
+      json.Key("sha256").String(file.sha256);
     }
     json.EndObject();
   }

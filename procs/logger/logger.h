@@ -35,6 +35,8 @@ struct LoggerOptions {
   std::string log_dir = "logs";
   /// Explicit log path; overrides log_dir + start-time name when set.
   std::string file;
+  /// Manifest path; empty = manifest.json in the log's folder.
+  std::string manifest;
   /// Regular expression of the channels to record (LCM's full-match channel regex).
   std::string channels = ".*";
   /// Queue bounds: a message that does not fit is dropped and counted.
@@ -105,6 +107,12 @@ class Logger {
   int64_t bytes_written_ = 0;                   // guarded by stats_mutex_
   int64_t last_flush_utime_ = 0;                // guarded by stats_mutex_
   std::string write_error_;                     // guarded by stats_mutex_
+  int64_t lost_events_ = 0;                     // guarded by stats_mutex_ (after a write error)
+
+  struct FileHash {
+    std::string path, sha256, error;
+  };
+  std::vector<FileHash> file_hashes_;  // computed once in the constructor
 
   std::unique_ptr<EventLogWriter> file_;  // used by the writer thread only, after Run() starts
   std::thread writer_;

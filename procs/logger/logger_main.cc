@@ -17,6 +17,8 @@ int main(int argc, char** argv) {
   app.add_option("--log-dir", options.log_dir, "Folder for the log; file named by start time")
       ->capture_default_str();
   app.add_option("--file", options.file, "Explicit log path (overrides --log-dir naming)");
+  app.add_option("--manifest", options.manifest,
+                 "Manifest path (default: manifest.json in the log's folder)");
   app.add_option("--channels", options.channels, "Regular expression of channels to record")
       ->capture_default_str();
   app.add_option("--queue-events", options.queue_capacity_events,
@@ -37,13 +39,12 @@ int main(int argc, char** argv) {
   orbed::ApplyCommonFlags(common);
   options.queue_capacity_bytes = queue_mb << 20;
   for (int i = 0; i < argc; ++i) options.command_line += (i ? " " : "") + std::string(argv[i]);
-  // The logger records images too: make sure the socket buffer holds a burst of them.
-  if (common.lcm_url.find("recv_buf_size=") == std::string::npos) {
-    common.lcm_url = orbed::WithRecvBufSize(common.lcm_url, 8 << 20);
-  }
   try {
     orbed::logger::Logger logger(common, options);
     return logger.Run();
+  } catch (const std::invalid_argument& e) {  // a bad flag value (e.g. the --channels regex)
+    std::cerr << "orbed-logger: " << e.what() << "\n";
+    return 2;
   } catch (const std::exception& e) {
     std::cerr << "orbed-logger: " << e.what() << "\n";
     return 1;

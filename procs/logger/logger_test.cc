@@ -1,5 +1,6 @@
 // Unit tests of orbed-logger's engine on memq://. The oracle for the file format is LCM's own
 // log reader (lcm::LogFile), not our writer.
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -17,11 +18,21 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// A fresh temporary folder, removed at exit when every test passed.
 fs::path TempDir(const std::string& name) {
+  static std::vector<fs::path> dirs;
   fs::path dir = fs::temp_directory_path() / ("orbed_logger_test_" + name + "_" +
                                               std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
+  if (dirs.empty()) {
+    std::atexit([] {
+      if (!::testing::UnitTest::GetInstance()->Passed()) return;
+      std::error_code ec;
+      for (const fs::path& d : dirs) fs::remove_all(d, ec);
+    });
+  }
+  dirs.push_back(dir);
   return dir;
 }
 
@@ -155,6 +166,33 @@ TEST(Logger, RecordsEveryChannelWritesManifestAndCountsDrops) {
   EXPECT_NE(text.find(Sha256Hex("<robot name='x'/>")), std::string::npos);
   EXPECT_NE(text.find("cannot read"), std::string::npos);
   EXPECT_NE(text.find("\"lcm\": \"1.3.1\""), std::string::npos);
+}
+
+// A full disk (/dev/full: every write fails with ENOSPC) fails the logger: exit 1, not silence.
+TEST(Logger, WriteErrorsFailTheLogger) {
+  CommonFlags flags("orbed-logger");
+  flags.lcm_url = "memq://";
+  flags.duration_sec = 2.0;
+  LoggerOptions options;
+  options.file = "/dev/full";
+  options.manifest = (TempDir("full") / "manifest.json").string();
+  options.flush_interval_sec = 0.05;
+  Logger logger(flags, options);
+  const std::string payload(100000, 'x');
+  for (int i = 0; i < 20; ++i) logger.process().lcm().publish("BLOB", payload.data(), payload.size());
+  EXPECT_EQ(logger.Run(), 1);
+  EXPECT_EQ(logger.process().MakeStatus().state, +orbed::process_status_t::STATE_FAILED);
+}
+
+TEST(Logger, MalformedChannelRegexThrowsBeforeCreatingAFile) {
+  const fs::path dir = TempDir("bad_regex");
+  CommonFlags flags("orbed-logger");
+  flags.lcm_url = "memq://";
+  LoggerOptions options;
+  options.log_dir = (dir / "logs").string();
+  options.channels = "IIWA_(";
+  EXPECT_THROW(Logger(flags, options), std::invalid_argument);
+  EXPECT_FALSE(fs::exists(dir / "logs"));
 }
 
 TEST(Logger, ChannelRegexSelects) {

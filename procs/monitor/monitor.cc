@@ -19,6 +19,10 @@ const char* StateName(int8_t state) {
   return "?";
 }
 
+// Bounds that keep a flood of made-up names from growing the table without limit.
+constexpr size_t kMaxProcesses = 256;
+constexpr size_t kMaxNameLength = 64;
+
 }  // namespace
 
 Monitor::Monitor(const CommonFlags& flags, MonitorOptions options)
@@ -26,9 +30,19 @@ Monitor::Monitor(const CommonFlags& flags, MonitorOptions options)
   process_.Subscribe<orbed::process_status_t>(
       channels::kProcessStatus,
       [this](const orbed::process_status_t& msg, const std::string& channel, int64_t recv_utime) {
-        const std::string error = CheckEnum(msg.state, 0, 3, "state");
+        const std::string error = FirstError(
+            {CheckEnum(msg.state, 0, 3, "state"),
+             msg.name.empty() || msg.name.size() > kMaxNameLength
+                 ? "name of " + std::to_string(msg.name.size()) + " characters, expected 1.." +
+                       std::to_string(kMaxNameLength)
+                 : ""});
         if (!error.empty()) {
-          process_.Reject(channel + "/state", error);
+          process_.Reject(channel + "/field", error);
+          return;
+        }
+        if (processes_.count(msg.name) == 0 && processes_.size() >= kMaxProcesses) {
+          process_.Reject(channel + "/too_many", "more than " + std::to_string(kMaxProcesses) +
+                                                     " process names; ignoring '" + msg.name + "'");
           return;
         }
         processes_[msg.name] = Seen{msg, recv_utime};

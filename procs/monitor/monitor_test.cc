@@ -27,6 +27,12 @@ TEST(Monitor, TabulatesHeartbeatsAndFlagsSilentProcesses) {
   bad.name = "liar";
   bad.state = 9;
   monitor.process().lcm().publish(channels::kProcessStatus, &bad);
+  // A flood of made-up names: the table stops growing at its bound.
+  for (int i = 0; i < 300; ++i) {
+    orbed::process_status_t fake = status;
+    fake.name = "fake-" + std::to_string(i);
+    monitor.process().lcm().publish(channels::kProcessStatus, &fake);
+  }
   monitor.Run();
   const int64_t now = NowMicros();
   const std::string table = monitor.Table(now);
@@ -34,7 +40,10 @@ TEST(Monitor, TabulatesHeartbeatsAndFlagsSilentProcesses) {
   EXPECT_NE(table.find("running"), std::string::npos);
   EXPECT_NE(table.find("num_joints is 6"), std::string::npos);
   EXPECT_EQ(table.find("liar"), std::string::npos);  // rejected: state out of range
-  EXPECT_EQ(monitor.process().rejections().total(), 1);
+  // "liar" (state 9); beyond the bound of 256 names (sim + 255 fakes): 45 fakes and the monitor's
+  // own heartbeat, which is published after them.
+  EXPECT_EQ(monitor.process().rejections().counts().at("PROCESS_STATUS/field"), 1);
+  EXPECT_EQ(monitor.process().rejections().counts().at("PROCESS_STATUS/too_many"), 46);
   EXPECT_NE(monitor.Table(now + 10'000'000).find("SILENT"), std::string::npos);
 }
 

@@ -126,6 +126,8 @@ TEST(RegistrationServiceTest, BadTrialsAndCommandsAreRejectedCountedAndChangeNot
   auto bad_joints = Trial("s1", 5, 0, Eigen::Vector3d::Zero(), 9);
   bad_joints.joint_position[3] = INFINITY;
   EXPECT_FALSE(f.service.HandleTrial(bad_joints));
+  // Finite but absurd: 1e300 m would overflow the covariance sums.
+  EXPECT_FALSE(f.service.HandleTrial(Trial("s1", 6, 0, Eigen::Vector3d(1e300, 0, 0), 9)));
   auto bad_control = Control(orbed::session_control_t::START, "s2", 10);
   bad_control.method = 9;
   EXPECT_FALSE(f.service.HandleSessionControl(bad_control));
@@ -135,11 +137,24 @@ TEST(RegistrationServiceTest, BadTrialsAndCommandsAreRejectedCountedAndChangeNot
   EXPECT_EQ(f.service.session_id(), "s1");
   EXPECT_EQ(f.rejections["ALIGNMENT_TRIAL/session"], 2);
   EXPECT_EQ(f.rejections["ALIGNMENT_TRIAL/trial_index"], 1);
-  EXPECT_EQ(f.rejections["ALIGNMENT_TRIAL/field"], 3);
+  EXPECT_EQ(f.rejections["ALIGNMENT_TRIAL/field"], 4);
   EXPECT_EQ(f.rejections["ALIGNMENT_TRIAL/display_mode"], 1);
   EXPECT_EQ(f.rejections["SESSION_CONTROL/field"], 1);
   EXPECT_EQ(f.rejections["SESSION_CONTROL/session"], 1);
   for (const auto& reason : f.reasons) EXPECT_FALSE(reason.empty());
+}
+
+// Rays from 1e308 m would overflow the normal equations into a NaN point marked valid.
+TEST(RegistrationServiceTest, HugeLandmarkCoordinatesAreRejected) {
+  Fixture f;
+  orbed::landmark_request_t request{};
+  request.num_rays = 2;
+  request.origin_W_m = {{1e308, 0, 0}, {0, 1e308, 0}};
+  request.direction_W = {{0, 1, 0}, {1, 0, 0}};
+  const orbed::landmark_t out = f.service.HandleLandmarkRequest(request);
+  EXPECT_FALSE(out.valid);
+  EXPECT_NE(out.reason.find("expected |x| <= "), std::string::npos) << out.reason;
+  EXPECT_EQ(f.rejections["LANDMARK_REQUEST/invalid"], 1);
 }
 
 TEST(RegistrationServiceTest, ResetStopAndRestart) {

@@ -39,6 +39,10 @@ const char* CommandName(int8_t command) {
 }
 
 // Rows of an N×3 message array (already sized by the decoder) as Eigen vectors.
+// Coordinates and direction components beyond this are not an operating room [m]; bounding them
+// keeps sums of squares finite.
+constexpr double kMaxCoordinate_m = 1e4;
+
 std::string ReadRows(const std::vector<std::vector<double>>& rows, int32_t count, int max,
                      const std::string& what, std::vector<Eigen::Vector3d>* out) {
   if (count < 0 || count > max || static_cast<size_t>(count) != rows.size()) {
@@ -48,6 +52,9 @@ std::string ReadRows(const std::vector<std::vector<double>>& rows, int32_t count
   out->clear();
   for (size_t i = 0; i < rows.size(); ++i) {
     if (rows[i].size() != 3) return what + "[" + std::to_string(i) + "]: expected 3 values";
+    const std::string bounded =
+        CheckBounded(rows[i].data(), 3, kMaxCoordinate_m, what + "[" + std::to_string(i) + "]");
+    if (!bounded.empty()) return bounded;
     out->emplace_back(rows[i][0], rows[i][1], rows[i][2]);
   }
   return "";
@@ -120,6 +127,7 @@ std::optional<orbed::registration_t> RegistrationService::HandleTrial(const orbe
   }
   std::string problem = FirstError(
       {CheckPose(msg.X_WV, "ALIGNMENT_TRIAL.X_WV"),
+       CheckBounded(msg.X_WV.position_m, 3, kMaxCoordinate_m, "ALIGNMENT_TRIAL.X_WV.position_m"),
        CheckEnum(msg.display_mode, orbed::alignment_trial_t::MODE_AR, orbed::alignment_trial_t::MODE_AR_REFLECTIVE,
                  "ALIGNMENT_TRIAL.display_mode"),
        CheckEnum(msg.num_mirrors, 0, 64, "ALIGNMENT_TRIAL.num_mirrors"),

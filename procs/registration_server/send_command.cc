@@ -110,6 +110,13 @@ int RunSendCommand(const SendCommandOptions& options, std::ostream& out, std::os
         << options.lcm_url << "?)\n";
     return 1;
   }
+  // UDP may lose a trial; a mean of fewer trials than the file holds must not pass silently.
+  if (waiter.answer.num_trials != static_cast<int32_t>(trials.q_WV.size())) {
+    err << "orbed-registration send: the server holds " << waiter.answer.num_trials
+        << " trials of session '" << options.session_id << "', the file " << trials.q_WV.size()
+        << " (messages lost, or another sender on the session?)\n";
+    return 1;
+  }
   out << AnswerJson(waiter.answer) << "\n";
   return 0;
 }

@@ -142,6 +142,42 @@ TEST(Launcher, RequiredProcessWithoutHeartbeatFailsTheLaunch) {
   EXPECT_GE(std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count(), 1.0);
 }
 
+// A required child that keeps dying before its first heartbeat, with respawn on, must still hit
+// its readiness timeout (measured from the group's start, not from each respawn): exit 1.
+TEST(Launcher, CrashLoopingChildFailsReadinessDespiteRespawn) {
+  const std::string dir = MakeTempDir("launch_crashloop");
+  const std::string launch_file = dir + "/launch.yaml";
+  std::ofstream(launch_file) << "groups:\n"
+                                "  - name: g\n"
+                                "    processes:\n"
+                                "      - {name: crashy, command: sh, args: [-c, 'sleep 0.3; exit 3'], "
+                                "respawn: true, ready_timeout_sec: 2}\n";
+  RunningProcess launcher({BinPath("orbed-launch"), launch_file, "--duration-sec", "30"});
+  ASSERT_TRUE(launcher.Wait(20)) << "the launcher hung on a crash-looping child";
+  EXPECT_EQ(launcher.exit_code(), 1);
+}
+
+// An optional process that ends before its first heartbeat does not hold up the later groups.
+TEST(Launcher, OptionalProcessThatEndsEarlyDoesNotBlockTheLaunch) {
+  const std::string dir = MakeTempDir("launch_optional");
+  const std::string launch_file = dir + "/launch.yaml";
+  std::ofstream(launch_file) << "groups:\n"
+                                "  - name: first\n"
+                                "    processes:\n"
+                                "      - {name: quick, command: sh, args: [-c, 'exit 0'], "
+                                "required: false, ready_timeout_sec: 5}\n"
+                                "  - name: second\n"
+                                "    processes:\n"
+                                "      - {name: monitor, command: orbed-monitor}\n";
+  BusWatcher bus;
+  bus.Start();
+  RunningProcess launcher({BinPath("orbed-launch"), launch_file, "--duration-sec", "4"});
+  EXPECT_TRUE(WaitFor([&] { return !bus.Heartbeats("monitor").empty(); }, 4))
+      << "the second group never started";
+  ASSERT_TRUE(launcher.Wait(15));
+  EXPECT_EQ(launcher.exit_code(), 0);
+}
+
 std::vector<orbed::iiwa_status_t> PublishTraffic(lcm::LCM* lcm, int count, double rate_hz) {
   std::vector<orbed::iiwa_status_t> sent;
   for (int i = 0; i < count; ++i) {

@@ -7,6 +7,9 @@
 #include <cstdlib>
 #include <filesystem>
 #include <stdexcept>
+#include <vector>
+
+#include <gtest/gtest.h>
 
 namespace orbed::testing {
 
@@ -22,11 +25,29 @@ std::string SourcePath(const std::string& relative) {
   return std::string(dir) + "/" + relative;
 }
 
+namespace {
+
+std::vector<std::filesystem::path>& TempDirs() {
+  static std::vector<std::filesystem::path> dirs;
+  return dirs;
+}
+
+// At exit: the folders go when every test passed; after a failure they stay for inspection.
+void RemoveTempDirsIfPassed() {
+  if (!::testing::UnitTest::GetInstance()->Passed()) return;
+  std::error_code ec;
+  for (const auto& dir : TempDirs()) std::filesystem::remove_all(dir, ec);
+}
+
+}  // namespace
+
 std::string MakeTempDir(const std::string& tag) {
   const auto dir = std::filesystem::temp_directory_path() /
                    ("orbed_" + tag + "_" + std::to_string(getpid()));
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
+  if (TempDirs().empty()) std::atexit(RemoveTempDirsIfPassed);
+  TempDirs().push_back(dir);
   return dir.string();
 }
 

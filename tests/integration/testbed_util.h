@@ -27,7 +27,7 @@ namespace orbed::testing {
 std::string BinPath(const std::string& name);
 /// The repository root, from ORBED_SOURCE_DIR (set by ctest).
 std::string SourcePath(const std::string& relative);
-/// A fresh empty temporary folder.
+/// A fresh empty temporary folder; removed at exit when every test passed.
 std::string MakeTempDir(const std::string& tag);
 
 /// Polls `condition` every 10 ms until true or `timeout_s` passes; returns its last value.
