@@ -53,6 +53,25 @@ std::vector<std::string> StringsAt(const std::string& source, const YAML::Node& 
 
 }  // namespace
 
+void ApplyOverrides(ScenarioConfig* config, int trials, const std::string& modes,
+                    const std::vector<std::string>& q_deg) {
+  if (trials > 0) config->trials = trials;
+  if (!modes.empty()) {
+    int mirrors = 1;
+    for (const ModeSpec& m : config->modes) {
+      if (m.num_mirrors > 0) mirrors = m.num_mirrors;
+    }
+    config->modes.clear();
+    std::stringstream list(modes);
+    std::string name;
+    while (std::getline(list, name, ',')) config->modes.push_back(ModeFromName(name, mirrors));
+  }
+  if (!q_deg.empty()) {
+    config->configurations_deg.clear();
+    for (const std::string& q : q_deg) config->configurations_deg.push_back(ParseJointList(q, "--q-deg"));
+  }
+}
+
 ModeSpec ModeFromName(const std::string& name, int reflective_mirrors) {
   if (name == "ar_reflective") {
     return {name, orbed::alignment_trial_t::MODE_AR_REFLECTIVE, reflective_mirrors};

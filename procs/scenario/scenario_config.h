@@ -53,6 +53,12 @@ ModeSpec ModeFromName(const std::string& name, int reflective_mirrors);
 /// "q1,q2,...,q7" [deg] → numbers; throws std::invalid_argument naming `what` on a bad list.
 std::vector<double> ParseJointList(const std::string& text, const std::string& what);
 
+/// Applies command-line overrides: `trials` (> 0), `modes` ("ar_reflective,ar" in run order; the
+/// reflective mode keeps the file's mirror count, else 1) and `q_deg` (each "q1,...,q7" [deg],
+/// replacing the file's list). Empty / 0 leaves the file's value. Throws std::invalid_argument.
+void ApplyOverrides(ScenarioConfig* config, int trials, const std::string& modes,
+                    const std::vector<std::string>& q_deg);
+
 /// Checks counts, joint-vector sizes (7), finiteness and pairwise distinctness (some joint differs
 /// by more than 1 deg); throws std::invalid_argument with the reason. Used after flags override
 /// the file.

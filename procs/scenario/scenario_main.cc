@@ -7,7 +7,6 @@
 /// Writes results.json to --results-dir (default $ORBED_LOG_DIR, else the working directory) and
 /// prints a progress line per step and a table at the end on stdout.
 #include <iostream>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -67,27 +66,7 @@ int main(int argc, char** argv) {
       scenario_path = orbed::scenario::ScenarioSourcePath(orbed::scenario::kDefaultScenarioRelativePath);
     }
     options.config = orbed::scenario::LoadScenarioFile(scenario_path);
-    if (trials > 0) options.config.trials = trials;
-    if (!modes.empty()) {
-      const int mirrors = [&] {
-        for (const auto& m : options.config.modes) {
-          if (m.num_mirrors > 0) return m.num_mirrors;
-        }
-        return 1;
-      }();
-      options.config.modes.clear();
-      std::stringstream ss(modes);
-      std::string name;
-      while (std::getline(ss, name, ',')) {
-        options.config.modes.push_back(orbed::scenario::ModeFromName(name, mirrors));
-      }
-    }
-    if (!q_deg.empty()) {
-      options.config.configurations_deg.clear();
-      for (const std::string& q : q_deg) {
-        options.config.configurations_deg.push_back(orbed::scenario::ParseJointList(q, "--q-deg"));
-      }
-    }
+    orbed::scenario::ApplyOverrides(&options.config, trials, modes, q_deg);
     options.out = &std::cout;
     orbed::scenario::ViraalScenario scenario(common, options);
     return scenario.Run();

@@ -149,6 +149,26 @@ void ExpectError(const std::string& yaml, const std::string& pattern) {
   }
 }
 
+TEST(ScenarioConfig, CommandLineOverrides) {
+  ScenarioConfig config = LoadScenarioFile(Source(kDefaultScenarioRelativePath));
+  ApplyOverrides(&config, 2, "ar,ar_reflective", {"0,10,0,-20,0,30,0", "5,10,0,-20,0,30,0"});
+  EXPECT_EQ(config.trials, 2);
+  ASSERT_EQ(config.modes.size(), 2u);
+  EXPECT_EQ(config.modes[0].num_mirrors, 0);
+  EXPECT_EQ(config.modes[1].num_mirrors, 1);
+  ASSERT_EQ(config.configurations_deg.size(), 2u);
+  EXPECT_EQ(config.configurations_deg[1][0], 5.0);
+  EXPECT_EQ(config.configurations_deg[1][6], 0.0);
+  ScenarioConfig untouched = LoadScenarioFile(Source(kDefaultScenarioRelativePath));
+  const int trials = untouched.trials;
+  ApplyOverrides(&untouched, 0, "", {});
+  EXPECT_EQ(untouched.trials, trials);
+  EXPECT_THROW(ApplyOverrides(&untouched, 0, "ar,mirror", {}), std::invalid_argument);
+  EXPECT_THROW(ApplyOverrides(&untouched, 0, "", {"1,x,3"}), std::invalid_argument);
+  ApplyOverrides(&untouched, 0, "", {"1,2,3"});  // parses; the size is checked with the rest:
+  EXPECT_THROW(ValidateScenarioConfig(untouched, 7), std::invalid_argument);
+}
+
 TEST(ScenarioConfig, ErrorsNameTheLineAndTheFix) {
   const std::string good = "configurations_deg:\n  - [0, 30, 0, -60, 0, 45, 0]\nlandmarks: [iiwa_link_ee]\n";
   EXPECT_NO_THROW(LoadScenarioString(good, "s.yaml"));
