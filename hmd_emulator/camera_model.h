@@ -7,7 +7,8 @@
 ///   Observer:  P_o = K_o [R_CW | p_CW]            (X_CW = X_WC⁻¹)
 ///   Mirror:    X_CM = [R_x(π) | (0, 0, D)]         (M is C rotated π about x, moved D along z_C)
 ///              X_WM = X_WC · X_CM,  K_m = diag(1, −1, 1) · K_o,  P_m = K_m [R_MW | p_MW]
-/// D is the distance from the camera centre to the gaze hit on the robot [m].
+/// (the flip and the shift act in C, after the extrinsics; the paper's printed product order differs,
+/// see reflective.h). D is the distance from the camera centre to the gaze hit on the robot [m].
 ///
 /// Pure functions; thread-safe.
 

@@ -1,11 +1,24 @@
 #include "hmd_emulator/head_trajectory.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 #include "hmd_emulator/yaml_fields.h"
 
 namespace orbed::hmd {
+namespace {
+
+// The parameter a in [0, 1] where v0 + a (v1 − v0) is shortest.
+template <int N>
+double ClosestToZero(const Eigen::Matrix<double, N, 1>& v0, const Eigen::Matrix<double, N, 1>& v1) {
+  const Eigen::Matrix<double, N, 1> dv = v1 - v0;
+  const double dd = dv.squaredNorm();
+  return dd > 0 ? std::clamp(-v0.dot(dv) / dd, 0.0, 1.0) : 0.0;
+}
+
+}  // namespace
 
 HeadTrajectoryConfig ParseHeadTrajectory(const YAML::Node& node, const std::string& source,
                                          const std::string& key) {
@@ -67,10 +80,42 @@ HeadTrajectory::HeadTrajectory(HeadTrajectoryConfig config) : config_(std::move(
   }
   const int n = static_cast<int>(w.size());
   for (int i = 0; i < n; ++i) {
-    if (!(w[i].dwell_s >= 0)) throw std::invalid_argument("head trajectory: dwell_s must be >= 0");
-    LookAt(w[i].p_WH, Target(i));  // throws when the target is degenerate
+    if (!(w[i].dwell_s >= 0)) {
+      throw std::invalid_argument("head trajectory: waypoint '" + w[i].name + "': dwell_s must be >= 0");
+    }
+    try {
+      LookAt(w[i].p_WH, Target(i));  // throws when the target is degenerate
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument("head trajectory: at waypoint '" + w[i].name + "': " + e.what());
+    }
   }
   const int num_segments = config_.loop ? n : n - 1;
+  // While walking a segment the line of sight d(a) = target(a) − p(a) is linear in the fraction a
+  // walked, and so is its horizontal part: X_WH() must never meet a vertical (or vanishing) line of
+  // sight there, or it would throw mid-walk. |d(a)| >= |d(a*)| and the heading is defined wherever
+  // |horizontal(a)| / |d(a)| > 1e-6 (LookAt), which the bound |d(a)| <= max(|d_i|, |d_j|) (d is
+  // convex in a) guarantees when the horizontal part's minimum exceeds 1e-6 · max(|d_i|, |d_j|).
+  for (int i = 0; i < num_segments; ++i) {
+    const int j = (i + 1) % n;
+    const Eigen::Vector3d d_i = Target(i) - w[i].p_WH, d_j = Target(j) - w[j].p_WH;
+    const double a_near = ClosestToZero<3>(d_i, d_j);
+    const Eigen::Vector2d h_i = d_i.head<2>(), h_j = d_j.head<2>();
+    const double a_vertical = ClosestToZero<2>(h_i, h_j);
+    const bool near = !(((1 - a_near) * d_i + a_near * d_j).norm() > 1e-3);
+    const double h_min = ((1 - a_vertical) * h_i + a_vertical * h_j).norm();
+    const bool vertical = !(h_min > 1e-6 * std::max(d_i.norm(), d_j.norm()));
+    if (near || vertical) {
+      const double a = near ? a_near : a_vertical;
+      const Eigen::Vector3d p = (1 - a) * w[i].p_WH + a * w[j].p_WH;
+      char where[120];
+      std::snprintf(where, sizeof(where), "%.0f %% of the way, at (%.3f, %.3f, %.3f) m", 100 * a, p.x(), p.y(),
+                    p.z());
+      throw std::invalid_argument("head trajectory: walking from waypoint '" + w[i].name + "' to '" + w[j].name +
+                                  "' the head passes " + (near ? "within 1 mm of" : "straight over or under") +
+                                  " its look-at target (" + where +
+                                  "), where the heading is undefined; move a waypoint or the target off that line");
+    }
+  }
   double t = 0, s = 0;
   for (int i = 0; i < n; ++i) {
     arrive_s_.push_back(t);

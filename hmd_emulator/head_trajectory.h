@@ -62,7 +62,10 @@ Eigen::Isometry3d LookAt(const Eigen::Vector3d& p_WH, const Eigen::Vector3d& p_W
 
 class HeadTrajectory {
  public:
-  /// Validates (>= 1 waypoint, speed > 0, dwell >= 0, targets not at/above/below a waypoint).
+  /// Validates (>= 1 waypoint, speed > 0, dwell >= 0, the look-at target neither within 1 mm of
+  /// nor straight above or below the head at a waypoint or anywhere along a segment walked, the
+  /// loop's closing segment included), so that X_WH() never throws. std::invalid_argument names
+  /// the waypoint (or the segment's two waypoints) at fault.
   explicit HeadTrajectory(HeadTrajectoryConfig config);
 
   /// X_WH_true at time t [s]; t < 0 gives the start; beyond the end the last pose (or, when looping,

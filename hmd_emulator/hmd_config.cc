@@ -5,10 +5,7 @@
 #include <stdexcept>
 
 #include "hmd_emulator/yaml_fields.h"
-
-#ifndef ORBED_BUILD_SOURCE_DIR
-#define ORBED_BUILD_SOURCE_DIR "."
-#endif
+#include "sim/model_paths.h"
 
 namespace orbed::hmd {
 namespace {
@@ -23,23 +20,20 @@ std::string Text(const YamlFields& f, const YAML::Node& map, const std::string& 
 
 }  // namespace
 
-std::string HmdSourcePath(const std::string& relative) {
-  const char* env = std::getenv("ORBED_SOURCE_DIR");
-  const std::string root = env && *env ? std::string(env) : std::string(ORBED_BUILD_SOURCE_DIR);
-  return root + "/" + relative;
-}
+std::string HmdSourcePath(const std::string& relative) { return sim::SourceTreePath(relative); }
 
 std::vector<std::string> DefaultHmdConfigRelativePaths() {
   return {kDefaultSlamConfigRelativePath, kDefaultUserConfigRelativePath, "hmd_emulator/config/viraal_walk.yaml",
           "hmd_emulator/config/hmd.yaml"};
 }
 
-HmdConfig ParseHmdConfig(const YAML::Node& node, const std::string& source, const std::string& key) {
+HmdConfig ParseHmdConfig(const YAML::Node& node, const std::string& source, const std::string& key,
+                         const HmdConfig& base) {
   const YamlFields f(source);
   f.CheckKeys(node, key,
               {"name", "gaze_hz", "reflective_hz", "ar_view_hz", "align_waypoint", "settle_s", "max_wait_s",
                "recapture_period_s", "gaze_fallback_distance_m", "max_gaze_distance_m", "displays"});
-  HmdConfig c;
+  HmdConfig c = base;
   c.name = Text(f, node, "name", key, c.name);
   c.gaze_hz = f.NumberOr(node, "gaze_hz", key, c.gaze_hz, 0.1, 120, "Hz");
   c.reflective_hz = f.NumberOr(node, "reflective_hz", key, c.reflective_hz, 0.1, 120, "Hz");
@@ -56,6 +50,7 @@ HmdConfig ParseHmdConfig(const YAML::Node& node, const std::string& source, cons
     if (!displays.IsSequence() || displays.size() == 0 || displays.size() > 16) {
       f.Fail(displays, key + ".displays", "expected a list of 1 to 16 {capture_waypoint: NAME}");
     }
+    c.displays.clear();  // a list is replaced as a whole
     for (std::size_t i = 0; i < displays.size(); ++i) {
       const std::string k = key + ".displays[" + std::to_string(i) + "]";
       f.CheckKeys(displays[i], k, {"capture_waypoint"});
@@ -70,21 +65,23 @@ HmdConfig ParseHmdConfig(const YAML::Node& node, const std::string& source, cons
 
 HmdConfigSet LoadHmdConfigs(const std::vector<std::string>& paths) {
   HmdConfigSet set;
-  std::string walk_source, hmd_source = "(defaults)";
+  std::string walk_source, align_source = "(defaults)", displays_source = "(defaults)";
   for (const std::string& path : paths) {
     const YAML::Node root = YamlFields::LoadFile(path);
     const YamlFields f(path);
     if (root.IsNull()) continue;  // an empty file sets nothing
     f.CheckKeys(root, "", {"slam", "user", "head_trajectory", "hmd"});
-    if (root["slam"]) set.slam = ParseSlamConfig(root["slam"], path);
-    if (root["user"]) set.user = ParseUserConfig(root["user"], path);
+    // Each section over what the earlier files set (key by key).
+    if (root["slam"]) set.slam = ParseSlamConfig(root["slam"], path, "slam", set.slam);
+    if (root["user"]) set.user = ParseUserConfig(root["user"], path, "user", set.user);
     if (root["head_trajectory"]) {
       set.walk = ParseHeadTrajectory(root["head_trajectory"], path);
       walk_source = path;
     }
     if (root["hmd"]) {
-      set.hmd = ParseHmdConfig(root["hmd"], path);
-      hmd_source = path;
+      set.hmd = ParseHmdConfig(root["hmd"], path, "hmd", set.hmd);
+      if (root["hmd"]["align_waypoint"]) align_source = path;
+      if (root["hmd"]["displays"]) displays_source = path;
     }
     set.sources.push_back(path);
   }
@@ -93,19 +90,20 @@ HmdConfigSet LoadHmdConfigs(const std::vector<std::string>& paths) {
                              ") has a `head_trajectory:` mapping; add one (see hmd_emulator/config/viraal_walk.yaml)");
   }
   HeadTrajectory walk(set.walk);  // validates the walk
-  auto check = [&](const std::string& name, const std::string& what) {
+  auto check = [&](const std::string& name, const std::string& what, const std::string& source) {
     if (walk.FindWaypoint(name) < 0) {
       std::string names;
       for (const auto& w : set.walk.waypoints) names += (names.empty() ? "" : ", ") + w.name;
-      throw std::runtime_error(hmd_source + ": " + what + ": the walk (" + walk_source + ") has no waypoint '" +
+      throw std::runtime_error(source + ": " + what + ": the walk (" + walk_source + ") has no waypoint '" +
                                name + "'; it has: " + names);
     }
   };
   if (set.hmd.displays.empty()) set.hmd.displays.push_back({set.walk.waypoints.front().name});
   if (set.hmd.align_waypoint.empty()) set.hmd.align_waypoint = set.walk.waypoints.back().name;
-  check(set.hmd.align_waypoint, "hmd.align_waypoint");
+  check(set.hmd.align_waypoint, "hmd.align_waypoint", align_source);
   for (std::size_t i = 0; i < set.hmd.displays.size(); ++i) {
-    check(set.hmd.displays[i].capture_waypoint, "hmd.displays[" + std::to_string(i) + "].capture_waypoint");
+    check(set.hmd.displays[i].capture_waypoint, "hmd.displays[" + std::to_string(i) + "].capture_waypoint",
+          displays_source);
   }
   return set;
 }

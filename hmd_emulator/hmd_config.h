@@ -6,9 +6,12 @@
 ///   user:            the emulated ViRAAl user      (user_model.h,      config/user.yaml)
 ///   head_trajectory: the wearer's walk             (head_trajectory.h, config/viraal_walk.yaml)
 ///   hmd:             the process itself (below)    (this file,         config/hmd.yaml)
-/// Files are applied in order; a mapping in a later file replaces the same mapping from an earlier
-/// one as a whole (its missing keys take the compiled-in defaults, which equal the shipped files).
-/// orbed-hmd loads the four shipped files first, then every --config file.
+/// Files are applied in order over the compiled-in defaults (which equal the shipped files). The
+/// slam:, user: and hmd: mappings merge key by key: a later file changes only the keys it has, so
+/// `user: {seed: 7}` makes a different person and keeps the start offset, the beliefs and all the
+/// rest of the earlier files (a list value, such as hmd.displays, is replaced as a whole). A
+/// head_trajectory: mapping replaces the walk as a whole (its speed, target and waypoints belong
+/// together). orbed-hmd loads the four shipped files first, then every --config file.
 ///
 /// The `hmd:` mapping (every key optional, every key checked):
 ///   hmd:
@@ -20,7 +23,7 @@
 ///     settle_s: 0.5                # standing time at the alignment waypoint before aligning [s]
 ///     max_wait_s: 30               # longest wait for tracking to recover before aligning [s]
 ///     recapture_period_s: 0.5      # a display re-captures at most this often after the robot moved [s]
-///     gaze_fallback_distance_m: 1.5  # D when the gaze ray hits nothing [m]
+///     gaze_fallback_distance_m: 1.5  # D when the gaze ray misses the robot [m]
 ///     max_gaze_distance_m: 10      # ray-casting range [m]
 ///     displays:                    # reflective displays, in order: where each captures its frame
 ///       - {capture_waypoint: foot_end}
@@ -60,8 +63,10 @@ struct HmdConfig {
   std::vector<DisplayPlacement> displays;
 };
 
-/// Reads the `hmd:` mapping (the node itself); errors name `source`, the line and the key.
-HmdConfig ParseHmdConfig(const YAML::Node& node, const std::string& source, const std::string& key = "hmd");
+/// Reads the `hmd:` mapping (the node itself) over `base`, key by key (a `displays` list replaces
+/// base's list); errors name `source`, the line and the key.
+HmdConfig ParseHmdConfig(const YAML::Node& node, const std::string& source, const std::string& key = "hmd",
+                         const HmdConfig& base = HmdConfig{});
 
 /// Everything orbed-hmd is configured by.
 struct HmdConfigSet {
@@ -72,7 +77,7 @@ struct HmdConfigSet {
   std::vector<std::string> sources;  ///< files read, in order
 };
 
-/// Loads `paths` in order (see the file comment) over the compiled-in defaults, then resolves and
+/// Loads `paths` in order (see the file comment: merged key by key), then resolves and
 /// checks the cross references: an empty display list becomes one display at the walk's first
 /// waypoint, an empty align_waypoint the walk's last; every waypoint named must exist in the walk
 /// (std::runtime_error naming the file that set it). A walk must come from some file.

@@ -281,14 +281,15 @@ class HmdProcess::ImagePipeline {
     mesh_X_WR_ = in.X_WR;
   }
 
-  // D: from the camera centre to where the line of sight of a head at X_WH hits the real world.
+  // D (paper Sec. II-B, issue 5 item 4): from the camera centre to where the line of sight of a
+  // head at X_WH hits the ROBOT (the real robot's primitives only: the first robot surface along
+  // the ray, whatever scene object may stand in front of it). When the gaze misses the robot (or
+  // no robot pose is known yet) D is hmd.gaze_fallback_distance_m: D only places the display, and
+  // a wall or the floor behind the robot would place it far from where the person works.
   double GazeDistance(const Eigen::Isometry3d& X_WH, const Eigen::Isometry3d& X_WC) const {
+    if (!mesh_robot_known_) return config_.hmd.gaze_fallback_distance_m;
     const Eigen::Vector3d p = X_WH.translation(), d = X_WH.linear().col(2);
-    RayHit hit = CastRay(scene_geometry_, p, d, kRealWorld, config_.hmd.max_gaze_distance_m);
-    if (mesh_robot_known_) {
-      const RayHit r = CastRay(robot_geometry_, p, d, kRealWorld, config_.hmd.max_gaze_distance_m);
-      if (r.hit && r.distance_m < hit.distance_m) hit = r;
-    }
+    const RayHit hit = CastRay(robot_geometry_, p, d, kRealWorld, config_.hmd.max_gaze_distance_m);
     if (!hit.hit) return config_.hmd.gaze_fallback_distance_m;
     const double D = (hit.p_WQ - X_WC.translation()).norm();
     return std::isfinite(D) && D > 0.01 ? D : config_.hmd.gaze_fallback_distance_m;
@@ -482,8 +483,8 @@ HmdProcess::HmdProcess(const orbed::CommonFlags& flags, const HmdOptions& option
   }
 
   scene_ = sim::LoadSceneFile(options_.scene_path);
-  robot_ = std::make_unique<sim::RobotModel>(sim::RobotModel::LoadFile(options_.urdf_path));
-  robot_->SetToolLength(scene_.tool_length_m);  // before any geometry copies the tool's primitives
+  // With the scene's tool length, before any geometry copies the tool's primitives.
+  robot_ = std::make_unique<sim::RobotModel>(sim::LoadRobotForScene(options_.urdf_path, scene_));
   user_ = std::make_unique<EmulatedUser>(config_.user);
   user_id_ = "emulated-seed-" + std::to_string(config_.user.seed);
   X_WV_start_ = user_->StartPose(scene_.X_WR);

@@ -20,7 +20,9 @@
 ///               REFLECTIVE_VIEW (reflective_view_t) at hmd.reflective_hz per display (--displays):
 ///               the display's captured frame composited with the virtual robot at the current X_WV,
 ///               K_m = diag(1, −1, 1) · K_o, X_WM = X_WC_est · [R_x(π) | (0, 0, D)], D = distance from
-///               the capture camera centre to the gaze hit (fallback hmd.gaze_fallback_distance_m);
+///               the capture camera centre to the gaze hit on the robot (the real robot's surface
+///               along the capture-time line of sight; hmd.gaze_fallback_distance_m when the gaze
+///               misses the robot or no robot pose is known);
 ///               AR_VIEW (image_t, JPEG) at hmd.ar_view_hz: the hologram at X_WV over the latest
 ///               camera frame, drawn with that frame's estimated pose;
 ///               ALIGNMENT_TRIAL (alignment_trial_t): one per accepted REQUEST_TRIAL (emulated user)

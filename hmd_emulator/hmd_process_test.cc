@@ -24,6 +24,7 @@
 #include <orbed/image_t.hpp>
 #include <orbed/reflective_view_t.hpp>
 
+#include "hmd_emulator/gaze.h"
 #include "hmd_emulator/renderer.h"
 #include "procs/common/conversions.h"
 
@@ -342,6 +343,18 @@ TEST(HmdProcess, CameraReflectiveAndArViewCarryTheirGeometry) {
   EXPECT_LT((X_WM.linear().col(0) - X_WC.linear().col(0)).norm(), 1e-9);
   EXPECT_LT((X_WM.linear().col(1) + X_WC.linear().col(1)).norm(), 1e-9);
   EXPECT_LT((X_WM.linear().col(2) + X_WC.linear().col(2)).norm(), 1e-9);
+  // D: from the capture camera centre to the gaze hit ON THE ROBOT (paper Sec. II-B), found here by
+  // casting the capture-time line of sight against the real robot alone.
+  const sim::RobotModel robot = sim::RobotModel::LoadFile(HmdSourcePath(sim::RobotModel::kDefaultUrdfRelativePath));
+  SceneGeometry robot_only;
+  Eigen::VectorXd q(kQDeg.size());
+  for (std::size_t i = 0; i < kQDeg.size(); ++i) q[i] = kQDeg[i] * kDeg;
+  robot_only.PoseRobot(robot_only.AddRobot(robot, BodyKind::kRealRobot), q, SceneX_WR());
+  ASSERT_EQ(got.truth.size(), 1u);
+  const Eigen::Isometry3d X_WH_true = FromPose(got.truth[0].X_WH);
+  const RayHit on_robot = CastRay(robot_only, X_WH_true.translation(), X_WH_true.linear().col(2));
+  ASSERT_TRUE(on_robot.hit);
+  EXPECT_NEAR(rv.distance_m, (on_robot.p_WQ - FromPose(got.truth[0].X_WC).translation()).norm(), 1e-6);
   const cv::Mat mirror = DecodeJpeg(rv.image.data);
   ASSERT_EQ(mirror.cols, 1280);
   ASSERT_EQ(mirror.rows, 720);
@@ -463,6 +476,52 @@ TEST(HmdConfig, ErrorsNameTheFileAndTheKey) {
   ASSERT_EQ(set.hmd.displays.size(), 2u);
   EXPECT_EQ(set.hmd.displays[0].capture_waypoint, "foot_end");
   EXPECT_EQ(set.hmd.align_waypoint, "head_end");
+}
+
+// A --config overlay changes only the keys it has: everything else stays as the files before it
+// set it (not the compiled-in defaults).
+TEST(HmdConfig, OverlaysMergeKeyByKey) {
+  std::vector<std::string> paths;
+  for (const auto& rel : DefaultHmdConfigRelativePaths()) paths.push_back(HmdSourcePath(rel));
+  const HmdConfigSet shipped = LoadHmdConfigs(paths);
+  const std::string first = ::testing::TempDir() + "/hmd_overlay_seed.yaml";
+  std::ofstream(first) << "user: {seed: 7}\nslam: {seed: 9, jitter: {translation_std_m: 0.004}}\n"
+                          "hmd: {gaze_hz: 20}\n";
+  const std::string second = ::testing::TempDir() + "/hmd_overlay_offset.yaml";
+  std::ofstream(second) << "user:\n  start_offset: {rpy_deg: [0, 0, 10]}\n  nudging: {gain: 0.5}\n";
+  paths.push_back(first);
+  paths.push_back(second);
+  const HmdConfigSet set = LoadHmdConfigs(paths);
+  // What the overlays set.
+  EXPECT_EQ(set.user.seed, 7u);
+  EXPECT_EQ(set.slam.seed, 9u);
+  EXPECT_DOUBLE_EQ(set.slam.jitter_translation_std_m, 0.004);
+  EXPECT_DOUBLE_EQ(set.hmd.gaze_hz, 20);
+  EXPECT_DOUBLE_EQ(set.user.gain, 0.5);
+  EXPECT_NEAR(Eigen::AngleAxisd(set.user.X_RV_start.linear()).angle(), 10 * M_PI / 180, 1e-12);
+  // What they leave: the start offset's position (shipped: 0.10, -0.08, 0.05), the rest of the
+  // user, the SLAM model and the process as the shipped files set them.
+  EXPECT_TRUE(set.user.X_RV_start.translation().isApprox(shipped.user.X_RV_start.translation(), 0));
+  EXPECT_NEAR(set.user.X_RV_start.translation().x(), 0.10, 1e-12);
+  EXPECT_DOUBLE_EQ(set.user.depth_bias_fraction_std, shipped.user.depth_bias_fraction_std);
+  EXPECT_DOUBLE_EQ(set.user.assumed_display_px, shipped.user.assumed_display_px);
+  EXPECT_EQ(set.user.max_nudges, shipped.user.max_nudges);
+  EXPECT_TRUE(set.slam.X_HC.isApprox(shipped.slam.X_HC, 0));
+  EXPECT_NE(set.slam.X_HC.translation().norm(), 0.0);
+  EXPECT_DOUBLE_EQ(set.slam.jitter_rotation_std_deg, shipped.slam.jitter_rotation_std_deg);
+  EXPECT_DOUBLE_EQ(set.slam.drift_fraction_of_distance, shipped.slam.drift_fraction_of_distance);
+  EXPECT_EQ(set.hmd.name, shipped.hmd.name);
+  ASSERT_EQ(set.hmd.displays.size(), 2u);
+  EXPECT_EQ(set.hmd.displays[1].capture_waypoint, "head_end");
+  EXPECT_EQ(set.hmd.align_waypoint, "head_end");
+  // A list is replaced as a whole.
+  const std::string third = ::testing::TempDir() + "/hmd_overlay_displays.yaml";
+  std::ofstream(third) << "hmd: {displays: [{capture_waypoint: head_end}]}\n";
+  paths.push_back(third);
+  const HmdConfigSet one = LoadHmdConfigs(paths);
+  ASSERT_EQ(one.hmd.displays.size(), 1u);
+  EXPECT_EQ(one.hmd.displays[0].capture_waypoint, "head_end");
+  EXPECT_DOUBLE_EQ(one.hmd.gaze_hz, 20);
 }
 
 }  // namespace

@@ -10,12 +10,24 @@
 ///     capture time, projected with the observer geometry P_o = K_o [R_CW | p_CW] of X_WC_est.
 ///   * So with X_WV = X_WR the overlay still misses the real robot by the SLAM error at capture
 ///     time (X_WC_true vs X_WC_est); an emulated user aligning in this image inherits that error.
-///   The content is independent of D, as the paper states ("does not affect the rendering content").
+///   The content is drawn with P_o, never with P_m, and is independent of D, as the paper states
+///   (D "does not affect the rendering content in the reflective-AR display"): no pixel changes
+///   with D.
 ///
 /// The reversed frustum (where and how the image is shown in the AR scene):
 ///   X_CM = [R_x(π) | (0, 0, D)]   (M: C turned π about x, moved D along the principal ray, so M
 ///                                   sits at the gaze hit on the robot and looks back toward C)
-///   X_WM = X_WC_est · X_CM,  K_m = diag(1, −1, 1) · K_o,  P_m = K_m [R_MW | p_MW].
+///   X_WM = X_WC · X_CM = X_WC · [R_x(π) | (0, 0, D)],  K_m = diag(1, −1, 1) · K_o,
+///   P_m = K_m [R_MW | p_MW] = K_m · P · X_MW,  X_MW = X_CM⁻¹ · X_CW = X_CM · X_CW
+/// (X_CM is its own inverse: R_x(π)² = I and R_x(π)·(0, 0, D) = (0, 0, −D)). This is the
+/// geometrically meaningful order: the turn and the shift act in the camera frame C, after the
+/// world-to-camera transform. The paper's equation for P_m writes the product in the other order,
+/// K_m · P · [R | p] · [R_x(π) | (0, 0, D)], which read literally would turn about the world's x axis
+/// and shift along the world's z before the extrinsics; its text ("the optical center of the
+/// observer frustum is rotated by π around the x axis, and translated by D along the principal ray")
+/// describes the order used here. P_m places the display (X_WM, the panel below); it is not what
+/// draws the content: the virtual robot is projected with P_o (the overlay must register with the
+/// captured image, which P_o formed), and the composed image is the same for every D.
 /// An eye at M looking into a planar mirror at z_C = D/2 (facing M) sees exactly the rays the camera
 /// captured: the mirror reflects M onto C. The display is that mirror: pixel (u, v) is shown at
 ///   p_M = s · ((u − cx)/fx, −(v − cy)/fy, 1),   s = D/2 by default (DisplayPanelPoint),
@@ -59,7 +71,10 @@ struct ReflectiveGeometry {
   Eigen::Isometry3d X_WM{Eigen::Isometry3d::Identity()};  ///< reversed frustum, X_WC · X_CM(D)
   double distance_m{0};                                ///< D [m]
   CameraMatrix P_o{CameraMatrix::Zero()};              ///< K_o [R_CW | p_CW]: draws the content
-  CameraMatrix P_m{CameraMatrix::Zero()};              ///< K_m [R_MW | p_MW] (paper eq. for P_m)
+  /// K_m [R_MW | p_MW] = K_m · P · X_CM · X_CW: the reversed frustum of the paper's Sec. II-B, in
+  /// the geometric order (the file comment; the paper's printed product order differs). Places the
+  /// display; the content is drawn with P_o.
+  CameraMatrix P_m{CameraMatrix::Zero()};
 };
 
 /// The geometry for a frame captured at X_WC with gaze distance D. Throws std::invalid_argument

@@ -7,7 +7,7 @@
 ///                              hologram from the device's estimate of that pose (2 cm, 0.8 deg SLAM
 ///                              error) and a registration X_WV that is 3 cm / 2 deg off
 /// Deterministic (no randomness). Usage: orbed-render-snapshot [--out DIR] (default docs/images under
-/// $ORBED_SOURCE_DIR, or the current directory's docs/images).
+/// the source tree, sim::SourceDir(): $ORBED_SOURCE_DIR, else the tree it was built from).
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -21,6 +21,7 @@
 #include "hmd_emulator/reflective.h"
 #include "hmd_emulator/renderer.h"
 #include "hmd_emulator/scene_geometry.h"
+#include "sim/model_paths.h"
 #include "sim/robot_model.h"
 #include "sim/scene.h"
 
@@ -48,9 +49,7 @@ void Caption(cv::Mat* image, const std::string& text) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const char* src = std::getenv("ORBED_SOURCE_DIR");
-  const std::string root = src ? src : ".";
-  std::string out = root + "/docs/images";
+  std::string out = orbed::sim::SourceTreePath("docs/images");
   for (int i = 1; i < argc; ++i) {
     if (std::strcmp(argv[i], "--help") == 0 || std::strcmp(argv[i], "-h") == 0) {
       std::printf("usage: orbed-render-snapshot [--out DIR]\n"
@@ -67,9 +66,9 @@ int main(int argc, char** argv) {
   try {
     namespace hmd = orbed::hmd;
     namespace sim = orbed::sim;
-    sim::RobotModel robot = sim::RobotModel::LoadFile(root + "/" + sim::RobotModel::kDefaultUrdfRelativePath);
-    const sim::Scene scene = sim::LoadSceneFile(root + "/" + sim::kDefaultSceneRelativePath);
-    robot.SetToolLength(scene.tool_length_m);
+    const sim::Scene scene = sim::LoadSceneFile(sim::SourceTreePath(sim::kDefaultSceneRelativePath));
+    const sim::RobotModel robot =
+        sim::LoadRobotForScene(sim::SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath), scene);
     Eigen::VectorXd q_deg(7);
     q_deg << -10, 40, 0, -65, 0, 55, 0;
     const Eigen::VectorXd q = sim::DegToRad(q_deg);

@@ -113,39 +113,6 @@ void TessellateBox(const Primitive& p, int body, ColorBgr color, Mesh* mesh) {
   }
 }
 
-// The URDF spells a capsule as a cylinder with a sphere of its radius on each end face (urdfdom has
-// no <capsule>). Their union is exactly a capsule; one capsule primitive renders without the
-// cylinder's end caps peeking through the tessellated spheres and casts rays the same.
-std::vector<sim::CollisionPrimitive> MergeCapsules(const std::vector<sim::CollisionPrimitive>& in) {
-  using Kind = sim::CollisionPrimitive::Kind;
-  std::vector<bool> used(in.size(), false);
-  std::vector<sim::CollisionPrimitive> out;
-  for (size_t i = 0; i < in.size(); ++i) {
-    if (used[i] || in[i].kind != Kind::kCylinder) continue;
-    const sim::CollisionPrimitive& cyl = in[i];
-    int ends[2] = {-1, -1};
-    for (int e = 0; e < 2; ++e) {
-      const Eigen::Vector3d p_LE = cyl.X_LG * Eigen::Vector3d(0, 0, (e ? 0.5 : -0.5) * cyl.length_m);
-      for (size_t j = 0; j < in.size(); ++j) {
-        if (used[j] || in[j].kind != Kind::kSphere || static_cast<int>(j) == ends[0]) continue;
-        if (std::abs(in[j].radius_m - cyl.radius_m) < 1e-9 &&
-            (in[j].X_LG.translation() - p_LE).norm() < 1e-6) {
-          ends[e] = static_cast<int>(j);
-          break;
-        }
-      }
-    }
-    if (ends[0] < 0 || ends[1] < 0) continue;
-    sim::CollisionPrimitive capsule = cyl;
-    capsule.kind = Kind::kCapsule;
-    out.push_back(capsule);
-    used[i] = used[ends[0]] = used[ends[1]] = true;
-  }
-  for (size_t i = 0; i < in.size(); ++i)
-    if (!used[i]) out.push_back(in[i]);
-  return out;
-}
-
 }  // namespace
 
 void SceneGeometry::AddSceneObjects(const sim::Scene& scene) {
@@ -205,7 +172,9 @@ int SceneGeometry::AddRobot(const sim::RobotModel& robot, BodyKind kind) {
     ++shown;
     bodies_.push_back(b);
     const int body = static_cast<int>(bodies_.size()) - 1;
-    for (const sim::CollisionPrimitive& cp : MergeCapsules(link.collision)) {
+    // Capsules as one primitive (the collision world's rule): no cylinder end cap peeks through the
+    // tessellated spheres, and rays hit the same shape the collision check sees.
+    for (const sim::CollisionPrimitive& cp : sim::FuseCapsules(link.collision)) {
       Primitive p;
       p.shape = ShapeOf(cp.kind);
       p.body = body;

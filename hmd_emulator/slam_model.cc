@@ -39,17 +39,19 @@ const char* TrackingStateName(TrackingState state) {
   return "unknown";
 }
 
-SlamConfig ParseSlamConfig(const YAML::Node& node, const std::string& source, const std::string& key) {
+SlamConfig ParseSlamConfig(const YAML::Node& node, const std::string& source, const std::string& key,
+                           const SlamConfig& base) {
   const YamlFields f(source);
   f.CheckKeys(node, key, {"seed", "rate_hz", "head_to_camera", "jitter", "drift", "tracking_loss"});
-  SlamConfig c;
-  c.seed = static_cast<std::uint64_t>(f.IntegerOr(node, "seed", key, 1, 0, (1LL << 62)));
+  SlamConfig c = base;
+  c.seed = static_cast<std::uint64_t>(
+      f.IntegerOr(node, "seed", key, static_cast<long long>(c.seed), 0, (1LL << 62)));
   c.rate_hz = f.NumberOr(node, "rate_hz", key, c.rate_hz, 1.0, 1000.0, "Hz");
   if (node["head_to_camera"]) {
     const std::string k = key + ".head_to_camera";
     const YAML::Node h = node["head_to_camera"];
     f.CheckKeys(h, k, {"position_m", "rpy_deg"});
-    c.X_HC.translation() = f.Vector3(f.Required(h, "position_m", k + ".position_m"), k + ".position_m", "m");
+    if (h["position_m"]) c.X_HC.translation() = f.Vector3(h["position_m"], k + ".position_m", "m");
     if (h["rpy_deg"]) c.X_HC.linear() = sim::RotationFromRpyDeg(f.Vector3(h["rpy_deg"], k + ".rpy_deg", "deg"));
   }
   const YAML::Node j = f.Section(node, "jitter", key + ".jitter");

@@ -79,9 +79,11 @@ struct SlamConfig {
   double jump_yaw_std_deg{0.5};
 };
 
-/// Reads the `slam:` mapping (the node itself). Every key is optional (defaults above) and checked;
-/// errors name `source`, the line and the key.
-SlamConfig ParseSlamConfig(const YAML::Node& node, const std::string& source, const std::string& key = "slam");
+/// Reads the `slam:` mapping (the node itself) over `base`, key by key: a key the mapping does not
+/// have keeps base's value (the compiled-in defaults above unless given). Every key is optional and
+/// checked; errors name `source`, the line and the key.
+SlamConfig ParseSlamConfig(const YAML::Node& node, const std::string& source, const std::string& key = "slam",
+                           const SlamConfig& base = SlamConfig{});
 /// Loads the `slam:` mapping of a YAML file (e.g. hmd_emulator/config/slam.yaml).
 SlamConfig LoadSlamConfigFile(const std::string& path);
 /// The shipped defaults, relative to the repository root.

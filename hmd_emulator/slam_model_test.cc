@@ -66,6 +66,57 @@ TEST(HeadTrajectory, TimingAndPath) {
   EXPECT_DOUBLE_EQ(loop.PathLength(24.0 + 5.0), 2 * 4.0 + 2.0);
 }
 
+// A segment walked straight over the look-at target: both waypoints are fine (the target is ahead
+// of each), but halfway the line of sight is vertical. The constructor refuses the walk, naming the
+// segment's waypoints, instead of X_WH() throwing mid-walk (inside orbed-hmd's 60 Hz timer).
+TEST(HeadTrajectory, SegmentOverTheTargetIsRefusedUpFront) {
+  HeadTrajectoryConfig c;
+  c.speed_m_per_s = 1.0;
+  c.p_W_look_at = Eigen::Vector3d(0, 0, 1.0);
+  c.waypoints = {{"west", {-1, 0, 1.7}, 0, {}}, {"east", {1, 0, 1.7}, 0, {}}};
+  try {
+    const HeadTrajectory t(c);
+    FAIL() << "expected an error";
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("from waypoint 'west' to 'east'"), std::string::npos) << what;
+    EXPECT_NE(what.find("straight over or under"), std::string::npos) << what;
+    EXPECT_NE(what.find("50 % of the way, at (0.000, 0.000, 1.700) m"), std::string::npos) << what;
+  }
+  // Passing 1 m beside the target is fine, and every pose along the segment is defined.
+  c.waypoints[1].p_WH = Eigen::Vector3d(1, 1, 1.7);
+  c.waypoints[0].p_WH = Eigen::Vector3d(-1, 1, 1.7);
+  const HeadTrajectory beside(c);
+  for (double t = 0; t <= beside.duration_s(); t += 0.01) EXPECT_NO_THROW(beside.X_WH(t));
+  // The loop's closing segment is checked too: east -> west is fine, but a third waypoint whose
+  // return leg crosses over the target is not.
+  c.loop = true;
+  c.waypoints = {{"a", {-1, -1, 1.7}, 0, {}}, {"b", {-1, 1, 1.7}, 0, {}}, {"c", {1, 1, 1.7}, 0, {}}};
+  EXPECT_THROW(HeadTrajectory{c}, std::invalid_argument);  // c -> a passes over (0, 0)
+  c.loop = false;
+  EXPECT_NO_THROW(HeadTrajectory{c});
+  // A waypoint right above its target names the waypoint.
+  c.waypoints = {{"above", {0, 0, 1.7}, 0, {}}};
+  try {
+    const HeadTrajectory t(c);
+    FAIL() << "expected an error";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("waypoint 'above'"), std::string::npos) << e.what();
+  }
+  // Through the YAML parser the message carries the file and the key.
+  try {
+    ParseHeadTrajectory(YamlFields::LoadString("speed_m_per_s: 1\nlook_at_m: [0, 0, 1]\nwaypoints:\n"
+                                               "  - {name: west, position_m: [-1, 0, 1.7]}\n"
+                                               "  - {name: east, position_m: [1, 0, 1.7]}\n",
+                                               "w.yaml"),
+                        "w.yaml");
+    FAIL() << "expected an error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("w.yaml:1: head_trajectory: "), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("'west' to 'east'"), std::string::npos) << e.what();
+  }
+}
+
 // A closed walk around the robot (a 3 m × 2 m rectangle at head height), looped.
 HeadTrajectoryConfig RectangleWalk() {
   HeadTrajectoryConfig c;

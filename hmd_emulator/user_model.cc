@@ -52,16 +52,18 @@ bool InImage(const Intrinsics& in, const Eigen::Vector2d& uv) {
 
 }  // namespace
 
-UserConfig ParseUserConfig(const YAML::Node& node, const std::string& source, const std::string& key) {
+UserConfig ParseUserConfig(const YAML::Node& node, const std::string& source, const std::string& key,
+                           const UserConfig& base) {
   const YamlFields f(source);
   f.CheckKeys(node, key, {"seed", "start_offset", "direct_view", "reflective_display", "belief", "nudging", "time"});
-  UserConfig c;
-  c.seed = static_cast<std::uint64_t>(f.IntegerOr(node, "seed", key, 1, 0, (1LL << 62)));
+  UserConfig c = base;
+  c.seed = static_cast<std::uint64_t>(
+      f.IntegerOr(node, "seed", key, static_cast<long long>(c.seed), 0, (1LL << 62)));
   if (node["start_offset"]) {
     const std::string k = key + ".start_offset";
     const YAML::Node s = node["start_offset"];
     f.CheckKeys(s, k, {"position_m", "rpy_deg"});
-    c.X_RV_start.translation() = f.Vector3(f.Required(s, "position_m", k + ".position_m"), k + ".position_m", "m");
+    if (s["position_m"]) c.X_RV_start.translation() = f.Vector3(s["position_m"], k + ".position_m", "m");
     if (s["rpy_deg"]) c.X_RV_start.linear() = sim::RotationFromRpyDeg(f.Vector3(s["rpy_deg"], k + ".rpy_deg", "deg"));
   }
   const double inf = INFINITY;
@@ -186,6 +188,7 @@ AlignmentResult EmulatedUser::Align(const ViewingContext& ctx, const std::vector
     Eigen::Isometry3d X_CW_est;
     std::vector<bool> seen;
     std::vector<Eigen::Vector2d> u_real;
+    Eigen::Vector2d u_centroid{Eigen::Vector2d::Zero()};  // the real centroid in the image
   };
   std::vector<DisplayState> displays;
   for (const auto& d : ctx.displays) {
@@ -194,12 +197,21 @@ AlignmentResult EmulatedUser::Align(const ViewingContext& ctx, const std::vector
     const CameraMatrix P_true = MakeCameraMatrix(d.intrinsics.K(), d.X_WC_true);
     s.seen.assign(n, false);
     s.u_real.assign(n, Eigen::Vector2d::Zero());
+    Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+    int num_seen = 0;
     for (std::size_t k = 0; k < n; ++k) {
       Eigen::Vector2d uv;
       if (Project(P_true, r[k], &uv) && InImage(d.intrinsics, uv)) {
         s.seen[k] = true;
         s.u_real[k] = uv;
+        sum += uv;
+        ++num_seen;
       }
+    }
+    // The centre of the image scale the person does not see: where the real centroid is imaged
+    // (the mean of the points seen if it is behind the camera).
+    if (!Project(P_true, real_c, &s.u_centroid)) {
+      s.u_centroid = num_seen > 0 ? Eigen::Vector2d(sum / num_seen) : sum;
     }
     displays.push_back(std::move(s));
   }
@@ -208,19 +220,19 @@ AlignmentResult EmulatedUser::Align(const ViewingContext& ctx, const std::vector
   const double w_depth = 1.0 / std::pow(c.assumed_depth_fraction, 2);              // × 1/ρ²
   const double w_px = 1.0 / std::pow(c.assumed_display_px, 2);
 
+  // Unknowns of the person's fit: the nudge ξ (0..5); when they are blind to small size
+  // differences, the apparent image scale σ of the hologram in the direct view (6) and in each
+  // display j (7 + j), nuisances they cannot act on.
+  const int num_unknowns = 7 + static_cast<int>(displays.size());
   AlignmentResult result;
   Eigen::Isometry3d X_WV = X_WV_start;
   while (true) {
     // Look.
     result.duration_s += c.look_time_s + c.display_look_time_s * static_cast<double>(displays.size());
     const Eigen::Vector3d c_W = X_WV * p_RC;  // the nudge's pivot, map coordinates
-    // Unknowns: the nudge ξ (6) and, when the person is blind to small size differences, the
-    // apparent image scale σ of the hologram about the real robot's centroid (a nuisance they
-    // cannot act on: index 6).
-    Eigen::Matrix<double, 7, 7> H = Eigen::Matrix<double, 7, 7>::Zero();
-    Eigen::Matrix<double, 7, 1> g = Eigen::Matrix<double, 7, 1>::Zero();
-    double depth2 = 0, px2 = 0;
-    int num_px = 0;
+    Eigen::MatrixXd H = Eigen::MatrixXd::Zero(num_unknowns, num_unknowns);
+    Eigen::VectorXd g = Eigen::VectorXd::Zero(num_unknowns);
+    double depth2 = 0;
     // Per point: perceived lateral discrepancy and its size-nuisance direction, over ρ [rad].
     std::vector<Eigen::Vector2d> lateral_rad, size_dir_rad;
     for (std::size_t k = 0; k < n; ++k) {
@@ -243,7 +255,7 @@ AlignmentResult EmulatedUser::Align(const ViewingContext& ctx, const std::vector
       B.row(0) = a.transpose();
       B.row(1) = b.transpose();
       B.row(2) = nr.transpose();
-      Eigen::Matrix<double, 3, 7> J = Eigen::Matrix<double, 3, 7>::Zero();
+      Eigen::MatrixXd J = Eigen::MatrixXd::Zero(3, num_unknowns);
       J.leftCols<6>() = B * A.linear() * PointJacobian(x, c_W);
       if (c.size_blind) {
         // A uniform scale of what is seen about the centroid's line of sight moves each point
@@ -257,6 +269,9 @@ AlignmentResult EmulatedUser::Align(const ViewingContext& ctx, const std::vector
       H += J.transpose() * w.asDiagonal() * J;
       g += J.transpose() * w.asDiagonal() * perceived;
     }
+    // Per display point: the perceived 2D discrepancy [px] and its size-nuisance direction.
+    std::vector<Eigen::Vector2d> display_px, display_size_dir;
+    std::vector<int> display_of;
     for (std::size_t j = 0; j < displays.size(); ++j) {
       const DisplayState& s = displays[j];
       for (std::size_t k = 0; k < n; ++k) {
@@ -267,28 +282,47 @@ AlignmentResult EmulatedUser::Align(const ViewingContext& ctx, const std::vector
         if (!ProjectWithJacobian(ctx.displays[j].intrinsics, s.X_CW_est, x, &u_virtual, &du_dx)) continue;
         const Eigen::Vector2d perceived = u_virtual - s.u_real[k] + display_bias_px[j] +
                                           c.display_noise_px * Eigen::Vector2d(rng.Normal(), rng.Normal());
-        px2 += perceived.squaredNorm();
-        ++num_px;
-        Eigen::Matrix<double, 2, 7> J = Eigen::Matrix<double, 2, 7>::Zero();
+        Eigen::MatrixXd J = Eigen::MatrixXd::Zero(2, num_unknowns);
         J.leftCols<6>() = du_dx * PointJacobian(x, c_W);
+        // The display is a picture too: a hologram moved along the capture camera's line of sight
+        // only changes its size in it, about the real centroid's image, and a size-blind person
+        // does not see that either (the same nuisance as in the direct view, one per display).
+        const Eigen::Vector2d size_dir =
+            c.size_blind ? Eigen::Vector2d(s.u_real[k] - s.u_centroid) : Eigen::Vector2d::Zero();
+        J.col(7 + static_cast<int>(j)) = size_dir;
+        display_px.push_back(perceived);
+        display_size_dir.push_back(size_dir);
+        display_of.push_back(static_cast<int>(j));
         H += w_px * J.transpose() * J;
         g += w_px * J.transpose() * perceived;
       }
     }
     // Decide the nudge: one Gauss–Newton step on the perceived discrepancies (tiny damping keeps an
     // unobservable direction, if any, still).
-    const double damping = 1e-12 * std::max(1.0, H.trace() / 7.0);
-    if (!c.size_blind) H(6, 6) = 1.0;  // σ fixed at 0
-    const Eigen::Matrix<double, 7, 1> solution =
-        -(H + damping * Eigen::Matrix<double, 7, 7>::Identity()).ldlt().solve(g);
+    const double damping = 1e-12 * std::max(1.0, H.trace() / num_unknowns);
+    if (!c.size_blind) {
+      for (int i = 6; i < num_unknowns; ++i) H(i, i) = 1.0;  // every σ fixed at 0
+    }
+    for (int i = 7; i < num_unknowns; ++i) {
+      if (!(H(i, i) > 0)) H(i, i) = 1.0;  // a display that shows no point: its σ is fixed at 0
+    }
+    const Eigen::VectorXd solution =
+        -(H + damping * Eigen::MatrixXd::Identity(num_unknowns, num_unknowns)).ldlt().solve(g);
     const Eigen::Matrix<double, 6, 1> xi = solution.head<6>();
 
-    // What the person judges: lateral discrepancies net of the size difference they do not see.
-    const double sigma = -solution[6];  // the image scale that best explains what they see
+    // What the person judges: discrepancies net of the size differences they do not see (σ: the
+    // image scale that best explains what they see, per view).
+    const double sigma = -solution[6];
     double lat2 = 0;
     for (std::size_t k = 0; k < lateral_rad.size(); ++k) {
       lat2 += (lateral_rad[k] - sigma * size_dir_rad[k]).squaredNorm();
     }
+    double px2 = 0;
+    for (std::size_t k = 0; k < display_px.size(); ++k) {
+      const double sigma_j = -solution[7 + display_of[k]];
+      px2 += (display_px[k] - sigma_j * display_size_dir[k]).squaredNorm();
+    }
+    const int num_px = static_cast<int>(display_px.size());
     const double num_direct = std::max<double>(1.0, static_cast<double>(lateral_rad.size()));
     result.perceived_lateral_arcmin = std::sqrt(lat2 / num_direct) / kArcminToRad;
     result.perceived_depth_fraction = std::sqrt(depth2 / num_direct);

@@ -36,12 +36,18 @@
 /// (size_blind): moving the hologram a distance t along the line of sight also rescales its image
 /// by ~t/ρ (1.2 % for 24 mm at 2 m), below what people discriminate in size (a few per cent), so the
 /// person's fit carries a nuisance image scale σ about the centroid's line of sight, which they
-/// cannot act on: depth in the direct view then rests on depth perception alone. They stop when every
-/// perceived discrepancy is below their thresholds (lateral [arcmin], depth [fraction of ρ],
-/// display [px]), when the step they would take is too small to bother (min_step_*), or after
-/// max_nudges. Nothing about "the mirror helps" is written in: the display's image plane, seen from
-/// another viewpoint, contains the direct view's ray direction, so it constrains the depth that the
-/// direct view leaves ambiguous, with its own (SLAM) error.
+/// cannot act on: depth in the direct view then rests on depth perception alone. A display is a
+/// picture too, and the same person is as blind to size in it: each display j has its own nuisance
+/// scale σ_j of the image about the real centroid's pixel u_c,j (Jacobian column u_real,k − u_c,j),
+/// so a shift along that camera's line of sight is not read from the display either, and the
+/// perceived display discrepancy is judged net of σ_j. They stop when every perceived discrepancy
+/// (net of the scales) is below their thresholds (lateral [arcmin], depth [fraction of ρ], display
+/// [px]), when the step they would take is too small to bother (min_step_*), or after max_nudges.
+/// Nothing about "the mirror helps" is written in: the display's image plane, seen from another
+/// viewpoint, contains the direct view's ray direction, so it constrains the depth that the direct
+/// view leaves ambiguous, with its own (SLAM) error; a display captured from the alignment
+/// viewpoint itself adds no second viewpoint and gives (almost) nothing (the negative control in
+/// user_model_test.cc).
 ///
 /// Every parameter is in UserConfig, loaded from hmd_emulator/config/user.yaml (sources beside each
 /// default there). Units: m, rad inside; arcmin/deg/px/fraction only where the name says so.
@@ -69,8 +75,9 @@ struct UserConfig {
   double depth_user_bias_fraction_std{0.006};
   double depth_noise_fraction_std{0.004};
   double user_scale_log_sigma{0.5};
-  /// The person does not see small differences in the hologram's overall size: the perspective
-  /// scale change that a shift along the line of sight causes is not taken as misalignment.
+  /// The person does not see small differences in the hologram's overall size, in the direct view
+  /// and in each display: the perspective scale change that a shift along the line of sight causes
+  /// is not taken as misalignment.
   bool size_blind{true};
   // Reflective display.
   double display_noise_px{2.0};
@@ -96,8 +103,11 @@ struct UserConfig {
   Eigen::Isometry3d X_RV_start{Eigen::Isometry3d::Identity()};
 };
 
-/// Reads the `user:` mapping; every key optional (defaults above) and checked.
-UserConfig ParseUserConfig(const YAML::Node& node, const std::string& source, const std::string& key = "user");
+/// Reads the `user:` mapping over `base` (key by key: a key that the mapping does not have keeps
+/// base's value, e.g. a start_offset with only rpy_deg keeps base's position); every key optional
+/// and checked. The default base is the compiled-in defaults above.
+UserConfig ParseUserConfig(const YAML::Node& node, const std::string& source, const std::string& key = "user",
+                           const UserConfig& base = UserConfig{});
 /// Loads the `user:` mapping of a YAML file (e.g. hmd_emulator/config/user.yaml).
 UserConfig LoadUserConfigFile(const std::string& path);
 inline constexpr const char* kDefaultUserConfigRelativePath = "hmd_emulator/config/user.yaml";

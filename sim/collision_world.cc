@@ -83,40 +83,6 @@ double PointDistance(const CollisionPrimitive& g, const Eigen::Vector3d& p) {
   return -kInf;
 }
 
-// Replaces each cylinder capped by two spheres of its radius at its end-face centres with a capsule.
-std::vector<CollisionPrimitive> FuseCapsules(const std::vector<CollisionPrimitive>& in) {
-  std::vector<bool> used(in.size(), false);
-  std::vector<CollisionPrimitive> out;
-  for (size_t i = 0; i < in.size(); ++i) {
-    if (in[i].kind != Kind::kCylinder) continue;
-    const CollisionPrimitive& c = in[i];
-    const Eigen::Vector3d axis = c.X_LG.linear().col(2);
-    const Eigen::Vector3d ends[2] = {c.X_LG.translation() + 0.5 * c.length_m * axis,
-                                     c.X_LG.translation() - 0.5 * c.length_m * axis};
-    int caps[2] = {-1, -1};
-    for (int e = 0; e < 2; ++e) {
-      for (size_t j = 0; j < in.size(); ++j) {
-        if (used[j] || j == i || in[j].kind != Kind::kSphere) continue;
-        if (std::abs(in[j].radius_m - c.radius_m) < 1e-12 && (in[j].X_LG.translation() - ends[e]).norm() < 1e-9 &&
-            static_cast<int>(j) != caps[0]) {
-          caps[e] = static_cast<int>(j);
-          break;
-        }
-      }
-    }
-    if (caps[0] >= 0 && caps[1] >= 0) {
-      used[i] = used[caps[0]] = used[caps[1]] = true;
-      CollisionPrimitive cap = c;
-      cap.kind = Kind::kCapsule;
-      out.push_back(cap);
-    }
-  }
-  for (size_t i = 0; i < in.size(); ++i) {
-    if (!used[i]) out.push_back(in[i]);
-  }
-  return out;
-}
-
 // The fast path's view of a Bullet shape: its core and margin as Bullet itself stores them.
 CoreShape CoreOf(const CollisionPrimitive& g, const btConvexShape& shape) {
   CoreShape c;

@@ -11,7 +11,8 @@
 /// No contact manifold is used or kept, so every result is computed fresh from the current poses.
 ///
 /// Geometry: a URDF cylinder with a sphere of the same radius centred on each end face is exactly a
-/// capsule and becomes one btCapsuleShapeZ (an exact segment-with-radius); other cylinders are
+/// capsule (recognised by FuseCapsules(), sim/robot_model.h, the renderer's rule too) and becomes one
+/// btCapsuleShapeZ (an exact segment-with-radius); other cylinders are
 /// btCylinderShapeZ (Bullet's btCylinderShape is along y; the Z variant matches URDF), boxes take
 /// half extents; box and cylinder margins are kMarginM (their edges are rounded by that much; faces
 /// are exact).

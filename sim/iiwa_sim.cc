@@ -1,8 +1,9 @@
 #include "sim/iiwa_sim.h"
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <stdexcept>
 
 #include <orbed/collision_status_t.hpp>
@@ -13,10 +14,6 @@
 #include "procs/common/conversions.h"
 #include "procs/common/log.h"
 #include "procs/common/validation.h"
-
-#ifndef ORBED_BUILD_SOURCE_DIR
-#define ORBED_BUILD_SOURCE_DIR "."
-#endif
 
 namespace orbed::sim {
 namespace {
@@ -39,9 +36,14 @@ std::string Fixed(double value, int digits) {
 IiwaSimOptions Resolved(IiwaSimOptions options) {
   if (options.urdf_path.empty()) options.urdf_path = SourceTreePath(RobotModel::kDefaultUrdfRelativePath);
   if (options.scene_path.empty()) options.scene_path = SourceTreePath(kDefaultSceneRelativePath);
-  if (!(options.period_sec > 0) || !std::isfinite(options.period_sec)) {
-    throw std::invalid_argument("--period-sec must be a finite number > 0");
+  // The sim clock counts whole microseconds (utime): the tick is P = period_sec rounded to them, and
+  // the arm steps by exactly P, so that stamps and steps agree.
+  if (!(options.period_sec > 0) || !(options.period_sec <= 3600) ||
+      std::llround(options.period_sec * 1e6) < 1) {
+    throw std::invalid_argument("--period-sec must be a number of seconds in [1e-6, 3600] (it is rounded to "
+                                "whole microseconds)");
   }
+  options.period_sec = static_cast<double>(std::llround(options.period_sec * 1e6)) / 1e6;
   if (!(options.stale_command_sec >= 0) || !std::isfinite(options.stale_command_sec)) {
     throw std::invalid_argument("--stale-command-sec must be a finite number >= 0 (0 disables the check)");
   }
@@ -79,16 +81,11 @@ orbed::contact_t ToContact(const PairDistance& pair) {
 
 }  // namespace
 
-std::string SourceTreePath(const std::string& relative) {
-  const char* env = std::getenv("ORBED_SOURCE_DIR");
-  const std::string root = env && *env ? std::string(env) : std::string(ORBED_BUILD_SOURCE_DIR);
-  return root + "/" + relative;
-}
-
 IiwaSim::IiwaSim(const orbed::CommonFlags& flags, const IiwaSimOptions& options)
-    : options_(Resolved(options)), scene_(LoadSceneFile(options_.scene_path)) {
-  RobotModel model = RobotModel::LoadFile(options_.urdf_path);
-  model.SetToolLength(scene_.tool_length_m);
+    : options_(Resolved(options)),
+      scene_(LoadSceneFile(options_.scene_path)),
+      period_us_(std::llround(options_.period_sec * 1e6)) {
+  const RobotModel model = LoadRobotForScene(options_.urdf_path, scene_);
   ManualArmOptions arm_options;
   arm_options.stop_margin_m = options_.stop_margin_m;
   arm_options.report_distance_m = options_.report_distance_m;
@@ -111,6 +108,9 @@ IiwaSim::IiwaSim(const orbed::CommonFlags& flags, const IiwaSimOptions& options)
       [this](const orbed::plan_check_request_t& msg, const std::string& channel, int64_t) {
         OnPlanCheck(msg, channel);
       });
+  // The sim clock starts with the timer: tick k is due k * P after start_mono_.
+  start_utime_ = NowMicros();
+  start_mono_ = std::chrono::steady_clock::now();
   process_->AddTimer(options_.period_sec, [this] { Tick(); });
   ORBED_LOG(kInfo) << "robot " << options_.urdf_path << " (" << model.num_joints() << " joints), scene "
                    << options_.scene_path << ", tick " << options_.period_sec * 1e3 << " ms";
@@ -195,8 +195,27 @@ void IiwaSim::OnPlanCheck(const orbed::plan_check_request_t& msg, const std::str
 
 void IiwaSim::Tick() {
   arm_->Step(options_.period_sec);
-  PublishAll(NowMicros());
+  ++ticks_;
+  // After a stall the loop skipped deadlines rather than run them: tick k jumps to the last deadline
+  // passed, so the sim clock does not fall behind for good. The arm made one step of P: the speed
+  // read from the stamps only drops.
+  const auto now = std::chrono::steady_clock::now();
+  const int64_t elapsed_us = std::chrono::duration_cast<std::chrono::microseconds>(now - start_mono_).count();
+  const int64_t due = elapsed_us / period_us_;
+  if ((due - ticks_) * period_us_ > MaxLagMicros()) {
+    skipped_ticks_ += due - ticks_;
+    ticks_ = due;
+    if (now - last_skip_warning_ >= std::chrono::seconds(10)) {
+      ORBED_LOG(kWarn) << "the process loop skipped " << skipped_ticks_ << " tick(s) of " << period_us_
+                       << " us (stalled); the sim clock jumped to the current tick";
+      skipped_ticks_ = 0;
+      last_skip_warning_ = now;
+    }
+  }
+  PublishAll(start_utime_ + ticks_ * period_us_);
 }
+
+int64_t IiwaSim::MaxLagMicros() const { return std::max<int64_t>(100'000, 20 * period_us_); }
 
 void IiwaSim::PublishAll(int64_t utime) {
   const RobotModel& model = arm_->model();

@@ -7,7 +7,8 @@
 ///
 ///   Subscribes: IIWA_COMMAND (iiwa_command_t, Drake's lcmt_iiwa_command layout) — the target;
 ///               PLAN_CHECK_REQUEST (plan_check_request_t).
-///   Publishes, every tick (period_sec, default 5 ms = 200 Hz), all with the same utime:
+///   Publishes, every tick (period_sec, default 5 ms = 200 Hz), all with the same utime (the sim
+///   clock, below):
 ///               IIWA_STATUS (iiwa_status_t, Drake's lcmt_iiwa_status layout), ROBOT_STATE
 ///               (robot_state_t: true X_WR from the scene, X_RF, X_RT, every link's X_RL, limit
 ///               flags, motion state and stop reason), COLLISION_STATUS (collision_status_t: pairs
@@ -18,7 +19,7 @@
 ///               PROCESS_STATUS at 1 Hz (Process), with rejections counted per class.
 ///
 /// IIWA_STATUS fields: joint_position_measured = q after this tick's step; joint_velocity_estimated
-/// = that step / period_sec; joint_position_commanded = the last accepted command as sent
+/// = that step / P (the period, below); joint_position_commanded = the last accepted command as sent
 /// (unclamped; q0 before any); joint_position_ipo = the set point tracked this tick (= measured:
 /// the simulated servo is perfect); torques 0 (no dynamics).
 ///
@@ -29,12 +30,26 @@
 /// A command beyond a joint limit is not rejected: it is clamped, and the arm stops at the limit
 /// with motion_state STOPPED_AT_LIMIT and the joint named in stop_reason.
 ///
-/// Clocks: utime of every output = wall clock (NowMicros) at the tick; the stale check compares a
-/// command's utime with the same clock. The tick itself runs on the monotonic clock (Process timer;
-/// late ticks are skipped, never bunched, and a step never exceeds v_max * period_sec).
+/// Clocks: IIWA_STATUS, ROBOT_STATE and COLLISION_STATUS carry the sim clock. P = period_sec
+/// rounded to whole microseconds (>= 1 us). Tick k steps the arm by exactly P and stamps its outputs
+///     utime_k = start_utime + k * P,
+/// start_utime being the wall clock (NowMicros) when the constructor set up the tick timer, whose
+/// deadlines are k * P after that on the monotonic clock. Each Tick() call is the next tick
+/// (k + 1), however late it runs: late ticks keep their stamps, and the Process loop runs a few
+/// missed deadlines back to back (catch-up), so the sim clock stays within a few periods of the wall
+/// clock. Only when a tick finds itself more than MaxLagMicros() = max(100 ms, 20 P) behind its
+/// deadline (a stall, whose deadlines the loop skipped) does k jump to the last deadline passed
+/// (logged, at most every 10 s): the sim clock never falls behind for good, and the jump never puts
+/// it ahead of the schedule. So utime strictly increases by whole multiples of P (exactly P but after a stall),
+/// a step never exceeds v_max * P (ManualArm), and the speed read from the stamps,
+/// |q_k - q_j| / (utime_k - utime_j), never exceeds the joint's velocity limit, however loaded the
+/// machine: utime says when the state holds in simulated time, not when it was computed. Tick()
+/// called directly (tests) advances k by one per call the same way. Wall clock: the stale-command
+/// check (senders stamp commands with their wall clocks), PLAN_CHECK_REPLY and PROCESS_STATUS.
 ///
 /// Threading: everything on the Process::Run() thread.
 
+#include <chrono>
 #include <memory>
 #include <string>
 #include <vector>
@@ -45,6 +60,7 @@
 #include "procs/common/channels.h"
 #include "procs/common/process.h"
 #include "sim/manual_arm.h"
+#include "sim/model_paths.h"
 #include "sim/robot_model.h"
 #include "sim/scene.h"
 
@@ -54,7 +70,7 @@ struct IiwaSimOptions {
   /// URDF and scene files; "" = the files shipped in the source tree (SourceTreePath()).
   std::string urdf_path;
   std::string scene_path;
-  /// Tick = status period [s], > 0.
+  /// Tick = status period [s]; rounded to whole microseconds, which must leave >= 1 us.
   double period_sec{0.005};
   /// Initial joint vector [deg]; empty = all zero (the arm upright). Must be within the limits.
   std::vector<double> initial_q_deg;
@@ -74,10 +90,6 @@ struct IiwaSimOptions {
   std::string plan_check_reply_channel{channels::kPlanCheckReply};
 };
 
-/// `relative` (e.g. "sim/models/iiwa7.urdf") under $ORBED_SOURCE_DIR if set, else under the
-/// source tree this library was built from (as `orbed-robot` does).
-std::string SourceTreePath(const std::string& relative);
-
 class IiwaSim {
  public:
   /// Loads the URDF and scene (std::runtime_error naming the file, element/key and what was
@@ -88,13 +100,22 @@ class IiwaSim {
 
   int Run() { return process_->Run(); }
   orbed::Process& process() { return *process_; }
-  /// The options with the file paths resolved.
+  /// The options with the file paths resolved and period_sec = P (whole microseconds).
   const IiwaSimOptions& options() const { return options_; }
+  /// The sim clock (see Clocks): P [us], start_utime [us since the epoch], k of the last tick (the
+  /// number of Tick() calls, plus any deadlines skipped after a stall); the last outputs carry
+  /// start_utime() + ticks() * period_us().
+  int64_t period_us() const { return period_us_; }
+  int64_t start_utime() const { return start_utime_; }
+  int64_t ticks() const { return ticks_; }
+  /// How far behind its deadline a tick may run before the sim clock skips ahead [us].
+  int64_t MaxLagMicros() const;
   const Scene& scene() const { return scene_; }
   const ManualArm& arm() const { return *arm_; }
 
-  /// One tick: step the arm and publish IIWA_STATUS, ROBOT_STATE, COLLISION_STATUS (the timer's
-  /// callback; public so tests can drive it without waiting).
+  /// One tick: step the arm by P, advance the sim clock by P and publish IIWA_STATUS, ROBOT_STATE,
+  /// COLLISION_STATUS stamped with it (the timer's callback; public so tests can drive it without
+  /// waiting).
   void Tick();
 
  private:
@@ -108,6 +129,12 @@ class IiwaSim {
   std::unique_ptr<orbed::Process> process_;
   std::vector<int> reported_links_;  // links with geometry and a finite clearance
   std::vector<Eigen::Isometry3d> X_RL_;
+  int64_t period_us_{0};
+  int64_t start_utime_{0};
+  std::chrono::steady_clock::time_point start_mono_;
+  int64_t ticks_{0};
+  int64_t skipped_ticks_{0};  // since the last warning
+  std::chrono::steady_clock::time_point last_skip_warning_{};
 };
 
 }  // namespace orbed::sim

@@ -1,12 +1,17 @@
 // orbed-iiwa-sim in-process on memq:// (the sim's own LCM instance delivers what the test publishes
 // on it): bad commands rejected and counted per class, plan checks answered (invalid ones too), a
-// command beyond a limit stops on the limit, every tick's step within the iiwa 7's published joint
-// speeds (DESIGN §4) x the period, and the published frames against the scene file and the DH facts.
+// command beyond a limit stops on the limit along positions worked out by hand, the outputs stamped
+// on the sim clock (tick k at start + k P, late or not) so that speeds read from the stamps stay
+// within the iiwa 7's published joint speeds (DESIGN §4), and the published frames against the
+// scene file and the DH facts.
 #include "sim/iiwa_sim.h"
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <map>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -180,12 +185,20 @@ TEST(IiwaSim, AnswersPlanChecksIncludingInvalidOnes) {
   EXPECT_EQ(sim.process().rejections().counts().at("PLAN_CHECK_REQUEST/non_finite"), 1);
 }
 
-// Joint 7 commanded to 200 deg (limit 175) and joint 1 to -30 deg: joint 7 sets the pace
-// (175/180 s vs 30/98 s); the arm ends exactly on the joint 7 limit and says so.
+// Joint 7 commanded to 200 deg (limit 175) and joint 1 to -30 deg, at P = 5 ms. Worked out by hand
+// from the motion law (manual_arm.h): the target is clamped to 175 deg; joint 7 sets the pace
+// (175/180 s vs 30/98 s), so every tick it moves 180 deg/s x 5 ms = 0.9 deg and joint 1 moves
+// 0.9 x 30/175 deg, on the straight line; after tick n of the move joint 7 is at 0.9 n deg, until
+// tick 195 (0.9 x 195 = 175.5 > 175) lands on 175 exactly. memq delivers every tick's status, so
+// status n of the move is tick n. Each is stamped on the sim clock, start + k P: a whole number of
+// periods after the previous one (exactly one but after a stall of more than 100 ms), so the speed
+// read from the stamps never exceeds the limit. A step off the law, or a stamp off the sim clock
+// (e.g. the wall clock at the tick), fails here.
 TEST(IiwaSim, CommandBeyondALimitStopsAtTheLimitWithinTheJointSpeeds) {
   IiwaSimOptions options;
   options.period_sec = 0.005;
   IiwaSim sim(MemqFlags(2.0), options);
+  ASSERT_EQ(sim.period_us(), 5000);
   Collector got;
   got.Attach(sim.process().lcm());
   const orbed::iiwa_command_t cmd = Command({-30, 0, 0, 0, 0, 0, 200});
@@ -193,22 +206,59 @@ TEST(IiwaSim, CommandBeyondALimitStopsAtTheLimitWithinTheJointSpeeds) {
   sim.Run();
 
   ASSERT_GT(got.status.size(), 250u);  // ~400 ticks in 2 s; 195 are needed to arrive
+  ASSERT_LE(static_cast<int64_t>(got.status.size()), sim.ticks());
   ASSERT_EQ(got.state.size(), got.status.size());
   ASSERT_EQ(got.collision.size(), got.status.size());
-  double peak_step7 = 0;
-  for (size_t k = 1; k < got.status.size(); ++k) {
-    for (int i = 0; i < 7; ++i) {
-      const double step =
-          std::abs(got.status[k].joint_position_measured[i] - got.status[k - 1].joint_position_measured[i]);
-      EXPECT_LE(step, kSpeedDegPerS[i] * kDeg * options.period_sec * (1 + 1e-9))
-          << "tick " << k << " joint " << i + 1;
-      if (i == 6) peak_step7 = std::max(peak_step7, step);
-    }
+  // The sim clock: start + k P, k increasing (by one per tick but after a stall).
+  int64_t previous_k = 0;
+  for (size_t k = 0; k < got.status.size(); ++k) {
+    const int64_t since_start = got.status[k].utime - sim.start_utime();
+    EXPECT_EQ(since_start % sim.period_us(), 0) << "status " << k << ": utime off the sim clock";
+    EXPECT_GT(since_start / sim.period_us(), previous_k) << "status " << k;
+    previous_k = since_start / sim.period_us();
     EXPECT_EQ(got.state[k].utime, got.status[k].utime);
     EXPECT_EQ(got.collision[k].utime, got.status[k].utime);
   }
-  // The bound is met, not merely respected: joint 7 ran at its full 180 deg/s.
-  EXPECT_NEAR(peak_step7, 180 * kDeg * options.period_sec, 1e-12);
+
+  // The move by hand: n = ticks since the command took effect (the first tick that moved joint 7).
+  size_t first = 0;  // status index
+  while (first < got.status.size() && got.status[first].joint_position_measured[6] == 0.0) ++first;
+  ASSERT_LT(first, 5u) << "the command took effect late";
+  const double step7_deg = 180 * 0.005;
+  for (size_t k = first; k < got.status.size(); ++k) {
+    const orbed::iiwa_status_t& s = got.status[k];
+    const double n = static_cast<double>(k - first + 1);
+    const double q7_deg = std::min(175.0, step7_deg * n);
+    EXPECT_NEAR(s.joint_position_measured[6], q7_deg * kDeg, 1e-10) << "tick " << k + 1;
+    EXPECT_NEAR(s.joint_position_measured[0], -30.0 * q7_deg / 175.0 * kDeg, 1e-10) << "tick " << k + 1;
+    for (int i = 1; i < 6; ++i) EXPECT_EQ(s.joint_position_measured[i], 0.0) << "tick " << k + 1;
+    // The estimate is the step over P: joint 7 at its full 180 deg/s while under way (the last,
+    // shortened step excepted), 0 once there.
+    const double v7_deg = s.joint_velocity_estimated[6] / kDeg;
+    if (step7_deg * n <= 175.0) {
+      EXPECT_NEAR(v7_deg, 180.0, 1e-6) << "tick " << k + 1;
+    } else if (step7_deg * (n - 1) >= 175.0) {
+      EXPECT_EQ(v7_deg, 0.0) << "tick " << k + 1;
+    }
+  }
+  ASSERT_GT(got.status.size(), first + 200);
+  EXPECT_LT(got.status[first + 193].joint_position_measured[6], 175 * kDeg);  // tick 194 of the move
+  // Tick 195 lands exactly on the limit (175 deg as the URDF states it).
+  EXPECT_EQ(got.status[first + 194].joint_position_measured[6], sim.arm().model().joints()[6].upper_rad);
+  EXPECT_NEAR(sim.arm().model().joints()[6].upper_rad, 175 * kDeg, 1e-12);
+  // Speeds read from the stamps, as a client sees them: within the limits, with joint 7 at its limit.
+  double peak7_deg_per_s = 0;
+  for (size_t k = 1; k < got.status.size(); ++k) {
+    const double dt_s = (got.status[k].utime - got.status[k - 1].utime) * 1e-6;
+    for (int i = 0; i < 7; ++i) {
+      const double speed_deg_per_s =
+          std::abs(got.status[k].joint_position_measured[i] - got.status[k - 1].joint_position_measured[i]) / dt_s /
+          kDeg;
+      EXPECT_LE(speed_deg_per_s, kSpeedDegPerS[i] * (1 + 1e-9)) << "tick " << k + 1 << " joint " << i + 1;
+      if (i == 6) peak7_deg_per_s = std::max(peak7_deg_per_s, speed_deg_per_s);
+    }
+  }
+  EXPECT_NEAR(peak7_deg_per_s, 180.0, 1e-6);
 
   const orbed::iiwa_status_t& last = got.status.back();
   EXPECT_NEAR(last.joint_position_measured[6], 175 * kDeg, 1e-12);
@@ -222,6 +272,67 @@ TEST(IiwaSim, CommandBeyondALimitStopsAtTheLimitWithinTheJointSpeeds) {
   // While under way it said MOVING.
   EXPECT_EQ(got.state[5].motion_state, +orbed::robot_state_t::MOTION_MOVING);
   EXPECT_FALSE(got.collision.back().in_collision);
+}
+
+// The sim clock driven by hand (Tick(), no loop). P is period_sec rounded to whole microseconds
+// (12.344 ms here, so a tick may run up to max(100 ms, 20 P) = 246.88 ms late before the clock
+// skips). Tick k is stamped start_utime + k P: tick 5, run 30 ms (2.4 periods) late, keeps its
+// stamp, exactly P after tick 4; tick 8, run after a 400 ms stall, jumps to the last deadline
+// passed (a whole number of periods, not ahead of the wall clock), and ticks 9 and 10 follow it by
+// P. Every tick steps joint 1 (toward 30 deg at 98 deg/s) by 98 deg/s x P, worked out by hand: the
+// speed read from the stamps is 98 deg/s at most, however late the tick.
+TEST(IiwaSim, StampsTicksOnTheSimClockHoweverLateTheyRun) {
+  IiwaSimOptions options;
+  options.period_sec = 0.0123444;
+  const int64_t before = NowMicros();
+  IiwaSim sim(MemqFlags(0.1), options);
+  const int64_t after = NowMicros();
+  constexpr int64_t kP = 12344;
+  EXPECT_EQ(sim.period_us(), kP);
+  EXPECT_EQ(sim.options().period_sec, 0.012344);
+  EXPECT_EQ(sim.MaxLagMicros(), 20 * kP);
+  EXPECT_GE(sim.start_utime(), before);
+  EXPECT_LE(sim.start_utime(), after);
+  Collector got;
+  lcm::LCM& lcm = sim.process().lcm();
+  got.Attach(lcm);
+  const orbed::iiwa_command_t cmd = Command({30, 0, 0, 0, 0, 0, 0});
+  lcm.publish("IIWA_COMMAND", &cmd);
+  while (lcm.handleTimeout(0) > 0) {
+  }
+  int64_t wall_before_8 = 0, wall_after_8 = 0;
+  for (int n = 1; n <= 10; ++n) {
+    if (n == 5) std::this_thread::sleep_for(std::chrono::milliseconds(30));
+    if (n == 8) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(400));
+      wall_before_8 = NowMicros();
+    }
+    sim.Tick();
+    if (n == 8) wall_after_8 = NowMicros();
+    while (lcm.handleTimeout(0) > 0) {
+    }
+  }
+  ASSERT_EQ(got.status.size(), 10u);
+  for (int n = 1; n <= 7; ++n) EXPECT_EQ(got.status[n - 1].utime, sim.start_utime() + n * kP) << "tick " << n;
+  const int64_t jumped = got.status[7].utime - sim.start_utime();
+  EXPECT_EQ(jumped % kP, 0);
+  EXPECT_GT(jumped / kP, 7 + 20) << "tick 8 did not skip the stalled deadlines";
+  EXPECT_LE(got.status[7].utime, wall_after_8 + 1000) << "the jump ran ahead of the wall clock";
+  EXPECT_GT(got.status[7].utime, wall_before_8 - kP - 1000) << "the jump fell short of the current deadline";
+  EXPECT_EQ(got.status[8].utime, got.status[7].utime + kP);
+  EXPECT_EQ(got.status[9].utime, got.status[7].utime + 2 * kP);
+  EXPECT_EQ(sim.ticks(), jumped / kP + 2);
+  for (int n = 1; n <= 10; ++n) {
+    const orbed::iiwa_status_t& s = got.status[n - 1];
+    EXPECT_NEAR(s.joint_position_measured[0], n * 98 * 0.012344 * kDeg, 1e-12) << "tick " << n;
+    EXPECT_NEAR(s.joint_velocity_estimated[0], 98 * kDeg, 1e-9) << "tick " << n;
+    if (n > 1) {
+      const double dq = s.joint_position_measured[0] - got.status[n - 2].joint_position_measured[0];
+      EXPECT_LE(dq / ((s.utime - got.status[n - 2].utime) * 1e-6), 98 * kDeg * (1 + 1e-9)) << "tick " << n;
+    }
+  }
+  EXPECT_EQ(got.state.back().utime, got.status.back().utime);
+  EXPECT_EQ(got.collision.back().utime, got.status.back().utime);
 }
 
 // The published frames against independent facts: X_WR from the scene file (position
@@ -275,8 +386,10 @@ TEST(IiwaSim, BadOptionsAndFilesAreNamed) {
     EXPECT_NE(std::string(e.what()).find("/nonexistent/scene.yaml"), std::string::npos) << e.what();
   }
   IiwaSimOptions period;
-  period.period_sec = 0;
-  EXPECT_THROW(IiwaSim(MemqFlags(0.1), period), std::invalid_argument);
+  for (double bad : {0.0, -0.005, 4e-7, std::nan(""), double{INFINITY}}) {  // 4e-7 s rounds to 0 us
+    period.period_sec = bad;
+    EXPECT_THROW(IiwaSim(MemqFlags(0.1), period), std::invalid_argument) << bad;
+  }
 }
 
 }  // namespace

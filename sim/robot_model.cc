@@ -35,6 +35,38 @@ bool FinitePositive(double v) { return std::isfinite(v) && v > 0; }
 
 }  // namespace
 
+std::vector<CollisionPrimitive> FuseCapsules(const std::vector<CollisionPrimitive>& primitives) {
+  using Kind = CollisionPrimitive::Kind;
+  const std::vector<CollisionPrimitive>& in = primitives;
+  std::vector<bool> used(in.size(), false);
+  std::vector<CollisionPrimitive> out;
+  for (size_t i = 0; i < in.size(); ++i) {
+    if (in[i].kind != Kind::kCylinder) continue;
+    const CollisionPrimitive& cylinder = in[i];
+    int caps[2] = {-1, -1};
+    for (int e = 0; e < 2; ++e) {
+      const Eigen::Vector3d p_LE = cylinder.X_LG * Eigen::Vector3d(0, 0, (e == 0 ? -0.5 : 0.5) * cylinder.length_m);
+      for (size_t j = 0; j < in.size(); ++j) {
+        if (used[j] || in[j].kind != Kind::kSphere || static_cast<int>(j) == caps[0]) continue;
+        if (std::abs(in[j].radius_m - cylinder.radius_m) <= kCapsuleFuseToleranceM &&
+            (in[j].X_LG.translation() - p_LE).norm() <= kCapsuleFuseToleranceM) {
+          caps[e] = static_cast<int>(j);
+          break;
+        }
+      }
+    }
+    if (caps[0] < 0 || caps[1] < 0) continue;
+    used[i] = used[caps[0]] = used[caps[1]] = true;
+    CollisionPrimitive capsule = cylinder;
+    capsule.kind = Kind::kCapsule;
+    out.push_back(capsule);
+  }
+  for (size_t i = 0; i < in.size(); ++i) {
+    if (!used[i]) out.push_back(in[i]);
+  }
+  return out;
+}
+
 Eigen::VectorXd DegToRad(const Eigen::VectorXd& q_deg) { return q_deg * (kPi / 180.0); }
 Eigen::VectorXd RadToDeg(const Eigen::VectorXd& q_rad) { return q_rad * (180.0 / kPi); }
 

@@ -132,6 +132,21 @@ class RobotModel {
   double tool_length_m_{0};
 };
 
+/// How close [m] a sphere's centre must be to a cylinder's end-face centre, and its radius to the
+/// cylinder's, for FuseCapsules() to take the two as one capsule (a nanometre: round-off of the
+/// URDF's origins, not a modelling tolerance).
+inline constexpr double kCapsuleFuseToleranceM = 1e-9;
+
+/// The URDF spelling of a capsule is a cylinder with a sphere of the cylinder's radius centred on
+/// each end face (urdfdom drops <capsule>); the union of the three is exactly the capsule. Returns
+/// `primitives` with every such triple replaced by one kCapsule primitive (the cylinder's name,
+/// X_LG, radius and length: the distance between the cap centres, along the primitive's z), first
+/// the capsules in the order of their cylinders, then every other primitive in input order. Matches
+/// within kCapsuleFuseToleranceM (centre and radius); each sphere caps at most one capsule; a
+/// cylinder missing a cap stays a cylinder. The one rule the collision world and the renderer share
+/// (collision_world.h, hmd_emulator/scene_geometry.h), so both see the same shapes.
+std::vector<CollisionPrimitive> FuseCapsules(const std::vector<CollisionPrimitive>& primitives);
+
 /// Degrees <-> radians, elementwise.
 Eigen::VectorXd DegToRad(const Eigen::VectorXd& q_deg);
 Eigen::VectorXd RadToDeg(const Eigen::VectorXd& q_rad);

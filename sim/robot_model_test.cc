@@ -137,6 +137,68 @@ TEST(RobotModelTest, SetToolLengthMovesTipAndStretchesShaft) {
   EXPECT_THROW(m.SetToolLength(std::nan("")), std::invalid_argument);
 }
 
+// FuseCapsules: the shipped model's capsules (links 1-5, one each) fuse; a hand-made tilted triple
+// fuses into one capsule listed first; a cap 10 nm off its end face, or 10 nm too large, does not.
+TEST(RobotModelTest, FuseCapsulesRecognisesExactTriplesOnly) {
+  using Kind = CollisionPrimitive::Kind;
+  const RobotModel m = LoadIiwa();
+  for (int l = 1; l <= 5; ++l) {
+    const int link = m.FindLink("iiwa_link_" + std::to_string(l));
+    ASSERT_GE(link, 0);
+    const std::vector<CollisionPrimitive> fused = FuseCapsules(m.links()[link].collision);
+    int capsules = 0, spheres = 0;
+    for (const auto& g : fused) {
+      capsules += g.kind == Kind::kCapsule;
+      spheres += g.kind == Kind::kSphere;
+    }
+    EXPECT_EQ(capsules, 1) << "iiwa_link_" << l;
+    EXPECT_EQ(spheres, 0) << "iiwa_link_" << l;
+  }
+
+  CollisionPrimitive box;
+  box.kind = Kind::kBox;
+  box.size_m = Eigen::Vector3d(0.1, 0.2, 0.3);
+  CollisionPrimitive cylinder;
+  cylinder.kind = Kind::kCylinder;
+  cylinder.name = "shaft";
+  cylinder.radius_m = 0.05;
+  cylinder.length_m = 0.3;
+  cylinder.X_LG.linear() = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  cylinder.X_LG.translation() = Eigen::Vector3d(0.1, -0.2, 0.3);
+  const Eigen::Vector3d axis = cylinder.X_LG.linear().col(2);
+  CollisionPrimitive cap_a, cap_b;
+  cap_a.kind = cap_b.kind = Kind::kSphere;
+  cap_a.radius_m = cap_b.radius_m = 0.05;
+  cap_a.X_LG.translation() = Eigen::Vector3d(0.1, -0.2, 0.3) + 0.15 * axis;
+  cap_b.X_LG.translation() = Eigen::Vector3d(0.1, -0.2, 0.3) - 0.15 * axis;
+
+  const std::vector<CollisionPrimitive> fused = FuseCapsules({box, cap_a, cylinder, cap_b});
+  ASSERT_EQ(fused.size(), 2u);
+  EXPECT_EQ(fused[0].kind, Kind::kCapsule);
+  EXPECT_EQ(fused[0].name, "shaft");
+  EXPECT_EQ(fused[0].length_m, 0.3);
+  EXPECT_EQ(fused[0].radius_m, 0.05);
+  EXPECT_TRUE(fused[0].X_LG.isApprox(cylinder.X_LG, 0));
+  EXPECT_EQ(fused[1].kind, Kind::kBox);
+
+  CollisionPrimitive off = cap_b;
+  off.X_LG.translation() += 1e-8 * Eigen::Vector3d::UnitX();
+  EXPECT_EQ(FuseCapsules({cylinder, cap_a, off}).size(), 3u);
+  CollisionPrimitive larger = cap_b;
+  larger.radius_m += 1e-8;
+  EXPECT_EQ(FuseCapsules({cylinder, cap_a, larger}).size(), 3u);
+  // One sphere caps one capsule: two cylinders sharing an end face, three spheres.
+  CollisionPrimitive next = cylinder;
+  next.X_LG.translation() += 0.3 * axis;
+  CollisionPrimitive cap_c = cap_a;
+  cap_c.X_LG.translation() += 0.3 * axis;
+  const std::vector<CollisionPrimitive> chain = FuseCapsules({cylinder, next, cap_a, cap_b, cap_c});
+  ASSERT_EQ(chain.size(), 3u);
+  EXPECT_EQ(chain[0].kind, Kind::kCapsule);
+  EXPECT_EQ(chain[1].kind, Kind::kCylinder);
+  EXPECT_EQ(chain[2].kind, Kind::kSphere);
+}
+
 TEST(RobotModelTest, ValidateJointVectorNamesTheJoint) {
   const RobotModel m = LoadIiwa();
   EXPECT_EQ(m.ValidateJointVector(Deg({170, 120, 170, 120, 170, 120, 175})), "");

@@ -1,7 +1,6 @@
 #include "sim/robot_tool.h"
 
 #include <cmath>
-#include <cstdlib>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -11,14 +10,11 @@
 
 #include "procs/common/json.h"
 #include "sim/collision_world.h"
+#include "sim/model_paths.h"
 #include "sim/robot_model.h"
 #include "sim/scene.h"
 #include "sim/trocar_ik.h"
 #include "sim/trocar_clearance.h"
-
-#ifndef ORBED_BUILD_SOURCE_DIR
-#define ORBED_BUILD_SOURCE_DIR "."
-#endif
 
 namespace orbed::sim {
 namespace {
@@ -27,11 +23,6 @@ namespace {
 struct UsageError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
-
-std::string SourceDir() {
-  const char* env = std::getenv("ORBED_SOURCE_DIR");
-  return env && *env ? std::string(env) : std::string(ORBED_BUILD_SOURCE_DIR);
-}
 
 Eigen::VectorXd ParseJointList(const std::string& text, int expected) {
   std::vector<double> values;
@@ -58,10 +49,11 @@ Eigen::VectorXd ParseJointList(const std::string& text, int expected) {
   return Eigen::Map<Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size()));
 }
 
-RobotModel LoadModel(const std::string& urdf_flag) {
-  const std::string path = urdf_flag.empty() ? SourceDir() + "/" + RobotModel::kDefaultUrdfRelativePath : urdf_flag;
+// The robot from --urdf (default: the shipped model), as it stands in `scene` if one is given.
+RobotModel LoadModel(const std::string& urdf_flag, const Scene* scene = nullptr) {
+  const std::string path = urdf_flag.empty() ? SourceTreePath(RobotModel::kDefaultUrdfRelativePath) : urdf_flag;
   try {
-    return RobotModel::LoadFile(path);
+    return scene ? LoadRobotForScene(path, *scene) : RobotModel::LoadFile(path);
   } catch (const std::exception& e) {
     throw UsageError(e.what());
   }
@@ -159,14 +151,11 @@ int RunFk(const std::string& q_text, const std::string& urdf, std::ostream& out)
 }
 
 int RunCheck(const std::string& q_text, const std::string& scene_path, const std::string& urdf, std::ostream& out) {
-  RobotModel model = LoadModel(urdf);
-  const Eigen::VectorXd q = ValidatedQ(model, q_text);
   Scene scene;
   const bool has_scene = !scene_path.empty();
-  if (has_scene) {
-    scene = LoadScene(scene_path);
-    model.SetToolLength(scene.tool_length_m);
-  }
+  if (has_scene) scene = LoadScene(scene_path);
+  const RobotModel model = LoadModel(urdf, has_scene ? &scene : nullptr);
+  const Eigen::VectorXd q = ValidatedQ(model, q_text);
   CollisionWorld world(model, has_scene ? &scene : nullptr);
   const CollisionResult r = world.Check(q);
   JsonWriter j;
@@ -185,9 +174,8 @@ int RunCheck(const std::string& q_text, const std::string& scene_path, const std
 }
 
 int RunIk(const std::string& scene_path, const std::string& urdf, uint64_t seed, int starts, std::ostream& out) {
-  RobotModel model = LoadModel(urdf);
   const Scene scene = LoadScene(scene_path);
-  model.SetToolLength(scene.tool_length_m);
+  const RobotModel model = LoadModel(urdf, &scene);
   CollisionWorld world(model, &scene);
   const ClearanceFunction clearance = MakeTrocarClearanceFunction(model, scene);
   const TrocarIkTarget target = TrocarTargetInBase(scene);

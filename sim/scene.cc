@@ -100,6 +100,16 @@ Scene LoadSceneFile(const std::string& path) {
   return LoadSceneString(ss.str(), path);
 }
 
+RobotModel LoadRobotForScene(const std::string& urdf_path, const Scene& scene) {
+  RobotModel model = RobotModel::LoadFile(urdf_path);
+  try {
+    model.SetToolLength(scene.tool_length_m);
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(scene.source + ": robot.tool_length_m does not fit " + urdf_path + ": " + e.what());
+  }
+  return model;
+}
+
 Scene LoadSceneString(const std::string& yaml_text, const std::string& source_name) {
   YAML::Node root;
   try {

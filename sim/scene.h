@@ -33,6 +33,8 @@
 
 #include <Eigen/Geometry>
 
+#include "sim/robot_model.h"
+
 namespace orbed::sim {
 
 struct SceneObject {
@@ -65,6 +67,13 @@ struct Scene {
 Scene LoadSceneFile(const std::string& path);
 /// The same from YAML text; `source_name` is used in error messages.
 Scene LoadSceneString(const std::string& yaml_text, const std::string& source_name);
+
+/// The robot as it stands in `scene`: RobotModel::LoadFile(urdf_path) with the scene's tool length
+/// applied (SetToolLength), so that FK, collision geometry and everything copied from it see the
+/// scene's tool. Every process and tool that loads the robot for a scene goes through this. Throws
+/// std::runtime_error naming the URDF (as LoadFile) or naming scene.source and tool_length_m when
+/// the model cannot take that tool length.
+RobotModel LoadRobotForScene(const std::string& urdf_path, const Scene& scene);
 
 /// R = Rz(yaw) Ry(pitch) Rx(roll), angles in degrees.
 Eigen::Matrix3d RotationFromRpyDeg(const Eigen::Vector3d& rpy_deg);

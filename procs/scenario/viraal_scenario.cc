@@ -16,10 +16,7 @@
 #include "procs/common/conversions.h"
 #include "procs/common/log.h"
 #include "procs/common/validation.h"
-
-#ifndef ORBED_BUILD_SOURCE_DIR
-#define ORBED_BUILD_SOURCE_DIR "."
-#endif
+#include "sim/model_paths.h"
 
 namespace orbed::scenario {
 namespace {
@@ -73,11 +70,7 @@ ScenarioOptions Resolved(ScenarioOptions options) {
 
 }  // namespace
 
-std::string ScenarioSourcePath(const std::string& relative) {
-  const char* env = std::getenv("ORBED_SOURCE_DIR");
-  const std::string root = env && *env ? std::string(env) : std::string(ORBED_BUILD_SOURCE_DIR);
-  return root + "/" + relative;
-}
+std::string ScenarioSourcePath(const std::string& relative) { return sim::SourceTreePath(relative); }
 
 ViraalScenario::ViraalScenario(const orbed::CommonFlags& flags, const ScenarioOptions& options)
     : options_(Resolved(options)) {
