@@ -34,7 +34,6 @@ class EventLogWriter {
   bool Flush();
   /// Flushes and closes; further writes fail.
   void Close();
-  int64_t events_written() const { return next_event_number_; }
 
   /// Size of the event header in bytes.
   static constexpr size_t kHeaderBytes = 4 + 8 + 8 + 4 + 4;

@@ -91,7 +91,6 @@ std::optional<orbed::registration_t> RegistrationService::HandleSessionControl(
     active_ = true;
     session_id_ = msg.session_id;
     display_mode_ = msg.display_mode;
-    num_mirrors_ = msg.num_mirrors;
     method_ = msg.method;
     trials_.clear();
     last_utime_ = msg.utime;

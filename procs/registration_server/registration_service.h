@@ -95,7 +95,6 @@ class RegistrationService {
   bool active_ = false;
   std::string session_id_;
   int8_t display_mode_ = 0;
-  int32_t num_mirrors_ = 0;
   int8_t method_ = orbed::registration_t::METHOD_KARCHER;
   std::vector<Trial> trials_;
   int64_t last_utime_ = 0;
