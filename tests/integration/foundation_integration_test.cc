@@ -204,11 +204,14 @@ std::vector<orbed::iiwa_status_t> PublishTraffic(lcm::LCM* lcm, int count, doubl
 TEST(Logger, LogPlaysBackIntoLcmLoggerUnchanged) {
   const std::string dir = MakeTempDir("replay");
   const std::string original = dir + "/orbed.lcmlog";
+  BusWatcher bus;
+  bus.Start();
   {
     RunningProcess logger({BinPath("orbed-logger"), "--file", original, "--channels",
-                           "IIWA_STATUS|BLOB"});
+                           "IIWA_STATUS|BLOB", "--name", "replay-logger"});
     lcm::LCM lcm("");
-    std::this_thread::sleep_for(std::chrono::milliseconds(300));  // logger subscribed
+    // Its first heartbeat is published after it subscribed.
+    ASSERT_TRUE(WaitFor([&] { return !bus.Heartbeats("replay-logger").empty(); }, 10));
     PublishTraffic(&lcm, 100, 200.0);
     std::this_thread::sleep_for(std::chrono::milliseconds(200));
     logger.Signal(SIGINT);
@@ -221,7 +224,9 @@ TEST(Logger, LogPlaysBackIntoLcmLoggerUnchanged) {
   const std::string copy = dir + "/copy.lcmlog";
   {
     RunningProcess lcm_logger({"/usr/bin/lcm-logger", "-q", "-f", copy});
-    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    // lcm-logger opens its file once it is set up; then give it a moment to subscribe.
+    ASSERT_TRUE(WaitFor([&] { return fs::exists(copy); }, 10));
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
     RunningProcess player({"/usr/bin/lcm-logplayer", "-s", "2", original});
     ASSERT_TRUE(player.Wait(30));
     std::this_thread::sleep_for(std::chrono::milliseconds(300));
@@ -241,10 +246,12 @@ TEST(Logger, LogPlaysBackIntoLcmLoggerUnchanged) {
 TEST(Logger, SigkilledLoggerLeavesAReadableLog) {
   const std::string dir = MakeTempDir("sigkill");
   const std::string path = dir + "/killed.lcmlog";
+  BusWatcher bus;
+  bus.Start();
   RunningProcess logger({BinPath("orbed-logger"), "--file", path, "--channels", "IIWA_STATUS|BLOB",
-                         "--flush-interval-sec", "0.1"});
+                         "--flush-interval-sec", "0.1", "--name", "killed-logger"});
   lcm::LCM lcm("");
-  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  ASSERT_TRUE(WaitFor([&] { return !bus.Heartbeats("killed-logger").empty(); }, 10));
   PublishTraffic(&lcm, 60, 200.0);
   std::this_thread::sleep_for(std::chrono::milliseconds(500));  // several flushes
   logger.Signal(SIGKILL);
