@@ -18,6 +18,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
+constexpr char kLcmSelfTestChannel[] = "LCM_SELF_TEST";
+
 std::string UtcStamp(int64_t utime, const char* format) {
   const std::time_t seconds = static_cast<std::time_t>(utime / 1000000);
   std::tm tm{};
@@ -89,6 +91,9 @@ std::string Logger::manifest_path() const {
 }
 
 void Logger::OnMessage(const lcm::ReceiveBuffer& rbuf, const std::string& channel) {
+  // LCM's own start-up probe (each new LCM instance sends one): not testbed traffic, and no type
+  // decodes it, so a replay in lcm-spy would show it as undecodable.
+  if (channel == kLcmSelfTestChannel) return;
   const int64_t size = static_cast<int64_t>(rbuf.data_size);
   {
     std::lock_guard<std::mutex> lock(queue_mutex_);

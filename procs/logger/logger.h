@@ -2,6 +2,8 @@
 /// @file
 /// orbed-logger's engine: records LCM traffic to a standard LCM event log.
 ///
+/// LCM's internal LCM_SELF_TEST probe packets are not recorded.
+///
 /// Threads: the receive thread (Process::Run, LCM's handler) stamps each message with LCM's
 /// receive time and appends it to a bounded in-memory queue, or counts a drop when the queue is
 /// full (by events or bytes) — never a silent loss. The writer thread drains the queue into the
