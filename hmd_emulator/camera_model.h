@@ -14,6 +14,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <stdexcept>
 
 namespace orbed::hmd {
 
@@ -33,6 +34,26 @@ struct Intrinsics {
     return k;
   }
 };
+
+/// The frame of a viewer (head or camera) at p_WE looking at p_WT, z up in W: z toward the target,
+/// x horizontal to the right, y down (computer-vision axes). Throws std::invalid_argument when the
+/// target is within 1 mm or straight above/below (roll undefined).
+inline Eigen::Isometry3d LookAt(const Eigen::Vector3d& p_WE, const Eigen::Vector3d& p_WT) {
+  const Eigen::Vector3d d = p_WT - p_WE;
+  if (!(d.norm() > 1e-3)) throw std::invalid_argument("look-at target within 1 mm of the viewer");
+  const Eigen::Vector3d z = d.normalized();
+  const Eigen::Vector3d x_raw = z.cross(Eigen::Vector3d::UnitZ());
+  if (!(x_raw.norm() > 1e-6)) {
+    throw std::invalid_argument("look-at target straight above or below the viewer");
+  }
+  const Eigen::Vector3d x = x_raw.normalized();
+  Eigen::Isometry3d X_WE = Eigen::Isometry3d::Identity();
+  X_WE.linear().col(0) = x;
+  X_WE.linear().col(1) = z.cross(x);
+  X_WE.linear().col(2) = z;
+  X_WE.translation() = p_WE;
+  return X_WE;
+}
 
 using CameraMatrix = Eigen::Matrix<double, 3, 4>;
 

@@ -11,16 +11,12 @@
 #include <gtest/gtest.h>
 
 #include "hmd_emulator/renderer.h"
+#include "sim/model_paths.h"
 #include "sim/robot_model.h"
 #include "sim/scene.h"
 
 namespace orbed::hmd {
 namespace {
-
-std::string SourcePath(const std::string& rel) {
-  const char* dir = std::getenv("ORBED_SOURCE_DIR");
-  return std::string(dir ? dir : ".") + "/" + rel;
-}
 
 Eigen::Isometry3d Pose(const Eigen::Vector3d& rpy_deg, const Eigen::Vector3d& p) {
   Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
@@ -175,8 +171,8 @@ TEST(Gaze, CapsuleBodyAndCapsByHand) {
 }
 
 TEST(Gaze, OperatingRoomNamesTheBodyAndSkipsTheHologram) {
-  const sim::RobotModel robot = sim::RobotModel::LoadFile(SourcePath(sim::RobotModel::kDefaultUrdfRelativePath));
-  const sim::Scene scene = sim::LoadSceneFile(SourcePath(sim::kDefaultSceneRelativePath));
+  const sim::RobotModel robot = sim::RobotModel::LoadFile(orbed::sim::SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath));
+  const sim::Scene scene = sim::LoadSceneFile(orbed::sim::SourceTreePath(sim::kDefaultSceneRelativePath));
   const Eigen::VectorXd q = Eigen::VectorXd::Zero(7);  // arm straight up
   const Eigen::Isometry3d X_WV = scene.X_WR;  // hologram exactly on the real robot
   SceneGeometry g = SceneGeometry::MakeOperatingRoom(scene, robot, q, scene.X_WR, &X_WV);
@@ -204,8 +200,8 @@ TEST(Gaze, OperatingRoomNamesTheBodyAndSkipsTheHologram) {
 }
 
 TEST(Gaze, AgreesWithTheRendererOnAFlatFace) {
-  const sim::RobotModel robot = sim::RobotModel::LoadFile(SourcePath(sim::RobotModel::kDefaultUrdfRelativePath));
-  const sim::Scene scene = sim::LoadSceneFile(SourcePath(sim::kDefaultSceneRelativePath));
+  const sim::RobotModel robot = sim::RobotModel::LoadFile(orbed::sim::SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath));
+  const sim::Scene scene = sim::LoadSceneFile(orbed::sim::SourceTreePath(sim::kDefaultSceneRelativePath));
   SceneGeometry g = SceneGeometry::MakeOperatingRoom(scene, robot, Eigen::VectorXd::Zero(7), scene.X_WR);
   Mesh mesh;
   Tessellate(g, kRealWorld, {}, &mesh);

@@ -56,22 +56,6 @@ HeadTrajectoryConfig LoadHeadTrajectoryFile(const std::string& path) {
   return ParseHeadTrajectory(f.Required(root, "head_trajectory", "head_trajectory"), path);
 }
 
-Eigen::Isometry3d LookAt(const Eigen::Vector3d& p_WH, const Eigen::Vector3d& p_WT) {
-  const Eigen::Vector3d d = p_WT - p_WH;
-  if (!(d.norm() > 1e-3)) throw std::invalid_argument("look-at target within 1 mm of the head");
-  const Eigen::Vector3d z = d.normalized();
-  const Eigen::Vector3d x_raw = z.cross(Eigen::Vector3d::UnitZ());
-  if (!(x_raw.norm() > 1e-6)) throw std::invalid_argument("look-at target straight above or below the head");
-  const Eigen::Vector3d x = x_raw.normalized();
-  const Eigen::Vector3d y = z.cross(x);
-  Eigen::Isometry3d X_WH = Eigen::Isometry3d::Identity();
-  X_WH.linear().col(0) = x;
-  X_WH.linear().col(1) = y;
-  X_WH.linear().col(2) = z;
-  X_WH.translation() = p_WH;
-  return X_WH;
-}
-
 HeadTrajectory::HeadTrajectory(HeadTrajectoryConfig config) : config_(std::move(config)) {
   const auto& w = config_.waypoints;
   if (w.empty()) throw std::invalid_argument("head trajectory: needs at least one waypoint");

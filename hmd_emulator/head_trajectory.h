@@ -32,6 +32,8 @@
 #include <Eigen/Geometry>
 #include <yaml-cpp/yaml.h>
 
+#include "hmd_emulator/camera_model.h"  // LookAt
+
 namespace orbed::hmd {
 
 struct HeadWaypoint {
@@ -54,11 +56,6 @@ HeadTrajectoryConfig ParseHeadTrajectory(const YAML::Node& node, const std::stri
                                          const std::string& key = "head_trajectory");
 /// Loads the `head_trajectory:` mapping of a YAML file.
 HeadTrajectoryConfig LoadHeadTrajectoryFile(const std::string& path);
-
-/// The head frame H of a viewer at p_WH looking at p_WT: z_H toward the target, x_H horizontal
-/// (to the right), y_H down. Throws std::invalid_argument when the target is within 1 mm or
-/// straight above/below (roll undefined).
-Eigen::Isometry3d LookAt(const Eigen::Vector3d& p_WH, const Eigen::Vector3d& p_WT);
 
 class HeadTrajectory {
  public:

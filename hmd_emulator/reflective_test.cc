@@ -14,24 +14,11 @@
 #include "hmd_emulator/gaze.h"
 #include "hmd_emulator/renderer.h"
 #include "hmd_emulator/scene_geometry.h"
+#include "sim/model_paths.h"
 #include "sim/scene.h"
 
 namespace orbed::hmd {
 namespace {
-
-std::string SourcePath(const std::string& rel) {
-  const char* dir = std::getenv("ORBED_SOURCE_DIR");
-  return std::string(dir ? dir : ".") + "/" + rel;
-}
-
-Eigen::Isometry3d LookAt(const Eigen::Vector3d& eye, const Eigen::Vector3d& target) {
-  const Eigen::Vector3d z = (target - eye).normalized();
-  const Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitZ()).normalized();
-  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
-  X.linear() << x, z.cross(x), z;
-  X.translation() = eye;
-  return X;
-}
 
 // Centroid of the pixels carrying `id`; (-1, -1) if none.
 Eigen::Vector2d Centroid(const cv::Mat& ids, int id, int* count = nullptr) {
@@ -46,8 +33,8 @@ Eigen::Vector2d Centroid(const cv::Mat& ids, int id, int* count = nullptr) {
 class ReflectiveTest : public ::testing::Test {
  protected:
   ReflectiveTest()
-      : robot_(sim::RobotModel::LoadFile(SourcePath(sim::RobotModel::kDefaultUrdfRelativePath))),
-        scene_(sim::LoadSceneFile(SourcePath(sim::kDefaultSceneRelativePath))) {
+      : robot_(sim::RobotModel::LoadFile(sim::SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath))),
+        scene_(sim::LoadSceneFile(sim::SourceTreePath(sim::kDefaultSceneRelativePath))) {
     Eigen::VectorXd q_deg(7);
     q_deg << 20, 40, 0, -60, 0, 50, 0;
     q_ = sim::DegToRad(q_deg);

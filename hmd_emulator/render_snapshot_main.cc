@@ -28,17 +28,9 @@
 namespace {
 
 using orbed::hmd::Intrinsics;
+using orbed::hmd::LookAt;
 
 constexpr double kDeg = 3.14159265358979323846 / 180.0;
-
-Eigen::Isometry3d LookAt(const Eigen::Vector3d& eye, const Eigen::Vector3d& target) {
-  const Eigen::Vector3d z = (target - eye).normalized();
-  const Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitZ()).normalized();
-  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
-  X.linear() << x, z.cross(x), z;
-  X.translation() = eye;
-  return X;
-}
 
 void Caption(cv::Mat* image, const std::string& text) {
   cv::rectangle(*image, cv::Rect(0, 0, image->cols, 34), cv::Scalar(30, 30, 30), cv::FILLED);

@@ -14,28 +14,11 @@
 
 #include "hmd_emulator/scene_geometry.h"
 #include "sim/robot_model.h"
+#include "sim/model_paths.h"
 #include "sim/scene.h"
 
 namespace orbed::hmd {
 namespace {
-
-std::string SourcePath(const std::string& rel) {
-  const char* dir = std::getenv("ORBED_SOURCE_DIR");
-  return std::string(dir ? dir : ".") + "/" + rel;
-}
-
-// Camera at `eye` looking at `target`, z up in W; computer-vision axes (x right, y down).
-Eigen::Isometry3d LookAt(const Eigen::Vector3d& eye, const Eigen::Vector3d& target) {
-  const Eigen::Vector3d z = (target - eye).normalized();
-  const Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitZ()).normalized();
-  const Eigen::Vector3d y = z.cross(x);
-  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
-  X.linear().col(0) = x;
-  X.linear().col(1) = y;
-  X.linear().col(2) = z;
-  X.translation() = eye;
-  return X;
-}
 
 Primitive Box(const Eigen::Vector3d& size, const Eigen::Isometry3d& X_WG) {
   Primitive p;
@@ -232,8 +215,8 @@ TEST(Renderer, FloorThroughTheNearPlaneIsClippedToTheHorizon) {
 }
 
 TEST(Renderer, OperatingRoomShowsEveryLinkAndObjectsInView) {
-  const sim::RobotModel robot = sim::RobotModel::LoadFile(SourcePath(sim::RobotModel::kDefaultUrdfRelativePath));
-  const sim::Scene scene = sim::LoadSceneFile(SourcePath(sim::kDefaultSceneRelativePath));
+  const sim::RobotModel robot = sim::RobotModel::LoadFile(sim::SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath));
+  const sim::Scene scene = sim::LoadSceneFile(sim::SourceTreePath(sim::kDefaultSceneRelativePath));
   Eigen::VectorXd q_deg(7);
   q_deg << 0, 35, 0, -70, 0, 45, 0;
   SceneGeometry g = SceneGeometry::MakeOperatingRoom(scene, robot, sim::DegToRad(q_deg), scene.X_WR);
@@ -288,8 +271,8 @@ TEST(Renderer, OverlayBlendsOnlyWhereTheHologramIs) {
 }
 
 TEST(Renderer, JpegRoundTripIsSmallAndFaithful) {
-  const sim::RobotModel robot = sim::RobotModel::LoadFile(SourcePath(sim::RobotModel::kDefaultUrdfRelativePath));
-  const sim::Scene scene = sim::LoadSceneFile(SourcePath(sim::kDefaultSceneRelativePath));
+  const sim::RobotModel robot = sim::RobotModel::LoadFile(sim::SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath));
+  const sim::Scene scene = sim::LoadSceneFile(sim::SourceTreePath(sim::kDefaultSceneRelativePath));
   SceneGeometry g = SceneGeometry::MakeOperatingRoom(scene, robot, Eigen::VectorXd::Zero(7), scene.X_WR);
   Mesh mesh;
   Tessellate(g, kAllKinds, {}, &mesh);

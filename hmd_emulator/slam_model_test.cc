@@ -16,14 +16,10 @@
 #include "hmd_emulator/stats.h"
 #include "hmd_emulator/yaml_fields.h"
 #include "orbed/hmd_pose_t.hpp"
+#include "sim/model_paths.h"
 
 namespace orbed::hmd {
 namespace {
-
-std::string SourcePath(const std::string& relative) {
-  const char* root = std::getenv("ORBED_SOURCE_DIR");
-  return std::string(root ? root : ".") + "/" + relative;
-}
 
 static_assert(static_cast<int>(TrackingState::kTracking) == orbed::hmd_pose_t::TRACKING);
 static_assert(static_cast<int>(TrackingState::kLimited) == orbed::hmd_pose_t::LIMITED);
@@ -159,7 +155,7 @@ RpeStats RelativePoseErrorPerMetre(const std::vector<SlamSample>& s) {
 }
 
 TEST(SlamModel, DriftPerMetreStaysInConfiguredBand) {
-  const SlamConfig shipped = LoadSlamConfigFile(SourcePath(kDefaultSlamConfigRelativePath));
+  const SlamConfig shipped = LoadSlamConfigFile(orbed::sim::SourceTreePath(kDefaultSlamConfigRelativePath));
   const HeadTrajectory walk(RectangleWalk());
   for (const double fraction : {shipped.drift_fraction_of_distance, 0.005}) {
     SlamConfig c = shipped;
@@ -292,11 +288,11 @@ TEST(SlamModel, SameSeedSameWalk) {
 }
 
 TEST(SlamConfig, ShippedFilesLoad) {
-  const SlamConfig c = LoadSlamConfigFile(SourcePath(kDefaultSlamConfigRelativePath));
+  const SlamConfig c = LoadSlamConfigFile(orbed::sim::SourceTreePath(kDefaultSlamConfigRelativePath));
   EXPECT_DOUBLE_EQ(c.rate_hz, 60.0);
   EXPECT_DOUBLE_EQ(c.drift_fraction_of_distance, 0.01);
   EXPECT_NEAR(c.X_HC.translation().z(), 0.06, 1e-12);
-  const HeadTrajectoryConfig w = LoadHeadTrajectoryFile(SourcePath("hmd_emulator/config/viraal_walk.yaml"));
+  const HeadTrajectoryConfig w = LoadHeadTrajectoryFile(orbed::sim::SourceTreePath("hmd_emulator/config/viraal_walk.yaml"));
   EXPECT_EQ(w.waypoints.size(), 2u);
 }
 

@@ -50,6 +50,30 @@ std::vector<double> AverageRanks(const std::vector<double>& x) {
 
 double NormalCdf(double z) { return 0.5 * std::erfc(-z / std::sqrt(2.0)); }
 
+namespace {
+
+// A rank statistic's normal approximation: z with the continuity correction (0.5 toward the mean)
+// and the two- and one-sided p-values. variance > 0.
+struct NormalApproximation {
+  double z, p_two_sided, p_less, p_greater;
+};
+
+NormalApproximation ApproximateByNormal(double statistic, double mean, double variance,
+                                        bool continuity_correction) {
+  const double sigma = std::sqrt(variance);
+  const double c = continuity_correction ? 0.5 : 0.0;
+  const double d = statistic - mean;
+  const double d_toward_zero = d > 0 ? std::max(0.0, d - c) : std::min(0.0, d + c);
+  NormalApproximation a;
+  a.z = d_toward_zero / sigma;
+  a.p_two_sided = std::min(1.0, 2.0 * NormalCdf(-std::abs(a.z)));
+  a.p_less = NormalCdf((d + c) / sigma);
+  a.p_greater = 1.0 - NormalCdf((d - c) / sigma);
+  return a;
+}
+
+}  // namespace
+
 MannWhitneyResult MannWhitneyU(const std::vector<double>& x, const std::vector<double>& y,
                                bool continuity_correction) {
   MannWhitneyResult r;
@@ -78,14 +102,12 @@ MannWhitneyResult MannWhitneyU(const std::vector<double>& x, const std::vector<d
   }
   r.variance_u = nx * ny / 12.0 * ((n + 1) - tie_sum / (n * (n - 1)));
   if (!(r.variance_u > 0)) return r;
-  const double sigma = std::sqrt(r.variance_u);
-  const double c = continuity_correction ? 0.5 : 0.0;
-  const double d = r.u_x - r.mean_u;
-  const double d_toward_zero = d > 0 ? std::max(0.0, d - c) : std::min(0.0, d + c);
-  r.z = d_toward_zero / sigma;
-  r.p_two_sided = std::min(1.0, 2.0 * NormalCdf(-std::abs(r.z)));
-  r.p_x_less = NormalCdf((d + c) / sigma);
-  r.p_x_greater = 1.0 - NormalCdf((d - c) / sigma);
+  const NormalApproximation a =
+      ApproximateByNormal(r.u_x, r.mean_u, r.variance_u, continuity_correction);
+  r.z = a.z;
+  r.p_two_sided = a.p_two_sided;
+  r.p_x_less = a.p_less;
+  r.p_x_greater = a.p_greater;
   r.valid = true;
   return r;
 }
@@ -123,14 +145,12 @@ SignedRankResult WilcoxonSignedRank(const std::vector<double>& x, const std::vec
   }
   r.variance_w = n * (n + 1) * (2 * n + 1) / 24.0 - tie_sum / 48.0;
   if (!(r.variance_w > 0)) return r;
-  const double sigma = std::sqrt(r.variance_w);
-  const double c = continuity_correction ? 0.5 : 0.0;
-  const double dw = r.w_plus - r.mean_w;
-  const double dw_toward_zero = dw > 0 ? std::max(0.0, dw - c) : std::min(0.0, dw + c);
-  r.z = dw_toward_zero / sigma;
-  r.p_two_sided = std::min(1.0, 2.0 * NormalCdf(-std::abs(r.z)));
-  r.p_x_less = NormalCdf((dw + c) / sigma);
-  r.p_x_greater = 1.0 - NormalCdf((dw - c) / sigma);
+  const NormalApproximation a =
+      ApproximateByNormal(r.w_plus, r.mean_w, r.variance_w, continuity_correction);
+  r.z = a.z;
+  r.p_two_sided = a.p_two_sided;
+  r.p_x_less = a.p_less;
+  r.p_x_greater = a.p_greater;
   r.valid = true;
   return r;
 }

@@ -1,6 +1,7 @@
 // Tests of the Bullet collision world against closed forms: segment-segment (capsules), point-box,
 // sphere-sphere, and hand-computed robot poses.
 #include "sim/collision_world.h"
+#include "sim/model_paths.h"
 
 #include <algorithm>
 #include <cmath>
@@ -19,11 +20,7 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 using Kind = CollisionPrimitive::Kind;
 
-std::string SourcePath(const std::string& rel) {
-  const char* dir = std::getenv("ORBED_SOURCE_DIR");
-  return std::string(dir ? dir : ".") + "/" + rel;
-}
-RobotModel LoadIiwa() { return RobotModel::LoadFile(SourcePath(RobotModel::kDefaultUrdfRelativePath)); }
+RobotModel LoadIiwa() { return RobotModel::LoadFile(orbed::sim::SourceTreePath(RobotModel::kDefaultUrdfRelativePath)); }
 
 Eigen::VectorXd Deg(std::initializer_list<double> v) {
   Eigen::VectorXd q(v.size());
@@ -270,7 +267,7 @@ TEST(CollisionWorldTest, LinksTwoApartNeverTouchWithinLimits) {
 
 TEST(CollisionWorldTest, ResultsAreFreshAndPruningChangesNothing) {
   const RobotModel m = LoadIiwa();
-  const Scene scene = LoadSceneFile(SourcePath(kDefaultSceneRelativePath));
+  const Scene scene = LoadSceneFile(orbed::sim::SourceTreePath(kDefaultSceneRelativePath));
   CollisionWorld pruned(m, &scene);
   CollisionWorld::Options no_prune;
   no_prune.prune = false;
@@ -433,7 +430,7 @@ TEST(CollisionWorldTest, SegmentBoxPenetrationIsExact) {
 
 TEST(CollisionWorldTest, FastPathMatchesGjkOverRandomConfigurations) {
   RobotModel m = LoadIiwa();
-  const Scene scene = LoadSceneFile(SourcePath(kDefaultSceneRelativePath));
+  const Scene scene = LoadSceneFile(orbed::sim::SourceTreePath(kDefaultSceneRelativePath));
   m.SetToolLength(scene.tool_length_m);
   // Every pair reported (so every pair is compared), and the default options (pruned).
   CollisionWorld::Options all;

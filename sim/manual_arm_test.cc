@@ -2,6 +2,7 @@
 // straight joint-space moves, commands clamped to the joint limits, steps refused before a
 // collision in the trocar OR scene, and the way back out of a stop.
 #include "sim/manual_arm.h"
+#include "sim/model_paths.h"
 
 #include <cmath>
 #include <cstdlib>
@@ -18,14 +19,9 @@ constexpr double kPeriodS = 0.005;
 const double kSpeedDegPerS[7] = {98, 98, 100, 130, 140, 180, 180};
 const double kLimitDeg[7] = {170, 120, 170, 120, 170, 120, 175};
 
-std::string SourcePath(const std::string& relative) {
-  const char* dir = std::getenv("ORBED_SOURCE_DIR");
-  return std::string(dir ? dir : ".") + "/" + relative;
-}
-
 struct Fixture {
-  Fixture() : model(RobotModel::LoadFile(SourcePath("sim/models/iiwa7.urdf"))),
-              scene(LoadSceneFile(SourcePath("sim/models/scenes/trocar_or.yaml"))) {
+  Fixture() : model(RobotModel::LoadFile(orbed::sim::SourceTreePath("sim/models/iiwa7.urdf"))),
+              scene(LoadSceneFile(orbed::sim::SourceTreePath("sim/models/scenes/trocar_or.yaml"))) {
     model.SetToolLength(scene.tool_length_m);
   }
   RobotModel model;

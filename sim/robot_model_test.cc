@@ -1,5 +1,6 @@
 // Tests of the URDF robot model against an independent standard-DH evaluation of the iiwa 7.
 #include "sim/robot_model.h"
+#include "sim/model_paths.h"
 
 #include <cmath>
 #include <cstdlib>
@@ -12,12 +13,7 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-std::string SourcePath(const std::string& rel) {
-  const char* dir = std::getenv("ORBED_SOURCE_DIR");
-  return std::string(dir ? dir : ".") + "/" + rel;
-}
-
-RobotModel LoadIiwa() { return RobotModel::LoadFile(SourcePath(RobotModel::kDefaultUrdfRelativePath)); }
+RobotModel LoadIiwa() { return RobotModel::LoadFile(orbed::sim::SourceTreePath(RobotModel::kDefaultUrdfRelativePath)); }
 
 // The iiwa 7 R800 data-sheet DH parameters (DESIGN §4), evaluated by hand:
 // T_{i-1,i} = Rz(theta_i) Tz(d_i) Tx(a_i) Rx(alpha_i).

@@ -9,6 +9,7 @@
 #include <CLI/CLI.hpp>
 
 #include "procs/common/json.h"
+#include "procs/common/number_list.h"
 #include "sim/collision_world.h"
 #include "sim/model_paths.h"
 #include "sim/robot_model.h"
@@ -26,22 +27,11 @@ struct UsageError : std::runtime_error {
 
 Eigen::VectorXd ParseJointList(const std::string& text, int expected) {
   std::vector<double> values;
-  std::stringstream ss(text);
-  std::string item;
-  while (std::getline(ss, item, ',')) {
-    size_t used = 0;
-    double v = 0;
-    try {
-      v = std::stod(item, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    while (used < item.size() && std::isspace(static_cast<unsigned char>(item[used]))) ++used;
-    if (item.empty() || used != item.size()) throw UsageError("--q-deg: '" + item + "' is not a number");
-    if (!std::isfinite(v)) throw UsageError("--q-deg: '" + item + "' is not a finite number");
-    values.push_back(v);
+  try {
+    values = ParseNumberList(text, "--q-deg");
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
   }
-  if (!text.empty() && text.back() == ',') throw UsageError("--q-deg: trailing comma");
   if (static_cast<int>(values.size()) != expected) {
     throw UsageError("--q-deg: expected " + std::to_string(expected) + " comma-separated angles in deg, got " +
                      std::to_string(values.size()));

@@ -1,5 +1,6 @@
 // Tests of the scene loader: the shipped scene and the error messages for bad files.
 #include "sim/scene.h"
+#include "sim/model_paths.h"
 
 #include <cmath>
 #include <cstdlib>
@@ -10,13 +11,8 @@
 namespace orbed::sim {
 namespace {
 
-std::string SourcePath(const std::string& rel) {
-  const char* dir = std::getenv("ORBED_SOURCE_DIR");
-  return std::string(dir ? dir : ".") + "/" + rel;
-}
-
 TEST(SceneTest, ShippedSceneLoads) {
-  const Scene s = LoadSceneFile(SourcePath(kDefaultSceneRelativePath));
+  const Scene s = LoadSceneFile(orbed::sim::SourceTreePath(kDefaultSceneRelativePath));
   EXPECT_EQ(s.name, "trocar_or");
   EXPECT_NEAR(s.tool_length_m, 0.25, 1e-12);
   EXPECT_TRUE(s.X_WR.translation().isApprox(Eigen::Vector3d(0.25, -0.55, 0.75)));

@@ -13,18 +13,14 @@
 #include "sim/collision_world.h"
 #include "sim/scene.h"
 #include "sim/trocar_clearance.h"
+#include "sim/model_paths.h"
 
 namespace orbed::sim {
 namespace {
 
-std::string SourcePath(const std::string& rel) {
-  const char* dir = std::getenv("ORBED_SOURCE_DIR");
-  return std::string(dir ? dir : ".") + "/" + rel;
-}
-
 TEST(TrocarIkTest, DocksAtTheTrocarCollisionFree) {
-  RobotModel model = RobotModel::LoadFile(SourcePath(RobotModel::kDefaultUrdfRelativePath));
-  const Scene scene = LoadSceneFile(SourcePath(kDefaultSceneRelativePath));
+  RobotModel model = RobotModel::LoadFile(orbed::sim::SourceTreePath(RobotModel::kDefaultUrdfRelativePath));
+  const Scene scene = LoadSceneFile(orbed::sim::SourceTreePath(kDefaultSceneRelativePath));
   model.SetToolLength(scene.tool_length_m);
   const TrocarIkResult r =
       SolveTrocarIk(model, TrocarTargetInBase(scene), TrocarIkOptions{}, MakeTrocarClearanceFunction(model, scene));
@@ -57,7 +53,7 @@ TEST(TrocarIkTest, DocksAtTheTrocarCollisionFree) {
 }
 
 TEST(TrocarIkTest, UnreachableTargetFailsHonestly) {
-  const RobotModel model = RobotModel::LoadFile(SourcePath(RobotModel::kDefaultUrdfRelativePath));
+  const RobotModel model = RobotModel::LoadFile(orbed::sim::SourceTreePath(RobotModel::kDefaultUrdfRelativePath));
   TrocarIkTarget far;
   far.p_RT = Eigen::Vector3d(3.0, 0, 0.5);
   far.axis_R = -Eigen::Vector3d::UnitZ();
@@ -71,7 +67,7 @@ TEST(TrocarIkTest, UnreachableTargetFailsHonestly) {
 }
 
 TEST(TrocarIkTest, ReachableWithoutScoreSucceedsOnlyIfAllowed) {
-  const RobotModel model = RobotModel::LoadFile(SourcePath(RobotModel::kDefaultUrdfRelativePath));
+  const RobotModel model = RobotModel::LoadFile(orbed::sim::SourceTreePath(RobotModel::kDefaultUrdfRelativePath));
   TrocarIkTarget t;
   t.p_RT = Eigen::Vector3d(0.5, 0.1, 0.3);
   t.axis_R = -Eigen::Vector3d::UnitZ();

@@ -276,6 +276,7 @@ TEST(Process, BadUrlThrowsNamingIt) {
 }  // namespace orbed
 
 #include "procs/common/json.h"
+#include "procs/common/number_list.h"
 #include "procs/common/sha256.h"
 
 namespace orbed {
@@ -289,6 +290,19 @@ TEST(Sha256, KnownVectors) {
             "248d6a61d20638b8e5c026930c3e6039a33ce45964ff2167f6ecedd419db06c1");
   EXPECT_EQ(Sha256Hex(std::string(1000000, 'a')),
             "cdc76e5c9914fb9281a1c7e284d73e67f1809a48a497200e046d39ccc7112cd0");
+}
+
+TEST(NumberList, ParsesAndRejectsWithTheItem) {
+  EXPECT_EQ(ParseNumberList("0, 30.5,-60 ", "--q-deg"), (std::vector<double>{0, 30.5, -60}));
+  EXPECT_EQ(ParseNumberList("", "x"), std::vector<double>{});
+  for (const char* bad : {"1,,2", "1,x", "1,2,", "1,nan", "1,inf", "1,2abc"}) {
+    EXPECT_THROW(ParseNumberList(bad, "--q-deg"), std::invalid_argument) << bad;
+  }
+  try {
+    ParseNumberList("1,abc", "--q-deg");
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()), "--q-deg: 'abc' is not a finite number");
+  }
 }
 
 TEST(Json, WritesEscapedCompactJson) {

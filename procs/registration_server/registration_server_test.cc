@@ -10,12 +10,13 @@
 #include <gtest/gtest.h>
 
 #include "procs/common/conversions.h"
+#include "procs/registration_server/test_rotations.h"
 
 namespace orbed::registration {
 namespace {
 
-constexpr double kPi = 3.141592653589793;
-constexpr double kDeg = kPi / 180.0;
+using testing::kDeg;
+using testing::kPi;
 
 orbed::session_control_t Control(int8_t command, const std::string& id, int64_t utime,
                                  int8_t method = orbed::registration_t::METHOD_KARCHER) {

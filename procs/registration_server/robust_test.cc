@@ -8,20 +8,15 @@
 #include <gtest/gtest.h>
 
 #include "procs/registration_server/rotation_mean.h"
+#include "procs/registration_server/test_rotations.h"
 
 namespace orbed::registration {
 namespace {
 
-constexpr double kPi = 3.141592653589793;
-constexpr double kDeg = kPi / 180.0;
-
-Eigen::Quaterniond Rot(double angle_rad, const Eigen::Vector3d& axis) {
-  return Eigen::Quaterniond(Eigen::AngleAxisd(angle_rad, axis.normalized()));
-}
-
-double AngleBetween(const Eigen::Quaterniond& a, const Eigen::Quaterniond& b) {
-  return Eigen::AngleAxisd(a.conjugate() * b).angle();
-}
+using testing::kDeg;
+using testing::kPi;
+using testing::Rot;
+using testing::AngleBetween;
 
 TEST(RobustTest, MedianOfValues) {
   EXPECT_EQ(Median({3.0, 1.0, 2.0}), 2.0);

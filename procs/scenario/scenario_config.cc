@@ -10,6 +10,8 @@
 #include <orbed/registration_t.hpp>
 #include <yaml-cpp/yaml.h>
 
+#include "procs/common/number_list.h"
+
 namespace orbed::scenario {
 namespace {
 
@@ -81,24 +83,7 @@ ModeSpec ModeFromName(const std::string& name, int reflective_mirrors) {
 }
 
 std::vector<double> ParseJointList(const std::string& text, const std::string& what) {
-  std::vector<double> out;
-  std::stringstream ss(text);
-  std::string item;
-  while (std::getline(ss, item, ',')) {
-    size_t used = 0;
-    double v = 0;
-    try {
-      v = std::stod(item, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    while (used < item.size() && std::isspace(static_cast<unsigned char>(item[used]))) ++used;
-    if (item.empty() || used != item.size() || !std::isfinite(v)) {
-      throw std::invalid_argument(what + ": '" + item + "' is not a number (expected q1,...,q7 in deg)");
-    }
-    out.push_back(v);
-  }
-  return out;
+  return ParseNumberList(text, what + " (q1,...,q7 in deg)");
 }
 
 void ValidateScenarioConfig(const ScenarioConfig& config, int num_joints) {

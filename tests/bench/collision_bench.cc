@@ -22,6 +22,7 @@
 #include <fcl/narrowphase/collision_object.h>
 #include <fcl/narrowphase/distance.h>
 
+#include "sim/model_paths.h"
 #include "sim/collision_world.h"
 #include "sim/robot_model.h"
 #include "sim/scene.h"
@@ -29,14 +30,9 @@
 namespace orbed::sim {
 namespace {
 
-std::string SourcePath(const std::string& rel) {
-  const char* dir = std::getenv("ORBED_SOURCE_DIR");
-  return std::string(dir ? dir : ".") + "/" + rel;
-}
-
 struct Fixture {
-  RobotModel model = RobotModel::LoadFile(SourcePath(RobotModel::kDefaultUrdfRelativePath));
-  Scene scene = LoadSceneFile(SourcePath(kDefaultSceneRelativePath));
+  RobotModel model = RobotModel::LoadFile(orbed::sim::SourceTreePath(RobotModel::kDefaultUrdfRelativePath));
+  Scene scene = LoadSceneFile(orbed::sim::SourceTreePath(kDefaultSceneRelativePath));
   std::vector<Eigen::VectorXd> pool;
   Fixture() {
     model.SetToolLength(scene.tool_length_m);

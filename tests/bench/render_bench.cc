@@ -24,28 +24,15 @@
 #include "hmd_emulator/renderer.h"
 #include "hmd_emulator/scene_geometry.h"
 #include "sim/robot_model.h"
+#include "sim/model_paths.h"
 #include "sim/scene.h"
 
 namespace orbed::hmd {
 namespace {
 
-std::string SourcePath(const std::string& rel) {
-  const char* dir = std::getenv("ORBED_SOURCE_DIR");
-  return std::string(dir ? dir : ".") + "/" + rel;
-}
-
-Eigen::Isometry3d LookAt(const Eigen::Vector3d& eye, const Eigen::Vector3d& target) {
-  const Eigen::Vector3d z = (target - eye).normalized();
-  const Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitZ()).normalized();
-  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
-  X.linear() << x, z.cross(x), z;
-  X.translation() = eye;
-  return X;
-}
-
 struct Fixture {
-  sim::RobotModel robot = sim::RobotModel::LoadFile(SourcePath(sim::RobotModel::kDefaultUrdfRelativePath));
-  sim::Scene scene = sim::LoadSceneFile(SourcePath(sim::kDefaultSceneRelativePath));
+  sim::RobotModel robot = sim::RobotModel::LoadFile(sim::SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath));
+  sim::Scene scene = sim::LoadSceneFile(sim::SourceTreePath(sim::kDefaultSceneRelativePath));
   std::vector<Eigen::VectorXd> q_pool;
   std::vector<Eigen::Isometry3d> cameras;
   Fixture() {
