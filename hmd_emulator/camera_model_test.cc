@@ -91,8 +91,8 @@ TEST(CameraModel, MirrorMatrixEqualsHandBuiltReversedFrustumPointForPoint) {
 
     for (int i = 0; i < 200; ++i) {
       // Points in front of M: between C and M, spread laterally.
-      const Eigen::Vector3d p_W = c.p_WC + depth_frac(rng) * D * z_C + lateral(rng) * x_C +
-                                  lateral(rng) * y_C;
+      const Eigen::Vector3d p_W =
+          c.p_WC + depth_frac(rng) * D * z_C + lateral(rng) * x_C + lateral(rng) * y_C;
       const Eigen::Vector3d p_M = R_MW * (p_W - centre_M);
       ASSERT_GT(p_M.z(), 0);
       const double u = fx * p_M.x() / p_M.z() + cx;

@@ -20,8 +20,8 @@ struct Nearest {
 
 // Offers the real roots of |o + t d - c|^2 = r^2 (d unit) whose point satisfies accept(point).
 template <typename Accept>
-void SphereRoots(const Eigen::Vector3d& o, const Eigen::Vector3d& d, const Eigen::Vector3d& c,
-                 double r, Accept accept, Nearest* out) {
+void SphereRoots(const Eigen::Vector3d& o, const Eigen::Vector3d& d, const Eigen::Vector3d& c, double r,
+                 Accept accept, Nearest* out) {
   const Eigen::Vector3d oc = o - c;
   const double b = oc.dot(d);
   const double disc = b * b - (oc.squaredNorm() - r * r);
@@ -34,8 +34,7 @@ void SphereRoots(const Eigen::Vector3d& o, const Eigen::Vector3d& d, const Eigen
 }
 
 // Roots of the infinite cylinder x^2 + y^2 = r^2 whose z lies in [-h, h].
-void SideRoots(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double r, double h,
-               Nearest* out) {
+void SideRoots(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double r, double h, Nearest* out) {
   const double a = d.x() * d.x() + d.y() * d.y();
   if (!(a > 1e-18)) return;  // parallel to the axis: the side is never crossed
   const double b = o.x() * d.x() + o.y() * d.y();
@@ -51,8 +50,8 @@ void SideRoots(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double r, dou
 
 }  // namespace
 
-RayHit IntersectPrimitive(const Primitive& g, const Eigen::Vector3d& p_WO,
-                          const Eigen::Vector3d& direction_W, double max_distance_m) {
+RayHit IntersectPrimitive(const Primitive& g, const Eigen::Vector3d& p_WO, const Eigen::Vector3d& direction_W,
+                          double max_distance_m) {
   const Eigen::Matrix3d R_GW = g.X_WG.linear().transpose();
   const Eigen::Vector3d o = R_GW * (p_WO - g.X_WG.translation());
   const Eigen::Vector3d d = R_GW * direction_W;
@@ -71,8 +70,14 @@ RayHit IntersectPrimitive(const Primitive& g, const Eigen::Vector3d& p_WO,
         }
         double t1 = (-h[i] - o[i]) / d[i], t2 = (h[i] - o[i]) / d[i];
         if (t1 > t2) std::swap(t1, t2);
-        if (t1 > t_enter) { t_enter = t1; enter_axis = i; }
-        if (t2 < t_exit) { t_exit = t2; exit_axis = i; }
+        if (t1 > t_enter) {
+          t_enter = t1;
+          enter_axis = i;
+        }
+        if (t2 < t_exit) {
+          t_exit = t2;
+          exit_axis = i;
+        }
       }
       if (t_enter > t_exit || t_exit < 0) return RayHit{};
       if (t_enter >= 0) {
@@ -87,8 +92,8 @@ RayHit IntersectPrimitive(const Primitive& g, const Eigen::Vector3d& p_WO,
       break;
     }
     case Primitive::Shape::kSphere:
-      SphereRoots(o, d, Eigen::Vector3d::Zero(), g.radius_m, [](const Eigen::Vector3d&) { return true; },
-                  &best);
+      SphereRoots(
+          o, d, Eigen::Vector3d::Zero(), g.radius_m, [](const Eigen::Vector3d&) { return true; }, &best);
       break;
     case Primitive::Shape::kCylinder: {
       const double h = 0.5 * g.length_m, r = g.radius_m;
@@ -106,10 +111,10 @@ RayHit IntersectPrimitive(const Primitive& g, const Eigen::Vector3d& p_WO,
       const double h = 0.5 * g.length_m, r = g.radius_m;
       SideRoots(o, d, r, h, &best);
       // Only the outer hemispheres of the two end spheres are on the capsule's surface.
-      SphereRoots(o, d, Eigen::Vector3d(0, 0, h), r, [h](const Eigen::Vector3d& p) { return p.z() >= h; },
-                  &best);
-      SphereRoots(o, d, Eigen::Vector3d(0, 0, -h), r,
-                  [h](const Eigen::Vector3d& p) { return p.z() <= -h; }, &best);
+      SphereRoots(
+          o, d, Eigen::Vector3d(0, 0, h), r, [h](const Eigen::Vector3d& p) { return p.z() >= h; }, &best);
+      SphereRoots(
+          o, d, Eigen::Vector3d(0, 0, -h), r, [h](const Eigen::Vector3d& p) { return p.z() <= -h; }, &best);
       break;
     }
   }
@@ -122,8 +127,8 @@ RayHit IntersectPrimitive(const Primitive& g, const Eigen::Vector3d& p_WO,
   return hit;
 }
 
-RayHit CastRay(const SceneGeometry& geometry, const Eigen::Vector3d& p_WO,
-               const Eigen::Vector3d& direction_W, KindMask kinds, double max_distance_m) {
+RayHit CastRay(const SceneGeometry& geometry, const Eigen::Vector3d& p_WO, const Eigen::Vector3d& direction_W,
+               KindMask kinds, double max_distance_m) {
   const double len = direction_W.norm();
   if (!std::isfinite(len) || !(len > 0) || !p_WO.allFinite())
     throw std::invalid_argument("CastRay: origin and direction must be finite, direction non-zero");

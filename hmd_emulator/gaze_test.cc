@@ -85,7 +85,10 @@ TEST(Gaze, RotatedBoxHitsLieOnTheSurfaceAndAreFirst) {
     double t_in = -1;
     for (double t = 0; t < 5; t += 1e-4) {
       const Eigen::Vector3d p_G = X_GW * (o + t * d);
-      if ((p_G.cwiseAbs() - half).maxCoeff() <= 0) { t_in = t; break; }
+      if ((p_G.cwiseAbs() - half).maxCoeff() <= 0) {
+        t_in = t;
+        break;
+      }
     }
     ASSERT_EQ(h.hit, t_in >= 0) << i;
     if (!h.hit) continue;
@@ -171,10 +174,11 @@ TEST(Gaze, CapsuleBodyAndCapsByHand) {
 }
 
 TEST(Gaze, OperatingRoomNamesTheBodyAndSkipsTheHologram) {
-  const sim::RobotModel robot = sim::RobotModel::LoadFile(orbed::sim::SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath));
+  const sim::RobotModel robot =
+      sim::RobotModel::LoadFile(orbed::sim::SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath));
   const sim::Scene scene = sim::LoadSceneFile(orbed::sim::SourceTreePath(sim::kDefaultSceneRelativePath));
   const Eigen::VectorXd q = Eigen::VectorXd::Zero(7);  // arm straight up
-  const Eigen::Isometry3d X_WV = scene.X_WR;  // hologram exactly on the real robot
+  const Eigen::Isometry3d X_WV = scene.X_WR;           // hologram exactly on the real robot
   SceneGeometry g = SceneGeometry::MakeOperatingRoom(scene, robot, q, scene.X_WR, &X_WV);
   // Straight down onto the patient's legs (top at 0.88 + 0.08).
   RayHit h = CastRay(g, {0.9, 0.0, 2.0}, {0, 0, -1});
@@ -200,7 +204,8 @@ TEST(Gaze, OperatingRoomNamesTheBodyAndSkipsTheHologram) {
 }
 
 TEST(Gaze, AgreesWithTheRendererOnAFlatFace) {
-  const sim::RobotModel robot = sim::RobotModel::LoadFile(orbed::sim::SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath));
+  const sim::RobotModel robot =
+      sim::RobotModel::LoadFile(orbed::sim::SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath));
   const sim::Scene scene = sim::LoadSceneFile(orbed::sim::SourceTreePath(sim::kDefaultSceneRelativePath));
   SceneGeometry g = SceneGeometry::MakeOperatingRoom(scene, robot, Eigen::VectorXd::Zero(7), scene.X_WR);
   Mesh mesh;
@@ -216,7 +221,8 @@ TEST(Gaze, AgreesWithTheRendererOnAFlatFace) {
   X_WC.translation() = eye;
   cv::Mat bgr, depth, ids;
   renderer.Render(mesh, X_WC, &bgr, &depth, &ids);
-  for (const Eigen::Vector2i& uv : {Eigen::Vector2i(597, 322), Eigen::Vector2i(700, 400), Eigen::Vector2i(500, 250)}) {
+  for (const Eigen::Vector2i& uv :
+       {Eigen::Vector2i(597, 322), Eigen::Vector2i(700, 400), Eigen::Vector2i(500, 250)}) {
     const Eigen::Vector3d ray_C((uv.x() - K.cx_px) / K.fx_px, (uv.y() - K.cy_px) / K.fy_px, 1.0);
     const RayHit h = CastRay(g, eye, X_WC.linear() * ray_C.normalized());
     ASSERT_TRUE(h.hit);

@@ -25,12 +25,13 @@ HeadTrajectoryConfig ParseHeadTrajectory(const YAML::Node& node, const std::stri
   const YamlFields f(source);
   f.CheckKeys(node, key, {"speed_m_per_s", "look_at_m", "loop", "waypoints"});
   HeadTrajectoryConfig c;
-  c.speed_m_per_s = f.Number(f.Required(node, "speed_m_per_s", key + ".speed_m_per_s"), key + ".speed_m_per_s",
-                             1e-3, 10.0, "m/s");
+  c.speed_m_per_s = f.Number(f.Required(node, "speed_m_per_s", key + ".speed_m_per_s"),
+                             key + ".speed_m_per_s", 1e-3, 10.0, "m/s");
   c.p_W_look_at = f.Vector3(f.Required(node, "look_at_m", key + ".look_at_m"), key + ".look_at_m", "m");
   c.loop = f.BoolOr(node, "loop", key, false);
   const YAML::Node wps = f.Required(node, "waypoints", key + ".waypoints");
-  if (!wps.IsSequence() || wps.size() == 0) f.Fail(wps, key + ".waypoints", "expected a list of >= 1 waypoints");
+  if (!wps.IsSequence() || wps.size() == 0)
+    f.Fail(wps, key + ".waypoints", "expected a list of >= 1 waypoints");
   for (std::size_t i = 0; i < wps.size(); ++i) {
     const std::string k = key + ".waypoints[" + std::to_string(i) + "]";
     const YAML::Node w = wps[i];
@@ -92,12 +93,13 @@ HeadTrajectory::HeadTrajectory(HeadTrajectoryConfig config) : config_(std::move(
       const double a = near ? a_near : a_vertical;
       const Eigen::Vector3d p = (1 - a) * w[i].p_WH + a * w[j].p_WH;
       char where[120];
-      std::snprintf(where, sizeof(where), "%.0f %% of the way, at (%.3f, %.3f, %.3f) m", 100 * a, p.x(), p.y(),
-                    p.z());
-      throw std::invalid_argument("head trajectory: walking from waypoint '" + w[i].name + "' to '" + w[j].name +
-                                  "' the head passes " + (near ? "within 1 mm of" : "straight over or under") +
-                                  " its look-at target (" + where +
-                                  "), where the heading is undefined; move a waypoint or the target off that line");
+      std::snprintf(where, sizeof(where), "%.0f %% of the way, at (%.3f, %.3f, %.3f) m", 100 * a, p.x(),
+                    p.y(), p.z());
+      throw std::invalid_argument(
+          "head trajectory: walking from waypoint '" + w[i].name + "' to '" + w[j].name +
+          "' the head passes " + (near ? "within 1 mm of" : "straight over or under") +
+          " its look-at target (" + where +
+          "), where the heading is undefined; move a waypoint or the target off that line");
     }
   }
   double t = 0, s = 0;

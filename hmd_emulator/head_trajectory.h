@@ -29,8 +29,8 @@
 #include <string>
 #include <vector>
 
-#include <Eigen/Geometry>
 #include <yaml-cpp/yaml.h>
+#include <Eigen/Geometry>
 
 #include "hmd_emulator/camera_model.h"  // LookAt
 
@@ -39,8 +39,8 @@ namespace orbed::hmd {
 struct HeadWaypoint {
   std::string name;
   Eigen::Vector3d p_WH{Eigen::Vector3d::Zero()};  ///< head position [m]
-  double dwell_s{0.0};                             ///< time standing here [s], >= 0
-  std::optional<Eigen::Vector3d> p_W_look_at;      ///< overrides the trajectory's target
+  double dwell_s{0.0};                            ///< time standing here [s], >= 0
+  std::optional<Eigen::Vector3d> p_W_look_at;     ///< overrides the trajectory's target
 };
 
 struct HeadTrajectoryConfig {
@@ -84,7 +84,7 @@ class HeadTrajectory {
  private:
   Eigen::Vector3d Target(int i) const;
   HeadTrajectoryConfig config_;
-  std::vector<double> arrive_s_;  // per waypoint; plus the loop's return to 0 at the end
+  std::vector<double> arrive_s_;   // per waypoint; plus the loop's return to 0 at the end
   std::vector<double> seg_len_m_;  // segment i: waypoint i -> i+1 (or -> 0 when looping)
   std::vector<double> cum_len_m_;  // path length at arrival at waypoint i
   double duration_s_{0};

@@ -23,8 +23,8 @@ std::string Text(const YamlFields& f, const YAML::Node& map, const std::string& 
 std::string HmdSourcePath(const std::string& relative) { return sim::SourceTreePath(relative); }
 
 std::vector<std::string> DefaultHmdConfigRelativePaths() {
-  return {kDefaultSlamConfigRelativePath, kDefaultUserConfigRelativePath, "hmd_emulator/config/viraal_walk.yaml",
-          "hmd_emulator/config/hmd.yaml"};
+  return {kDefaultSlamConfigRelativePath, kDefaultUserConfigRelativePath,
+          "hmd_emulator/config/viraal_walk.yaml", "hmd_emulator/config/hmd.yaml"};
 }
 
 HmdConfig ParseHmdConfig(const YAML::Node& node, const std::string& source, const std::string& key,
@@ -56,7 +56,8 @@ HmdConfig ParseHmdConfig(const YAML::Node& node, const std::string& source, cons
       f.CheckKeys(displays[i], k, {"capture_waypoint"});
       DisplayPlacement d;
       d.capture_waypoint = Text(f, displays[i], "capture_waypoint", k, "");
-      if (d.capture_waypoint.empty()) f.Fail(displays[i], k + ".capture_waypoint", "missing (a waypoint name)");
+      if (d.capture_waypoint.empty())
+        f.Fail(displays[i], k + ".capture_waypoint", "missing (a waypoint name)");
       c.displays.push_back(d);
     }
   }
@@ -86,8 +87,9 @@ HmdConfigSet LoadHmdConfigs(const std::vector<std::string>& paths) {
     set.sources.push_back(path);
   }
   if (set.walk.waypoints.empty()) {
-    throw std::runtime_error("no head_trajectory: none of the config files (" + std::to_string(paths.size()) +
-                             ") has a `head_trajectory:` mapping; add one (see hmd_emulator/config/viraal_walk.yaml)");
+    throw std::runtime_error(
+        "no head_trajectory: none of the config files (" + std::to_string(paths.size()) +
+        ") has a `head_trajectory:` mapping; add one (see hmd_emulator/config/viraal_walk.yaml)");
   }
   HeadTrajectory walk(set.walk);  // validates the walk
   auto check = [&](const std::string& name, const std::string& what, const std::string& source) {

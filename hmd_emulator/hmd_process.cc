@@ -49,7 +49,8 @@ std::uint64_t SplitMix64(std::uint64_t x) {
 }
 
 // A seed per (process seed, session, trial, purpose): the same inputs give the same trial.
-std::uint64_t TrialSeed(std::uint64_t seed, const std::string& session, int32_t index, std::uint64_t purpose) {
+std::uint64_t TrialSeed(std::uint64_t seed, const std::string& session, int32_t index,
+                        std::uint64_t purpose) {
   std::uint64_t h = 1469598103934665603ULL;  // FNV-1a of the session id
   for (unsigned char c : session) h = (h ^ c) * 1099511628211ULL;
   return SplitMix64(SplitMix64(SplitMix64(seed ^ h) ^ static_cast<std::uint64_t>(index)) ^ purpose);
@@ -146,7 +147,8 @@ class HmdProcess::ImagePipeline {
     mesh_ = scene_mesh_;
     for (int i = 0; i < options.displays; ++i) {
       Display d;
-      d.capture_t_s = trajectory.ArrivalTime(trajectory.FindWaypoint(config.hmd.displays[i].capture_waypoint));
+      d.capture_t_s =
+          trajectory.ArrivalTime(trajectory.FindWaypoint(config.hmd.displays[i].capture_waypoint));
       displays_.push_back(std::move(d));
     }
     if (options.threaded) worker_ = std::thread([this] { WorkerLoop(); });
@@ -326,8 +328,9 @@ class HmdProcess::ImagePipeline {
   void Camera(const FrameInputs& in) {
     if (!in.have_sample) return;
     const Eigen::Isometry3d& X_WC_true = in.sample.X_WC_true;
-    const bool same = have_frame_ && SamePose(X_WC_true, frame_X_WC_true_) &&
-                      !RobotDiffers(in.robot_known, in.q_rad, in.X_WR, frame_robot_known_, frame_q_, frame_X_WR_);
+    const bool same =
+        have_frame_ && SamePose(X_WC_true, frame_X_WC_true_) &&
+        !RobotDiffers(in.robot_known, in.q_rad, in.X_WR, frame_robot_known_, frame_q_, frame_X_WR_);
     if (same) {
       ++reused_;
     } else {
@@ -359,7 +362,8 @@ class HmdProcess::ImagePipeline {
         Capture(&d, in);
       } else if (d.captured &&
                  RobotDiffers(mesh_robot_known_, mesh_q_, mesh_X_WR_, d.has_robot, d.frame.q_rad, d.X_WR) &&
-                 Clock::now() - d.captured_at >= std::chrono::duration<double>(config_.hmd.recapture_period_s)) {
+                 Clock::now() - d.captured_at >=
+                     std::chrono::duration<double>(config_.hmd.recapture_period_s)) {
         UpdateRobot(in);
         Recapture(&d);
       }
@@ -378,7 +382,8 @@ class HmdProcess::ImagePipeline {
           view.bgr = d.frame.bgr.clone();
           view.geometry = MakeReflectiveGeometry(d.frame.intrinsics, d.frame.X_WC_est, d.D_m);
         }
-        if (!EncodeJpeg(view.bgr, options_.jpeg_quality, &d.jpeg)) throw std::runtime_error("JPEG encoding failed");
+        if (!EncodeJpeg(view.bgr, options_.jpeg_quality, &d.jpeg))
+          throw std::runtime_error("JPEG encoding failed");
         d.geometry = view.geometry;
         d.composed_version = d.version;
         d.composed_X_WV = in.X_WV;
@@ -413,8 +418,8 @@ class HmdProcess::ImagePipeline {
     }
     if (!publish) return;
     if (!EncodeJpeg(ar, options_.jpeg_quality, &ar_jpeg_)) throw std::runtime_error("JPEG encoding failed");
-    process_->Publish(options_.ar_view_channel,
-                      JpegImage(ar_jpeg_, renderer_.intrinsics(), frame_utime_, frame_X_WC_est_, frame_utime_));
+    process_->Publish(options_.ar_view_channel, JpegImage(ar_jpeg_, renderer_.intrinsics(), frame_utime_,
+                                                          frame_X_WC_est_, frame_utime_));
   }
 
   const sim::RobotModel& robot_;
@@ -432,7 +437,8 @@ class HmdProcess::ImagePipeline {
   bool have_frame_{false};
   cv::Mat bgr_;
   std::vector<std::uint8_t> jpeg_, ar_jpeg_;
-  Eigen::Isometry3d frame_X_WC_true_{Eigen::Isometry3d::Identity()}, frame_X_WC_est_{Eigen::Isometry3d::Identity()};
+  Eigen::Isometry3d frame_X_WC_true_{Eigen::Isometry3d::Identity()},
+      frame_X_WC_est_{Eigen::Isometry3d::Identity()};
   int64_t frame_utime_{0};
   bool frame_robot_known_{false};
   Eigen::VectorXd frame_q_;
@@ -459,12 +465,14 @@ class HmdProcess::ImagePipeline {
 };
 
 HmdProcess::HmdProcess(const orbed::CommonFlags& flags, const HmdOptions& options) : options_(options) {
-  if (options_.urdf_path.empty()) options_.urdf_path = HmdSourcePath(sim::RobotModel::kDefaultUrdfRelativePath);
+  if (options_.urdf_path.empty())
+    options_.urdf_path = HmdSourcePath(sim::RobotModel::kDefaultUrdfRelativePath);
   if (options_.scene_path.empty()) options_.scene_path = HmdSourcePath(sim::kDefaultSceneRelativePath);
   if (!(options_.camera_hz > 0 && options_.camera_hz <= 120)) {
     throw std::invalid_argument("--camera-hz must be in (0, 120] Hz");
   }
-  if (!(options_.pose_hz > 0 && options_.pose_hz <= 1000)) throw std::invalid_argument("--pose-hz must be in (0, 1000] Hz");
+  if (!(options_.pose_hz > 0 && options_.pose_hz <= 1000))
+    throw std::invalid_argument("--pose-hz must be in (0, 1000] Hz");
   if (options_.jpeg_quality < 1 || options_.jpeg_quality > 100) {
     throw std::invalid_argument("--jpeg-quality must be in [1, 100]");
   }
@@ -478,8 +486,9 @@ HmdProcess::HmdProcess(const orbed::CommonFlags& flags, const HmdOptions& option
   if (options_.user_seed) config_.user.seed = *options_.user_seed;
   const int placed = static_cast<int>(config_.hmd.displays.size());
   if (options_.displays < 0 || options_.displays > placed) {
-    throw std::invalid_argument("--displays must be in [0, " + std::to_string(placed) + "]: the config places " +
-                                std::to_string(placed) + " reflective display(s) (hmd.displays)");
+    throw std::invalid_argument("--displays must be in [0, " + std::to_string(placed) +
+                                "]: the config places " + std::to_string(placed) +
+                                " reflective display(s) (hmd.displays)");
   }
 
   scene_ = sim::LoadSceneFile(options_.scene_path);
@@ -508,20 +517,23 @@ HmdProcess::HmdProcess(const orbed::CommonFlags& flags, const HmdOptions& option
       options_.registration_channel,
       [this](const orbed::registration_t& m, const std::string& ch, int64_t) { OnRegistration(m, ch); });
 
-  pipeline_ = std::make_unique<ImagePipeline>(*robot_, scene_, config_, options_, live_->trajectory, process_.get());
+  pipeline_ =
+      std::make_unique<ImagePipeline>(*robot_, scene_, config_, options_, live_->trajectory, process_.get());
 
   process_->AddTimer(1.0 / options_.pose_hz, [this] { PublishPose(); });
   process_->AddTimer(1.0 / config_.hmd.gaze_hz, [this] { PublishGaze(); });
   process_->AddTimer(1.0 / options_.camera_hz, [this] { RequestCamera(); });
-  if (options_.displays > 0) process_->AddTimer(1.0 / config_.hmd.reflective_hz, [this] { RequestReflective(); });
+  if (options_.displays > 0)
+    process_->AddTimer(1.0 / config_.hmd.reflective_hz, [this] { RequestReflective(); });
   process_->AddTimer(1.0 / config_.hmd.ar_view_hz, [this] { RequestArView(); });
   if (options_.interactive) process_->AddTimer(1.0 / kInteractiveHz, [this] { InteractiveTick(); });
 
   ORBED_LOG(kInfo) << "robot " << options_.urdf_path << ", scene " << options_.scene_path << "; walk of "
-                   << config_.walk.waypoints.size() << " waypoints (" << Fixed(live_->trajectory.length_m(), 2)
-                   << " m), user seed " << config_.user.seed << ", " << options_.displays
-                   << " reflective display(s); pose " << options_.pose_hz << " Hz, camera " << options_.camera_hz
-                   << " Hz" << (options_.interactive ? ", interactive" : "");
+                   << config_.walk.waypoints.size() << " waypoints ("
+                   << Fixed(live_->trajectory.length_m(), 2) << " m), user seed " << config_.user.seed << ", "
+                   << options_.displays << " reflective display(s); pose " << options_.pose_hz
+                   << " Hz, camera " << options_.camera_hz << " Hz"
+                   << (options_.interactive ? ", interactive" : "");
 }
 
 HmdProcess::~HmdProcess() {
@@ -646,7 +658,7 @@ void HmdProcess::OnRobotState(const orbed::robot_state_t& msg, const std::string
 }
 
 void HmdProcess::OnRegistration(const orbed::registration_t& msg, const std::string& channel) {
-  if (!msg.valid) return;  // no mean yet: nothing to draw
+  if (!msg.valid) return;                                             // no mean yet: nothing to draw
   if (!session_.id.empty() && msg.session_id != session_.id) return;  // another session's mean
   const std::string error = CheckPose(msg.X_WV_mean, "X_WV_mean");
   if (!error.empty()) {
@@ -710,7 +722,8 @@ void HmdProcess::OnSessionControl(const orbed::session_control_t& msg, const std
       return;  // for the registration server
     case SC::STOP:
       if (msg.session_id == session_.id) {
-        ORBED_LOG(kInfo) << "session '" << session_.id << "' stopped after " << session_.next_index << " trial(s)";
+        ORBED_LOG(kInfo) << "session '" << session_.id << "' stopped after " << session_.next_index
+                         << " trial(s)";
         session_ = Session{};
       }
       return;
@@ -718,7 +731,8 @@ void HmdProcess::OnSessionControl(const orbed::session_control_t& msg, const std
       if (msg.session_id != session_.id) {
         process_->Reject(channel + "/unknown_session",
                          "REQUEST_TRIAL for session '" + msg.session_id + "', the active session is '" +
-                             (session_.id.empty() ? std::string("(none)") : session_.id) + "' (send START first)");
+                             (session_.id.empty() ? std::string("(none)") : session_.id) +
+                             "' (send START first)");
         return;
       }
       if (!(have_q_ && have_X_WR_)) {
@@ -770,11 +784,12 @@ void HmdProcess::EmulateTrial(const std::string& channel) {
   X_WV_user_ = outcome.alignment.X_WV;
   const int32_t index = session_.next_index;
   PublishTrial(outcome.alignment.X_WV, outcome.alignment.duration_s, user_id_);
-  ORBED_LOG(kInfo) << "trial " << index << " of '" << session_.id << "' (" << ModeName(session_.display_mode) << ", "
-                   << session_.num_mirrors << " display(s)): " << outcome.alignment.stop_reason << " after "
-                   << outcome.alignment.nudges << " nudges, " << Fixed(outcome.alignment.duration_s, 1)
-                   << " s emulated; error vs truth " << Fixed(outcome.registration.translation_error_m * 1e3, 1)
-                   << " mm, " << Fixed(outcome.registration.rotation_error_deg, 2) << " deg";
+  ORBED_LOG(kInfo) << "trial " << index << " of '" << session_.id << "' (" << ModeName(session_.display_mode)
+                   << ", " << session_.num_mirrors << " display(s)): " << outcome.alignment.stop_reason
+                   << " after " << outcome.alignment.nudges << " nudges, "
+                   << Fixed(outcome.alignment.duration_s, 1) << " s emulated; error vs truth "
+                   << Fixed(outcome.registration.translation_error_m * 1e3, 1) << " mm, "
+                   << Fixed(outcome.registration.rotation_error_deg, 2) << " deg";
 }
 
 void HmdProcess::PublishTrial(const Eigen::Isometry3d& X_WV, double duration_s, const std::string& user_id) {
@@ -811,7 +826,8 @@ void HmdProcess::HandleKey(int key) {
       return;
     case KeyAction::kSubmit: {
       if (!(have_q_ && have_X_WR_)) {
-        last_event_ = "cannot submit yet: no " + options_.iiwa_status_channel + " / " + options_.robot_state_channel;
+        last_event_ =
+            "cannot submit yet: no " + options_.iiwa_status_channel + " / " + options_.robot_state_channel;
         ORBED_LOG(kWarn) << last_event_;
         return;
       }
@@ -845,10 +861,11 @@ void HmdProcess::HandleKey(int key) {
 
 cv::Mat HmdProcess::CurrentWindowImage() {
   std::vector<std::string> lines;
-  std::string session = session_.id.empty() ? std::string("no session (Enter starts a local one)")
-                                            : "session '" + session_.id + "' (" + ModeName(session_.display_mode) +
-                                                  ", " + std::to_string(session_.num_mirrors) +
-                                                  " display(s)), next trial " + std::to_string(session_.next_index);
+  std::string session = session_.id.empty()
+                            ? std::string("no session (Enter starts a local one)")
+                            : "session '" + session_.id + "' (" + ModeName(session_.display_mode) + ", " +
+                                  std::to_string(session_.num_mirrors) + " display(s)), next trial " +
+                                  std::to_string(session_.next_index);
   if (trial_requested_) session += "   >> TRIAL REQUESTED: align, then Enter <<";
   lines.push_back(session);
   const Eigen::Isometry3d X_WV = CurrentX_WV();
@@ -856,7 +873,8 @@ cv::Mat HmdProcess::CurrentWindowImage() {
   const double dtheta_deg =
       Eigen::AngleAxisd(X_WV_start_.linear().transpose() * X_WV.linear()).angle() * 180.0 / M_PI;
   char text[256];
-  std::snprintf(text, sizeof(text), "X_WV from the start pose: (%+.1f, %+.1f, %+.1f) mm, %.2f deg   robot: %s   tracking: %s",
+  std::snprintf(text, sizeof(text),
+                "X_WV from the start pose: (%+.1f, %+.1f, %+.1f) mm, %.2f deg   robot: %s   tracking: %s",
                 dp_mm.x(), dp_mm.y(), dp_mm.z(), dtheta_deg,
                 have_q_ && have_X_WR_ ? "live" : "waiting for IIWA_STATUS + ROBOT_STATE",
                 live_->have_sample ? TrackingStateName(live_->sample.state) : "-");
@@ -879,8 +897,9 @@ int HmdProcess::Run() {
   if (options_.interactive) {
     const char* display = std::getenv("DISPLAY");
     if (!display || !*display) {
-      throw std::runtime_error("--interactive needs an X display ($DISPLAY is not set); on a headless machine run "
-                               "it under `xvfb-run -a`");
+      throw std::runtime_error(
+          "--interactive needs an X display ($DISPLAY is not set); on a headless machine run "
+          "it under `xvfb-run -a`");
     }
     try {
       cv::namedWindow(kWindowName, cv::WINDOW_AUTOSIZE);
@@ -901,7 +920,8 @@ int HmdProcess::Run() {
       ORBED_LOG(kError) << "cannot write the screenshot " << options_.screenshot_path;
       return 1;
     }
-    ORBED_LOG(kInfo) << "screenshot " << options_.screenshot_path << " (" << image.cols << "x" << image.rows << ")";
+    ORBED_LOG(kInfo) << "screenshot " << options_.screenshot_path << " (" << image.cols << "x" << image.rows
+                     << ")";
   }
   return code;
 }

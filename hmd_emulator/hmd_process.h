@@ -103,13 +103,13 @@ struct HmdOptions {
   std::optional<std::uint64_t> user_seed;
   double camera_hz{30.0};
   double pose_hz{60.0};
-  int jpeg_quality{85};          ///< 1..100
-  int displays{1};               ///< live reflective displays, 0..hmd.displays.size()
-  bool interactive{false};       ///< a person in an OpenCV window instead of the emulated user
-  std::string screenshot_path;   ///< interactive: the window's last image is written here at exit
+  int jpeg_quality{85};         ///< 1..100
+  int displays{1};              ///< live reflective displays, 0..hmd.displays.size()
+  bool interactive{false};      ///< a person in an OpenCV window instead of the emulated user
+  std::string screenshot_path;  ///< interactive: the window's last image is written here at exit
   /// Interactive: key codes fed as if typed, one per window refresh, before real keys (tests, demos).
   std::string scripted_keys;
-  bool threaded{true};           ///< images on a worker thread (see the file comment)
+  bool threaded{true};  ///< images on a worker thread (see the file comment)
   std::string iiwa_status_channel{channels::kIiwaStatus};
   std::string robot_state_channel{channels::kRobotState};
   std::string session_control_channel{channels::kSessionControl};

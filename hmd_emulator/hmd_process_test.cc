@@ -36,7 +36,9 @@ using SC = orbed::session_control_t;
 using AT = orbed::alignment_trial_t;
 
 // The shipped scene's X_WR (sim/models/scenes/trocar_or.yaml), read back through the scene loader.
-Eigen::Isometry3d SceneX_WR() { return sim::LoadSceneFile(HmdSourcePath(sim::kDefaultSceneRelativePath)).X_WR; }
+Eigen::Isometry3d SceneX_WR() {
+  return sim::LoadSceneFile(HmdSourcePath(sim::kDefaultSceneRelativePath)).X_WR;
+}
 
 struct Collector {
   std::vector<orbed::alignment_trial_t> trials;
@@ -45,15 +47,25 @@ struct Collector {
   std::vector<orbed::reflective_view_t> reflective;
   std::vector<orbed::gaze_ray_t> gaze;
   std::vector<orbed::session_control_t> control;
-  void OnTrial(const lcm::ReceiveBuffer*, const std::string&, const orbed::alignment_trial_t* m) { trials.push_back(*m); }
-  void OnPose(const lcm::ReceiveBuffer*, const std::string&, const orbed::hmd_pose_t* m) { est.push_back(*m); }
-  void OnTruth(const lcm::ReceiveBuffer*, const std::string&, const orbed::hmd_pose_t* m) { truth.push_back(*m); }
-  void OnCamera(const lcm::ReceiveBuffer*, const std::string&, const orbed::image_t* m) { camera.push_back(*m); }
+  void OnTrial(const lcm::ReceiveBuffer*, const std::string&, const orbed::alignment_trial_t* m) {
+    trials.push_back(*m);
+  }
+  void OnPose(const lcm::ReceiveBuffer*, const std::string&, const orbed::hmd_pose_t* m) {
+    est.push_back(*m);
+  }
+  void OnTruth(const lcm::ReceiveBuffer*, const std::string&, const orbed::hmd_pose_t* m) {
+    truth.push_back(*m);
+  }
+  void OnCamera(const lcm::ReceiveBuffer*, const std::string&, const orbed::image_t* m) {
+    camera.push_back(*m);
+  }
   void OnAr(const lcm::ReceiveBuffer*, const std::string&, const orbed::image_t* m) { ar.push_back(*m); }
   void OnReflective(const lcm::ReceiveBuffer*, const std::string&, const orbed::reflective_view_t* m) {
     reflective.push_back(*m);
   }
-  void OnGaze(const lcm::ReceiveBuffer*, const std::string&, const orbed::gaze_ray_t* m) { gaze.push_back(*m); }
+  void OnGaze(const lcm::ReceiveBuffer*, const std::string&, const orbed::gaze_ray_t* m) {
+    gaze.push_back(*m);
+  }
   void OnControl(const lcm::ReceiveBuffer*, const std::string&, const orbed::session_control_t* m) {
     control.push_back(*m);
   }
@@ -109,7 +121,8 @@ orbed::robot_state_t State(const Eigen::Isometry3d& X_WR) {
   return m;
 }
 
-orbed::session_control_t Control(const std::string& id, int8_t command, int8_t mode = +AT::MODE_AR, int32_t mirrors = 0) {
+orbed::session_control_t Control(const std::string& id, int8_t command, int8_t mode = +AT::MODE_AR,
+                                 int32_t mirrors = 0) {
   orbed::session_control_t m{};
   m.utime = NowMicros();
   m.session_id = id;
@@ -302,7 +315,7 @@ TEST(HmdProcess, CameraReflectiveAndArViewCarryTheirGeometry) {
   lcm.publish("ROBOT_STATE", &state);
   Drain(lcm);
   hmd.PublishPose();
-  hmd.RequestCamera();     // display 0 captures at the first waypoint, i.e. this frame
+  hmd.RequestCamera();  // display 0 captures at the first waypoint, i.e. this frame
   hmd.RequestReflective();
   hmd.RequestArView();
   hmd.PublishGaze();
@@ -345,7 +358,8 @@ TEST(HmdProcess, CameraReflectiveAndArViewCarryTheirGeometry) {
   EXPECT_LT((X_WM.linear().col(2) + X_WC.linear().col(2)).norm(), 1e-9);
   // D: from the capture camera centre to the gaze hit ON THE ROBOT (paper Sec. II-B), found here by
   // casting the capture-time line of sight against the real robot alone.
-  const sim::RobotModel robot = sim::RobotModel::LoadFile(HmdSourcePath(sim::RobotModel::kDefaultUrdfRelativePath));
+  const sim::RobotModel robot =
+      sim::RobotModel::LoadFile(HmdSourcePath(sim::RobotModel::kDefaultUrdfRelativePath));
   SceneGeometry robot_only;
   Eigen::VectorXd q(kQDeg.size());
   for (std::size_t i = 0; i < kQDeg.size(); ++i) q[i] = kQDeg[i] * kDeg;

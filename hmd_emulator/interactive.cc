@@ -15,11 +15,13 @@ void Rotate(const Eigen::Vector3d& axis_W, double angle_rad, Eigen::Isometry3d* 
   X_WV->linear() = Eigen::AngleAxisd(angle_rad, axis_W).toRotationMatrix() * X_WV->linear();
 }
 
-void Text(cv::Mat* image, const std::string& text, cv::Point at, double scale, cv::Scalar color, int thickness = 1) {
+void Text(cv::Mat* image, const std::string& text, cv::Point at, double scale, cv::Scalar color,
+          int thickness = 1) {
   cv::putText(*image, text, at, cv::FONT_HERSHEY_SIMPLEX, scale, color, thickness, cv::LINE_AA);
 }
 
-cv::Mat Panel(const cv::Mat& image, int width, int height, const std::string& title, const std::string& empty_text) {
+cv::Mat Panel(const cv::Mat& image, int width, int height, const std::string& title,
+              const std::string& empty_text) {
   cv::Mat panel(height, width, CV_8UC3, cv::Scalar(40, 40, 40));
   if (!image.empty() && image.type() == CV_8UC3) {
     cv::resize(image, panel, cv::Size(width, height), 0, 0, cv::INTER_AREA);
@@ -36,33 +38,72 @@ cv::Mat Panel(const cv::Mat& image, int width, int height, const std::string& ti
 KeyAction ApplyKey(int key, int num_displays, InteractiveState* s, Eigen::Isometry3d* X_WV) {
   const double t = s->step_m, r = s->step_deg * kDeg;
   switch (key & 0xFF) {
-    case 'a': X_WV->translation().x() -= t; return KeyAction::kMoved;
-    case 'd': X_WV->translation().x() += t; return KeyAction::kMoved;
-    case 'w': X_WV->translation().y() += t; return KeyAction::kMoved;
-    case 's': X_WV->translation().y() -= t; return KeyAction::kMoved;
-    case 'r': X_WV->translation().z() += t; return KeyAction::kMoved;
-    case 'f': X_WV->translation().z() -= t; return KeyAction::kMoved;
-    case 'j': Rotate(Eigen::Vector3d::UnitZ(), -r, X_WV); return KeyAction::kMoved;
-    case 'l': Rotate(Eigen::Vector3d::UnitZ(), r, X_WV); return KeyAction::kMoved;
-    case 'i': Rotate(Eigen::Vector3d::UnitY(), r, X_WV); return KeyAction::kMoved;
-    case 'k': Rotate(Eigen::Vector3d::UnitY(), -r, X_WV); return KeyAction::kMoved;
-    case 'u': Rotate(Eigen::Vector3d::UnitX(), -r, X_WV); return KeyAction::kMoved;
-    case 'o': Rotate(Eigen::Vector3d::UnitX(), r, X_WV); return KeyAction::kMoved;
-    case '[': s->step_m = std::max(0.0005, s->step_m / 2); return KeyAction::kStep;
-    case ']': s->step_m = std::min(0.1, s->step_m * 2); return KeyAction::kStep;
-    case '-': s->step_deg = std::max(0.05, s->step_deg / 2); return KeyAction::kStep;
-    case '=': s->step_deg = std::min(10.0, s->step_deg * 2); return KeyAction::kStep;
-    case 'h': s->show_help = !s->show_help; return KeyAction::kHelp;
-    case '0': return KeyAction::kReset;
+    case 'a':
+      X_WV->translation().x() -= t;
+      return KeyAction::kMoved;
+    case 'd':
+      X_WV->translation().x() += t;
+      return KeyAction::kMoved;
+    case 'w':
+      X_WV->translation().y() += t;
+      return KeyAction::kMoved;
+    case 's':
+      X_WV->translation().y() -= t;
+      return KeyAction::kMoved;
+    case 'r':
+      X_WV->translation().z() += t;
+      return KeyAction::kMoved;
+    case 'f':
+      X_WV->translation().z() -= t;
+      return KeyAction::kMoved;
+    case 'j':
+      Rotate(Eigen::Vector3d::UnitZ(), -r, X_WV);
+      return KeyAction::kMoved;
+    case 'l':
+      Rotate(Eigen::Vector3d::UnitZ(), r, X_WV);
+      return KeyAction::kMoved;
+    case 'i':
+      Rotate(Eigen::Vector3d::UnitY(), r, X_WV);
+      return KeyAction::kMoved;
+    case 'k':
+      Rotate(Eigen::Vector3d::UnitY(), -r, X_WV);
+      return KeyAction::kMoved;
+    case 'u':
+      Rotate(Eigen::Vector3d::UnitX(), -r, X_WV);
+      return KeyAction::kMoved;
+    case 'o':
+      Rotate(Eigen::Vector3d::UnitX(), r, X_WV);
+      return KeyAction::kMoved;
+    case '[':
+      s->step_m = std::max(0.0005, s->step_m / 2);
+      return KeyAction::kStep;
+    case ']':
+      s->step_m = std::min(0.1, s->step_m * 2);
+      return KeyAction::kStep;
+    case '-':
+      s->step_deg = std::max(0.05, s->step_deg / 2);
+      return KeyAction::kStep;
+    case '=':
+      s->step_deg = std::min(10.0, s->step_deg * 2);
+      return KeyAction::kStep;
+    case 'h':
+      s->show_help = !s->show_help;
+      return KeyAction::kHelp;
+    case '0':
+      return KeyAction::kReset;
     case 'n':
       s->shown_display = num_displays > 0 ? (s->shown_display + 1) % num_displays : 0;
       return KeyAction::kNextDisplay;
-    case 'c': return KeyAction::kRecapture;
+    case 'c':
+      return KeyAction::kRecapture;
     case 10:
-    case 13: return KeyAction::kSubmit;
+    case 13:
+      return KeyAction::kSubmit;
     case 'q':
-    case 27: return KeyAction::kQuit;
-    default: return KeyAction::kNone;
+    case 27:
+      return KeyAction::kQuit;
+    default:
+      return KeyAction::kNone;
   }
 }
 
@@ -89,7 +130,8 @@ cv::Mat WindowImage(const cv::Mat& ar_view, const cv::Mat& reflective, const Int
   Panel(ar_view, w, h, "AR view: the hologram over the live camera frame", "waiting for the camera")
       .copyTo(window(cv::Rect(0, 0, w, h)));
   char title[96];
-  std::snprintf(title, sizeof(title), "reflective display %d (mirror view of a captured frame)", state.shown_display);
+  std::snprintf(title, sizeof(title), "reflective display %d (mirror view of a captured frame)",
+                state.shown_display);
   Panel(reflective, w, h, title, "no reflective display (--displays 0) or no frame yet")
       .copyTo(window(cv::Rect(w, 0, w, h)));
   cv::line(window, cv::Point(w, 0), cv::Point(w, h), cv::Scalar(90, 90, 90), 2);
@@ -100,7 +142,8 @@ cv::Mat WindowImage(const cv::Mat& ar_view, const cv::Mat& reflective, const Int
                 state.step_m * 1e3, state.step_deg);
   Text(&window, steps, cv::Point(12, h + 24), 0.6, cv::Scalar(120, 230, 255));
   for (std::size_t i = 0; i < status_lines.size(); ++i) {
-    Text(&window, status_lines[i], cv::Point(12, h + 48 + 24 * static_cast<int>(i)), 0.55, cv::Scalar(225, 225, 225));
+    Text(&window, status_lines[i], cv::Point(12, h + 48 + 24 * static_cast<int>(i)), 0.55,
+         cv::Scalar(225, 225, 225));
   }
 
   if (state.show_help) {

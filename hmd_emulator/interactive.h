@@ -26,18 +26,18 @@
 namespace orbed::hmd {
 
 struct InteractiveState {
-  double step_m{0.005};     ///< translation per key press [m]
-  double step_deg{0.5};     ///< rotation per key press [deg]
+  double step_m{0.005};  ///< translation per key press [m]
+  double step_deg{0.5};  ///< rotation per key press [deg]
   bool show_help{false};
-  int shown_display{0};     ///< index of the reflective display in the right panel
+  int shown_display{0};  ///< index of the reflective display in the right panel
 };
 
 enum class KeyAction {
-  kNone,      ///< not a key of the interactive mode
-  kMoved,     ///< X_WV changed
-  kStep,      ///< a step size changed
-  kHelp,      ///< help overlay toggled
-  kReset,     ///< back to the start pose (the caller sets X_WV)
+  kNone,   ///< not a key of the interactive mode
+  kMoved,  ///< X_WV changed
+  kStep,   ///< a step size changed
+  kHelp,   ///< help overlay toggled
+  kReset,  ///< back to the start pose (the caller sets X_WV)
   kNextDisplay,
   kRecapture,
   kSubmit,

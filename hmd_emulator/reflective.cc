@@ -8,8 +8,8 @@ namespace orbed::hmd {
 namespace {
 
 bool SameIntrinsics(const Intrinsics& a, const Intrinsics& b) {
-  return a.width_px == b.width_px && a.height_px == b.height_px && a.fx_px == b.fx_px &&
-         a.fy_px == b.fy_px && a.cx_px == b.cx_px && a.cy_px == b.cy_px;
+  return a.width_px == b.width_px && a.height_px == b.height_px && a.fx_px == b.fx_px && a.fy_px == b.fy_px &&
+         a.cx_px == b.cx_px && a.cy_px == b.cy_px;
 }
 
 }  // namespace
@@ -17,8 +17,7 @@ bool SameIntrinsics(const Intrinsics& a, const Intrinsics& b) {
 ReflectiveGeometry MakeReflectiveGeometry(const Intrinsics& intrinsics, const Eigen::Isometry3d& X_WC,
                                           double D_m) {
   if (!std::isfinite(D_m) || !(D_m > 0))
-    throw std::invalid_argument("reflective display: D must be finite and > 0, got " +
-                                std::to_string(D_m));
+    throw std::invalid_argument("reflective display: D must be finite and > 0, got " + std::to_string(D_m));
   ReflectiveGeometry g;
   g.K_o = intrinsics.K();
   g.K_m = MirrorIntrinsics(g.K_o);
@@ -45,11 +44,11 @@ Compositor::Compositor(const sim::RobotModel& robot, const OverlayStyle& style,
 }
 
 void Compositor::Overlay(const Intrinsics& intrinsics, const Eigen::Isometry3d& X_WC,
-                         const Eigen::VectorXd& q_rad, const Eigen::Isometry3d& X_WV,
-                         cv::Mat* image, cv::Mat* body_id) {
+                         const Eigen::VectorXd& q_rad, const Eigen::Isometry3d& X_WV, cv::Mat* image,
+                         cv::Mat* body_id) {
   if (q_rad.size() != robot_.num_joints())
-    throw std::invalid_argument("compositor: q has " + std::to_string(q_rad.size()) +
-                                " entries, the robot " + std::to_string(robot_.num_joints()));
+    throw std::invalid_argument("compositor: q has " + std::to_string(q_rad.size()) + " entries, the robot " +
+                                std::to_string(robot_.num_joints()));
   if (!renderer_ || !SameIntrinsics(renderer_->intrinsics(), intrinsics))
     renderer_ = std::make_unique<Renderer>(intrinsics);
   virtual_robot_.PoseRobot(handle_, q_rad, X_WV);
@@ -58,9 +57,8 @@ void Compositor::Overlay(const Intrinsics& intrinsics, const Eigen::Isometry3d& 
   renderer_->RenderOverlay(mesh_, X_WC, style_, image, body_id);
 }
 
-void Compositor::ComposeReflective(const CapturedFrame& frame, double D_m,
-                                   const Eigen::Isometry3d& X_WV, ReflectiveView* view,
-                                   cv::Mat* body_id) {
+void Compositor::ComposeReflective(const CapturedFrame& frame, double D_m, const Eigen::Isometry3d& X_WV,
+                                   ReflectiveView* view, cv::Mat* body_id) {
   const Intrinsics& K = frame.intrinsics;
   if (frame.bgr.empty() || frame.bgr.type() != CV_8UC3 || frame.bgr.cols != K.width_px ||
       frame.bgr.rows != K.height_px)

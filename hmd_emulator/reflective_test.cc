@@ -116,7 +116,8 @@ TEST_F(ReflectiveTest, HologramLandsWhereProjectSaysWithTheEstimatedCapturePose)
   ASSERT_GE(real_wrist, 0);
   Eigen::Vector2d uv_est, uv_true;
   ASSERT_TRUE(Project(P_est, WristCentre(X_WV), &uv_est));
-  ASSERT_TRUE(Project(MakeCameraMatrix(frame.intrinsics.K(), X_WC_true_), WristCentre(scene_.X_WR), &uv_true));
+  ASSERT_TRUE(
+      Project(MakeCameraMatrix(frame.intrinsics.K(), X_WC_true_), WristCentre(scene_.X_WR), &uv_true));
   int n_holo = 0, n_real = 0;
   const Eigen::Vector2d c_holo = Centroid(holo_ids, holo_wrist, &n_holo);
   const Eigen::Vector2d c_real = Centroid(real_ids, real_wrist, &n_real);
@@ -195,7 +196,7 @@ TEST(ReflectiveGeometry, PanelPixelsLieOnTheirCaptureRaysAndThroughTheReversedFr
   for (double D : {0.8, 2.0}) {
     const ReflectiveGeometry g = MakeReflectiveGeometry(K, X_WC, D);
     for (const Eigen::Vector2d& px : {Eigen::Vector2d(0, 0), Eigen::Vector2d(597.2, 322.1),
-                                     Eigen::Vector2d(1279, 719), Eigen::Vector2d(100, 600)}) {
+                                      Eigen::Vector2d(1279, 719), Eigen::Vector2d(100, 600)}) {
       // The mirror plane (default): half way between C and M.
       const Eigen::Vector3d p_W = DisplayPanelPoint(g, px.x(), px.y());
       EXPECT_NEAR((X_WC.inverse() * p_W).z(), D / 2, 1e-12);
@@ -227,8 +228,8 @@ TEST_F(ReflectiveTest, ArViewEqualsTheReflectiveContentForTheSameInputs) {
   cv::Mat in_place = frame.bgr.clone();
   compositor.ComposeArView(in_place, frame.intrinsics, frame.X_WC_est, q_, X_WV, &in_place);
   EXPECT_EQ(cv::norm(in_place, view.bgr, cv::NORM_INF), 0);
-  EXPECT_THROW(compositor.ComposeArView(frame.bgr, frame.intrinsics, frame.X_WC_est,
-                                        Eigen::VectorXd::Zero(3), X_WV, &ar),
+  EXPECT_THROW(compositor.ComposeArView(frame.bgr, frame.intrinsics, frame.X_WC_est, Eigen::VectorXd::Zero(3),
+                                        X_WV, &ar),
                std::invalid_argument);
 }
 

@@ -34,8 +34,8 @@ constexpr double kDeg = 3.14159265358979323846 / 180.0;
 
 void Caption(cv::Mat* image, const std::string& text) {
   cv::rectangle(*image, cv::Rect(0, 0, image->cols, 34), cv::Scalar(30, 30, 30), cv::FILLED);
-  cv::putText(*image, text, cv::Point(12, 24), cv::FONT_HERSHEY_SIMPLEX, 0.62,
-              cv::Scalar(235, 235, 235), 1, cv::LINE_AA);
+  cv::putText(*image, text, cv::Point(12, 24), cv::FONT_HERSHEY_SIMPLEX, 0.62, cv::Scalar(235, 235, 235), 1,
+              cv::LINE_AA);
 }
 
 }  // namespace
@@ -44,9 +44,10 @@ int main(int argc, char** argv) {
   std::string out = orbed::sim::SourceTreePath("docs/images");
   for (int i = 1; i < argc; ++i) {
     if (std::strcmp(argv[i], "--help") == 0 || std::strcmp(argv[i], "-h") == 0) {
-      std::printf("usage: orbed-render-snapshot [--out DIR]\n"
-                  "Writes camera_frame.png and reflective_view.png (default DIR: "
-                  "$ORBED_SOURCE_DIR/docs/images).\n");
+      std::printf(
+          "usage: orbed-render-snapshot [--out DIR]\n"
+          "Writes camera_frame.png and reflective_view.png (default DIR: "
+          "$ORBED_SOURCE_DIR/docs/images).\n");
       return 0;
     } else if (std::strcmp(argv[i], "--out") == 0 && i + 1 < argc) {
       out = argv[++i];
@@ -80,7 +81,8 @@ int main(int argc, char** argv) {
     // 2. A reflective view: captured from the foot of the table, SLAM error at capture, X_WV off.
     const Eigen::Isometry3d X_WC_true = LookAt({2.05, 0.55, 1.75}, {0.25, -0.4, 1.15});
     Eigen::Isometry3d X_CtrueCest = Eigen::Isometry3d::Identity();
-    X_CtrueCest.linear() = Eigen::AngleAxisd(0.8 * kDeg, Eigen::Vector3d(0.3, 1, 0).normalized()).toRotationMatrix();
+    X_CtrueCest.linear() =
+        Eigen::AngleAxisd(0.8 * kDeg, Eigen::Vector3d(0.3, 1, 0).normalized()).toRotationMatrix();
     X_CtrueCest.translation() = Eigen::Vector3d(0.015, -0.01, 0.008);
     hmd::CapturedFrame captured;
     renderer.Render(mesh, X_WC_true, &captured.bgr);
@@ -94,8 +96,8 @@ int main(int argc, char** argv) {
     // D: the gaze from the capture position to the robot's elbow, hit on the spatial map.
     const int elbow = robot.FindLink("iiwa_link_4");
     const Eigen::Vector3d p_W_elbow = scene.X_WR * robot.CalcLinkPoses(q)[elbow].translation();
-    const hmd::RayHit gaze = hmd::CastRay(g, captured.X_WC_est.translation(),
-                                          p_W_elbow - captured.X_WC_est.translation());
+    const hmd::RayHit gaze =
+        hmd::CastRay(g, captured.X_WC_est.translation(), p_W_elbow - captured.X_WC_est.translation());
     const double D = gaze.hit ? gaze.distance_m : (p_W_elbow - captured.X_WC_est.translation()).norm();
     hmd::Compositor compositor(robot);
     hmd::ReflectiveView view;

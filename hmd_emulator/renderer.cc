@@ -14,9 +14,9 @@ struct Renderer::Target {
   std::uint8_t* bgr{nullptr};
   size_t bgr_step{0};  // bytes per row
   float* inv_z{nullptr};
-  size_t z_step{0};    // floats per row
+  size_t z_step{0};  // floats per row
   std::int32_t* ids{nullptr};
-  size_t id_step{0};   // ints per row
+  size_t id_step{0};  // ints per row
   int width{0}, height{0};
 };
 
@@ -43,8 +43,7 @@ Renderer::Renderer(const Intrinsics& intrinsics, const RenderOptions& options)
 }
 
 template <bool kWriteIds>
-void Renderer::FillTriangle(const double (*uvw)[3], const std::uint8_t* color, int body,
-                            Target* t) {
+void Renderer::FillTriangle(const double (*uvw)[3], const std::uint8_t* color, int body, Target* t) {
   // Sort the three projected vertices by v (row).
   const double* a = uvw[0];
   const double* b = uvw[1];
@@ -170,8 +169,8 @@ void Renderer::Draw(const Mesh& mesh, const Eigen::Isometry3d& X_WC, Target* t) 
   }
 }
 
-void Renderer::Render(const Mesh& mesh, const Eigen::Isometry3d& X_WC, cv::Mat* bgr,
-                      cv::Mat* depth_m, cv::Mat* body_id) {
+void Renderer::Render(const Mesh& mesh, const Eigen::Isometry3d& X_WC, cv::Mat* bgr, cv::Mat* depth_m,
+                      cv::Mat* body_id) {
   const int W = intrinsics_.width_px, H = intrinsics_.height_px;
   background_.copyTo(*bgr);
   Target t;
@@ -200,8 +199,8 @@ void Renderer::Render(const Mesh& mesh, const Eigen::Isometry3d& X_WC, cv::Mat* 
   }
 }
 
-void Renderer::RenderOverlay(const Mesh& mesh, const Eigen::Isometry3d& X_WC,
-                             const OverlayStyle& style, cv::Mat* bgr, cv::Mat* body_id) {
+void Renderer::RenderOverlay(const Mesh& mesh, const Eigen::Isometry3d& X_WC, const OverlayStyle& style,
+                             cv::Mat* bgr, cv::Mat* body_id) {
   const int W = intrinsics_.width_px, H = intrinsics_.height_px;
   if (bgr->type() != CV_8UC3 || bgr->cols != W || bgr->rows != H)
     throw std::invalid_argument("RenderOverlay: image must be CV_8UC3 of the intrinsics' size");

@@ -30,19 +30,19 @@
 namespace orbed::hmd {
 
 struct RenderOptions {
-  ColorBgr background_top{72, 66, 62};      ///< vertical gradient behind everything (walls)
+  ColorBgr background_top{72, 66, 62};  ///< vertical gradient behind everything (walls)
   ColorBgr background_bottom{120, 112, 104};
   Eigen::Vector3d light_toward_W{0.35, -0.45, 1.0};  ///< direction toward the key light (any length)
   float ambient{0.28f};
   float key_light{0.42f};
   float headlight{0.38f};
-  double near_m{0.02};                      ///< near clipping plane z_C [m]
+  double near_m{0.02};  ///< near clipping plane z_C [m]
   bool cull_back_faces{true};
 };
 
 struct OverlayStyle {
-  float face_alpha{0.55f};                  ///< opacity of the hologram's faces, 0..1
-  bool draw_edges{true};                    ///< outline silhouettes and link boundaries
+  float face_alpha{0.55f};  ///< opacity of the hologram's faces, 0..1
+  bool draw_edges{true};    ///< outline silhouettes and link boundaries
   ColorBgr edge_color{255, 255, 210};
   float edge_alpha{0.9f};
 };
@@ -57,14 +57,14 @@ class Renderer {
   /// Renders `mesh` seen from X_WC into `bgr` (CV_8UC3, (re)allocated to the intrinsics' size and
   /// fully overwritten). `depth_m` (CV_32F, z_C [m], 0 where no surface) and `body_id` (CV_32S,
   /// Mesh::Triangle::body, -1 where no surface) are written when not null.
-  void Render(const Mesh& mesh, const Eigen::Isometry3d& X_WC, cv::Mat* bgr,
-              cv::Mat* depth_m = nullptr, cv::Mat* body_id = nullptr);
+  void Render(const Mesh& mesh, const Eigen::Isometry3d& X_WC, cv::Mat* bgr, cv::Mat* depth_m = nullptr,
+              cv::Mat* body_id = nullptr);
 
   /// Draws `mesh` seen from X_WC over `bgr` (CV_8UC3 of the intrinsics' size, modified in place) in
   /// the hologram style. `body_id`, when not null, receives the overlay's ids (CV_32S, -1 elsewhere).
   /// Throws std::invalid_argument if `bgr` has the wrong type or size.
-  void RenderOverlay(const Mesh& mesh, const Eigen::Isometry3d& X_WC, const OverlayStyle& style,
-                     cv::Mat* bgr, cv::Mat* body_id = nullptr);
+  void RenderOverlay(const Mesh& mesh, const Eigen::Isometry3d& X_WC, const OverlayStyle& style, cv::Mat* bgr,
+                     cv::Mat* body_id = nullptr);
 
   /// Triangles rasterised by the last call (after culling and clipping).
   int last_triangle_count() const { return last_triangles_; }

@@ -13,8 +13,8 @@
 #include <gtest/gtest.h>
 
 #include "hmd_emulator/scene_geometry.h"
-#include "sim/robot_model.h"
 #include "sim/model_paths.h"
+#include "sim/robot_model.h"
 #include "sim/scene.h"
 
 namespace orbed::hmd {
@@ -41,9 +41,8 @@ double Cross(const Eigen::Vector2d& o, const Eigen::Vector2d& a, const Eigen::Ve
 
 // Area of the convex hull (Andrew's monotone chain + shoelace).
 double ConvexHullArea(std::vector<Eigen::Vector2d> pts) {
-  std::sort(pts.begin(), pts.end(), [](const auto& a, const auto& b) {
-    return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
-  });
+  std::sort(pts.begin(), pts.end(),
+            [](const auto& a, const auto& b) { return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y()); });
   std::vector<Eigen::Vector2d> hull(2 * pts.size());
   size_t k = 0;
   for (size_t i = 0; i < pts.size(); ++i) {
@@ -162,8 +161,9 @@ TEST(Renderer, NearerObjectWinsWhereTwoOverlapInEitherOrder) {
     EXPECT_EQ(bgr.at<cv::Vec3b>(v, u)[0], 0);  // red-only colour: no blue from the sphere
     // The far sphere is still visible around the box.
     const Eigen::Vector2d uv_far = HandProject(K, X_WC, X_far.translation() + Eigen::Vector3d(-0.3, 0, 0));
-    EXPECT_EQ(ids.at<int>(static_cast<int>(std::lround(uv_far.y())), static_cast<int>(std::lround(uv_far.x()))),
-              far_id);
+    EXPECT_EQ(
+        ids.at<int>(static_cast<int>(std::lround(uv_far.y())), static_cast<int>(std::lround(uv_far.x()))),
+        far_id);
     // Every pixel of the near box is nearer than the sphere could be.
     EXPECT_GT(CountId(ids, near_id), 10000);
     EXPECT_GT(CountId(ids, far_id), 10000);
@@ -215,7 +215,8 @@ TEST(Renderer, FloorThroughTheNearPlaneIsClippedToTheHorizon) {
 }
 
 TEST(Renderer, OperatingRoomShowsEveryLinkAndObjectsInView) {
-  const sim::RobotModel robot = sim::RobotModel::LoadFile(sim::SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath));
+  const sim::RobotModel robot =
+      sim::RobotModel::LoadFile(sim::SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath));
   const sim::Scene scene = sim::LoadSceneFile(sim::SourceTreePath(sim::kDefaultSceneRelativePath));
   Eigen::VectorXd q_deg(7);
   q_deg << 0, 35, 0, -70, 0, 45, 0;
@@ -229,8 +230,8 @@ TEST(Renderer, OperatingRoomShowsEveryLinkAndObjectsInView) {
   for (int v = 0; v < ids.rows; ++v)
     for (int u = 0; u < ids.cols; ++u)
       if (ids.at<int>(v, u) >= 0) seen.insert(g.bodies()[ids.at<int>(v, u)].name);
-  for (const char* name : {"iiwa_link_1", "iiwa_link_2", "iiwa_link_3", "iiwa_link_4", "iiwa_link_5",
-                           "floor", "table_top", "robot_cart"})
+  for (const char* name : {"iiwa_link_1", "iiwa_link_2", "iiwa_link_3", "iiwa_link_4", "iiwa_link_5", "floor",
+                           "table_top", "robot_cart"})
     EXPECT_TRUE(seen.count(name)) << name;
   EXPECT_EQ(g.FindBody("virtual/iiwa_link_1"), -1);
   // Adjacent links are told apart by colour.
@@ -245,7 +246,8 @@ TEST(Renderer, OverlayBlendsOnlyWhereTheHologramIs) {
   SceneGeometry g;
   Eigen::Isometry3d X_WG = Eigen::Isometry3d::Identity();
   X_WG.translation() = Eigen::Vector3d(0, 0, 1.0);
-  const int id = g.AddBody("holo", BodyKind::kVirtualRobot, ColorBgr{255, 255, 0}, Box({0.4, 0.4, 0.4}, X_WG));
+  const int id =
+      g.AddBody("holo", BodyKind::kVirtualRobot, ColorBgr{255, 255, 0}, Box({0.4, 0.4, 0.4}, X_WG));
   Mesh mesh;
   Tessellate(g, kAllKinds, {}, &mesh);
   const Eigen::Isometry3d X_WC = LookAt({0, -2.0, 1.0}, {0, 0, 1.0});
@@ -255,8 +257,8 @@ TEST(Renderer, OverlayBlendsOnlyWhereTheHologramIs) {
   renderer.RenderOverlay(mesh, X_WC, style, &image, &ids);
   const cv::Vec3b centre = image.at<cv::Vec3b>(322, 597);
   EXPECT_EQ(ids.at<int>(322, 597), id);
-  EXPECT_GT(centre[0], 100);   // blended toward the hologram's colour
-  EXPECT_LT(centre[2], 30);    // ... which has no red
+  EXPECT_GT(centre[0], 100);                                      // blended toward the hologram's colour
+  EXPECT_LT(centre[2], 30);                                       // ... which has no red
   EXPECT_EQ(image.at<cv::Vec3b>(10, 10), cv::Vec3b(10, 20, 30));  // untouched outside
   EXPECT_EQ(ids.at<int>(10, 10), -1);
   // The silhouette is outlined in the edge colour: the left edge of the face, on the centre row.
@@ -271,7 +273,8 @@ TEST(Renderer, OverlayBlendsOnlyWhereTheHologramIs) {
 }
 
 TEST(Renderer, JpegRoundTripIsSmallAndFaithful) {
-  const sim::RobotModel robot = sim::RobotModel::LoadFile(sim::SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath));
+  const sim::RobotModel robot =
+      sim::RobotModel::LoadFile(sim::SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath));
   const sim::Scene scene = sim::LoadSceneFile(sim::SourceTreePath(sim::kDefaultSceneRelativePath));
   SceneGeometry g = SceneGeometry::MakeOperatingRoom(scene, robot, Eigen::VectorXd::Zero(7), scene.X_WR);
   Mesh mesh;

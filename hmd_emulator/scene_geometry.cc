@@ -31,10 +31,14 @@ constexpr ColorBgr kHoloTool{255, 170, 150};
 
 Primitive::Shape ShapeOf(sim::CollisionPrimitive::Kind k) {
   switch (k) {
-    case sim::CollisionPrimitive::Kind::kSphere: return Primitive::Shape::kSphere;
-    case sim::CollisionPrimitive::Kind::kCylinder: return Primitive::Shape::kCylinder;
-    case sim::CollisionPrimitive::Kind::kBox: return Primitive::Shape::kBox;
-    case sim::CollisionPrimitive::Kind::kCapsule: return Primitive::Shape::kCapsule;
+    case sim::CollisionPrimitive::Kind::kSphere:
+      return Primitive::Shape::kSphere;
+    case sim::CollisionPrimitive::Kind::kCylinder:
+      return Primitive::Shape::kCylinder;
+    case sim::CollisionPrimitive::Kind::kBox:
+      return Primitive::Shape::kBox;
+    case sim::CollisionPrimitive::Kind::kCapsule:
+      return Primitive::Shape::kCapsule;
   }
   return Primitive::Shape::kSphere;
 }
@@ -56,8 +60,8 @@ void PushTriangle(Mesh* mesh, int a, int b, int c, int body, ColorBgr color) {
 
 // A surface of revolution about G's z axis from a profile of (radius, z) points ordered from the top
 // (+z) to the bottom; a point with radius 0 is a pole (one vertex). Triangles wind outward.
-void Lathe(const std::vector<std::pair<double, double>>& profile, int segments,
-           const Eigen::Isometry3d& X_WG, int body, ColorBgr color, Mesh* mesh) {
+void Lathe(const std::vector<std::pair<double, double>>& profile, int segments, const Eigen::Isometry3d& X_WG,
+           int body, ColorBgr color, Mesh* mesh) {
   std::vector<double> c(segments), s(segments);
   for (int i = 0; i < segments; ++i) {
     c[i] = std::cos(2 * kPi * i / segments);
@@ -99,8 +103,7 @@ void TessellateBox(const Primitive& p, int body, ColorBgr color, Mesh* mesh) {
   const int base = static_cast<int>(mesh->p_W.size());
   // Vertex i has x = ±h.x by bit 0, y by bit 1, z by bit 2.
   for (int i = 0; i < 8; ++i) {
-    const Eigen::Vector3d p_G((i & 1) ? h.x() : -h.x(), (i & 2) ? h.y() : -h.y(),
-                              (i & 4) ? h.z() : -h.z());
+    const Eigen::Vector3d p_G((i & 1) ? h.x() : -h.x(), (i & 2) ? h.y() : -h.y(), (i & 4) ? h.z() : -h.z());
     mesh->p_W.push_back((p.X_WG * p_G).cast<float>());
   }
   // Faces as quads wound counter-clockwise seen from outside.
@@ -124,9 +127,15 @@ void SceneGeometry::AddSceneObjects(const sim::Scene& scene) {
     p.radius_m = o.radius_m;
     p.length_m = o.length_m;
     switch (o.shape) {
-      case sim::SceneObject::Shape::kBox: p.shape = Primitive::Shape::kBox; break;
-      case sim::SceneObject::Shape::kCylinder: p.shape = Primitive::Shape::kCylinder; break;
-      case sim::SceneObject::Shape::kSphere: p.shape = Primitive::Shape::kSphere; break;
+      case sim::SceneObject::Shape::kBox:
+        p.shape = Primitive::Shape::kBox;
+        break;
+      case sim::SceneObject::Shape::kCylinder:
+        p.shape = Primitive::Shape::kCylinder;
+        break;
+      case sim::SceneObject::Shape::kSphere:
+        p.shape = Primitive::Shape::kSphere;
+        break;
     }
     const ColorBgr color =
         o.name == "floor" ? kFloor : kScenePalette[n++ % (sizeof(kScenePalette) / sizeof(ColorBgr))];
@@ -192,8 +201,7 @@ int SceneGeometry::AddRobot(const sim::RobotModel& robot, BodyKind kind) {
   return handle;
 }
 
-void SceneGeometry::PoseRobot(int handle, const Eigen::VectorXd& q_rad,
-                              const Eigen::Isometry3d& X_WB) {
+void SceneGeometry::PoseRobot(int handle, const Eigen::VectorXd& q_rad, const Eigen::Isometry3d& X_WB) {
   if (handle < 0 || handle >= static_cast<int>(robots_.size()))
     throw std::invalid_argument("PoseRobot: unknown robot handle " + std::to_string(handle));
   RobotEntry& r = robots_[handle];
@@ -202,18 +210,15 @@ void SceneGeometry::PoseRobot(int handle, const Eigen::VectorXd& q_rad,
     primitives_[r.primitive_index[k]].X_WG = X_WB * r.X_BL[r.primitive_link[k]] * r.X_LG[k];
 }
 
-SceneGeometry SceneGeometry::MakeOperatingRoom(const sim::Scene& scene,
-                                               const sim::RobotModel& robot,
-                                               const Eigen::VectorXd& q_rad,
-                                               const Eigen::Isometry3d& X_WR,
+SceneGeometry SceneGeometry::MakeOperatingRoom(const sim::Scene& scene, const sim::RobotModel& robot,
+                                               const Eigen::VectorXd& q_rad, const Eigen::Isometry3d& X_WR,
                                                const Eigen::Isometry3d* X_WV,
                                                const Eigen::VectorXd* q_virtual_rad) {
   SceneGeometry g;
   g.AddSceneObjects(scene);
   g.PoseRobot(g.AddRobot(robot, BodyKind::kRealRobot), q_rad, X_WR);
   if (X_WV != nullptr) {
-    g.PoseRobot(g.AddRobot(robot, BodyKind::kVirtualRobot), q_virtual_rad ? *q_virtual_rad : q_rad,
-                *X_WV);
+    g.PoseRobot(g.AddRobot(robot, BodyKind::kVirtualRobot), q_virtual_rad ? *q_virtual_rad : q_rad, *X_WV);
   }
   return g;
 }
@@ -224,8 +229,8 @@ int SceneGeometry::FindBody(const std::string& name) const {
   return -1;
 }
 
-void TessellatePrimitive(const Primitive& p, int body, ColorBgr color,
-                         const TessellationOptions& options, Mesh* mesh) {
+void TessellatePrimitive(const Primitive& p, int body, ColorBgr color, const TessellationOptions& options,
+                         Mesh* mesh) {
   const int seg = std::max(3, options.cylinder_segments);
   const int sseg = std::max(3, options.sphere_segments);
   const int rings = std::max(2, options.sphere_rings);
@@ -257,8 +262,7 @@ void TessellatePrimitive(const Primitive& p, int body, ColorBgr color,
       }
       for (int k = 0; k <= half; ++k) {  // bottom cap, equator to pole
         const double phi = 0.5 * kPi + 0.5 * kPi * k / half;
-        profile.emplace_back(k == half ? 0.0 : p.radius_m * std::sin(phi),
-                             -h + p.radius_m * std::cos(phi));
+        profile.emplace_back(k == half ? 0.0 : p.radius_m * std::sin(phi), -h + p.radius_m * std::cos(phi));
       }
       Lathe(profile, std::max(seg, sseg), p.X_WG, body, color, mesh);
       return;

@@ -45,17 +45,17 @@ struct Body {
   std::string name;  ///< scene object name, robot link name; virtual links are "virtual/<link>"
   BodyKind kind{BodyKind::kSceneObject};
   ColorBgr color;
-  int robot{-1};     ///< robot handle from AddRobot(), -1 for scene objects
-  int link{-1};      ///< link index in the robot model, -1 for scene objects
+  int robot{-1};  ///< robot handle from AddRobot(), -1 for scene objects
+  int link{-1};   ///< link index in the robot model, -1 for scene objects
 };
 
 struct Primitive {
   enum class Shape : std::uint8_t { kBox, kCylinder, kSphere, kCapsule };
   Shape shape{Shape::kBox};
-  int body{-1};                                         ///< index into SceneGeometry::bodies()
+  int body{-1};  ///< index into SceneGeometry::bodies()
   Eigen::Isometry3d X_WG{Eigen::Isometry3d::Identity()};
-  Eigen::Vector3d size_m{Eigen::Vector3d::Zero()};      ///< box: full extents
-  double radius_m{0};                                   ///< cylinder, sphere, capsule
+  Eigen::Vector3d size_m{Eigen::Vector3d::Zero()};  ///< box: full extents
+  double radius_m{0};                               ///< cylinder, sphere, capsule
   double length_m{0};  ///< cylinder: full length; capsule: distance between the cap centres
 };
 
@@ -95,10 +95,10 @@ class SceneGeometry {
   struct RobotEntry {
     const sim::RobotModel* model{nullptr};
     BodyKind kind{BodyKind::kRealRobot};
-    std::vector<int> primitive_index;       ///< into primitives_
-    std::vector<int> primitive_link;        ///< link index of each
-    std::vector<Eigen::Isometry3d> X_LG;    ///< primitive pose in its link
-    std::vector<Eigen::Isometry3d> X_BL;    ///< scratch for forward kinematics
+    std::vector<int> primitive_index;     ///< into primitives_
+    std::vector<int> primitive_link;      ///< link index of each
+    std::vector<Eigen::Isometry3d> X_LG;  ///< primitive pose in its link
+    std::vector<Eigen::Isometry3d> X_BL;  ///< scratch for forward kinematics
   };
   std::vector<Body> bodies_;
   std::vector<Primitive> primitives_;

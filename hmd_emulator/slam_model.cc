@@ -31,10 +31,14 @@ Eigen::Matrix3d ExpRotation(const Eigen::Vector3d& w) {
 
 const char* TrackingStateName(TrackingState state) {
   switch (state) {
-    case TrackingState::kTracking: return "tracking";
-    case TrackingState::kLimited: return "limited";
-    case TrackingState::kLost: return "lost";
-    case TrackingState::kRelocalized: return "relocalized";
+    case TrackingState::kTracking:
+      return "tracking";
+    case TrackingState::kLimited:
+      return "limited";
+    case TrackingState::kLost:
+      return "lost";
+    case TrackingState::kRelocalized:
+      return "relocalized";
   }
   return "unknown";
 }
@@ -52,36 +56,44 @@ SlamConfig ParseSlamConfig(const YAML::Node& node, const std::string& source, co
     const YAML::Node h = node["head_to_camera"];
     f.CheckKeys(h, k, {"position_m", "rpy_deg"});
     if (h["position_m"]) c.X_HC.translation() = f.Vector3(h["position_m"], k + ".position_m", "m");
-    if (h["rpy_deg"]) c.X_HC.linear() = sim::RotationFromRpyDeg(f.Vector3(h["rpy_deg"], k + ".rpy_deg", "deg"));
+    if (h["rpy_deg"])
+      c.X_HC.linear() = sim::RotationFromRpyDeg(f.Vector3(h["rpy_deg"], k + ".rpy_deg", "deg"));
   }
   const YAML::Node j = f.Section(node, "jitter", key + ".jitter");
   const std::string kj = key + ".jitter";
   f.CheckKeys(j, kj, {"translation_std_m", "rotation_std_deg"});
-  c.jitter_translation_std_m = f.NumberOr(j, "translation_std_m", kj, c.jitter_translation_std_m, 0, 0.1, "m");
+  c.jitter_translation_std_m =
+      f.NumberOr(j, "translation_std_m", kj, c.jitter_translation_std_m, 0, 0.1, "m");
   c.jitter_rotation_std_deg = f.NumberOr(j, "rotation_std_deg", kj, c.jitter_rotation_std_deg, 0, 5, "deg");
   const YAML::Node d = f.Section(node, "drift", key + ".drift");
   const std::string kd = key + ".drift";
   f.CheckKeys(d, kd, {"fraction_of_distance", "yaw_deg_per_m", "direction_correlation_m", "band_fraction"});
-  c.drift_fraction_of_distance = f.NumberOr(d, "fraction_of_distance", kd, c.drift_fraction_of_distance, 0, 0.2);
+  c.drift_fraction_of_distance =
+      f.NumberOr(d, "fraction_of_distance", kd, c.drift_fraction_of_distance, 0, 0.2);
   c.drift_yaw_deg_per_m = f.NumberOr(d, "yaw_deg_per_m", kd, c.drift_yaw_deg_per_m, 0, 10, "deg/m");
   c.drift_direction_correlation_m =
       f.NumberOr(d, "direction_correlation_m", kd, c.drift_direction_correlation_m, 0.01, 1e6, "m");
   if (d["band_fraction"]) {
     const YAML::Node b = d["band_fraction"];
-    if (!b.IsSequence() || b.size() != 2) f.Fail(b, kd + ".band_fraction", "expected [min, max] with 0 <= min <= max");
+    if (!b.IsSequence() || b.size() != 2)
+      f.Fail(b, kd + ".band_fraction", "expected [min, max] with 0 <= min <= max");
     c.drift_band_min_fraction = f.Number(b[0], kd + ".band_fraction[0]", 0, 0.2);
     c.drift_band_max_fraction = f.Number(b[1], kd + ".band_fraction[1]", c.drift_band_min_fraction, 0.2);
   }
   const YAML::Node t = f.Section(node, "tracking_loss", key + ".tracking_loss");
   const std::string kt = key + ".tracking_loss";
-  f.CheckKeys(t, kt, {"rate_per_min", "limited_mean_s", "limited_drift_multiplier", "lost_probability",
-                      "lost_mean_s", "relocalization_correction", "jump_translation_std_m", "jump_yaw_std_deg"});
-  c.tracking_loss_rate_per_min = f.NumberOr(t, "rate_per_min", kt, c.tracking_loss_rate_per_min, 0, 600, "1/min");
+  f.CheckKeys(t, kt,
+              {"rate_per_min", "limited_mean_s", "limited_drift_multiplier", "lost_probability",
+               "lost_mean_s", "relocalization_correction", "jump_translation_std_m", "jump_yaw_std_deg"});
+  c.tracking_loss_rate_per_min =
+      f.NumberOr(t, "rate_per_min", kt, c.tracking_loss_rate_per_min, 0, 600, "1/min");
   c.limited_mean_s = f.NumberOr(t, "limited_mean_s", kt, c.limited_mean_s, 1e-3, 600, "s");
-  c.limited_drift_multiplier = f.NumberOr(t, "limited_drift_multiplier", kt, c.limited_drift_multiplier, 0, 100);
+  c.limited_drift_multiplier =
+      f.NumberOr(t, "limited_drift_multiplier", kt, c.limited_drift_multiplier, 0, 100);
   c.lost_probability = f.NumberOr(t, "lost_probability", kt, c.lost_probability, 0, 1);
   c.lost_mean_s = f.NumberOr(t, "lost_mean_s", kt, c.lost_mean_s, 1e-3, 600, "s");
-  c.relocalization_correction = f.NumberOr(t, "relocalization_correction", kt, c.relocalization_correction, 0, 1);
+  c.relocalization_correction =
+      f.NumberOr(t, "relocalization_correction", kt, c.relocalization_correction, 0, 1);
   c.jump_translation_std_m = f.NumberOr(t, "jump_translation_std_m", kt, c.jump_translation_std_m, 0, 1, "m");
   c.jump_yaw_std_deg = f.NumberOr(t, "jump_yaw_std_deg", kt, c.jump_yaw_std_deg, 0, 45, "deg");
   return c;
@@ -160,11 +172,9 @@ SlamSample SlamModel::Step(const Eigen::Isometry3d& X_WH_true, double t_s) {
     // Re-matched to the stored map: shrink the accumulated error about the head, then jump.
     const double keep = 1.0 - config_.relocalization_correction;
     const Eigen::Vector3d e_head = E_ * p_WH - p_WH;  // the head's position error before
-    const Eigen::Isometry3d shrunk =
-        YawAboutPoint(p_WH, keep * YawOf(E_), keep * e_head);
-    const Eigen::Isometry3d jump =
-        YawAboutPoint(p_WH, config_.jump_yaw_std_deg * kDegToRad * rng_.Normal(),
-                      config_.jump_translation_std_m * rng_.Normal3());
+    const Eigen::Isometry3d shrunk = YawAboutPoint(p_WH, keep * YawOf(E_), keep * e_head);
+    const Eigen::Isometry3d jump = YawAboutPoint(p_WH, config_.jump_yaw_std_deg * kDegToRad * rng_.Normal(),
+                                                 config_.jump_translation_std_m * rng_.Normal3());
     E_ = jump * shrunk;
   } else if (state_ != TrackingState::kLost) {
     Drift(p_WH, ds, state_ == TrackingState::kLimited ? config_.limited_drift_multiplier : 1.0);
@@ -193,7 +203,8 @@ SlamSample SlamModel::Step(const Eigen::Isometry3d& X_WH_true, double t_s) {
   return s;
 }
 
-std::vector<SlamSample> SimulateWalk(const HeadTrajectory& trajectory, const SlamConfig& config, double t_end_s) {
+std::vector<SlamSample> SimulateWalk(const HeadTrajectory& trajectory, const SlamConfig& config,
+                                     double t_end_s) {
   SlamModel model(config);
   std::vector<SlamSample> samples;
   const double dt = 1.0 / config.rate_hz;

@@ -45,8 +45,8 @@
 #include <string>
 #include <vector>
 
-#include <Eigen/Geometry>
 #include <yaml-cpp/yaml.h>
+#include <Eigen/Geometry>
 
 #include "hmd_emulator/head_trajectory.h"
 #include "hmd_emulator/random.h"
@@ -144,6 +144,7 @@ class SlamModel {
 
 /// Samples a trajectory at config.rate_hz from t = 0 to t_end_s (inclusive of 0): one SlamModel
 /// with config's seed.
-std::vector<SlamSample> SimulateWalk(const HeadTrajectory& trajectory, const SlamConfig& config, double t_end_s);
+std::vector<SlamSample> SimulateWalk(const HeadTrajectory& trajectory, const SlamConfig& config,
+                                     double t_end_s);
 
 }  // namespace orbed::hmd

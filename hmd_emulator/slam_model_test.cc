@@ -167,8 +167,8 @@ TEST(SlamModel, DriftPerMetreStaysInConfiguredBand) {
     const RpeStats rpe = RelativePoseErrorPerMetre(s);
     ASSERT_GT(rpe.per_metre.size(), 150u);
     const double mean = stats::Mean(rpe.per_metre);
-    std::printf("configured drift %.4f, measured relative pose error %.4f per metre over %zu segments\n", fraction,
-                mean, rpe.per_metre.size());
+    std::printf("configured drift %.4f, measured relative pose error %.4f per metre over %zu segments\n",
+                fraction, mean, rpe.per_metre.size());
     EXPECT_GE(mean, c.drift_band_min_fraction) << "fraction " << fraction;
     EXPECT_LE(mean, c.drift_band_max_fraction) << "fraction " << fraction;
     // Closed form for a drift direction decorrelating as exp(−s/L): the RMS drift over ℓ = 1 m is
@@ -292,7 +292,8 @@ TEST(SlamConfig, ShippedFilesLoad) {
   EXPECT_DOUBLE_EQ(c.rate_hz, 60.0);
   EXPECT_DOUBLE_EQ(c.drift_fraction_of_distance, 0.01);
   EXPECT_NEAR(c.X_HC.translation().z(), 0.06, 1e-12);
-  const HeadTrajectoryConfig w = LoadHeadTrajectoryFile(orbed::sim::SourceTreePath("hmd_emulator/config/viraal_walk.yaml"));
+  const HeadTrajectoryConfig w =
+      LoadHeadTrajectoryFile(orbed::sim::SourceTreePath("hmd_emulator/config/viraal_walk.yaml"));
   EXPECT_EQ(w.waypoints.size(), 2u);
 }
 
@@ -311,12 +312,13 @@ TEST(SlamConfig, ErrorsNameFileKeyAndExpectation) {
     parse("slam:\n  jiter: {}\n");
     FAIL() << "expected an error";
   } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find("bad.yaml:2: slam.jiter: unknown key; expected one of:"), std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("bad.yaml:2: slam.jiter: unknown key; expected one of:"),
+              std::string::npos)
         << e.what();
   }
   try {
-    ParseHeadTrajectory(YamlFields::LoadString("speed_m_per_s: 1\nlook_at_m: [0, 0]\nwaypoints: []\n", "w.yaml"),
-                        "w.yaml");
+    ParseHeadTrajectory(
+        YamlFields::LoadString("speed_m_per_s: 1\nlook_at_m: [0, 0]\nwaypoints: []\n", "w.yaml"), "w.yaml");
     FAIL() << "expected an error";
   } catch (const std::runtime_error& e) {
     EXPECT_EQ(std::string(e.what()), "w.yaml:2: head_trajectory.look_at_m: expected a list of 3 numbers [m]");

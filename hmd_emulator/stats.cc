@@ -102,8 +102,7 @@ MannWhitneyResult MannWhitneyU(const std::vector<double>& x, const std::vector<d
   }
   r.variance_u = nx * ny / 12.0 * ((n + 1) - tie_sum / (n * (n - 1)));
   if (!(r.variance_u > 0)) return r;
-  const NormalApproximation a =
-      ApproximateByNormal(r.u_x, r.mean_u, r.variance_u, continuity_correction);
+  const NormalApproximation a = ApproximateByNormal(r.u_x, r.mean_u, r.variance_u, continuity_correction);
   r.z = a.z;
   r.p_two_sided = a.p_two_sided;
   r.p_x_less = a.p_less;
@@ -145,8 +144,7 @@ SignedRankResult WilcoxonSignedRank(const std::vector<double>& x, const std::vec
   }
   r.variance_w = n * (n + 1) * (2 * n + 1) / 24.0 - tie_sum / 48.0;
   if (!(r.variance_w > 0)) return r;
-  const NormalApproximation a =
-      ApproximateByNormal(r.w_plus, r.mean_w, r.variance_w, continuity_correction);
+  const NormalApproximation a = ApproximateByNormal(r.w_plus, r.mean_w, r.variance_w, continuity_correction);
   r.z = a.z;
   r.p_two_sided = a.p_two_sided;
   r.p_x_less = a.p_less;

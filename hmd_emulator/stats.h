@@ -42,33 +42,33 @@ double Quantile(std::vector<double> x, double q);
 std::vector<double> AverageRanks(const std::vector<double>& x);
 
 struct MannWhitneyResult {
-  bool valid = false;            ///< false when a sample is empty or σ = 0 (all values tied)
+  bool valid = false;  ///< false when a sample is empty or σ = 0 (all values tied)
   int n_x = 0, n_y = 0;
-  double rank_sum_x = 0;         ///< R_x
-  double u_x = 0, u_y = 0;       ///< U_x + U_y = n_x n_y
-  double mean_u = 0;             ///< n_x n_y / 2
-  double variance_u = 0;         ///< tie-corrected σ²
-  double z = 0;                  ///< (U_x − mean, continuity-corrected toward 0) / σ
+  double rank_sum_x = 0;    ///< R_x
+  double u_x = 0, u_y = 0;  ///< U_x + U_y = n_x n_y
+  double mean_u = 0;        ///< n_x n_y / 2
+  double variance_u = 0;    ///< tie-corrected σ²
+  double z = 0;             ///< (U_x − mean, continuity-corrected toward 0) / σ
   double p_two_sided = 1;
-  double p_x_less = 1;           ///< one-sided: x stochastically smaller than y
-  double p_x_greater = 1;        ///< one-sided: x stochastically larger than y
+  double p_x_less = 1;     ///< one-sided: x stochastically smaller than y
+  double p_x_greater = 1;  ///< one-sided: x stochastically larger than y
 };
 
 MannWhitneyResult MannWhitneyU(const std::vector<double>& x, const std::vector<double>& y,
                                bool continuity_correction = true);
 
 struct SignedRankResult {
-  bool valid = false;       ///< false when the sizes differ, no pair differs, or σ = 0
-  int n = 0;                ///< pairs with a non-zero difference
-  int n_zero = 0;           ///< pairs dropped for a zero difference
-  double w_plus = 0;        ///< sum of the ranks of the positive differences
-  double w_minus = 0;       ///< W⁺ + W⁻ = n(n + 1)/2
-  double mean_w = 0;        ///< n(n + 1)/4
-  double variance_w = 0;    ///< tie-corrected σ²
-  double z = 0;             ///< (W⁺ − mean, continuity-corrected toward 0) / σ
+  bool valid = false;     ///< false when the sizes differ, no pair differs, or σ = 0
+  int n = 0;              ///< pairs with a non-zero difference
+  int n_zero = 0;         ///< pairs dropped for a zero difference
+  double w_plus = 0;      ///< sum of the ranks of the positive differences
+  double w_minus = 0;     ///< W⁺ + W⁻ = n(n + 1)/2
+  double mean_w = 0;      ///< n(n + 1)/4
+  double variance_w = 0;  ///< tie-corrected σ²
+  double z = 0;           ///< (W⁺ − mean, continuity-corrected toward 0) / σ
   double p_two_sided = 1;
-  double p_x_less = 1;      ///< one-sided: x_i tend to be smaller than y_i
-  double p_x_greater = 1;   ///< one-sided: x_i tend to be larger than y_i
+  double p_x_less = 1;     ///< one-sided: x_i tend to be smaller than y_i
+  double p_x_greater = 1;  ///< one-sided: x_i tend to be larger than y_i
 };
 
 /// Paired test on (x[i], y[i]); x and y must have the same size (else valid = false).

@@ -55,7 +55,8 @@ bool InImage(const Intrinsics& in, const Eigen::Vector2d& uv) {
 UserConfig ParseUserConfig(const YAML::Node& node, const std::string& source, const std::string& key,
                            const UserConfig& base) {
   const YamlFields f(source);
-  f.CheckKeys(node, key, {"seed", "start_offset", "direct_view", "reflective_display", "belief", "nudging", "time"});
+  f.CheckKeys(node, key,
+              {"seed", "start_offset", "direct_view", "reflective_display", "belief", "nudging", "time"});
   UserConfig c = base;
   c.seed = static_cast<std::uint64_t>(
       f.IntegerOr(node, "seed", key, static_cast<long long>(c.seed), 0, (1LL << 62)));
@@ -64,22 +65,26 @@ UserConfig ParseUserConfig(const YAML::Node& node, const std::string& source, co
     const YAML::Node s = node["start_offset"];
     f.CheckKeys(s, k, {"position_m", "rpy_deg"});
     if (s["position_m"]) c.X_RV_start.translation() = f.Vector3(s["position_m"], k + ".position_m", "m");
-    if (s["rpy_deg"]) c.X_RV_start.linear() = sim::RotationFromRpyDeg(f.Vector3(s["rpy_deg"], k + ".rpy_deg", "deg"));
+    if (s["rpy_deg"])
+      c.X_RV_start.linear() = sim::RotationFromRpyDeg(f.Vector3(s["rpy_deg"], k + ".rpy_deg", "deg"));
   }
   const double inf = INFINITY;
   {
     const std::string k = key + ".direct_view";
     const YAML::Node d = f.Section(node, "direct_view", k);
-    f.CheckKeys(d, k, {"lateral_noise_arcmin", "lateral_bias_arcmin", "depth_bias_fraction_std",
-                       "depth_user_bias_fraction_std", "depth_noise_fraction_std", "user_scale_log_sigma",
-                       "size_blind"});
+    f.CheckKeys(
+        d, k,
+        {"lateral_noise_arcmin", "lateral_bias_arcmin", "depth_bias_fraction_std",
+         "depth_user_bias_fraction_std", "depth_noise_fraction_std", "user_scale_log_sigma", "size_blind"});
     c.size_blind = f.BoolOr(d, "size_blind", k, c.size_blind);
-    c.lateral_noise_arcmin = f.NumberOr(d, "lateral_noise_arcmin", k, c.lateral_noise_arcmin, 0, 600, "arcmin");
+    c.lateral_noise_arcmin =
+        f.NumberOr(d, "lateral_noise_arcmin", k, c.lateral_noise_arcmin, 0, 600, "arcmin");
     c.lateral_bias_arcmin = f.NumberOr(d, "lateral_bias_arcmin", k, c.lateral_bias_arcmin, 0, 600, "arcmin");
     c.depth_bias_fraction_std = f.NumberOr(d, "depth_bias_fraction_std", k, c.depth_bias_fraction_std, 0, 1);
     c.depth_user_bias_fraction_std =
         f.NumberOr(d, "depth_user_bias_fraction_std", k, c.depth_user_bias_fraction_std, 0, 1);
-    c.depth_noise_fraction_std = f.NumberOr(d, "depth_noise_fraction_std", k, c.depth_noise_fraction_std, 0, 1);
+    c.depth_noise_fraction_std =
+        f.NumberOr(d, "depth_noise_fraction_std", k, c.depth_noise_fraction_std, 0, 1);
     c.user_scale_log_sigma = f.NumberOr(d, "user_scale_log_sigma", k, c.user_scale_log_sigma, 0, 3);
   }
   {
@@ -93,15 +98,17 @@ UserConfig ParseUserConfig(const YAML::Node& node, const std::string& source, co
     const std::string k = key + ".belief";
     const YAML::Node d = f.Section(node, "belief", k);
     f.CheckKeys(d, k, {"lateral_arcmin", "depth_fraction", "display_px"});
-    c.assumed_lateral_arcmin = f.NumberOr(d, "lateral_arcmin", k, c.assumed_lateral_arcmin, 1e-3, 600, "arcmin");
+    c.assumed_lateral_arcmin =
+        f.NumberOr(d, "lateral_arcmin", k, c.assumed_lateral_arcmin, 1e-3, 600, "arcmin");
     c.assumed_depth_fraction = f.NumberOr(d, "depth_fraction", k, c.assumed_depth_fraction, 1e-5, 1);
     c.assumed_display_px = f.NumberOr(d, "display_px", k, c.assumed_display_px, 1e-3, 1000, "px");
   }
   {
     const std::string k = key + ".nudging";
     const YAML::Node d = f.Section(node, "nudging", k);
-    f.CheckKeys(d, k, {"gain", "motor_noise_fraction", "max_nudges", "stop_lateral_arcmin", "stop_depth_fraction",
-                       "stop_display_px", "min_step_m", "min_step_deg"});
+    f.CheckKeys(d, k,
+                {"gain", "motor_noise_fraction", "max_nudges", "stop_lateral_arcmin", "stop_depth_fraction",
+                 "stop_display_px", "min_step_m", "min_step_deg"});
     c.gain = f.NumberOr(d, "gain", k, c.gain, 0.01, 1.5);
     c.motor_noise_fraction = f.NumberOr(d, "motor_noise_fraction", k, c.motor_noise_fraction, 0, 1);
     c.max_nudges = static_cast<int>(f.IntegerOr(d, "max_nudges", k, c.max_nudges, 1, 10000));
@@ -143,7 +150,8 @@ std::vector<Eigen::Vector3d> RobotModelPoints(const sim::RobotModel& model, cons
     for (const auto& g : model.links()[i].collision) {
       const Eigen::Isometry3d X_RG = X_RL[i] * g.X_LG;
       add(X_RG.translation());
-      if (g.kind == sim::CollisionPrimitive::Kind::kCylinder || g.kind == sim::CollisionPrimitive::Kind::kCapsule) {
+      if (g.kind == sim::CollisionPrimitive::Kind::kCylinder ||
+          g.kind == sim::CollisionPrimitive::Kind::kCapsule) {
         const Eigen::Vector3d half = 0.5 * g.length_m * X_RG.linear().col(2);
         add(X_RG.translation() + half);
         add(X_RG.translation() - half);
@@ -217,7 +225,7 @@ AlignmentResult EmulatedUser::Align(const ViewingContext& ctx, const std::vector
   }
 
   const double w_lat = 1.0 / std::pow(c.assumed_lateral_arcmin * kArcminToRad, 2);  // × 1/ρ²
-  const double w_depth = 1.0 / std::pow(c.assumed_depth_fraction, 2);              // × 1/ρ²
+  const double w_depth = 1.0 / std::pow(c.assumed_depth_fraction, 2);               // × 1/ρ²
   const double w_px = 1.0 / std::pow(c.assumed_display_px, 2);
 
   // Unknowns of the person's fit: the nudge ξ (0..5); when they are blind to small size
@@ -351,7 +359,8 @@ AlignmentResult EmulatedUser::Align(const ViewingContext& ctx, const std::vector
     for (int i = 0; i < 6; ++i) applied[i] = c.gain * xi[i] * (1.0 + c.motor_noise_fraction * rng.Normal());
     const Eigen::Vector3d w_applied = applied.head<3>();
     Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-    if (w_applied.norm() > 0) T.linear() = Eigen::AngleAxisd(w_applied.norm(), w_applied.normalized()).toRotationMatrix();
+    if (w_applied.norm() > 0)
+      T.linear() = Eigen::AngleAxisd(w_applied.norm(), w_applied.normalized()).toRotationMatrix();
     T.translation() = c_W + applied.tail<3>() - T.linear() * c_W;
     X_WV = T * X_WV;
     X_WV.linear() = Eigen::Quaterniond(X_WV.linear()).normalized().toRotationMatrix();
@@ -375,8 +384,7 @@ PoseError EvaluatePose(const Eigen::Isometry3d& X_WV_cmp, const Eigen::Isometry3
   e.along_ray_m = std::abs(e.centroid_error_W_m.dot(nr));
   e.lateral_m = (e.centroid_error_W_m - e.centroid_error_W_m.dot(nr) * nr).norm();
   e.base_translation_error_m = (X_WV_cmp.translation() - X_WR.translation()).norm();
-  e.rotation_error_deg =
-      Eigen::AngleAxisd(X_WR.linear().transpose() * X_WV_cmp.linear()).angle() / kDegToRad;
+  e.rotation_error_deg = Eigen::AngleAxisd(X_WR.linear().transpose() * X_WV_cmp.linear()).angle() / kDegToRad;
   double sum = 0;
   for (const auto& p : p_RQ) sum += (X_WV_cmp * p - X_WR * p).norm();
   e.mean_point_error_m = sum / static_cast<double>(p_RQ.size());

@@ -58,8 +58,8 @@
 #include <string>
 #include <vector>
 
-#include <Eigen/Geometry>
 #include <yaml-cpp/yaml.h>
+#include <Eigen/Geometry>
 
 #include "hmd_emulator/camera_model.h"
 #include "sim/robot_model.h"
@@ -127,10 +127,10 @@ struct ReflectiveDisplayView {
 
 /// Everything that decides what the person sees during one trial.
 struct ViewingContext {
-  Eigen::Isometry3d X_WR{Eigen::Isometry3d::Identity()};        ///< real robot base (truth)
-  Eigen::Isometry3d X_WH_true{Eigen::Isometry3d::Identity()};   ///< head while aligning
-  Eigen::Isometry3d X_WH_est{Eigen::Isometry3d::Identity()};    ///< the device's estimate then
-  std::vector<ReflectiveDisplayView> displays;                  ///< empty: AR only
+  Eigen::Isometry3d X_WR{Eigen::Isometry3d::Identity()};       ///< real robot base (truth)
+  Eigen::Isometry3d X_WH_true{Eigen::Isometry3d::Identity()};  ///< head while aligning
+  Eigen::Isometry3d X_WH_est{Eigen::Isometry3d::Identity()};   ///< the device's estimate then
+  std::vector<ReflectiveDisplayView> displays;                 ///< empty: AR only
 };
 
 struct AlignmentResult {
@@ -158,10 +158,12 @@ class EmulatedUser {
                         const Eigen::Isometry3d& X_WV_start, std::uint64_t trial_seed) const;
 
   /// X_WV_start = X_WR_nominal · X_RV_start: the virtual robot shown at its known offset.
-  Eigen::Isometry3d StartPose(const Eigen::Isometry3d& X_WR_nominal) const { return X_WR_nominal * config_.X_RV_start; }
+  Eigen::Isometry3d StartPose(const Eigen::Isometry3d& X_WR_nominal) const {
+    return X_WR_nominal * config_.X_RV_start;
+  }
 
   const UserConfig& config() const { return config_; }
-  double depth_scale() const { return depth_scale_; }                ///< s
+  double depth_scale() const { return depth_scale_; }                   ///< s
   double depth_user_bias_fraction() const { return depth_user_bias_; }  ///< β_user
 
  private:

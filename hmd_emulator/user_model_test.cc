@@ -22,7 +22,9 @@ std::string SourceDir() {
   return root ? root : ".";
 }
 
-sim::RobotModel Robot() { return sim::RobotModel::LoadFile(SourceDir() + "/" + sim::RobotModel::kDefaultUrdfRelativePath); }
+sim::RobotModel Robot() {
+  return sim::RobotModel::LoadFile(SourceDir() + "/" + sim::RobotModel::kDefaultUrdfRelativePath);
+}
 
 TEST(RobotModelPoints, OnTheUprightArm) {
   const sim::RobotModel robot = Robot();
@@ -43,7 +45,8 @@ TEST(RobotModelPoints, OnTheUprightArm) {
 // A person who perceives perfectly, with perfect tracking, ends where the real robot is.
 TEST(EmulatedUser, PerfectPerceiverFindsTheTruth) {
   const sim::RobotModel robot = Robot();
-  const std::vector<Eigen::Vector3d> p_RQ = RobotModelPoints(robot, sim::DegToRad((Eigen::VectorXd(7) << 0, 20, 0, -70, 0, 60, 0).finished()));
+  const std::vector<Eigen::Vector3d> p_RQ =
+      RobotModelPoints(robot, sim::DegToRad((Eigen::VectorXd(7) << 0, 20, 0, -70, 0, 60, 0).finished()));
   UserConfig c;
   c.lateral_noise_arcmin = c.lateral_bias_arcmin = 0;
   c.depth_bias_fraction_std = c.depth_user_bias_fraction_std = c.depth_noise_fraction_std = 0;
@@ -86,7 +89,8 @@ TEST(EmulatedUser, PerfectPerceiverFindsTheTruth) {
 // about β · ρ (ρ ≈ 1.6 m to the robot's middle).
 TEST(EmulatedUser, DepthMisjudgementMovesAlongTheRay) {
   const sim::RobotModel robot = Robot();
-  const std::vector<Eigen::Vector3d> p_RQ = RobotModelPoints(robot, sim::DegToRad((Eigen::VectorXd(7) << 0, 20, 0, -70, 0, 60, 0).finished()));
+  const std::vector<Eigen::Vector3d> p_RQ =
+      RobotModelPoints(robot, sim::DegToRad((Eigen::VectorXd(7) << 0, 20, 0, -70, 0, 60, 0).finished()));
   UserConfig c;
   c.lateral_noise_arcmin = c.lateral_bias_arcmin = 0;
   c.depth_bias_fraction_std = c.depth_noise_fraction_std = 0;
@@ -181,7 +185,8 @@ TEST(EmulatedUser, DisplayFromTheAlignmentViewpointDoesNotHelp) {
   }
   const stats::MannWhitneyResult mw = stats::MannWhitneyU(reg[1], reg[0]);
   ASSERT_TRUE(mw.valid);
-  EXPECT_GT(mw.p_x_less, 0.05) << "same-viewpoint display: " << stats::Mean(reg[1]) << " vs " << stats::Mean(reg[0]);
+  EXPECT_GT(mw.p_x_less, 0.05) << "same-viewpoint display: " << stats::Mean(reg[1]) << " vs "
+                               << stats::Mean(reg[0]);
   EXPECT_GT(stats::Mean(reg[1]), 0.95 * stats::Mean(reg[0]));
 }
 
@@ -207,10 +212,12 @@ TEST(UserConfig, ShippedFileAndErrors) {
   EXPECT_DOUBLE_EQ(c.depth_bias_fraction_std, 0.012);
   EXPECT_NEAR(c.X_RV_start.translation().x(), 0.10, 1e-12);
   try {
-    ParseUserConfig(YamlFields::LoadString("user:\n  nudging:\n    gain: fast\n", "u.yaml")["user"], "u.yaml");
+    ParseUserConfig(YamlFields::LoadString("user:\n  nudging:\n    gain: fast\n", "u.yaml")["user"],
+                    "u.yaml");
     FAIL() << "expected an error";
   } catch (const std::runtime_error& e) {
-    EXPECT_EQ(std::string(e.what()), "u.yaml:3: user.nudging.gain: expected a number in [0.01, 1.5], got 'fast'");
+    EXPECT_EQ(std::string(e.what()),
+              "u.yaml:3: user.nudging.gain: expected a number in [0.01, 1.5], got 'fast'");
   }
 }
 

@@ -47,19 +47,22 @@ void AppendLine(std::string* out, const char* label, const std::vector<double>& 
 std::vector<StudyMode> RunStudy(const StudyOptions& o) {
   const std::string root = o.source_dir + "/";
   const sim::Scene scene = sim::LoadSceneFile(root + sim::kDefaultSceneRelativePath);
-  const sim::RobotModel robot = sim::LoadRobotForScene(root + sim::RobotModel::kDefaultUrdfRelativePath, scene);
-  const SlamConfig slam_base =
-      LoadSlamConfigFile(o.slam_config_path.empty() ? root + kDefaultSlamConfigRelativePath : o.slam_config_path);
-  const UserConfig user_base =
-      LoadUserConfigFile(o.user_config_path.empty() ? root + kDefaultUserConfigRelativePath : o.user_config_path);
-  const HeadTrajectoryConfig walk =
-      LoadHeadTrajectoryFile(o.walk_path.empty() ? root + "hmd_emulator/config/viraal_walk.yaml" : o.walk_path);
+  const sim::RobotModel robot =
+      sim::LoadRobotForScene(root + sim::RobotModel::kDefaultUrdfRelativePath, scene);
+  const SlamConfig slam_base = LoadSlamConfigFile(
+      o.slam_config_path.empty() ? root + kDefaultSlamConfigRelativePath : o.slam_config_path);
+  const UserConfig user_base = LoadUserConfigFile(
+      o.user_config_path.empty() ? root + kDefaultUserConfigRelativePath : o.user_config_path);
+  const HeadTrajectoryConfig walk = LoadHeadTrajectoryFile(
+      o.walk_path.empty() ? root + "hmd_emulator/config/viraal_walk.yaml" : o.walk_path);
   const std::vector<std::string> display_waypoints =
-      o.display_waypoints.empty() ? std::vector<std::string>{walk.waypoints.front().name} : o.display_waypoints;
+      o.display_waypoints.empty() ? std::vector<std::string>{walk.waypoints.front().name}
+                                  : o.display_waypoints;
 
   std::vector<std::vector<Eigen::Vector3d>> points;
   for (const auto& q_deg : kStudyConfigurationsDeg) {
-    points.push_back(RobotModelPoints(robot, sim::DegToRad(Eigen::Map<const Eigen::VectorXd>(q_deg.data(), 7))));
+    points.push_back(
+        RobotModelPoints(robot, sim::DegToRad(Eigen::Map<const Eigen::VectorXd>(q_deg.data(), 7))));
   }
 
   std::vector<StudyMode> modes;
@@ -103,29 +106,23 @@ std::string FormatStudyReport(const std::vector<StudyMode>& modes) {
     char head[120];
     std::snprintf(head, sizeof(head), "%s (%zu trials)\n", m.name.c_str(), m.trials.size());
     out += head;
-    AppendLine(&out, "registration, centroid [mm]", Series(m, [](const TrialOutcome& t) {
-                 return t.registration.translation_error_m;
-               }), 1e3);
-    AppendLine(&out, "registration, base origin [mm]", Series(m, [](const TrialOutcome& t) {
-                 return t.registration.base_translation_error_m;
-               }), 1e3);
-    AppendLine(&out, "registration, rotation [deg]", Series(m, [](const TrialOutcome& t) {
-                 return t.registration.rotation_error_deg;
-               }), 1.0);
-    AppendLine(&out, "augmentation, centroid [mm]", Series(m, [](const TrialOutcome& t) {
-                 return t.augmentation.translation_error_m;
-               }), 1e3);
-    AppendLine(&out, "augmentation, along the ray [mm]", Series(m, [](const TrialOutcome& t) {
-                 return t.augmentation.along_ray_m;
-               }), 1e3);
-    AppendLine(&out, "augmentation, across the ray [mm]", Series(m, [](const TrialOutcome& t) {
-                 return t.augmentation.lateral_m;
-               }), 1e3);
-    AppendLine(&out, "augmentation, mean point [mm]", Series(m, [](const TrialOutcome& t) {
-                 return t.augmentation.mean_point_error_m;
-               }), 1e3);
+    AppendLine(&out, "registration, centroid [mm]",
+               Series(m, [](const TrialOutcome& t) { return t.registration.translation_error_m; }), 1e3);
+    AppendLine(&out, "registration, base origin [mm]",
+               Series(m, [](const TrialOutcome& t) { return t.registration.base_translation_error_m; }), 1e3);
+    AppendLine(&out, "registration, rotation [deg]",
+               Series(m, [](const TrialOutcome& t) { return t.registration.rotation_error_deg; }), 1.0);
+    AppendLine(&out, "augmentation, centroid [mm]",
+               Series(m, [](const TrialOutcome& t) { return t.augmentation.translation_error_m; }), 1e3);
+    AppendLine(&out, "augmentation, along the ray [mm]",
+               Series(m, [](const TrialOutcome& t) { return t.augmentation.along_ray_m; }), 1e3);
+    AppendLine(&out, "augmentation, across the ray [mm]",
+               Series(m, [](const TrialOutcome& t) { return t.augmentation.lateral_m; }), 1e3);
+    AppendLine(&out, "augmentation, mean point [mm]",
+               Series(m, [](const TrialOutcome& t) { return t.augmentation.mean_point_error_m; }), 1e3);
     AppendLine(&out, "nudges", Series(m, [](const TrialOutcome& t) { return t.alignment.nudges; }), 1.0);
-    AppendLine(&out, "duration [s]", Series(m, [](const TrialOutcome& t) { return t.alignment.duration_s; }), 1.0);
+    AppendLine(&out, "duration [s]", Series(m, [](const TrialOutcome& t) { return t.alignment.duration_s; }),
+               1.0);
     AppendLine(&out, "SE(3) mean of 3, base origin [mm]", m.mean_base_error_m, 1e3);
   }
   if (modes.size() >= 2) {
@@ -137,10 +134,11 @@ std::string FormatStudyReport(const std::vector<StudyMode>& modes) {
                   c.mann_whitney.p_x_less);
     out += line;
     if (c.signed_rank.valid) {
-      std::snprintf(line, sizeof(line),
-                    "Wilcoxon signed-rank (paired trials, %s < %s): W+ = %.1f of %d pairs, z = %.2f, p = %.3g\n",
-                    modes.back().name.c_str(), modes.front().name.c_str(), c.signed_rank.w_plus, c.signed_rank.n,
-                    c.signed_rank.z, c.signed_rank.p_x_less);
+      std::snprintf(
+          line, sizeof(line),
+          "Wilcoxon signed-rank (paired trials, %s < %s): W+ = %.1f of %d pairs, z = %.2f, p = %.3g\n",
+          modes.back().name.c_str(), modes.front().name.c_str(), c.signed_rank.w_plus, c.signed_rank.n,
+          c.signed_rank.z, c.signed_rank.p_x_less);
       out += line;
     }
   }

@@ -39,7 +39,7 @@ inline const std::array<std::array<double, 7>, 3> kStudyConfigurationsDeg{{
 struct StudyOptions {
   std::string source_dir = ".";  ///< repository root (URDF, scene, configs)
   int trials_per_mode = 200;
-  int trials_per_user = 10;      ///< the paper: 10 trials per user
+  int trials_per_user = 10;  ///< the paper: 10 trials per user
   std::uint64_t base_user_seed = 1000;
   /// Optional overrides of the shipped configs (empty = hmd_emulator/config/*.yaml).
   std::string slam_config_path, user_config_path, walk_path;

@@ -38,7 +38,8 @@ int main(int argc, char** argv) {
     const bool has_value = i + 1 < argc;
     if (a == "--help" || a == "-h") {
       std::printf(
-          "usage: hmd-user-study [--trials N] [--source DIR] [--user FILE] [--slam FILE] [--display-at WAYPOINT]...\n"
+          "usage: hmd-user-study [--trials N] [--source DIR] [--user FILE] [--slam FILE] [--display-at "
+          "WAYPOINT]...\n"
           "  --trials N            trials per display mode, a positive integer (default %d)\n"
           "  --display-at WAYPOINT where the reflective display captures its frame (repeat for more\n"
           "                        displays; default: the walk's first waypoint)\n",

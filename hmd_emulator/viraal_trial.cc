@@ -15,7 +15,8 @@ TrialOutcome RunTrial(const TrialSetup& setup, const SlamConfig& slam, const Emu
   };
   const double t_align = trajectory.ArrivalTime(waypoint(setup.align_waypoint)) + setup.settle_s;
   std::vector<double> t_capture;
-  for (const auto& name : setup.capture_waypoints) t_capture.push_back(trajectory.ArrivalTime(waypoint(name)));
+  for (const auto& name : setup.capture_waypoints)
+    t_capture.push_back(trajectory.ArrivalTime(waypoint(name)));
 
   TrialOutcome out;
   SlamModel model(slam);
@@ -38,8 +39,8 @@ TrialOutcome RunTrial(const TrialSetup& setup, const SlamConfig& slam, const Emu
   // A person waits for the headset to track again before aligning (holograms swim or freeze while
   // tracking is limited or lost): keep standing until TRACKING, for at most max_wait_s.
   const Eigen::Isometry3d X_WH_stand = trajectory.X_WH(t_align);
-  for (double t = t_align + dt; out.at_alignment.state != TrackingState::kTracking && t <= t_align + setup.max_wait_s;
-       t += dt) {
+  for (double t = t_align + dt;
+       out.at_alignment.state != TrackingState::kTracking && t <= t_align + setup.max_wait_s; t += dt) {
     out.at_alignment = model.Step(X_WH_stand, t);
     if (out.at_alignment.state == TrackingState::kRelocalized) ++out.relocalizations;
   }
@@ -58,8 +59,8 @@ TrialOutcome RunTrial(const TrialSetup& setup, const SlamConfig& slam, const Emu
   out.alignment = user.Align(ctx, setup.p_RQ, X_WV_start, trial_seed);
   const Eigen::Vector3d p_W_eye = ctx.X_WH_true.translation();
   out.registration = EvaluatePose(out.alignment.X_WV, setup.X_WR, setup.p_RQ, p_W_eye);
-  out.augmentation =
-      EvaluatePose(ApparentPose(ctx.X_WH_true, ctx.X_WH_est, out.alignment.X_WV), setup.X_WR, setup.p_RQ, p_W_eye);
+  out.augmentation = EvaluatePose(ApparentPose(ctx.X_WH_true, ctx.X_WH_est, out.alignment.X_WV), setup.X_WR,
+                                  setup.p_RQ, p_W_eye);
   return out;
 }
 

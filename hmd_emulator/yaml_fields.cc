@@ -60,7 +60,8 @@ void YamlFields::CheckKeys(const YAML::Node& map, const std::string& key,
   }
 }
 
-YAML::Node YamlFields::Required(const YAML::Node& map, const std::string& name, const std::string& key) const {
+YAML::Node YamlFields::Required(const YAML::Node& map, const std::string& name,
+                                const std::string& key) const {
   const YAML::Node child = map[name];
   if (!child.IsDefined() || child.IsNull()) Fail(map, key, "missing (required)");
   return child;
@@ -83,7 +84,8 @@ double YamlFields::Number(const YAML::Node& node, const std::string& key, double
   } catch (const YAML::Exception&) {
     Fail(node, key, "expected " + expected + ", got '" + node.Scalar() + "'");
   }
-  if (!std::isfinite(v) || v < lo || v > hi) Fail(node, key, "expected " + expected + ", got '" + node.Scalar() + "'");
+  if (!std::isfinite(v) || v < lo || v > hi)
+    Fail(node, key, "expected " + expected + ", got '" + node.Scalar() + "'");
   return v;
 }
 
@@ -94,7 +96,8 @@ double YamlFields::NumberOr(const YAML::Node& map, const std::string& name, cons
   return Number(child, Join(prefix, name), lo, hi, unit);
 }
 
-long long YamlFields::Integer(const YAML::Node& node, const std::string& key, long long lo, long long hi) const {
+long long YamlFields::Integer(const YAML::Node& node, const std::string& key, long long lo,
+                              long long hi) const {
   const std::string expected = "an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
   if (!node.IsScalar()) Fail(node, key, "expected " + expected);
   long long v = 0;
@@ -125,7 +128,8 @@ bool YamlFields::BoolOr(const YAML::Node& map, const std::string& name, const st
   }
 }
 
-Eigen::Vector3d YamlFields::Vector3(const YAML::Node& node, const std::string& key, const std::string& unit) const {
+Eigen::Vector3d YamlFields::Vector3(const YAML::Node& node, const std::string& key,
+                                    const std::string& unit) const {
   const std::string expected = "a list of 3 numbers [" + unit + "]";
   if (!node.IsSequence() || node.size() != 3) Fail(node, key, "expected " + expected);
   Eigen::Vector3d v;

@@ -11,8 +11,8 @@
 #include <set>
 #include <string>
 
-#include <Eigen/Core>
 #include <yaml-cpp/yaml.h>
+#include <Eigen/Core>
 
 namespace orbed::hmd {
 

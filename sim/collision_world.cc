@@ -5,11 +5,11 @@
 #include <numeric>
 #include <stdexcept>
 
-#include <btBulletCollisionCommon.h>
 #include <BulletCollision/NarrowPhaseCollision/btGjkEpaPenetrationDepthSolver.h>
 #include <BulletCollision/NarrowPhaseCollision/btGjkPairDetector.h>
 #include <BulletCollision/NarrowPhaseCollision/btPointCollector.h>
 #include <BulletCollision/NarrowPhaseCollision/btVoronoiSimplexSolver.h>
+#include <btBulletCollisionCommon.h>
 
 #include "sim/distance_closed_form.h"
 
@@ -43,7 +43,8 @@ std::unique_ptr<btConvexShape> MakeShape(const CollisionPrimitive& g) {
       shape->setMargin(CollisionWorld::kMarginM);
       break;
     case Kind::kBox:
-      shape = std::make_unique<btBoxShape>(btVector3(0.5 * g.size_m.x(), 0.5 * g.size_m.y(), 0.5 * g.size_m.z()));
+      shape =
+          std::make_unique<btBoxShape>(btVector3(0.5 * g.size_m.x(), 0.5 * g.size_m.y(), 0.5 * g.size_m.z()));
       shape->setMargin(CollisionWorld::kMarginM);
       break;
   }
@@ -53,10 +54,14 @@ std::unique_ptr<btConvexShape> MakeShape(const CollisionPrimitive& g) {
 // Radius of the sphere about the primitive's origin that contains it.
 double BoundingRadius(const CollisionPrimitive& g) {
   switch (g.kind) {
-    case Kind::kSphere: return g.radius_m;
-    case Kind::kCapsule: return 0.5 * g.length_m + g.radius_m;
-    case Kind::kCylinder: return std::hypot(0.5 * g.length_m, g.radius_m);
-    case Kind::kBox: return 0.5 * g.size_m.norm();
+    case Kind::kSphere:
+      return g.radius_m;
+    case Kind::kCapsule:
+      return 0.5 * g.length_m + g.radius_m;
+    case Kind::kCylinder:
+      return std::hypot(0.5 * g.length_m, g.radius_m);
+    case Kind::kBox:
+      return 0.5 * g.size_m.norm();
   }
   return kInf;
 }
@@ -65,14 +70,16 @@ double BoundingRadius(const CollisionPrimitive& g) {
 // but these are exact.
 double PointDistance(const CollisionPrimitive& g, const Eigen::Vector3d& p) {
   switch (g.kind) {
-    case Kind::kSphere: return p.norm() - g.radius_m;
+    case Kind::kSphere:
+      return p.norm() - g.radius_m;
     case Kind::kCapsule: {
       const double h = 0.5 * g.length_m;
       const Eigen::Vector3d c(0, 0, std::clamp(p.z(), -h, h));
       return (p - c).norm() - g.radius_m;
     }
     case Kind::kCylinder: {
-      const Eigen::Vector2d q(std::sqrt(p.x() * p.x() + p.y() * p.y()) - g.radius_m, std::abs(p.z()) - 0.5 * g.length_m);
+      const Eigen::Vector2d q(std::sqrt(p.x() * p.x() + p.y() * p.y()) - g.radius_m,
+                              std::abs(p.z()) - 0.5 * g.length_m);
       return q.cwiseMax(0.0).norm() + std::min(q.maxCoeff(), 0.0);
     }
     case Kind::kBox: {
@@ -149,8 +156,8 @@ struct PairCache {
 };
 
 // One exact signed distance between two posed convex shapes by GJK (EPA when the cores overlap).
-void GjkDistance(const btConvexShape* a, const btTransform& X_WA, const btConvexShape* b, const btTransform& X_WB,
-                 SignedDistance* out) {
+void GjkDistance(const btConvexShape* a, const btTransform& X_WA, const btConvexShape* b,
+                 const btTransform& X_WB, SignedDistance* out) {
   btVoronoiSimplexSolver simplex;
   btGjkEpaPenetrationDepthSolver epa;
   btGjkPairDetector gjk(a, b, &simplex, &epa);
@@ -185,7 +192,8 @@ bool ChildDistance(const Child& a, const Child& b, bool fast_path, SignedDistanc
 // Lower bound on the distance of two children: bounding spheres for self pairs, the exact scene
 // shape against the robot child's bounding sphere otherwise.
 double ChildLowerBound(const Child& ca, const Child& cb, bool self) {
-  if (self) return (ca.X_WC.translation() - cb.X_WC.translation()).norm() - ca.bound_radius_m - cb.bound_radius_m;
+  if (self)
+    return (ca.X_WC.translation() - cb.X_WC.translation()).norm() - ca.bound_radius_m - cb.bound_radius_m;
   return PointDistance(cb.prim, cb.X_CW * ca.X_WC.translation()) - ca.bound_radius_m;
 }
 
@@ -203,7 +211,7 @@ struct CollisionWorld::Impl {
   // Scratch for queries (sized once, reused).
   std::vector<double> lower_bound;
   std::vector<char> done;
-  std::vector<int> seed;  // per link, then self group, then environment group: the pair of least bound
+  std::vector<int> seed;         // per link, then self group, then environment group: the pair of least bound
   std::vector<PairCache> cache;  // per pair
 
   ~Impl() {
@@ -296,13 +304,14 @@ CollisionWorld::CollisionWorld(const RobotModel& model, const Scene* scene, cons
       const SceneObject& o = scene->objects[im.bodies[b].object];
       for (const auto& name : o.ignore_links) {
         if (model_.FindLink(name) < 0) {
-          throw std::invalid_argument(scene->source + ": object '" + o.name + "' ignore_links names '" + name +
-                                      "', which is not a link of " + model_.source_name());
+          throw std::invalid_argument(scene->source + ": object '" + o.name + "' ignore_links names '" +
+                                      name + "', which is not a link of " + model_.source_name());
         }
       }
       for (int a = 0; a < num_robot_bodies; ++a) {
         const std::string& link_name = im.bodies[a].name;
-        if (std::find(o.ignore_links.begin(), o.ignore_links.end(), link_name) != o.ignore_links.end()) continue;
+        if (std::find(o.ignore_links.begin(), o.ignore_links.end(), link_name) != o.ignore_links.end())
+          continue;
         im.pairs.push_back({a, b, false});
       }
     }
@@ -312,7 +321,8 @@ CollisionWorld::CollisionWorld(const RobotModel& model, const Scene* scene, cons
 CollisionWorld::~CollisionWorld() = default;
 
 int CollisionWorld::num_self_pairs() const {
-  return static_cast<int>(std::count_if(impl_->pairs.begin(), impl_->pairs.end(), [](const Pair& p) { return p.self; }));
+  return static_cast<int>(
+      std::count_if(impl_->pairs.begin(), impl_->pairs.end(), [](const Pair& p) { return p.self; }));
 }
 
 int CollisionWorld::num_environment_pairs() const {
@@ -450,8 +460,10 @@ CollisionResult CollisionWorld::CheckPoses(const std::vector<Eigen::Isometry3d>&
       // Skip only what cannot lower link A's or B's clearance, its group's closest pair (and so the
       // overall minimum) or enter the report list.
       const double clear_b = p.self ? result.link_clearance_m[im.bodies[p.b].link] : -kInf;
-      const double group_min = p.self ? result.closest_self.distance_m : result.closest_environment.distance_m;
-      if (lb >= result.link_clearance_m[im.bodies[p.a].link] && lb >= clear_b && lb >= group_min && lb >= report) {
+      const double group_min =
+          p.self ? result.closest_self.distance_m : result.closest_environment.distance_m;
+      if (lb >= result.link_clearance_m[im.bodies[p.a].link] && lb >= clear_b && lb >= group_min &&
+          lb >= report) {
         continue;
       }
       compute(i);
@@ -485,7 +497,8 @@ std::vector<CollisionWorld::CheckedPair> CollisionWorld::CheckedPairs() const {
 
 std::vector<CollisionPrimitive> CollisionWorld::LinkPrimitives(int link) const {
   std::vector<CollisionPrimitive> out;
-  if (link < 0 || link >= static_cast<int>(impl_->body_of_link.size()) || impl_->body_of_link[link] < 0) return out;
+  if (link < 0 || link >= static_cast<int>(impl_->body_of_link.size()) || impl_->body_of_link[link] < 0)
+    return out;
   for (const Child& c : impl_->bodies[impl_->body_of_link[link]].children) out.push_back(c.prim);
   return out;
 }

@@ -56,16 +56,16 @@ namespace orbed::sim {
 
 /// The closest points of one checked pair.
 struct PairDistance {
-  std::string body_a;   ///< a robot link name
-  std::string body_b;   ///< a robot link name (self) or a scene object name (environment)
-  int link_a{-1};       ///< robot link index of body_a
-  int link_b{-1};       ///< robot link index of body_b, -1 for a scene object
-  int object_b{-1};     ///< scene object index of body_b, -1 for a robot link
+  std::string body_a;  ///< a robot link name
+  std::string body_b;  ///< a robot link name (self) or a scene object name (environment)
+  int link_a{-1};      ///< robot link index of body_a
+  int link_b{-1};      ///< robot link index of body_b, -1 for a scene object
+  int object_b{-1};    ///< scene object index of body_b, -1 for a robot link
   bool self{false};
   double distance_m{std::numeric_limits<double>::infinity()};  ///< signed; < 0 penetrating
-  Eigen::Vector3d p_WA{Eigen::Vector3d::Zero()};  ///< closest (deepest) point on A
-  Eigen::Vector3d p_WB{Eigen::Vector3d::Zero()};  ///< closest (deepest) point on B
-  Eigen::Vector3d normal_W{Eigen::Vector3d::UnitZ()};  ///< unit, from B toward A
+  Eigen::Vector3d p_WA{Eigen::Vector3d::Zero()};               ///< closest (deepest) point on A
+  Eigen::Vector3d p_WB{Eigen::Vector3d::Zero()};               ///< closest (deepest) point on B
+  Eigen::Vector3d normal_W{Eigen::Vector3d::UnitZ()};          ///< unit, from B toward A
   bool valid() const { return link_a >= 0; }
 };
 
@@ -80,7 +80,7 @@ struct CollisionResult {
   std::vector<double> link_clearance_m;
   /// Every pair closer than Options::report_distance_m, sorted by distance.
   std::vector<PairDistance> contacts;
-  int pairs_computed{0};  ///< pairs whose exact distance was computed (the rest were pruned)
+  int pairs_computed{0};       ///< pairs whose exact distance was computed (the rest were pruned)
   int primitive_pairs_gjk{0};  ///< primitive pairs of those that went to GJK/EPA (not a closed form)
 };
 

@@ -20,7 +20,9 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 using Kind = CollisionPrimitive::Kind;
 
-RobotModel LoadIiwa() { return RobotModel::LoadFile(orbed::sim::SourceTreePath(RobotModel::kDefaultUrdfRelativePath)); }
+RobotModel LoadIiwa() {
+  return RobotModel::LoadFile(orbed::sim::SourceTreePath(RobotModel::kDefaultUrdfRelativePath));
+}
 
 Eigen::VectorXd Deg(std::initializer_list<double> v) {
   Eigen::VectorXd q(v.size());
@@ -102,8 +104,8 @@ TEST(CollisionWorldTest, SphereSphereAndSphereBoxClosedForms) {
   CollisionPrimitive box;
   box.kind = Kind::kBox;
   box.size_m = Eigen::Vector3d(1.0, 0.6, 0.2);  // half extents 0.5, 0.3, 0.1
-  for (const Eigen::Vector3d& c : {Eigen::Vector3d(0.2, 0.1, 0.35), Eigen::Vector3d(0.2, 0.1, 0.15),
-                                   Eigen::Vector3d(0.0, 0.45, 0.0)}) {
+  for (const Eigen::Vector3d& c :
+       {Eigen::Vector3d(0.2, 0.1, 0.35), Eigen::Vector3d(0.2, 0.1, 0.15), Eigen::Vector3d(0.0, 0.45, 0.0)}) {
     XA.translation() = c;
     const double face = std::max(std::abs(c.z()) - 0.1, std::abs(c.y()) - 0.3);
     EXPECT_NEAR(CollisionWorld::PrimitiveDistance(s, XA, box, Eigen::Isometry3d::Identity()).distance_m,
@@ -187,7 +189,8 @@ TEST(CollisionWorldTest, SelfDistancesMatchSegmentDistancesAndSelfCollisionExist
   std::string example;
   for (int n = 0; n < 3000; ++n) {
     Eigen::VectorXd q(7);
-    for (int i = 0; i < 7; ++i) q[i] = m.joints()[i].lower_rad + u(rng) * (m.joints()[i].upper_rad - m.joints()[i].lower_rad);
+    for (int i = 0; i < 7; ++i)
+      q[i] = m.joints()[i].lower_rad + u(rng) * (m.joints()[i].upper_rad - m.joints()[i].lower_rad);
     const CollisionResult r = world.Check(q);
     const auto caps = ArmCapsules(m, q);
     if (r.closest_self.distance_m < 0) {
@@ -196,7 +199,8 @@ TEST(CollisionWorldTest, SelfDistancesMatchSegmentDistancesAndSelfCollisionExist
     }
     for (int i = 1; i <= 6; ++i) {
       for (int j = i + 2; j <= 6; ++j) {
-        const PairDistance* p = FindPair(r, "iiwa_link_" + std::to_string(i), "iiwa_link_" + std::to_string(j));
+        const PairDistance* p =
+            FindPair(r, "iiwa_link_" + std::to_string(i), "iiwa_link_" + std::to_string(j));
         ASSERT_NE(p, nullptr) << i << "," << j;
         const double seg = SegmentSegmentDistance(caps[i].a, caps[i].b, caps[j].a, caps[j].b);
         if (seg < 1e-3) continue;
@@ -209,15 +213,16 @@ TEST(CollisionWorldTest, SelfDistancesMatchSegmentDistancesAndSelfCollisionExist
   EXPECT_GT(checked, 10000);
   // Within the limits the folded arm can hit itself.
   EXPECT_GT(any_self_collision, 0);
-  std::cout << "self-collisions in " << any_self_collision << " of 3000 random joint vectors (e.g. " << example
-            << "); among the capsule links 1-6: " << collisions << "\n";
+  std::cout << "self-collisions in " << any_self_collision << " of 3000 random joint vectors (e.g. "
+            << example << "); among the capsule links 1-6: " << collisions << "\n";
 }
 
 TEST(CollisionWorldTest, FoldedArmHitsItsBaseByHandComputedDepth) {
   // q2 = 120 tilts the upper arm 30 deg below horizontal (toward +x), q4 = -120 folds the forearm
   // back to 240 deg from vertical: direction (-sin 60, -cos 60). The link-5 capsule's lower cap
   // centre, 0.27 m down the forearm from joint 4, is then at
-  //   x = 0.4 sin 120 + 0.27 sin 240 = 0.13 sin 60 = 0.112583 m,  z = 0.34 + 0.4 cos 120 + 0.27 cos 240 = 0.005 m,
+  //   x = 0.4 sin 120 + 0.27 sin 240 = 0.13 sin 60 = 0.112583 m,  z = 0.34 + 0.4 cos 120 + 0.27 cos 240 =
+  //   0.005 m,
   // inside the base cylinder's height (0..0.15 m) and 0.012583 m out from its side (r 0.1), so the
   // capsule (r 0.065) sinks 0.065 - 0.012583 = 0.052417 m into the base.
   const RobotModel m = LoadIiwa();
@@ -276,7 +281,8 @@ TEST(CollisionWorldTest, ResultsAreFreshAndPruningChangesNothing) {
   std::uniform_real_distribution<double> u(0, 1);
   for (int n = 0; n < 200; ++n) {
     Eigen::VectorXd q(7);
-    for (int i = 0; i < 7; ++i) q[i] = m.joints()[i].lower_rad + u(rng) * (m.joints()[i].upper_rad - m.joints()[i].lower_rad);
+    for (int i = 0; i < 7; ++i)
+      q[i] = m.joints()[i].lower_rad + u(rng) * (m.joints()[i].upper_rad - m.joints()[i].lower_rad);
     const CollisionResult a = pruned.Check(q), b = full.Check(q);
     EXPECT_EQ(a.in_collision, b.in_collision);
     EXPECT_DOUBLE_EQ(a.min_distance_m, b.min_distance_m);
@@ -325,8 +331,8 @@ double PointRoundedCylinder(const Eigen::Vector3d& p, double radius, double leng
 
 // Reference distance of a sphere or capsule A to a cylinder B: the point distance minimised along
 // A's axis by golden-section search (convex), to ~1e-15.
-double ReferenceToCylinder(const CollisionPrimitive& a, const Eigen::Isometry3d& XA, const CollisionPrimitive& b,
-                           const Eigen::Isometry3d& XB) {
+double ReferenceToCylinder(const CollisionPrimitive& a, const Eigen::Isometry3d& XA,
+                           const CollisionPrimitive& b, const Eigen::Isometry3d& XB) {
   const double h = a.kind == Kind::kCapsule ? 0.5 * a.length_m : 0.0;
   const Eigen::Vector3d c = XB.inverse() * XA.translation(), z = XB.linear().transpose() * XA.linear().col(2);
   auto f = [&](double t) { return PointRoundedCylinder(c + t * z, b.radius_m, b.length_m); };
@@ -361,9 +367,9 @@ TEST(CollisionWorldTest, FastPathMatchesGjkForEveryPrimitivePair) {
         const Eigen::Isometry3d XA = RandomPose(rng, 0.25), XB = RandomPose(rng, 0.25);
         const PairDistance fast = CollisionWorld::PrimitiveDistance(a, XA, b, XB, true);
         const PairDistance gjk = CollisionWorld::PrimitiveDistance(a, XA, b, XB, false);
-        const std::string what = std::to_string(static_cast<int>(ka)) + std::to_string(static_cast<int>(kb)) + " #" +
-                                 std::to_string(i) + " fast " + std::to_string(fast.distance_m) + " gjk " +
-                                 std::to_string(gjk.distance_m);
+        const std::string what = std::to_string(static_cast<int>(ka)) + std::to_string(static_cast<int>(kb)) +
+                                 " #" + std::to_string(i) + " fast " + std::to_string(fast.distance_m) +
+                                 " gjk " + std::to_string(gjk.distance_m);
         const double diff = std::abs(fast.distance_m - gjk.distance_m);
         // The fast path's witnesses are consistent with its distance.
         EXPECT_NEAR((fast.p_WA - (fast.p_WB + fast.normal_W * fast.distance_m)).norm(), 0.0, 1e-12) << what;
@@ -372,7 +378,8 @@ TEST(CollisionWorldTest, FastPathMatchesGjkForEveryPrimitivePair) {
         const bool with_cylinder = ka == Kind::kCylinder || kb == Kind::kCylinder;
         if (with_cylinder && (round(ka) || round(kb))) {
           // Sphere/capsule against a cylinder: the fast path is exact, GJK over-estimates a little.
-          const double ref = round(ka) ? ReferenceToCylinder(a, XA, b, XB) : ReferenceToCylinder(b, XB, a, XA);
+          const double ref =
+              round(ka) ? ReferenceToCylinder(a, XA, b, XB) : ReferenceToCylinder(b, XB, a, XA);
           if (disjoint_cores || ka == Kind::kSphere || kb == Kind::kSphere) {
             EXPECT_NEAR(fast.distance_m, ref, kExactTolM) << what;
             max_ref = std::max(max_ref, std::abs(fast.distance_m - ref));
@@ -403,10 +410,10 @@ TEST(CollisionWorldTest, FastPathMatchesGjkForEveryPrimitivePair) {
   EXPECT_GT(exact, 10000);
   EXPECT_GT(epa, 1000);
   EXPECT_GT(cylinder, 5000);
-  std::cout << "fast vs GJK: " << exact << " disjoint-core pairs, max |diff| " << max_exact << " m (closest points "
-            << max_point << " m); " << epa << " overlapping-core pairs, max |diff| " << max_epa << " m; " << cylinder
-            << " sphere/capsule-cylinder pairs: fast vs reference " << max_ref << " m, GJK over-estimates by up to "
-            << max_gjk_cyl << " m\n";
+  std::cout << "fast vs GJK: " << exact << " disjoint-core pairs, max |diff| " << max_exact
+            << " m (closest points " << max_point << " m); " << epa << " overlapping-core pairs, max |diff| "
+            << max_epa << " m; " << cylinder << " sphere/capsule-cylinder pairs: fast vs reference "
+            << max_ref << " m, GJK over-estimates by up to " << max_gjk_cyl << " m\n";
 }
 
 TEST(CollisionWorldTest, SegmentBoxPenetrationIsExact) {
@@ -424,8 +431,9 @@ TEST(CollisionWorldTest, SegmentBoxPenetrationIsExact) {
   EXPECT_NEAR(d.normal_W.z(), 1.0, 1e-12);
   EXPECT_NEAR(d.p_WB.z(), 0.1, 1e-12);
   EXPECT_NEAR(d.p_WA.z(), 0.02, 1e-12);
-  EXPECT_NEAR(CollisionWorld::PrimitiveDistance(cap, XA, box, Eigen::Isometry3d::Identity(), false).distance_m, -0.08,
-              1e-9);
+  EXPECT_NEAR(
+      CollisionWorld::PrimitiveDistance(cap, XA, box, Eigen::Isometry3d::Identity(), false).distance_m, -0.08,
+      1e-9);
 }
 
 TEST(CollisionWorldTest, FastPathMatchesGjkOverRandomConfigurations) {
@@ -447,7 +455,8 @@ TEST(CollisionWorldTest, FastPathMatchesGjkOverRandomConfigurations) {
   };
   std::map<std::tuple<int, int, int>, PairInfo> info;
   for (const auto& p : fast.CheckedPairs()) {
-    std::vector<CollisionPrimitive> bs = p.link_b >= 0 ? fast.LinkPrimitives(p.link_b) : std::vector<CollisionPrimitive>(1);
+    std::vector<CollisionPrimitive> bs =
+        p.link_b >= 0 ? fast.LinkPrimitives(p.link_b) : std::vector<CollisionPrimitive>(1);
     if (p.link_b < 0) {
       const SceneObject& o = scene.objects[p.object_b];
       bs[0].kind = o.shape == SceneObject::Shape::kBox        ? Kind::kBox
@@ -467,11 +476,13 @@ TEST(CollisionWorldTest, FastPathMatchesGjkOverRandomConfigurations) {
   }
   std::mt19937_64 rng(17);
   std::uniform_real_distribution<double> u(0, 1);
-  int exact = 0, epa = 0, cylinder = 0, fast_gjk_prims = 0, gjk_gjk_prims = 0, clearances = 0, clearances_1e9 = 0;
+  int exact = 0, epa = 0, cylinder = 0, fast_gjk_prims = 0, gjk_gjk_prims = 0, clearances = 0,
+      clearances_1e9 = 0;
   double max_exact = 0, max_epa = 0, max_cyl = 0, max_clear = 0;
   for (int n = 0; n < 3000; ++n) {
     Eigen::VectorXd q(7);
-    for (int i = 0; i < 7; ++i) q[i] = m.joints()[i].lower_rad + u(rng) * (m.joints()[i].upper_rad - m.joints()[i].lower_rad);
+    for (int i = 0; i < 7; ++i)
+      q[i] = m.joints()[i].lower_rad + u(rng) * (m.joints()[i].upper_rad - m.joints()[i].lower_rad);
     // Per pair: fast vs GJK.
     const CollisionResult fa = fast_all.Check(q), ga = gjk_all.Check(q);
     ASSERT_EQ(fa.contacts.size(), ga.contacts.size());
@@ -501,16 +512,20 @@ TEST(CollisionWorldTest, FastPathMatchesGjkOverRandomConfigurations) {
     fast_gjk_prims += f.primitive_pairs_gjk;
     gjk_gjk_prims += g.primitive_pairs_gjk;
     EXPECT_EQ(f.min_distance_m, fa.min_distance_m) << "q#" << n;
-    EXPECT_EQ(f.closest.body_a + "/" + f.closest.body_b, fa.closest.body_a + "/" + fa.closest.body_b) << "q#" << n;
+    EXPECT_EQ(f.closest.body_a + "/" + f.closest.body_b, fa.closest.body_a + "/" + fa.closest.body_b)
+        << "q#" << n;
     EXPECT_EQ(f.closest_self.distance_m, fa.closest_self.distance_m) << "q#" << n;
     EXPECT_EQ(f.closest_environment.distance_m, fa.closest_environment.distance_m) << "q#" << n;
-    for (int i = 0; i < m.num_links(); ++i) EXPECT_EQ(f.link_clearance_m[i], fa.link_clearance_m[i]) << "q#" << n;
+    for (int i = 0; i < m.num_links(); ++i)
+      EXPECT_EQ(f.link_clearance_m[i], fa.link_clearance_m[i]) << "q#" << n;
     // Fast vs GJK on the query result: the same closest pair (unless the runner-up is within GJK's
     // cylinder error) and the same clearances within the per-pair tolerances.
     EXPECT_EQ(f.in_collision, g.in_collision) << "q#" << n;
     EXPECT_NEAR(f.min_distance_m, g.min_distance_m, kGjkCylinderTolM) << "q#" << n;
-    if (fa.contacts.size() < 2 || fa.contacts[1].distance_m - fa.contacts[0].distance_m > 2 * kGjkCylinderTolM) {
-      EXPECT_EQ(f.closest.body_a + "/" + f.closest.body_b, g.closest.body_a + "/" + g.closest.body_b) << "q#" << n;
+    if (fa.contacts.size() < 2 ||
+        fa.contacts[1].distance_m - fa.contacts[0].distance_m > 2 * kGjkCylinderTolM) {
+      EXPECT_EQ(f.closest.body_a + "/" + f.closest.body_b, g.closest.body_a + "/" + g.closest.body_b)
+          << "q#" << n;
     }
     for (int i = 0; i < m.num_links(); ++i) {
       const double gi = g.link_clearance_m[i], fi = f.link_clearance_m[i];
@@ -529,10 +544,11 @@ TEST(CollisionWorldTest, FastPathMatchesGjkOverRandomConfigurations) {
   EXPECT_GT(exact, 100000);
   EXPECT_GT(epa, 100);
   EXPECT_LT(fast_gjk_prims, gjk_gjk_prims / 5);
-  std::cout << "3000 configurations, fast vs GJK per pair: " << exact << " exact-both pairs max |diff| " << max_exact
-            << " m; " << epa << " overlapping-core (EPA) pairs max " << max_epa << " m; " << cylinder
-            << " sphere/capsule-cylinder pairs max " << max_cyl << " m (GJK's error). Per-link clearance: "
-            << clearances_1e9 << " of " << clearances << " within 1e-9 m, max " << max_clear
+  std::cout << "3000 configurations, fast vs GJK per pair: " << exact << " exact-both pairs max |diff| "
+            << max_exact << " m; " << epa << " overlapping-core (EPA) pairs max " << max_epa << " m; "
+            << cylinder << " sphere/capsule-cylinder pairs max " << max_cyl
+            << " m (GJK's error). Per-link clearance: " << clearances_1e9 << " of " << clearances
+            << " within 1e-9 m, max " << max_clear
             << " m. GJK primitive pairs per query: " << fast_gjk_prims / 3000.0 << " (fast path) vs "
             << gjk_gjk_prims / 3000.0 << " (GJK only)\n";
 }

@@ -101,8 +101,8 @@ double ClosestOnCore(const CoreShape& b, const Vector3d& p, Vector3d* cp, Vector
 // secant step on g' (bisection when the bracket stops halving). The intersection of the tangent
 // lines at the bracket ends is a lower bound on the minimum, so the search stops with a certified
 // gap. False if the segment comes within kTouchM of the core or the search does not converge.
-bool SegmentToCore(const Vector3d& a, const Vector3d& d, const CoreShape& core, Vector3d* p_best, Vector3d* cp_best,
-                   Vector3d* n_best, double* g_best) {
+bool SegmentToCore(const Vector3d& a, const Vector3d& d, const CoreShape& core, Vector3d* p_best,
+                   Vector3d* cp_best, Vector3d* n_best, double* g_best) {
   struct Sample {
     double t, g, dg;
     Vector3d p, cp, n;
@@ -204,8 +204,8 @@ bool SegmentInBox(const Vector3d& p0, const Vector3d& d, const Vector3d& e, doub
 }
 
 // Core distance for kind(a) <= kind(b) (Point < Segment < Box < Cylinder).
-bool CoreDistance(const CoreShape& a, const Eigen::Isometry3d& X_WA, const CoreShape& b, const Eigen::Isometry3d& X_WB,
-                  CoreResult* r) {
+bool CoreDistance(const CoreShape& a, const Eigen::Isometry3d& X_WA, const CoreShape& b,
+                  const Eigen::Isometry3d& X_WB, CoreResult* r) {
   const Vector3d ca = X_WA.translation(), cb = X_WB.translation();
   const Vector3d za = X_WA.linear().col(2), zb = X_WB.linear().col(2);
   switch (b.kind) {
@@ -225,8 +225,9 @@ bool CoreDistance(const CoreShape& a, const Eigen::Isometry3d& X_WA, const CoreS
       // Crossing cores: the depth is the sum of the radii along the normal of the plane of both axes
       // (any perpendicular if parallel), oriented from B toward A.
       Vector3d fallback = da.cross(db);
-      fallback = fallback.squaredNorm() > 1e-24 ? Vector3d(fallback.normalized())
-                                                : (da.squaredNorm() > 0 ? AnyPerpendicular(da) : Vector3d::UnitZ());
+      fallback = fallback.squaredNorm() > 1e-24
+                     ? Vector3d(fallback.normalized())
+                     : (da.squaredNorm() > 0 ? AnyPerpendicular(da) : Vector3d::UnitZ());
       if (fallback.dot(ca - cb) < 0) fallback = -fallback;
       FromPoints(p0 + s * da, q0 + t * db, fallback, r);
       return true;
@@ -247,7 +248,8 @@ bool CoreDistance(const CoreShape& a, const Eigen::Isometry3d& X_WA, const CoreS
         if (!SegmentToCore(p0_B, d_B, b, &p_B, &cp_B, &n_B, &g)) {
           // The axis reaches the core: exact for a box, GJK/EPA for a cylinder.
           double depth = 0;
-          if (b.kind != Kind::kBox || !SegmentInBox(p0_B, d_B, b.half_extents_m, &depth, &n_B, &p_B)) return false;
+          if (b.kind != Kind::kBox || !SegmentInBox(p0_B, d_B, b.half_extents_m, &depth, &n_B, &p_B))
+            return false;
           g = -depth;
           cp_B = p_B + depth * n_B;  // on the box's supporting plane along n
         }
@@ -264,8 +266,8 @@ bool CoreDistance(const CoreShape& a, const Eigen::Isometry3d& X_WA, const CoreS
 
 }  // namespace
 
-double ClosestSegmentSegment(const Vector3d& p0, const Vector3d& p1, const Vector3d& q0, const Vector3d& q1, double* s,
-                             double* t) {
+double ClosestSegmentSegment(const Vector3d& p0, const Vector3d& p1, const Vector3d& q0, const Vector3d& q1,
+                             double* s, double* t) {
   const Vector3d d1 = p1 - p0, d2 = q1 - q0, r = p0 - q0;
   const double a = d1.squaredNorm(), e = d2.squaredNorm(), f = d2.dot(r);
   double sc = 0, tc = 0;

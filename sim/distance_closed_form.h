@@ -44,10 +44,11 @@ namespace orbed::sim {
 struct CoreShape {
   enum class Kind { kPoint, kSegment, kBox, kCylinder };
   Kind kind{Kind::kPoint};
-  double half_length_m{0};                              ///< kSegment: core from -h to +h on z
-  Eigen::Vector3d half_extents_m{Eigen::Vector3d::Zero()};  ///< kBox: core half extents;
-                                                        ///< kCylinder: x = core radius, z = core half height
-  double margin_m{0};                                   ///< ball radius swept over the core
+  double half_length_m{0};  ///< kSegment: core from -h to +h on z
+  Eigen::Vector3d half_extents_m{
+      Eigen::Vector3d::Zero()};  ///< kBox: core half extents;
+                                 ///< kCylinder: x = core radius, z = core half height
+  double margin_m{0};            ///< ball radius swept over the core
 };
 
 /// Signed distance and closest points of two primitives (see the file comment for conventions).

@@ -20,7 +20,8 @@ namespace {
 
 static_assert(static_cast<int>(MotionState::kIdle) == orbed::robot_state_t::MOTION_IDLE &&
                   static_cast<int>(MotionState::kMoving) == orbed::robot_state_t::MOTION_MOVING &&
-                  static_cast<int>(MotionState::kStoppedAtLimit) == orbed::robot_state_t::MOTION_STOPPED_AT_LIMIT &&
+                  static_cast<int>(MotionState::kStoppedAtLimit) ==
+                      orbed::robot_state_t::MOTION_STOPPED_AT_LIMIT &&
                   static_cast<int>(MotionState::kStoppedBeforeCollision) ==
                       orbed::robot_state_t::MOTION_STOPPED_BEFORE_COLLISION &&
                   static_cast<int>(MotionState::kInCollision) == orbed::robot_state_t::MOTION_IN_COLLISION,
@@ -40,8 +41,9 @@ IiwaSimOptions Resolved(IiwaSimOptions options) {
   // the arm steps by exactly P, so that stamps and steps agree.
   if (!(options.period_sec > 0) || !(options.period_sec <= 3600) ||
       std::llround(options.period_sec * 1e6) < 1) {
-    throw std::invalid_argument("--period-sec must be a number of seconds in [1e-6, 3600] (it is rounded to "
-                                "whole microseconds)");
+    throw std::invalid_argument(
+        "--period-sec must be a number of seconds in [1e-6, 3600] (it is rounded to "
+        "whole microseconds)");
   }
   options.period_sec = static_cast<double>(std::llround(options.period_sec * 1e6)) / 1e6;
   if (!(options.stale_command_sec >= 0) || !std::isfinite(options.stale_command_sec)) {
@@ -101,8 +103,8 @@ IiwaSim::IiwaSim(const orbed::CommonFlags& flags, const IiwaSimOptions& options)
 
   process_ = std::make_unique<orbed::Process>(flags);
   process_->Subscribe<orbed::iiwa_command_t>(
-      options_.iiwa_command_channel,
-      [this](const orbed::iiwa_command_t& msg, const std::string& channel, int64_t) { OnCommand(msg, channel); });
+      options_.iiwa_command_channel, [this](const orbed::iiwa_command_t& msg, const std::string& channel,
+                                            int64_t) { OnCommand(msg, channel); });
   process_->Subscribe<orbed::plan_check_request_t>(
       options_.plan_check_request_channel,
       [this](const orbed::plan_check_request_t& msg, const std::string& channel, int64_t) {
@@ -129,7 +131,8 @@ void IiwaSim::OnCommand(const orbed::iiwa_command_t& msg, const std::string& cha
       static_cast<size_t>(msg.num_torques) != msg.joint_torque.size()) {
     process_->Reject(channel + "/num_torques", "num_torques is " + std::to_string(msg.num_torques) +
                                                    " with " + std::to_string(msg.joint_torque.size()) +
-                                                   " torques, expected 0 or num_joints (" + std::to_string(n) + ")");
+                                                   " torques, expected 0 or num_joints (" +
+                                                   std::to_string(n) + ")");
     return;
   }
   error = FirstError(
@@ -142,10 +145,10 @@ void IiwaSim::OnCommand(const orbed::iiwa_command_t& msg, const std::string& cha
     // In double: a wild utime (e.g. INT64_MIN) must not overflow the subtraction.
     const double age_s = (static_cast<double>(NowMicros()) - static_cast<double>(msg.utime)) * 1e-6;
     if (std::abs(age_s) > options_.stale_command_sec) {
-      process_->Reject(channel + "/stale", "utime " + std::to_string(msg.utime) + " is " +
-                                               Fixed(std::abs(age_s), 3) + " s " +
-                                               (age_s > 0 ? "older than" : "ahead of") + " the wall clock (limit " +
-                                               Fixed(options_.stale_command_sec, 3) + " s)");
+      process_->Reject(channel + "/stale",
+                       "utime " + std::to_string(msg.utime) + " is " + Fixed(std::abs(age_s), 3) + " s " +
+                           (age_s > 0 ? "older than" : "ahead of") + " the wall clock (limit " +
+                           Fixed(options_.stale_command_sec, 3) + " s)");
       return;
     }
   }

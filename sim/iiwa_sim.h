@@ -40,12 +40,12 @@
 /// clock. Only when a tick finds itself more than MaxLagMicros() = max(100 ms, 20 P) behind its
 /// deadline (a stall, whose deadlines the loop skipped) does k jump to the last deadline passed
 /// (logged, at most every 10 s): the sim clock never falls behind for good, and the jump never puts
-/// it ahead of the schedule. So utime strictly increases by whole multiples of P (exactly P but after a stall),
-/// a step never exceeds v_max * P (ManualArm), and the speed read from the stamps,
-/// |q_k - q_j| / (utime_k - utime_j), never exceeds the joint's velocity limit, however loaded the
-/// machine: utime says when the state holds in simulated time, not when it was computed. Tick()
-/// called directly (tests) advances k by one per call the same way. Wall clock: the stale-command
-/// check (senders stamp commands with their wall clocks), PLAN_CHECK_REPLY and PROCESS_STATUS.
+/// it ahead of the schedule. So utime strictly increases by whole multiples of P (exactly P but after a
+/// stall), a step never exceeds v_max * P (ManualArm), and the speed read from the stamps, |q_k - q_j| /
+/// (utime_k - utime_j), never exceeds the joint's velocity limit, however loaded the machine: utime says when
+/// the state holds in simulated time, not when it was computed. Tick() called directly (tests) advances k by
+/// one per call the same way. Wall clock: the stale-command check (senders stamp commands with their wall
+/// clocks), PLAN_CHECK_REPLY and PROCESS_STATUS.
 ///
 /// Threading: everything on the Process::Run() thread.
 

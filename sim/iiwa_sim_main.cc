@@ -10,9 +10,10 @@
 #include "sim/iiwa_sim.h"
 
 int main(int argc, char** argv) {
-  CLI::App app{"orbed-iiwa-sim: simulated iiwa 7 arm (URDF + Bullet collision world) executing\n"
-               "IIWA_COMMAND like a hand-guided arm; publishes IIWA_STATUS, ROBOT_STATE and\n"
-               "COLLISION_STATUS every tick and answers PLAN_CHECK_REQUEST."};
+  CLI::App app{
+      "orbed-iiwa-sim: simulated iiwa 7 arm (URDF + Bullet collision world) executing\n"
+      "IIWA_COMMAND like a hand-guided arm; publishes IIWA_STATUS, ROBOT_STATE and\n"
+      "COLLISION_STATUS every tick and answers PLAN_CHECK_REQUEST."};
   orbed::CommonFlags common("orbed-iiwa-sim");
   orbed::AddCommonFlags(&app, &common);
   orbed::sim::IiwaSimOptions options;
@@ -24,7 +25,8 @@ int main(int argc, char** argv) {
   app.add_option("--period-sec", options.period_sec, "Tick and status period [s] (0.005 = 200 Hz)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  app.add_option("--initial-q-deg", options.initial_q_deg, "Initial joint angles q1,...,q7 [deg] (default: all 0)")
+  app.add_option("--initial-q-deg", options.initial_q_deg,
+                 "Initial joint angles q1,...,q7 [deg] (default: all 0)")
       ->delimiter(',');
   app.add_option("--stale-command-sec", options.stale_command_sec,
                  "Reject IIWA_COMMAND whose utime is further than this from the wall clock [s]; 0 = off")

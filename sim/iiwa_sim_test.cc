@@ -34,8 +34,12 @@ struct Collector {
   std::vector<orbed::robot_state_t> state;
   std::vector<orbed::collision_status_t> collision;
   std::map<int64_t, orbed::plan_check_reply_t> replies;
-  void OnStatus(const lcm::ReceiveBuffer*, const std::string&, const orbed::iiwa_status_t* m) { status.push_back(*m); }
-  void OnState(const lcm::ReceiveBuffer*, const std::string&, const orbed::robot_state_t* m) { state.push_back(*m); }
+  void OnStatus(const lcm::ReceiveBuffer*, const std::string&, const orbed::iiwa_status_t* m) {
+    status.push_back(*m);
+  }
+  void OnState(const lcm::ReceiveBuffer*, const std::string&, const orbed::robot_state_t* m) {
+    state.push_back(*m);
+  }
   void OnCollision(const lcm::ReceiveBuffer*, const std::string&, const orbed::collision_status_t* m) {
     collision.push_back(*m);
   }
@@ -142,7 +146,8 @@ TEST(IiwaSim, AnswersPlanChecksIncludingInvalidOnes) {
   const orbed::plan_check_request_t six = Request(14, {0, 0, 0, 0, 0, 0});
   orbed::plan_check_request_t nan_request = Request(15, {0, 0, 0, 0, 0, 0, 0});
   nan_request.joint_position[2] = std::nan("");
-  const std::vector<orbed::plan_check_request_t> requests{upright, elbow_in_patient, beyond_limit, six, nan_request};
+  const std::vector<orbed::plan_check_request_t> requests{upright, elbow_in_patient, beyond_limit, six,
+                                                          nan_request};
   for (const orbed::plan_check_request_t& req : requests) {
     lcm.publish("PLAN_CHECK_REQUEST", &req);
   }
@@ -252,8 +257,8 @@ TEST(IiwaSim, CommandBeyondALimitStopsAtTheLimitWithinTheJointSpeeds) {
     const double dt_s = (got.status[k].utime - got.status[k - 1].utime) * 1e-6;
     for (int i = 0; i < 7; ++i) {
       const double speed_deg_per_s =
-          std::abs(got.status[k].joint_position_measured[i] - got.status[k - 1].joint_position_measured[i]) / dt_s /
-          kDeg;
+          std::abs(got.status[k].joint_position_measured[i] - got.status[k - 1].joint_position_measured[i]) /
+          dt_s / kDeg;
       EXPECT_LE(speed_deg_per_s, kSpeedDegPerS[i] * (1 + 1e-9)) << "tick " << k + 1 << " joint " << i + 1;
       if (i == 6) peak7_deg_per_s = std::max(peak7_deg_per_s, speed_deg_per_s);
     }

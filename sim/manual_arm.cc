@@ -26,11 +26,16 @@ CollisionWorld::Options WorldOptions(const ManualArmOptions& options) {
 
 const char* MotionStateName(MotionState state) {
   switch (state) {
-    case MotionState::kIdle: return "idle";
-    case MotionState::kMoving: return "moving";
-    case MotionState::kStoppedAtLimit: return "stopped at limit";
-    case MotionState::kStoppedBeforeCollision: return "stopped before collision";
-    case MotionState::kInCollision: return "in collision";
+    case MotionState::kIdle:
+      return "idle";
+    case MotionState::kMoving:
+      return "moving";
+    case MotionState::kStoppedAtLimit:
+      return "stopped at limit";
+    case MotionState::kStoppedBeforeCollision:
+      return "stopped before collision";
+    case MotionState::kInCollision:
+      return "in collision";
   }
   return "?";
 }
@@ -154,7 +159,8 @@ void ManualArm::ApplyCollisionState() {
   if (!collision_.in_collision) return;
   state_ = MotionState::kInCollision;
   const PairDistance& c = collision_.closest;
-  stop_reason_ = "in collision: " + c.body_a + " vs " + c.body_b + " penetrate by " + Fixed(-c.distance_m, 4) + " m";
+  stop_reason_ =
+      "in collision: " + c.body_a + " vs " + c.body_b + " penetrate by " + Fixed(-c.distance_m, 4) + " m";
 }
 
 std::vector<int> ManualArm::LimitHits() const {

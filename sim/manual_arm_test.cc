@@ -20,8 +20,9 @@ const double kSpeedDegPerS[7] = {98, 98, 100, 130, 140, 180, 180};
 const double kLimitDeg[7] = {170, 120, 170, 120, 170, 120, 175};
 
 struct Fixture {
-  Fixture() : model(RobotModel::LoadFile(orbed::sim::SourceTreePath("sim/models/iiwa7.urdf"))),
-              scene(LoadSceneFile(orbed::sim::SourceTreePath("sim/models/scenes/trocar_or.yaml"))) {
+  Fixture()
+      : model(RobotModel::LoadFile(orbed::sim::SourceTreePath("sim/models/iiwa7.urdf"))),
+        scene(LoadSceneFile(orbed::sim::SourceTreePath("sim/models/scenes/trocar_or.yaml"))) {
     model.SetToolLength(scene.tool_length_m);
   }
   RobotModel model;

@@ -45,7 +45,8 @@ std::vector<CollisionPrimitive> FuseCapsules(const std::vector<CollisionPrimitiv
     const CollisionPrimitive& cylinder = in[i];
     int caps[2] = {-1, -1};
     for (int e = 0; e < 2; ++e) {
-      const Eigen::Vector3d p_LE = cylinder.X_LG * Eigen::Vector3d(0, 0, (e == 0 ? -0.5 : 0.5) * cylinder.length_m);
+      const Eigen::Vector3d p_LE =
+          cylinder.X_LG * Eigen::Vector3d(0, 0, (e == 0 ? -0.5 : 0.5) * cylinder.length_m);
       for (size_t j = 0; j < in.size(); ++j) {
         if (used[j] || in[j].kind != Kind::kSphere || static_cast<int>(j) == caps[0]) continue;
         if (std::abs(in[j].radius_m - cylinder.radius_m) <= kCapsuleFuseToleranceM &&
@@ -83,16 +84,14 @@ RobotModel RobotModel::LoadFile(const std::string& path, const std::string& flan
 }
 
 RobotModel RobotModel::LoadString(const std::string& urdf_xml, const std::string& source_name,
-                                  const std::string& flange_link,
-                                  const std::string& tool_tip_link) {
+                                  const std::string& flange_link, const std::string& tool_tip_link) {
   const std::string src = source_name;
-  auto fail = [&src](const std::string& what) -> void {
-    throw std::runtime_error(src + ": " + what);
-  };
+  auto fail = [&src](const std::string& what) -> void { throw std::runtime_error(src + ": " + what); };
   urdf::ModelInterfaceSharedPtr urdf_model = urdf::parseURDF(urdf_xml);
   if (!urdf_model) {
-    fail("urdfdom could not parse this URDF (malformed XML, a missing <robot>, a joint naming an "
-         "unknown link, or a loop; `check_urdf` prints the details)");
+    fail(
+        "urdfdom could not parse this URDF (malformed XML, a missing <robot>, a joint naming an "
+        "unknown link, or a loop; `check_urdf` prints the details)");
   }
   urdf::LinkConstSharedPtr root = urdf_model->getRoot();
   if (!root) fail("the URDF has no root link");
@@ -102,86 +101,87 @@ RobotModel RobotModel::LoadString(const std::string& urdf_xml, const std::string
   std::map<std::string, int> index_of;
 
   // Depth-first walk from the root, parent before child.
-  std::function<void(const urdf::LinkConstSharedPtr&, int)> visit =
-      [&](const urdf::LinkConstSharedPtr& link, int parent) {
-        RobotLink out;
-        out.name = link->name;
-        out.parent = parent;
-        if (parent >= 0) {
-          const urdf::JointConstSharedPtr joint = link->parent_joint;
-          const std::string where = "joint '" + joint->name + "'";
-          out.joint_name = joint->name;
-          out.X_PJ = ToIsometry(joint->parent_to_joint_origin_transform);
-          if (joint->type == urdf::Joint::REVOLUTE) {
-            const Eigen::Vector3d axis(joint->axis.x, joint->axis.y, joint->axis.z);
-            if (!axis.allFinite() || axis.norm() < 1e-9) fail(where + ": <axis xyz> must be a non-zero vector");
-            out.axis_J = axis.normalized();
-            if (!joint->limits) fail(where + ": a revolute joint needs <limit lower upper velocity>");
-            JointInfo info;
-            info.name = joint->name;
-            info.lower_rad = joint->limits->lower;
-            info.upper_rad = joint->limits->upper;
-            info.velocity_rad_per_s = joint->limits->velocity;
-            if (!std::isfinite(info.lower_rad) || !std::isfinite(info.upper_rad) ||
-                !(info.lower_rad < info.upper_rad)) {
-              fail(where + ": <limit lower upper> must be finite with lower < upper (got " +
-                   Fmt(info.lower_rad) + ", " + Fmt(info.upper_rad) + ")");
-            }
-            if (!FinitePositive(info.velocity_rad_per_s)) {
-              fail(where + ": <limit velocity> must be > 0 rad/s (got " + Fmt(info.velocity_rad_per_s) + ")");
-            }
-            out.joint_index = static_cast<int>(model.joints_.size());
-            info.link = static_cast<int>(model.links_.size());
-            model.joints_.push_back(info);
-          } else if (joint->type != urdf::Joint::FIXED) {
-            fail(where + ": only 'revolute' (with limits) and 'fixed' joints are supported");
-          }
+  std::function<void(const urdf::LinkConstSharedPtr&, int)> visit = [&](const urdf::LinkConstSharedPtr& link,
+                                                                        int parent) {
+    RobotLink out;
+    out.name = link->name;
+    out.parent = parent;
+    if (parent >= 0) {
+      const urdf::JointConstSharedPtr joint = link->parent_joint;
+      const std::string where = "joint '" + joint->name + "'";
+      out.joint_name = joint->name;
+      out.X_PJ = ToIsometry(joint->parent_to_joint_origin_transform);
+      if (joint->type == urdf::Joint::REVOLUTE) {
+        const Eigen::Vector3d axis(joint->axis.x, joint->axis.y, joint->axis.z);
+        if (!axis.allFinite() || axis.norm() < 1e-9) fail(where + ": <axis xyz> must be a non-zero vector");
+        out.axis_J = axis.normalized();
+        if (!joint->limits) fail(where + ": a revolute joint needs <limit lower upper velocity>");
+        JointInfo info;
+        info.name = joint->name;
+        info.lower_rad = joint->limits->lower;
+        info.upper_rad = joint->limits->upper;
+        info.velocity_rad_per_s = joint->limits->velocity;
+        if (!std::isfinite(info.lower_rad) || !std::isfinite(info.upper_rad) ||
+            !(info.lower_rad < info.upper_rad)) {
+          fail(where + ": <limit lower upper> must be finite with lower < upper (got " + Fmt(info.lower_rad) +
+               ", " + Fmt(info.upper_rad) + ")");
         }
-        for (const auto& c : link->collision_array) {
-          if (!c || !c->geometry) continue;
-          const std::string where =
-              "link '" + link->name + "' <collision" + (c->name.empty() ? "" : " name='" + c->name + "'") + ">";
-          CollisionPrimitive g;
-          g.name = c->name;
-          g.X_LG = ToIsometry(c->origin);
-          switch (c->geometry->type) {
-            case urdf::Geometry::SPHERE: {
-              const auto& s = static_cast<const urdf::Sphere&>(*c->geometry);
-              g.kind = CollisionPrimitive::Kind::kSphere;
-              g.radius_m = s.radius;
-              if (!FinitePositive(g.radius_m)) fail(where + ": <sphere radius> must be > 0 m");
-              break;
-            }
-            case urdf::Geometry::CYLINDER: {
-              const auto& s = static_cast<const urdf::Cylinder&>(*c->geometry);
-              g.kind = CollisionPrimitive::Kind::kCylinder;
-              g.radius_m = s.radius;
-              g.length_m = s.length;
-              if (!FinitePositive(g.radius_m) || !FinitePositive(g.length_m)) {
-                fail(where + ": <cylinder radius length> must both be > 0 m");
-              }
-              break;
-            }
-            case urdf::Geometry::BOX: {
-              const auto& s = static_cast<const urdf::Box&>(*c->geometry);
-              g.kind = CollisionPrimitive::Kind::kBox;
-              g.size_m = Eigen::Vector3d(s.dim.x, s.dim.y, s.dim.z);
-              if (!(g.size_m.array() > 0).all() || !g.size_m.allFinite()) {
-                fail(where + ": <box size> must be three lengths > 0 m");
-              }
-              break;
-            }
-            default:
-              fail(where + ": only <sphere>, <cylinder> and <box> collision geometry is supported "
-                           "(meshes are not; <capsule> is dropped by urdfdom — use a cylinder plus two spheres)");
-          }
-          out.collision.push_back(g);
+        if (!FinitePositive(info.velocity_rad_per_s)) {
+          fail(where + ": <limit velocity> must be > 0 rad/s (got " + Fmt(info.velocity_rad_per_s) + ")");
         }
-        const int me = static_cast<int>(model.links_.size());
-        index_of[out.name] = me;
-        model.links_.push_back(out);
-        for (const auto& child : link->child_links) visit(child, me);
-      };
+        out.joint_index = static_cast<int>(model.joints_.size());
+        info.link = static_cast<int>(model.links_.size());
+        model.joints_.push_back(info);
+      } else if (joint->type != urdf::Joint::FIXED) {
+        fail(where + ": only 'revolute' (with limits) and 'fixed' joints are supported");
+      }
+    }
+    for (const auto& c : link->collision_array) {
+      if (!c || !c->geometry) continue;
+      const std::string where =
+          "link '" + link->name + "' <collision" + (c->name.empty() ? "" : " name='" + c->name + "'") + ">";
+      CollisionPrimitive g;
+      g.name = c->name;
+      g.X_LG = ToIsometry(c->origin);
+      switch (c->geometry->type) {
+        case urdf::Geometry::SPHERE: {
+          const auto& s = static_cast<const urdf::Sphere&>(*c->geometry);
+          g.kind = CollisionPrimitive::Kind::kSphere;
+          g.radius_m = s.radius;
+          if (!FinitePositive(g.radius_m)) fail(where + ": <sphere radius> must be > 0 m");
+          break;
+        }
+        case urdf::Geometry::CYLINDER: {
+          const auto& s = static_cast<const urdf::Cylinder&>(*c->geometry);
+          g.kind = CollisionPrimitive::Kind::kCylinder;
+          g.radius_m = s.radius;
+          g.length_m = s.length;
+          if (!FinitePositive(g.radius_m) || !FinitePositive(g.length_m)) {
+            fail(where + ": <cylinder radius length> must both be > 0 m");
+          }
+          break;
+        }
+        case urdf::Geometry::BOX: {
+          const auto& s = static_cast<const urdf::Box&>(*c->geometry);
+          g.kind = CollisionPrimitive::Kind::kBox;
+          g.size_m = Eigen::Vector3d(s.dim.x, s.dim.y, s.dim.z);
+          if (!(g.size_m.array() > 0).all() || !g.size_m.allFinite()) {
+            fail(where + ": <box size> must be three lengths > 0 m");
+          }
+          break;
+        }
+        default:
+          fail(where +
+               ": only <sphere>, <cylinder> and <box> collision geometry is supported "
+               "(meshes are not; <capsule> is dropped by urdfdom — use a cylinder plus two spheres)");
+      }
+      out.collision.push_back(g);
+    }
+    const int me = static_cast<int>(model.links_.size());
+    index_of[out.name] = me;
+    model.links_.push_back(out);
+    for (const auto& child : link->child_links) visit(child, me);
+  };
   visit(root, -1);
   if (model.joints_.empty()) fail("the URDF has no revolute joint");
 
@@ -214,7 +214,8 @@ RobotModel RobotModel::LoadString(const std::string& urdf_xml, const std::string
     const auto X = model.CalcLinkPoses(q0);
     const Eigen::Isometry3d X_FT = X[model.flange_link_].inverse() * X[model.tool_tip_link_];
     if (model.links_[model.tool_tip_link_].body != model.links_[model.flange_link_].body) {
-      fail("link '" + tool_tip_link + "' (the tool tip T) must be attached to the flange by fixed joints only");
+      fail("link '" + tool_tip_link +
+           "' (the tool tip T) must be attached to the flange by fixed joints only");
     }
     if ((X_FT.linear() - Eigen::Matrix3d::Identity()).norm() > 1e-9 ||
         X_FT.translation().head<2>().norm() > 1e-9 || X_FT.translation().z() <= 0) {

@@ -26,21 +26,21 @@ namespace orbed::sim {
 struct CollisionPrimitive {
   enum class Kind { kSphere, kCylinder, kBox, kCapsule };
   Kind kind{Kind::kSphere};
-  std::string name;            ///< the URDF <collision name=...> (may be empty)
+  std::string name;  ///< the URDF <collision name=...> (may be empty)
   Eigen::Isometry3d X_LG{Eigen::Isometry3d::Identity()};
-  double radius_m{0};          ///< sphere, cylinder, capsule
-  double length_m{0};          ///< cylinder, capsule
+  double radius_m{0};                               ///< sphere, cylinder, capsule
+  double length_m{0};                               ///< cylinder, capsule
   Eigen::Vector3d size_m{Eigen::Vector3d::Zero()};  ///< box, full extents
 };
 
 /// A link of the kinematic tree, in topological order (parent before child).
 struct RobotLink {
   std::string name;
-  int parent{-1};              ///< index into links(), -1 for the root R
-  int joint_index{-1};         ///< index into the actuated joints, -1 if rigidly attached
-  std::string joint_name;      ///< the URDF joint connecting it to its parent (empty for the root)
+  int parent{-1};          ///< index into links(), -1 for the root R
+  int joint_index{-1};     ///< index into the actuated joints, -1 if rigidly attached
+  std::string joint_name;  ///< the URDF joint connecting it to its parent (empty for the root)
   Eigen::Isometry3d X_PJ{Eigen::Isometry3d::Identity()};  ///< joint frame in the parent link frame
-  Eigen::Vector3d axis_J{Eigen::Vector3d::UnitZ()};      ///< unit joint axis in the joint frame
+  Eigen::Vector3d axis_J{Eigen::Vector3d::UnitZ()};       ///< unit joint axis in the joint frame
   std::vector<CollisionPrimitive> collision;
   /// Index of the rigid body this link belongs to: links joined by fixed joints share one body (e.g.
   /// iiwa_link_7, iiwa_link_ee, iiwa_tool, tool_tip). Two bodies are *adjacent* when one actuated
@@ -51,7 +51,7 @@ struct RobotLink {
 /// Limits of one actuated (revolute) joint.
 struct JointInfo {
   std::string name;
-  int link{-1};                ///< the child link it moves
+  int link{-1};  ///< the child link it moves
   double lower_rad{0};
   double upper_rad{0};
   double velocity_rad_per_s{0};
@@ -110,8 +110,8 @@ class RobotModel {
   std::vector<Eigen::Isometry3d> CalcLinkPoses(const Eigen::VectorXd& q_rad) const;
   /// Same without allocation; `X_RL` is resized to num_links().
   void CalcLinkPoses(const Eigen::VectorXd& q_rad, std::vector<Eigen::Isometry3d>* X_RL) const;
-  Eigen::Isometry3d CalcFlangePose(const Eigen::VectorXd& q_rad) const;    ///< X_RF
-  Eigen::Isometry3d CalcToolTipPose(const Eigen::VectorXd& q_rad) const;   ///< X_RT
+  Eigen::Isometry3d CalcFlangePose(const Eigen::VectorXd& q_rad) const;   ///< X_RF
+  Eigen::Isometry3d CalcToolTipPose(const Eigen::VectorXd& q_rad) const;  ///< X_RT
 
   /// Geometric Jacobian of frame `link` (origin point) in R: rows 0-2 angular velocity w_RL, rows 3-5
   /// translational velocity v_RL of L's origin, both expressed in R; 6 x num_joints().

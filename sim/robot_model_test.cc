@@ -13,17 +13,16 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-RobotModel LoadIiwa() { return RobotModel::LoadFile(orbed::sim::SourceTreePath(RobotModel::kDefaultUrdfRelativePath)); }
+RobotModel LoadIiwa() {
+  return RobotModel::LoadFile(orbed::sim::SourceTreePath(RobotModel::kDefaultUrdfRelativePath));
+}
 
 // The iiwa 7 R800 data-sheet DH parameters (DESIGN §4), evaluated by hand:
 // T_{i-1,i} = Rz(theta_i) Tz(d_i) Tx(a_i) Rx(alpha_i).
 Eigen::Matrix4d DhTransform(double theta, double d, double a, double alpha) {
   const double ct = std::cos(theta), st = std::sin(theta), ca = std::cos(alpha), sa = std::sin(alpha);
   Eigen::Matrix4d T;
-  T << ct, -st * ca, st * sa, a * ct,
-       st, ct * ca, -ct * sa, a * st,
-       0, sa, ca, d,
-       0, 0, 0, 1;
+  T << ct, -st * ca, st * sa, a * ct, st, ct * ca, -ct * sa, a * st, 0, sa, ca, d, 0, 0, 0, 1;
   return T;
 }
 
@@ -61,7 +60,8 @@ TEST(RobotModelTest, LoadsSevenJointsWithDataSheetLimits) {
 TEST(RobotModelTest, ZeroPoseFlangeAt1266Upright) {
   const RobotModel m = LoadIiwa();
   const Eigen::Isometry3d X_RF = m.CalcFlangePose(Eigen::VectorXd::Zero(7));
-  EXPECT_TRUE(X_RF.translation().isApprox(Eigen::Vector3d(0, 0, 1.266), 1e-12)) << X_RF.translation().transpose();
+  EXPECT_TRUE(X_RF.translation().isApprox(Eigen::Vector3d(0, 0, 1.266), 1e-12))
+      << X_RF.translation().transpose();
   EXPECT_TRUE(X_RF.linear().isApprox(Eigen::Matrix3d::Identity(), 1e-12));
   const Eigen::Isometry3d X_RT = m.CalcToolTipPose(Eigen::VectorXd::Zero(7));
   EXPECT_NEAR(X_RT.translation().z(), 1.266 + 0.25, 1e-12);
@@ -121,7 +121,7 @@ TEST(RobotModelTest, SetToolLengthMovesTipAndStretchesShaft) {
   for (const auto& g : m.links()[m.tool_link()].collision) {
     if (g.name == "shaft") {
       found = true;
-      EXPECT_NEAR(g.length_m, 0.35, 1e-12);                    // from 0.05 to 0.40
+      EXPECT_NEAR(g.length_m, 0.35, 1e-12);  // from 0.05 to 0.40
       EXPECT_NEAR(g.X_LG.translation().z(), 0.225, 1e-12);
     }
     if (g.name == "adaptor") {
@@ -226,20 +226,25 @@ std::string Expect(const std::string& xml) {
 TEST(RobotModelTest, BadUrdfsAreRejectedWithTheElement) {
   const std::string head = "<robot name='r'><link name='a'/><link name='iiwa_link_ee'/>";
   EXPECT_NE(Expect("<robot").find("bad.urdf"), std::string::npos);
-  std::string e = Expect(head + "<joint name='j1' type='continuous'><parent link='a'/><child link='iiwa_link_ee'/>"
+  std::string e = Expect(head +
+                         "<joint name='j1' type='continuous'><parent link='a'/><child link='iiwa_link_ee'/>"
                          "<axis xyz='0 0 1'/></joint></robot>");
   EXPECT_NE(e.find("bad.urdf: joint 'j1'"), std::string::npos) << e;
-  e = Expect(head + "<joint name='j1' type='revolute'><parent link='a'/><child link='iiwa_link_ee'/>"
+  e = Expect(head +
+             "<joint name='j1' type='revolute'><parent link='a'/><child link='iiwa_link_ee'/>"
              "<axis xyz='0 0 1'/><limit lower='-1' upper='1' effort='1' velocity='0'/></joint></robot>");
   EXPECT_NE(e.find("velocity"), std::string::npos) << e;
-  e = Expect("<robot name='r'><link name='a'><collision><geometry><mesh filename='x.stl'/></geometry></collision>"
-             "</link><link name='iiwa_link_ee'/><joint name='j1' type='revolute'><parent link='a'/>"
-             "<child link='iiwa_link_ee'/><limit lower='-1' upper='1' effort='1' velocity='1'/></joint></robot>");
+  e = Expect(
+      "<robot name='r'><link name='a'><collision><geometry><mesh filename='x.stl'/></geometry></collision>"
+      "</link><link name='iiwa_link_ee'/><joint name='j1' type='revolute'><parent link='a'/>"
+      "<child link='iiwa_link_ee'/><limit lower='-1' upper='1' effort='1' velocity='1'/></joint></robot>");
   EXPECT_NE(e.find("link 'a'"), std::string::npos) << e;
-  EXPECT_NE(Expect("<robot name='r'><link name='a'/><link name='b'/><joint name='j' type='revolute'><parent "
-                   "link='a'/><child link='b'/><limit lower='-1' upper='1' effort='1' velocity='1'/></joint></robot>")
-                .find("iiwa_link_ee"),
-            std::string::npos);
+  EXPECT_NE(
+      Expect(
+          "<robot name='r'><link name='a'/><link name='b'/><joint name='j' type='revolute'><parent "
+          "link='a'/><child link='b'/><limit lower='-1' upper='1' effort='1' velocity='1'/></joint></robot>")
+          .find("iiwa_link_ee"),
+      std::string::npos);
   EXPECT_THROW(RobotModel::LoadFile("/nonexistent/x.urdf"), std::runtime_error);
 }
 

@@ -14,8 +14,8 @@
 #include "sim/model_paths.h"
 #include "sim/robot_model.h"
 #include "sim/scene.h"
-#include "sim/trocar_ik.h"
 #include "sim/trocar_clearance.h"
+#include "sim/trocar_ik.h"
 
 namespace orbed::sim {
 namespace {
@@ -33,15 +33,16 @@ Eigen::VectorXd ParseJointList(const std::string& text, int expected) {
     throw UsageError(e.what());
   }
   if (static_cast<int>(values.size()) != expected) {
-    throw UsageError("--q-deg: expected " + std::to_string(expected) + " comma-separated angles in deg, got " +
-                     std::to_string(values.size()));
+    throw UsageError("--q-deg: expected " + std::to_string(expected) +
+                     " comma-separated angles in deg, got " + std::to_string(values.size()));
   }
   return Eigen::Map<Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size()));
 }
 
 // The robot from --urdf (default: the shipped model), as it stands in `scene` if one is given.
 RobotModel LoadModel(const std::string& urdf_flag, const Scene* scene = nullptr) {
-  const std::string path = urdf_flag.empty() ? SourceTreePath(RobotModel::kDefaultUrdfRelativePath) : urdf_flag;
+  const std::string path =
+      urdf_flag.empty() ? SourceTreePath(RobotModel::kDefaultUrdfRelativePath) : urdf_flag;
   try {
     return scene ? LoadRobotForScene(path, *scene) : RobotModel::LoadFile(path);
   } catch (const std::exception& e) {
@@ -95,7 +96,8 @@ void WritePair(JsonWriter& j, const PairDistance& p) {
   j.EndObject();
 }
 
-void WriteCheck(JsonWriter& j, const RobotModel& model, const CollisionWorld& world, const CollisionResult& r) {
+void WriteCheck(JsonWriter& j, const RobotModel& model, const CollisionWorld& world,
+                const CollisionResult& r) {
   j.Key("in_collision").Bool(r.in_collision);
   j.Key("min_distance_m").Number(r.min_distance_m);
   j.Key("closest");
@@ -140,7 +142,8 @@ int RunFk(const std::string& q_text, const std::string& urdf, std::ostream& out)
   return 0;
 }
 
-int RunCheck(const std::string& q_text, const std::string& scene_path, const std::string& urdf, std::ostream& out) {
+int RunCheck(const std::string& q_text, const std::string& scene_path, const std::string& urdf,
+             std::ostream& out) {
   Scene scene;
   const bool has_scene = !scene_path.empty();
   if (has_scene) scene = LoadScene(scene_path);
@@ -163,7 +166,8 @@ int RunCheck(const std::string& q_text, const std::string& scene_path, const std
   return 0;
 }
 
-int RunIk(const std::string& scene_path, const std::string& urdf, uint64_t seed, int starts, std::ostream& out) {
+int RunIk(const std::string& scene_path, const std::string& urdf, uint64_t seed, int starts,
+          std::ostream& out) {
   const Scene scene = LoadScene(scene_path);
   const RobotModel model = LoadModel(urdf, &scene);
   CollisionWorld world(model, &scene);
@@ -207,7 +211,8 @@ int RunIk(const std::string& scene_path, const std::string& urdf, uint64_t seed,
 }  // namespace
 
 int RunRobotTool(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
-  CLI::App app{"orbed-robot: forward kinematics, collision check and trocar IK of the iiwa 7 model (JSON out)"};
+  CLI::App app{
+      "orbed-robot: forward kinematics, collision check and trocar IK of the iiwa 7 model (JSON out)"};
   app.require_subcommand(1);
   std::string q_text, urdf, scene_path;
   uint64_t seed = 1;

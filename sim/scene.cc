@@ -87,7 +87,8 @@ class Reader {
 
 Eigen::Matrix3d RotationFromRpyDeg(const Eigen::Vector3d& rpy_deg) {
   const Eigen::Vector3d r = rpy_deg * (kPi / 180.0);
-  return (Eigen::AngleAxisd(r.z(), Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(r.y(), Eigen::Vector3d::UnitY()) *
+  return (Eigen::AngleAxisd(r.z(), Eigen::Vector3d::UnitZ()) *
+          Eigen::AngleAxisd(r.y(), Eigen::Vector3d::UnitY()) *
           Eigen::AngleAxisd(r.x(), Eigen::Vector3d::UnitX()))
       .toRotationMatrix();
 }
@@ -105,7 +106,8 @@ RobotModel LoadRobotForScene(const std::string& urdf_path, const Scene& scene) {
   try {
     model.SetToolLength(scene.tool_length_m);
   } catch (const std::invalid_argument& e) {
-    throw std::runtime_error(scene.source + ": robot.tool_length_m does not fit " + urdf_path + ": " + e.what());
+    throw std::runtime_error(scene.source + ": robot.tool_length_m does not fit " + urdf_path + ": " +
+                             e.what());
   }
   return model;
 }
@@ -115,7 +117,8 @@ Scene LoadSceneString(const std::string& yaml_text, const std::string& source_na
   try {
     root = YAML::Load(yaml_text);
   } catch (const YAML::Exception& e) {
-    throw std::runtime_error(source_name + ":" + std::to_string(e.mark.line + 1) + ": not valid YAML: " + e.msg);
+    throw std::runtime_error(source_name + ":" + std::to_string(e.mark.line + 1) +
+                             ": not valid YAML: " + e.msg);
   }
   const Reader r(source_name);
   if (!root || !root.IsMap()) {
@@ -128,12 +131,14 @@ Scene LoadSceneString(const std::string& yaml_text, const std::string& source_na
 
   const YAML::Node robot = r.Required(root, "robot", "robot", "a mapping with base_pose and tool_length_m");
   r.OnlyKeys(robot, "robot", {"base_pose", "tool_length_m"});
-  scene.X_WR = r.Pose(r.Required(robot, "base_pose", "robot.base_pose", "{position_m: [x, y, z], rpy_deg: [r, p, y]}"),
-                      "robot.base_pose");
-  scene.tool_length_m =
-      r.Positive(r.Required(robot, "tool_length_m", "robot.tool_length_m", "a length > 0 [m]"), "robot.tool_length_m");
+  scene.X_WR =
+      r.Pose(r.Required(robot, "base_pose", "robot.base_pose", "{position_m: [x, y, z], rpy_deg: [r, p, y]}"),
+             "robot.base_pose");
+  scene.tool_length_m = r.Positive(
+      r.Required(robot, "tool_length_m", "robot.tool_length_m", "a length > 0 [m]"), "robot.tool_length_m");
 
-  const YAML::Node trocar = r.Required(root, "trocar", "trocar", "a mapping with position_m and insertion_direction");
+  const YAML::Node trocar =
+      r.Required(root, "trocar", "trocar", "a mapping with position_m and insertion_direction");
   r.OnlyKeys(trocar, "trocar", {"position_m", "insertion_direction"});
   scene.trocar.p_WT = r.Vector3(r.Required(trocar, "position_m", "trocar.position_m", "[x, y, z] in m"),
                                 "trocar.position_m", "a list of 3 numbers [m]");
@@ -158,21 +163,27 @@ Scene LoadSceneString(const std::string& yaml_text, const std::string& source_na
       const YAML::Node name = r.Required(o, "name", key + ".name", "a unique name");
       obj.name = name.as<std::string>();
       if (obj.name.empty() || !names.insert(obj.name).second) {
-        r.Fail(name, key + ".name", "expected a non-empty name not used by another object ('" + obj.name + "')");
+        r.Fail(name, key + ".name",
+               "expected a non-empty name not used by another object ('" + obj.name + "')");
       }
-      const std::string shape = r.Required(o, "shape", key + ".shape", "box, cylinder or sphere").as<std::string>();
+      const std::string shape =
+          r.Required(o, "shape", key + ".shape", "box, cylinder or sphere").as<std::string>();
       if (shape == "box") {
         obj.shape = SceneObject::Shape::kBox;
         const YAML::Node s = r.Required(o, "size_m", key + ".size_m", "[lx, ly, lz] full side lengths in m");
         obj.size_m = r.Vector3(s, key + ".size_m", "a list of 3 numbers > 0 [m]");
-        if ((obj.size_m.array() <= 0).any()) r.Fail(s, key + ".size_m", "expected a list of 3 numbers > 0 [m]");
+        if ((obj.size_m.array() <= 0).any())
+          r.Fail(s, key + ".size_m", "expected a list of 3 numbers > 0 [m]");
       } else if (shape == "cylinder") {
         obj.shape = SceneObject::Shape::kCylinder;
-        obj.radius_m = r.Positive(r.Required(o, "radius_m", key + ".radius_m", "a radius > 0 [m]"), key + ".radius_m");
-        obj.length_m = r.Positive(r.Required(o, "length_m", key + ".length_m", "a length > 0 [m]"), key + ".length_m");
+        obj.radius_m =
+            r.Positive(r.Required(o, "radius_m", key + ".radius_m", "a radius > 0 [m]"), key + ".radius_m");
+        obj.length_m =
+            r.Positive(r.Required(o, "length_m", key + ".length_m", "a length > 0 [m]"), key + ".length_m");
       } else if (shape == "sphere") {
         obj.shape = SceneObject::Shape::kSphere;
-        obj.radius_m = r.Positive(r.Required(o, "radius_m", key + ".radius_m", "a radius > 0 [m]"), key + ".radius_m");
+        obj.radius_m =
+            r.Positive(r.Required(o, "radius_m", key + ".radius_m", "a radius > 0 [m]"), key + ".radius_m");
       } else {
         r.Fail(o["shape"], key + ".shape", "expected box, cylinder or sphere, got '" + shape + "'");
       }

@@ -43,13 +43,13 @@ struct SceneObject {
   Shape shape{Shape::kBox};
   Eigen::Isometry3d X_WO{Eigen::Isometry3d::Identity()};
   Eigen::Vector3d size_m{Eigen::Vector3d::Zero()};  ///< box: full side lengths
-  double radius_m{0};                                ///< cylinder, sphere
-  double length_m{0};                                ///< cylinder
+  double radius_m{0};                               ///< cylinder, sphere
+  double length_m{0};                               ///< cylinder
   std::vector<std::string> ignore_links;
 };
 
 struct Trocar {
-  Eigen::Vector3d p_WT{Eigen::Vector3d::Zero()};                    ///< docking point [m]
+  Eigen::Vector3d p_WT{Eigen::Vector3d::Zero()};                     ///< docking point [m]
   Eigen::Vector3d insertion_direction_W{-Eigen::Vector3d::UnitZ()};  ///< unit vector
 };
 

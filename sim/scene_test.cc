@@ -57,12 +57,17 @@ trocar:
 
 TEST(SceneTest, ErrorsNameFileLineKeyAndExpectation) {
   EXPECT_EQ(Error(kGood), "(no error)");
-  std::string e = Error(std::string(kGood) + "objects:\n  - name: t\n    shape: box\n    size_m: [1, 2]\n"
+  std::string e = Error(std::string(kGood) +
+                        "objects:\n  - name: t\n    shape: box\n    size_m: [1, 2]\n"
                         "    pose: {position_m: [0, 0, 0]}\n");
-  EXPECT_NE(e.find("bad.yaml:10: objects[0].size_m: expected a list of 3 numbers > 0"), std::string::npos) << e;
-  e = Error(std::string(kGood) + "objects:\n  - name: t\n    shape: cone\n    pose: {position_m: [0, 0, 0]}\n");
+  EXPECT_NE(e.find("bad.yaml:10: objects[0].size_m: expected a list of 3 numbers > 0"), std::string::npos)
+      << e;
+  e = Error(std::string(kGood) +
+            "objects:\n  - name: t\n    shape: cone\n    pose: {position_m: [0, 0, 0]}\n");
   EXPECT_NE(e.find("objects[0].shape: expected box, cylinder or sphere, got 'cone'"), std::string::npos) << e;
-  e = Error("robot:\n  base_pose: {position_m: [0, 0, 0]}\ntrocar: {position_m: [0,0,0], insertion_direction: [0,0,-1]}\n");
+  e = Error(
+      "robot:\n  base_pose: {position_m: [0, 0, 0]}\ntrocar: {position_m: [0,0,0], insertion_direction: "
+      "[0,0,-1]}\n");
   EXPECT_NE(e.find("robot.tool_length_m: missing"), std::string::npos) << e;
   e = Error("robot:\n  base_pose: {position_m: [0, 0, x]}\n  tool_length_m: 0.2\n");
   EXPECT_NE(e.find("robot.base_pose.position_m[2]"), std::string::npos) << e;
@@ -70,16 +75,20 @@ TEST(SceneTest, ErrorsNameFileLineKeyAndExpectation) {
   EXPECT_NE(e.find("extra: unknown key"), std::string::npos) << e;
   e = Error("robot:\n  base_pose: {position_m: [0, 0, 0]}\n  tool_length_m: -0.2\n");
   EXPECT_NE(e.find("robot.tool_length_m: expected a number > 0"), std::string::npos) << e;
-  e = Error("robot:\n  base_pose: {position_m: [0, 0, 0]}\n  tool_length_m: 0.2\n"
-            "trocar: {position_m: [0,0,0], insertion_direction: [0,0,-2]}\n");
+  e = Error(
+      "robot:\n  base_pose: {position_m: [0, 0, 0]}\n  tool_length_m: 0.2\n"
+      "trocar: {position_m: [0,0,0], insertion_direction: [0,0,-2]}\n");
   EXPECT_NE(e.find("trocar.insertion_direction: expected a unit vector"), std::string::npos) << e;
   e = Error("robot: [1, 2\n");
   EXPECT_NE(e.find("bad.yaml:"), std::string::npos) << e;
   EXPECT_NE(e.find("not valid YAML"), std::string::npos) << e;
-  e = Error(std::string(kGood) + "objects:\n  - {name: a, shape: sphere, radius_m: 1, pose: {position_m: [0,0,0]}}\n"
-                                 "  - {name: a, shape: sphere, radius_m: 1, pose: {position_m: [0,0,0]}}\n");
+  e = Error(std::string(kGood) +
+            "objects:\n  - {name: a, shape: sphere, radius_m: 1, pose: {position_m: [0,0,0]}}\n"
+            "  - {name: a, shape: sphere, radius_m: 1, pose: {position_m: [0,0,0]}}\n");
   EXPECT_NE(e.find("objects[1].name"), std::string::npos) << e;
-  e = Error(std::string(kGood) + "objects:\n  - {name: a, shape: sphere, radius_m: 1, length_m: 2, pose: {position_m: [0,0,0]}}\n");
+  e = Error(
+      std::string(kGood) +
+      "objects:\n  - {name: a, shape: sphere, radius_m: 1, length_m: 2, pose: {position_m: [0,0,0]}}\n");
   EXPECT_NE(e.find("objects[0].length_m: not used by a sphere"), std::string::npos) << e;
   EXPECT_THROW(LoadSceneFile("/nonexistent.yaml"), std::runtime_error);
 }

@@ -62,7 +62,8 @@ bool Project(const RobotModel& model, const TrocarIkTarget& target, const Trocar
   double lambda = 1e-2;
   Task t = EvalTask(model, target, *q, X_RL);
   for (int it = 0; it < opt.max_iterations; ++it) {
-    if (t.position_error_m < opt.position_tolerance_m && t.angle_error_rad < opt.angle_tolerance_rad) return true;
+    if (t.position_error_m < opt.position_tolerance_m && t.angle_error_rad < opt.angle_tolerance_rad)
+      return true;
     const Eigen::Matrix<double, 5, 5> A =
         t.J * t.J.transpose() + lambda * lambda * Eigen::Matrix<double, 5, 5>::Identity();
     Eigen::VectorXd dq = t.J.transpose() * A.ldlt().solve(t.e);
@@ -173,9 +174,9 @@ TrocarIkResult SolveTrocarIk(const RobotModel& model, const TrocarIkTarget& targ
       if (!improved) step *= 0.5;
     }
   }
-  const Candidate& best = *std::max_element(distinct.begin(), distinct.end(), [](const Candidate& a, const Candidate& b) {
-    return a.clearance < b.clearance;
-  });
+  const Candidate& best =
+      *std::max_element(distinct.begin(), distinct.end(),
+                        [](const Candidate& a, const Candidate& b) { return a.clearance < b.clearance; });
   result.q_rad = best.q;
   result.clearance_m = best.clearance;
   TrocarIkResiduals(model, target, best.q, &result.position_error_m, &result.angle_error_rad);
@@ -188,8 +189,8 @@ TrocarIkResult SolveTrocarIk(const RobotModel& model, const TrocarIkTarget& targ
     return result;
   }
   result.success = true;
-  os << "clearance objective " << best.clearance << " m; " << result.seeds_converged << " of " << result.seeds_tried
-     << " starts converged";
+  os << "clearance objective " << best.clearance << " m; " << result.seeds_converged << " of "
+     << result.seeds_tried << " starts converged";
   result.message = os.str();
   return result;
 }

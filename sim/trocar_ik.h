@@ -27,8 +27,8 @@
 namespace orbed::sim {
 
 struct TrocarIkTarget {
-  Eigen::Vector3d p_RT{Eigen::Vector3d::Zero()};            ///< wanted tool tip position [m]
-  Eigen::Vector3d axis_R{-Eigen::Vector3d::UnitZ()};        ///< wanted tool axis, unit
+  Eigen::Vector3d p_RT{Eigen::Vector3d::Zero()};      ///< wanted tool tip position [m]
+  Eigen::Vector3d axis_R{-Eigen::Vector3d::UnitZ()};  ///< wanted tool axis, unit
 };
 
 struct TrocarIkOptions {
@@ -38,19 +38,19 @@ struct TrocarIkOptions {
   double angle_tolerance_rad{1e-4};
   /// Solutions keep this far inside every joint limit [rad].
   double limit_margin_rad{0.01};
-  int max_iterations{200};           ///< per projection onto the task
-  int refine_best{4};                ///< how many distinct solutions the pattern search improves
-  int max_refine_steps{80};          ///< accepted + rejected pattern steps per solution
-  double min_clearance_m{0.0};       ///< a solution must have clearance above this
+  int max_iterations{200};      ///< per projection onto the task
+  int refine_best{4};           ///< how many distinct solutions the pattern search improves
+  int max_refine_steps{80};     ///< accepted + rejected pattern steps per solution
+  double min_clearance_m{0.0};  ///< a solution must have clearance above this
 };
 
 struct TrocarIkResult {
   bool success{false};
-  std::string message;               ///< why it failed, or a one-line summary
-  Eigen::VectorXd q_rad;             ///< best solution found (empty if none converged)
-  double position_error_m{0};        ///< |p_RT(q) - p_RT*|
-  double angle_error_rad{0};         ///< angle between the tool axis and axis_R
-  double clearance_m{0};             ///< the clearance function at q_rad
+  std::string message;         ///< why it failed, or a one-line summary
+  Eigen::VectorXd q_rad;       ///< best solution found (empty if none converged)
+  double position_error_m{0};  ///< |p_RT(q) - p_RT*|
+  double angle_error_rad{0};   ///< angle between the tool axis and axis_R
+  double clearance_m{0};       ///< the clearance function at q_rad
   int seeds_tried{0};
   int seeds_converged{0};
 };

@@ -11,9 +11,9 @@
 #include <gtest/gtest.h>
 
 #include "sim/collision_world.h"
+#include "sim/model_paths.h"
 #include "sim/scene.h"
 #include "sim/trocar_clearance.h"
-#include "sim/model_paths.h"
 
 namespace orbed::sim {
 namespace {
@@ -22,8 +22,8 @@ TEST(TrocarIkTest, DocksAtTheTrocarCollisionFree) {
   RobotModel model = RobotModel::LoadFile(orbed::sim::SourceTreePath(RobotModel::kDefaultUrdfRelativePath));
   const Scene scene = LoadSceneFile(orbed::sim::SourceTreePath(kDefaultSceneRelativePath));
   model.SetToolLength(scene.tool_length_m);
-  const TrocarIkResult r =
-      SolveTrocarIk(model, TrocarTargetInBase(scene), TrocarIkOptions{}, MakeTrocarClearanceFunction(model, scene));
+  const TrocarIkResult r = SolveTrocarIk(model, TrocarTargetInBase(scene), TrocarIkOptions{},
+                                         MakeTrocarClearanceFunction(model, scene));
   ASSERT_TRUE(r.success) << r.message;
   EXPECT_EQ(model.ValidateJointVector(r.q_rad), "");
   // Independent residuals: FK in W against the scene's trocar.
@@ -53,7 +53,8 @@ TEST(TrocarIkTest, DocksAtTheTrocarCollisionFree) {
 }
 
 TEST(TrocarIkTest, UnreachableTargetFailsHonestly) {
-  const RobotModel model = RobotModel::LoadFile(orbed::sim::SourceTreePath(RobotModel::kDefaultUrdfRelativePath));
+  const RobotModel model =
+      RobotModel::LoadFile(orbed::sim::SourceTreePath(RobotModel::kDefaultUrdfRelativePath));
   TrocarIkTarget far;
   far.p_RT = Eigen::Vector3d(3.0, 0, 0.5);
   far.axis_R = -Eigen::Vector3d::UnitZ();
@@ -67,7 +68,8 @@ TEST(TrocarIkTest, UnreachableTargetFailsHonestly) {
 }
 
 TEST(TrocarIkTest, ReachableWithoutScoreSucceedsOnlyIfAllowed) {
-  const RobotModel model = RobotModel::LoadFile(orbed::sim::SourceTreePath(RobotModel::kDefaultUrdfRelativePath));
+  const RobotModel model =
+      RobotModel::LoadFile(orbed::sim::SourceTreePath(RobotModel::kDefaultUrdfRelativePath));
   TrocarIkTarget t;
   t.p_RT = Eigen::Vector3d(0.5, 0.1, 0.3);
   t.axis_R = -Eigen::Vector3d::UnitZ();

@@ -63,9 +63,9 @@ void ExpectDefaultRoundTrip(const char* name) {
 TEST(LcmTypes, EveryTypeRoundTripsAndHasAUniqueFingerprint) {
   std::map<int64_t, std::string> seen;
   int count = 0;
-#define ORBED_CHECK(type)                                                          \
-  ExpectDefaultRoundTrip<orbed::type>(#type);                                     \
-  EXPECT_TRUE(seen.emplace(orbed::type::getHash(), #type).second) << #type;      \
+#define ORBED_CHECK(type)                                                   \
+  ExpectDefaultRoundTrip<orbed::type>(#type);                               \
+  EXPECT_TRUE(seen.emplace(orbed::type::getHash(), #type).second) << #type; \
   ++count;
   ORBED_FOR_EACH_LCM_TYPE(ORBED_CHECK)
 #undef ORBED_CHECK

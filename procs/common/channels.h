@@ -5,27 +5,27 @@
 
 namespace orbed::channels {
 
-inline constexpr char kIiwaStatus[] = "IIWA_STATUS";              // iiwa_status_t, sim, 200 Hz
-inline constexpr char kIiwaCommand[] = "IIWA_COMMAND";            // iiwa_command_t, → sim
-inline constexpr char kRobotState[] = "ROBOT_STATE";              // robot_state_t, sim, 200 Hz
-inline constexpr char kCollisionStatus[] = "COLLISION_STATUS";    // collision_status_t, sim
-inline constexpr char kPlanCheckRequest[] = "PLAN_CHECK_REQUEST"; // plan_check_request_t, → sim
-inline constexpr char kPlanCheckReply[] = "PLAN_CHECK_REPLY";     // plan_check_reply_t, sim
-inline constexpr char kHmdPose[] = "HMD_POSE";                    // hmd_pose_t (estimate), 60 Hz
-inline constexpr char kHmdPoseTruth[] = "HMD_POSE_TRUTH";         // hmd_pose_t (truth), 60 Hz
-inline constexpr char kHmdCamera[] = "HMD_CAMERA";                // image_t (JPEG), 30 Hz
-inline constexpr char kArView[] = "AR_VIEW";                      // image_t (JPEG)
-inline constexpr char kGazeRay[] = "GAZE_RAY";                    // gaze_ray_t
-inline constexpr char kReflectiveView[] = "REFLECTIVE_VIEW";      // reflective_view_t, 30 Hz
-inline constexpr char kAlignmentTrial[] = "ALIGNMENT_TRIAL";      // alignment_trial_t
-inline constexpr char kRegistration[] = "REGISTRATION";           // registration_t
-inline constexpr char kSessionControl[] = "SESSION_CONTROL";      // session_control_t
-inline constexpr char kLandmarkRequest[] = "LANDMARK_REQUEST";    // landmark_request_t
-inline constexpr char kLandmark[] = "LANDMARK";                   // landmark_t
+inline constexpr char kIiwaStatus[] = "IIWA_STATUS";                    // iiwa_status_t, sim, 200 Hz
+inline constexpr char kIiwaCommand[] = "IIWA_COMMAND";                  // iiwa_command_t, → sim
+inline constexpr char kRobotState[] = "ROBOT_STATE";                    // robot_state_t, sim, 200 Hz
+inline constexpr char kCollisionStatus[] = "COLLISION_STATUS";          // collision_status_t, sim
+inline constexpr char kPlanCheckRequest[] = "PLAN_CHECK_REQUEST";       // plan_check_request_t, → sim
+inline constexpr char kPlanCheckReply[] = "PLAN_CHECK_REPLY";           // plan_check_reply_t, sim
+inline constexpr char kHmdPose[] = "HMD_POSE";                          // hmd_pose_t (estimate), 60 Hz
+inline constexpr char kHmdPoseTruth[] = "HMD_POSE_TRUTH";               // hmd_pose_t (truth), 60 Hz
+inline constexpr char kHmdCamera[] = "HMD_CAMERA";                      // image_t (JPEG), 30 Hz
+inline constexpr char kArView[] = "AR_VIEW";                            // image_t (JPEG)
+inline constexpr char kGazeRay[] = "GAZE_RAY";                          // gaze_ray_t
+inline constexpr char kReflectiveView[] = "REFLECTIVE_VIEW";            // reflective_view_t, 30 Hz
+inline constexpr char kAlignmentTrial[] = "ALIGNMENT_TRIAL";            // alignment_trial_t
+inline constexpr char kRegistration[] = "REGISTRATION";                 // registration_t
+inline constexpr char kSessionControl[] = "SESSION_CONTROL";            // session_control_t
+inline constexpr char kLandmarkRequest[] = "LANDMARK_REQUEST";          // landmark_request_t
+inline constexpr char kLandmark[] = "LANDMARK";                         // landmark_t
 inline constexpr char kMisalignmentRequest[] = "MISALIGNMENT_REQUEST";  // misalignment_request_t
-inline constexpr char kMisalignment[] = "MISALIGNMENT";           // misalignment_t
-inline constexpr char kGuidance[] = "GUIDANCE";                   // guidance_t, 30 Hz
-inline constexpr char kProcessStatus[] = "PROCESS_STATUS";        // process_status_t, 1 Hz each
-inline constexpr char kLoggerStatus[] = "LOGGER_STATUS";          // logger_status_t, 1 Hz
+inline constexpr char kMisalignment[] = "MISALIGNMENT";                 // misalignment_t
+inline constexpr char kGuidance[] = "GUIDANCE";                         // guidance_t, 30 Hz
+inline constexpr char kProcessStatus[] = "PROCESS_STATUS";              // process_status_t, 1 Hz each
+inline constexpr char kLoggerStatus[] = "LOGGER_STATUS";                // logger_status_t, 1 Hz
 
 }  // namespace orbed::channels

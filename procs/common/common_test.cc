@@ -155,15 +155,15 @@ TEST(Process, CountsMessagesRejectionsAndPublishesHeartbeat) {
   process.Subscribe<process_status_t>(
       channels::kProcessStatus,
       [&](const process_status_t& msg, const std::string&, int64_t) { heartbeats.push_back(msg); });
-  process.Subscribe<iiwa_command_t>(
-      channels::kIiwaCommand, [&](const iiwa_command_t& msg, const std::string& channel, int64_t) {
-        const std::string error = CheckSize(msg.num_joints, 7, "num_joints");
-        if (!error.empty()) {
-          process.Reject(channel + "/num_joints", error);
-          return;
-        }
-        ++accepted;
-      });
+  process.Subscribe<iiwa_command_t>(channels::kIiwaCommand,
+                                    [&](const iiwa_command_t& msg, const std::string& channel, int64_t) {
+                                      const std::string error = CheckSize(msg.num_joints, 7, "num_joints");
+                                      if (!error.empty()) {
+                                        process.Reject(channel + "/num_joints", error);
+                                        return;
+                                      }
+                                      ++accepted;
+                                    });
   iiwa_command_t good{};
   good.num_joints = 7;
   good.joint_position.assign(7, 0.0);
@@ -241,10 +241,9 @@ TEST(Process, ExceptionsInTimersAndHandlersAreCountedNotFatal) {
     ++ticks;
     throw std::runtime_error("bad tick");
   });
-  process.Subscribe<iiwa_command_t>(channels::kIiwaCommand,
-                                    [&](const iiwa_command_t&, const std::string&, int64_t) {
-                                      throw std::out_of_range("bad message");
-                                    });
+  process.Subscribe<iiwa_command_t>(
+      channels::kIiwaCommand,
+      [&](const iiwa_command_t&, const std::string&, int64_t) { throw std::out_of_range("bad message"); });
   iiwa_command_t cmd{};
   process.lcm().publish(channels::kIiwaCommand, &cmd);
   EXPECT_EQ(process.Run(), 0);

@@ -28,8 +28,7 @@ std::string WithRecvBufSize(const std::string& url, int64_t bytes) {
 
 void AddCommonFlags(CLI::App* app, CommonFlags* flags) {
   app->add_option("--lcm-url", flags->lcm_url,
-                  "LCM provider URL (default: $ORBED_LCM_URL, else " +
-                      std::string(kDefaultLcmUrl) + ")")
+                  "LCM provider URL (default: $ORBED_LCM_URL, else " + std::string(kDefaultLcmUrl) + ")")
       ->capture_default_str();
   app->add_option("--name", flags->name, "Process name on PROCESS_STATUS and in log lines")
       ->capture_default_str();

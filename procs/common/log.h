@@ -45,7 +45,7 @@ class LogLine {
 /// Usage: ORBED_LOG(kInfo) << "listening on " << url;  (the stream is not evaluated when filtered)
 /// (A one-shot for loop rather than if/else, so that `if (x) ORBED_LOG(kInfo) << ...;` has no
 /// dangling else.)
-#define ORBED_LOG(level)                                                             \
-  for (bool orbed_log_once = ::orbed::LogLevel::level >= ::orbed::GetLogLevel();     \
-       orbed_log_once; orbed_log_once = false)                                       \
+#define ORBED_LOG(level)                                                                         \
+  for (bool orbed_log_once = ::orbed::LogLevel::level >= ::orbed::GetLogLevel(); orbed_log_once; \
+       orbed_log_once = false)                                                                   \
   ::orbed::internal::LogLine(::orbed::LogLevel::level)

@@ -20,8 +20,7 @@ std::atomic<bool> g_stop_signalled{false};
 extern "C" void HandleStopSignal(int) { g_stop_signalled = true; }
 
 std::chrono::steady_clock::duration Seconds(double s) {
-  return std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-      std::chrono::duration<double>(s));
+  return std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(s));
 }
 
 }  // namespace
@@ -91,14 +90,13 @@ lcm::Subscription* Process::SubscribeRaw(
   try {
     std::regex check(channel_regex);
   } catch (const std::regex_error& e) {
-    throw std::invalid_argument("invalid channel regular expression '" + channel_regex +
-                                "': " + e.what());
+    throw std::invalid_argument("invalid channel regular expression '" + channel_regex + "': " + e.what());
   }
   auto sub = std::make_unique<RawSubscription>();
   sub->process = this;
   sub->handler = std::move(handler);
-  lcm::Subscription* subscription = lcm_->subscribe(
-      channel_regex, &SubscriptionBase::OnRaw, static_cast<SubscriptionBase*>(sub.get()));
+  lcm::Subscription* subscription =
+      lcm_->subscribe(channel_regex, &SubscriptionBase::OnRaw, static_cast<SubscriptionBase*>(sub.get()));
   subscriptions_.push_back(std::move(sub));
   return subscription;
 }
@@ -157,8 +155,8 @@ int Process::Run() {
   running_ = true;
   ORBED_LOG(kInfo) << "running (pid " << getpid() << ")";
   PublishStatus();  // the first heartbeat tells the launcher we are ready
-  const auto deadline = duration_sec_ > 0 ? start_ + Seconds(duration_sec_)
-                                          : std::chrono::steady_clock::time_point::max();
+  const auto deadline =
+      duration_sec_ > 0 ? start_ + Seconds(duration_sec_) : std::chrono::steady_clock::time_point::max();
   // Waits are capped so that a stop request is noticed within 50 ms.
   const auto max_wait = std::chrono::milliseconds(50);
   while (!stop_requested_ && !StopSignalled()) {
@@ -188,8 +186,7 @@ int Process::Run() {
     }
     auto next = std::min(deadline, now + max_wait);
     for (const Timer& timer : timers_) next = std::min(next, timer.next);
-    const auto wait_ns =
-        std::chrono::duration_cast<std::chrono::nanoseconds>(next - now).count();
+    const auto wait_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(next - now).count();
     // Wait on LCM's file descriptor with ppoll (nanosecond timeout) rather than handleTimeout,
     // whose millisecond rounding would make a 1 kHz timer drift late and skip ticks.
     pollfd fd{lcm_->getFileno(), POLLIN, 0};

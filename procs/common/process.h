@@ -58,9 +58,8 @@ class Process {
   /// bridges). The handler gets LCM's receive buffer (data valid only during the call).
   /// Returns LCM's subscription so the caller can raise its queue capacity. Throws
   /// std::invalid_argument for a malformed regular expression.
-  lcm::Subscription* SubscribeRaw(
-      const std::string& channel_regex,
-      std::function<void(const lcm::ReceiveBuffer&, const std::string&)> handler);
+  lcm::Subscription* SubscribeRaw(const std::string& channel_regex,
+                                  std::function<void(const lcm::ReceiveBuffer&, const std::string&)> handler);
 
   /// Publishes and counts one message out.
   template <class Msg>
@@ -144,8 +143,8 @@ struct Process::TypedSubscription : Process::SubscriptionBase {
       decoded = -1;
     }
     if (decoded != static_cast<int>(rbuf->data_size)) {
-      process->Reject(channel + "/decode", "cannot decode " + std::to_string(rbuf->data_size) +
-                                               " bytes as " + Msg::getTypeName());
+      process->Reject(channel + "/decode",
+                      "cannot decode " + std::to_string(rbuf->data_size) + " bytes as " + Msg::getTypeName());
       return;
     }
     try {

@@ -48,8 +48,14 @@ void Compress(std::array<uint32_t, 8>* state, const uint8_t* block) {
     b = a;
     a = t1 + t2;
   }
-  (*state)[0] += a; (*state)[1] += b; (*state)[2] += c; (*state)[3] += d;
-  (*state)[4] += e; (*state)[5] += f; (*state)[6] += g; (*state)[7] += h;
+  (*state)[0] += a;
+  (*state)[1] += b;
+  (*state)[2] += c;
+  (*state)[3] += d;
+  (*state)[4] += e;
+  (*state)[5] += f;
+  (*state)[6] += g;
+  (*state)[7] += h;
 }
 
 }  // namespace

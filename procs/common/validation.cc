@@ -42,8 +42,7 @@ std::string CheckSize(int64_t actual, int64_t expected, const std::string& what)
   return out.str();
 }
 
-std::string CheckLength(int64_t length_field, size_t array_size, int64_t max,
-                        const std::string& what) {
+std::string CheckLength(int64_t length_field, size_t array_size, int64_t max, const std::string& what) {
   std::ostringstream out;
   if (length_field < 0 || length_field > max) {
     out << what << " is " << length_field << ", expected 0.." << max;
@@ -56,12 +55,11 @@ std::string CheckLength(int64_t length_field, size_t array_size, int64_t max,
   return "";
 }
 
-std::string CheckUnitQuaternion(const double q_wxyz[4], const std::string& what,
-                                double tolerance) {
+std::string CheckUnitQuaternion(const double q_wxyz[4], const std::string& what, double tolerance) {
   std::string finite = CheckFinite(q_wxyz, 4, what);
   if (!finite.empty()) return finite;
-  const double norm = std::sqrt(q_wxyz[0] * q_wxyz[0] + q_wxyz[1] * q_wxyz[1] +
-                                q_wxyz[2] * q_wxyz[2] + q_wxyz[3] * q_wxyz[3]);
+  const double norm = std::sqrt(q_wxyz[0] * q_wxyz[0] + q_wxyz[1] * q_wxyz[1] + q_wxyz[2] * q_wxyz[2] +
+                                q_wxyz[3] * q_wxyz[3]);
   if (std::abs(norm - 1.0) <= tolerance) return "";
   std::ostringstream out;
   out << what << ": norm " << norm << ", expected 1 +/- " << tolerance;
@@ -81,19 +79,16 @@ std::string CheckEnum(int64_t value, int64_t lo, int64_t hi, const std::string& 
 }
 
 std::string CheckWithinLimits(const std::vector<double>& values, const std::vector<double>& lower,
-                              const std::vector<double>& upper, const std::string& what,
-                              double slack) {
+                              const std::vector<double>& upper, const std::string& what, double slack) {
   if (values.size() != lower.size() || values.size() != upper.size()) {
-    return CheckSize(static_cast<int64_t>(values.size()), static_cast<int64_t>(lower.size()),
-                     what + " size");
+    return CheckSize(static_cast<int64_t>(values.size()), static_cast<int64_t>(lower.size()), what + " size");
   }
   std::string finite = CheckFinite(values, what);
   if (!finite.empty()) return finite;
   for (size_t i = 0; i < values.size(); ++i) {
     if (values[i] < lower[i] - slack || values[i] > upper[i] + slack) {
       std::ostringstream out;
-      out << what << "[" << i << "] = " << values[i] << " outside [" << lower[i] << ", "
-          << upper[i] << "]";
+      out << what << "[" << i << "] = " << values[i] << " outside [" << lower[i] << ", " << upper[i] << "]";
       return out.str();
     }
   }

@@ -29,8 +29,7 @@ std::string CheckBounded(const double* values, int count, double max_abs, const 
 /// `actual` must equal `expected` (e.g. num_joints vs the arm's joint count).
 std::string CheckSize(int64_t actual, int64_t expected, const std::string& what);
 /// A length field must match the array it describes and lie in [0, max].
-std::string CheckLength(int64_t length_field, size_t array_size, int64_t max,
-                        const std::string& what);
+std::string CheckLength(int64_t length_field, size_t array_size, int64_t max, const std::string& what);
 /// (w, x, y, z) finite with norm within `tolerance` of 1.
 std::string CheckUnitQuaternion(const double q_wxyz[4], const std::string& what,
                                 double tolerance = kUnitQuaternionTolerance);
@@ -40,8 +39,7 @@ std::string CheckPose(const orbed::pose_t& pose, const std::string& what);
 std::string CheckEnum(int64_t value, int64_t lo, int64_t hi, const std::string& what);
 /// Each value within [lower[i], upper[i]] (inclusive, plus `slack`); sizes must agree.
 std::string CheckWithinLimits(const std::vector<double>& values, const std::vector<double>& lower,
-                              const std::vector<double>& upper, const std::string& what,
-                              double slack = 0.0);
+                              const std::vector<double>& upper, const std::string& what, double slack = 0.0);
 
 /// Joins several checks: the first non-empty reason, or "".
 std::string FirstError(std::initializer_list<std::string> reasons);

@@ -39,9 +39,8 @@ Child::~Child() {
   if (output_fd_ >= 0) close(output_fd_);
 }
 
-bool Child::Start(const std::vector<std::string>& argv,
-                  const std::map<std::string, std::string>& env, const std::string& search_dir,
-                  std::string* error) {
+bool Child::Start(const std::vector<std::string>& argv, const std::map<std::string, std::string>& env,
+                  const std::string& search_dir, std::string* error) {
   const std::string executable = ResolveExecutable(argv.at(0), search_dir);
   if (executable.empty()) {
     *error = "cannot find executable '" + argv[0] + "' (looked in " +

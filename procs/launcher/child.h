@@ -33,7 +33,7 @@ class Child {
   bool running() const { return pid_ > 0 && !exited_; }
   pid_t pid() const { return pid_; }
   /// Valid after Poll() returned true.
-  int exit_code() const { return exit_code_; }     // -1 when killed by a signal
+  int exit_code() const { return exit_code_; }      // -1 when killed by a signal
   int term_signal() const { return term_signal_; }  // 0 unless killed by a signal
   std::string DescribeExit() const;
 

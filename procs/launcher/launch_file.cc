@@ -63,8 +63,8 @@ ProcessSpec ParseProcess(const std::string& path, const YAML::Node& node,
   spec.name = GetString(path, node, "name", "process");
   const std::string context = "process '" + spec.name + "'";
   CheckKeys(path, node,
-            {"name", "command", "args", "env", "required", "respawn", "stop_signal",
-             "stop_timeout_sec", "ready", "ready_timeout_sec", "exit_stops_all"},
+            {"name", "command", "args", "env", "required", "respawn", "stop_signal", "stop_timeout_sec",
+             "ready", "ready_timeout_sec", "exit_stops_all"},
             context);
   if (spec.name.empty() || spec.name.find_first_of(" \t/") != std::string::npos) {
     Fail(path, node["name"], "process name '" + spec.name + "' must be non-empty, no spaces or '/'");
@@ -99,13 +99,13 @@ ProcessSpec ParseProcess(const std::string& path, const YAML::Node& node,
       GetScalar<std::string>(path, node, "stop_signal", "SIGINT", "a signal name");
   spec.stop_signal = SignalFromName(signal_name);
   if (spec.stop_signal < 0) {
-    Fail(path, node["stop_signal"], "unknown stop_signal '" + signal_name +
-                                        "'; expected SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGUSR1, "
-                                        "SIGUSR2 or SIGKILL");
+    Fail(path, node["stop_signal"],
+         "unknown stop_signal '" + signal_name +
+             "'; expected SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGUSR1, "
+             "SIGUSR2 or SIGKILL");
   }
   spec.stop_timeout_sec = GetScalar<double>(path, node, "stop_timeout_sec", 5.0, "a number of seconds");
-  spec.ready_timeout_sec =
-      GetScalar<double>(path, node, "ready_timeout_sec", 10.0, "a number of seconds");
+  spec.ready_timeout_sec = GetScalar<double>(path, node, "ready_timeout_sec", 10.0, "a number of seconds");
   if (!(spec.stop_timeout_sec >= 0) || !(spec.ready_timeout_sec > 0)) {
     Fail(path, node, "stop_timeout_sec must be >= 0 and ready_timeout_sec > 0 in " + context);
   }
@@ -122,8 +122,7 @@ ProcessSpec ParseProcess(const std::string& path, const YAML::Node& node,
 
 }  // namespace
 
-std::string ExpandVariables(const std::string& text,
-                            const std::map<std::string, std::string>& environment) {
+std::string ExpandVariables(const std::string& text, const std::map<std::string, std::string>& environment) {
   std::string out;
   size_t i = 0;
   while (i < text.size()) {
@@ -146,7 +145,7 @@ std::string ExpandVariables(const std::string& text,
 
 int SignalFromName(const std::string& name) {
   static const std::map<std::string, int> kSignals = {
-      {"SIGINT", SIGINT},   {"SIGTERM", SIGTERM}, {"SIGHUP", SIGHUP}, {"SIGQUIT", SIGQUIT},
+      {"SIGINT", SIGINT},   {"SIGTERM", SIGTERM}, {"SIGHUP", SIGHUP},  {"SIGQUIT", SIGQUIT},
       {"SIGUSR1", SIGUSR1}, {"SIGUSR2", SIGUSR2}, {"SIGKILL", SIGKILL}};
   const auto it = kSignals.find(name);
   return it == kSignals.end() ? -1 : it->second;
@@ -214,8 +213,7 @@ LaunchSpec ParseLaunchYamlUnchecked(const std::string& yaml, const std::string& 
   return spec;
 }
 
-LaunchSpec LoadLaunchFile(const std::string& path,
-                          const std::map<std::string, std::string>& environment) {
+LaunchSpec LoadLaunchFile(const std::string& path, const std::map<std::string, std::string>& environment) {
   std::ifstream in(path);
   if (!in) throw LaunchFileError(path + ": cannot read the launch file");
   std::stringstream text;

@@ -62,15 +62,13 @@ struct LaunchSpec {
 };
 
 /// Parses a launch file. `environment` supplies ${VAR} values.
-LaunchSpec LoadLaunchFile(const std::string& path,
-                          const std::map<std::string, std::string>& environment);
+LaunchSpec LoadLaunchFile(const std::string& path, const std::map<std::string, std::string>& environment);
 /// The same from YAML text; `path` only names the source in errors.
 LaunchSpec ParseLaunchYaml(const std::string& yaml, const std::string& path,
                            const std::map<std::string, std::string>& environment);
 
 /// Expands ${VAR}; throws std::invalid_argument naming an unset variable.
-std::string ExpandVariables(const std::string& text,
-                            const std::map<std::string, std::string>& environment);
+std::string ExpandVariables(const std::string& text, const std::map<std::string, std::string>& environment);
 
 /// "SIGINT" → 2 etc.; returns -1 for an unknown name.
 int SignalFromName(const std::string& name);

@@ -39,10 +39,8 @@ Launcher::Launcher(const CommonFlags& flags, LaunchSpec spec, std::string bin_di
     }
   }
   process_.Subscribe<orbed::process_status_t>(
-      channels::kProcessStatus,
-      [this](const orbed::process_status_t& status, const std::string&, int64_t recv_utime) {
-        OnHeartbeat(status, recv_utime);
-      });
+      channels::kProcessStatus, [this](const orbed::process_status_t& status, const std::string&,
+                                       int64_t recv_utime) { OnHeartbeat(status, recv_utime); });
   process_.AddTimer(0.02, [this] { Tick(); });
 }
 
@@ -101,8 +99,8 @@ void Launcher::OnHeartbeat(const orbed::process_status_t& status, int64_t) {
   for (Managed& m : managed_) {
     if (m.spec.name != status.name || !m.child->running() || m.ready) continue;
     m.ready = true;
-    ORBED_LOG(kInfo) << m.spec.name << " is ready (first heartbeat after "
-                     << SecondsSince(m.started_at) << " s)";
+    ORBED_LOG(kInfo) << m.spec.name << " is ready (first heartbeat after " << SecondsSince(m.started_at)
+                     << " s)";
   }
 }
 
@@ -127,16 +125,15 @@ void Launcher::HandleExit(Managed* m) {
     ORBED_LOG(kWarn) << m->spec.name << " " << m->last_exit << "; respawning"
                      << (delay > 0 ? " in " + std::to_string(delay) + " s" : "");
     m->respawn_pending = true;
-    m->respawn_at = Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                       std::chrono::duration<double>(delay));
+    m->respawn_at =
+        Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(delay));
     return;
   }
   m->finished = true;
   if (m->spec.required && !success) {
     FailTestbed("required process '" + m->spec.name + "' " + m->last_exit);
   } else if (m->spec.required && !m->ready) {
-    FailTestbed("required process '" + m->spec.name + "' " + m->last_exit +
-                " before its first heartbeat");
+    FailTestbed("required process '" + m->spec.name + "' " + m->last_exit + " before its first heartbeat");
   } else if (!success) {
     ORBED_LOG(kWarn) << "optional process " << m->spec.name << " " << m->last_exit
                      << "; continuing without it";
@@ -188,8 +185,7 @@ void Launcher::Tick() {
     StartGroup(starting_group_ + 1);
   } else {
     all_started_ = true;
-    ORBED_LOG(kInfo) << "testbed '" << spec_.name << "' is up ("
-                     << SecondsSince(launch_started_at_) << " s)";
+    ORBED_LOG(kInfo) << "testbed '" << spec_.name << "' is up (" << SecondsSince(launch_started_at_) << " s)";
   }
 }
 
@@ -248,8 +244,7 @@ void Launcher::PrintSummary() const {
   std::fprintf(stdout, "  %-*s  %-8s  %s\n", static_cast<int>(name_width_), "process", "restarts",
                "last state");
   for (const Managed& m : managed_) {
-    std::fprintf(stdout, "  %-*s  %-8d  %s\n", static_cast<int>(name_width_),
-                 m.spec.name.c_str(), m.restarts,
+    std::fprintf(stdout, "  %-*s  %-8d  %s\n", static_cast<int>(name_width_), m.spec.name.c_str(), m.restarts,
                  m.started ? m.last_exit.c_str() : "not started");
   }
   std::fflush(stdout);
@@ -257,8 +252,7 @@ void Launcher::PrintSummary() const {
 
 int Launcher::Run() {
   launch_started_at_ = Clock::now();
-  ORBED_LOG(kInfo) << "launching '" << spec_.name << "' from " << spec_.path << " on "
-                   << flags_.lcm_url;
+  ORBED_LOG(kInfo) << "launching '" << spec_.name << "' from " << spec_.path << " on " << flags_.lcm_url;
   StartGroup(0);
   process_.Run();
   StopEverything();

@@ -27,8 +27,7 @@ int main(int argc, char** argv) {
 
   // Commands without '/' are looked up beside this executable first.
   std::error_code ec;
-  const std::string bin_dir =
-      std::filesystem::read_symlink("/proc/self/exe", ec).parent_path().string();
+  const std::string bin_dir = std::filesystem::read_symlink("/proc/self/exe", ec).parent_path().string();
   auto environment = orbed::launcher::CurrentEnvironment();
   environment.emplace("ORBED_BIN_DIR", bin_dir);
   orbed::launcher::LaunchSpec spec;
@@ -44,8 +43,7 @@ int main(int argc, char** argv) {
       for (const auto& p : group.processes) {
         std::cout << "  " << p.name << ": " << p.command;
         for (const auto& a : p.args) std::cout << " " << a;
-        std::cout << (p.respawn ? "  [respawn]" : "") << (p.required ? "  [required]" : "")
-                  << "\n";
+        std::cout << (p.respawn ? "  [respawn]" : "") << (p.required ? "  [required]" : "") << "\n";
       }
     }
     return 0;

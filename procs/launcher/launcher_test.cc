@@ -66,16 +66,15 @@ groups:
 }
 
 TEST(LaunchFile, ErrorsNameFileLineKeyAndFix) {
-  EXPECT_EQ(ErrorOf("groups: []"),
-            "test.yaml:1: 'groups' must be a non-empty list of {name, processes}");
+  EXPECT_EQ(ErrorOf("groups: []"), "test.yaml:1: 'groups' must be a non-empty list of {name, processes}");
   const std::string typo = ErrorOf(
       "groups:\n  - name: g\n    processes:\n      - name: a\n        command: x\n        "
       "respawm: true\n");
   EXPECT_NE(typo.find("test.yaml:6: unknown key 'respawm' in process 'a'"), std::string::npos) << typo;
   EXPECT_NE(typo.find("respawn"), std::string::npos);
-  EXPECT_NE(ErrorOf("groups:\n  - name: g\n    processes:\n      - name: a\n").find(
-                "process 'a' needs 'command'"),
-            std::string::npos);
+  EXPECT_NE(
+      ErrorOf("groups:\n  - name: g\n    processes:\n      - name: a\n").find("process 'a' needs 'command'"),
+      std::string::npos);
   EXPECT_NE(ErrorOf("groups:\n  - name: g\n    processes:\n      - {name: a, command: x, "
                     "stop_signal: SIGFOO}\n")
                 .find("unknown stop_signal 'SIGFOO'"),
@@ -130,8 +129,8 @@ bool WaitForExit(Child* child, double seconds) {
 TEST(Child, ReportsExitCodeAndEnvironment) {
   Child child;
   std::string error;
-  ASSERT_TRUE(child.Start({"sh", "-c", "test \"$ORBED_X\" = 42 && exit 3; exit 9"},
-                          {{"ORBED_X", "42"}}, "", &error))
+  ASSERT_TRUE(
+      child.Start({"sh", "-c", "test \"$ORBED_X\" = 42 && exit 3; exit 9"}, {{"ORBED_X", "42"}}, "", &error))
       << error;
   ASSERT_TRUE(WaitForExit(&child, 5));
   EXPECT_EQ(child.exit_code(), 3);

@@ -23,8 +23,8 @@ EventLogWriter::EventLogWriter(const std::string& path, size_t buffer_bytes) : p
 
 EventLogWriter::~EventLogWriter() { Close(); }
 
-size_t EventLogWriter::Write(int64_t timestamp_us, const std::string& channel,
-                             const uint8_t* data, size_t size) {
+size_t EventLogWriter::Write(int64_t timestamp_us, const std::string& channel, const uint8_t* data,
+                             size_t size) {
   if (!ok()) return 0;
   uint8_t header[kHeaderBytes];
   PutBigEndian(header, kSyncWord, 4);

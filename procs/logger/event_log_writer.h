@@ -28,8 +28,7 @@ class EventLogWriter {
 
   /// Appends one event; the event number is assigned in order from 0. Returns bytes written
   /// (header + channel + data), or 0 after an error.
-  size_t Write(int64_t timestamp_us, const std::string& channel, const uint8_t* data,
-               size_t size);
+  size_t Write(int64_t timestamp_us, const std::string& channel, const uint8_t* data, size_t size);
   /// Pushes buffered bytes to the kernel (fflush). Returns false on an I/O error.
   bool Flush();
   /// Flushes and closes; further writes fail.

@@ -52,9 +52,7 @@ Logger::Logger(const CommonFlags& flags, LoggerOptions options)
   // Subscribe first: a malformed --channels regex throws before any file is created.
   lcm::Subscription* subscription = process_.SubscribeRaw(
       options_.channels,
-      [this](const lcm::ReceiveBuffer& rbuf, const std::string& channel) {
-        OnMessage(rbuf, channel);
-      });
+      [this](const lcm::ReceiveBuffer& rbuf, const std::string& channel) { OnMessage(rbuf, channel); });
   subscription->setQueueCapacity(options_.lcm_queue_capacity);
 
   log_path_ = ChooseLogPath(options_, start_utime_);
@@ -115,8 +113,8 @@ void Logger::OnMessage(const lcm::ReceiveBuffer& rbuf, const std::string& channe
 
 void Logger::WriterLoop() {
   using Clock = std::chrono::steady_clock;
-  const auto flush_period = std::chrono::duration_cast<Clock::duration>(
-      std::chrono::duration<double>(options_.flush_interval_sec));
+  const auto flush_period =
+      std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(options_.flush_interval_sec));
   auto next_flush = Clock::now() + flush_period;
   std::deque<Event> batch;
   for (;;) {
@@ -129,8 +127,7 @@ void Logger::WriterLoop() {
       stop = writer_stop_;
     }
     for (const Event& event : batch) {
-      const size_t written =
-          file_->Write(event.utime, event.channel, event.data.data(), event.data.size());
+      const size_t written = file_->Write(event.utime, event.channel, event.data.data(), event.data.size());
       std::lock_guard<std::mutex> lock(stats_mutex_);
       if (written == 0) {
         // Disk full or gone: every later event is lost too. Say so once, count the losses as
@@ -232,8 +229,7 @@ void Logger::WriteManifest(bool complete) const {
   json.Key("command_line").String(options_.command_line);
   json.Key("versions").BeginObject();
   json.Key("orbed").String(ORBED_VERSION);
-  json.Key("lcm").String(std::to_string(LCM_MAJOR_VERSION) + "." +
-                         std::to_string(LCM_MINOR_VERSION) + "." +
+  json.Key("lcm").String(std::to_string(LCM_MAJOR_VERSION) + "." + std::to_string(LCM_MINOR_VERSION) + "." +
                          std::to_string(LCM_MICRO_VERSION));
   json.EndObject();
   json.Key("lcm_url").String(flags_.lcm_url);

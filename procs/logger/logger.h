@@ -98,18 +98,18 @@ class Logger {
 
   mutable std::mutex queue_mutex_;
   std::condition_variable queue_cv_;
-  std::deque<Event> queue_;       // guarded by queue_mutex_
-  int64_t queue_bytes_ = 0;       // guarded by queue_mutex_
-  int64_t drops_ = 0;             // guarded by queue_mutex_
-  bool writer_stop_ = false;      // guarded by queue_mutex_
+  std::deque<Event> queue_;   // guarded by queue_mutex_
+  int64_t queue_bytes_ = 0;   // guarded by queue_mutex_
+  int64_t drops_ = 0;         // guarded by queue_mutex_
+  bool writer_stop_ = false;  // guarded by queue_mutex_
 
   mutable std::mutex stats_mutex_;
   std::map<std::string, ChannelStats> stats_;  // guarded by stats_mutex_
-  int64_t events_written_ = 0;                  // guarded by stats_mutex_
-  int64_t bytes_written_ = 0;                   // guarded by stats_mutex_
-  int64_t last_flush_utime_ = 0;                // guarded by stats_mutex_
-  std::string write_error_;                     // guarded by stats_mutex_
-  int64_t lost_events_ = 0;                     // guarded by stats_mutex_ (after a write error)
+  int64_t events_written_ = 0;                 // guarded by stats_mutex_
+  int64_t bytes_written_ = 0;                  // guarded by stats_mutex_
+  int64_t last_flush_utime_ = 0;               // guarded by stats_mutex_
+  std::string write_error_;                    // guarded by stats_mutex_
+  int64_t lost_events_ = 0;                    // guarded by stats_mutex_ (after a write error)
 
   struct FileHash {
     std::string path, sha256, error;

@@ -21,8 +21,7 @@ namespace fs = std::filesystem;
 // A fresh temporary folder, removed at exit when every test passed.
 fs::path TempDir(const std::string& name) {
   static std::vector<fs::path> dirs;
-  fs::path dir = fs::temp_directory_path() / ("orbed_logger_test_" + name + "_" +
-                                              std::to_string(::getpid()));
+  fs::path dir = fs::temp_directory_path() / ("orbed_logger_test_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   if (dirs.empty()) {
@@ -121,9 +120,8 @@ TEST(Logger, RecordsEveryChannelWritesManifestAndCountsDrops) {
   iiwa_status_t status{};
   status.num_joints = 7;
   for (auto* v : {&status.joint_position_measured, &status.joint_velocity_estimated,
-                  &status.joint_position_commanded, &status.joint_position_ipo,
-                  &status.joint_torque_measured, &status.joint_torque_commanded,
-                  &status.joint_torque_external}) {
+                  &status.joint_position_commanded, &status.joint_position_ipo, &status.joint_torque_measured,
+                  &status.joint_torque_commanded, &status.joint_torque_external}) {
     v->assign(7, 0.25);
   }
   for (int i = 0; i < 10; ++i) {

@@ -11,10 +11,14 @@ namespace {
 
 const char* StateName(int8_t state) {
   switch (state) {
-    case orbed::process_status_t::STATE_STARTING: return "starting";
-    case orbed::process_status_t::STATE_RUNNING: return "running";
-    case orbed::process_status_t::STATE_STOPPING: return "stopping";
-    case orbed::process_status_t::STATE_FAILED: return "FAILED";
+    case orbed::process_status_t::STATE_STARTING:
+      return "starting";
+    case orbed::process_status_t::STATE_RUNNING:
+      return "running";
+    case orbed::process_status_t::STATE_STOPPING:
+      return "stopping";
+    case orbed::process_status_t::STATE_FAILED:
+      return "FAILED";
   }
   return "?";
 }
@@ -25,17 +29,16 @@ constexpr size_t kMaxNameLength = 64;
 
 }  // namespace
 
-Monitor::Monitor(const CommonFlags& flags, MonitorOptions options)
-    : options_(options), process_(flags) {
+Monitor::Monitor(const CommonFlags& flags, MonitorOptions options) : options_(options), process_(flags) {
   process_.Subscribe<orbed::process_status_t>(
       channels::kProcessStatus,
       [this](const orbed::process_status_t& msg, const std::string& channel, int64_t recv_utime) {
-        const std::string error = FirstError(
-            {CheckEnum(msg.state, 0, 3, "state"),
-             msg.name.empty() || msg.name.size() > kMaxNameLength
-                 ? "name of " + std::to_string(msg.name.size()) + " characters, expected 1.." +
-                       std::to_string(kMaxNameLength)
-                 : ""});
+        const std::string error =
+            FirstError({CheckEnum(msg.state, 0, 3, "state"),
+                        msg.name.empty() || msg.name.size() > kMaxNameLength
+                            ? "name of " + std::to_string(msg.name.size()) + " characters, expected 1.." +
+                                  std::to_string(kMaxNameLength)
+                            : ""});
         if (!error.empty()) {
           process_.Reject(channel + "/field", error);
           return;
@@ -48,14 +51,11 @@ Monitor::Monitor(const CommonFlags& flags, MonitorOptions options)
         processes_[msg.name] = Seen{msg, recv_utime};
       });
   process_.Subscribe<orbed::logger_status_t>(
-      channels::kLoggerStatus,
-      [this](const orbed::logger_status_t& msg, const std::string&, int64_t) {
+      channels::kLoggerStatus, [this](const orbed::logger_status_t& msg, const std::string&, int64_t) {
         logger_ = msg;
         have_logger_ = true;
       });
-  process_.AddTimer(options_.print_period_sec, [this] {
-    std::cout << Table(NowMicros()) << std::flush;
-  });
+  process_.AddTimer(options_.print_period_sec, [this] { std::cout << Table(NowMicros()) << std::flush; });
 }
 
 std::string Monitor::Table(int64_t now_utime) const {
@@ -64,20 +64,18 @@ std::string Monitor::Table(int64_t now_utime) const {
   for (const auto& [name, seen] : processes_) {
     const orbed::process_status_t& s = seen.status;
     const double age_s = (now_utime - seen.recv_utime) * 1e-6;
-    const std::string state =
-        age_s > options_.silent_after_sec ? "SILENT" : StateName(s.state);
-    std::snprintf(line, sizeof(line), "%-20s  %-8s  %8.1f  %7lld  %8lld  %8lld  %s\n",
-                  name.c_str(), state.c_str(), s.uptime_s, static_cast<long long>(s.messages_in),
-                  static_cast<long long>(s.messages_out),
-                  static_cast<long long>(s.rejected_inputs), s.last_error.substr(0, 60).c_str());
+    const std::string state = age_s > options_.silent_after_sec ? "SILENT" : StateName(s.state);
+    std::snprintf(line, sizeof(line), "%-20s  %-8s  %8.1f  %7lld  %8lld  %8lld  %s\n", name.c_str(),
+                  state.c_str(), s.uptime_s, static_cast<long long>(s.messages_in),
+                  static_cast<long long>(s.messages_out), static_cast<long long>(s.rejected_inputs),
+                  s.last_error.substr(0, 60).c_str());
     out += line;
   }
   if (have_logger_) {
     std::snprintf(line, sizeof(line), "log: %s  events %lld  bytes %lld  drops %lld  queue %d/%d\n",
                   logger_.file.c_str(), static_cast<long long>(logger_.events_written),
-                  static_cast<long long>(logger_.bytes_written),
-                  static_cast<long long>(logger_.drops), logger_.queue_depth,
-                  logger_.queue_capacity);
+                  static_cast<long long>(logger_.bytes_written), static_cast<long long>(logger_.drops),
+                  logger_.queue_depth, logger_.queue_capacity);
     out += line;
   }
   return out;

@@ -6,8 +6,9 @@
 #include "procs/monitor/monitor.h"
 
 int main(int argc, char** argv) {
-  CLI::App app{"orbed-monitor: print a table of every orbed process's heartbeat and the logger's\n"
-               "state, flagging processes whose heartbeat stopped."};
+  CLI::App app{
+      "orbed-monitor: print a table of every orbed process's heartbeat and the logger's\n"
+      "state, flagging processes whose heartbeat stopped."};
   orbed::CommonFlags common("orbed-monitor");
   orbed::AddCommonFlags(&app, &common);
   orbed::monitor::MonitorOptions options;

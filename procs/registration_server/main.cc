@@ -22,12 +22,13 @@
 
 #include "procs/common/flags.h"
 #include "procs/registration_server/mean_command.h"
-#include "procs/registration_server/send_command.h"
 #include "procs/registration_server/registration_server.h"
+#include "procs/registration_server/send_command.h"
 
 int main(int argc, char** argv) {
-  CLI::App app{"orbed-registration: SE(3) averaging of alignment trials (paper eqs. 2-3), landmark\n"
-               "triangulation and misalignment evaluation. Without a subcommand: the LCM server."};
+  CLI::App app{
+      "orbed-registration: SE(3) averaging of alignment trials (paper eqs. 2-3), landmark\n"
+      "triangulation and misalignment evaluation. Without a subcommand: the LCM server."};
   app.require_subcommand(0, 1);
 
   // Server flags.
@@ -35,7 +36,8 @@ int main(int argc, char** argv) {
   orbed::AddCommonFlags(&app, &common);
   orbed::registration::RegistrationServerOptions server;
   std::vector<double> server_centroid_m;
-  app.add_option("--state-period-sec", server.state_period_s, "Period of the full-state REGISTRATION (0 = off)")
+  app.add_option("--state-period-sec", server.state_period_s,
+                 "Period of the full-state REGISTRATION (0 = off)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--model-centroid-m", server_centroid_m,
@@ -53,16 +55,20 @@ int main(int argc, char** argv) {
   app.add_option("--session-control-channel", server.session_control_channel)->capture_default_str();
   app.add_option("--landmark-request-channel", server.landmark_request_channel)->capture_default_str();
   app.add_option("--landmark-channel", server.landmark_channel)->capture_default_str();
-  app.add_option("--misalignment-request-channel", server.misalignment_request_channel)->capture_default_str();
+  app.add_option("--misalignment-request-channel", server.misalignment_request_channel)
+      ->capture_default_str();
   app.add_option("--misalignment-channel", server.misalignment_channel)->capture_default_str();
 
   // The offline command.
   orbed::registration::MeanCommandOptions mean_options;
   std::vector<double> mean_centroid_m;
-  CLI::App* mean = app.add_subcommand("mean", "Offline SE(3) mean of a trial file (qw,qx,qy,qz,tx,ty,tz per line)");
-  mean->add_option("--input", mean_options.input_path, "Trial file, one qw,qx,qy,qz,tx,ty,tz per line; '-' = stdin")
+  CLI::App* mean =
+      app.add_subcommand("mean", "Offline SE(3) mean of a trial file (qw,qx,qy,qz,tx,ty,tz per line)");
+  mean->add_option("--input", mean_options.input_path,
+                   "Trial file, one qw,qx,qy,qz,tx,ty,tz per line; '-' = stdin")
       ->required();
-  mean->add_flag("--robust", mean_options.robust, "Reject outlying trials (L1 median + k*MAD) before the Karcher mean");
+  mean->add_flag("--robust", mean_options.robust,
+                 "Reject outlying trials (L1 median + k*MAD) before the Karcher mean");
   mean->add_flag("--json", mean_options.json, "Print one JSON object instead of a text report");
   mean->add_option("--model-centroid-m", mean_centroid_m,
                    "Average translations about this model centroid p_VC (3 numbers, metres, in V)")
@@ -72,7 +78,8 @@ int main(int argc, char** argv) {
   orbed::registration::SendCommandOptions send_options;
   CLI::App* send = app.add_subcommand(
       "send", "Send a trial file to a running orbed-registration as one session and print its mean");
-  send->add_option("--input", send_options.input_path, "Trial file, one qw,qx,qy,qz,tx,ty,tz per line; '-' = stdin")
+  send->add_option("--input", send_options.input_path,
+                   "Trial file, one qw,qx,qy,qz,tx,ty,tz per line; '-' = stdin")
       ->required();
   send->add_option("--session-id", send_options.session_id, "Session id to use")->capture_default_str();
   send->add_flag("--robust", send_options.robust, "Ask for the robust mean");

@@ -27,10 +27,11 @@ const char* Bool(bool b) { return b ? "true" : "false"; }
 std::string FormatMeanJson(const Se3MeanResult& result) {
   const Eigen::Quaterniond& q = result.q_WV_mean;
   const Eigen::Vector3d& p = result.p_WV_mean;
-  std::string s = "{\"rotation_wxyz\":[" + Number(q.w()) + "," + Number(q.x()) + "," + Number(q.y()) +
-                  "," + Number(q.z()) + "],\"translation_m\":[" + Number(p.x()) + "," + Number(p.y()) +
-                  "," + Number(p.z()) + "],\"converged\":" + Bool(result.converged) +
-                  ",\"unique\":" + Bool(result.unique) + ",\"iterations\":" + std::to_string(result.iterations) +
+  std::string s = "{\"rotation_wxyz\":[" + Number(q.w()) + "," + Number(q.x()) + "," + Number(q.y()) + "," +
+                  Number(q.z()) + "],\"translation_m\":[" + Number(p.x()) + "," + Number(p.y()) + "," +
+                  Number(p.z()) + "],\"converged\":" + Bool(result.converged) +
+                  ",\"unique\":" + Bool(result.unique) +
+                  ",\"iterations\":" + std::to_string(result.iterations) +
                   ",\"n_used\":" + std::to_string(result.dispersion.num_used) + ",\"rejected\":[";
   for (size_t k = 0; k < result.rejected.size(); ++k) {
     if (k > 0) s += ",";

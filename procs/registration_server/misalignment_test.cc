@@ -30,7 +30,8 @@ TEST(MisalignmentTest, TwoPairsMatchHandComputedTableOneColumns) {
 TEST(MisalignmentTest, BadInputIsRejectedWithAReason) {
   EXPECT_NE(EvaluateMisalignment({}, {}).reason.find("no landmark pairs"), std::string::npos);
   EXPECT_NE(EvaluateMisalignment({{0, 0, 0}}, {}).reason.find("virtual"), std::string::npos);
-  EXPECT_NE(EvaluateMisalignment({{0, 0, 0}}, {{std::nan(""), 0, 0}}).reason.find("pair 0"), std::string::npos);
+  EXPECT_NE(EvaluateMisalignment({{0, 0, 0}}, {{std::nan(""), 0, 0}}).reason.find("pair 0"),
+            std::string::npos);
 }
 
 }  // namespace

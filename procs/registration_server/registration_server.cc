@@ -4,10 +4,12 @@
 
 namespace orbed::registration {
 
-RegistrationServer::RegistrationServer(const orbed::CommonFlags& flags, const RegistrationServerOptions& options)
+RegistrationServer::RegistrationServer(const orbed::CommonFlags& flags,
+                                       const RegistrationServerOptions& options)
     : Process(flags),
       options_(options),
-      service_(options.service, [this](const std::string& key, const std::string& reason) { Reject(key, reason); }) {
+      service_(options.service,
+               [this](const std::string& key, const std::string& reason) { Reject(key, reason); }) {
   Subscribe<orbed::session_control_t>(
       options_.session_control_channel,
       [this](const orbed::session_control_t& msg, const std::string&, int64_t) {
@@ -18,7 +20,8 @@ RegistrationServer::RegistrationServer(const orbed::CommonFlags& flags, const Re
         if (auto state = service_.HandleTrial(msg)) Publish(options_.registration_channel, *state);
       });
   Subscribe<orbed::landmark_request_t>(
-      options_.landmark_request_channel, [this](const orbed::landmark_request_t& msg, const std::string&, int64_t) {
+      options_.landmark_request_channel,
+      [this](const orbed::landmark_request_t& msg, const std::string&, int64_t) {
         Publish(options_.landmark_channel, service_.HandleLandmarkRequest(msg));
       });
   Subscribe<orbed::misalignment_request_t>(

@@ -30,8 +30,8 @@ orbed::session_control_t Control(int8_t command, const std::string& id, int64_t 
   return msg;
 }
 
-orbed::alignment_trial_t Trial(const std::string& id, int index, double angle_about_z_rad, const Eigen::Vector3d& p,
-                               int64_t utime) {
+orbed::alignment_trial_t Trial(const std::string& id, int index, double angle_about_z_rad,
+                               const Eigen::Vector3d& p, int64_t utime) {
   orbed::alignment_trial_t msg{};
   msg.utime = utime;
   msg.session_id = id;
@@ -59,7 +59,8 @@ std::vector<uint8_t> Bytes(const Msg& msg) {
 struct Fixture {
   std::map<std::string, int> rejections;
   std::vector<std::string> reasons;
-  RegistrationService service{RegistrationServiceOptions{}, [this](const std::string& key, const std::string& reason) {
+  RegistrationService service{RegistrationServiceOptions{},
+                              [this](const std::string& key, const std::string& reason) {
                                 ++rejections[key];
                                 reasons.push_back(reason);
                               }};
@@ -71,7 +72,8 @@ TEST(RegistrationServiceTest, ThreeTrialsGiveTheClosedFormMean) {
   std::optional<orbed::registration_t> state;
   const double angles_deg[3] = {10, 20, 45};
   for (int i = 0; i < 3; ++i) {
-    state = f.service.HandleTrial(Trial("s1", i, angles_deg[i] * kDeg, Eigen::Vector3d(i + 1.0, -1.0, 0.5), 1000 + i));
+    state = f.service.HandleTrial(
+        Trial("s1", i, angles_deg[i] * kDeg, Eigen::Vector3d(i + 1.0, -1.0, 0.5), 1000 + i));
     ASSERT_TRUE(state.has_value());
     EXPECT_EQ(state->num_trials, i + 1);
     EXPECT_EQ(state->utime, 1000 + i);
@@ -85,7 +87,8 @@ TEST(RegistrationServiceTest, ThreeTrialsGiveTheClosedFormMean) {
   EXPECT_TRUE(state->unique);
   // On one axis the Karcher mean is the mean angle, 25°; translations average to (2, −1, 0.5).
   const Eigen::Quaterniond q_mean = QuaternionFromWxyz(state->X_WV_mean.quaternion_wxyz);
-  EXPECT_NEAR(Eigen::AngleAxisd(q_mean.conjugate() * Eigen::Quaterniond(Eigen::AngleAxisd(25 * kDeg, Eigen::Vector3d::UnitZ())))
+  EXPECT_NEAR(Eigen::AngleAxisd(q_mean.conjugate() *
+                                Eigen::Quaterniond(Eigen::AngleAxisd(25 * kDeg, Eigen::Vector3d::UnitZ())))
                   .angle(),
               0.0, 1e-12);
   EXPECT_NEAR(state->X_WV_mean.position_m[0], 2.0, 1e-15);
@@ -93,13 +96,14 @@ TEST(RegistrationServiceTest, ThreeTrialsGiveTheClosedFormMean) {
   EXPECT_NEAR(state->X_WV_mean.position_m[2], 0.5, 1e-15);
   EXPECT_NEAR(state->rotation_max_deg, 20.0, 1e-9);
   EXPECT_NEAR(state->rotation_median_deg, 15.0, 1e-9);
-  EXPECT_NEAR(state->rotation_covariance_rad2[2][2], (std::pow(15 * kDeg, 2) + std::pow(5 * kDeg, 2) + std::pow(20 * kDeg, 2)) / 3,
-              1e-12);
+  EXPECT_NEAR(state->rotation_covariance_rad2[2][2],
+              (std::pow(15 * kDeg, 2) + std::pow(5 * kDeg, 2) + std::pow(20 * kDeg, 2)) / 3, 1e-12);
   EXPECT_NEAR(state->translation_rms_m, std::sqrt(2.0 / 3.0), 1e-15);
   EXPECT_TRUE(f.rejections.empty());
 
   // COMPUTE answers with the command's utime; the periodic state carries the last input's.
-  const auto computed = f.service.HandleSessionControl(Control(orbed::session_control_t::COMPUTE, "s1", 5000));
+  const auto computed =
+      f.service.HandleSessionControl(Control(orbed::session_control_t::COMPUTE, "s1", 5000));
   ASSERT_TRUE(computed.has_value());
   EXPECT_EQ(computed->utime, 5000);
   EXPECT_EQ(computed->reason, int{orbed::registration_t::REASON_COMPUTE});
@@ -184,7 +188,8 @@ TEST(RegistrationServiceTest, RobustSessionReportsTheRejectedTrialIndex) {
   std::optional<orbed::registration_t> state;
   const double offsets_deg[6] = {-0.4, 0.3, 0.0, 0.2, -0.1, 120.0};
   for (int i = 0; i < 6; ++i) {
-    state = f.service.HandleTrial(Trial("r", 10 + i, (30 + offsets_deg[i]) * kDeg, Eigen::Vector3d(1, 1, 1), 100 + i));
+    state = f.service.HandleTrial(
+        Trial("r", 10 + i, (30 + offsets_deg[i]) * kDeg, Eigen::Vector3d(1, 1, 1), 100 + i));
   }
   ASSERT_TRUE(state && state->valid);
   EXPECT_EQ(state->method, int{orbed::registration_t::METHOD_ROBUST});
@@ -253,15 +258,17 @@ TEST(RegistrationServiceTest, ReplayIsBitIdentical) {
   auto run = [] {
     Fixture f;
     std::vector<std::vector<uint8_t>> out;
-    f.service.HandleSessionControl(Control(orbed::session_control_t::START, "replay", 1,
-                                           orbed::registration_t::METHOD_ROBUST));
+    f.service.HandleSessionControl(
+        Control(orbed::session_control_t::START, "replay", 1, orbed::registration_t::METHOD_ROBUST));
     for (int i = 0; i < 8; ++i) {
       const double angle = (i == 5 ? 100.0 : 3.0 * std::sin(i)) * kDeg;
-      if (auto s = f.service.HandleTrial(Trial("replay", i, angle, Eigen::Vector3d(0.01 * i, 0, 1), 10 + i))) {
+      if (auto s =
+              f.service.HandleTrial(Trial("replay", i, angle, Eigen::Vector3d(0.01 * i, 0, 1), 10 + i))) {
         out.push_back(Bytes(*s));
       }
     }
-    out.push_back(Bytes(*f.service.HandleSessionControl(Control(orbed::session_control_t::COMPUTE, "replay", 99))));
+    out.push_back(
+        Bytes(*f.service.HandleSessionControl(Control(orbed::session_control_t::COMPUTE, "replay", 99))));
     out.push_back(Bytes(*f.service.PeriodicState()));
     return out;
   };

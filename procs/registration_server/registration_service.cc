@@ -71,15 +71,15 @@ void RegistrationService::Reject(const std::string& key, const std::string& reas
 
 std::optional<orbed::registration_t> RegistrationService::HandleSessionControl(
     const orbed::session_control_t& msg) {
-  const std::string problem = FirstError(
-      {CheckSessionId(msg.session_id, "SESSION_CONTROL"),
-       CheckEnum(msg.command, orbed::session_control_t::START,
-                 orbed::session_control_t::REQUEST_TRIAL, "SESSION_CONTROL.command"),
-       CheckEnum(msg.display_mode, orbed::alignment_trial_t::MODE_AR,
-                 orbed::alignment_trial_t::MODE_AR_REFLECTIVE, "SESSION_CONTROL.display_mode"),
-       CheckEnum(msg.method, orbed::registration_t::METHOD_CHORDAL, orbed::registration_t::METHOD_ROBUST,
-                 "SESSION_CONTROL.method"),
-       CheckEnum(msg.num_mirrors, 0, 64, "SESSION_CONTROL.num_mirrors")});
+  const std::string problem =
+      FirstError({CheckSessionId(msg.session_id, "SESSION_CONTROL"),
+                  CheckEnum(msg.command, orbed::session_control_t::START,
+                            orbed::session_control_t::REQUEST_TRIAL, "SESSION_CONTROL.command"),
+                  CheckEnum(msg.display_mode, orbed::alignment_trial_t::MODE_AR,
+                            orbed::alignment_trial_t::MODE_AR_REFLECTIVE, "SESSION_CONTROL.display_mode"),
+                  CheckEnum(msg.method, orbed::registration_t::METHOD_CHORDAL,
+                            orbed::registration_t::METHOD_ROBUST, "SESSION_CONTROL.method"),
+                  CheckEnum(msg.num_mirrors, 0, 64, "SESSION_CONTROL.num_mirrors")});
   if (!problem.empty()) {
     Reject("SESSION_CONTROL/field", problem);
     return std::nullopt;
@@ -124,15 +124,16 @@ std::optional<orbed::registration_t> RegistrationService::HandleTrial(const orbe
                         : std::string("no session is active (send SESSION_CONTROL START)")));
     return std::nullopt;
   }
-  std::string problem = FirstError(
-      {CheckPose(msg.X_WV, "ALIGNMENT_TRIAL.X_WV"),
-       CheckBounded(msg.X_WV.position_m, 3, kMaxCoordinate_m, "ALIGNMENT_TRIAL.X_WV.position_m"),
-       CheckEnum(msg.display_mode, orbed::alignment_trial_t::MODE_AR, orbed::alignment_trial_t::MODE_AR_REFLECTIVE,
-                 "ALIGNMENT_TRIAL.display_mode"),
-       CheckEnum(msg.num_mirrors, 0, 64, "ALIGNMENT_TRIAL.num_mirrors"),
-       CheckLength(msg.num_joints, msg.joint_position.size(), options_.max_joints, "ALIGNMENT_TRIAL.num_joints"),
-       CheckFinite(msg.joint_position, "ALIGNMENT_TRIAL.joint_position"),
-       CheckFinite(&msg.duration_s, 1, "ALIGNMENT_TRIAL.duration_s")});
+  std::string problem =
+      FirstError({CheckPose(msg.X_WV, "ALIGNMENT_TRIAL.X_WV"),
+                  CheckBounded(msg.X_WV.position_m, 3, kMaxCoordinate_m, "ALIGNMENT_TRIAL.X_WV.position_m"),
+                  CheckEnum(msg.display_mode, orbed::alignment_trial_t::MODE_AR,
+                            orbed::alignment_trial_t::MODE_AR_REFLECTIVE, "ALIGNMENT_TRIAL.display_mode"),
+                  CheckEnum(msg.num_mirrors, 0, 64, "ALIGNMENT_TRIAL.num_mirrors"),
+                  CheckLength(msg.num_joints, msg.joint_position.size(), options_.max_joints,
+                              "ALIGNMENT_TRIAL.num_joints"),
+                  CheckFinite(msg.joint_position, "ALIGNMENT_TRIAL.joint_position"),
+                  CheckFinite(&msg.duration_s, 1, "ALIGNMENT_TRIAL.duration_s")});
   if (!problem.empty()) {
     Reject("ALIGNMENT_TRIAL/field", problem);
     return std::nullopt;
@@ -153,8 +154,8 @@ std::optional<orbed::registration_t> RegistrationService::HandleTrial(const orbe
   }
   for (const Trial& t : trials_) {
     if (t.trial_index == msg.trial_index) {
-      Reject("ALIGNMENT_TRIAL/trial_index",
-             "trial_index " + std::to_string(msg.trial_index) + " already received in session '" + session_id_ + "'");
+      Reject("ALIGNMENT_TRIAL/trial_index", "trial_index " + std::to_string(msg.trial_index) +
+                                                " already received in session '" + session_id_ + "'");
       return std::nullopt;
     }
   }
@@ -228,9 +229,11 @@ orbed::landmark_t RegistrationService::HandleLandmarkRequest(const orbed::landma
   out.name = msg.name;
   out.valid = false;
   std::vector<Eigen::Vector3d> origins, directions;
-  std::string problem = ReadRows(msg.origin_W_m, msg.num_rays, options_.max_rays, "LANDMARK_REQUEST.origin_W_m", &origins);
+  std::string problem =
+      ReadRows(msg.origin_W_m, msg.num_rays, options_.max_rays, "LANDMARK_REQUEST.origin_W_m", &origins);
   if (problem.empty()) {
-    problem = ReadRows(msg.direction_W, msg.num_rays, options_.max_rays, "LANDMARK_REQUEST.direction_W", &directions);
+    problem = ReadRows(msg.direction_W, msg.num_rays, options_.max_rays, "LANDMARK_REQUEST.direction_W",
+                       &directions);
   }
   if (problem.empty()) {
     const TriangulationResult r = TriangulateRays(origins, directions, options_.triangulation);
@@ -247,7 +250,8 @@ orbed::landmark_t RegistrationService::HandleLandmarkRequest(const orbed::landma
   return out;
 }
 
-orbed::misalignment_t RegistrationService::HandleMisalignmentRequest(const orbed::misalignment_request_t& msg) {
+orbed::misalignment_t RegistrationService::HandleMisalignmentRequest(
+    const orbed::misalignment_request_t& msg) {
   orbed::misalignment_t out{};
   out.utime = msg.utime;
   out.request_id = msg.request_id;
@@ -258,8 +262,8 @@ orbed::misalignment_t RegistrationService::HandleMisalignmentRequest(const orbed
   std::string problem =
       ReadRows(msg.p_W_real_m, msg.num_pairs, options_.max_pairs, "MISALIGNMENT_REQUEST.p_W_real_m", &real);
   if (problem.empty()) {
-    problem = ReadRows(msg.p_W_virtual_m, msg.num_pairs, options_.max_pairs, "MISALIGNMENT_REQUEST.p_W_virtual_m",
-                       &virt);
+    problem = ReadRows(msg.p_W_virtual_m, msg.num_pairs, options_.max_pairs,
+                       "MISALIGNMENT_REQUEST.p_W_virtual_m", &virt);
   }
   if (problem.empty()) {
     const MisalignmentResult r = EvaluateMisalignment(real, virt);

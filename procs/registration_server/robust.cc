@@ -110,8 +110,7 @@ RotationL1MedianResult ComputeRotationL1Median(const std::vector<Eigen::Quaterni
 }
 
 PointL1MedianResult ComputePointL1Median(const std::vector<Eigen::Vector3d>& p_W,
-                                         const std::vector<double>& weights,
-                                         const L1MedianOptions& options) {
+                                         const std::vector<double>& weights, const L1MedianOptions& options) {
   PointL1MedianResult result;
   if (p_W.empty()) {
     result.reason = "no points";
@@ -156,8 +155,8 @@ OutlierResult RejectOutliers(const std::vector<Eigen::Quaterniond>& q_WV,
                              const std::vector<Eigen::Vector3d>& p_WV, const OutlierOptions& options) {
   OutlierResult result;
   if (q_WV.size() != p_WV.size()) {
-    result.reason = "got " + std::to_string(q_WV.size()) + " rotations but " +
-                    std::to_string(p_WV.size()) + " translations";
+    result.reason = "got " + std::to_string(q_WV.size()) + " rotations but " + std::to_string(p_WV.size()) +
+                    " translations";
     return result;
   }
   if (!(options.k_mad > 0.0) || !(options.min_rotation_threshold_deg >= 0.0) ||

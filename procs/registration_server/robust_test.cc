@@ -13,10 +13,10 @@
 namespace orbed::registration {
 namespace {
 
+using testing::AngleBetween;
 using testing::kDeg;
 using testing::kPi;
 using testing::Rot;
-using testing::AngleBetween;
 
 TEST(RobustTest, MedianOfValues) {
   EXPECT_EQ(Median({3.0, 1.0, 2.0}), 2.0);
@@ -75,7 +75,8 @@ TEST(RobustTest, OneBotchedTrialOfElevenIsRejectedAndTheMeanStaysWithinHalfADegr
   std::vector<Eigen::Vector3d> p;
   for (int i = 0; i < 10; ++i) {
     // Rotation noise of 1° RMS angle (σ = 1/√3 ° per axis), 5 mm per axis.
-    const Eigen::Vector3d w = (1.0 / std::sqrt(3.0)) * kDeg * Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
+    const Eigen::Vector3d w =
+        (1.0 / std::sqrt(3.0)) * kDeg * Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
     q.push_back(truth * Rot(w.norm(), w));
     p.push_back(p_truth + 0.005 * Eigen::Vector3d(normal(rng), normal(rng), normal(rng)));
   }
@@ -102,7 +103,8 @@ TEST(RobustTest, OneBotchedTrialOfElevenIsRejectedAndTheMeanStaysWithinHalfADegr
 
 TEST(RobustTest, TranslationOutlierIsRejected) {
   std::vector<Eigen::Quaterniond> q(6, Eigen::Quaterniond::Identity());
-  std::vector<Eigen::Vector3d> p = {{0, 0, 0}, {0.002, 0, 0}, {0, 0.003, 0}, {0, 0, -0.002}, {-0.001, 0, 0}, {0.3, 0, 0}};
+  std::vector<Eigen::Vector3d> p = {{0, 0, 0},      {0.002, 0, 0},  {0, 0.003, 0},
+                                    {0, 0, -0.002}, {-0.001, 0, 0}, {0.3, 0, 0}};
   const OutlierResult r = RejectOutliers(q, p);
   ASSERT_TRUE(r.valid);
   ASSERT_EQ(r.rejected.size(), 1u);
@@ -115,8 +117,9 @@ TEST(RobustTest, IdenticalTrialsAndTooFewTrialsRejectNothing) {
   std::vector<Eigen::Vector3d> p(5, Eigen::Vector3d(1, 2, 3));
   p[2].x() += 1e-4;  // MAD = 0; below the floor
   EXPECT_TRUE(RejectOutliers(q, p).rejected.empty());
-  const OutlierResult two = RejectOutliers({Eigen::Quaterniond::Identity(), Rot(2.0, Eigen::Vector3d::UnitX())},
-                                           {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()});
+  const OutlierResult two =
+      RejectOutliers({Eigen::Quaterniond::Identity(), Rot(2.0, Eigen::Vector3d::UnitX())},
+                     {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()});
   ASSERT_TRUE(two.valid);
   EXPECT_TRUE(two.rejected.empty());
   EXPECT_FALSE(RejectOutliers(q, {Eigen::Vector3d::Zero()}).valid);

@@ -32,8 +32,8 @@ std::string ValidateRotationSamples(const std::vector<Eigen::Quaterniond>& q_WV,
     const Eigen::Quaterniond& q = q_WV[i];
     if (!q.coeffs().allFinite()) return "rotation " + std::to_string(i) + " has a non-finite component";
     if (std::abs(q.norm() - 1.0) > kUnitTolerance) {
-      return "rotation " + std::to_string(i) + " is not a unit quaternion (norm " +
-             std::to_string(q.norm()) + ")";
+      return "rotation " + std::to_string(i) + " is not a unit quaternion (norm " + std::to_string(q.norm()) +
+             ")";
     }
   }
   if (!weights.empty()) {
@@ -79,8 +79,7 @@ ChordalMeanResult ComputeChordalMean(const std::vector<Eigen::Quaterniond>& q_WV
 }
 
 KarcherMeanResult ComputeKarcherMean(const std::vector<Eigen::Quaterniond>& q_WV,
-                                     const std::vector<double>& weights,
-                                     const KarcherOptions& options) {
+                                     const std::vector<double>& weights, const KarcherOptions& options) {
   KarcherMeanResult result;
   if (!(options.step_tolerance_rad > 0.0) || options.max_iterations < 1) {
     result.reason = "Karcher options need step_tolerance_rad > 0 and max_iterations >= 1";

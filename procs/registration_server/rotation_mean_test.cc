@@ -12,10 +12,10 @@
 namespace orbed::registration {
 namespace {
 
+using testing::AngleBetween;
 using testing::kDeg;
 using testing::kPi;
 using testing::Rot;
-using testing::AngleBetween;
 
 // Signed angle of a rotation about +z (assumes the rotation is about z).
 double AngleAboutZ(const Eigen::Quaterniond& q) { return 2.0 * std::atan2(q.z(), q.w()); }
@@ -93,7 +93,8 @@ TEST(RotationMeanTest, RotationAndItsInverseAverageToIdentity) {
 }
 
 TEST(RotationMeanTest, MeanIsBiInvariant) {
-  const std::vector<Eigen::Quaterniond> q = RandomCluster(9, 25 * kDeg, 11, Rot(0.8, Eigen::Vector3d(1, 1, 1)));
+  const std::vector<Eigen::Quaterniond> q =
+      RandomCluster(9, 25 * kDeg, 11, Rot(0.8, Eigen::Vector3d(1, 1, 1)));
   const Eigen::Quaterniond L = Rot(2.1, Eigen::Vector3d(-1, 0.5, 2));
   const Eigen::Quaterniond S = Rot(-0.6, Eigen::Vector3d(0, 1, 3));
   std::vector<Eigen::Quaterniond> moved;
@@ -106,7 +107,8 @@ TEST(RotationMeanTest, MeanIsBiInvariant) {
 }
 
 TEST(RotationMeanTest, ResidualsSumToZeroAtTheOptimum) {
-  const std::vector<Eigen::Quaterniond> q = RandomCluster(15, 40 * kDeg, 5, Rot(-2.5, Eigen::Vector3d(0, 1, 0)));
+  const std::vector<Eigen::Quaterniond> q =
+      RandomCluster(15, 40 * kDeg, 5, Rot(-2.5, Eigen::Vector3d(0, 1, 0)));
   const KarcherMeanResult r = ComputeKarcherMean(q);
   ASSERT_TRUE(r.valid);
   EXPECT_TRUE(r.converged);
@@ -147,7 +149,8 @@ TEST(RotationMeanTest, ClusterAroundAHalfTurnConverges) {
   // Symmetric pairs C·exp(±δ_k): the mean is C by symmetry. C is a half turn, 180° from identity.
   const Eigen::Quaterniond C = Rot(kPi, Eigen::Vector3d(1, 2, 3));
   std::vector<Eigen::Quaterniond> q;
-  const std::vector<Eigen::Vector3d> deltas = {Eigen::Vector3d(0.1, 0.02, -0.05), Eigen::Vector3d(-0.03, 0.2, 0.01),
+  const std::vector<Eigen::Vector3d> deltas = {Eigen::Vector3d(0.1, 0.02, -0.05),
+                                               Eigen::Vector3d(-0.03, 0.2, 0.01),
                                                Eigen::Vector3d(0.05, -0.04, 0.15)};
   for (const auto& d : deltas) {
     q.push_back(C * Rot(d.norm(), d));
@@ -162,15 +165,17 @@ TEST(RotationMeanTest, ClusterAroundAHalfTurnConverges) {
 }
 
 TEST(RotationMeanTest, SignFlippedQuaternionsGiveTheSameMean) {
-  const std::vector<Eigen::Quaterniond> q = RandomCluster(8, 30 * kDeg, 3, Rot(1.0, Eigen::Vector3d(0, 0, 1)));
+  const std::vector<Eigen::Quaterniond> q =
+      RandomCluster(8, 30 * kDeg, 3, Rot(1.0, Eigen::Vector3d(0, 0, 1)));
   std::vector<Eigen::Quaterniond> flipped = q;
   for (size_t i = 0; i < flipped.size(); i += 2) flipped[i].coeffs() *= -1.0;
   const KarcherMeanResult a = ComputeKarcherMean(q);
   const KarcherMeanResult b = ComputeKarcherMean(flipped);
   ASSERT_TRUE(a.valid && b.valid);
   EXPECT_LT(AngleBetween(a.q_WV_mean, b.q_WV_mean), 1e-13);
-  EXPECT_LT((ComputeChordalMean(q).q_WV_mean.coeffs() - ComputeChordalMean(flipped).q_WV_mean.coeffs()).norm(),
-            1e-13);
+  EXPECT_LT(
+      (ComputeChordalMean(q).q_WV_mean.coeffs() - ComputeChordalMean(flipped).q_WV_mean.coeffs()).norm(),
+      1e-13);
   EXPECT_GE(b.q_WV_mean.w(), 0.0);  // canonical sign
 }
 
@@ -196,11 +201,14 @@ TEST(RotationMeanTest, SingleRotationIsItsOwnMean) {
 TEST(RotationMeanTest, BadInputIsRejectedWithAReason) {
   EXPECT_NE(ComputeKarcherMean({}).reason.find("no rotations"), std::string::npos);
   const Eigen::Quaterniond bad(2, 0, 0, 0);
-  EXPECT_NE(ComputeKarcherMean({Eigen::Quaterniond::Identity(), bad}).reason.find("rotation 1"), std::string::npos);
+  EXPECT_NE(ComputeKarcherMean({Eigen::Quaterniond::Identity(), bad}).reason.find("rotation 1"),
+            std::string::npos);
   EXPECT_NE(ComputeKarcherMean({Eigen::Quaterniond::Identity()}, {1.0, 2.0}).reason.find("weights"),
             std::string::npos);
-  EXPECT_NE(ComputeKarcherMean({Eigen::Quaterniond::Identity()}, {-1.0}).reason.find("weight 0"), std::string::npos);
-  EXPECT_NE(ComputeKarcherMean({Eigen::Quaterniond::Identity()}, {0.0}).reason.find("zero"), std::string::npos);
+  EXPECT_NE(ComputeKarcherMean({Eigen::Quaterniond::Identity()}, {-1.0}).reason.find("weight 0"),
+            std::string::npos);
+  EXPECT_NE(ComputeKarcherMean({Eigen::Quaterniond::Identity()}, {0.0}).reason.find("zero"),
+            std::string::npos);
   const Eigen::Quaterniond nan(std::nan(""), 0, 0, 0);
   EXPECT_FALSE(ComputeChordalMean({nan}).valid);
   KarcherOptions options;

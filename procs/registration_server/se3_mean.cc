@@ -36,8 +36,8 @@ Se3MeanResult ComputeSe3Mean(const std::vector<Eigen::Quaterniond>& q_WV,
     return result;
   }
   if (q_WV.size() != p_WV.size()) {
-    result.reason = "got " + std::to_string(q_WV.size()) + " rotations but " +
-                    std::to_string(p_WV.size()) + " translations";
+    result.reason = "got " + std::to_string(q_WV.size()) + " rotations but " + std::to_string(p_WV.size()) +
+                    " translations";
     return result;
   }
   if (q_WV.empty()) {

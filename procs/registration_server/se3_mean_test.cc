@@ -11,10 +11,10 @@
 namespace orbed::registration {
 namespace {
 
+using testing::AngleBetween;
 using testing::kDeg;
 using testing::kPi;
 using testing::Rot;
-using testing::AngleBetween;
 
 TEST(Se3MeanTest, TranslationIsTheArithmeticMeanAndDispersionMatchesHandValues) {
   const Eigen::Vector3d z = Eigen::Vector3d::UnitZ();
@@ -83,7 +83,8 @@ TEST(Se3MeanTest, RobustMethodReportsTheRejectedTrial) {
   const Eigen::Quaterniond truth = Rot(0.5, Eigen::Vector3d(1, 0, 1));
   std::vector<Eigen::Quaterniond> q;
   std::vector<Eigen::Vector3d> p;
-  const std::vector<Eigen::Vector3d> deltas = {{0.01, 0, 0}, {-0.01, 0, 0}, {0, 0.01, 0}, {0, -0.01, 0}, {0, 0, 0.01}};
+  const std::vector<Eigen::Vector3d> deltas = {
+      {0.01, 0, 0}, {-0.01, 0, 0}, {0, 0.01, 0}, {0, -0.01, 0}, {0, 0, 0.01}};
   for (const auto& d : deltas) {
     q.push_back(truth * Rot(d.norm(), d));
     p.push_back(Eigen::Vector3d(0.5, 0.5, 0.5) + 0.1 * d);
@@ -103,10 +104,13 @@ TEST(Se3MeanTest, RobustMethodReportsTheRejectedTrial) {
 
 TEST(Se3MeanTest, BadInputIsRejectedWithAReason) {
   EXPECT_NE(ComputeSe3Mean({}, {}).reason.find("no trials"), std::string::npos);
-  EXPECT_NE(ComputeSe3Mean({Eigen::Quaterniond::Identity()}, {}).reason.find("translations"), std::string::npos);
-  EXPECT_NE(ComputeSe3Mean({Eigen::Quaterniond::Identity()}, {{0, std::nan(""), 0}}).reason.find("non-finite"),
+  EXPECT_NE(ComputeSe3Mean({Eigen::Quaterniond::Identity()}, {}).reason.find("translations"),
             std::string::npos);
-  EXPECT_NE(ComputeSe3Mean({Eigen::Quaterniond(0.5, 0, 0, 0)}, {{0, 0, 0}}).reason.find("unit"), std::string::npos);
+  EXPECT_NE(
+      ComputeSe3Mean({Eigen::Quaterniond::Identity()}, {{0, std::nan(""), 0}}).reason.find("non-finite"),
+      std::string::npos);
+  EXPECT_NE(ComputeSe3Mean({Eigen::Quaterniond(0.5, 0, 0, 0)}, {{0, 0, 0}}).reason.find("unit"),
+            std::string::npos);
   Se3MeanOptions options;
   options.method = static_cast<AveragingMethod>(7);
   EXPECT_NE(ComputeSe3Mean({Eigen::Quaterniond::Identity()}, {{0, 0, 0}}, options).reason.find("method"),

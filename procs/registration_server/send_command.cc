@@ -31,10 +31,9 @@ struct AnswerWaiter {
 std::string AnswerJson(const orbed::registration_t& r) {
   JsonWriter json;
   json.BeginObject();
-  json.Key("rotation_wxyz").Array(std::vector<double>(r.X_WV_mean.quaternion_wxyz,
-                                                      r.X_WV_mean.quaternion_wxyz + 4));
-  json.Key("translation_m").Array(std::vector<double>(r.X_WV_mean.position_m,
-                                                      r.X_WV_mean.position_m + 3));
+  json.Key("rotation_wxyz")
+      .Array(std::vector<double>(r.X_WV_mean.quaternion_wxyz, r.X_WV_mean.quaternion_wxyz + 4));
+  json.Key("translation_m").Array(std::vector<double>(r.X_WV_mean.position_m, r.X_WV_mean.position_m + 3));
   json.Key("converged").Bool(r.converged);
   json.Key("unique").Bool(r.unique);
   json.Key("iterations").Int(r.iterations);
@@ -81,8 +80,8 @@ int RunSendCommand(const SendCommandOptions& options, std::ostream& out, std::os
   control.session_id = options.session_id;
   control.command = orbed::session_control_t::START;
   control.display_mode = orbed::alignment_trial_t::MODE_AR;
-  control.method = options.robust ? orbed::registration_t::METHOD_ROBUST
-                                  : orbed::registration_t::METHOD_KARCHER;
+  control.method =
+      options.robust ? orbed::registration_t::METHOD_ROBUST : orbed::registration_t::METHOD_KARCHER;
   lcm.publish(options.session_control_channel, &control);
   for (size_t i = 0; i < trials.q_WV.size(); ++i) {
     orbed::alignment_trial_t trial{};
@@ -105,15 +104,14 @@ int RunSendCommand(const SendCommandOptions& options, std::ostream& out, std::os
                         std::chrono::milliseconds(static_cast<int64_t>(options.timeout_s * 1000));
   while (!waiter.got && std::chrono::steady_clock::now() < deadline) lcm.handleTimeout(50);
   if (!waiter.got) {
-    err << "orbed-registration send: no REGISTRATION for session '" << options.session_id
-        << "' within " << options.timeout_s << " s (is orbed-registration running on "
-        << options.lcm_url << "?)\n";
+    err << "orbed-registration send: no REGISTRATION for session '" << options.session_id << "' within "
+        << options.timeout_s << " s (is orbed-registration running on " << options.lcm_url << "?)\n";
     return 1;
   }
   // UDP may lose a trial; a mean of fewer trials than the file holds must not pass silently.
   if (waiter.answer.num_trials != static_cast<int32_t>(trials.q_WV.size())) {
-    err << "orbed-registration send: the server holds " << waiter.answer.num_trials
-        << " trials of session '" << options.session_id << "', the file " << trials.q_WV.size()
+    err << "orbed-registration send: the server holds " << waiter.answer.num_trials << " trials of session '"
+        << options.session_id << "', the file " << trials.q_WV.size()
         << " (messages lost, or another sender on the session?)\n";
     return 1;
   }

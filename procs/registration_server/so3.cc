@@ -33,8 +33,8 @@ Eigen::Matrix3d Hat(const Eigen::Vector3d& w) {
 Eigen::Quaterniond ExpQuaternion(const Eigen::Vector3d& w) {
   const double theta2 = w.squaredNorm();
   const double theta = std::sqrt(theta2);
-  double c;             // cos(θ/2)
-  double sin_over_th;   // sin(θ/2)/θ
+  double c;            // cos(θ/2)
+  double sin_over_th;  // sin(θ/2)/θ
   if (theta < kSmallAngle) {
     c = 1.0 - theta2 / 8.0;
     sin_over_th = 0.5 - theta2 / 48.0;
@@ -95,12 +95,13 @@ RotationCheck ValidateRotationMatrix(const Eigen::Matrix3d& R, const RotationTol
   const double det = R.determinant();
   check.error = (R.transpose() * R - Eigen::Matrix3d::Identity()).norm();
   if (!(det > 0.0)) {
-    check.message = Format("rotation matrix has det = %.6g <= 0 (a reflection or singular), not a rotation", det);
+    check.message =
+        Format("rotation matrix has det = %.6g <= 0 (a reflection or singular), not a rotation", det);
     return check;
   }
   if (check.error > tolerance.projectable) {
-    check.message = Format("not a rotation: |R^T R - I|_F = %.3g exceeds %.3g", check.error,
-                           tolerance.projectable);
+    check.message =
+        Format("not a rotation: |R^T R - I|_F = %.3g exceeds %.3g", check.error, tolerance.projectable);
     return check;
   }
   Eigen::Matrix3d R_use = R;
@@ -127,7 +128,8 @@ RotationCheck ValidateQuaternionWxyz(const Eigen::Vector4d& wxyz, const Rotation
   const double norm = wxyz.norm();
   check.error = std::abs(norm - 1.0);
   if (check.error > tolerance.projectable) {
-    check.message = Format("quaternion norm %.9g is not 1 (off by more than %.3g)", norm, tolerance.projectable);
+    check.message =
+        Format("quaternion norm %.9g is not 1 (off by more than %.3g)", norm, tolerance.projectable);
     return check;
   }
   check.q = Eigen::Quaterniond(wxyz[0], wxyz[1], wxyz[2], wxyz[3]);

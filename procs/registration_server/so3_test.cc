@@ -15,15 +15,16 @@ constexpr double kPi = 3.141592653589793;
 // Exact quaternion for angle θ about unit axis a.
 Eigen::Quaterniond AxisAngleQuaternion(double theta, const Eigen::Vector3d& a) {
   const Eigen::Vector3d u = a.normalized();
-  return Eigen::Quaterniond(std::cos(0.5 * theta), std::sin(0.5 * theta) * u.x(), std::sin(0.5 * theta) * u.y(),
-                            std::sin(0.5 * theta) * u.z());
+  return Eigen::Quaterniond(std::cos(0.5 * theta), std::sin(0.5 * theta) * u.x(),
+                            std::sin(0.5 * theta) * u.y(), std::sin(0.5 * theta) * u.z());
 }
 
 TEST(So3Test, ExpOfQuarterTurnAboutZIsTheClosedForm) {
   Eigen::Matrix3d expected;
   expected << 0, -1, 0, 1, 0, 0, 0, 0, 1;
   EXPECT_TRUE(ExpSO3(Eigen::Vector3d(0, 0, kPi / 2)).isApprox(expected, 1e-15));
-  EXPECT_TRUE(Hat(Eigen::Vector3d(1, 2, 3)).isApprox((Eigen::Matrix3d() << 0, -3, 2, 3, 0, -1, -2, 1, 0).finished()));
+  EXPECT_TRUE(
+      Hat(Eigen::Vector3d(1, 2, 3)).isApprox((Eigen::Matrix3d() << 0, -3, 2, 3, 0, -1, -2, 1, 0).finished()));
 }
 
 TEST(So3Test, LogIsAccurateAtTinyAngle) {
@@ -70,14 +71,16 @@ TEST(So3Test, ExpAndLogRoundTripAcrossTheRange) {
     const Eigen::Quaterniond expected = AxisAngleQuaternion(theta, a);
     const Eigen::Quaterniond q = ExpQuaternion(theta * a);
     EXPECT_LT((q.coeffs() - expected.coeffs()).norm(), 1e-15) << theta;
-    EXPECT_LT((LogQuaternion(expected) - theta * a).norm(), 4e-15 * std::max(theta, 1e-300) + 1e-300) << theta;
+    EXPECT_LT((LogQuaternion(expected) - theta * a).norm(), 4e-15 * std::max(theta, 1e-300) + 1e-300)
+        << theta;
     EXPECT_NEAR(RotationAngle(expected), theta, 4e-16 * std::max(1.0, theta)) << theta;
   }
 }
 
 TEST(So3Test, GeodesicDistanceIsTheRelativeAngle) {
   const Eigen::Quaterniond a(Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitX()));
-  const Eigen::Quaterniond b = a * Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 1, 0).normalized()));
+  const Eigen::Quaterniond b =
+      a * Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 1, 0).normalized()));
   EXPECT_NEAR(GeodesicDistance(a, b), 0.7, 1e-15);
   EXPECT_NEAR(GeodesicDistance(a, Eigen::Quaterniond(-b.coeffs())), 0.7, 1e-15);
 }

@@ -31,7 +31,8 @@ std::string ParseTrialLine(const std::string& text, Eigen::Quaterniond* q_WV, Ei
   size_t start = 0;
   while (true) {
     const size_t comma = content.find(',', start);
-    fields.push_back(Trim(content.substr(start, comma == std::string::npos ? std::string::npos : comma - start)));
+    fields.push_back(
+        Trim(content.substr(start, comma == std::string::npos ? std::string::npos : comma - start)));
     if (comma == std::string::npos) break;
     start = comma + 1;
   }

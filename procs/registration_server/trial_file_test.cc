@@ -69,7 +69,8 @@ TEST(MeanCommandTest, MalformedFileExitsTwoNamingTheLine) {
   options.input_path = kTestData + "/malformed_trials.txt";
   std::ostringstream out, err;
   EXPECT_EQ(RunMeanCommand(options, out, err), 2);
-  EXPECT_NE(err.str().find("malformed_trials.txt:5: error: line 5: expected 7"), std::string::npos) << err.str();
+  EXPECT_NE(err.str().find("malformed_trials.txt:5: error: line 5: expected 7"), std::string::npos)
+      << err.str();
   EXPECT_TRUE(out.str().empty());
 }
 

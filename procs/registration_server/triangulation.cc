@@ -26,8 +26,8 @@ TriangulationResult TriangulateRays(const std::vector<Eigen::Vector3d>& origin_W
   TriangulationResult result;
   const size_t n = origin_W_m.size();
   if (n != direction_W.size()) {
-    result.reason = "got " + std::to_string(n) + " ray origins but " + std::to_string(direction_W.size()) +
-                    " directions";
+    result.reason =
+        "got " + std::to_string(n) + " ray origins but " + std::to_string(direction_W.size()) + " directions";
     return result;
   }
   if (n < 2) {

@@ -81,7 +81,8 @@ TEST(TriangulationTest, BadInputIsRejectedWithAReason) {
   EXPECT_NE(TriangulateRays({{0, 0, 0}, {1, 0, 0}}, {z}).reason.find("directions"), std::string::npos);
   EXPECT_NE(TriangulateRays({{0, 0, 0}, {1, 0, 0}}, {z, 2.0 * Eigen::Vector3d::UnitX()}).reason.find("norm"),
             std::string::npos);
-  EXPECT_NE(TriangulateRays({{0, 0, std::nan("")}, {1, 0, 0}}, {z, Eigen::Vector3d::UnitX()}).reason.find("non-finite"),
+  EXPECT_NE(TriangulateRays({{0, 0, std::nan("")}, {1, 0, 0}}, {z, Eigen::Vector3d::UnitX()})
+                .reason.find("non-finite"),
             std::string::npos);
 }
 

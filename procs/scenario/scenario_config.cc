@@ -6,9 +6,9 @@
 #include <sstream>
 #include <stdexcept>
 
+#include <yaml-cpp/yaml.h>
 #include <orbed/alignment_trial_t.hpp>
 #include <orbed/registration_t.hpp>
-#include <yaml-cpp/yaml.h>
 
 #include "procs/common/number_list.h"
 
@@ -43,7 +43,8 @@ int IntAt(const std::string& source, const YAML::Node& node, const std::string& 
   return static_cast<int>(v);
 }
 
-std::vector<std::string> StringsAt(const std::string& source, const YAML::Node& node, const std::string& key) {
+std::vector<std::string> StringsAt(const std::string& source, const YAML::Node& node,
+                                   const std::string& key) {
   if (!node.IsSequence() || node.size() == 0) FailAt(source, node, key, "expected a non-empty list of names");
   std::vector<std::string> out;
   for (size_t i = 0; i < node.size(); ++i) {
@@ -93,10 +94,12 @@ void ValidateScenarioConfig(const ScenarioConfig& config, int num_joints) {
   for (const ModeSpec& m : config.modes) {
     if (!seen.insert(m.name).second) throw std::invalid_argument("modes: '" + m.name + "' is listed twice");
   }
-  if (config.method < orbed::registration_t::METHOD_CHORDAL || config.method > orbed::registration_t::METHOD_ROBUST) {
+  if (config.method < orbed::registration_t::METHOD_CHORDAL ||
+      config.method > orbed::registration_t::METHOD_ROBUST) {
     throw std::invalid_argument("method: out of range");
   }
-  if (config.configurations_deg.empty()) throw std::invalid_argument("configurations: at least one is needed");
+  if (config.configurations_deg.empty())
+    throw std::invalid_argument("configurations: at least one is needed");
   const size_t n = static_cast<size_t>(num_joints);
   for (size_t k = 0; k < config.configurations_deg.size(); ++k) {
     const auto& q = config.configurations_deg[k];
@@ -105,11 +108,13 @@ void ValidateScenarioConfig(const ScenarioConfig& config, int num_joints) {
                                   " joint angles [deg], got " + std::to_string(q.size()));
     }
     for (double v : q) {
-      if (!std::isfinite(v)) throw std::invalid_argument("configuration " + std::to_string(k) + ": not finite");
+      if (!std::isfinite(v))
+        throw std::invalid_argument("configuration " + std::to_string(k) + ": not finite");
     }
     for (size_t j = 0; j < k; ++j) {
       double max_diff = 0;
-      for (size_t i = 0; i < n; ++i) max_diff = std::max(max_diff, std::abs(q[i] - config.configurations_deg[j][i]));
+      for (size_t i = 0; i < n; ++i)
+        max_diff = std::max(max_diff, std::abs(q[i] - config.configurations_deg[j][i]));
       if (max_diff <= 1.0) {
         throw std::invalid_argument("configurations " + std::to_string(j) + " and " + std::to_string(k) +
                                     " are the same (no joint differs by more than 1 deg); the paper's trials "
@@ -136,14 +141,15 @@ ScenarioConfig LoadScenarioString(const std::string& yaml_text, const std::strin
     throw std::runtime_error(source + ":" + std::to_string(e.mark.line + 1) + ": not valid YAML: " + e.msg);
   }
   if (!root.IsMap()) FailAt(source, root, "(top level)", "expected a mapping of trials, modes, ...");
-  const std::set<std::string> allowed = {"trials", "modes", "reflective_mirrors", "method", "configurations_deg",
-                                         "landmarks"};
+  const std::set<std::string> allowed = {
+      "trials", "modes", "reflective_mirrors", "method", "configurations_deg", "landmarks"};
   for (const auto& kv : root) {
     const std::string key = kv.first.as<std::string>();
     if (!allowed.count(key)) {
-      FailAt(source, kv.first, key,
-             "unknown key; expected one of: configurations_deg, landmarks, method, modes, reflective_mirrors, "
-             "trials");
+      FailAt(
+          source, kv.first, key,
+          "unknown key; expected one of: configurations_deg, landmarks, method, modes, reflective_mirrors, "
+          "trials");
     }
   }
   const auto required = [&](const std::string& key) {
@@ -187,7 +193,8 @@ ScenarioConfig LoadScenarioString(const std::string& yaml_text, const std::strin
     const std::string key = "configurations_deg[" + std::to_string(k) + "]";
     if (!q.IsSequence()) FailAt(source, q, key, "expected a list of joint angles [deg]");
     std::vector<double> values;
-    for (size_t i = 0; i < q.size(); ++i) values.push_back(NumberAt(source, q[i], key + "[" + std::to_string(i) + "]"));
+    for (size_t i = 0; i < q.size(); ++i)
+      values.push_back(NumberAt(source, q[i], key + "[" + std::to_string(i) + "]"));
     config.configurations_deg.push_back(values);
   }
   config.landmarks = StringsAt(source, required("landmarks"), "landmarks");

@@ -13,9 +13,10 @@
 #include "procs/scenario/viraal_scenario.h"
 
 int main(int argc, char** argv) {
-  CLI::App app{"orbed-scenario: conducts the ViRAAl experiment: per display mode N alignment trials by\n"
-               "the user (orbed-hmd) at distinct robot configurations, the registration server's SE(3)\n"
-               "mean, and the errors of every trial and mean against the simulator's truth."};
+  CLI::App app{
+      "orbed-scenario: conducts the ViRAAl experiment: per display mode N alignment trials by\n"
+      "the user (orbed-hmd) at distinct robot configurations, the registration server's SE(3)\n"
+      "mean, and the errors of every trial and mean against the simulator's truth."};
   orbed::CommonFlags common("orbed-scenario");
   orbed::AddCommonFlags(&app, &common);
   orbed::scenario::ScenarioOptions options;
@@ -26,14 +27,17 @@ int main(int argc, char** argv) {
   app.add_option("--scenario", scenario_path,
                  "Scenario YAML (default: procs/scenario/viraal.yaml under $ORBED_SOURCE_DIR, else under "
                  "the source tree it was built from)");
-  app.add_option("--trials", trials, "Trials per mode (overrides the file's trials)")->check(CLI::Range(1, 1000));
+  app.add_option("--trials", trials, "Trials per mode (overrides the file's trials)")
+      ->check(CLI::Range(1, 1000));
   app.add_option("--modes", modes, "Comma-separated run order of ar_reflective, ar (overrides the file)");
   app.add_option("--q-deg", q_deg,
                  "A trial configuration q1,...,q7 [deg]; repeat for each (replaces the file's list)");
-  app.add_option("--run-id", options.run_id, "Run id; sessions are <run-id>-<mode> (default viraal-<UTC time>)");
+  app.add_option("--run-id", options.run_id,
+                 "Run id; sessions are <run-id>-<mode> (default viraal-<UTC time>)");
   app.add_option("--results-dir", options.results_dir,
                  "Folder of results.json (default: $ORBED_LOG_DIR, else the working directory)");
-  app.add_option("--urdf", options.urdf_path, "Robot URDF for the landmark FK (default: sim/models/iiwa7.urdf)");
+  app.add_option("--urdf", options.urdf_path,
+                 "Robot URDF for the landmark FK (default: sim/models/iiwa7.urdf)");
   app.add_option("--tolerance-deg", options.tolerance_deg, "Arrival tolerance per joint [deg]")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
@@ -44,7 +48,8 @@ int main(int argc, char** argv) {
                  "Wait for PLAN_CHECK_REPLY / REGISTRATION / MISALIGNMENT [s]")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  app.add_option("--move-timeout-sec", options.move_timeout_s, "Wait for the arm to reach a configuration [s]")
+  app.add_option("--move-timeout-sec", options.move_timeout_s,
+                 "Wait for the arm to reach a configuration [s]")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   app.add_option("--trial-timeout-sec", options.trial_timeout_s, "Wait for the user's ALIGNMENT_TRIAL [s]")
@@ -57,7 +62,8 @@ int main(int argc, char** argv) {
   app.add_option("--session-control-channel", options.session_control_channel)->capture_default_str();
   app.add_option("--trial-channel", options.trial_channel)->capture_default_str();
   app.add_option("--registration-channel", options.registration_channel)->capture_default_str();
-  app.add_option("--misalignment-request-channel", options.misalignment_request_channel)->capture_default_str();
+  app.add_option("--misalignment-request-channel", options.misalignment_request_channel)
+      ->capture_default_str();
   app.add_option("--misalignment-channel", options.misalignment_channel)->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   orbed::ApplyCommonFlags(common);

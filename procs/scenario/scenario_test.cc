@@ -92,8 +92,8 @@ TEST(ViraalErrors, TenMillimetresAndOneDegreeInTheWorldFrame) {
   EXPECT_NEAR(e.base_translation_m, 0.010, 1e-15);
   EXPECT_NEAR(e.centroid_translation_m, 0.010, 1e-14);
   // W offset of the flange: (0.01 − 0.5 sin 1°, 0.5 (cos 1° − 1), 0).
-  EXPECT_NEAR(e.flange_translation_m, std::hypot(0.01 - 0.5 * std::sin(1 * kDeg), 0.5 * (std::cos(1 * kDeg) - 1)),
-              1e-14);
+  EXPECT_NEAR(e.flange_translation_m,
+              std::hypot(0.01 - 0.5 * std::sin(1 * kDeg), 0.5 * (std::cos(1 * kDeg) - 1)), 1e-14);
 }
 
 TEST(ViraalErrors, MeanOverConfigurationsAveragesPointErrorsAndPoolsLandmarks) {
@@ -173,13 +173,15 @@ TEST(ScenarioConfig, ErrorsNameTheLineAndTheFix) {
   const std::string good = "configurations_deg:\n  - [0, 30, 0, -60, 0, 45, 0]\nlandmarks: [iiwa_link_ee]\n";
   EXPECT_NO_THROW(LoadScenarioString(good, "s.yaml"));
   ExpectError("trails: 3\n" + good, "s.yaml:1: trails: unknown key");
-  ExpectError(good + "modes: [ar, vr]\n", "s.yaml:4: modes\\[1\\]: unknown mode 'vr', expected ar_reflective or ar");
+  ExpectError(good + "modes: [ar, vr]\n",
+              "s.yaml:4: modes\\[1\\]: unknown mode 'vr', expected ar_reflective or ar");
   ExpectError(good + "trials: 0\n", "s.yaml:4: trials: expected a whole number >= 1");
   ExpectError(good + "method: mean\n", "s.yaml:4: method: expected chordal, karcher or robust");
   ExpectError("configurations_deg:\n  - [0, 30, 0, x, 0, 45, 0]\nlandmarks: [a]\n",
               "s.yaml:2: configurations_deg\\[0\\]\\[3\\]: expected a number");
-  ExpectError("configurations_deg:\n  - [0, 30, 0, -60, 0, 45, 0]\n  - [0, 30, 0, -60, 0, 45, 0.5]\nlandmarks: [a]\n",
-              "configurations 0 and 1 are the same");
+  ExpectError(
+      "configurations_deg:\n  - [0, 30, 0, -60, 0, 45, 0]\n  - [0, 30, 0, -60, 0, 45, 0.5]\nlandmarks: [a]\n",
+      "configurations 0 and 1 are the same");
   ExpectError("landmarks: [a]\n", "s.yaml:1: configurations_deg: missing");
   EXPECT_THROW(ParseJointList("1,2,x", "--q-deg"), std::invalid_argument);
   EXPECT_EQ(ParseJointList("1, 2.5,-3", "--q-deg"), (std::vector<double>{1, 2.5, -3}));
@@ -194,7 +196,8 @@ TEST(ViraalResults, MeanStdWithTheSampleDenominator) {
 
 int Count(const std::string& text, const std::string& pattern) {
   const std::regex re(pattern);
-  return static_cast<int>(std::distance(std::sregex_iterator(text.begin(), text.end(), re), std::sregex_iterator()));
+  return static_cast<int>(
+      std::distance(std::sregex_iterator(text.begin(), text.end(), re), std::sregex_iterator()));
 }
 
 TEST(ViraalResults, JsonHasTheDocumentedShape) {
@@ -327,7 +330,8 @@ class FakeTestbed {
     return r;
   }
   // Stands in for the server's Table 1 evaluation: mean |virtual − real| per axis and its norm.
-  void OnMisalignment(const lcm::ReceiveBuffer*, const std::string&, const orbed::misalignment_request_t* msg) {
+  void OnMisalignment(const lcm::ReceiveBuffer*, const std::string&,
+                      const orbed::misalignment_request_t* msg) {
     orbed::misalignment_t m{};
     m.utime = msg->utime;
     m.request_id = msg->request_id;
@@ -406,7 +410,8 @@ TEST(ViraalScenario, AFullRunOnMemqGivesTheUsersKnownOffset) {
   for (const SessionResult& s : r.sessions) {
     ASSERT_EQ(s.trials.size(), 3u);
     ASSERT_TRUE(s.mean.has_value());
-    for (const ErrorMeasures& e : {s.trials[0].errors, s.trials[1].errors, s.trials[2].errors, s.mean->errors}) {
+    for (const ErrorMeasures& e :
+         {s.trials[0].errors, s.trials[1].errors, s.trials[2].errors, s.mean->errors}) {
       // A pure 10 mm shift: every point is 10 mm off, no rotation; t̄ = (10, 0, 0) mm, ‖t̄‖ = 10 mm.
       EXPECT_NEAR(e.translation_error_mm, 10.0, 1e-9);
       EXPECT_NEAR(e.base_translation_error_mm, 10.0, 1e-9);
@@ -491,7 +496,8 @@ TEST(ViraalScenario, ConfigurationsOutsideTheLimitsAreRefusedAtConstruction) {
     ViraalScenario scenario(MemqFlags(), options);
     ADD_FAILURE() << "no error";
   } catch (const std::invalid_argument& e) {
-    EXPECT_TRUE(std::regex_search(std::string(e.what()), std::regex("configuration 1: .*iiwa_joint_2"))) << e.what();
+    EXPECT_TRUE(std::regex_search(std::string(e.what()), std::regex("configuration 1: .*iiwa_joint_2")))
+        << e.what();
   }
 }
 

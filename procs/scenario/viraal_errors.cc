@@ -5,14 +5,15 @@
 
 namespace orbed::scenario {
 
-RobotPointSet::RobotPointSet(const orbed::sim::RobotModel& model, const std::vector<std::string>& landmark_links)
+RobotPointSet::RobotPointSet(const orbed::sim::RobotModel& model,
+                             const std::vector<std::string>& landmark_links)
     : model_(&model), landmark_names_(landmark_links) {
   if (landmark_links.empty()) throw std::invalid_argument("landmarks: at least one link is needed");
   for (const std::string& name : landmark_links) {
     const int index = model.FindLink(name);
     if (index < 0) {
-      throw std::invalid_argument("landmarks: the robot model " + model.source_name() + " has no link '" + name +
-                                  "'");
+      throw std::invalid_argument("landmarks: the robot model " + model.source_name() + " has no link '" +
+                                  name + "'");
     }
     landmark_indices_.push_back(index);
   }

@@ -22,7 +22,8 @@ void WritePose(JsonWriter* json, const Eigen::Isometry3d& X) {
   // w >= 0, as ToPose does, so equal rotations print equally.
   const double s = q.w() < 0 ? -1.0 : 1.0;
   json->BeginObject();
-  json->Key("position_m").Array(std::vector<double>{X.translation().x(), X.translation().y(), X.translation().z()});
+  json->Key("position_m")
+      .Array(std::vector<double>{X.translation().x(), X.translation().y(), X.translation().z()});
   json->Key("quaternion_wxyz").Array(std::vector<double>{s * q.w(), s * q.x(), s * q.y(), s * q.z()});
   json->EndObject();
 }
@@ -34,7 +35,8 @@ void WriteMeasures(JsonWriter* json, const ErrorMeasures& e) {
   json->Key("base_translation_error_mm").Number(e.base_translation_error_mm);
   json->Key("flange_translation_error_mm").Number(e.flange_translation_error_mm);
   json->Key("misalignment_axes_mm")
-      .Array(std::vector<double>{e.misalignment_axes_mm.x(), e.misalignment_axes_mm.y(), e.misalignment_axes_mm.z()});
+      .Array(std::vector<double>{e.misalignment_axes_mm.x(), e.misalignment_axes_mm.y(),
+                                 e.misalignment_axes_mm.z()});
   json->Key("misalignment_mean_pair_distance_mm").Number(e.misalignment_mean_pair_distance_mm);
 }
 
@@ -86,12 +88,14 @@ std::string ResultsJson(const RunResults& r) {
   json.Key("started_utime").Int(r.started_utime);
   json.Key("duration_s").Number(r.duration_s);
   json.Key("translation_error_point")
-      .String("robot centroid: mean of the link origins from the base to the flange at the trial's q "
-              "(for a mean: averaged over the session's configurations)");
+      .String(
+          "robot centroid: mean of the link origins from the base to the flange at the trial's q "
+          "(for a mean: averaged over the session's configurations)");
   json.Key("misalignment_definition")
-      .String("paper Table 1: norm of the mean absolute per-axis error over the landmark pairs, "
-              "||t_bar||_2 (orbed-registration MISALIGNMENT mean_error_norm_m); for a mean: the pairs of "
-              "all the session's configurations");
+      .String(
+          "paper Table 1: norm of the mean absolute per-axis error over the landmark pairs, "
+          "||t_bar||_2 (orbed-registration MISALIGNMENT mean_error_norm_m); for a mean: the pairs of "
+          "all the session's configurations");
   json.Key("landmarks").BeginArray();
   for (const std::string& name : r.landmarks) json.String(name);
   json.EndArray();
@@ -177,9 +181,10 @@ std::string ResultsTable(const RunResults& r) {
   std::ostringstream out;
   const auto row = [&](const std::string& mode, const std::string& what, const std::string& q,
                        const ErrorMeasures& e) {
-    out << PadRight(mode, 15) << PadRight(what, 8) << PadRight(q, 44) << PadLeft(Fixed(e.translation_error_mm, 1), 9)
-        << PadLeft(Fixed(e.rotation_error_deg, 2), 9) << PadLeft(Fixed(e.misalignment_mm, 1), 10)
-        << PadLeft(Fixed(e.base_translation_error_mm, 1), 9) << "\n";
+    out << PadRight(mode, 15) << PadRight(what, 8) << PadRight(q, 44)
+        << PadLeft(Fixed(e.translation_error_mm, 1), 9) << PadLeft(Fixed(e.rotation_error_deg, 2), 9)
+        << PadLeft(Fixed(e.misalignment_mm, 1), 10) << PadLeft(Fixed(e.base_translation_error_mm, 1), 9)
+        << "\n";
   };
   out << "ViRAAl run " << r.run_id << " (" << (r.ok ? "ok" : "FAILED: " + r.error) << ")\n";
   out << PadRight("mode", 15) << PadRight("trial", 8) << PadRight("q [deg]", 44) << PadLeft("t [mm]", 9)
@@ -192,14 +197,15 @@ std::string ResultsTable(const RunResults& r) {
       row(s.mode, std::to_string(t.index), q + ")", t.errors);
       misalignment.push_back(t.errors.misalignment_mm);
     }
-    if (s.mean) row(s.mode, "mean", "SE(3) mean of " + std::to_string(s.mean->num_used) + " trials", s.mean->errors);
+    if (s.mean)
+      row(s.mode, "mean", "SE(3) mean of " + std::to_string(s.mean->num_used) + " trials", s.mean->errors);
     const MeanStd stats = ComputeMeanStd(misalignment);
     out << PadRight("", 23) << "trial misalignment " << Fixed(stats.mean, 1) << " +/- " << Fixed(stats.std, 1)
         << " mm";
     if (s.mode == "ar_reflective") {
       out << "   (paper: " << Fixed(kPaperReflectiveMm, 1) << " +/- " << Fixed(kPaperReflectiveStdMm, 1)
-          << " mm; its mean " << Fixed(kPaperReflectiveMeanMm, 1) << " +/- " << Fixed(kPaperReflectiveMeanStdMm, 2)
-          << " mm)";
+          << " mm; its mean " << Fixed(kPaperReflectiveMeanMm, 1) << " +/- "
+          << Fixed(kPaperReflectiveMeanStdMm, 2) << " mm)";
     } else if (s.mode == "ar") {
       out << "   (paper: " << Fixed(kPaperArMm, 1) << " +/- " << Fixed(kPaperArStdMm, 1) << " mm)";
     }

@@ -44,7 +44,7 @@ namespace orbed::scenario {
 struct ErrorMeasures {
   double translation_error_mm{0};  ///< at the robot's centroid
   double rotation_error_deg{0};
-  double misalignment_mm{0};       ///< paper Table 1: ‖t̄‖₂ over the landmark pairs
+  double misalignment_mm{0};  ///< paper Table 1: ‖t̄‖₂ over the landmark pairs
   double base_translation_error_mm{0};
   double flange_translation_error_mm{0};
   Eigen::Vector3d misalignment_axes_mm{Eigen::Vector3d::Zero()};  ///< t̄ = mean |virtual − real| per axis

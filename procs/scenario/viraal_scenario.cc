@@ -49,17 +49,21 @@ std::string UtcStamp() {
 
 // Checks the options that are numbers, before anything is opened.
 ScenarioOptions Resolved(ScenarioOptions options) {
-  if (options.urdf_path.empty()) options.urdf_path = ScenarioSourcePath(orbed::sim::RobotModel::kDefaultUrdfRelativePath);
+  if (options.urdf_path.empty())
+    options.urdf_path = ScenarioSourcePath(orbed::sim::RobotModel::kDefaultUrdfRelativePath);
   if (options.run_id.empty()) options.run_id = "viraal-" + UtcStamp();
   if (options.results_dir.empty()) {
     const char* env = std::getenv("ORBED_LOG_DIR");
     options.results_dir = env && *env ? env : ".";
   }
-  const std::pair<const char*, double> positive[] = {
-      {"--tolerance-deg", options.tolerance_deg},       {"--startup-timeout-sec", options.startup_timeout_s},
-      {"--reply-timeout-sec", options.reply_timeout_s}, {"--move-timeout-sec", options.move_timeout_s},
-      {"--trial-timeout-sec", options.trial_timeout_s}, {"--stopped-grace-sec", options.stopped_grace_s},
-      {"command resend period", options.command_resend_s}, {"tick period", options.tick_s}};
+  const std::pair<const char*, double> positive[] = {{"--tolerance-deg", options.tolerance_deg},
+                                                     {"--startup-timeout-sec", options.startup_timeout_s},
+                                                     {"--reply-timeout-sec", options.reply_timeout_s},
+                                                     {"--move-timeout-sec", options.move_timeout_s},
+                                                     {"--trial-timeout-sec", options.trial_timeout_s},
+                                                     {"--stopped-grace-sec", options.stopped_grace_s},
+                                                     {"command resend period", options.command_resend_s},
+                                                     {"tick period", options.tick_s}};
   for (const auto& [name, value] : positive) {
     if (!(value > 0) || !std::isfinite(value)) {
       throw std::invalid_argument(std::string(name) + " must be a finite number > 0");
@@ -78,29 +82,30 @@ ViraalScenario::ViraalScenario(const orbed::CommonFlags& flags, const ScenarioOp
   const ScenarioConfig& config = options_.config;
   ValidateScenarioConfig(config, model_->num_joints());
   for (size_t k = 0; k < config.configurations_deg.size(); ++k) {
-    const std::string why = model_->ValidateJointVector(orbed::sim::DegToRad(ToVectorX(config.configurations_deg[k])));
+    const std::string why =
+        model_->ValidateJointVector(orbed::sim::DegToRad(ToVectorX(config.configurations_deg[k])));
     if (!why.empty()) throw std::invalid_argument("configuration " + std::to_string(k) + ": " + why);
   }
   points_ = std::make_unique<RobotPointSet>(*model_, config.landmarks);
 
   process_ = std::make_unique<orbed::Process>(flags);
   process_->Subscribe<orbed::robot_state_t>(
-      options_.robot_state_channel,
-      [this](const orbed::robot_state_t& msg, const std::string& channel, int64_t) { OnRobotState(msg, channel); });
+      options_.robot_state_channel, [this](const orbed::robot_state_t& msg, const std::string& channel,
+                                           int64_t) { OnRobotState(msg, channel); });
   process_->Subscribe<orbed::plan_check_reply_t>(
       options_.plan_check_reply_channel,
       [this](const orbed::plan_check_reply_t& msg, const std::string& channel, int64_t) {
         OnPlanCheckReply(msg, channel);
       });
   process_->Subscribe<orbed::alignment_trial_t>(
-      options_.trial_channel,
-      [this](const orbed::alignment_trial_t& msg, const std::string& channel, int64_t) { OnTrial(msg, channel); });
+      options_.trial_channel, [this](const orbed::alignment_trial_t& msg, const std::string& channel,
+                                     int64_t) { OnTrial(msg, channel); });
   process_->Subscribe<orbed::registration_t>(
-      options_.registration_channel,
-      [this](const orbed::registration_t& msg, const std::string& channel, int64_t) { OnRegistration(msg, channel); });
+      options_.registration_channel, [this](const orbed::registration_t& msg, const std::string& channel,
+                                            int64_t) { OnRegistration(msg, channel); });
   process_->Subscribe<orbed::misalignment_t>(
-      options_.misalignment_channel,
-      [this](const orbed::misalignment_t& msg, const std::string& channel, int64_t) { OnMisalignment(msg, channel); });
+      options_.misalignment_channel, [this](const orbed::misalignment_t& msg, const std::string& channel,
+                                            int64_t) { OnMisalignment(msg, channel); });
   process_->AddTimer(options_.tick_s, [this] { Tick(); });
 
   run_start_ = phase_start_ = last_command_ = Clock::now();
@@ -146,8 +151,8 @@ void ViraalScenario::OnRobotState(const orbed::robot_state_t& msg, const std::st
        CheckLength(msg.num_joints, msg.joint_limit_hit.size(), kMaxJoints, "ROBOT_STATE.joint_limit_hit"),
        CheckFinite(msg.joint_position, "ROBOT_STATE.joint_position"),
        CheckLength(msg.num_links, msg.X_RL.size(), kMaxLinks, "ROBOT_STATE.num_links"),
-       CheckEnum(msg.motion_state, orbed::robot_state_t::MOTION_IDLE, orbed::robot_state_t::MOTION_IN_COLLISION,
-                 "ROBOT_STATE.motion_state")});
+       CheckEnum(msg.motion_state, orbed::robot_state_t::MOTION_IDLE,
+                 orbed::robot_state_t::MOTION_IN_COLLISION, "ROBOT_STATE.motion_state")});
   if (!problem.empty()) {
     Refuse(channel + "/field", problem);
     return;
@@ -159,7 +164,8 @@ void ViraalScenario::OnRobotState(const orbed::robot_state_t& msg, const std::st
 
 void ViraalScenario::OnPlanCheckReply(const orbed::plan_check_reply_t& msg, const std::string& channel) {
   const int64_t k = msg.request_id - plan_request_base_;
-  if (phase_ != Phase::kCheckPlans || k < 0 || k >= static_cast<int64_t>(plan_answered_.size())) return;  // not ours
+  if (phase_ != Phase::kCheckPlans || k < 0 || k >= static_cast<int64_t>(plan_answered_.size()))
+    return;  // not ours
   const std::string problem =
       CheckLength(msg.num_pairs, msg.pairs.size(), kMaxPairs, "PLAN_CHECK_REPLY.num_pairs");
   if (!problem.empty()) {
@@ -213,13 +219,13 @@ void ViraalScenario::OnTrial(const orbed::alignment_trial_t& msg, const std::str
     return;
   }
   if (msg.num_mirrors != mode.num_mirrors) {
-    ORBED_LOG(kWarn) << "trial " << msg.trial_index << " reports " << msg.num_mirrors << " mirrors, the session has "
-                     << mode.num_mirrors;
+    ORBED_LOG(kWarn) << "trial " << msg.trial_index << " reports " << msg.num_mirrors
+                     << " mirrors, the session has " << mode.num_mirrors;
   }
   trial_ = msg;
   const Eigen::VectorXd q = ToVectorX(msg.joint_position);
-  const Eigen::VectorXd q_target =
-      orbed::sim::DegToRad(ToVectorX(options_.config.configurations_deg[trial_index_ % options_.config.configurations_deg.size()]));
+  const Eigen::VectorXd q_target = orbed::sim::DegToRad(ToVectorX(
+      options_.config.configurations_deg[trial_index_ % options_.config.configurations_deg.size()]));
   const double off_deg = (q - q_target).cwiseAbs().maxCoeff() * kRadToDeg;
   if (off_deg > options_.tolerance_deg) {
     ORBED_LOG(kWarn) << "trial " << msg.trial_index << " was made at a q " << Fixed(off_deg, 3)
@@ -258,10 +264,11 @@ void ViraalScenario::OnMisalignment(const orbed::misalignment_t& msg, const std:
   if (msg.request_id != misalignment_request_id_ || misalignment_request_id_ == 0) return;  // not ours
   std::string problem;
   if (msg.valid) {
-    problem = FirstError({CheckLength(msg.num_pairs, msg.error_norm_m.size(), kMaxPairs, "MISALIGNMENT.num_pairs"),
-                          CheckFinite(msg.mean_error_W_m, 3, "MISALIGNMENT.mean_error_W_m"),
-                          CheckFinite(&msg.mean_error_norm_m, 1, "MISALIGNMENT.mean_error_norm_m"),
-                          CheckFinite(&msg.mean_pair_distance_m, 1, "MISALIGNMENT.mean_pair_distance_m")});
+    problem =
+        FirstError({CheckLength(msg.num_pairs, msg.error_norm_m.size(), kMaxPairs, "MISALIGNMENT.num_pairs"),
+                    CheckFinite(msg.mean_error_W_m, 3, "MISALIGNMENT.mean_error_W_m"),
+                    CheckFinite(&msg.mean_error_norm_m, 1, "MISALIGNMENT.mean_error_norm_m"),
+                    CheckFinite(&msg.mean_pair_distance_m, 1, "MISALIGNMENT.mean_pair_distance_m")});
     if (problem.empty() && msg.num_pairs != static_cast<int32_t>(pending_error_.p_W_real.size())) {
       problem = "MISALIGNMENT.num_pairs is " + std::to_string(msg.num_pairs) + ", the request had " +
                 std::to_string(pending_error_.p_W_real.size());
@@ -312,13 +319,15 @@ void ViraalScenario::Tick() {
             " configurations checked with orbed-iiwa-sim: within limits and collision-free");
         StartSession();
       } else if (waited > options_.reply_timeout_s) {
-        FailRun("orbed-iiwa-sim answered " + std::to_string(answered) + " of " + std::to_string(plan_answered_.size()) +
-                " PLAN_CHECK_REQUESTs within " + Fixed(options_.reply_timeout_s, 1) + " s" + refusal);
+        FailRun("orbed-iiwa-sim answered " + std::to_string(answered) + " of " +
+                std::to_string(plan_answered_.size()) + " PLAN_CHECK_REQUESTs within " +
+                Fixed(options_.reply_timeout_s, 1) + " s" + refusal);
       }
       return;
     }
     case Phase::kMove: {
-      const auto& q_deg = options_.config.configurations_deg[trial_index_ % options_.config.configurations_deg.size()];
+      const auto& q_deg =
+          options_.config.configurations_deg[trial_index_ % options_.config.configurations_deg.size()];
       const orbed::robot_state_t& state = *robot_state_;
       double off_deg = 0;
       for (int i = 0; i < model_->num_joints(); ++i) {
@@ -335,9 +344,11 @@ void ViraalScenario::Tick() {
       const bool fresh = robot_state_received_ - last_command_ > std::chrono::milliseconds(50);
       if (stopped && fresh) {
         if (!stopped_since_) stopped_since_ = Clock::now();
-        if (std::chrono::duration<double>(Clock::now() - *stopped_since_).count() > options_.stopped_grace_s) {
+        if (std::chrono::duration<double>(Clock::now() - *stopped_since_).count() >
+            options_.stopped_grace_s) {
           FailRun("the arm stopped " + Fixed(off_deg, 2) + " deg short of configuration " +
-                  JointList(q_deg, 1) + " deg: " + (state.stop_reason.empty() ? "stopped" : state.stop_reason));
+                  JointList(q_deg, 1) +
+                  " deg: " + (state.stop_reason.empty() ? "stopped" : state.stop_reason));
           return;
         }
       } else {
@@ -352,7 +363,8 @@ void ViraalScenario::Tick() {
                 "): is orbed-iiwa-sim receiving " + options_.iiwa_command_channel + "?");
         return;
       }
-      if (Clock::now() - last_command_ > std::chrono::duration<double>(options_.command_resend_s)) StartMove(false);
+      if (Clock::now() - last_command_ > std::chrono::duration<double>(options_.command_resend_s))
+        StartMove(false);
       return;
     }
     case Phase::kAwaitTrial:
@@ -360,7 +372,8 @@ void ViraalScenario::Tick() {
         FailRun("no ALIGNMENT_TRIAL for session '" + results_.sessions.back().session_id + "' trial " +
                 std::to_string(trial_index_) + " within " + Fixed(options_.trial_timeout_s, 1) +
                 " s of SESSION_CONTROL REQUEST_TRIAL: is orbed-hmd running (its emulated user answers "
-                "REQUEST_TRIAL on " + options_.trial_channel + ")?" + refusal);
+                "REQUEST_TRIAL on " +
+                options_.trial_channel + ")?" + refusal);
       }
       return;
     case Phase::kAwaitTrialResults: {
@@ -385,15 +398,15 @@ void ViraalScenario::Tick() {
                   "), expected " + std::to_string(options_.config.trials));
           return;
         }
-        pending_error_ =
-            EvaluateOverConfigurations(FromPose(robot_state_->X_WR), FromPose(mean.X_WV_mean), session_points_);
+        pending_error_ = EvaluateOverConfigurations(FromPose(robot_state_->X_WR), FromPose(mean.X_WV_mean),
+                                                    session_points_);
         misalignment_.reset();
         misalignment_request_id_ = SendMisalignment(pending_error_);
         Enter(Phase::kAwaitMeanMisalignment);
       } else if (waited > options_.reply_timeout_s) {
         FailRun("no REGISTRATION (reason COMPUTE) from orbed-registration for session '" +
-                results_.sessions.back().session_id + "' within " + Fixed(options_.reply_timeout_s, 1) + " s" +
-                refusal);
+                results_.sessions.back().session_id + "' within " + Fixed(options_.reply_timeout_s, 1) +
+                " s" + refusal);
       }
       return;
     case Phase::kAwaitMeanMisalignment:
@@ -401,8 +414,8 @@ void ViraalScenario::Tick() {
         FinishSession();
       } else if (waited > options_.reply_timeout_s) {
         FailRun("no MISALIGNMENT answer from orbed-registration for the mean of session '" +
-                results_.sessions.back().session_id + "' within " + Fixed(options_.reply_timeout_s, 1) + " s" +
-                refusal);
+                results_.sessions.back().session_id + "' within " + Fixed(options_.reply_timeout_s, 1) +
+                " s" + refusal);
       }
       return;
     case Phase::kDone:
@@ -450,13 +463,15 @@ void ViraalScenario::StartSession() {
   last_trial_registration_.reset();
   mean_registration_.reset();
   SendSessionControl(+orbed::session_control_t::START);
-  Say("[" + mode.name + "] session " + session.session_id + " started: " + std::to_string(options_.config.trials) +
-      " trials, " + std::to_string(mode.num_mirrors) + " reflective display(s)");
+  Say("[" + mode.name + "] session " + session.session_id +
+      " started: " + std::to_string(options_.config.trials) + " trials, " + std::to_string(mode.num_mirrors) +
+      " reflective display(s)");
   StartMove(true);
 }
 
 void ViraalScenario::StartMove(bool first) {
-  const auto& q_deg = options_.config.configurations_deg[trial_index_ % options_.config.configurations_deg.size()];
+  const auto& q_deg =
+      options_.config.configurations_deg[trial_index_ % options_.config.configurations_deg.size()];
   orbed::iiwa_command_t command{};
   command.utime = NowMicros();
   command.num_joints = static_cast<int32_t>(q_deg.size());
@@ -521,9 +536,9 @@ void ViraalScenario::FinishTrial() {
   result.X_WR = FromPose(robot_state_->X_WR);
   results_.sessions.back().trials.push_back(result);
   Say(StepLabel() + ": robot at q=" + JointList(result.q_deg, 1) + " deg (reached in " + Fixed(reach_s_, 1) +
-      " s); aligned in " + Fixed(trial.duration_s, 1) + " s of user time: " + Fixed(result.errors.translation_error_mm, 1) +
-      " mm, " + Fixed(result.errors.rotation_error_deg, 2) + " deg, misalignment " +
-      Fixed(result.errors.misalignment_mm, 1) + " mm");
+      " s); aligned in " + Fixed(trial.duration_s, 1) + " s of user time: " +
+      Fixed(result.errors.translation_error_mm, 1) + " mm, " + Fixed(result.errors.rotation_error_deg, 2) +
+      " deg, misalignment " + Fixed(result.errors.misalignment_mm, 1) + " mm");
   ++trial_index_;
   if (trial_index_ < options_.config.trials) {
     StartMove(true);
@@ -549,8 +564,9 @@ void ViraalScenario::FinishSession() {
   SessionResult& session = results_.sessions.back();
   session.mean = mean;
   Say("[" + session.mode + "] mean of " + std::to_string(reg.num_used) + " trials (SE(3), " +
-      (reg.converged ? "converged" : "NOT converged") + "): " + Fixed(mean.errors.translation_error_mm, 1) + " mm, " +
-      Fixed(mean.errors.rotation_error_deg, 2) + " deg, misalignment " + Fixed(mean.errors.misalignment_mm, 1) + " mm");
+      (reg.converged ? "converged" : "NOT converged") + "): " + Fixed(mean.errors.translation_error_mm, 1) +
+      " mm, " + Fixed(mean.errors.rotation_error_deg, 2) + " deg, misalignment " +
+      Fixed(mean.errors.misalignment_mm, 1) + " mm");
   SendSessionControl(+orbed::session_control_t::STOP);
   ++mode_index_;
   if (mode_index_ < options_.config.modes.size()) {
@@ -599,7 +615,8 @@ void ViraalScenario::FailRun(const std::string& reason) {
 std::string ViraalScenario::StepLabel() const {
   const int total = static_cast<int>(options_.config.modes.size()) * options_.config.trials;
   const int step = static_cast<int>(mode_index_) * options_.config.trials + trial_index_ + 1;
-  const std::string mode = mode_index_ < options_.config.modes.size() ? options_.config.modes[mode_index_].name : "";
+  const std::string mode =
+      mode_index_ < options_.config.modes.size() ? options_.config.modes[mode_index_].name : "";
   return "[" + std::to_string(step) + "/" + std::to_string(total) + "] " + mode + " trial " +
          std::to_string(trial_index_);
 }

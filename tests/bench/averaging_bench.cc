@@ -9,9 +9,9 @@
 /// angle, a realistic spread of user alignment trials), around a fixed centre R_c.
 /// Goal (issue 4): Karcher N = 3 ≤ 1.5 µs, N = 1000 ≤ 150 µs.
 
+#include <unistd.h>
 #include <cmath>
 #include <cstdio>
-#include <unistd.h>
 #include <map>
 #include <random>
 #include <string>
@@ -34,7 +34,8 @@ std::vector<Eigen::Quaterniond> Cluster(int n) {
   const Eigen::Quaterniond center(Eigen::AngleAxisd(1.1, Eigen::Vector3d(0.2, -0.7, 0.4).normalized()));
   std::vector<Eigen::Quaterniond> q;
   q.reserve(n);
-  for (int i = 0; i < n; ++i) q.push_back(center * ExpQuaternion(Eigen::Vector3d(normal(rng), normal(rng), normal(rng))));
+  for (int i = 0; i < n; ++i)
+    q.push_back(center * ExpQuaternion(Eigen::Vector3d(normal(rng), normal(rng), normal(rng))));
   return q;
 }
 
@@ -106,8 +107,9 @@ int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   // Colour only on a terminal (ConsoleReporter itself ignores --benchmark_color when given to us).
-  orbed::registration::RatioReporter reporter(isatty(fileno(stdout)) ? benchmark::ConsoleReporter::OO_ColorTabular
-                                                                      : benchmark::ConsoleReporter::OO_Tabular);
+  orbed::registration::RatioReporter reporter(isatty(fileno(stdout))
+                                                  ? benchmark::ConsoleReporter::OO_ColorTabular
+                                                  : benchmark::ConsoleReporter::OO_Tabular);
   benchmark::RunSpecifiedBenchmarks(&reporter);
   benchmark::Shutdown();
   return 0;

@@ -25,8 +25,7 @@ struct Usage {
 /// build/bin, from ORBED_BIN_DIR (set by `scripts/orbed bench`) or beside build/bench/<exe>.
 inline std::string BinDir() {
   if (const char* dir = std::getenv("ORBED_BIN_DIR")) return dir;
-  return (std::filesystem::read_symlink("/proc/self/exe").parent_path().parent_path() / "bin")
-      .string();
+  return (std::filesystem::read_symlink("/proc/self/exe").parent_path().parent_path() / "bin").string();
 }
 
 /// fork + execv (argv[0] is a path); the child's stdout goes to /dev/null.

@@ -22,8 +22,8 @@
 #include <fcl/narrowphase/collision_object.h>
 #include <fcl/narrowphase/distance.h>
 
-#include "sim/model_paths.h"
 #include "sim/collision_world.h"
+#include "sim/model_paths.h"
 #include "sim/robot_model.h"
 #include "sim/scene.h"
 
@@ -41,7 +41,8 @@ struct Fixture {
     for (int n = 0; n < 1024; ++n) {
       Eigen::VectorXd q(model.num_joints());
       for (int i = 0; i < q.size(); ++i) {
-        q[i] = model.joints()[i].lower_rad + u(rng) * (model.joints()[i].upper_rad - model.joints()[i].lower_rad);
+        q[i] = model.joints()[i].lower_rad +
+               u(rng) * (model.joints()[i].upper_rad - model.joints()[i].lower_rad);
       }
       pool.push_back(q);
     }
@@ -56,10 +57,14 @@ Fixture& F() {
 std::shared_ptr<fcl::CollisionGeometryd> ToFcl(const CollisionPrimitive& g) {
   using K = CollisionPrimitive::Kind;
   switch (g.kind) {
-    case K::kSphere: return std::make_shared<fcl::Sphered>(g.radius_m);
-    case K::kCapsule: return std::make_shared<fcl::Capsuled>(g.radius_m, g.length_m);
-    case K::kCylinder: return std::make_shared<fcl::Cylinderd>(g.radius_m, g.length_m);
-    case K::kBox: return std::make_shared<fcl::Boxd>(g.size_m.x(), g.size_m.y(), g.size_m.z());
+    case K::kSphere:
+      return std::make_shared<fcl::Sphered>(g.radius_m);
+    case K::kCapsule:
+      return std::make_shared<fcl::Capsuled>(g.radius_m, g.length_m);
+    case K::kCylinder:
+      return std::make_shared<fcl::Cylinderd>(g.radius_m, g.length_m);
+    case K::kBox:
+      return std::make_shared<fcl::Boxd>(g.size_m.x(), g.size_m.y(), g.size_m.z());
   }
   return nullptr;
 }
@@ -67,13 +72,19 @@ std::shared_ptr<fcl::CollisionGeometryd> ToFcl(const CollisionPrimitive& g) {
 CollisionPrimitive ObjectPrimitive(const SceneObject& o) {
   CollisionPrimitive g;
   switch (o.shape) {
-    case SceneObject::Shape::kBox: g.kind = CollisionPrimitive::Kind::kBox; g.size_m = o.size_m; break;
+    case SceneObject::Shape::kBox:
+      g.kind = CollisionPrimitive::Kind::kBox;
+      g.size_m = o.size_m;
+      break;
     case SceneObject::Shape::kCylinder:
       g.kind = CollisionPrimitive::Kind::kCylinder;
       g.radius_m = o.radius_m;
       g.length_m = o.length_m;
       break;
-    case SceneObject::Shape::kSphere: g.kind = CollisionPrimitive::Kind::kSphere; g.radius_m = o.radius_m; break;
+    case SceneObject::Shape::kSphere:
+      g.kind = CollisionPrimitive::Kind::kSphere;
+      g.radius_m = o.radius_m;
+      break;
   }
   return g;
 }
@@ -81,7 +92,8 @@ CollisionPrimitive ObjectPrimitive(const SceneObject& o) {
 // The same query on FCL: every checked pair, every primitive pair, signed distance.
 class FclChecker {
  public:
-  explicit FclChecker(const CollisionWorld& world, const Scene& scene) : model_(world.model()), X_WR_(scene.X_WR) {
+  explicit FclChecker(const CollisionWorld& world, const Scene& scene)
+      : model_(world.model()), X_WR_(scene.X_WR) {
     links_.resize(model_.num_links());
     for (int l = 0; l < model_.num_links(); ++l) {
       for (const auto& g : world.LinkPrimitives(l)) {
@@ -194,7 +206,8 @@ void BM_FclFkAndCheck(benchmark::State& state) {
   int closest = -1;
   double max_diff = 0;
   for (const auto& q : f.pool) {
-    max_diff = std::max(max_diff, std::abs(fcl_checker.Check(q, &clearance, &closest) - world.Check(q).min_distance_m));
+    max_diff = std::max(max_diff,
+                        std::abs(fcl_checker.Check(q, &clearance, &closest) - world.Check(q).min_distance_m));
   }
   size_t i = 0;
   for (auto _ : state) {

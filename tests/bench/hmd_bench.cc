@@ -37,7 +37,9 @@ using Clock = std::chrono::steady_clock;
 struct Counter {
   std::vector<int64_t> pose_recv_utime;
   int64_t cameras = 0, reflective = 0;
-  void OnPose(const lcm::ReceiveBuffer* rbuf, const std::string&) { pose_recv_utime.push_back(rbuf->recv_utime); }
+  void OnPose(const lcm::ReceiveBuffer* rbuf, const std::string&) {
+    pose_recv_utime.push_back(rbuf->recv_utime);
+  }
   void OnCamera(const lcm::ReceiveBuffer*, const std::string&) { ++cameras; }
   void OnReflective(const lcm::ReceiveBuffer*, const std::string&) { ++reflective; }
 };
@@ -67,8 +69,8 @@ void RunHmd(benchmark::State& state, bool walking_and_moving) {
     lcm.subscribe("REFLECTIVE_VIEW", &Counter::OnReflective, &counter);
     const pid_t sim = Spawn({BinDir() + "/orbed-iiwa-sim", "--name", "hmd_bench_sim", "--log-level", "warn",
                              "--initial-q-deg", "0,30,0,-60,0,45,0"});
-    std::vector<std::string> argv{BinDir() + "/orbed-hmd", "--name", "hmd_bench", "--log-level", "warn",
-                                  "--displays", "1"};
+    std::vector<std::string> argv{
+        BinDir() + "/orbed-hmd", "--name", "hmd_bench", "--log-level", "warn", "--displays", "1"};
     if (walking_and_moving) {
       argv.push_back("--config");
       argv.push_back(SourceDir() + "/hmd_emulator/config/walk_loop.yaml");
@@ -88,7 +90,8 @@ void RunHmd(benchmark::State& state, bool walking_and_moving) {
                         std::chrono::system_clock::now().time_since_epoch())
                         .count();
         cmd.num_joints = 7;
-        for (double q : targets[next_target++ % targets.size()]) cmd.joint_position.push_back(q * M_PI / 180.0);
+        for (double q : targets[next_target++ % targets.size()])
+          cmd.joint_position.push_back(q * M_PI / 180.0);
         cmd.num_torques = 0;
         lcm.publish("IIWA_COMMAND", &cmd);
         next_command += std::chrono::milliseconds(1500);

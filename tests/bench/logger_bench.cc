@@ -19,8 +19,8 @@
 #include <benchmark/benchmark.h>
 #include <lcm/lcm-cpp.hpp>
 #include <orbed/hmd_pose_t.hpp>
-#include <orbed/image_t.hpp>
 #include <orbed/iiwa_status_t.hpp>
+#include <orbed/image_t.hpp>
 
 #include "tests/bench/bench_util.h"
 
@@ -58,8 +58,8 @@ void BM_LoggerUnderLoad_VsLcmLogger(benchmark::State& state) {
   Usage orbed_usage, lcm_usage, monitor_usage;
   int64_t published = 0, orbed_events = 0, lcm_events = 0;
   for (auto _ : state) {
-    const pid_t orbed_logger = Spawn({bin + "/orbed-logger", "--file", ours, "--channels", channels,
-                                      "--log-level", "warn"});
+    const pid_t orbed_logger =
+        Spawn({bin + "/orbed-logger", "--file", ours, "--channels", channels, "--log-level", "warn"});
     // The same receive buffer for both (orbed-logger asks for 8 MB itself).
     const pid_t lcm_logger =
         Spawn({"/usr/bin/lcm-logger", "-q", "-f", "-c", channels,
@@ -70,10 +70,10 @@ void BM_LoggerUnderLoad_VsLcmLogger(benchmark::State& state) {
     lcm::LCM lcm("udpm://239.255.76.67:7667?ttl=0");
     orbed::iiwa_status_t status{};
     status.num_joints = 7;
-    for (auto* v : {&status.joint_position_measured, &status.joint_velocity_estimated,
-                    &status.joint_position_commanded, &status.joint_position_ipo,
-                    &status.joint_torque_measured, &status.joint_torque_commanded,
-                    &status.joint_torque_external}) {
+    for (auto* v :
+         {&status.joint_position_measured, &status.joint_velocity_estimated, &status.joint_position_commanded,
+          &status.joint_position_ipo, &status.joint_torque_measured, &status.joint_torque_commanded,
+          &status.joint_torque_external}) {
       v->assign(7, 0.5);
     }
     orbed::hmd_pose_t pose{};
@@ -91,9 +91,20 @@ void BM_LoggerUnderLoad_VsLcmLogger(benchmark::State& state) {
     int64_t tick = 0;  // 1200 Hz base tick: status every 6, pose every 20, image every 40
     while (std::chrono::duration<double>(Clock::now() - start).count() < seconds) {
       status.utime = tick;
-      if (tick % 6 == 0) { lcm.publish("BENCH_IIWA_STATUS", &status); ++published; }
-      if (tick % 20 == 0) { pose.seq = tick; lcm.publish("BENCH_HMD_POSE", &pose); ++published; }
-      if (tick % 40 == 0) { image.utime = tick; lcm.publish("BENCH_HMD_CAMERA", &image); ++published; }
+      if (tick % 6 == 0) {
+        lcm.publish("BENCH_IIWA_STATUS", &status);
+        ++published;
+      }
+      if (tick % 20 == 0) {
+        pose.seq = tick;
+        lcm.publish("BENCH_HMD_POSE", &pose);
+        ++published;
+      }
+      if (tick % 40 == 0) {
+        image.utime = tick;
+        lcm.publish("BENCH_HMD_CAMERA", &image);
+        ++published;
+      }
       ++tick;
       std::this_thread::sleep_until(start + std::chrono::microseconds(tick * 1000000 / 1200));
     }

@@ -23,15 +23,16 @@
 #include "hmd_emulator/reflective.h"
 #include "hmd_emulator/renderer.h"
 #include "hmd_emulator/scene_geometry.h"
-#include "sim/robot_model.h"
 #include "sim/model_paths.h"
+#include "sim/robot_model.h"
 #include "sim/scene.h"
 
 namespace orbed::hmd {
 namespace {
 
 struct Fixture {
-  sim::RobotModel robot = sim::RobotModel::LoadFile(sim::SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath));
+  sim::RobotModel robot =
+      sim::RobotModel::LoadFile(sim::SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath));
   sim::Scene scene = sim::LoadSceneFile(sim::SourceTreePath(sim::kDefaultSceneRelativePath));
   std::vector<Eigen::VectorXd> q_pool;
   std::vector<Eigen::Isometry3d> cameras;

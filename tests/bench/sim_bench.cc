@@ -56,9 +56,9 @@ void BM_IiwaSimAt1kHz(benchmark::State& state) {
   const double seconds = seconds_env ? std::atof(seconds_env) : 30.0;
   const std::vector<std::vector<double>> targets{
       {0, 0, 0, 0, 0, 0, 0},
-      {90, -40, 30, -60, 20, 40, 90},     // far, collision-free path
+      {90, -40, 30, -60, 20, 40, 90},  // far, collision-free path
       {0, 0, 0, 0, 0, 0, 0},
-      {-30, 80, 0, -30, 0, 60, 0},        // into the table: stops before contact
+      {-30, 80, 0, -30, 0, 60, 0},  // into the table: stops before contact
   };
   Usage usage;
   double wall_s = 0;

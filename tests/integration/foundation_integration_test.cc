@@ -29,8 +29,7 @@ std::vector<LogEvent> ReadLog(const std::string& path) {
   lcm::LogFile log(path, "r");
   if (!log.good()) return events;
   while (const lcm::LogEvent* e = log.readNextEvent()) {
-    events.push_back({e->channel, std::string(static_cast<const char*>(e->data), e->datalen),
-                      e->timestamp});
+    events.push_back({e->channel, std::string(static_cast<const char*>(e->data), e->datalen), e->timestamp});
   }
   return events;
 }
@@ -54,16 +53,16 @@ TEST(Launcher, StartsRespawnsAndStopsInOrder) {
                                 "  - name: recording\n"
                                 "    processes:\n"
                                 "      - {name: logger, command: orbed-logger, args: [--log-dir, \""
-                             << dir << "/logs\"]}\n"
+                             << dir
+                             << "/logs\"]}\n"
                                 "  - name: health\n"
                                 "    processes:\n"
                                 "      - {name: monitor, command: orbed-monitor, respawn: true}\n";
   BusWatcher bus;
   bus.Start();
   RunningProcess launcher({BinPath("orbed-launch"), launch_file});
-  ASSERT_TRUE(WaitFor([&] { return !bus.Heartbeats("logger").empty() &&
-                                   !bus.Heartbeats("monitor").empty(); },
-                      15))
+  ASSERT_TRUE(
+      WaitFor([&] { return !bus.Heartbeats("logger").empty() && !bus.Heartbeats("monitor").empty(); }, 15))
       << "no heartbeat from logger and monitor";
   const pid_t logger_pid = bus.Heartbeats("logger").front().status.pid;
   const pid_t monitor_pid = bus.Heartbeats("monitor").front().status.pid;
@@ -183,10 +182,10 @@ std::vector<orbed::iiwa_status_t> PublishTraffic(lcm::LCM* lcm, int count, doubl
     orbed::iiwa_status_t status{};
     status.utime = i;
     status.num_joints = 7;
-    for (auto* v : {&status.joint_position_measured, &status.joint_velocity_estimated,
-                    &status.joint_position_commanded, &status.joint_position_ipo,
-                    &status.joint_torque_measured, &status.joint_torque_commanded,
-                    &status.joint_torque_external}) {
+    for (auto* v :
+         {&status.joint_position_measured, &status.joint_velocity_estimated, &status.joint_position_commanded,
+          &status.joint_position_ipo, &status.joint_torque_measured, &status.joint_torque_commanded,
+          &status.joint_torque_external}) {
       v->assign(7, 0.001 * i);
     }
     lcm->publish("IIWA_STATUS", &status);
@@ -206,8 +205,8 @@ TEST(Logger, LogPlaysBackIntoLcmLoggerUnchanged) {
   BusWatcher bus;
   bus.Start();
   {
-    RunningProcess logger({BinPath("orbed-logger"), "--file", original, "--channels",
-                           "IIWA_STATUS|BLOB", "--name", "replay-logger"});
+    RunningProcess logger({BinPath("orbed-logger"), "--file", original, "--channels", "IIWA_STATUS|BLOB",
+                           "--name", "replay-logger"});
     lcm::LCM lcm("");
     // Its first heartbeat is published after it subscribed.
     ASSERT_TRUE(WaitFor([&] { return !bus.Heartbeats("replay-logger").empty(); }, 10));

@@ -179,10 +179,12 @@ TEST(OrbedHmd, RatesImagesAndOneTrialOverRealLcm) {
   ASSERT_FALSE(mirror.empty()) << "REFLECTIVE_VIEW did not decode as JPEG";
   EXPECT_EQ(mirror.cols, rv.image.width);
   EXPECT_EQ(mirror.rows, rv.image.height);
-  const double K_o[3][3] = {{rv.image.fx_px, 0, rv.image.cx_px}, {0, rv.image.fy_px, rv.image.cy_px}, {0, 0, 1}};
+  const double K_o[3][3] = {
+      {rv.image.fx_px, 0, rv.image.cx_px}, {0, rv.image.fy_px, rv.image.cy_px}, {0, 0, 1}};
   const double flip[3] = {1, -1, 1};
   for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) EXPECT_DOUBLE_EQ(rv.K_m[r][c], flip[r] * K_o[r][c]) << "K_m(" << r << "," << c << ")";
+    for (int c = 0; c < 3; ++c)
+      EXPECT_DOUBLE_EQ(rv.K_m[r][c], flip[r] * K_o[r][c]) << "K_m(" << r << "," << c << ")";
   }
   EXPECT_GT(rv.distance_m, 0.0);
 

@@ -100,8 +100,7 @@ std::vector<std::string> RunSession(lcm::LCM* lcm, Collector* collector) {
   const std::vector<orbed::alignment_trial_t> trials = {
       Trial(0, 0.0, {1.00, 2.00, 0.50}, 2000),
       Trial(1, 10.0, {std::nan(""), 2.0, 0.5}, 2500),  // rejected: NaN position
-      Trial(1, 10.0, {1.03, 2.00, 0.50}, 3000),
-      Trial(2, 20.0, {1.00, 2.03, 0.50}, 4000)};
+      Trial(1, 10.0, {1.03, 2.00, 0.50}, 3000), Trial(2, 20.0, {1.00, 2.03, 0.50}, 4000)};
   for (const auto& trial : trials) lcm->publish("ALIGNMENT_TRIAL", &trial);
   std::vector<std::string> per_trial;
   WaitFor(
@@ -198,8 +197,7 @@ std::string Capture(const std::string& command, int* exit_code) {
 std::vector<double> Numbers(const std::string& text) {
   std::vector<double> numbers;
   const std::regex number(R"(-?[0-9]+(\.[0-9]+)?([eE][-+]?[0-9]+)?)");
-  for (auto it = std::sregex_iterator(text.begin(), text.end(), number); it != std::sregex_iterator();
-       ++it) {
+  for (auto it = std::sregex_iterator(text.begin(), text.end(), number); it != std::sregex_iterator(); ++it) {
     numbers.push_back(std::stod(it->str()));
   }
   return numbers;
@@ -215,11 +213,11 @@ TEST(Registration, LiveServerAgreesWithTheOfflineMean) {
   ASSERT_TRUE(WaitFor([&] { return !bus.Heartbeats("registration-send").empty(); }, 10));
   const std::string trials = SourcePath("procs/registration_server/testdata/robust_trials.txt");
   int offline_code = -1, live_code = -1;
-  const std::string offline = Capture(
-      BinPath("orbed-registration") + " mean --robust --json --input " + trials + " 2>/dev/null",
-      &offline_code);
-  const std::string live = Capture(
-      BinPath("orbed-registration") + " send --robust --input " + trials, &live_code);
+  const std::string offline =
+      Capture(BinPath("orbed-registration") + " mean --robust --json --input " + trials + " 2>/dev/null",
+              &offline_code);
+  const std::string live =
+      Capture(BinPath("orbed-registration") + " send --robust --input " + trials, &live_code);
   EXPECT_EQ(offline_code, 0);
   EXPECT_EQ(live_code, 0);
   EXPECT_NE(offline.find("\"rejected\":[10]"), std::string::npos) << offline;

@@ -13,8 +13,8 @@
 #include <sstream>
 #include <thread>
 
-#include <Eigen/Geometry>
 #include <gtest/gtest.h>
+#include <Eigen/Geometry>
 #include <lcm/lcm-cpp.hpp>
 #include <orbed/alignment_trial_t.hpp>
 #include <orbed/robot_state_t.hpp>
@@ -76,7 +76,8 @@ class FakeUser {
     const Offset& offset = kOffsets.at(mode);
     const Eigen::Isometry3d X_WR = FromPose(state_.X_WR);
     Eigen::Isometry3d X_WV = X_WR;
-    X_WV.linear() = Eigen::AngleAxisd(offset.yaw_deg * kDeg, Eigen::Vector3d::UnitZ()).toRotationMatrix() * X_WR.linear();
+    X_WV.linear() =
+        Eigen::AngleAxisd(offset.yaw_deg * kDeg, Eigen::Vector3d::UnitZ()).toRotationMatrix() * X_WR.linear();
     X_WV.translation() += offset.p_W;
     orbed::alignment_trial_t trial{};
     trial.utime = NowMicros();
@@ -135,21 +136,25 @@ struct Expected {
   double misalignment_mm;
 };
 Expected ExpectedErrors(const std::vector<orbed::robot_state_t>& states, const Offset& offset) {
-  const Eigen::Matrix3d R = Eigen::AngleAxisd(offset.yaw_deg * kDeg, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const Eigen::Matrix3d R =
+      Eigen::AngleAxisd(offset.yaw_deg * kDeg, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   double centroid = 0;
   Eigen::Vector3d t_bar = Eigen::Vector3d::Zero();
   int pairs = 0;
   for (const orbed::robot_state_t& s : states) {
     const Eigen::Matrix3d R_WR = FromPose(s.X_WR).linear();
     // p_WQ_virtual − p_WQ_real = (R − I)·R_WR·p_RQ + p_offset for the offset about the base origin.
-    const auto d = [&](const Eigen::Vector3d& p_RQ) { return Eigen::Vector3d((R - Eigen::Matrix3d::Identity()) * R_WR * p_RQ + offset.p_W); };
+    const auto d = [&](const Eigen::Vector3d& p_RQ) {
+      return Eigen::Vector3d((R - Eigen::Matrix3d::Identity()) * R_WR * p_RQ + offset.p_W);
+    };
     Eigen::Vector3d p_RC = Eigen::Vector3d::Zero();
     int n = 0;
     for (int i = 0; i < s.num_links; ++i) {
       const Eigen::Vector3d p_RL = ToVector3(s.X_RL[i].position_m);
       ++n;
       p_RC += p_RL;
-      if (s.link_names[i] == "iiwa_link_4" || s.link_names[i] == "iiwa_link_6" || s.link_names[i] == "iiwa_link_ee") {
+      if (s.link_names[i] == "iiwa_link_4" || s.link_names[i] == "iiwa_link_6" ||
+          s.link_names[i] == "iiwa_link_ee") {
         t_bar += d(p_RL).cwiseAbs();
         ++pairs;
       }
@@ -161,9 +166,21 @@ Expected ExpectedErrors(const std::vector<orbed::robot_state_t>& states, const O
 }
 
 std::vector<std::string> ScenarioArgs(const std::string& dir) {
-  return {BinPath("orbed-scenario"), "--name", "scenario", "--run-id", "it", "--results-dir", dir,
-          "--trial-timeout-sec", "5", "--reply-timeout-sec", "5", "--move-timeout-sec", "20",
-          "--startup-timeout-sec", "10"};
+  return {BinPath("orbed-scenario"),
+          "--name",
+          "scenario",
+          "--run-id",
+          "it",
+          "--results-dir",
+          dir,
+          "--trial-timeout-sec",
+          "5",
+          "--reply-timeout-sec",
+          "5",
+          "--move-timeout-sec",
+          "20",
+          "--startup-timeout-sec",
+          "10"};
 }
 
 TEST(Scenario, TheViraalRunMeasuresTheUsersKnownOffsets) {
@@ -171,7 +188,8 @@ TEST(Scenario, TheViraalRunMeasuresTheUsersKnownOffsets) {
   bus.Start();
   RunningProcess sim({BinPath("orbed-iiwa-sim"), "--name", "sim"});
   RunningProcess registration({BinPath("orbed-registration"), "--name", "registration"});
-  ASSERT_TRUE(WaitFor([&] { return !bus.Heartbeats("sim").empty() && !bus.Heartbeats("registration").empty(); }, 15));
+  ASSERT_TRUE(
+      WaitFor([&] { return !bus.Heartbeats("sim").empty() && !bus.Heartbeats("registration").empty(); }, 15));
   FakeUser user(true);
   const std::string dir = MakeTempDir("scenario_it");
   RunningProcess scenario(ScenarioArgs(dir));
@@ -229,8 +247,8 @@ TEST(Scenario, WithoutAUserItFailsNamingOrbedHmd) {
   bus.Start();
   RunningProcess sim({BinPath("orbed-iiwa-sim"), "--name", "sim-2"});
   RunningProcess registration({BinPath("orbed-registration"), "--name", "registration-2"});
-  ASSERT_TRUE(
-      WaitFor([&] { return !bus.Heartbeats("sim-2").empty() && !bus.Heartbeats("registration-2").empty(); }, 15));
+  ASSERT_TRUE(WaitFor(
+      [&] { return !bus.Heartbeats("sim-2").empty() && !bus.Heartbeats("registration-2").empty(); }, 15));
   const std::string dir = MakeTempDir("scenario_it_no_user");
   std::vector<std::string> args = ScenarioArgs(dir);
   args.push_back("--trials");

@@ -18,9 +18,9 @@
 #include <thread>
 #include <vector>
 
+#include <gtest/gtest.h>
 #include <drake/lcmt_iiwa_command.hpp>
 #include <drake/lcmt_iiwa_status.hpp>
-#include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
 #include <orbed/collision_status_t.hpp>
 #include <orbed/robot_state_t.hpp>
@@ -32,9 +32,9 @@ namespace orbed::testing {
 namespace {
 
 constexpr double kDeg = M_PI / 180.0;
-constexpr double kPeriodS = 0.005;     // the sim's default tick
+constexpr double kPeriodS = 0.005;  // the sim's default tick
 constexpr int64_t kPeriodUs = 5000;
-constexpr double kStopMarginM = 0.01;  // the sim's default --stop-margin-m
+constexpr double kStopMarginM = 0.01;                               // the sim's default --stop-margin-m
 const double kSpeedDegPerS[7] = {98, 98, 100, 130, 140, 180, 180};  // iiwa 7 R800, DESIGN §4
 
 // Everything the sim publishes, seen by a Drake-typed client (IIWA_STATUS) and orbed types.
@@ -161,7 +161,8 @@ std::vector<double> ExpectWithinJointSpeeds(const std::vector<drake::lcmt_iiwa_s
     const double window_s = (s[k].utime - s[k - kWindow].utime) * 1e-6;
     for (int i = 0; i < 7; ++i) {
       const double speed_deg_per_s =
-          std::abs(s[k].joint_position_measured[i] - s[k - kWindow].joint_position_measured[i]) / window_s / kDeg;
+          std::abs(s[k].joint_position_measured[i] - s[k - kWindow].joint_position_measured[i]) / window_s /
+          kDeg;
       EXPECT_LE(speed_deg_per_s, kSpeedDegPerS[i] * kRoundOff) << "joint " << i + 1 << " at message " << k;
       peak[i] = std::max(peak[i], speed_deg_per_s);
     }
@@ -271,8 +272,9 @@ TEST(IiwaSim, CommandIntoTheTableStopsShortOfContact) {
     EXPECT_NEAR(last.joint_position_measured[i], fraction * target_deg[i] * kDeg, 1e-9) << "joint " << i + 1;
   }
   ExpectWithinJointSpeeds(status);
-  std::printf("stopped at %.1f %% of the path (first contact at %.0f %%), clearance %.4f m: %s\n", 100 * fraction,
-              100 * first_contact, collision.back().min_distance_m, state.stop_reason.c_str());
+  std::printf("stopped at %.1f %% of the path (first contact at %.0f %%), clearance %.4f m: %s\n",
+              100 * fraction, 100 * first_contact, collision.back().min_distance_m,
+              state.stop_reason.c_str());
 }
 
 // The rate as the subscriber sees it: IIWA_STATUS messages handed to the client within a 5 s window
@@ -304,9 +306,10 @@ TEST(IiwaSim, StatusRateIs200HzWithin5PercentOver5s) {
   const double rate_hz = count / 5.0;
   const int64_t span_ticks = (status[first + count - 1].utime - status[first].utime) / kPeriodUs;
   const int64_t lost = span_ticks + 1 - static_cast<int64_t>(count);
-  std::printf("IIWA_STATUS: %zu messages received in 5 s = %.1f Hz; they span %lld ticks of the sim clock "
-              "(%lld lost)\n",
-              count, rate_hz, static_cast<long long>(span_ticks + 1), static_cast<long long>(lost));
+  std::printf(
+      "IIWA_STATUS: %zu messages received in 5 s = %.1f Hz; they span %lld ticks of the sim clock "
+      "(%lld lost)\n",
+      count, rate_hz, static_cast<long long>(span_ticks + 1), static_cast<long long>(lost));
   EXPECT_NEAR(rate_hz, 200.0, 10.0);
   EXPECT_TRUE(sim->running());
 }

@@ -42,8 +42,7 @@ void RemoveTempDirsIfPassed() {
 }  // namespace
 
 std::string MakeTempDir(const std::string& tag) {
-  const auto dir = std::filesystem::temp_directory_path() /
-                   ("orbed_" + tag + "_" + std::to_string(getpid()));
+  const auto dir = std::filesystem::temp_directory_path() / ("orbed_" + tag + "_" + std::to_string(getpid()));
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   if (TempDirs().empty()) std::atexit(RemoveTempDirsIfPassed);
@@ -52,9 +51,9 @@ std::string MakeTempDir(const std::string& tag) {
 }
 
 bool WaitFor(const std::function<bool()>& condition, double timeout_s) {
-  const auto deadline = std::chrono::steady_clock::now() +
-                        std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                            std::chrono::duration<double>(timeout_s));
+  const auto deadline =
+      std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                             std::chrono::duration<double>(timeout_s));
   while (std::chrono::steady_clock::now() < deadline) {
     if (condition()) return true;
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
@@ -107,8 +106,7 @@ BusWatcher::~BusWatcher() {
   if (thread_.joinable()) thread_.join();
 }
 
-void BusWatcher::OnStatus(const lcm::ReceiveBuffer*, const std::string&,
-                          const orbed::process_status_t* msg) {
+void BusWatcher::OnStatus(const lcm::ReceiveBuffer*, const std::string&, const orbed::process_status_t* msg) {
   std::lock_guard<std::mutex> lock(mutex_);
   beats_[msg->name].push_back(Beat{*msg, std::chrono::steady_clock::now()});
 }

@@ -7,8 +7,8 @@
 #include <set>
 
 #include <gtest/gtest.h>
-#include <lcm/lcm-cpp.hpp>
 #include <yaml-cpp/yaml.h>
+#include <lcm/lcm-cpp.hpp>
 
 #include "tests/integration/testbed_util.h"
 
@@ -30,9 +30,9 @@ void ExpectErrors(const YAML::Node& node, const std::string& where) {
 
 TEST(ViraalRun, LaunchFileRunsTheStudyAndWritesResults) {
   const std::string log_dir = MakeTempDir("viraal_e2e");
-  RunningProcess launcher({BinPath("orbed-launch"), SourcePath("scripts/launch/viraal.yaml"),
-                           "--duration-sec", "240"},
-                          {{"ORBED_LOG_DIR", log_dir}});
+  RunningProcess launcher(
+      {BinPath("orbed-launch"), SourcePath("scripts/launch/viraal.yaml"), "--duration-sec", "240"},
+      {{"ORBED_LOG_DIR", log_dir}});
   ASSERT_TRUE(launcher.Wait(240)) << "the run did not finish";
   EXPECT_EQ(launcher.term_signal(), 0);
   ASSERT_EQ(launcher.exit_code(), 0);
@@ -60,8 +60,8 @@ TEST(ViraalRun, LaunchFileRunsTheStudyAndWritesResults) {
   const YAML::Node manifest = YAML::LoadFile(log_dir + "/manifest.json");
   EXPECT_TRUE(manifest["complete"].as<bool>());
   EXPECT_EQ(manifest["drops"].as<int>(), 0);
-  for (const char* channel : {"ALIGNMENT_TRIAL", "REGISTRATION", "HMD_POSE", "HMD_CAMERA",
-                              "REFLECTIVE_VIEW", "IIWA_STATUS", "SESSION_CONTROL"}) {
+  for (const char* channel : {"ALIGNMENT_TRIAL", "REGISTRATION", "HMD_POSE", "HMD_CAMERA", "REFLECTIVE_VIEW",
+                              "IIWA_STATUS", "SESSION_CONTROL"}) {
     EXPECT_TRUE(manifest["channels"][channel]) << channel << " missing from the log";
   }
   EXPECT_EQ(manifest["channels"]["ALIGNMENT_TRIAL"]["events"].as<int>(), 6);

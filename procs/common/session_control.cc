@@ -1,0 +1,81 @@
+#include "procs/common/session_control.h"
+
+#include <orbed/alignment_trial_t.hpp>
+#include <orbed/registration_t.hpp>
+
+#include "procs/common/validation.h"
+
+namespace orbed {
+namespace {
+
+using SC = orbed::session_control_t;
+using AT = orbed::alignment_trial_t;
+using RT = orbed::registration_t;
+
+SessionCommand::Kind KindOf(int8_t command) {
+  switch (command) {
+    case SC::START:
+      return SessionCommand::Kind::kStart;
+    case SC::RESET:
+      return SessionCommand::Kind::kReset;
+    case SC::COMPUTE:
+      return SessionCommand::Kind::kCompute;
+    case SC::STOP:
+      return SessionCommand::Kind::kStop;
+    default:
+      return SessionCommand::Kind::kRequestTrial;
+  }
+}
+
+}  // namespace
+
+const char* SessionCommandName(SessionCommand::Kind kind) {
+  switch (kind) {
+    case SessionCommand::Kind::kStart:
+      return "START";
+    case SessionCommand::Kind::kReset:
+      return "RESET";
+    case SessionCommand::Kind::kCompute:
+      return "COMPUTE";
+    case SessionCommand::Kind::kStop:
+      return "STOP";
+    case SessionCommand::Kind::kRequestTrial:
+      return "REQUEST_TRIAL";
+  }
+  return "?";
+}
+
+std::variant<SessionCommand, Refusal> CheckSessionControl(const orbed::session_control_t& msg) {
+  std::string error = CheckEnum(msg.command, SC::START, SC::REQUEST_TRIAL, "SESSION_CONTROL.command");
+  if (!error.empty()) return Refusal{"command", error};
+  if (msg.session_id.empty()) return Refusal{"session_id", "SESSION_CONTROL.session_id is empty"};
+  if (msg.session_id.size() > kMaxSessionIdLength) {
+    return Refusal{"session_id", "SESSION_CONTROL.session_id is " + std::to_string(msg.session_id.size()) +
+                                     " bytes, at most " + std::to_string(kMaxSessionIdLength) + " allowed"};
+  }
+  SessionCommand command;
+  command.utime = msg.utime;
+  command.session_id = msg.session_id;
+  command.kind = KindOf(msg.command);
+  command.display_mode = msg.display_mode;
+  command.num_mirrors = msg.num_mirrors;
+  command.method = msg.method;
+  if (command.kind != SessionCommand::Kind::kStart) return command;
+
+  error = CheckEnum(msg.display_mode, AT::MODE_AR, AT::MODE_AR_REFLECTIVE, "SESSION_CONTROL.display_mode");
+  if (!error.empty()) return Refusal{"display_mode", error};
+  if (msg.display_mode == AT::MODE_AR ? msg.num_mirrors != 0
+                                      : (msg.num_mirrors < 1 || msg.num_mirrors > kMaxMirrors)) {
+    return Refusal{"num_mirrors",
+                   "SESSION_CONTROL START '" + msg.session_id + "': num_mirrors " +
+                       std::to_string(msg.num_mirrors) +
+                       (msg.display_mode == AT::MODE_AR
+                            ? " with MODE_AR, expected 0"
+                            : " with MODE_AR_REFLECTIVE, expected 1.." + std::to_string(kMaxMirrors))};
+  }
+  error = CheckEnum(msg.method, RT::METHOD_CHORDAL, RT::METHOD_ROBUST, "SESSION_CONTROL.method");
+  if (!error.empty()) return Refusal{"method", error};
+  return command;
+}
+
+}  // namespace orbed

@@ -1,0 +1,62 @@
+#pragma once
+/// @file
+/// The one check of SESSION_CONTROL (session_control_t): every process that reads the message turns
+/// it into a SessionCommand here, or refuses it with the same reason, so the registration server,
+/// the headset and any later reader agree on what a valid command is.
+///
+/// The contract:
+///   - session_id: 1..kMaxSessionIdLength bytes;
+///   - command: START, RESET, COMPUTE, STOP or REQUEST_TRIAL;
+///   - START only: display_mode MODE_AR with num_mirrors 0, or MODE_AR_REFLECTIVE with
+///     1..kMaxMirrors mirrors; method one of registration_t's METHOD_*. The other commands name a
+///     session that START opened; their mode, mirror and method fields are not read.
+/// A repeated START of the session that is already active with the same mode and mirrors is a
+/// no-op for every reader (SessionCommand::SameSessionAs tells it): it neither clears trials nor
+/// restarts the trial count. How many displays a headset has placed is that headset's own check.
+///
+/// Refusal keys are "<field>" (session_id, command, display_mode, num_mirrors, method); processes
+/// count them as "<channel>/<field>" on PROCESS_STATUS.
+///
+/// Threading: pure functions.
+
+#include <cstdint>
+#include <string>
+#include <variant>
+
+#include <orbed/session_control_t.hpp>
+
+namespace orbed {
+
+inline constexpr size_t kMaxSessionIdLength = 256;
+inline constexpr int32_t kMaxMirrors = 64;
+
+/// Why a message was refused: `key` names the field (the counter's class), `reason` is one line.
+struct Refusal {
+  std::string key;
+  std::string reason;
+};
+
+struct SessionCommand {
+  enum class Kind { kStart, kReset, kCompute, kStop, kRequestTrial };
+  int64_t utime{0};
+  std::string session_id;
+  Kind kind{Kind::kStart};
+  int8_t display_mode{0};  ///< alignment_trial_t::MODE_* (START; else as sent)
+  int32_t num_mirrors{0};  ///< (START; else as sent)
+  int8_t method{0};        ///< registration_t::METHOD_* (START; else as sent)
+
+  /// True when this START names the active session `session_id` with the same mode and mirrors.
+  bool RepeatsStartOf(const std::string& active_session_id, int8_t active_display_mode,
+                      int32_t active_num_mirrors) const {
+    return kind == Kind::kStart && session_id == active_session_id && display_mode == active_display_mode &&
+           num_mirrors == active_num_mirrors;
+  }
+};
+
+/// "START", "RESET", ... for log lines.
+const char* SessionCommandName(SessionCommand::Kind kind);
+
+/// The checked command, or the refusal.
+std::variant<SessionCommand, Refusal> CheckSessionControl(const orbed::session_control_t& msg);
+
+}  // namespace orbed
