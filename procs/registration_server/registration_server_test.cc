@@ -144,7 +144,7 @@ TEST(RegistrationServiceTest, BadTrialsAndCommandsAreRejectedCountedAndChangeNot
   EXPECT_EQ(f.rejections["ALIGNMENT_TRIAL/trial_index"], 1);
   EXPECT_EQ(f.rejections["ALIGNMENT_TRIAL/field"], 4);
   EXPECT_EQ(f.rejections["ALIGNMENT_TRIAL/display_mode"], 1);
-  EXPECT_EQ(f.rejections["SESSION_CONTROL/field"], 1);
+  EXPECT_EQ(f.rejections["SESSION_CONTROL/method"], 1);
   EXPECT_EQ(f.rejections["SESSION_CONTROL/session"], 1);
   for (const auto& reason : f.reasons) EXPECT_FALSE(reason.empty());
 }
@@ -179,6 +179,27 @@ TEST(RegistrationServiceTest, ResetStopAndRestart) {
   f.service.HandleSessionControl(Control(orbed::session_control_t::START, "s2", 7));
   EXPECT_EQ(f.service.num_trials(), 0);
   EXPECT_TRUE(f.service.session_active());
+}
+
+// The contract shared with the headset (procs/common/session_control.h): a repeated START of the
+// active session keeps its trials; a START with mirrors in AR mode is refused by the same rule.
+TEST(RegistrationServiceTest, RepeatedStartKeepsTrialsAndMirrorsFollowTheMode) {
+  Fixture f;
+  f.service.HandleSessionControl(Control(orbed::session_control_t::START, "s1", 1));
+  f.service.HandleTrial(Trial("s1", 0, 0, Eigen::Vector3d::Zero(), 2));
+  f.service.HandleSessionControl(Control(orbed::session_control_t::START, "s1", 3));
+  EXPECT_EQ(f.service.num_trials(), 1);
+  auto ar_with_mirror = Control(orbed::session_control_t::START, "s2", 4);
+  ar_with_mirror.display_mode = orbed::alignment_trial_t::MODE_AR;
+  f.service.HandleSessionControl(ar_with_mirror);
+  EXPECT_EQ(f.rejections["SESSION_CONTROL/num_mirrors"], 1);
+  EXPECT_EQ(f.service.session_id(), "s1");
+  EXPECT_EQ(f.service.num_trials(), 1);
+  // The same id with another mode is a new session: its trials start over.
+  auto reflective_two = Control(orbed::session_control_t::START, "s1", 5);
+  reflective_two.num_mirrors = 2;
+  f.service.HandleSessionControl(reflective_two);
+  EXPECT_EQ(f.service.num_trials(), 0);
 }
 
 TEST(RegistrationServiceTest, RobustSessionReportsTheRejectedTrialIndex) {

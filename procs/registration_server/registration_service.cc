@@ -5,38 +5,13 @@
 #include <utility>
 
 #include "procs/common/conversions.h"
+#include "procs/common/session_control.h"
 #include "procs/common/validation.h"
 #include "procs/registration_server/misalignment.h"
 #include "procs/registration_server/se3_mean.h"
 
 namespace orbed::registration {
 namespace {
-
-constexpr size_t kMaxSessionIdLength = 256;
-
-std::string CheckSessionId(const std::string& id, const std::string& what) {
-  if (id.empty()) return what + ": empty session_id";
-  if (id.size() > kMaxSessionIdLength) {
-    return what + ": session_id longer than " + std::to_string(kMaxSessionIdLength) + " characters";
-  }
-  return "";
-}
-
-const char* CommandName(int8_t command) {
-  switch (command) {
-    case orbed::session_control_t::START:
-      return "START";
-    case orbed::session_control_t::RESET:
-      return "RESET";
-    case orbed::session_control_t::COMPUTE:
-      return "COMPUTE";
-    case orbed::session_control_t::STOP:
-      return "STOP";
-    case orbed::session_control_t::REQUEST_TRIAL:
-      return "REQUEST_TRIAL";
-  }
-  return "?";
-}
 
 // Rows of an N×3 message array (already sized by the decoder) as Eigen vectors.
 // Coordinates and direction components beyond this are not an operating room [m]; bounding them
@@ -71,48 +46,45 @@ void RegistrationService::Reject(const std::string& key, const std::string& reas
 
 std::optional<orbed::registration_t> RegistrationService::HandleSessionControl(
     const orbed::session_control_t& msg) {
-  const std::string problem =
-      FirstError({CheckSessionId(msg.session_id, "SESSION_CONTROL"),
-                  CheckEnum(msg.command, orbed::session_control_t::START,
-                            orbed::session_control_t::REQUEST_TRIAL, "SESSION_CONTROL.command"),
-                  CheckEnum(msg.display_mode, orbed::alignment_trial_t::MODE_AR,
-                            orbed::alignment_trial_t::MODE_AR_REFLECTIVE, "SESSION_CONTROL.display_mode"),
-                  CheckEnum(msg.method, orbed::registration_t::METHOD_CHORDAL,
-                            orbed::registration_t::METHOD_ROBUST, "SESSION_CONTROL.method"),
-                  CheckEnum(msg.num_mirrors, 0, 64, "SESSION_CONTROL.num_mirrors")});
-  if (!problem.empty()) {
-    Reject("SESSION_CONTROL/field", problem);
+  const auto checked = CheckSessionControl(msg);
+  if (const auto* refusal = std::get_if<Refusal>(&checked)) {
+    Reject("SESSION_CONTROL/" + refusal->key, refusal->reason);
     return std::nullopt;
   }
+  const SessionCommand& command = std::get<SessionCommand>(checked);
+  using Kind = SessionCommand::Kind;
   // A trial request is for the user, not for the server.
-  if (msg.command == orbed::session_control_t::REQUEST_TRIAL) return std::nullopt;
-  if (msg.command == orbed::session_control_t::START) {
+  if (command.kind == Kind::kRequestTrial) return std::nullopt;
+  if (command.kind == Kind::kStart) {
+    // A repeated START of the active session changes nothing (its trials stay).
+    if (active_ && command.RepeatsStartOf(session_id_, display_mode_, num_mirrors_)) return std::nullopt;
     has_session_ = true;
     active_ = true;
-    session_id_ = msg.session_id;
-    display_mode_ = msg.display_mode;
-    method_ = msg.method;
+    session_id_ = command.session_id;
+    display_mode_ = command.display_mode;
+    num_mirrors_ = command.num_mirrors;
+    method_ = command.method;
     trials_.clear();
-    last_utime_ = msg.utime;
+    last_utime_ = command.utime;
     return std::nullopt;
   }
-  if (!has_session_ || msg.session_id != session_id_) {
-    Reject("SESSION_CONTROL/session", std::string("SESSION_CONTROL ") + CommandName(msg.command) +
-                                          " for session '" + msg.session_id + "', but the session is '" +
+  if (!has_session_ || command.session_id != session_id_) {
+    Reject("SESSION_CONTROL/session", std::string("SESSION_CONTROL ") + SessionCommandName(command.kind) +
+                                          " for session '" + command.session_id + "', but the session is '" +
                                           (has_session_ ? session_id_ : std::string("<none>")) + "'");
     return std::nullopt;
   }
-  switch (msg.command) {
-    case orbed::session_control_t::RESET:
+  switch (command.kind) {
+    case Kind::kReset:
       trials_.clear();
-      last_utime_ = msg.utime;
+      last_utime_ = command.utime;
       return std::nullopt;
-    case orbed::session_control_t::STOP:
+    case Kind::kStop:
       active_ = false;
-      last_utime_ = msg.utime;
+      last_utime_ = command.utime;
       return std::nullopt;
     default:  // COMPUTE
-      return MakeState(msg.utime, orbed::registration_t::REASON_COMPUTE);
+      return MakeState(command.utime, orbed::registration_t::REASON_COMPUTE);
   }
 }
 

@@ -10,8 +10,9 @@
 /// input that changed the session; LANDMARK / MISALIGNMENT the request's utime. Replaying a log
 /// therefore reproduces the same bytes.
 ///
-/// Sessions: START(session_id, display_mode, num_mirrors, method) opens a session (replacing any
-/// other); trials for it are collected until STOP; RESET drops its trials; COMPUTE asks for the
+/// Sessions (commands checked by procs/common/session_control.h): START(session_id, display_mode,
+/// num_mirrors, method) opens a session (replacing any other; a repeated START of the active session
+/// with the same mode and mirrors changes nothing); trials for it are collected until STOP; RESET drops its trials; COMPUTE asks for the
 /// full state now. The last session's state stays available (periodic state, COMPUTE) after STOP
 /// until the next START.
 ///
@@ -95,6 +96,7 @@ class RegistrationService {
   bool active_ = false;
   std::string session_id_;
   int8_t display_mode_ = 0;
+  int32_t num_mirrors_ = 0;
   int8_t method_ = orbed::registration_t::METHOD_KARCHER;
   std::vector<Trial> trials_;
   int64_t last_utime_ = 0;

@@ -6,6 +6,7 @@
 ///             IIWA_COMMAND, MISALIGNMENT_REQUEST, PROCESS_STATUS (1 Hz).
 /// Writes results.json to --results-dir (default $ORBED_LOG_DIR, else the working directory) and
 /// prints a progress line per step and a table at the end on stdout.
+#include <cstdlib>
 #include <iostream>
 #include <string>
 #include <vector>
@@ -33,7 +34,7 @@ int main(int argc, char** argv) {
   app.add_option("--q-deg", q_deg,
                  "A trial configuration q1,...,q7 [deg]; repeat for each (replaces the file's list)");
   app.add_option("--run-id", options.run_id,
-                 "Run id; sessions are <run-id>-<mode> (default viraal-<UTC time>)");
+                 "Run id; sessions are <run-id>-<mode> (default $ORBED_RUN_ID, else viraal-<UTC time>)");
   app.add_option("--results-dir", options.results_dir,
                  "Folder of results.json (default: $ORBED_LOG_DIR, else the working directory)");
   app.add_option("--urdf", options.urdf_path,
@@ -67,6 +68,9 @@ int main(int argc, char** argv) {
   app.add_option("--misalignment-channel", options.misalignment_channel)->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   orbed::ApplyCommonFlags(common);
+  if (const char* env_run_id = std::getenv("ORBED_RUN_ID"); options.run_id.empty() && env_run_id != nullptr) {
+    options.run_id = env_run_id;
+  }
   try {
     if (scenario_path.empty()) {
       scenario_path = orbed::scenario::ScenarioSourcePath(orbed::scenario::kDefaultScenarioRelativePath);
