@@ -2,9 +2,16 @@
 // scripts/launch/viraal.yaml (logger, sim, registration, monitor, orbed-hmd, orbed-scenario) in a
 // private network namespace. The scenario ends the run; the launcher must exit 0 and leave a log,
 // a complete manifest and a results.json with 2 sessions × 3 trials and 2 means.
+//
+// The run is seeded (every process's default --seed 1, run id "pinned"), so its results.json is
+// fully determined: it must equal, number for number, testdata/viraal_pinned_results.json, which
+// was written by the testbed before its redesign into pure cores and shared libraries. A change
+// that moves any emulated trial, registration or error shows here.
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <set>
+#include <string>
 
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
@@ -28,11 +35,42 @@ void ExpectErrors(const YAML::Node& node, const std::string& where) {
   EXPECT_LT(node["rotation_error_deg"].as<double>(), 10.0) << where;
 }
 
+// Walks `expected` and `actual` together: same keys, same sequence lengths, numbers within a
+// relative 1e-9 (the run's arithmetic, not the JSON printing, decides), other scalars equal.
+// Keys in `skip` (times of the run) are not compared.
+void ExpectSameTree(const YAML::Node& expected, const YAML::Node& actual, const std::string& where,
+                    const std::set<std::string>& skip) {
+  ASSERT_EQ(expected.Type(), actual.Type()) << where;
+  if (expected.IsMap()) {
+    size_t compared = 0;
+    for (const auto& item : actual) compared += skip.count(item.first.as<std::string>()) == 0;
+    EXPECT_EQ(compared, expected.size()) << where << ": a key was added or removed";
+    for (const auto& item : expected) {
+      const std::string key = item.first.as<std::string>();
+      if (skip.count(key)) continue;
+      ASSERT_TRUE(actual[key]) << where << "." << key << " missing";
+      ExpectSameTree(item.second, actual[key], where + "." + key, skip);
+    }
+  } else if (expected.IsSequence()) {
+    ASSERT_EQ(expected.size(), actual.size()) << where;
+    for (size_t i = 0; i < expected.size(); ++i) {
+      ExpectSameTree(expected[i], actual[i], where + "[" + std::to_string(i) + "]", skip);
+    }
+  } else if (expected.IsScalar()) {
+    double e = 0, a = 0;
+    if (YAML::convert<double>::decode(expected, e) && YAML::convert<double>::decode(actual, a)) {
+      EXPECT_NEAR(a, e, 1e-9 * std::max(1.0, std::abs(e))) << where;
+    } else {
+      EXPECT_EQ(expected.as<std::string>(), actual.as<std::string>()) << where;
+    }
+  }
+}
+
 TEST(ViraalRun, LaunchFileRunsTheStudyAndWritesResults) {
   const std::string log_dir = MakeTempDir("viraal_e2e");
   RunningProcess launcher(
       {BinPath("orbed-launch"), SourcePath("scripts/launch/viraal.yaml"), "--duration-sec", "240"},
-      {{"ORBED_LOG_DIR", log_dir}});
+      {{"ORBED_LOG_DIR", log_dir}, {"ORBED_RUN_ID", "pinned"}});
   ASSERT_TRUE(launcher.Wait(240)) << "the run did not finish";
   EXPECT_EQ(launcher.term_signal(), 0);
   ASSERT_EQ(launcher.exit_code(), 0);
@@ -55,6 +93,11 @@ TEST(ViraalRun, LaunchFileRunsTheStudyAndWritesResults) {
     ExpectErrors(session["mean"], mode + " mean");
   }
   EXPECT_EQ(modes, (std::set<std::string>{"ar", "ar_reflective"}));
+
+  // Seeded: the numbers of the run before the redesign, exactly.
+  const YAML::Node pinned =
+      YAML::LoadFile(SourcePath("tests/integration/testdata/viraal_pinned_results.json"));
+  ExpectSameTree(pinned, results, "results", {"started_utime", "duration_s"});
 
   // The log beside it is whole and holds the study's messages.
   const YAML::Node manifest = YAML::LoadFile(log_dir + "/manifest.json");
