@@ -11,7 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "hmd_emulator/renderer.h"
-#include "sim/model_paths.h"
+#include "base/source_paths.h"
 #include "sim/robot_model.h"
 #include "sim/scene.h"
 
@@ -175,8 +175,8 @@ TEST(Gaze, CapsuleBodyAndCapsByHand) {
 
 TEST(Gaze, OperatingRoomNamesTheBodyAndSkipsTheHologram) {
   const sim::RobotModel robot =
-      sim::RobotModel::LoadFile(orbed::sim::SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath));
-  const sim::Scene scene = sim::LoadSceneFile(orbed::sim::SourceTreePath(sim::kDefaultSceneRelativePath));
+      sim::RobotModel::LoadFile(orbed::SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath));
+  const sim::Scene scene = sim::LoadSceneFile(orbed::SourceTreePath(sim::kDefaultSceneRelativePath));
   const Eigen::VectorXd q = Eigen::VectorXd::Zero(7);  // arm straight up
   const Eigen::Isometry3d X_WV = scene.X_WR;           // hologram exactly on the real robot
   SceneGeometry g = SceneGeometry::MakeOperatingRoom(scene, robot, q, scene.X_WR, &X_WV);
@@ -205,12 +205,12 @@ TEST(Gaze, OperatingRoomNamesTheBodyAndSkipsTheHologram) {
 
 TEST(Gaze, AgreesWithTheRendererOnAFlatFace) {
   const sim::RobotModel robot =
-      sim::RobotModel::LoadFile(orbed::sim::SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath));
-  const sim::Scene scene = sim::LoadSceneFile(orbed::sim::SourceTreePath(sim::kDefaultSceneRelativePath));
+      sim::RobotModel::LoadFile(orbed::SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath));
+  const sim::Scene scene = sim::LoadSceneFile(orbed::SourceTreePath(sim::kDefaultSceneRelativePath));
   SceneGeometry g = SceneGeometry::MakeOperatingRoom(scene, robot, Eigen::VectorXd::Zero(7), scene.X_WR);
   Mesh mesh;
   Tessellate(g, kRealWorld, {}, &mesh);
-  const Intrinsics K = Intrinsics::HoloLensPv();
+  const geometry::Intrinsics K = geometry::Intrinsics::HoloLensPv();
   Renderer renderer(K);
   // Looking down at 60 deg onto the patient's torso from the bedside.
   Eigen::Isometry3d X_WC = Eigen::Isometry3d::Identity();

@@ -69,7 +69,7 @@ HeadTrajectory::HeadTrajectory(HeadTrajectoryConfig config) : config_(std::move(
       throw std::invalid_argument("head trajectory: waypoint '" + w[i].name + "': dwell_s must be >= 0");
     }
     try {
-      LookAt(w[i].p_WH, Target(i));  // throws when the target is degenerate
+      geometry::LookAt(w[i].p_WH, Target(i));  // throws when the target is degenerate
     } catch (const std::invalid_argument& e) {
       throw std::invalid_argument("head trajectory: at waypoint '" + w[i].name + "': " + e.what());
     }
@@ -78,7 +78,7 @@ HeadTrajectory::HeadTrajectory(HeadTrajectoryConfig config) : config_(std::move(
   // While walking a segment the line of sight d(a) = target(a) − p(a) is linear in the fraction a
   // walked, and so is its horizontal part: X_WH() must never meet a vertical (or vanishing) line of
   // sight there, or it would throw mid-walk. |d(a)| >= |d(a*)| and the heading is defined wherever
-  // |horizontal(a)| / |d(a)| > 1e-6 (LookAt), which the bound |d(a)| <= max(|d_i|, |d_j|) (d is
+  // |horizontal(a)| / |d(a)| > 1e-6 (geometry::LookAt), which the bound |d(a)| <= max(|d_i|, |d_j|) (d is
   // convex in a) guarantees when the horizontal part's minimum exceeds 1e-6 · max(|d_i|, |d_j|).
   for (int i = 0; i < num_segments; ++i) {
     const int j = (i + 1) % n;
@@ -137,7 +137,7 @@ Eigen::Isometry3d HeadTrajectory::X_WH(double t_s) const {
   if (config_.loop && duration_s_ > 0) t = std::fmod(t, duration_s_);
   for (int i = 0; i < n; ++i) {
     const double leave = arrive_s_[i] + w[i].dwell_s;
-    if (t <= leave) return LookAt(w[i].p_WH, Target(i));
+    if (t <= leave) return geometry::LookAt(w[i].p_WH, Target(i));
     if (i < static_cast<int>(seg_len_m_.size())) {
       const double walk = seg_len_m_[i] / config_.speed_m_per_s;
       if (t <= leave + walk) {
@@ -145,13 +145,13 @@ Eigen::Isometry3d HeadTrajectory::X_WH(double t_s) const {
         const int j = (i + 1) % n;
         const Eigen::Vector3d p = (1 - a) * w[i].p_WH + a * w[j].p_WH;
         const Eigen::Vector3d target = (1 - a) * Target(i) + a * Target(j);
-        return LookAt(p, target);
+        return geometry::LookAt(p, target);
       }
     }
   }
   // Past the end of a non-looping path (or rounding at the loop's end): the last / first waypoint.
   const int last = config_.loop ? 0 : n - 1;
-  return LookAt(w[last].p_WH, Target(last));
+  return geometry::LookAt(w[last].p_WH, Target(last));
 }
 
 double HeadTrajectory::PathLength(double t_s) const {

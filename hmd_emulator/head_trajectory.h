@@ -32,7 +32,7 @@
 #include <yaml-cpp/yaml.h>
 #include <Eigen/Geometry>
 
-#include "hmd_emulator/camera_model.h"  // LookAt
+#include "geometry/camera_model.h"  // geometry::LookAt
 
 namespace orbed::hmd {
 

@@ -5,7 +5,7 @@
 #include <stdexcept>
 
 #include "hmd_emulator/yaml_fields.h"
-#include "sim/model_paths.h"
+#include "base/source_paths.h"
 
 namespace orbed::hmd {
 namespace {
@@ -20,7 +20,7 @@ std::string Text(const YamlFields& f, const YAML::Node& map, const std::string& 
 
 }  // namespace
 
-std::string HmdSourcePath(const std::string& relative) { return sim::SourceTreePath(relative); }
+std::string HmdSourcePath(const std::string& relative) { return orbed::SourceTreePath(relative); }
 
 std::vector<std::string> DefaultHmdConfigRelativePaths() {
   return {kDefaultSlamConfigRelativePath, kDefaultUserConfigRelativePath,

@@ -17,7 +17,7 @@
 #include <orbed/image_t.hpp>
 #include <orbed/reflective_view_t.hpp>
 
-#include "hmd_emulator/camera_model.h"
+#include "geometry/camera_model.h"
 #include "hmd_emulator/gaze.h"
 #include "hmd_emulator/reflective.h"
 #include "hmd_emulator/renderer.h"
@@ -68,7 +68,7 @@ const char* ModeName(int8_t mode) {
   return mode == orbed::alignment_trial_t::MODE_AR_REFLECTIVE ? "ar_reflective" : "ar";
 }
 
-orbed::image_t JpegImage(const std::vector<std::uint8_t>& jpeg, const Intrinsics& K, int64_t utime,
+orbed::image_t JpegImage(const std::vector<std::uint8_t>& jpeg, const geometry::Intrinsics& K, int64_t utime,
                          const Eigen::Isometry3d& X_WC_est, int64_t pose_utime) {
   orbed::image_t img{};
   img.utime = utime;
@@ -139,7 +139,7 @@ class HmdProcess::ImagePipeline {
         config_(config),
         options_(options),
         process_(process),
-        renderer_(Intrinsics::HoloLensPv()),
+        renderer_(geometry::Intrinsics::HoloLensPv()),
         compositor_(robot) {
     scene_geometry_.AddSceneObjects(scene);
     robot_geometry_.AddRobot(robot, BodyKind::kRealRobot);
@@ -766,7 +766,7 @@ void HmdProcess::EmulateTrial(const std::string& channel) {
   setup.align_waypoint = config_.hmd.align_waypoint;
   setup.settle_s = config_.hmd.settle_s;
   setup.max_wait_s = config_.hmd.max_wait_s;
-  setup.intrinsics = Intrinsics::HoloLensPv();
+  setup.intrinsics = geometry::Intrinsics::HoloLensPv();
   for (int i = 0; i < session_.num_mirrors; ++i) {
     setup.capture_waypoints.push_back(config_.hmd.displays[i].capture_waypoint);
   }

@@ -7,25 +7,25 @@
 namespace orbed::hmd {
 namespace {
 
-bool SameIntrinsics(const Intrinsics& a, const Intrinsics& b) {
+bool SameIntrinsics(const geometry::Intrinsics& a, const geometry::Intrinsics& b) {
   return a.width_px == b.width_px && a.height_px == b.height_px && a.fx_px == b.fx_px && a.fy_px == b.fy_px &&
          a.cx_px == b.cx_px && a.cy_px == b.cy_px;
 }
 
 }  // namespace
 
-ReflectiveGeometry MakeReflectiveGeometry(const Intrinsics& intrinsics, const Eigen::Isometry3d& X_WC,
+ReflectiveGeometry MakeReflectiveGeometry(const geometry::Intrinsics& intrinsics, const Eigen::Isometry3d& X_WC,
                                           double D_m) {
   if (!std::isfinite(D_m) || !(D_m > 0))
     throw std::invalid_argument("reflective display: D must be finite and > 0, got " + std::to_string(D_m));
   ReflectiveGeometry g;
   g.K_o = intrinsics.K();
-  g.K_m = MirrorIntrinsics(g.K_o);
+  g.K_m = geometry::MirrorIntrinsics(g.K_o);
   g.X_WC = X_WC;
-  g.X_WM = X_WC * MirrorPoseInCamera(D_m);
+  g.X_WM = X_WC * geometry::MirrorPoseInCamera(D_m);
   g.distance_m = D_m;
-  g.P_o = MakeCameraMatrix(g.K_o, X_WC);
-  g.P_m = MakeMirrorCameraMatrix(g.K_o, X_WC, D_m);
+  g.P_o = geometry::MakeCameraMatrix(g.K_o, X_WC);
+  g.P_m = geometry::MakeMirrorCameraMatrix(g.K_o, X_WC, D_m);
   return g;
 }
 
@@ -43,7 +43,7 @@ Compositor::Compositor(const sim::RobotModel& robot, const OverlayStyle& style,
   handle_ = virtual_robot_.AddRobot(robot, BodyKind::kVirtualRobot);
 }
 
-void Compositor::Overlay(const Intrinsics& intrinsics, const Eigen::Isometry3d& X_WC,
+void Compositor::Overlay(const geometry::Intrinsics& intrinsics, const Eigen::Isometry3d& X_WC,
                          const Eigen::VectorXd& q_rad, const Eigen::Isometry3d& X_WV, cv::Mat* image,
                          cv::Mat* body_id) {
   if (q_rad.size() != robot_.num_joints())
@@ -59,7 +59,7 @@ void Compositor::Overlay(const Intrinsics& intrinsics, const Eigen::Isometry3d& 
 
 void Compositor::ComposeReflective(const CapturedFrame& frame, double D_m, const Eigen::Isometry3d& X_WV,
                                    ReflectiveView* view, cv::Mat* body_id) {
-  const Intrinsics& K = frame.intrinsics;
+  const geometry::Intrinsics& K = frame.intrinsics;
   if (frame.bgr.empty() || frame.bgr.type() != CV_8UC3 || frame.bgr.cols != K.width_px ||
       frame.bgr.rows != K.height_px)
     throw std::invalid_argument("reflective display: the frame must be CV_8UC3 of its intrinsics' size");
@@ -70,7 +70,7 @@ void Compositor::ComposeReflective(const CapturedFrame& frame, double D_m, const
   Overlay(K, frame.X_WC_est, frame.q_rad, X_WV, &view->bgr, body_id);
 }
 
-void Compositor::ComposeArView(const cv::Mat& live_bgr, const Intrinsics& intrinsics,
+void Compositor::ComposeArView(const cv::Mat& live_bgr, const geometry::Intrinsics& intrinsics,
                                const Eigen::Isometry3d& X_WC_est, const Eigen::VectorXd& q_rad,
                                const Eigen::Isometry3d& X_WV, cv::Mat* out, cv::Mat* body_id) {
   if (live_bgr.empty() || live_bgr.type() != CV_8UC3 || live_bgr.cols != intrinsics.width_px ||

@@ -47,7 +47,7 @@
 #include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 
-#include "hmd_emulator/camera_model.h"
+#include "geometry/camera_model.h"
 #include "hmd_emulator/renderer.h"
 #include "hmd_emulator/scene_geometry.h"
 #include "sim/robot_model.h"
@@ -57,7 +57,7 @@ namespace orbed::hmd {
 /// A camera frame as the device holds it.
 struct CapturedFrame {
   cv::Mat bgr;            ///< CV_8UC3, rendered from the TRUE capture pose
-  Intrinsics intrinsics;  ///< K_o of the frame
+  geometry::Intrinsics intrinsics;  ///< K_o of the frame
   Eigen::Isometry3d X_WC_est{Eigen::Isometry3d::Identity()};  ///< SLAM estimate at capture
   Eigen::VectorXd q_rad;  ///< robot joint vector at capture (IIWA_STATUS) [rad]
   std::int64_t utime{0};  ///< capture time [µs]
@@ -70,16 +70,16 @@ struct ReflectiveGeometry {
   Eigen::Isometry3d X_WC{Eigen::Isometry3d::Identity()};  ///< capture pose used (the estimate)
   Eigen::Isometry3d X_WM{Eigen::Isometry3d::Identity()};  ///< reversed frustum, X_WC · X_CM(D)
   double distance_m{0};                                   ///< D [m]
-  CameraMatrix P_o{CameraMatrix::Zero()};                 ///< K_o [R_CW | p_CW]: draws the content
+  geometry::CameraMatrix P_o{geometry::CameraMatrix::Zero()};                 ///< K_o [R_CW | p_CW]: draws the content
   /// K_m [R_MW | p_MW] = K_m · P · X_CM · X_CW: the reversed frustum of the paper's Sec. II-B, in
   /// the geometric order (the file comment; the paper's printed product order differs). Places the
   /// display; the content is drawn with P_o.
-  CameraMatrix P_m{CameraMatrix::Zero()};
+  geometry::CameraMatrix P_m{geometry::CameraMatrix::Zero()};
 };
 
 /// The geometry for a frame captured at X_WC with gaze distance D. Throws std::invalid_argument
 /// unless D is finite and > 0.
-ReflectiveGeometry MakeReflectiveGeometry(const Intrinsics& intrinsics, const Eigen::Isometry3d& X_WC,
+ReflectiveGeometry MakeReflectiveGeometry(const geometry::Intrinsics& intrinsics, const Eigen::Isometry3d& X_WC,
                                           double D_m);
 
 /// Where the display shows pixel (u, v), in W: p_M = s ((u − cx)/fx, −(v − cy)/fy, 1) with
@@ -109,7 +109,7 @@ class Compositor {
 
   /// AR view: the virtual robot at (q, X_WV) over a live frame, drawn from the current estimate
   /// X_WC_est. `out` may alias `live_bgr`'s buffer only if it is the same Mat object.
-  void ComposeArView(const cv::Mat& live_bgr, const Intrinsics& intrinsics, const Eigen::Isometry3d& X_WC_est,
+  void ComposeArView(const cv::Mat& live_bgr, const geometry::Intrinsics& intrinsics, const Eigen::Isometry3d& X_WC_est,
                      const Eigen::VectorXd& q_rad, const Eigen::Isometry3d& X_WV, cv::Mat* out,
                      cv::Mat* body_id = nullptr);
 
@@ -117,7 +117,7 @@ class Compositor {
   const SceneGeometry& virtual_geometry() const { return virtual_robot_; }
 
  private:
-  void Overlay(const Intrinsics& intrinsics, const Eigen::Isometry3d& X_WC, const Eigen::VectorXd& q_rad,
+  void Overlay(const geometry::Intrinsics& intrinsics, const Eigen::Isometry3d& X_WC, const Eigen::VectorXd& q_rad,
                const Eigen::Isometry3d& X_WV, cv::Mat* image, cv::Mat* body_id);
 
   const sim::RobotModel& robot_;

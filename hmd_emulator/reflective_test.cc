@@ -1,4 +1,4 @@
-// Reflective-AR display and AR view: the hologram lands where Project() says (with the capture
+// Reflective-AR display and AR view: the hologram lands where geometry::Project() says (with the capture
 // pose the device believes), SLAM error at capture shows up as misalignment against the real robot
 // in the captured image, D never changes the pixels, and the display panel's geometry (X_WM, K_m,
 // P_m) is the paper's reversed frustum.
@@ -10,11 +10,11 @@
 
 #include <gtest/gtest.h>
 
-#include "hmd_emulator/camera_model.h"
+#include "geometry/camera_model.h"
 #include "hmd_emulator/gaze.h"
 #include "hmd_emulator/renderer.h"
 #include "hmd_emulator/scene_geometry.h"
-#include "sim/model_paths.h"
+#include "base/source_paths.h"
 #include "sim/scene.h"
 
 namespace orbed::hmd {
@@ -33,12 +33,12 @@ Eigen::Vector2d Centroid(const cv::Mat& ids, int id, int* count = nullptr) {
 class ReflectiveTest : public ::testing::Test {
  protected:
   ReflectiveTest()
-      : robot_(sim::RobotModel::LoadFile(sim::SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath))),
-        scene_(sim::LoadSceneFile(sim::SourceTreePath(sim::kDefaultSceneRelativePath))) {
+      : robot_(sim::RobotModel::LoadFile(orbed::SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath))),
+        scene_(sim::LoadSceneFile(orbed::SourceTreePath(sim::kDefaultSceneRelativePath))) {
     Eigen::VectorXd q_deg(7);
     q_deg << 20, 40, 0, -60, 0, 50, 0;
     q_ = sim::DegToRad(q_deg);
-    X_WC_true_ = LookAt({1.6, -2.0, 1.7}, {0.25, -0.45, 1.2});
+    X_WC_true_ = geometry::LookAt({1.6, -2.0, 1.7}, {0.25, -0.45, 1.2});
   }
 
   // The frame the camera captures: the real scene from the TRUE pose; ids of the real bodies.
@@ -47,10 +47,10 @@ class ReflectiveTest : public ::testing::Test {
     real_geometry_ = g;
     Mesh mesh;
     Tessellate(g, kRealWorld, {}, &mesh);
-    Renderer renderer(Intrinsics::HoloLensPv());
+    Renderer renderer(geometry::Intrinsics::HoloLensPv());
     CapturedFrame f;
     renderer.Render(mesh, X_WC_true_, &f.bgr, nullptr, real_ids);
-    f.intrinsics = Intrinsics::HoloLensPv();
+    f.intrinsics = geometry::Intrinsics::HoloLensPv();
     f.X_WC_est = X_WC_est;
     f.q_rad = q_;
     f.utime = 123456789;
@@ -91,11 +91,11 @@ TEST_F(ReflectiveTest, HologramLandsWhereProjectSaysWithTheEstimatedCapturePose)
   // Every virtual primitive's centre, projected with the device's belief P_o(X_WC_est), lands on a
   // hologram pixel showing the body that an analytic ray from X_WC_est through that pixel hits.
   const SceneGeometry& holo = compositor.virtual_geometry();
-  const CameraMatrix P_est = MakeCameraMatrix(frame.intrinsics.K(), X_WC_est);
+  const geometry::CameraMatrix P_est = geometry::MakeCameraMatrix(frame.intrinsics.K(), X_WC_est);
   int agree = 0, total = 0;
   for (const Primitive& p : holo.primitives()) {
     Eigen::Vector2d uv;
-    ASSERT_TRUE(Project(P_est, p.X_WG.translation(), &uv));
+    ASSERT_TRUE(geometry::Project(P_est, p.X_WG.translation(), &uv));
     const int u = static_cast<int>(std::lround(uv.x())), v = static_cast<int>(std::lround(uv.y()));
     if (u < 0 || v < 0 || u >= holo_ids.cols || v >= holo_ids.rows) continue;
     const Eigen::Vector3d ray_C((u - frame.intrinsics.cx_px) / frame.intrinsics.fx_px,
@@ -115,9 +115,9 @@ TEST_F(ReflectiveTest, HologramLandsWhereProjectSaysWithTheEstimatedCapturePose)
   ASSERT_GE(holo_wrist, 0);
   ASSERT_GE(real_wrist, 0);
   Eigen::Vector2d uv_est, uv_true;
-  ASSERT_TRUE(Project(P_est, WristCentre(X_WV), &uv_est));
+  ASSERT_TRUE(geometry::Project(P_est, WristCentre(X_WV), &uv_est));
   ASSERT_TRUE(
-      Project(MakeCameraMatrix(frame.intrinsics.K(), X_WC_true_), WristCentre(scene_.X_WR), &uv_true));
+      geometry::Project(geometry::MakeCameraMatrix(frame.intrinsics.K(), X_WC_true_), WristCentre(scene_.X_WR), &uv_true));
   int n_holo = 0, n_real = 0;
   const Eigen::Vector2d c_holo = Centroid(holo_ids, holo_wrist, &n_holo);
   const Eigen::Vector2d c_real = Centroid(real_ids, real_wrist, &n_real);
@@ -174,8 +174,8 @@ TEST_F(ReflectiveTest, DistanceChangesThePanelNotThePixels) {
 }
 
 TEST(ReflectiveGeometry, IsThePapersReversedFrustum) {
-  const Intrinsics K = Intrinsics::HoloLensPv();
-  const Eigen::Isometry3d X_WC = LookAt({1.0, -1.5, 1.6}, {0.2, 0.3, 1.0});
+  const geometry::Intrinsics K = geometry::Intrinsics::HoloLensPv();
+  const Eigen::Isometry3d X_WC = geometry::LookAt({1.0, -1.5, 1.6}, {0.2, 0.3, 1.0});
   const double D = 1.7;
   const ReflectiveGeometry g = MakeReflectiveGeometry(K, X_WC, D);
   // M: at the gaze point D along the principal ray, x kept, y and z reversed.
@@ -191,8 +191,8 @@ TEST(ReflectiveGeometry, IsThePapersReversedFrustum) {
 }
 
 TEST(ReflectiveGeometry, PanelPixelsLieOnTheirCaptureRaysAndThroughTheReversedFrustum) {
-  const Intrinsics K = Intrinsics::HoloLensPv();
-  const Eigen::Isometry3d X_WC = LookAt({1.0, -1.5, 1.6}, {0.2, 0.3, 1.0});
+  const geometry::Intrinsics K = geometry::Intrinsics::HoloLensPv();
+  const Eigen::Isometry3d X_WC = geometry::LookAt({1.0, -1.5, 1.6}, {0.2, 0.3, 1.0});
   for (double D : {0.8, 2.0}) {
     const ReflectiveGeometry g = MakeReflectiveGeometry(K, X_WC, D);
     for (const Eigen::Vector2d& px : {Eigen::Vector2d(0, 0), Eigen::Vector2d(597.2, 322.1),
@@ -201,14 +201,14 @@ TEST(ReflectiveGeometry, PanelPixelsLieOnTheirCaptureRaysAndThroughTheReversedFr
       const Eigen::Vector3d p_W = DisplayPanelPoint(g, px.x(), px.y());
       EXPECT_NEAR((X_WC.inverse() * p_W).z(), D / 2, 1e-12);
       Eigen::Vector2d uv;
-      ASSERT_TRUE(Project(g.P_o, p_W, &uv));  // seen from the capture position: its own ray
+      ASSERT_TRUE(geometry::Project(g.P_o, p_W, &uv));  // seen from the capture position: its own ray
       EXPECT_LT((uv - px).norm(), 1e-9);
-      ASSERT_TRUE(Project(g.P_m, p_W, &uv));  // through P_m: the same pixel, row axis negated
+      ASSERT_TRUE(geometry::Project(g.P_m, p_W, &uv));  // through P_m: the same pixel, row axis negated
       EXPECT_NEAR(uv.x(), px.x(), 1e-9);
       EXPECT_NEAR(uv.y(), px.y() - 2 * K.cy_px, 1e-9);
       // Any other panel depth in M keeps both properties.
       const Eigen::Vector3d q_W = DisplayPanelPoint(g, px.x(), px.y(), 0.3 * D);
-      ASSERT_TRUE(Project(g.P_m, q_W, &uv));
+      ASSERT_TRUE(geometry::Project(g.P_m, q_W, &uv));
       EXPECT_NEAR(uv.y(), px.y() - 2 * K.cy_px, 1e-9);
     }
   }

@@ -7,7 +7,7 @@
 ///                              hologram from the device's estimate of that pose (2 cm, 0.8 deg SLAM
 ///                              error) and a registration X_WV that is 3 cm / 2 deg off
 /// Deterministic (no randomness). Usage: orbed-render-snapshot [--out DIR] (default docs/images under
-/// the source tree, sim::SourceDir(): $ORBED_SOURCE_DIR, else the tree it was built from).
+/// the source tree, orbed::SourceDir(): $ORBED_SOURCE_DIR, else the tree it was built from).
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -21,16 +21,15 @@
 #include "hmd_emulator/reflective.h"
 #include "hmd_emulator/renderer.h"
 #include "hmd_emulator/scene_geometry.h"
-#include "sim/model_paths.h"
+#include "base/source_paths.h"
 #include "sim/robot_model.h"
 #include "sim/scene.h"
+#include "base/units.h"
 
 namespace {
 
 using orbed::hmd::Intrinsics;
 using orbed::hmd::LookAt;
-
-constexpr double kDeg = 3.14159265358979323846 / 180.0;
 
 void Caption(cv::Mat* image, const std::string& text) {
   cv::rectangle(*image, cv::Rect(0, 0, image->cols, 34), cv::Scalar(30, 30, 30), cv::FILLED);
@@ -41,7 +40,7 @@ void Caption(cv::Mat* image, const std::string& text) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string out = orbed::sim::SourceTreePath("docs/images");
+  std::string out = orbed::SourceTreePath("docs/images");
   for (int i = 1; i < argc; ++i) {
     if (std::strcmp(argv[i], "--help") == 0 || std::strcmp(argv[i], "-h") == 0) {
       std::printf(
@@ -59,30 +58,30 @@ int main(int argc, char** argv) {
   try {
     namespace hmd = orbed::hmd;
     namespace sim = orbed::sim;
-    const sim::Scene scene = sim::LoadSceneFile(sim::SourceTreePath(sim::kDefaultSceneRelativePath));
+    const sim::Scene scene = sim::LoadSceneFile(orbed::SourceTreePath(sim::kDefaultSceneRelativePath));
     const sim::RobotModel robot =
-        sim::LoadRobotForScene(sim::SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath), scene);
+        sim::LoadRobotForScene(orbed::SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath), scene);
     Eigen::VectorXd q_deg(7);
     q_deg << -10, 40, 0, -65, 0, 55, 0;
     const Eigen::VectorXd q = sim::DegToRad(q_deg);
     hmd::SceneGeometry g = hmd::SceneGeometry::MakeOperatingRoom(scene, robot, q, scene.X_WR);
     hmd::Mesh mesh;
     hmd::Tessellate(g, hmd::kRealWorld, {}, &mesh);
-    const Intrinsics K = Intrinsics::HoloLensPv();
+    const geometry::Intrinsics K = geometry::Intrinsics::HoloLensPv();
     hmd::Renderer renderer(K);
 
     // 1. A camera frame from the bedside.
     cv::Mat frame;
-    renderer.Render(mesh, LookAt({1.75, -2.15, 1.7}, {0.2, -0.35, 1.05}), &frame);
+    renderer.Render(mesh, geometry::LookAt({1.75, -2.15, 1.7}, {0.2, -0.35, 1.05}), &frame);
     cv::Mat shown = frame.clone();
     Caption(&shown, "HMD_CAMERA  1280x720, HoloLens PV intrinsics, rendered from the true head pose");
     if (!cv::imwrite(out + "/camera_frame.png", shown)) throw std::runtime_error("cannot write " + out);
 
     // 2. A reflective view: captured from the foot of the table, SLAM error at capture, X_WV off.
-    const Eigen::Isometry3d X_WC_true = LookAt({2.05, 0.55, 1.75}, {0.25, -0.4, 1.15});
+    const Eigen::Isometry3d X_WC_true = geometry::LookAt({2.05, 0.55, 1.75}, {0.25, -0.4, 1.15});
     Eigen::Isometry3d X_CtrueCest = Eigen::Isometry3d::Identity();
     X_CtrueCest.linear() =
-        Eigen::AngleAxisd(0.8 * kDeg, Eigen::Vector3d(0.3, 1, 0).normalized()).toRotationMatrix();
+        Eigen::AngleAxisd(0.8 * orbed::kDegToRad, Eigen::Vector3d(0.3, 1, 0).normalized()).toRotationMatrix();
     X_CtrueCest.translation() = Eigen::Vector3d(0.015, -0.01, 0.008);
     hmd::CapturedFrame captured;
     renderer.Render(mesh, X_WC_true, &captured.bgr);
@@ -90,7 +89,7 @@ int main(int argc, char** argv) {
     captured.X_WC_est = X_WC_true * X_CtrueCest;
     captured.q_rad = q;
     Eigen::Isometry3d X_RV = Eigen::Isometry3d::Identity();
-    X_RV.linear() = Eigen::AngleAxisd(2.0 * kDeg, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    X_RV.linear() = Eigen::AngleAxisd(2.0 * orbed::kDegToRad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
     X_RV.translation() = Eigen::Vector3d(0.02, -0.015, 0.015);
     const Eigen::Isometry3d X_WV = scene.X_WR * X_RV;
     // D: the gaze from the capture position to the robot's elbow, hit on the spatial map.

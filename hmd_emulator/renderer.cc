@@ -20,7 +20,7 @@ struct Renderer::Target {
   int width{0}, height{0};
 };
 
-Renderer::Renderer(const Intrinsics& intrinsics, const RenderOptions& options)
+Renderer::Renderer(const geometry::Intrinsics& intrinsics, const RenderOptions& options)
     : intrinsics_(intrinsics), options_(options) {
   if (intrinsics.width_px <= 0 || intrinsics.height_px <= 0 || !(intrinsics.fx_px > 0) ||
       !(intrinsics.fy_px > 0))

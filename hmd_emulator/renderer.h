@@ -1,7 +1,7 @@
 #pragma once
 /// @file
 /// A z-buffered software rasteriser for the HMD camera: renders a tessellated scene (Mesh, in W)
-/// from a camera at X_WC with pinhole Intrinsics into an 8-bit BGR cv::Mat, flat Lambert-shaded
+/// from a camera at X_WC with pinhole geometry::Intrinsics into an 8-bit BGR cv::Mat, flat Lambert-shaded
 /// (ambient + a key light fixed in W + a headlight at the camera), optionally with a depth image
 /// and a body-id image. OpenCV is used only for the image containers and JPEG coding.
 ///
@@ -24,7 +24,7 @@
 #include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 
-#include "hmd_emulator/camera_model.h"
+#include "geometry/camera_model.h"
 #include "hmd_emulator/scene_geometry.h"
 
 namespace orbed::hmd {
@@ -49,9 +49,9 @@ struct OverlayStyle {
 
 class Renderer {
  public:
-  explicit Renderer(const Intrinsics& intrinsics, const RenderOptions& options = {});
+  explicit Renderer(const geometry::Intrinsics& intrinsics, const RenderOptions& options = {});
 
-  const Intrinsics& intrinsics() const { return intrinsics_; }
+  const geometry::Intrinsics& intrinsics() const { return intrinsics_; }
   const RenderOptions& options() const { return options_; }
 
   /// Renders `mesh` seen from X_WC into `bgr` (CV_8UC3, (re)allocated to the intrinsics' size and
@@ -76,7 +76,7 @@ class Renderer {
   template <bool kWriteIds>
   void FillTriangle(const double (*uvw)[3], const std::uint8_t* bgr, int body, Target* target);
 
-  Intrinsics intrinsics_;
+  geometry::Intrinsics intrinsics_;
   RenderOptions options_;
   Eigen::Vector3f light_W_;
   cv::Mat background_;   // cached gradient, CV_8UC3

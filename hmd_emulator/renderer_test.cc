@@ -13,7 +13,7 @@
 #include <gtest/gtest.h>
 
 #include "hmd_emulator/scene_geometry.h"
-#include "sim/model_paths.h"
+#include "base/source_paths.h"
 #include "sim/robot_model.h"
 #include "sim/scene.h"
 
@@ -29,7 +29,7 @@ Primitive Box(const Eigen::Vector3d& size, const Eigen::Isometry3d& X_WG) {
 }
 
 // Independent pinhole projection (no camera_model.h): K (R_CW p + p_CW).
-Eigen::Vector2d HandProject(const Intrinsics& K, const Eigen::Isometry3d& X_WC, const Eigen::Vector3d& p_W) {
+Eigen::Vector2d HandProject(const geometry::Intrinsics& K, const Eigen::Isometry3d& X_WC, const Eigen::Vector3d& p_W) {
   const Eigen::Matrix3d R_CW = X_WC.linear().transpose();
   const Eigen::Vector3d p_C = R_CW * (p_W - X_WC.translation());
   return {K.fx_px * p_C.x() / p_C.z() + K.cx_px, K.fy_px * p_C.y() / p_C.z() + K.cy_px};
@@ -66,7 +66,7 @@ double ConvexHullArea(std::vector<Eigen::Vector2d> pts) {
 int CountId(const cv::Mat& ids, int id) { return cv::countNonZero(ids == id); }
 
 TEST(Renderer, BoxSilhouetteAreaMatchesAnalyticProjection) {
-  const Intrinsics K = Intrinsics::HoloLensPv();
+  const geometry::Intrinsics K = geometry::Intrinsics::HoloLensPv();
   Renderer renderer(K);
   struct Case {
     Eigen::Vector3d size;
@@ -87,7 +87,7 @@ TEST(Renderer, BoxSilhouetteAreaMatchesAnalyticProjection) {
     const int body = g.AddBody("box", BodyKind::kSceneObject, ColorBgr{50, 100, 200}, Box(c.size, X_WG));
     Mesh mesh;
     Tessellate(g, kAllKinds, {}, &mesh);
-    const Eigen::Isometry3d X_WC = LookAt(c.eye, c.centre + Eigen::Vector3d(0.05, -0.03, 0.02));
+    const Eigen::Isometry3d X_WC = geometry::LookAt(c.eye, c.centre + Eigen::Vector3d(0.05, -0.03, 0.02));
     cv::Mat bgr, ids;
     renderer.Render(mesh, X_WC, &bgr, nullptr, &ids);
     std::vector<Eigen::Vector2d> corners;
@@ -110,7 +110,7 @@ TEST(Renderer, BoxSilhouetteAreaMatchesAnalyticProjection) {
 }
 
 TEST(Renderer, DepthOfAFrontoParallelFaceIsItsDistance) {
-  const Intrinsics K = Intrinsics::HoloLensPv();
+  const geometry::Intrinsics K = geometry::Intrinsics::HoloLensPv();
   Renderer renderer(K);
   SceneGeometry g;
   Eigen::Isometry3d X_WG = Eigen::Isometry3d::Identity();
@@ -119,7 +119,7 @@ TEST(Renderer, DepthOfAFrontoParallelFaceIsItsDistance) {
   Mesh mesh;
   Tessellate(g, kAllKinds, {}, &mesh);
   // Camera 2 m in front of the -y face, looking along +y: the face is at depth 2 - 0.25 = 1.75 m.
-  const Eigen::Isometry3d X_WC = LookAt({0, -2.0, 1.0}, {0, 0, 1.0});
+  const Eigen::Isometry3d X_WC = geometry::LookAt({0, -2.0, 1.0}, {0, 0, 1.0});
   cv::Mat bgr, depth;
   renderer.Render(mesh, X_WC, &bgr, &depth);
   EXPECT_NEAR(depth.at<float>(322, 597), 1.75, 1e-4);
@@ -128,9 +128,9 @@ TEST(Renderer, DepthOfAFrontoParallelFaceIsItsDistance) {
 }
 
 TEST(Renderer, NearerObjectWinsWhereTwoOverlapInEitherOrder) {
-  const Intrinsics K = Intrinsics::HoloLensPv();
+  const geometry::Intrinsics K = geometry::Intrinsics::HoloLensPv();
   Renderer renderer(K);
-  const Eigen::Isometry3d X_WC = LookAt({0, -3.0, 1.0}, {0, 0, 1.0});
+  const Eigen::Isometry3d X_WC = geometry::LookAt({0, -3.0, 1.0}, {0, 0, 1.0});
   for (bool near_first : {true, false}) {
     SceneGeometry g;
     Eigen::Isometry3d X_near = Eigen::Isometry3d::Identity(), X_far = Eigen::Isometry3d::Identity();
@@ -171,9 +171,9 @@ TEST(Renderer, NearerObjectWinsWhereTwoOverlapInEitherOrder) {
 }
 
 TEST(Renderer, SphereOnThePrincipalAxisIsCentredOnThePrincipalPoint) {
-  const Intrinsics K = Intrinsics::HoloLensPv();
+  const geometry::Intrinsics K = geometry::Intrinsics::HoloLensPv();
   Renderer renderer(K);
-  const Eigen::Isometry3d X_WC = LookAt({0.3, -2.0, 1.4}, {0.1, 0.4, 0.9});
+  const Eigen::Isometry3d X_WC = geometry::LookAt({0.3, -2.0, 1.4}, {0.1, 0.4, 0.9});
   Primitive s;
   s.shape = Primitive::Shape::kSphere;
   s.radius_m = 0.1;
@@ -194,7 +194,7 @@ TEST(Renderer, SphereOnThePrincipalAxisIsCentredOnThePrincipalPoint) {
 }
 
 TEST(Renderer, FloorThroughTheNearPlaneIsClippedToTheHorizon) {
-  const Intrinsics K = Intrinsics::HoloLensPv();
+  const geometry::Intrinsics K = geometry::Intrinsics::HoloLensPv();
   Renderer renderer(K);
   SceneGeometry g;
   // A 40 m floor, camera 1.6 m above it looking level: most of the floor is behind the camera, yet
@@ -203,7 +203,7 @@ TEST(Renderer, FloorThroughTheNearPlaneIsClippedToTheHorizon) {
                               Box({40, 40, 0.02}, Eigen::Isometry3d(Eigen::Translation3d(0, 0, -0.01))));
   Mesh mesh;
   Tessellate(g, kAllKinds, {}, &mesh);
-  const Eigen::Isometry3d X_WC = LookAt({0.0, 0.0, 1.6}, {5.0, 0.5, 1.6});
+  const Eigen::Isometry3d X_WC = geometry::LookAt({0.0, 0.0, 1.6}, {5.0, 0.5, 1.6});
   cv::Mat bgr, ids;
   renderer.Render(mesh, X_WC, &bgr, nullptr, &ids);
   for (int u : {0, 300, 640, 1279}) {
@@ -216,16 +216,16 @@ TEST(Renderer, FloorThroughTheNearPlaneIsClippedToTheHorizon) {
 
 TEST(Renderer, OperatingRoomShowsEveryLinkAndObjectsInView) {
   const sim::RobotModel robot =
-      sim::RobotModel::LoadFile(sim::SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath));
-  const sim::Scene scene = sim::LoadSceneFile(sim::SourceTreePath(sim::kDefaultSceneRelativePath));
+      sim::RobotModel::LoadFile(orbed::SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath));
+  const sim::Scene scene = sim::LoadSceneFile(orbed::SourceTreePath(sim::kDefaultSceneRelativePath));
   Eigen::VectorXd q_deg(7);
   q_deg << 0, 35, 0, -70, 0, 45, 0;
   SceneGeometry g = SceneGeometry::MakeOperatingRoom(scene, robot, sim::DegToRad(q_deg), scene.X_WR);
   Mesh mesh;
   Tessellate(g, kAllKinds, {}, &mesh);
-  Renderer renderer(Intrinsics::HoloLensPv());
+  Renderer renderer(geometry::Intrinsics::HoloLensPv());
   cv::Mat bgr, ids;
-  renderer.Render(mesh, LookAt({1.7, -2.2, 1.7}, {0.25, -0.4, 1.1}), &bgr, nullptr, &ids);
+  renderer.Render(mesh, geometry::LookAt({1.7, -2.2, 1.7}, {0.25, -0.4, 1.1}), &bgr, nullptr, &ids);
   std::set<std::string> seen;
   for (int v = 0; v < ids.rows; ++v)
     for (int u = 0; u < ids.cols; ++u)
@@ -241,7 +241,7 @@ TEST(Renderer, OperatingRoomShowsEveryLinkAndObjectsInView) {
 }
 
 TEST(Renderer, OverlayBlendsOnlyWhereTheHologramIs) {
-  const Intrinsics K = Intrinsics::HoloLensPv();
+  const geometry::Intrinsics K = geometry::Intrinsics::HoloLensPv();
   Renderer renderer(K);
   SceneGeometry g;
   Eigen::Isometry3d X_WG = Eigen::Isometry3d::Identity();
@@ -250,7 +250,7 @@ TEST(Renderer, OverlayBlendsOnlyWhereTheHologramIs) {
       g.AddBody("holo", BodyKind::kVirtualRobot, ColorBgr{255, 255, 0}, Box({0.4, 0.4, 0.4}, X_WG));
   Mesh mesh;
   Tessellate(g, kAllKinds, {}, &mesh);
-  const Eigen::Isometry3d X_WC = LookAt({0, -2.0, 1.0}, {0, 0, 1.0});
+  const Eigen::Isometry3d X_WC = geometry::LookAt({0, -2.0, 1.0}, {0, 0, 1.0});
   cv::Mat image(K.height_px, K.width_px, CV_8UC3, cv::Scalar(10, 20, 30));
   cv::Mat ids;
   OverlayStyle style;
@@ -274,14 +274,14 @@ TEST(Renderer, OverlayBlendsOnlyWhereTheHologramIs) {
 
 TEST(Renderer, JpegRoundTripIsSmallAndFaithful) {
   const sim::RobotModel robot =
-      sim::RobotModel::LoadFile(sim::SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath));
-  const sim::Scene scene = sim::LoadSceneFile(sim::SourceTreePath(sim::kDefaultSceneRelativePath));
+      sim::RobotModel::LoadFile(orbed::SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath));
+  const sim::Scene scene = sim::LoadSceneFile(orbed::SourceTreePath(sim::kDefaultSceneRelativePath));
   SceneGeometry g = SceneGeometry::MakeOperatingRoom(scene, robot, Eigen::VectorXd::Zero(7), scene.X_WR);
   Mesh mesh;
   Tessellate(g, kAllKinds, {}, &mesh);
-  Renderer renderer(Intrinsics::HoloLensPv());
+  Renderer renderer(geometry::Intrinsics::HoloLensPv());
   cv::Mat bgr;
-  renderer.Render(mesh, LookAt({1.7, -2.2, 1.7}, {0.25, -0.4, 1.1}), &bgr);
+  renderer.Render(mesh, geometry::LookAt({1.7, -2.2, 1.7}, {0.25, -0.4, 1.1}), &bgr);
   std::vector<std::uint8_t> jpeg;
   ASSERT_TRUE(EncodeJpeg(bgr, 85, &jpeg));
   EXPECT_LT(jpeg.size(), 300000u);

@@ -5,11 +5,10 @@
 
 #include "hmd_emulator/yaml_fields.h"
 #include "sim/scene.h"
+#include "base/units.h"
 
 namespace orbed::hmd {
 namespace {
-
-constexpr double kDegToRad = M_PI / 180.0;
 
 // The rigid motion that rotates by yaw_rad about the vertical axis through p_W, then translates by t_W.
 Eigen::Isometry3d YawAboutPoint(const Eigen::Vector3d& p_W, double yaw_rad, const Eigen::Vector3d& t_W) {

@@ -12,11 +12,11 @@
 
 #include <gtest/gtest.h>
 
-#include "hmd_emulator/camera_model.h"
-#include "hmd_emulator/stats.h"
+#include "geometry/camera_model.h"
+#include "base/stats.h"
 #include "hmd_emulator/yaml_fields.h"
 #include "orbed/hmd_pose_t.hpp"
-#include "sim/model_paths.h"
+#include "base/source_paths.h"
 
 namespace orbed::hmd {
 namespace {
@@ -28,12 +28,12 @@ static_assert(static_cast<int>(TrackingState::kRelocalized) == orbed::hmd_pose_t
 
 TEST(HeadTrajectory, LookAtAxes) {
   // Looking along +x_W from (1, 2, 1.7): right is −y_W, down is −z_W.
-  const Eigen::Isometry3d X_WH = LookAt({1, 2, 1.7}, {5, 2, 1.7});
+  const Eigen::Isometry3d X_WH = geometry::LookAt({1, 2, 1.7}, {5, 2, 1.7});
   EXPECT_TRUE(X_WH.linear().col(2).isApprox(Eigen::Vector3d(1, 0, 0), 1e-12));
   EXPECT_TRUE(X_WH.linear().col(0).isApprox(Eigen::Vector3d(0, -1, 0), 1e-12));
   EXPECT_TRUE(X_WH.linear().col(1).isApprox(Eigen::Vector3d(0, 0, -1), 1e-12));
   EXPECT_TRUE(X_WH.translation().isApprox(Eigen::Vector3d(1, 2, 1.7)));
-  EXPECT_THROW(LookAt({0, 0, 1}, {0, 0, 3}), std::invalid_argument);
+  EXPECT_THROW(geometry::LookAt({0, 0, 1}, {0, 0, 3}), std::invalid_argument);
 }
 
 TEST(HeadTrajectory, TimingAndPath) {
@@ -155,7 +155,7 @@ RpeStats RelativePoseErrorPerMetre(const std::vector<SlamSample>& s) {
 }
 
 TEST(SlamModel, DriftPerMetreStaysInConfiguredBand) {
-  const SlamConfig shipped = LoadSlamConfigFile(orbed::sim::SourceTreePath(kDefaultSlamConfigRelativePath));
+  const SlamConfig shipped = LoadSlamConfigFile(orbed::SourceTreePath(kDefaultSlamConfigRelativePath));
   const HeadTrajectory walk(RectangleWalk());
   for (const double fraction : {shipped.drift_fraction_of_distance, 0.005}) {
     SlamConfig c = shipped;
@@ -245,16 +245,16 @@ TEST(SlamModel, HologramRelation) {
 
   // (2) The device's overlay in its own camera image (drawn with X_WC_est) falls where the true
   //     camera sees the apparent hologram.
-  const Intrinsics in = Intrinsics::HoloLensPv();
+  const geometry::Intrinsics in = geometry::Intrinsics::HoloLensPv();
   Eigen::Isometry3d X_WV = Eigen::Isometry3d::Identity();
   X_WV.translation() = Eigen::Vector3d(0.25, -0.55, 0.75);
   const Eigen::Isometry3d apparent = ApparentPose(x.X_WH_true, x.X_WH_est, X_WV);
-  const CameraMatrix P_est = MakeCameraMatrix(in.K(), x.X_WC_est);
-  const CameraMatrix P_true = MakeCameraMatrix(in.K(), x.X_WC_true);
+  const geometry::CameraMatrix P_est = geometry::MakeCameraMatrix(in.K(), x.X_WC_est);
+  const geometry::CameraMatrix P_true = geometry::MakeCameraMatrix(in.K(), x.X_WC_true);
   for (const Eigen::Vector3d& p_V : {Eigen::Vector3d(0, 0, 0.5), Eigen::Vector3d(0.1, -0.2, 1.1)}) {
     Eigen::Vector2d u_device, u_true;
-    ASSERT_TRUE(Project(P_est, X_WV * p_V, &u_device));
-    ASSERT_TRUE(Project(P_true, apparent * p_V, &u_true));
+    ASSERT_TRUE(geometry::Project(P_est, X_WV * p_V, &u_device));
+    ASSERT_TRUE(geometry::Project(P_true, apparent * p_V, &u_true));
     EXPECT_LT((u_device - u_true).norm(), 1e-6);
   }
 
@@ -288,12 +288,12 @@ TEST(SlamModel, SameSeedSameWalk) {
 }
 
 TEST(SlamConfig, ShippedFilesLoad) {
-  const SlamConfig c = LoadSlamConfigFile(orbed::sim::SourceTreePath(kDefaultSlamConfigRelativePath));
+  const SlamConfig c = LoadSlamConfigFile(orbed::SourceTreePath(kDefaultSlamConfigRelativePath));
   EXPECT_DOUBLE_EQ(c.rate_hz, 60.0);
   EXPECT_DOUBLE_EQ(c.drift_fraction_of_distance, 0.01);
   EXPECT_NEAR(c.X_HC.translation().z(), 0.06, 1e-12);
   const HeadTrajectoryConfig w =
-      LoadHeadTrajectoryFile(orbed::sim::SourceTreePath("hmd_emulator/config/viraal_walk.yaml"));
+      LoadHeadTrajectoryFile(orbed::SourceTreePath("hmd_emulator/config/viraal_walk.yaml"));
   EXPECT_EQ(w.waypoints.size(), 2u);
 }
 

@@ -6,12 +6,12 @@
 #include "hmd_emulator/random.h"
 #include "hmd_emulator/yaml_fields.h"
 #include "sim/scene.h"
+#include "base/units.h"
 
 namespace orbed::hmd {
 namespace {
 
 constexpr double kArcminToRad = M_PI / (180.0 * 60.0);
-constexpr double kDegToRad = M_PI / 180.0;
 
 Eigen::Matrix3d Skew(const Eigen::Vector3d& w) {
   Eigen::Matrix3d S;
@@ -34,7 +34,7 @@ Eigen::Vector3d Centroid(const std::vector<Eigen::Vector3d>& p) {
 }
 
 // Pixel of p_W through the camera at X_WC with K, and du/dp_W (2×3). False behind the camera.
-bool ProjectWithJacobian(const Intrinsics& in, const Eigen::Isometry3d& X_CW, const Eigen::Vector3d& p_W,
+bool ProjectWithJacobian(const geometry::Intrinsics& in, const Eigen::Isometry3d& X_CW, const Eigen::Vector3d& p_W,
                          Eigen::Vector2d* uv, Eigen::Matrix<double, 2, 3>* J) {
   const Eigen::Vector3d y = X_CW * p_W;
   if (!(y.z() > 1e-6)) return false;
@@ -46,7 +46,7 @@ bool ProjectWithJacobian(const Intrinsics& in, const Eigen::Isometry3d& X_CW, co
   return true;
 }
 
-bool InImage(const Intrinsics& in, const Eigen::Vector2d& uv) {
+bool InImage(const geometry::Intrinsics& in, const Eigen::Vector2d& uv) {
   return uv.x() >= 0 && uv.y() >= 0 && uv.x() <= in.width_px - 1 && uv.y() <= in.height_px - 1;
 }
 
@@ -202,14 +202,14 @@ AlignmentResult EmulatedUser::Align(const ViewingContext& ctx, const std::vector
   for (const auto& d : ctx.displays) {
     DisplayState s;
     s.X_CW_est = d.X_WC_est.inverse();
-    const CameraMatrix P_true = MakeCameraMatrix(d.intrinsics.K(), d.X_WC_true);
+    const geometry::CameraMatrix P_true = geometry::MakeCameraMatrix(d.intrinsics.K(), d.X_WC_true);
     s.seen.assign(n, false);
     s.u_real.assign(n, Eigen::Vector2d::Zero());
     Eigen::Vector2d sum = Eigen::Vector2d::Zero();
     int num_seen = 0;
     for (std::size_t k = 0; k < n; ++k) {
       Eigen::Vector2d uv;
-      if (Project(P_true, r[k], &uv) && InImage(d.intrinsics, uv)) {
+      if (geometry::Project(P_true, r[k], &uv) && InImage(d.intrinsics, uv)) {
         s.seen[k] = true;
         s.u_real[k] = uv;
         sum += uv;
@@ -218,7 +218,7 @@ AlignmentResult EmulatedUser::Align(const ViewingContext& ctx, const std::vector
     }
     // The centre of the image scale the person does not see: where the real centroid is imaged
     // (the mean of the points seen if it is behind the camera).
-    if (!Project(P_true, real_c, &s.u_centroid)) {
+    if (!geometry::Project(P_true, real_c, &s.u_centroid)) {
       s.u_centroid = num_seen > 0 ? Eigen::Vector2d(sum / num_seen) : sum;
     }
     displays.push_back(std::move(s));

@@ -61,7 +61,7 @@
 #include <yaml-cpp/yaml.h>
 #include <Eigen/Geometry>
 
-#include "hmd_emulator/camera_model.h"
+#include "geometry/camera_model.h"
 #include "sim/robot_model.h"
 
 namespace orbed::hmd {
@@ -119,7 +119,7 @@ std::vector<Eigen::Vector3d> RobotModelPoints(const sim::RobotModel& model, cons
 /// One reflective display as it stands during the trial: the frame it shows was captured with the
 /// camera truly at X_WC_true and stamped X_WC_est (the estimate at capture time).
 struct ReflectiveDisplayView {
-  Intrinsics intrinsics;
+  geometry::Intrinsics intrinsics;
   Eigen::Isometry3d X_WC_true{Eigen::Isometry3d::Identity()};
   Eigen::Isometry3d X_WC_est{Eigen::Isometry3d::Identity()};
   double D_m{1.5};  ///< gaze distance of the reversed frustum (places the display; no effect here)

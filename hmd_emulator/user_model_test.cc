@@ -3,13 +3,14 @@
 // with the rank test of stats.h (whose own oracles are hand computations).
 #include "hmd_emulator/user_model.h"
 
+#include "base/source_paths.h"
 #include <cmath>
 #include <cstdlib>
 #include <string>
 
 #include <gtest/gtest.h>
 
-#include "hmd_emulator/stats.h"
+#include "base/stats.h"
 #include "hmd_emulator/user_study.h"
 #include "hmd_emulator/yaml_fields.h"
 #include "sim/scene.h"
@@ -17,13 +18,8 @@
 namespace orbed::hmd {
 namespace {
 
-std::string SourceDir() {
-  const char* root = std::getenv("ORBED_SOURCE_DIR");
-  return root ? root : ".";
-}
-
 sim::RobotModel Robot() {
-  return sim::RobotModel::LoadFile(SourceDir() + "/" + sim::RobotModel::kDefaultUrdfRelativePath);
+  return sim::RobotModel::LoadFile(orbed::SourceDir() + "/" + sim::RobotModel::kDefaultUrdfRelativePath);
 }
 
 TEST(RobotModelPoints, OnTheUprightArm) {
@@ -64,12 +60,12 @@ TEST(EmulatedUser, PerfectPerceiverFindsTheTruth) {
   ViewingContext ctx;
   ctx.X_WR.translation() = Eigen::Vector3d(0.25, -0.55, 0.75);
   ctx.X_WR.linear() = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  ctx.X_WH_true = LookAt({-0.75, -1.4, 1.7}, {0.25, -0.45, 1.25});
+  ctx.X_WH_true = geometry::LookAt({-0.75, -1.4, 1.7}, {0.25, -0.45, 1.25});
   ctx.X_WH_est = ctx.X_WH_true;
   for (const bool with_display : {false, true}) {
     if (with_display) {
       ReflectiveDisplayView d;
-      d.X_WC_true = d.X_WC_est = LookAt({1.45, -1.2, 1.7}, {0.25, -0.45, 1.25});
+      d.X_WC_true = d.X_WC_est = geometry::LookAt({1.45, -1.2, 1.7}, {0.25, -0.45, 1.25});
       ctx.displays.push_back(d);
     }
     const AlignmentResult r = user.Align(ctx, p_RQ, user.StartPose(ctx.X_WR), 42);
@@ -103,7 +99,7 @@ TEST(EmulatedUser, DepthMisjudgementMovesAlongTheRay) {
   c.stop_lateral_arcmin = 0.05;
   ViewingContext ctx;
   ctx.X_WR.translation() = Eigen::Vector3d(0.25, -0.55, 0.75);
-  ctx.X_WH_true = ctx.X_WH_est = LookAt({-0.75, -1.4, 1.7}, {0.25, -0.45, 1.25});
+  ctx.X_WH_true = ctx.X_WH_est = geometry::LookAt({-0.75, -1.4, 1.7}, {0.25, -0.45, 1.25});
   for (std::uint64_t seed = 1; seed <= 5; ++seed) {
     c.seed = seed;
     const EmulatedUser user(c);
@@ -121,7 +117,7 @@ TEST(EmulatedUser, DepthMisjudgementMovesAlongTheRay) {
 // The paper's Table 1 claim, emerging from the mechanism: 200 seeded trials per mode.
 TEST(EmulatedUser, ReflectiveDisplayReducesErrorSignificantly) {
   StudyOptions o;
-  o.source_dir = SourceDir();
+  o.source_dir = orbed::SourceDir();
   o.trials_per_mode = 200;
   const std::vector<StudyMode> modes = RunStudy(o);
   ASSERT_EQ(modes.size(), 2u);
@@ -173,10 +169,10 @@ TEST(EmulatedUser, ReflectiveDisplayReducesErrorSignificantly) {
 // display from the other side.
 TEST(EmulatedUser, DisplayFromTheAlignmentViewpointDoesNotHelp) {
   StudyOptions o;
-  o.source_dir = SourceDir();
+  o.source_dir = orbed::SourceDir();
   o.trials_per_mode = 200;
   o.display_waypoints = {
-      LoadHeadTrajectoryFile(SourceDir() + "/hmd_emulator/config/viraal_walk.yaml").waypoints.back().name};
+      LoadHeadTrajectoryFile(orbed::SourceDir() + "/hmd_emulator/config/viraal_walk.yaml").waypoints.back().name};
   const std::vector<StudyMode> modes = RunStudy(o);
   ASSERT_EQ(modes.size(), 2u);
   std::vector<double> reg[2];
@@ -200,7 +196,7 @@ TEST(EmulatedUser, SeedIsAPersonAndTrialsAreReproducible) {
   EXPECT_NE(a.depth_user_bias_fraction(), b.depth_user_bias_fraction());
   const std::vector<Eigen::Vector3d> p_RQ = RobotModelPoints(Robot(), Eigen::VectorXd::Zero(7));
   ViewingContext ctx;
-  ctx.X_WH_true = ctx.X_WH_est = LookAt({1.5, -1.2, 1.7}, {0, 0, 1.0});
+  ctx.X_WH_true = ctx.X_WH_est = geometry::LookAt({1.5, -1.2, 1.7}, {0, 0, 1.0});
   const AlignmentResult r1 = a.Align(ctx, p_RQ, a.StartPose(ctx.X_WR), 9);
   const AlignmentResult r2 = a.Align(ctx, p_RQ, a.StartPose(ctx.X_WR), 9);
   EXPECT_TRUE(r1.X_WV.isApprox(r2.X_WV, 0));
@@ -208,7 +204,7 @@ TEST(EmulatedUser, SeedIsAPersonAndTrialsAreReproducible) {
 }
 
 TEST(UserConfig, ShippedFileAndErrors) {
-  const UserConfig c = LoadUserConfigFile(SourceDir() + "/" + kDefaultUserConfigRelativePath);
+  const UserConfig c = LoadUserConfigFile(orbed::SourceDir() + "/" + kDefaultUserConfigRelativePath);
   EXPECT_DOUBLE_EQ(c.depth_bias_fraction_std, 0.012);
   EXPECT_NEAR(c.X_RV_start.translation().x(), 0.10, 1e-12);
   try {

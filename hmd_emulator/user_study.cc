@@ -3,7 +3,7 @@
 #include <cstdio>
 #include <functional>
 
-#include "procs/registration_server/se3_mean.h"
+#include "geometry/se3_mean.h"
 #include "sim/robot_model.h"
 #include "sim/scene.h"
 

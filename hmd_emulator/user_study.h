@@ -2,7 +2,7 @@
 /// @file
 /// A batch of emulated ViRAAl trials per display mode in the trocar OR, from the shipped files
 /// (URDF, scene, slam.yaml, user.yaml, viraal_walk.yaml): the statistics the tests assert on and
-/// the `hmd-user-study` tool prints next to the paper's Table 1.
+/// the `orbed-user-study` tool prints next to the paper's Table 1.
 ///
 /// Trial i of a mode uses person (user seed) base_user_seed + i / trials_per_user, SLAM seed
 /// 100000 + i, trial seed 900000 + i and joint configuration i mod 3 of kStudyConfigurationsDeg.
@@ -24,7 +24,7 @@
 #include <string>
 #include <vector>
 
-#include "hmd_emulator/stats.h"
+#include "base/stats.h"
 #include "hmd_emulator/viraal_trial.h"
 
 namespace orbed::hmd {
@@ -69,7 +69,7 @@ struct StudyComparison {
 };
 StudyComparison CompareModes(const StudyMode& with, const StudyMode& without);
 
-/// The `hmd-user-study` report: per mode the error statistics (registration, augmentation along
+/// The `orbed-user-study` report: per mode the error statistics (registration, augmentation along
 /// and across the ray, nudges, duration, SE(3) means of three), the comparison of the last mode
 /// with the first, and the paper's Table 1 for reference.
 std::string FormatStudyReport(const std::vector<StudyMode>& modes);

@@ -1,9 +1,9 @@
 /// @file
-/// hmd-user-study: runs the emulated ViRAAl study (user_study.h) and prints, per display mode, the
+/// orbed-user-study: runs the emulated ViRAAl study (user_study.h) and prints, per display mode, the
 /// error statistics next to the paper's Table 1, and the rank tests comparing the modes.
-/// No LCM. Usage: hmd-user-study [--trials N] [--source DIR] [--user FILE] [--slam FILE]
+/// No LCM. Usage: orbed-user-study [--trials N] [--source DIR] [--user FILE] [--slam FILE]
 ///                               [--display-at WAYPOINT]...
-/// DIR defaults to sim::SourceDir() ($ORBED_SOURCE_DIR, else the source tree it was built from); a
+/// DIR defaults to orbed::SourceDir() ($ORBED_SOURCE_DIR, else the source tree it was built from); a
 /// bad argument exits 2, a failed run 1.
 #include <cerrno>
 #include <climits>
@@ -13,7 +13,7 @@
 #include <string>
 
 #include "hmd_emulator/user_study.h"
-#include "sim/model_paths.h"
+#include "base/source_paths.h"
 
 namespace {
 
@@ -32,13 +32,13 @@ bool ParsePositiveInt(const char* text, int* value) {
 
 int main(int argc, char** argv) {
   orbed::hmd::StudyOptions o;
-  o.source_dir = orbed::sim::SourceDir();
+  o.source_dir = orbed::SourceDir();
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     const bool has_value = i + 1 < argc;
     if (a == "--help" || a == "-h") {
       std::printf(
-          "usage: hmd-user-study [--trials N] [--source DIR] [--user FILE] [--slam FILE] [--display-at "
+          "usage: orbed-user-study [--trials N] [--source DIR] [--user FILE] [--slam FILE] [--display-at "
           "WAYPOINT]...\n"
           "  --trials N            trials per display mode, a positive integer (default %d)\n"
           "  --display-at WAYPOINT where the reflective display captures its frame (repeat for more\n"
@@ -47,7 +47,7 @@ int main(int argc, char** argv) {
       return 0;
     } else if (a == "--trials") {
       if (!has_value || !ParsePositiveInt(argv[i + 1], &o.trials_per_mode)) {
-        std::fprintf(stderr, "hmd-user-study: --trials needs a positive integer, got '%s'\n",
+        std::fprintf(stderr, "orbed-user-study: --trials needs a positive integer, got '%s'\n",
                      has_value ? argv[i + 1] : "(nothing)");
         return 2;
       }
@@ -61,14 +61,14 @@ int main(int argc, char** argv) {
     } else if (a == "--display-at" && has_value) {
       o.display_waypoints.push_back(argv[++i]);
     } else {
-      std::fprintf(stderr, "hmd-user-study: unknown argument '%s' (try --help)\n", a.c_str());
+      std::fprintf(stderr, "orbed-user-study: unknown argument '%s' (try --help)\n", a.c_str());
       return 2;
     }
   }
   try {
     std::fputs(orbed::hmd::FormatStudyReport(orbed::hmd::RunStudy(o)).c_str(), stdout);
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "hmd-user-study: %s\n", e.what());
+    std::fprintf(stderr, "orbed-user-study: %s\n", e.what());
     return 1;
   }
   return 0;

@@ -35,7 +35,7 @@ struct TrialSetup {
   /// If tracking is not TRACKING at the alignment time, the person stands and waits up to this
   /// long for it to recover (then aligns anyway) [s].
   double max_wait_s{30.0};
-  Intrinsics intrinsics;
+  geometry::Intrinsics intrinsics;
 };
 
 struct TrialOutcome {

@@ -1,7 +1,7 @@
 // Tests of the Bullet collision world against closed forms: segment-segment (capsules), point-box,
 // sphere-sphere, and hand-computed robot poses.
 #include "sim/collision_world.h"
-#include "sim/model_paths.h"
+#include "base/source_paths.h"
 
 #include <algorithm>
 #include <cmath>
@@ -21,7 +21,7 @@ constexpr double kPi = 3.14159265358979323846;
 using Kind = CollisionPrimitive::Kind;
 
 RobotModel LoadIiwa() {
-  return RobotModel::LoadFile(orbed::sim::SourceTreePath(RobotModel::kDefaultUrdfRelativePath));
+  return RobotModel::LoadFile(orbed::SourceTreePath(RobotModel::kDefaultUrdfRelativePath));
 }
 
 Eigen::VectorXd Deg(std::initializer_list<double> v) {
@@ -272,7 +272,7 @@ TEST(CollisionWorldTest, LinksTwoApartNeverTouchWithinLimits) {
 
 TEST(CollisionWorldTest, ResultsAreFreshAndPruningChangesNothing) {
   const RobotModel m = LoadIiwa();
-  const Scene scene = LoadSceneFile(orbed::sim::SourceTreePath(kDefaultSceneRelativePath));
+  const Scene scene = LoadSceneFile(orbed::SourceTreePath(kDefaultSceneRelativePath));
   CollisionWorld pruned(m, &scene);
   CollisionWorld::Options no_prune;
   no_prune.prune = false;
@@ -438,7 +438,7 @@ TEST(CollisionWorldTest, SegmentBoxPenetrationIsExact) {
 
 TEST(CollisionWorldTest, FastPathMatchesGjkOverRandomConfigurations) {
   RobotModel m = LoadIiwa();
-  const Scene scene = LoadSceneFile(orbed::sim::SourceTreePath(kDefaultSceneRelativePath));
+  const Scene scene = LoadSceneFile(orbed::SourceTreePath(kDefaultSceneRelativePath));
   m.SetToolLength(scene.tool_length_m);
   // Every pair reported (so every pair is compared), and the default options (pruned).
   CollisionWorld::Options all;

@@ -11,6 +11,7 @@
 #include <orbed/plan_check_reply_t.hpp>
 #include <orbed/robot_state_t.hpp>
 
+#include "base/format.h"
 #include "procs/common/conversions.h"
 #include "procs/common/log.h"
 #include "procs/common/validation.h"
@@ -26,12 +27,6 @@ static_assert(static_cast<int>(MotionState::kIdle) == orbed::robot_state_t::MOTI
                       orbed::robot_state_t::MOTION_STOPPED_BEFORE_COLLISION &&
                   static_cast<int>(MotionState::kInCollision) == orbed::robot_state_t::MOTION_IN_COLLISION,
               "MotionState must number as robot_state_t::MOTION_*");
-
-std::string Fixed(double value, int digits) {
-  char text[64];
-  std::snprintf(text, sizeof(text), "%.*f", digits, value);
-  return text;
-}
 
 // Resolves default paths and checks every number before anything is loaded.
 IiwaSimOptions Resolved(IiwaSimOptions options) {

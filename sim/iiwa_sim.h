@@ -60,7 +60,7 @@
 #include "procs/common/channels.h"
 #include "procs/common/process.h"
 #include "sim/manual_arm.h"
-#include "sim/model_paths.h"
+#include "base/source_paths.h"
 #include "sim/robot_model.h"
 #include "sim/scene.h"
 

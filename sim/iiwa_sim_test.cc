@@ -21,11 +21,11 @@
 #include <orbed/robot_state_t.hpp>
 
 #include "procs/common/conversions.h"
+#include "base/units.h"
 
 namespace orbed::sim {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
 const double kSpeedDegPerS[7] = {98, 98, 100, 130, 140, 180, 180};  // DESIGN §4
 
 // Everything the sim publishes, as received on the same memq instance.
@@ -65,7 +65,7 @@ orbed::iiwa_command_t Command(const std::vector<double>& q_deg) {
   orbed::iiwa_command_t cmd{};
   cmd.utime = NowMicros();
   cmd.num_joints = static_cast<int32_t>(q_deg.size());
-  for (double q : q_deg) cmd.joint_position.push_back(q * kDeg);
+  for (double q : q_deg) cmd.joint_position.push_back(q * kDegToRad);
   cmd.num_torques = 0;
   return cmd;
 }
@@ -75,7 +75,7 @@ orbed::plan_check_request_t Request(int64_t id, const std::vector<double>& q_deg
   req.utime = NowMicros();
   req.request_id = id;
   req.num_joints = static_cast<int32_t>(q_deg.size());
-  for (double q : q_deg) req.joint_position.push_back(q * kDeg);
+  for (double q : q_deg) req.joint_position.push_back(q * kDegToRad);
   return req;
 }
 
@@ -125,8 +125,8 @@ TEST(IiwaSim, RejectsBadCommandsPerReasonAndKeepsRunning) {
   // Still ticking, and the good command was executed.
   ASSERT_GT(got.status.size(), 20u);
   const orbed::iiwa_status_t& last = got.status.back();
-  EXPECT_NEAR(last.joint_position_measured[0], 2 * kDeg, 1e-12);
-  EXPECT_NEAR(last.joint_position_commanded[0], 2 * kDeg, 1e-15);
+  EXPECT_NEAR(last.joint_position_measured[0], 2 * kDegToRad, 1e-12);
+  EXPECT_NEAR(last.joint_position_commanded[0], 2 * kDegToRad, 1e-15);
   for (int i = 1; i < 7; ++i) EXPECT_EQ(last.joint_position_measured[i], 0.0);
 }
 
@@ -234,12 +234,12 @@ TEST(IiwaSim, CommandBeyondALimitStopsAtTheLimitWithinTheJointSpeeds) {
     const orbed::iiwa_status_t& s = got.status[k];
     const double n = static_cast<double>(k - first + 1);
     const double q7_deg = std::min(175.0, step7_deg * n);
-    EXPECT_NEAR(s.joint_position_measured[6], q7_deg * kDeg, 1e-10) << "tick " << k + 1;
-    EXPECT_NEAR(s.joint_position_measured[0], -30.0 * q7_deg / 175.0 * kDeg, 1e-10) << "tick " << k + 1;
+    EXPECT_NEAR(s.joint_position_measured[6], q7_deg * kDegToRad, 1e-10) << "tick " << k + 1;
+    EXPECT_NEAR(s.joint_position_measured[0], -30.0 * q7_deg / 175.0 * kDegToRad, 1e-10) << "tick " << k + 1;
     for (int i = 1; i < 6; ++i) EXPECT_EQ(s.joint_position_measured[i], 0.0) << "tick " << k + 1;
     // The estimate is the step over P: joint 7 at its full 180 deg/s while under way (the last,
     // shortened step excepted), 0 once there.
-    const double v7_deg = s.joint_velocity_estimated[6] / kDeg;
+    const double v7_deg = s.joint_velocity_estimated[6] / kDegToRad;
     if (step7_deg * n <= 175.0) {
       EXPECT_NEAR(v7_deg, 180.0, 1e-6) << "tick " << k + 1;
     } else if (step7_deg * (n - 1) >= 175.0) {
@@ -247,10 +247,10 @@ TEST(IiwaSim, CommandBeyondALimitStopsAtTheLimitWithinTheJointSpeeds) {
     }
   }
   ASSERT_GT(got.status.size(), first + 200);
-  EXPECT_LT(got.status[first + 193].joint_position_measured[6], 175 * kDeg);  // tick 194 of the move
+  EXPECT_LT(got.status[first + 193].joint_position_measured[6], 175 * kDegToRad);  // tick 194 of the move
   // Tick 195 lands exactly on the limit (175 deg as the URDF states it).
   EXPECT_EQ(got.status[first + 194].joint_position_measured[6], sim.arm().model().joints()[6].upper_rad);
-  EXPECT_NEAR(sim.arm().model().joints()[6].upper_rad, 175 * kDeg, 1e-12);
+  EXPECT_NEAR(sim.arm().model().joints()[6].upper_rad, 175 * kDegToRad, 1e-12);
   // Speeds read from the stamps, as a client sees them: within the limits, with joint 7 at its limit.
   double peak7_deg_per_s = 0;
   for (size_t k = 1; k < got.status.size(); ++k) {
@@ -258,7 +258,7 @@ TEST(IiwaSim, CommandBeyondALimitStopsAtTheLimitWithinTheJointSpeeds) {
     for (int i = 0; i < 7; ++i) {
       const double speed_deg_per_s =
           std::abs(got.status[k].joint_position_measured[i] - got.status[k - 1].joint_position_measured[i]) /
-          dt_s / kDeg;
+          dt_s / kDegToRad;
       EXPECT_LE(speed_deg_per_s, kSpeedDegPerS[i] * (1 + 1e-9)) << "tick " << k + 1 << " joint " << i + 1;
       if (i == 6) peak7_deg_per_s = std::max(peak7_deg_per_s, speed_deg_per_s);
     }
@@ -266,9 +266,9 @@ TEST(IiwaSim, CommandBeyondALimitStopsAtTheLimitWithinTheJointSpeeds) {
   EXPECT_NEAR(peak7_deg_per_s, 180.0, 1e-6);
 
   const orbed::iiwa_status_t& last = got.status.back();
-  EXPECT_NEAR(last.joint_position_measured[6], 175 * kDeg, 1e-12);
-  EXPECT_NEAR(last.joint_position_measured[0], -30 * kDeg, 1e-12);
-  EXPECT_NEAR(last.joint_position_commanded[6], 200 * kDeg, 1e-15);
+  EXPECT_NEAR(last.joint_position_measured[6], 175 * kDegToRad, 1e-12);
+  EXPECT_NEAR(last.joint_position_measured[0], -30 * kDegToRad, 1e-12);
+  EXPECT_NEAR(last.joint_position_commanded[6], 200 * kDegToRad, 1e-15);
   EXPECT_EQ(last.joint_velocity_estimated[6], 0.0);
   const orbed::robot_state_t& state = got.state.back();
   EXPECT_EQ(state.motion_state, +orbed::robot_state_t::MOTION_STOPPED_AT_LIMIT);
@@ -329,11 +329,11 @@ TEST(IiwaSim, StampsTicksOnTheSimClockHoweverLateTheyRun) {
   EXPECT_EQ(sim.ticks(), jumped / kP + 2);
   for (int n = 1; n <= 10; ++n) {
     const orbed::iiwa_status_t& s = got.status[n - 1];
-    EXPECT_NEAR(s.joint_position_measured[0], n * 98 * 0.012344 * kDeg, 1e-12) << "tick " << n;
-    EXPECT_NEAR(s.joint_velocity_estimated[0], 98 * kDeg, 1e-9) << "tick " << n;
+    EXPECT_NEAR(s.joint_position_measured[0], n * 98 * 0.012344 * kDegToRad, 1e-12) << "tick " << n;
+    EXPECT_NEAR(s.joint_velocity_estimated[0], 98 * kDegToRad, 1e-9) << "tick " << n;
     if (n > 1) {
       const double dq = s.joint_position_measured[0] - got.status[n - 2].joint_position_measured[0];
-      EXPECT_LE(dq / ((s.utime - got.status[n - 2].utime) * 1e-6), 98 * kDeg * (1 + 1e-9)) << "tick " << n;
+      EXPECT_LE(dq / ((s.utime - got.status[n - 2].utime) * 1e-6), 98 * kDegToRad * (1 + 1e-9)) << "tick " << n;
     }
   }
   EXPECT_EQ(got.state.back().utime, got.status.back().utime);

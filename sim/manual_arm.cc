@@ -5,16 +5,12 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "base/format.h"
+
 namespace orbed::sim {
 namespace {
 
 constexpr double kLimitToleranceRad = 1e-9;
-
-std::string Fixed(double value, int digits) {
-  char text[64];
-  std::snprintf(text, sizeof(text), "%.*f", digits, value);
-  return text;
-}
 
 CollisionWorld::Options WorldOptions(const ManualArmOptions& options) {
   CollisionWorld::Options world;

@@ -2,7 +2,8 @@
 // straight joint-space moves, commands clamped to the joint limits, steps refused before a
 // collision in the trocar OR scene, and the way back out of a stop.
 #include "sim/manual_arm.h"
-#include "sim/model_paths.h"
+#include "base/source_paths.h"
+#include "base/units.h"
 
 #include <cmath>
 #include <cstdlib>
@@ -13,7 +14,6 @@
 namespace orbed::sim {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
 constexpr double kPeriodS = 0.005;
 // iiwa 7 R800 joint speeds [deg/s] and limits [deg] as published (DESIGN §4).
 const double kSpeedDegPerS[7] = {98, 98, 100, 130, 140, 180, 180};
@@ -21,8 +21,8 @@ const double kLimitDeg[7] = {170, 120, 170, 120, 170, 120, 175};
 
 struct Fixture {
   Fixture()
-      : model(RobotModel::LoadFile(orbed::sim::SourceTreePath("sim/models/iiwa7.urdf"))),
-        scene(LoadSceneFile(orbed::sim::SourceTreePath("sim/models/scenes/trocar_or.yaml"))) {
+      : model(RobotModel::LoadFile(orbed::SourceTreePath("sim/models/iiwa7.urdf"))),
+        scene(LoadSceneFile(orbed::SourceTreePath("sim/models/scenes/trocar_or.yaml"))) {
     model.SetToolLength(scene.tool_length_m);
   }
   RobotModel model;
@@ -32,7 +32,7 @@ struct Fixture {
 Eigen::VectorXd Deg(std::initializer_list<double> q_deg) {
   Eigen::VectorXd q(static_cast<Eigen::Index>(q_deg.size()));
   int i = 0;
-  for (double v : q_deg) q[i++] = v * kDeg;
+  for (double v : q_deg) q[i++] = v * kDegToRad;
   return q;
 }
 
@@ -45,8 +45,8 @@ int RunToRest(ManualArm* arm, int max_ticks) {
     arm->Step(kPeriodS);
     const Eigen::VectorXd step = arm->q_rad() - before;
     for (int i = 0; i < 7; ++i) {
-      EXPECT_LE(std::abs(step[i]), kSpeedDegPerS[i] * kDeg * kPeriodS * (1 + 1e-9)) << "joint " << i + 1;
-      EXPECT_LE(std::abs(arm->q_rad()[i]), kLimitDeg[i] * kDeg * (1 + 1e-12)) << "joint " << i + 1;
+      EXPECT_LE(std::abs(step[i]), kSpeedDegPerS[i] * kDegToRad * kPeriodS * (1 + 1e-9)) << "joint " << i + 1;
+      EXPECT_LE(std::abs(arm->q_rad()[i]), kLimitDeg[i] * kDegToRad * (1 + 1e-12)) << "joint " << i + 1;
     }
     if (step.cwiseAbs().maxCoeff() == 0.0) break;
   }
@@ -60,13 +60,13 @@ TEST(ManualArm, OneJointMovesAtItsPublishedSpeed) {
   arm.SetCommand(Deg({0, 0, 0, 0, 0, 0, 90}));
   // 180 deg/s for 10 ticks of 5 ms: 9 deg, exactly.
   for (int k = 0; k < 10; ++k) arm.Step(kPeriodS);
-  EXPECT_NEAR(arm.q_rad()[6], 9.0 * kDeg, 1e-12);
-  EXPECT_NEAR(arm.velocity_rad_per_s()[6], 180.0 * kDeg, 1e-9);
+  EXPECT_NEAR(arm.q_rad()[6], 9.0 * kDegToRad, 1e-12);
+  EXPECT_NEAR(arm.velocity_rad_per_s()[6], 180.0 * kDegToRad, 1e-9);
   EXPECT_EQ(arm.state(), MotionState::kMoving);
   // 90 deg at 180 deg/s = 0.5 s = 100 ticks in all; then at rest exactly on the command.
   const int ticks = RunToRest(&arm, 1000);
   EXPECT_EQ(ticks + 10, 100);
-  EXPECT_NEAR(arm.q_rad()[6], 90.0 * kDeg, 1e-15);
+  EXPECT_NEAR(arm.q_rad()[6], 90.0 * kDegToRad, 1e-15);
   EXPECT_EQ(arm.state(), MotionState::kIdle);
   EXPECT_EQ(arm.stop_reason(), "");
 }
@@ -78,10 +78,10 @@ TEST(ManualArm, JointsArriveTogetherOnAStraightJointSpaceLine) {
   const Eigen::VectorXd target = Deg({49, 0, 0, 0, 0, 0, 45});
   arm.SetCommand(target);
   for (int k = 0; k < 50; ++k) arm.Step(kPeriodS);  // 0.25 s: half way
-  EXPECT_NEAR(arm.q_rad()[0], 24.5 * kDeg, 1e-12);
-  EXPECT_NEAR(arm.q_rad()[6], 22.5 * kDeg, 1e-12);
-  EXPECT_NEAR(arm.velocity_rad_per_s()[0], 98 * kDeg, 1e-9);
-  EXPECT_NEAR(arm.velocity_rad_per_s()[6], 90 * kDeg, 1e-9);
+  EXPECT_NEAR(arm.q_rad()[0], 24.5 * kDegToRad, 1e-12);
+  EXPECT_NEAR(arm.q_rad()[6], 22.5 * kDegToRad, 1e-12);
+  EXPECT_NEAR(arm.velocity_rad_per_s()[0], 98 * kDegToRad, 1e-9);
+  EXPECT_NEAR(arm.velocity_rad_per_s()[6], 90 * kDegToRad, 1e-9);
   EXPECT_EQ(RunToRest(&arm, 1000) + 50, 100);
   EXPECT_EQ(arm.q_rad(), target);
 }
@@ -90,10 +90,10 @@ TEST(ManualArm, CommandBeyondALimitStopsOnTheLimit) {
   Fixture f;
   ManualArm arm(f.model, &f.scene, Eigen::VectorXd::Zero(7), {});
   arm.SetCommand(Deg({0, -130, 0, 0, 0, 0, 200}));
-  EXPECT_EQ(arm.command_rad()[6], 200 * kDeg);  // kept as sent
+  EXPECT_EQ(arm.command_rad()[6], 200 * kDegToRad);  // kept as sent
   RunToRest(&arm, 2000);
-  EXPECT_NEAR(arm.q_rad()[1], -120 * kDeg, 1e-12);
-  EXPECT_NEAR(arm.q_rad()[6], 175 * kDeg, 1e-12);
+  EXPECT_NEAR(arm.q_rad()[1], -120 * kDegToRad, 1e-12);
+  EXPECT_NEAR(arm.q_rad()[6], 175 * kDegToRad, 1e-12);
   EXPECT_EQ(arm.state(), MotionState::kStoppedAtLimit);
   EXPECT_NE(arm.stop_reason().find("iiwa_joint_2"), std::string::npos) << arm.stop_reason();
   EXPECT_NE(arm.stop_reason().find("iiwa_joint_7"), std::string::npos) << arm.stop_reason();

@@ -1,6 +1,6 @@
 // Tests of the URDF robot model against an independent standard-DH evaluation of the iiwa 7.
 #include "sim/robot_model.h"
-#include "sim/model_paths.h"
+#include "base/source_paths.h"
 
 #include <cmath>
 #include <cstdlib>
@@ -14,7 +14,7 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 
 RobotModel LoadIiwa() {
-  return RobotModel::LoadFile(orbed::sim::SourceTreePath(RobotModel::kDefaultUrdfRelativePath));
+  return RobotModel::LoadFile(orbed::SourceTreePath(RobotModel::kDefaultUrdfRelativePath));
 }
 
 // The iiwa 7 R800 data-sheet DH parameters (DESIGN §4), evaluated by hand:

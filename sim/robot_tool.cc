@@ -8,10 +8,10 @@
 
 #include <CLI/CLI.hpp>
 
-#include "procs/common/json.h"
-#include "procs/common/number_list.h"
+#include "base/json.h"
+#include "base/number_list.h"
 #include "sim/collision_world.h"
-#include "sim/model_paths.h"
+#include "base/source_paths.h"
 #include "sim/robot_model.h"
 #include "sim/scene.h"
 #include "sim/trocar_clearance.h"

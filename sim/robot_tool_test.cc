@@ -1,6 +1,8 @@
 // Tests of the orbed-robot command line, run in-process.
 #include "sim/robot_tool.h"
 
+#include "base/source_paths.h"
+
 #include <cstdlib>
 #include <sstream>
 #include <string>
@@ -25,10 +27,7 @@ ToolRun Tool(std::vector<std::string> args) {
   return {code, out.str(), err.str()};
 }
 
-std::string Scene() {
-  const char* dir = std::getenv("ORBED_SOURCE_DIR");
-  return std::string(dir ? dir : ".") + "/sim/models/scenes/trocar_or.yaml";
-}
+std::string Scene() { return orbed::SourceTreePath("sim/models/scenes/trocar_or.yaml"); }
 
 int Lines(const std::string& s) {
   int n = 0;

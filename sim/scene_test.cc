@@ -1,6 +1,6 @@
 // Tests of the scene loader: the shipped scene and the error messages for bad files.
 #include "sim/scene.h"
-#include "sim/model_paths.h"
+#include "base/source_paths.h"
 
 #include <cmath>
 #include <cstdlib>
@@ -12,7 +12,7 @@ namespace orbed::sim {
 namespace {
 
 TEST(SceneTest, ShippedSceneLoads) {
-  const Scene s = LoadSceneFile(orbed::sim::SourceTreePath(kDefaultSceneRelativePath));
+  const Scene s = LoadSceneFile(orbed::SourceTreePath(kDefaultSceneRelativePath));
   EXPECT_EQ(s.name, "trocar_or");
   EXPECT_NEAR(s.tool_length_m, 0.25, 1e-12);
   EXPECT_TRUE(s.X_WR.translation().isApprox(Eigen::Vector3d(0.25, -0.55, 0.75)));

@@ -11,7 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "sim/collision_world.h"
-#include "sim/model_paths.h"
+#include "base/source_paths.h"
 #include "sim/scene.h"
 #include "sim/trocar_clearance.h"
 
@@ -19,8 +19,8 @@ namespace orbed::sim {
 namespace {
 
 TEST(TrocarIkTest, DocksAtTheTrocarCollisionFree) {
-  RobotModel model = RobotModel::LoadFile(orbed::sim::SourceTreePath(RobotModel::kDefaultUrdfRelativePath));
-  const Scene scene = LoadSceneFile(orbed::sim::SourceTreePath(kDefaultSceneRelativePath));
+  RobotModel model = RobotModel::LoadFile(orbed::SourceTreePath(RobotModel::kDefaultUrdfRelativePath));
+  const Scene scene = LoadSceneFile(orbed::SourceTreePath(kDefaultSceneRelativePath));
   model.SetToolLength(scene.tool_length_m);
   const TrocarIkResult r = SolveTrocarIk(model, TrocarTargetInBase(scene), TrocarIkOptions{},
                                          MakeTrocarClearanceFunction(model, scene));
@@ -54,7 +54,7 @@ TEST(TrocarIkTest, DocksAtTheTrocarCollisionFree) {
 
 TEST(TrocarIkTest, UnreachableTargetFailsHonestly) {
   const RobotModel model =
-      RobotModel::LoadFile(orbed::sim::SourceTreePath(RobotModel::kDefaultUrdfRelativePath));
+      RobotModel::LoadFile(orbed::SourceTreePath(RobotModel::kDefaultUrdfRelativePath));
   TrocarIkTarget far;
   far.p_RT = Eigen::Vector3d(3.0, 0, 0.5);
   far.axis_R = -Eigen::Vector3d::UnitZ();
@@ -69,7 +69,7 @@ TEST(TrocarIkTest, UnreachableTargetFailsHonestly) {
 
 TEST(TrocarIkTest, ReachableWithoutScoreSucceedsOnlyIfAllowed) {
   const RobotModel model =
-      RobotModel::LoadFile(orbed::sim::SourceTreePath(RobotModel::kDefaultUrdfRelativePath));
+      RobotModel::LoadFile(orbed::SourceTreePath(RobotModel::kDefaultUrdfRelativePath));
   TrocarIkTarget t;
   t.p_RT = Eigen::Vector3d(0.5, 0.1, 0.3);
   t.axis_R = -Eigen::Vector3d::UnitZ();

@@ -9,9 +9,9 @@
 #include <stdexcept>
 
 #include "procs/common/conversions.h"
-#include "procs/common/json.h"
+#include "base/json.h"
 #include "procs/common/log.h"
-#include "procs/common/sha256.h"
+#include "base/sha256.h"
 
 namespace orbed::logger {
 namespace {

@@ -9,7 +9,7 @@
 #include <lcm/lcm-cpp.hpp>
 #include <orbed/iiwa_status_t.hpp>
 
-#include "procs/common/sha256.h"
+#include "base/sha256.h"
 #include "procs/logger/event_log_writer.h"
 #include "procs/logger/logger.h"
 

@@ -24,7 +24,7 @@ const char* Bool(bool b) { return b ? "true" : "false"; }
 
 }  // namespace
 
-std::string FormatMeanJson(const Se3MeanResult& result) {
+std::string FormatMeanJson(const geometry::Se3MeanResult& result) {
   const Eigen::Quaterniond& q = result.q_WV_mean;
   const Eigen::Vector3d& p = result.p_WV_mean;
   std::string s = "{\"rotation_wxyz\":[" + Number(q.w()) + "," + Number(q.x()) + "," + Number(q.y()) + "," +
@@ -69,15 +69,15 @@ int RunMeanCommand(const MeanCommandOptions& options, std::ostream& out, std::os
         << file.max_norm_error << ")\n";
   }
 
-  Se3MeanOptions mean_options;
-  mean_options.method = options.robust ? AveragingMethod::kRobust : AveragingMethod::kKarcher;
+  geometry::Se3MeanOptions mean_options;
+  mean_options.method = options.robust ? geometry::AveragingMethod::kRobust : geometry::AveragingMethod::kKarcher;
   mean_options.p_VC = options.p_VC;
-  const Se3MeanResult result = ComputeSe3Mean(file.q_WV, file.p_WV, mean_options);
+  const geometry::Se3MeanResult result = geometry::ComputeSe3Mean(file.q_WV, file.p_WV, mean_options);
   if (!result.valid) {
     err << name << ": error: " << result.reason << "\n";
     return 1;
   }
-  for (const RejectedTrial& r : result.rejected) {
+  for (const geometry::RejectedTrial& r : result.rejected) {
     err << name << ":" << file.line[r.index] << ": note: trial " << r.index << " rejected: " << r.reason
         << "\n";
   }
@@ -94,10 +94,10 @@ int RunMeanCommand(const MeanCommandOptions& options, std::ostream& out, std::os
   }
   const Eigen::Quaterniond& q = result.q_WV_mean;
   const Eigen::Vector3d& p = result.p_WV_mean;
-  const Se3Dispersion& d = result.dispersion;
+  const geometry::Se3Dispersion& d = result.dispersion;
   std::ostringstream text;
   text.precision(9);
-  text << "X_WV_mean (" << AveragingMethodName(result.method) << " mean of " << d.num_used << " of "
+  text << "X_WV_mean (" << geometry::AveragingMethodName(result.method) << " mean of " << d.num_used << " of "
        << result.num_trials << " trials)\n"
        << "  rotation (w, x, y, z): " << q.w() << ", " << q.x() << ", " << q.y() << ", " << q.z() << "\n"
        << "  translation [m]:       " << p.x() << ", " << p.y() << ", " << p.z() << "\n"
@@ -108,7 +108,7 @@ int RunMeanCommand(const MeanCommandOptions& options, std::ostream& out, std::os
        << "  translation rms [m]:    " << d.translation_rms_m << "\n"
        << "  rejected:";
   if (result.rejected.empty()) text << " none";
-  for (const RejectedTrial& r : result.rejected) text << " " << r.index;
+  for (const geometry::RejectedTrial& r : result.rejected) text << " " << r.index;
   text << "\n";
   out << text.str();
   return 0;

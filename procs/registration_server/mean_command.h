@@ -21,7 +21,7 @@
 
 #include <Eigen/Core>
 
-#include "procs/registration_server/se3_mean.h"
+#include "geometry/se3_mean.h"
 
 namespace orbed::registration {
 
@@ -38,6 +38,6 @@ struct MeanCommandOptions {
 int RunMeanCommand(const MeanCommandOptions& options, std::ostream& out, std::ostream& err);
 
 /// The JSON object above, without a trailing newline.
-std::string FormatMeanJson(const Se3MeanResult& result);
+std::string FormatMeanJson(const geometry::Se3MeanResult& result);
 
 }  // namespace orbed::registration

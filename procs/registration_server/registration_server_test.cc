@@ -10,13 +10,11 @@
 #include <gtest/gtest.h>
 
 #include "procs/common/conversions.h"
-#include "procs/registration_server/test_rotations.h"
+#include "geometry/test_rotations.h"
+#include "base/units.h"
 
 namespace orbed::registration {
 namespace {
-
-using testing::kDeg;
-using testing::kPi;
 
 orbed::session_control_t Control(int8_t command, const std::string& id, int64_t utime,
                                  int8_t method = orbed::registration_t::METHOD_KARCHER) {
@@ -73,7 +71,7 @@ TEST(RegistrationServiceTest, ThreeTrialsGiveTheClosedFormMean) {
   const double angles_deg[3] = {10, 20, 45};
   for (int i = 0; i < 3; ++i) {
     state = f.service.HandleTrial(
-        Trial("s1", i, angles_deg[i] * kDeg, Eigen::Vector3d(i + 1.0, -1.0, 0.5), 1000 + i));
+        Trial("s1", i, angles_deg[i] * kDegToRad, Eigen::Vector3d(i + 1.0, -1.0, 0.5), 1000 + i));
     ASSERT_TRUE(state.has_value());
     EXPECT_EQ(state->num_trials, i + 1);
     EXPECT_EQ(state->utime, 1000 + i);
@@ -88,7 +86,7 @@ TEST(RegistrationServiceTest, ThreeTrialsGiveTheClosedFormMean) {
   // On one axis the Karcher mean is the mean angle, 25°; translations average to (2, −1, 0.5).
   const Eigen::Quaterniond q_mean = QuaternionFromWxyz(state->X_WV_mean.quaternion_wxyz);
   EXPECT_NEAR(Eigen::AngleAxisd(q_mean.conjugate() *
-                                Eigen::Quaterniond(Eigen::AngleAxisd(25 * kDeg, Eigen::Vector3d::UnitZ())))
+                                Eigen::Quaterniond(Eigen::AngleAxisd(25 * kDegToRad, Eigen::Vector3d::UnitZ())))
                   .angle(),
               0.0, 1e-12);
   EXPECT_NEAR(state->X_WV_mean.position_m[0], 2.0, 1e-15);
@@ -97,7 +95,7 @@ TEST(RegistrationServiceTest, ThreeTrialsGiveTheClosedFormMean) {
   EXPECT_NEAR(state->rotation_max_deg, 20.0, 1e-9);
   EXPECT_NEAR(state->rotation_median_deg, 15.0, 1e-9);
   EXPECT_NEAR(state->rotation_covariance_rad2[2][2],
-              (std::pow(15 * kDeg, 2) + std::pow(5 * kDeg, 2) + std::pow(20 * kDeg, 2)) / 3, 1e-12);
+              (std::pow(15 * kDegToRad, 2) + std::pow(5 * kDegToRad, 2) + std::pow(20 * kDegToRad, 2)) / 3, 1e-12);
   EXPECT_NEAR(state->translation_rms_m, std::sqrt(2.0 / 3.0), 1e-15);
   EXPECT_TRUE(f.rejections.empty());
 
@@ -210,7 +208,7 @@ TEST(RegistrationServiceTest, RobustSessionReportsTheRejectedTrialIndex) {
   const double offsets_deg[6] = {-0.4, 0.3, 0.0, 0.2, -0.1, 120.0};
   for (int i = 0; i < 6; ++i) {
     state = f.service.HandleTrial(
-        Trial("r", 10 + i, (30 + offsets_deg[i]) * kDeg, Eigen::Vector3d(1, 1, 1), 100 + i));
+        Trial("r", 10 + i, (30 + offsets_deg[i]) * kDegToRad, Eigen::Vector3d(1, 1, 1), 100 + i));
   }
   ASSERT_TRUE(state && state->valid);
   EXPECT_EQ(state->method, int{orbed::registration_t::METHOD_ROBUST});
@@ -218,7 +216,7 @@ TEST(RegistrationServiceTest, RobustSessionReportsTheRejectedTrialIndex) {
   ASSERT_EQ(state->num_rejected, 1);
   EXPECT_EQ(state->rejected_indices, std::vector<int32_t>{15});
   const Eigen::Quaterniond q_mean = QuaternionFromWxyz(state->X_WV_mean.quaternion_wxyz);
-  EXPECT_NEAR(2.0 * std::atan2(q_mean.z(), q_mean.w()) / kDeg, 30.0, 1e-9);  // mean of the offsets is 0
+  EXPECT_NEAR(2.0 * std::atan2(q_mean.z(), q_mean.w()) / kDegToRad, 30.0, 1e-9);  // mean of the offsets is 0
 }
 
 TEST(RegistrationServiceTest, LandmarkAndMisalignmentRequests) {
@@ -282,7 +280,7 @@ TEST(RegistrationServiceTest, ReplayIsBitIdentical) {
     f.service.HandleSessionControl(
         Control(orbed::session_control_t::START, "replay", 1, orbed::registration_t::METHOD_ROBUST));
     for (int i = 0; i < 8; ++i) {
-      const double angle = (i == 5 ? 100.0 : 3.0 * std::sin(i)) * kDeg;
+      const double angle = (i == 5 ? 100.0 : 3.0 * std::sin(i)) * kDegToRad;
       if (auto s =
               f.service.HandleTrial(Trial("replay", i, angle, Eigen::Vector3d(0.01 * i, 0, 1), 10 + i))) {
         out.push_back(Bytes(*s));
@@ -324,7 +322,7 @@ TEST(RegistrationServerTest, ServesOverInProcessLcm) {
   auto start = Control(orbed::session_control_t::START, "live", 1);
   server.lcm().publish(channels::kSessionControl, &start);
   for (int i = 0; i < 3; ++i) {
-    auto trial = Trial("live", i, (10.0 * i) * kDeg, Eigen::Vector3d(0, 0, i), 10 + i);
+    auto trial = Trial("live", i, (10.0 * i) * kDegToRad, Eigen::Vector3d(0, 0, i), 10 + i);
     server.lcm().publish(channels::kAlignmentTrial, &trial);
   }
   orbed::landmark_request_t request{};
@@ -346,7 +344,7 @@ TEST(RegistrationServerTest, ServesOverInProcessLcm) {
   EXPECT_EQ(per_trial[2].num_trials, 3);
   EXPECT_TRUE(per_trial[2].valid);
   const Eigen::Quaterniond q_mean = QuaternionFromWxyz(per_trial[2].X_WV_mean.quaternion_wxyz);
-  EXPECT_NEAR(2.0 * std::atan2(q_mean.z(), q_mean.w()) / kDeg, 10.0, 1e-9);
+  EXPECT_NEAR(2.0 * std::atan2(q_mean.z(), q_mean.w()) / kDegToRad, 10.0, 1e-9);
   EXPECT_NEAR(per_trial[2].X_WV_mean.position_m[2], 1.0, 1e-15);
   EXPECT_GE(periodic.size(), 1u);
   for (const auto& s : periodic) EXPECT_EQ(s.utime, 12);

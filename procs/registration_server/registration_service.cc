@@ -7,8 +7,8 @@
 #include "procs/common/conversions.h"
 #include "procs/common/session_control.h"
 #include "procs/common/validation.h"
-#include "procs/registration_server/misalignment.h"
-#include "procs/registration_server/se3_mean.h"
+#include "geometry/misalignment.h"
+#include "geometry/se3_mean.h"
 
 namespace orbed::registration {
 namespace {
@@ -166,11 +166,11 @@ orbed::registration_t RegistrationService::MakeState(int64_t utime, int8_t reaso
     q.push_back(t.q_WV);
     p.push_back(t.p_WV);
   }
-  Se3MeanOptions options;
+  geometry::Se3MeanOptions options;
   options.method = static_cast<AveragingMethod>(method_);
   options.p_VC = options_.p_VC;
   options.outlier = options_.outlier;
-  const Se3MeanResult mean = ComputeSe3Mean(q, p, options);
+  const geometry::Se3MeanResult mean = geometry::ComputeSe3Mean(q, p, options);
   if (!mean.valid) return out;  // cannot happen for validated trials; left invalid if it does
 
   Eigen::Isometry3d X_WV_mean = Eigen::Isometry3d::Identity();
@@ -179,7 +179,7 @@ orbed::registration_t RegistrationService::MakeState(int64_t utime, int8_t reaso
   out.valid = true;
   out.X_WV_mean = ToPose(X_WV_mean);
   out.num_used = mean.dispersion.num_used;
-  for (const RejectedTrial& r : mean.rejected) out.rejected_indices.push_back(trials_[r.index].trial_index);
+  for (const geometry::RejectedTrial& r : mean.rejected) out.rejected_indices.push_back(trials_[r.index].trial_index);
   out.num_rejected = static_cast<int32_t>(out.rejected_indices.size());
   out.rotation_rms_deg = mean.dispersion.rotation_rms_deg;
   out.rotation_median_deg = mean.dispersion.rotation_median_deg;
@@ -208,7 +208,7 @@ orbed::landmark_t RegistrationService::HandleLandmarkRequest(const orbed::landma
                        &directions);
   }
   if (problem.empty()) {
-    const TriangulationResult r = TriangulateRays(origins, directions, options_.triangulation);
+    const geometry::TriangulationResult r = geometry::TriangulateRays(origins, directions, options_.triangulation);
     FromVector3(r.p_W, out.p_W_m);
     out.ray_angle_deg = r.ray_angle_deg;
     out.gap_m = r.gap_m;
@@ -238,7 +238,7 @@ orbed::misalignment_t RegistrationService::HandleMisalignmentRequest(
                        "MISALIGNMENT_REQUEST.p_W_virtual_m", &virt);
   }
   if (problem.empty()) {
-    const MisalignmentResult r = EvaluateMisalignment(real, virt);
+    const geometry::MisalignmentResult r = geometry::EvaluateMisalignment(real, virt);
     if (r.valid) {
       out.valid = true;
       out.num_pairs = static_cast<int32_t>(r.error_W_m.size());

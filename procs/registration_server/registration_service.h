@@ -41,8 +41,8 @@
 #include <orbed/registration_t.hpp>
 #include <orbed/session_control_t.hpp>
 
-#include "procs/registration_server/robust.h"
-#include "procs/registration_server/triangulation.h"
+#include "geometry/robust.h"
+#include "geometry/triangulation.h"
 
 namespace orbed::registration {
 
@@ -50,9 +50,9 @@ struct RegistrationServiceOptions {
   /// Model centroid C in V [m] for averaging translations about it (se3_mean.h); unset = eq. 3.
   std::optional<Eigen::Vector3d> p_VC;
   /// Robust-mode rejection (robust.h).
-  OutlierOptions outlier;
+  geometry::OutlierOptions outlier;
   /// Landmark triangulation (triangulation.h).
-  TriangulationOptions triangulation;
+  geometry::TriangulationOptions triangulation;
   /// Bounds that keep a flood of input from growing memory without limit.
   int max_trials_per_session = 10000;
   int max_rays = 1000;

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "procs/registration_server/so3.h"
+#include "geometry/so3.h"
 
 namespace orbed::registration {
 namespace {
@@ -56,7 +56,7 @@ std::string ParseTrialLine(const std::string& text, Eigen::Quaterniond* q_WV, Ei
       return std::string("field ") + std::to_string(k + 1) + " (" + kFieldNames[k] + ") is not finite";
     }
   }
-  const RotationCheck check = ValidateQuaternionWxyz(Eigen::Vector4d(v[0], v[1], v[2], v[3]));
+  const geometry::RotationCheck check = geometry::ValidateQuaternionWxyz(Eigen::Vector4d(v[0], v[1], v[2], v[3]));
   if (!check.valid) return check.message;
   *q_WV = check.q;
   *p_WV = Eigen::Vector3d(v[4], v[5], v[6]);
@@ -80,7 +80,7 @@ TrialFile ParseTrialFile(std::istream& in) {
       file.error = problem;
       return file;
     }
-    if (norm_error > RotationTolerance{}.exact) {
+    if (norm_error > geometry::RotationTolerance{}.exact) {
       ++file.normalized;
       file.max_norm_error = std::max(file.max_norm_error, norm_error);
     }

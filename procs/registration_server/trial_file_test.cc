@@ -100,7 +100,7 @@ TEST(MeanCommandTest, RobustJsonHasExactlyTheDocumentedShape) {
 }
 
 TEST(MeanCommandTest, JsonNumbersRoundTrip) {
-  Se3MeanResult r;
+  geometry::Se3MeanResult r;
   r.q_WV_mean = Eigen::Quaterniond(0.1, 0.2, 0.3, 1.0 / 3.0);
   r.p_WV_mean = Eigen::Vector3d(1e-20, -2.5, 3);
   r.converged = true;

@@ -10,7 +10,7 @@
 #include <orbed/alignment_trial_t.hpp>
 #include <orbed/registration_t.hpp>
 
-#include "procs/common/number_list.h"
+#include "base/number_list.h"
 
 namespace orbed::scenario {
 namespace {

@@ -7,7 +7,8 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "procs/common/json.h"
+#include "base/format.h"
+#include "base/json.h"
 
 namespace orbed::scenario {
 namespace {
@@ -49,12 +50,6 @@ const std::vector<std::pair<std::string, std::function<double(const ErrorMeasure
       {"base_translation_error_mm", [](const ErrorMeasures& e) { return e.base_translation_error_mm; }},
       {"flange_translation_error_mm", [](const ErrorMeasures& e) { return e.flange_translation_error_mm; }}};
   return measures;
-}
-
-std::string Fixed(double value, int digits) {
-  char text[64];
-  std::snprintf(text, sizeof(text), "%.*f", digits, value);
-  return text;
 }
 
 std::string PadLeft(const std::string& text, size_t width) {

@@ -16,7 +16,7 @@
 #include "procs/common/conversions.h"
 #include "procs/common/log.h"
 #include "procs/common/validation.h"
-#include "sim/model_paths.h"
+#include "base/source_paths.h"
 
 namespace orbed::scenario {
 namespace {
@@ -74,7 +74,7 @@ ScenarioOptions Resolved(ScenarioOptions options) {
 
 }  // namespace
 
-std::string ScenarioSourcePath(const std::string& relative) { return sim::SourceTreePath(relative); }
+std::string ScenarioSourcePath(const std::string& relative) { return orbed::SourceTreePath(relative); }
 
 ViraalScenario::ViraalScenario(const orbed::CommonFlags& flags, const ScenarioOptions& options)
     : options_(Resolved(options)) {

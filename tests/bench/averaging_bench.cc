@@ -19,30 +19,29 @@
 
 #include <benchmark/benchmark.h>
 
-#include "procs/registration_server/robust.h"
-#include "procs/registration_server/rotation_mean.h"
-#include "procs/registration_server/so3.h"
+#include "geometry/robust.h"
+#include "geometry/rotation_mean.h"
+#include "geometry/so3.h"
+#include "base/units.h"
 
-namespace orbed::registration {
+namespace orbed::geometry {
 namespace {
-
-constexpr double kDeg = 3.141592653589793 / 180.0;
 
 std::vector<Eigen::Quaterniond> Cluster(int n) {
   std::mt19937 rng(42);
-  std::normal_distribution<double> normal(0.0, 5.0 * kDeg / std::sqrt(3.0));
+  std::normal_distribution<double> normal(0.0, 5.0 * kDegToRad / std::sqrt(3.0));
   const Eigen::Quaterniond center(Eigen::AngleAxisd(1.1, Eigen::Vector3d(0.2, -0.7, 0.4).normalized()));
   std::vector<Eigen::Quaterniond> q;
   q.reserve(n);
   for (int i = 0; i < n; ++i)
-    q.push_back(center * ExpQuaternion(Eigen::Vector3d(normal(rng), normal(rng), normal(rng))));
+    q.push_back(center * geometry::ExpQuaternion(Eigen::Vector3d(normal(rng), normal(rng), normal(rng))));
   return q;
 }
 
 void BM_ChordalMean(benchmark::State& state) {
   const std::vector<Eigen::Quaterniond> q = Cluster(static_cast<int>(state.range(0)));
   for (auto _ : state) {
-    ChordalMeanResult r = ComputeChordalMean(q);
+    geometry::ChordalMeanResult r = geometry::ComputeChordalMean(q);
     benchmark::DoNotOptimize(r);
   }
 }
@@ -51,7 +50,7 @@ void BM_KarcherMean(benchmark::State& state) {
   const std::vector<Eigen::Quaterniond> q = Cluster(static_cast<int>(state.range(0)));
   int iterations = 0;
   for (auto _ : state) {
-    KarcherMeanResult r = ComputeKarcherMean(q);
+    geometry::KarcherMeanResult r = geometry::ComputeKarcherMean(q);
     iterations = r.iterations;
     benchmark::DoNotOptimize(r);
   }
@@ -62,7 +61,7 @@ void BM_RobustRejection(benchmark::State& state) {
   const std::vector<Eigen::Quaterniond> q = Cluster(static_cast<int>(state.range(0)));
   const std::vector<Eigen::Vector3d> p(q.size(), Eigen::Vector3d(1, 2, 3));
   for (auto _ : state) {
-    OutlierResult r = RejectOutliers(q, p);
+    geometry::OutlierResult r = geometry::RejectOutliers(q, p);
     benchmark::DoNotOptimize(r);
   }
 }
@@ -101,7 +100,7 @@ class RatioReporter : public benchmark::ConsoleReporter {
 };
 
 }  // namespace
-}  // namespace orbed::registration
+}  // namespace orbed::geometry
 
 int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);

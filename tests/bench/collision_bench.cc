@@ -23,7 +23,7 @@
 #include <fcl/narrowphase/distance.h>
 
 #include "sim/collision_world.h"
-#include "sim/model_paths.h"
+#include "base/source_paths.h"
 #include "sim/robot_model.h"
 #include "sim/scene.h"
 
@@ -31,8 +31,8 @@ namespace orbed::sim {
 namespace {
 
 struct Fixture {
-  RobotModel model = RobotModel::LoadFile(orbed::sim::SourceTreePath(RobotModel::kDefaultUrdfRelativePath));
-  Scene scene = LoadSceneFile(orbed::sim::SourceTreePath(kDefaultSceneRelativePath));
+  RobotModel model = RobotModel::LoadFile(orbed::SourceTreePath(RobotModel::kDefaultUrdfRelativePath));
+  Scene scene = LoadSceneFile(orbed::SourceTreePath(kDefaultSceneRelativePath));
   std::vector<Eigen::VectorXd> pool;
   Fixture() {
     model.SetToolLength(scene.tool_length_m);

@@ -12,6 +12,7 @@
 // (user + system from wait4 over its wall time), its peak RSS [MB] (goal <= 400 MB), the received
 // rates, and the HMD_POSE jitter: percentiles of |inter-arrival − 1/60 s| [ms].
 // Run in a private network namespace: scripts/orbed bench hmd_bench.
+#include "base/source_paths.h"
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -51,11 +52,6 @@ double Percentile(std::vector<double> v, double p) {
   return v[k];
 }
 
-std::string SourceDir() {
-  const char* dir = std::getenv("ORBED_SOURCE_DIR");
-  return dir ? dir : ".";
-}
-
 void RunHmd(benchmark::State& state, bool walking_and_moving) {
   const char* seconds_env = std::getenv("ORBED_BENCH_SECONDS");
   const double seconds = seconds_env ? std::atof(seconds_env) : 30.0;
@@ -73,7 +69,7 @@ void RunHmd(benchmark::State& state, bool walking_and_moving) {
         BinDir() + "/orbed-hmd", "--name", "hmd_bench", "--log-level", "warn", "--displays", "1"};
     if (walking_and_moving) {
       argv.push_back("--config");
-      argv.push_back(SourceDir() + "/hmd_emulator/config/walk_loop.yaml");
+      argv.push_back(orbed::SourceDir() + "/hmd_emulator/config/walk_loop.yaml");
     }
     const auto spawned = Clock::now();
     const pid_t hmd = Spawn(argv);

@@ -23,7 +23,7 @@
 #include "hmd_emulator/reflective.h"
 #include "hmd_emulator/renderer.h"
 #include "hmd_emulator/scene_geometry.h"
-#include "sim/model_paths.h"
+#include "base/source_paths.h"
 #include "sim/robot_model.h"
 #include "sim/scene.h"
 
@@ -32,8 +32,8 @@ namespace {
 
 struct Fixture {
   sim::RobotModel robot =
-      sim::RobotModel::LoadFile(sim::SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath));
-  sim::Scene scene = sim::LoadSceneFile(sim::SourceTreePath(sim::kDefaultSceneRelativePath));
+      sim::RobotModel::LoadFile(orbed::SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath));
+  sim::Scene scene = sim::LoadSceneFile(orbed::SourceTreePath(sim::kDefaultSceneRelativePath));
   std::vector<Eigen::VectorXd> q_pool;
   std::vector<Eigen::Isometry3d> cameras;
   Fixture() {
@@ -49,7 +49,7 @@ struct Fixture {
     for (int k = 0; k < 16; ++k) {
       const double a = -2.6 + 2.2 * k / 15.0;
       const Eigen::Vector3d eye(0.25 + 2.3 * std::cos(a), -0.3 + 2.3 * std::sin(a), 1.7);
-      cameras.push_back(LookAt(eye, {0.25, -0.45, 1.1}));
+      cameras.push_back(geometry::LookAt(eye, {0.25, -0.45, 1.1}));
     }
   }
 };
@@ -73,7 +73,7 @@ void BM_RenderFrame(benchmark::State& state) {
   Fixture& f = F();
   SceneGeometry g = SceneGeometry::MakeOperatingRoom(f.scene, f.robot, f.q_pool[0], f.scene.X_WR);
   Mesh mesh;
-  Renderer renderer(Intrinsics::HoloLensPv());
+  Renderer renderer(geometry::Intrinsics::HoloLensPv());
   cv::Mat bgr;
   size_t i = 0;
   double triangles = 0;
@@ -89,7 +89,7 @@ void BM_JpegEncode(benchmark::State& state) {
   Fixture& f = F();
   SceneGeometry g = SceneGeometry::MakeOperatingRoom(f.scene, f.robot, f.q_pool[0], f.scene.X_WR);
   Mesh mesh;
-  Renderer renderer(Intrinsics::HoloLensPv());
+  Renderer renderer(geometry::Intrinsics::HoloLensPv());
   cv::Mat bgr;
   RenderOne(&g, &mesh, &renderer, 3, &bgr);
   std::vector<std::uint8_t> jpeg;
@@ -105,7 +105,7 @@ void BM_RenderAndJpeg(benchmark::State& state) {
   Fixture& f = F();
   SceneGeometry g = SceneGeometry::MakeOperatingRoom(f.scene, f.robot, f.q_pool[0], f.scene.X_WR);
   Mesh mesh;
-  Renderer renderer(Intrinsics::HoloLensPv());
+  Renderer renderer(geometry::Intrinsics::HoloLensPv());
   cv::Mat bgr;
   std::vector<std::uint8_t> jpeg;
   size_t i = 0;
@@ -124,13 +124,13 @@ void BM_ReflectiveCompose(benchmark::State& state) {
   Fixture& f = F();
   SceneGeometry g = SceneGeometry::MakeOperatingRoom(f.scene, f.robot, f.q_pool[0], f.scene.X_WR);
   Mesh mesh;
-  Renderer renderer(Intrinsics::HoloLensPv());
+  Renderer renderer(geometry::Intrinsics::HoloLensPv());
   // A few captured frames, each with a slightly wrong capture-pose estimate.
   std::vector<CapturedFrame> frames;
   for (size_t k = 0; k < 8; ++k) {
     CapturedFrame fr;
     RenderOne(&g, &mesh, &renderer, 2 * k, &fr.bgr);
-    fr.intrinsics = Intrinsics::HoloLensPv();
+    fr.intrinsics = geometry::Intrinsics::HoloLensPv();
     fr.X_WC_est = f.cameras[(2 * k) % f.cameras.size()] *
                   Eigen::Isometry3d(Eigen::AngleAxisd(0.01, Eigen::Vector3d::UnitY()));
     fr.q_rad = f.q_pool[(2 * k) % f.q_pool.size()];

@@ -20,11 +20,10 @@
 #include <orbed/session_control_t.hpp>
 
 #include "tests/integration/testbed_util.h"
+#include "base/units.h"
 
 namespace orbed::testing {
 namespace {
-
-constexpr double kDeg = M_PI / 180.0;
 
 // Collects raw REGISTRATION and LANDMARK messages on its own thread.
 class Collector {
@@ -78,8 +77,8 @@ orbed::alignment_trial_t Trial(int index, double angle_deg, Eigen::Vector3d p, i
   trial.num_joints = 7;
   trial.joint_position.assign(7, 0.1 * index);
   // Rotation about z by angle: q = (cos a/2, 0, 0, sin a/2).
-  trial.X_WV.quaternion_wxyz[0] = std::cos(angle_deg * kDeg / 2);
-  trial.X_WV.quaternion_wxyz[3] = std::sin(angle_deg * kDeg / 2);
+  trial.X_WV.quaternion_wxyz[0] = std::cos(angle_deg * kDegToRad / 2);
+  trial.X_WV.quaternion_wxyz[3] = std::sin(angle_deg * kDegToRad / 2);
   for (int i = 0; i < 3; ++i) trial.X_WV.position_m[i] = p[i];
   trial.duration_s = 30;
   trial.user_id = "test";
@@ -134,10 +133,10 @@ TEST(Registration, ThreeTrialsInClosedFormMeanOutAndReplaysBitForBit) {
     EXPECT_TRUE(mean.converged);
     EXPECT_TRUE(mean.unique);
     // Rotations about one axis at 0°, 10°, 20°: the geodesic mean is 10° about z.
-    EXPECT_NEAR(mean.X_WV_mean.quaternion_wxyz[0], std::cos(5 * kDeg), 1e-9);
+    EXPECT_NEAR(mean.X_WV_mean.quaternion_wxyz[0], std::cos(5 * kDegToRad), 1e-9);
     EXPECT_NEAR(mean.X_WV_mean.quaternion_wxyz[1], 0.0, 1e-9);
     EXPECT_NEAR(mean.X_WV_mean.quaternion_wxyz[2], 0.0, 1e-9);
-    EXPECT_NEAR(mean.X_WV_mean.quaternion_wxyz[3], std::sin(5 * kDeg), 1e-9);
+    EXPECT_NEAR(mean.X_WV_mean.quaternion_wxyz[3], std::sin(5 * kDegToRad), 1e-9);
     // Translation mean (paper eq. 3): (1.01, 2.01, 0.5).
     EXPECT_NEAR(mean.X_WV_mean.position_m[0], 1.01, 1e-12);
     EXPECT_NEAR(mean.X_WV_mean.position_m[1], 2.01, 1e-12);

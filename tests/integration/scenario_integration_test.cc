@@ -22,11 +22,10 @@
 
 #include "procs/common/conversions.h"
 #include "tests/integration/testbed_util.h"
+#include "base/units.h"
 
 namespace orbed::testing {
 namespace {
-
-constexpr double kDeg = M_PI / 180.0;
 
 // The user's misplacement of the virtual robot per mode, about the virtual base's own origin:
 // R_WV = R_offset · R_WR, p_WV = p_WR + p_offset.
@@ -77,7 +76,7 @@ class FakeUser {
     const Eigen::Isometry3d X_WR = FromPose(state_.X_WR);
     Eigen::Isometry3d X_WV = X_WR;
     X_WV.linear() =
-        Eigen::AngleAxisd(offset.yaw_deg * kDeg, Eigen::Vector3d::UnitZ()).toRotationMatrix() * X_WR.linear();
+        Eigen::AngleAxisd(offset.yaw_deg * kDegToRad, Eigen::Vector3d::UnitZ()).toRotationMatrix() * X_WR.linear();
     X_WV.translation() += offset.p_W;
     orbed::alignment_trial_t trial{};
     trial.utime = NowMicros();
@@ -137,7 +136,7 @@ struct Expected {
 };
 Expected ExpectedErrors(const std::vector<orbed::robot_state_t>& states, const Offset& offset) {
   const Eigen::Matrix3d R =
-      Eigen::AngleAxisd(offset.yaw_deg * kDeg, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+      Eigen::AngleAxisd(offset.yaw_deg * kDegToRad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   double centroid = 0;
   Eigen::Vector3d t_bar = Eigen::Vector3d::Zero();
   int pairs = 0;

@@ -27,11 +27,11 @@
 
 #include "procs/common/conversions.h"
 #include "tests/integration/testbed_util.h"
+#include "base/units.h"
 
 namespace orbed::testing {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
 constexpr double kPeriodS = 0.005;  // the sim's default tick
 constexpr int64_t kPeriodUs = 5000;
 constexpr double kStopMarginM = 0.01;                               // the sim's default --stop-margin-m
@@ -48,18 +48,26 @@ class SimClient {
     if (!pub_.good()) throw std::runtime_error("LCM publisher not available");
   }
 
+  /// One IIWA_STATUS and when it was handed to this client (monotonic clock).
+  struct ReceivedStatus {
+    drake::lcmt_iiwa_status msg;
+    std::chrono::steady_clock::time_point received;
+  };
+
   std::vector<drake::lcmt_iiwa_status> status() const {
     std::lock_guard<std::mutex> lock(mutex_);
-    return status_;
+    std::vector<drake::lcmt_iiwa_status> out;
+    for (const auto& r : status_) out.push_back(r.msg);
+    return out;
   }
   size_t num_status() const {
     std::lock_guard<std::mutex> lock(mutex_);
     return status_.size();
   }
-  /// When each IIWA_STATUS was handed to this client (monotonic clock), as status().
-  std::vector<std::chrono::steady_clock::time_point> status_received() const {
+  /// Every IIWA_STATUS with its receive time, taken under one lock (one moment).
+  std::vector<ReceivedStatus> status_log() const {
     std::lock_guard<std::mutex> lock(mutex_);
-    return status_received_;
+    return status_;
   }
   std::vector<orbed::robot_state_t> state() const {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -72,7 +80,6 @@ class SimClient {
   void Clear() {
     std::lock_guard<std::mutex> lock(mutex_);
     status_.clear();
-    status_received_.clear();
     state_.clear();
     collision_.clear();
   }
@@ -82,7 +89,7 @@ class SimClient {
     drake::lcmt_iiwa_command cmd{};
     cmd.utime = utime;
     cmd.num_joints = static_cast<int32_t>(q_deg.size());
-    for (double q : q_deg) cmd.joint_position.push_back(q * kDeg);
+    for (double q : q_deg) cmd.joint_position.push_back(q * kDegToRad);
     cmd.num_torques = 0;
     pub_.publish("IIWA_COMMAND", &cmd);
   }
@@ -91,8 +98,7 @@ class SimClient {
   void OnStatus(const lcm::ReceiveBuffer*, const std::string&, const drake::lcmt_iiwa_status* m) {
     const auto now = std::chrono::steady_clock::now();
     std::lock_guard<std::mutex> lock(mutex_);
-    status_.push_back(*m);
-    status_received_.push_back(now);
+    status_.push_back({*m, now});
   }
   void OnState(const lcm::ReceiveBuffer*, const std::string&, const orbed::robot_state_t* m) {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -104,8 +110,7 @@ class SimClient {
   }
 
   mutable std::mutex mutex_;
-  std::vector<drake::lcmt_iiwa_status> status_;
-  std::vector<std::chrono::steady_clock::time_point> status_received_;
+  std::vector<ReceivedStatus> status_;
   std::vector<orbed::robot_state_t> state_;
   std::vector<orbed::collision_status_t> collision_;
   lcm::LCM pub_{""};
@@ -154,7 +159,7 @@ std::vector<double> ExpectWithinJointSpeeds(const std::vector<drake::lcmt_iiwa_s
     const double dt_s = dt_us * 1e-6;
     for (int i = 0; i < 7; ++i) {
       const double step = std::abs(s[k].joint_position_measured[i] - s[k - 1].joint_position_measured[i]);
-      EXPECT_LE(step, kSpeedDegPerS[i] * kDeg * dt_s * kRoundOff)
+      EXPECT_LE(step, kSpeedDegPerS[i] * kDegToRad * dt_s * kRoundOff)
           << "joint " << i + 1 << " between messages " << k - 1 << " and " << k;
     }
     if (k < kWindow) continue;
@@ -162,7 +167,7 @@ std::vector<double> ExpectWithinJointSpeeds(const std::vector<drake::lcmt_iiwa_s
     for (int i = 0; i < 7; ++i) {
       const double speed_deg_per_s =
           std::abs(s[k].joint_position_measured[i] - s[k - kWindow].joint_position_measured[i]) / window_s /
-          kDeg;
+          kDegToRad;
       EXPECT_LE(speed_deg_per_s, kSpeedDegPerS[i] * kRoundOff) << "joint " << i + 1 << " at message " << k;
       peak[i] = std::max(peak[i], speed_deg_per_s);
     }
@@ -203,10 +208,10 @@ TEST(IiwaSim, DrakeCommandBeyondTheLimitsStopsOnTheLimitsWithinTheJointSpeeds) {
   const auto status = client.status();
   const drake::lcmt_iiwa_status& last = status.back();
   ASSERT_EQ(last.num_joints, 7);
-  EXPECT_NEAR(last.joint_position_measured[1], -120 * kDeg, 1e-9);
-  EXPECT_NEAR(last.joint_position_measured[6], 175 * kDeg, 1e-9);
+  EXPECT_NEAR(last.joint_position_measured[1], -120 * kDegToRad, 1e-9);
+  EXPECT_NEAR(last.joint_position_measured[6], 175 * kDegToRad, 1e-9);
   for (int i : {0, 2, 3, 4, 5}) EXPECT_EQ(last.joint_position_measured[i], 0.0);
-  EXPECT_NEAR(last.joint_position_commanded[6], 200 * kDeg, 1e-12);
+  EXPECT_NEAR(last.joint_position_commanded[6], 200 * kDegToRad, 1e-12);
   const orbed::robot_state_t state = client.state().back();
   EXPECT_NE(state.stop_reason.find("iiwa_joint_2"), std::string::npos) << state.stop_reason;
   EXPECT_NE(state.stop_reason.find("iiwa_joint_7"), std::string::npos) << state.stop_reason;
@@ -265,11 +270,11 @@ TEST(IiwaSim, CommandIntoTheTableStopsShortOfContact) {
   // Where it stopped: on the straight line, before the first contact.
   const auto status = client.status();
   const drake::lcmt_iiwa_status& last = status.back();
-  const double fraction = last.joint_position_measured[1] / (target_deg[1] * kDeg);
+  const double fraction = last.joint_position_measured[1] / (target_deg[1] * kDegToRad);
   EXPECT_GT(fraction, 0.5);
   EXPECT_LT(fraction, first_contact);
   for (int i = 0; i < 7; ++i) {
-    EXPECT_NEAR(last.joint_position_measured[i], fraction * target_deg[i] * kDeg, 1e-9) << "joint " << i + 1;
+    EXPECT_NEAR(last.joint_position_measured[i], fraction * target_deg[i] * kDegToRad, 1e-9) << "joint " << i + 1;
   }
   ExpectWithinJointSpeeds(status);
   std::printf("stopped at %.1f %% of the path (first contact at %.0f %%), clearance %.4f m: %s\n",
@@ -294,17 +299,17 @@ TEST(IiwaSim, StatusRateIs200HzWithin5PercentOver5s) {
   const auto begin = std::chrono::steady_clock::now() + std::chrono::milliseconds(500);
   const auto end = begin + std::chrono::seconds(5);
   wait(end + std::chrono::milliseconds(200));  // messages received before `end` are all handled
-  const auto status = client.status();
-  const auto received = client.status_received();
-  ASSERT_EQ(status.size(), received.size());
-  size_t first = received.size(), count = 0;
-  for (size_t k = 0; k < received.size(); ++k) {
-    if (received[k] < begin || received[k] >= end) continue;
+  // One snapshot of messages and receive times together: two reads at two moments would disagree
+  // while messages keep arriving.
+  const auto log = client.status_log();
+  size_t first = log.size(), count = 0;
+  for (size_t k = 0; k < log.size(); ++k) {
+    if (log[k].received < begin || log[k].received >= end) continue;
     if (count++ == 0) first = k;
   }
   ASSERT_GT(count, 1u) << "no IIWA_STATUS in the window";
   const double rate_hz = count / 5.0;
-  const int64_t span_ticks = (status[first + count - 1].utime - status[first].utime) / kPeriodUs;
+  const int64_t span_ticks = (log[first + count - 1].msg.utime - log[first].msg.utime) / kPeriodUs;
   const int64_t lost = span_ticks + 1 - static_cast<int64_t>(count);
   std::printf(
       "IIWA_STATUS: %zu messages received in 5 s = %.1f Hz; they span %lld ticks of the sim clock "

@@ -1,5 +1,7 @@
 #include "tests/integration/testbed_util.h"
 
+#include "base/source_paths.h"
+
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -19,11 +21,7 @@ std::string BinPath(const std::string& name) {
   return std::string(dir) + "/" + name;
 }
 
-std::string SourcePath(const std::string& relative) {
-  const char* dir = std::getenv("ORBED_SOURCE_DIR");
-  if (dir == nullptr) throw std::runtime_error("ORBED_SOURCE_DIR is not set (run through ctest)");
-  return std::string(dir) + "/" + relative;
-}
+std::string SourcePath(const std::string& relative) { return orbed::SourceTreePath(relative); }
 
 namespace {
 

@@ -1,0 +1,81 @@
+#pragma once
+/// @file
+/// Small statistics for comparing alignment trials: mean, median, sample standard deviation, and
+/// the Mann–Whitney U (Wilcoxon rank-sum) test, implemented here.
+///
+/// Mann–Whitney U for samples x (n_x) and y (n_y): all values are ranked together, ties getting the
+/// average of the ranks they span; U_x = R_x − n_x(n_x + 1)/2 with R_x the sum of x's ranks, which
+/// equals the number of pairs (x_i, y_j) with x_i > y_j plus half the tied pairs; U_y = n_x n_y − U_x.
+/// Normal approximation: mean n_x n_y / 2, variance with the tie correction
+///     σ² = n_x n_y / 12 · [(n + 1) − Σ_k (t_k³ − t_k) / (n (n − 1))],   n = n_x + n_y,
+/// t_k the size of the k-th group of tied values; z = (U_x − mean ∓ 0.5) / σ with a continuity
+/// correction of 0.5 toward the mean (optional). p-values from the standard normal:
+///     two-sided:  P(|Z| ≥ |z|) (capped at 1),
+///     x_less:     alternative "x tends to be smaller than y" = Φ((U_x − mean + c) / σ),
+///     x_greater:  alternative "x tends to be larger than y"  = 1 − Φ((U_x − mean − c) / σ),
+/// c = 0.5 with the continuity correction, else 0. Adequate for n_x, n_y ≳ 8 (the uses here have
+/// hundreds); for tiny samples exact tables are better.
+///
+/// Wilcoxon signed-rank test for paired samples (x_i, y_i): differences d_i = x_i − y_i, zero
+/// differences dropped (Wilcoxon's convention), |d_i| ranked with average ranks for ties;
+/// W⁺ = the sum of the ranks of the positive d_i, over n non-zero pairs. Normal approximation:
+/// mean n(n + 1)/4, variance n(n + 1)(2n + 1)/24 − Σ_k (t_k³ − t_k)/48 (t_k: tie groups of |d|),
+/// the same continuity correction and one-sided alternatives as above ("x_less": the x_i tend to be
+/// smaller than their y_i). Adequate for n ≳ 10.
+///
+/// Threading: pure functions, reentrant.
+
+#include <vector>
+
+namespace orbed::stats {
+
+/// Arithmetic mean; NaN for an empty sample.
+double Mean(const std::vector<double>& x);
+/// Median (the mean of the two middle values for an even count); NaN for an empty sample.
+double Median(std::vector<double> x);
+/// Sample standard deviation (N − 1 in the denominator); 0 for one value, NaN for none.
+double StdDev(const std::vector<double>& x);
+/// The q-quantile, q in [0, 1], linear interpolation between order statistics (R type 7).
+double Quantile(std::vector<double> x, double q);
+
+/// Average ranks (1-based) of x, ties sharing the mean of their ranks.
+std::vector<double> AverageRanks(const std::vector<double>& x);
+
+struct MannWhitneyResult {
+  bool valid = false;  ///< false when a sample is empty or σ = 0 (all values tied)
+  int n_x = 0, n_y = 0;
+  double rank_sum_x = 0;    ///< R_x
+  double u_x = 0, u_y = 0;  ///< U_x + U_y = n_x n_y
+  double mean_u = 0;        ///< n_x n_y / 2
+  double variance_u = 0;    ///< tie-corrected σ²
+  double z = 0;             ///< (U_x − mean, continuity-corrected toward 0) / σ
+  double p_two_sided = 1;
+  double p_x_less = 1;     ///< one-sided: x stochastically smaller than y
+  double p_x_greater = 1;  ///< one-sided: x stochastically larger than y
+};
+
+MannWhitneyResult MannWhitneyU(const std::vector<double>& x, const std::vector<double>& y,
+                               bool continuity_correction = true);
+
+struct SignedRankResult {
+  bool valid = false;     ///< false when the sizes differ, no pair differs, or σ = 0
+  int n = 0;              ///< pairs with a non-zero difference
+  int n_zero = 0;         ///< pairs dropped for a zero difference
+  double w_plus = 0;      ///< sum of the ranks of the positive differences
+  double w_minus = 0;     ///< W⁺ + W⁻ = n(n + 1)/2
+  double mean_w = 0;      ///< n(n + 1)/4
+  double variance_w = 0;  ///< tie-corrected σ²
+  double z = 0;           ///< (W⁺ − mean, continuity-corrected toward 0) / σ
+  double p_two_sided = 1;
+  double p_x_less = 1;     ///< one-sided: x_i tend to be smaller than y_i
+  double p_x_greater = 1;  ///< one-sided: x_i tend to be larger than y_i
+};
+
+/// Paired test on (x[i], y[i]); x and y must have the same size (else valid = false).
+SignedRankResult WilcoxonSignedRank(const std::vector<double>& x, const std::vector<double>& y,
+                                    bool continuity_correction = true);
+
+/// Standard normal CDF Φ(z).
+double NormalCdf(double z);
+
+}  // namespace orbed::stats
