@@ -3,7 +3,7 @@
 /// SO(3) primitives for the registration server: the exponential and logarithm maps, rotation
 /// distances, and validation of rotations that arrive from outside (files, messages).
 ///
-/// Conventions (DESIGN.md §2): a rotation R_AB maps vectors expressed in B to A. Quaternions are
+/// Conventions (docs/design.md, "Frames"): a rotation R_AB maps vectors expressed in B to A. Quaternions are
 /// Eigen::Quaterniond, stored (x, y, z, w) internally but always read/written as (w, x, y, z) at the
 /// boundary. q and -q are the same rotation; every function here accepts either sign.
 /// A rotation vector w = θ·a (unit axis a, angle θ [rad]) is the Lie-algebra coordinate:

@@ -4,7 +4,7 @@
 /// virtual robot V until it looks aligned with the real robot R in everything they can see, and
 /// returns the pose they settled on (an alignment trial).
 ///
-/// Frames (DESIGN.md §2; the SLAM relation of slam_model.h). W is the true world, the user's chosen
+/// Frames (docs/design.md; the SLAM relation of slam_model.h). W is the true world, the user's chosen
 /// X_WV is in map coordinates (the device's W'). The real robot is at X_WR (truth) at joint vector q;
 /// the virtual robot is the same model at the same q at X_WV. Model points p_RQ (= p_VQ) come from
 /// forward kinematics (RobotModelPoints). The head is truly at X_WH_true; the device believes

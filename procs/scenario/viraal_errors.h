@@ -4,7 +4,7 @@
 /// pose X_WV chosen by the user) puts points of the robot compared with where the real robot R
 /// (true base pose X_WR) has them, at the joint configuration q of the trial.
 ///
-/// Frames (DESIGN.md §2): W the OR world, R the real robot base, V the virtual robot base (the same
+/// Frames (docs/design.md): W the OR world, R the real robot base, V the virtual robot base (the same
 /// model, so a point fixed on link L is p_RQ = X_RL(q)·p_LQ on the real robot and p_VQ = p_RQ on the
 /// virtual one). A point Q of the robot is at p_WQ_real = X_WR·p_RQ and p_WQ_virtual = X_WV·p_RQ.
 ///

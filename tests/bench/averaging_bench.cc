@@ -1,13 +1,13 @@
 /// @file
 /// Rotation averaging cost: the Karcher (geodesic L2) mean, started from the chordal mean, beside
 /// the chordal (quaternion-eigenvector) mean alone, for N = 3, 10, 100, 1000 rotations in the same
-/// run; the ratio Karcher / chordal is printed after the table (DESIGN.md §6: a ratio against a
+/// run; the ratio Karcher / chordal is printed after the table (a ratio against a
 /// baseline measured in the same run). Also the robust pipeline (L1 median + MAD rejection +
 /// Karcher) for reference.
 ///
 /// Data: a fixed-seed cluster of R_WV_i = R_c·exp(δ_i), δ_i ~ N(0, (5°)²/3 per axis) (≈ 5° RMS
 /// angle, a realistic spread of user alignment trials), around a fixed centre R_c.
-/// Goal (issue 4): Karcher N = 3 ≤ 1.5 µs, N = 1000 ≤ 150 µs.
+/// Goal: Karcher N = 3 ≤ 1.5 µs, N = 1000 ≤ 150 µs.
 
 #include <unistd.h>
 #include <cmath>

@@ -1,5 +1,5 @@
 /// @file
-/// The HMD camera and displays per frame, one thread (DESIGN §4, issue 5 goals: render + JPEG of a
+/// The HMD camera and displays per frame, one thread (goals: render + JPEG of a
 /// 1280×720 frame <= 10 ms; reflective compositing <= 5 ms):
 ///   BM_RenderFrame           FK of the real robot + tessellation + z-buffered render of the shipped
 ///                            OR scene (HoloLens PV intrinsics) into BGR
