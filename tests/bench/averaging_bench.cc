@@ -106,7 +106,7 @@ int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   // Colour only on a terminal (ConsoleReporter itself ignores --benchmark_color when given to us).
-  orbed::registration::RatioReporter reporter(isatty(fileno(stdout))
+  orbed::geometry::RatioReporter reporter(isatty(fileno(stdout))
                                                   ? benchmark::ConsoleReporter::OO_ColorTabular
                                                   : benchmark::ConsoleReporter::OO_Tabular);
   benchmark::RunSpecifiedBenchmarks(&reporter);
