@@ -167,7 +167,7 @@ orbed::registration_t RegistrationService::MakeState(int64_t utime, int8_t reaso
     p.push_back(t.p_WV);
   }
   geometry::Se3MeanOptions options;
-  options.method = static_cast<AveragingMethod>(method_);
+  options.method = static_cast<geometry::AveragingMethod>(method_);
   options.p_VC = options_.p_VC;
   options.outlier = options_.outlier;
   const geometry::Se3MeanResult mean = geometry::ComputeSe3Mean(q, p, options);
