@@ -24,8 +24,9 @@
 /// Post() hands it a job with its inputs, latest wins: a job that finds the previous request of its
 /// kind still pending replaces it and counts as skipped, so that a busy frame never delays the
 /// caller. The callbacks are then called on the worker thread. Without threading Post() does the
-/// work at once on the caller's thread (deterministic). Post(), Flush() and the accessors may be
-/// called from any thread; the callbacks must not call back into the pipeline.
+/// work at once on the caller's thread (deterministic). Post() and Flush() are called from one
+/// thread (the owner's); RequestRecapture() and the Latest*() accessors from any. The callbacks must
+/// not call back into the pipeline.
 ///
 /// Clocks (injected, ImagePipelineClocks): wall_utime stamps REFLECTIVE_VIEW.utime [µs];
 /// monotonic_s paces the re-captures [s]. Everything else comes from the inputs.
