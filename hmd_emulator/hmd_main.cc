@@ -1,67 +1,8 @@
 /// @file
-/// orbed-hmd: the emulated headset (HoloLens 1) and the person wearing it (hmd_emulator/hmd_process.h).
-/// Subscribes: IIWA_STATUS (q), ROBOT_STATE (X_WR), SESSION_CONTROL (START / RESET / STOP /
-///             REQUEST_TRIAL), REGISTRATION (X_WV_mean, where the hologram is drawn).
-/// Publishes:  HMD_POSE + HMD_POSE_TRUTH (hmd_pose_t, --pose-hz, 60 Hz), HMD_CAMERA (image_t JPEG,
-///             --camera-hz, 30 Hz), GAZE_RAY (gaze_ray_t, 10 Hz), REFLECTIVE_VIEW (reflective_view_t,
-///             30 Hz per display, --displays), AR_VIEW (image_t JPEG, 5 Hz), ALIGNMENT_TRIAL
-///             (alignment_trial_t, one per REQUEST_TRIAL, or per Enter with --interactive),
-///             PROCESS_STATUS at 1 Hz. Channel names can be overridden by flags.
+/// orbed-hmd: the emulated headset (HoloLens 1) and the person wearing it. Flags, channels and exit
+/// codes: hmd_emulator/hmd_cli.h; the process: hmd_emulator/hmd_process.h.
 #include <iostream>
 
-#include "hmd_emulator/hmd_process.h"
+#include "hmd_emulator/hmd_cli.h"
 
-int main(int argc, char** argv) {
-  CLI::App app{
-      "orbed-hmd: the emulated headset (SLAM pose stream, camera, gaze, reflective-AR displays,\n"
-      "AR view) and its wearer, who performs a ViRAAl alignment trial on each SESSION_CONTROL\n"
-      "REQUEST_TRIAL; --interactive puts a person in its place (OpenCV window)."};
-  orbed::CommonFlags common("orbed-hmd");
-  orbed::AddCommonFlags(&app, &common);
-  orbed::hmd::HmdOptions o;
-  app.add_option("--urdf", o.urdf_path,
-                 "Robot URDF (default: sim/models/iiwa7.urdf under $ORBED_SOURCE_DIR, else the source tree)");
-  app.add_option("--scene", o.scene_path,
-                 "Scene YAML (default: sim/models/scenes/trocar_or.yaml, found like --urdf)");
-  app.add_option(
-      "--config", o.config_paths,
-      "YAML file(s) with slam:, user:, head_trajectory: and/or hmd: mappings, applied in order after "
-      "the shipped hmd_emulator/config/{slam,user,viraal_walk,hmd}.yaml (repeatable)");
-  app.add_option_function<std::uint64_t>(
-      "--user-seed", [&o](const std::uint64_t& seed) { o.user_seed = seed; },
-      "The emulated person (overrides user.seed): a different seed is a different person");
-  app.add_option("--camera-hz", o.camera_hz, "HMD_CAMERA rate [Hz]")->capture_default_str();
-  app.add_option("--pose-hz", o.pose_hz, "HMD_POSE / HMD_POSE_TRUTH rate [Hz]")->capture_default_str();
-  app.add_option("--jpeg-quality", o.jpeg_quality, "JPEG quality of every image, 1..100")
-      ->capture_default_str();
-  app.add_option("--displays", o.displays,
-                 "Reflective displays published live (placed by hmd.displays in the config)")
-      ->capture_default_str();
-  app.add_flag("--interactive", o.interactive,
-               "A person aligns instead of the emulated user: a window with the AR view and a reflective "
-               "display; keys nudge the virtual robot, Enter submits, h shows the keys");
-  app.add_option("--screenshot", o.screenshot_path,
-                 "With --interactive: write the window's image here at exit (PNG)");
-  app.add_option("--scripted-keys", o.scripted_keys,
-                 "With --interactive: keys typed one per refresh before real ones (\\n = Enter, \\e = Esc)");
-  app.add_option("--iiwa-status-channel", o.iiwa_status_channel)->capture_default_str();
-  app.add_option("--robot-state-channel", o.robot_state_channel)->capture_default_str();
-  app.add_option("--session-control-channel", o.session_control_channel)->capture_default_str();
-  app.add_option("--registration-channel", o.registration_channel)->capture_default_str();
-  app.add_option("--hmd-pose-channel", o.hmd_pose_channel)->capture_default_str();
-  app.add_option("--hmd-pose-truth-channel", o.hmd_pose_truth_channel)->capture_default_str();
-  app.add_option("--camera-channel", o.camera_channel)->capture_default_str();
-  app.add_option("--gaze-channel", o.gaze_channel)->capture_default_str();
-  app.add_option("--reflective-channel", o.reflective_channel)->capture_default_str();
-  app.add_option("--ar-view-channel", o.ar_view_channel)->capture_default_str();
-  app.add_option("--trial-channel", o.trial_channel)->capture_default_str();
-  CLI11_PARSE(app, argc, argv);
-  orbed::ApplyCommonFlags(common);
-  try {
-    orbed::hmd::HmdProcess hmd(common, o);
-    return hmd.Run();
-  } catch (const std::exception& e) {
-    std::cerr << "orbed-hmd: " << e.what() << "\n";
-    return 1;
-  }
-}
+int main(int argc, char** argv) { return orbed::hmd::RunHmd(argc, argv, std::cout, std::cerr); }

@@ -1,68 +1,50 @@
 #pragma once
 /// @file
-/// The orbed-hmd process (DESIGN.md §4 "orbed-hmd"): the headset and the person wearing it, wired to
-/// the bus. The engines (hmd_render_lib, hmd_user_lib) know nothing of LCM; this class feeds them
-/// what arrives and publishes what they produce.
+/// The orbed-hmd process: the headset and the person wearing it, wired to the bus. A thin shell:
+/// the work is done by cores that know nothing of LCM or of the clock, and this class feeds them
+/// what arrives, drives them from its timers and publishes what they produce:
+///   pose_stream.h      the walk, the SLAM model, HMD_POSE / HMD_POSE_TRUTH and GAZE_RAY;
+///   image_pipeline.h   HMD_CAMERA, REFLECTIVE_VIEW and AR_VIEW (threaded or inline);
+///   hmd_session.h      the SESSION_CONTROL state machine and its refusals;
+///   headset_trial.h    the emulated trial answering a REQUEST_TRIAL;
+///   interactive.h      the person at the window (--interactive).
 ///
 ///   Subscribes: IIWA_STATUS (iiwa_status_t): q of the real robot [rad] (drawn, and the trial's q);
 ///               ROBOT_STATE (robot_state_t): X_WR, the true robot base (drawn, and the trial's truth);
 ///               SESSION_CONTROL (session_control_t): START / RESET / STOP / REQUEST_TRIAL;
 ///               REGISTRATION (registration_t): X_WV_mean, where the hologram is drawn when valid.
-///   Publishes:  HMD_POSE and HMD_POSE_TRUTH (hmd_pose_t) at pose_hz: one SLAM sample as the device
-///               estimates it (X_WH_est, X_WC_est, tracking state) and the truth, same seq and utime;
-///               HMD_CAMERA (image_t, JPEG) at camera_hz: the scene and the real robot (latest q,
-///               X_WR) rendered from the TRUE camera pose of the latest sample, stamped with the
-///               ESTIMATED pose and that sample's utime (capture time = sample time), K_o;
-///               GAZE_RAY (gaze_ray_t) at hmd.gaze_hz: from the estimated head along its line of
-///               sight (toward the walk's look-at target), the hit found by ray casting the true
-///               ray against the scene and the real robot (distance and body), reported in map
-///               coordinates (origin_est + t · direction_est);
-///               REFLECTIVE_VIEW (reflective_view_t) at hmd.reflective_hz per display (--displays):
-///               the display's captured frame composited with the virtual robot at the current X_WV,
-///               K_m = diag(1, −1, 1) · K_o, X_WM = X_WC_est · [R_x(π) | (0, 0, D)], D = distance from
-///               the capture camera centre to the gaze hit on the robot (the real robot's surface
-///               along the capture-time line of sight; hmd.gaze_fallback_distance_m when the gaze
-///               misses the robot or no robot pose is known);
-///               AR_VIEW (image_t, JPEG) at hmd.ar_view_hz: the hologram at X_WV over the latest
-///               camera frame, drawn with that frame's estimated pose;
+///   Publishes:  HMD_POSE and HMD_POSE_TRUTH (hmd_pose_t) at pose_hz (pose_stream.h);
+///               HMD_CAMERA (image_t, JPEG) at camera_hz, REFLECTIVE_VIEW (reflective_view_t) at
+///               hmd.reflective_hz per display (--displays), AR_VIEW (image_t, JPEG) at
+///               hmd.ar_view_hz (image_pipeline.h), from the latest sample, robot and X_WV;
+///               GAZE_RAY (gaze_ray_t) at hmd.gaze_hz (pose_stream.h);
 ///               ALIGNMENT_TRIAL (alignment_trial_t): one per accepted REQUEST_TRIAL (emulated user)
 ///               or Enter (interactive); SESSION_CONTROL START once, for a local session, when a
 ///               person submits in interactive mode with no session active; PROCESS_STATUS at 1 Hz.
 ///
+/// The robot: one RobotState (robot_state.h), the latest valid q and X_WR.
 /// The current X_WV (map coordinates): in interactive mode the person's; otherwise the latest valid
 /// REGISTRATION.X_WV_mean (of the active session while one is active), else the emulated user's
 /// last X_WV, else the configured start offset X_WR_nominal · X_RV_start (user.yaml start_offset,
-/// X_WR_nominal from the scene file).
+/// X_WR_nominal from the scene file). A new session forgets the first two.
 ///
-/// Sessions (the contract with orbed-scenario): START opens session s with display_mode MODE_AR
-/// (num_mirrors must be 0) or MODE_AR_REFLECTIVE (1 <= num_mirrors <= the displays placed in
-/// hmd.yaml), trial index 0; a repeated START of the active session is a no-op; RESET sets the
-/// index to 0; STOP closes it. REQUEST_TRIAL for the active session: the emulated user performs one
-/// ViRAAl alignment at once, in emulated time (viraal_trial.h: its own walk along the configured
-/// path with its own SLAM model seeded from (--seed, session, index), displays capturing at their
-/// waypoints, alignment at hmd.align_waypoint) at the latest IIWA_STATUS q against the latest
-/// ROBOT_STATE X_WR, starting from the start offset; then ALIGNMENT_TRIAL {session, index (per
-/// session from 0), mode, num_mirrors, q, X_WV, duration_s = the emulated alignment time,
-/// user_id "emulated-seed-<user seed>"}. In interactive mode REQUEST_TRIAL only tells the person.
+/// Sessions (hmd_session.h): an accepted REQUEST_TRIAL runs RunHeadsetTrial() (headset_trial.h) at
+/// once, in emulated time, at the latest q against the latest X_WR from the start offset, seeded
+/// from (--seed, session, index); then ALIGNMENT_TRIAL {session, index (per session from 0), mode,
+/// num_mirrors, q, X_WV, duration_s = the emulated alignment time, user_id "emulated-seed-<user
+/// seed>"}. In interactive mode REQUEST_TRIAL only tells the person.
 ///
 /// Rejections (Process::Reject, key "<channel>/<class>"; the process keeps running):
 ///   IIWA_STATUS/num_joints, /non_finite, /limits (beyond a joint limit by > 0.01 rad);
 ///   ROBOT_STATE/pose (X_WR not finite or not a unit quaternion);
 ///   REGISTRATION/pose (a valid mean with a bad X_WV_mean);
-///   SESSION_CONTROL/command, /session_id (empty), /display_mode, /num_mirrors, /unknown_session
-///   (RESET/REQUEST_TRIAL for a session that is not the active one), /no_robot_state (REQUEST_TRIAL
-///   before any valid IIWA_STATUS and ROBOT_STATE: the trial needs q and X_WR), /trial_failed;
+///   SESSION_CONTROL/<key> with the keys of hmd_session.h, and /trial_failed;
 ///   and <channel>/decode for undecodable bytes (Process).
 ///
 /// Threading: handlers and timers run on the Process::Run() thread. With options.threaded (the
-/// default) the images (render, composite, JPEG) are made on one worker thread that the timers hand
-/// the latest state to (latest wins: a request that finds the previous one still pending replaces
-/// it and counts as a skipped frame), so that a frame never delays a 60 Hz pose; the worker
-/// publishes HMD_CAMERA, REFLECTIVE_VIEW and AR_VIEW itself (LCM's publish is thread-safe). Without
-/// it everything runs inline on the Run() thread (deterministic, for tests). A frame whose inputs
-/// (true camera pose, q, X_WR) equal the previous frame's reuses its JPEG bytes (a standing wearer
-/// and a resting arm give the same picture), restamped; REFLECTIVE_VIEW re-composites only when its
-/// frame or X_WV changed.
+/// default) the images are made on the pipeline's worker thread, which publishes them itself
+/// (LCM's publish is thread-safe), so that a frame never delays a 60 Hz pose. Without it
+/// everything runs inline on the Run() thread (deterministic, for tests).
 ///
 /// Clocks: message utimes are the wall clock (NowMicros) at sampling; the walk's time t [s] runs on
 /// the monotonic clock from the first pose tick.
@@ -85,11 +67,14 @@
 #include <orbed/session_control_t.hpp>
 
 #include "hmd_emulator/hmd_config.h"
+#include "hmd_emulator/hmd_session.h"
+#include "hmd_emulator/image_pipeline.h"
 #include "hmd_emulator/interactive.h"
+#include "hmd_emulator/pose_stream.h"
+#include "hmd_emulator/robot_state.h"
 #include "procs/common/channels.h"
 #include "procs/common/process.h"
 #include "sim/robot_model.h"
-#include "sim/scene.h"
 
 namespace orbed::hmd {
 
@@ -127,14 +112,14 @@ class HmdProcess {
  public:
   /// Loads the URDF, scene and configs (std::runtime_error naming the file and key), validates the
   /// options (std::invalid_argument naming the flag), opens LCM (std::runtime_error naming the URL),
-  /// starts the worker thread (threaded) and, when interactive, the window (std::runtime_error
-  /// without a display).
+  /// starts the worker thread (threaded). Interactive mode opens its window in Run().
   HmdProcess(const orbed::CommonFlags& flags, const HmdOptions& options);
   ~HmdProcess();
   HmdProcess(const HmdProcess&) = delete;
   HmdProcess& operator=(const HmdProcess&) = delete;
 
-  /// Runs until stopped; in interactive mode also until q/Esc. Writes the screenshot at the end.
+  /// Runs until stopped; in interactive mode also until q/Esc (std::runtime_error without a
+  /// display). Writes the screenshot at the end.
   int Run();
   orbed::Process& process() { return *process_; }
   const HmdOptions& options() const { return options_; }
@@ -158,57 +143,37 @@ class HmdProcess {
 
   /// The current X_WV (see the file comment) and the active session ("" when none).
   Eigen::Isometry3d CurrentX_WV() const;
-  const std::string& active_session() const { return session_.id; }
-  int64_t skipped_frames() const;
+  const std::string& active_session() const { return session_.state().id; }
+  int64_t skipped_frames() const { return pipeline_->skipped(); }
 
  private:
-  class ImagePipeline;
-  struct Session {
-    std::string id;
-    int8_t display_mode{0};
-    int32_t num_mirrors{0};
-    int8_t method{0};
-    int32_t next_index{0};
-  };
-  struct FrameInputs;
-
   void OnIiwaStatus(const orbed::iiwa_status_t& msg, const std::string& channel);
   void OnRobotState(const orbed::robot_state_t& msg, const std::string& channel);
   void OnSessionControl(const orbed::session_control_t& msg, const std::string& channel);
   void OnRegistration(const orbed::registration_t& msg, const std::string& channel);
   void EmulateTrial(const std::string& channel);
+  void SubmitInteractiveTrial();
   void PublishTrial(const Eigen::Isometry3d& X_WV, double duration_s, const std::string& user_id);
   void InteractiveTick();
   FrameInputs Inputs() const;
 
   HmdOptions options_;
   HmdConfigSet config_;
-  sim::Scene scene_;
-  std::unique_ptr<sim::RobotModel> robot_;
+  std::unique_ptr<sim::RobotModel> robot_model_;
   std::unique_ptr<orbed::Process> process_;
+  std::unique_ptr<PoseStream> stream_;
   std::unique_ptr<ImagePipeline> pipeline_;
-  struct Live;
-  std::unique_ptr<Live> live_;  // head trajectory, SLAM model, latest sample, ray-cast geometry
+  HmdSession session_;
+  std::optional<InteractiveSession> interactive_;  // always set; the person only with --interactive
+  std::chrono::steady_clock::time_point t0_;       // the walk's t = 0: the first pose tick
+  bool started_{false};
+  bool window_open_{false};
 
   // Latest valid inputs (Run() thread).
-  bool have_q_{false}, have_X_WR_{false};
-  Eigen::VectorXd q_rad_;
-  Eigen::Isometry3d X_WR_{Eigen::Isometry3d::Identity()};
-  Session session_;
+  RobotState robot_;
   std::optional<Eigen::Isometry3d> X_WV_registration_, X_WV_user_;
   Eigen::Isometry3d X_WV_start_{Eigen::Isometry3d::Identity()};
-  Eigen::Isometry3d X_WV_manual_{Eigen::Isometry3d::Identity()};  // interactive
-  std::unique_ptr<EmulatedUser> user_;
   std::string user_id_;
-
-  // Interactive mode.
-  InteractiveState ui_;
-  bool trial_requested_{false};
-  std::chrono::steady_clock::time_point trial_started_{std::chrono::steady_clock::now()};
-  std::string last_event_;
-  std::size_t scripted_next_{0};
-  cv::Mat last_window_;
-  bool window_open_{false};
 };
 
 }  // namespace orbed::hmd

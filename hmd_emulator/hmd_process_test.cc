@@ -9,7 +9,8 @@
 //   - HMD_CAMERA is a 1280×720 JPEG with the HoloLens PV intrinsics stamped with the estimated
 //     pose of the sample it was rendered at; REFLECTIVE_VIEW's K_m = diag(1, −1, 1)·K_o and X_WM is
 //     the camera turned π about x and moved D along its principal ray (computed here by hand);
-//   - the interactive mode's keys move the hologram by the shown steps and Enter submits a trial.
+//   - the interactive mode's keys move the hologram by the shown steps and Enter submits a trial;
+//   - a published trial equals RunHeadsetTrial() (headset_trial.h) of the same inputs.
 #include "hmd_emulator/hmd_process.h"
 
 #include <cmath>
@@ -25,6 +26,7 @@
 #include <orbed/reflective_view_t.hpp>
 
 #include "hmd_emulator/gaze.h"
+#include "hmd_emulator/headset_trial.h"
 #include "hmd_emulator/renderer.h"
 #include "procs/common/conversions.h"
 
@@ -204,6 +206,49 @@ TEST(HmdProcess, SameSeedSameSessionGivesTheSameTrial) {
   }
   for (int i = 0; i < 3; ++i) EXPECT_EQ(runs[0].X_WV.position_m[i], runs[1].X_WV.position_m[i]);
   EXPECT_EQ(runs[0].duration_s, runs[1].duration_s);
+}
+
+// The published trial is RunHeadsetTrial() of the same inputs (headset_trial.h), bit for bit: what
+// another program gets when it calls the function with the process's seed, session and index.
+TEST(HmdProcess, PublishedTrialIsTheHeadsetTrialFunction) {
+  CommonFlags flags = MemqFlags(0.2);
+  flags.seed = 7;
+  HmdProcess hmd(flags, Inline());
+  Collector got;
+  got.Attach(hmd.process().lcm());
+  const Eigen::Isometry3d X_WR = SceneX_WR() * Eigen::Translation3d(0.004, -0.003, 0.0);
+  const auto status = Status(kQDeg);
+  const auto state = State(X_WR);
+  const auto start = Control("fn", +SC::START, +AT::MODE_AR_REFLECTIVE, 2);
+  const auto request = Control("fn", +SC::REQUEST_TRIAL);
+  hmd.process().lcm().publish("IIWA_STATUS", &status);
+  hmd.process().lcm().publish("ROBOT_STATE", &state);
+  hmd.process().lcm().publish("SESSION_CONTROL", &start);
+  hmd.process().lcm().publish("SESSION_CONTROL", &request);
+  hmd.process().lcm().publish("SESSION_CONTROL", &request);
+  EXPECT_EQ(hmd.Run(), 0);
+  ASSERT_EQ(got.trials.size(), 2u);
+
+  const sim::Scene scene = sim::LoadSceneFile(HmdSourcePath(sim::kDefaultSceneRelativePath));
+  const sim::RobotModel robot =
+      sim::LoadRobotForScene(HmdSourcePath(sim::RobotModel::kDefaultUrdfRelativePath), scene);
+  HeadsetTrialInputs in;
+  in.p_RQ = RobotModelPoints(robot, ToVectorX(status.joint_position_measured));
+  in.X_WR = FromPose(state.X_WR);
+  in.X_WV_start = EmulatedUser(hmd.config().user).StartPose(scene.X_WR);
+  in.process_seed = 7;
+  in.session_id = "fn";
+  in.num_mirrors = 2;
+  for (int32_t index = 0; index < 2; ++index) {
+    in.trial_index = index;
+    const TrialOutcome outcome = RunHeadsetTrial(hmd.config(), in);
+    const orbed::alignment_trial_t& t = got.trials[index];
+    EXPECT_EQ(t.trial_index, index);
+    const orbed::pose_t X_WV = ToPose(outcome.alignment.X_WV);
+    for (int i = 0; i < 3; ++i) EXPECT_EQ(t.X_WV.position_m[i], X_WV.position_m[i]) << index;
+    for (int i = 0; i < 4; ++i) EXPECT_EQ(t.X_WV.quaternion_wxyz[i], X_WV.quaternion_wxyz[i]) << index;
+    EXPECT_EQ(t.duration_s, outcome.alignment.duration_s);
+  }
 }
 
 TEST(HmdProcess, RejectsBadInputsPerReasonAndKeepsRunning) {

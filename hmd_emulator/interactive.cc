@@ -6,10 +6,10 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "base/units.h"
+
 namespace orbed::hmd {
 namespace {
-
-constexpr double kDeg = M_PI / 180.0;
 
 void Rotate(const Eigen::Vector3d& axis_W, double angle_rad, Eigen::Isometry3d* X_WV) {
   X_WV->linear() = Eigen::AngleAxisd(angle_rad, axis_W).toRotationMatrix() * X_WV->linear();
@@ -36,7 +36,7 @@ cv::Mat Panel(const cv::Mat& image, int width, int height, const std::string& ti
 }  // namespace
 
 KeyAction ApplyKey(int key, int num_displays, InteractiveState* s, Eigen::Isometry3d* X_WV) {
-  const double t = s->step_m, r = s->step_deg * kDeg;
+  const double t = s->step_m, r = s->step_deg * kDegToRad;
   switch (key & 0xFF) {
     case 'a':
       X_WV->translation().x() -= t;
@@ -161,6 +161,90 @@ cv::Mat WindowImage(const cv::Mat& ar_view, const cv::Mat& reflective, const Int
     }
   }
   return window;
+}
+
+std::vector<int> ScriptedKeys(const std::string& text) {
+  std::vector<int> keys;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    if (text[i] == '\\' && i + 1 < text.size() && (text[i + 1] == 'n' || text[i + 1] == 'e')) {
+      keys.push_back(text[++i] == 'n' ? 13 : 27);
+    } else {
+      keys.push_back(static_cast<unsigned char>(text[i]));
+    }
+  }
+  return keys;
+}
+
+InteractiveSession::InteractiveSession(int num_displays, const Eigen::Isometry3d& X_WV_start,
+                                       const std::string& scripted_keys, double now_s)
+    : num_displays_(num_displays),
+      X_WV_start_(X_WV_start),
+      X_WV_(X_WV_start),
+      scripted_(ScriptedKeys(scripted_keys)),
+      trial_started_s_(now_s) {}
+
+InteractiveSession::Request InteractiveSession::HandleKey(int key) {
+  switch (ApplyKey(key, num_displays_, &ui_, &X_WV_)) {
+    case KeyAction::kReset:
+      X_WV_ = X_WV_start_;
+      last_event_ = "back at the start pose";
+      return Request::kNone;
+    case KeyAction::kRecapture:
+      last_event_ = "display " + std::to_string(ui_.shown_display) + " re-captured from here";
+      return Request::kRecapture;
+    case KeyAction::kQuit:
+      return Request::kQuit;
+    case KeyAction::kSubmit:
+      return Request::kSubmit;
+    default:
+      return Request::kNone;
+  }
+}
+
+int InteractiveSession::NextScriptedKey() {
+  return scripted_next_ < scripted_.size() ? scripted_[scripted_next_++] : -1;
+}
+
+const std::string& InteractiveSession::TrialRequested(const std::string& session_id, int32_t index,
+                                                      double now_s) {
+  trial_requested_ = true;
+  trial_started_s_ = now_s;
+  last_event_ = "trial " + std::to_string(index) + " of '" + session_id +
+                "' requested: align the hologram, then press Enter";
+  return last_event_;
+}
+
+double InteractiveSession::Submitted(const std::string& session_id, int32_t index, double now_s) {
+  const double duration_s = now_s - trial_started_s_;
+  trial_requested_ = false;
+  trial_started_s_ = now_s;
+  char seconds[32];
+  std::snprintf(seconds, sizeof(seconds), "%.1f", duration_s);
+  last_event_ = "submitted trial " + std::to_string(index) + " of '" + session_id + "' (" + seconds + " s)";
+  return duration_s;
+}
+
+cv::Mat InteractiveSession::Window(const cv::Mat& ar_view, const cv::Mat& reflective,
+                                   const HmdSessionState& session, const Eigen::Isometry3d& X_WV_shown,
+                                   bool robot_known, const std::string& tracking) const {
+  std::vector<std::string> lines;
+  std::string line = session.active()
+                         ? session.Describe() + ", next trial " + std::to_string(session.next_index)
+                         : std::string("no session (Enter starts a local one)");
+  if (trial_requested_) line += "   >> TRIAL REQUESTED: align, then Enter <<";
+  lines.push_back(line);
+  const Eigen::Isometry3d& X_WV = X_WV_shown;
+  const Eigen::Vector3d dp_mm = (X_WV.translation() - X_WV_start_.translation()) * 1e3;
+  const double dtheta_deg =
+      Eigen::AngleAxisd(X_WV_start_.linear().transpose() * X_WV.linear()).angle() * 180.0 / M_PI;
+  char text[256];
+  std::snprintf(text, sizeof(text),
+                "X_WV from the start pose: (%+.1f, %+.1f, %+.1f) mm, %.2f deg   robot: %s   tracking: %s",
+                dp_mm.x(), dp_mm.y(), dp_mm.z(), dtheta_deg,
+                robot_known ? "live" : "waiting for IIWA_STATUS + ROBOT_STATE", tracking.c_str());
+  lines.push_back(text);
+  lines.push_back(last_event_.empty() ? std::string(" ") : last_event_);
+  return WindowImage(ar_view, reflective, ui_, lines);
 }
 
 }  // namespace orbed::hmd

@@ -14,14 +14,22 @@
 ///   c       re-capture the shown display from the current view
 ///   Enter   submit the alignment trial   h   help overlay on/off      q / Esc   quit
 ///
-/// Frames: W world (map), V virtual robot base. Units: m, deg where named.
-/// Threading: pure functions of their arguments.
+/// InteractiveSession holds the rest of the person's side without a window, a bus or a clock: the
+/// hologram pose they set, the requested-trial flag and its timer (times come in as arguments),
+/// the last event line, the scripted keys, and the window's status lines. orbed-hmd's shell acts on
+/// what HandleKey() asks (re-capture, quit, submit) and shows Window().
+///
+/// Frames: W world (map), V virtual robot base. Units: m, deg where named, s.
+/// Threading: pure functions of their arguments; an InteractiveSession is not synchronised (one
+/// thread, the Process::Run() thread).
 
 #include <string>
 #include <vector>
 
 #include <Eigen/Geometry>
 #include <opencv2/core.hpp>
+
+#include "hmd_emulator/hmd_session.h"
 
 namespace orbed::hmd {
 
@@ -56,5 +64,64 @@ std::vector<std::string> InteractiveHelpLines();
 /// overlay when state.show_help. Returns CV_8UC3.
 cv::Mat WindowImage(const cv::Mat& ar_view, const cv::Mat& reflective, const InteractiveState& state,
                     const std::vector<std::string>& status_lines, int panel_width_px = 800);
+
+/// Decodes the two-character escapes "\n" (Enter, 13) and "\e" (Esc, 27) of --scripted-keys; every
+/// other byte is its own key code.
+std::vector<int> ScriptedKeys(const std::string& text);
+
+class InteractiveSession {
+ public:
+  /// What a key asks of the shell beyond this object.
+  enum class Request {
+    kNone,
+    kRecapture,  ///< re-capture shown_display() from the current view
+    kQuit,
+    kSubmit,  ///< submit an ALIGNMENT_TRIAL at X_WV() (then Submitted() or CannotSubmit())
+  };
+
+  /// The hologram starts at X_WV_start; `scripted_keys` as --scripted-keys; the trial timer starts
+  /// at now_s [s, any monotonic origin].
+  InteractiveSession(int num_displays, const Eigen::Isometry3d& X_WV_start, const std::string& scripted_keys,
+                     double now_s);
+
+  /// Applies one key (ApplyKey(); 0 puts the hologram back at the start pose).
+  Request HandleKey(int key);
+  /// The next scripted key, one per call, or -1 once all were typed.
+  int NextScriptedKey();
+
+  /// Restarts the trial timer (e.g. when the window opens).
+  void RestartTimer(double now_s) { trial_started_s_ = now_s; }
+  /// A REQUEST_TRIAL for trial `index` of `session_id` arrived: asks the person, restarts the
+  /// timer. Returns the event line.
+  const std::string& TrialRequested(const std::string& session_id, int32_t index, double now_s);
+  /// The trial was submitted now: returns its duration since the request, the previous submission
+  /// or the timer's start [s]; clears the request and restarts the timer.
+  double Submitted(const std::string& session_id, int32_t index, double now_s);
+  /// Sets the event line (shown in the window).
+  void SetEvent(std::string event) { last_event_ = std::move(event); }
+
+  const Eigen::Isometry3d& X_WV() const { return X_WV_; }
+  const Eigen::Isometry3d& X_WV_start() const { return X_WV_start_; }
+  int shown_display() const { return ui_.shown_display; }
+  bool trial_requested() const { return trial_requested_; }
+  const std::string& last_event() const { return last_event_; }
+
+  /// The window (WindowImage()) with the status lines: the session, the offset of the hologram
+  /// drawn (X_WV_shown) from the start pose, whether the robot is live, the tracking state
+  /// (`tracking`, "-" when none), and the last event.
+  cv::Mat Window(const cv::Mat& ar_view, const cv::Mat& reflective, const HmdSessionState& session,
+                 const Eigen::Isometry3d& X_WV_shown, bool robot_known, const std::string& tracking) const;
+
+ private:
+  int num_displays_;
+  Eigen::Isometry3d X_WV_start_;
+  Eigen::Isometry3d X_WV_;
+  InteractiveState ui_;
+  std::vector<int> scripted_;
+  std::size_t scripted_next_{0};
+  bool trial_requested_{false};
+  double trial_started_s_{0};
+  std::string last_event_;
+};
 
 }  // namespace orbed::hmd

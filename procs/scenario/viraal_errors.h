@@ -19,7 +19,7 @@
 ///   - flange_translation_m: the same at the flange origin F.
 ///   - landmark pairs: p_W_real / p_W_virtual of each landmark (a link origin, e.g. elbow
 ///     iiwa_link_4, wrist iiwa_link_6, flange iiwa_link_ee), the input of the paper's Table 1
-///     misalignment (procs/registration_server/misalignment.h), which orbed-registration evaluates.
+///     misalignment (geometry/misalignment.h), which orbed-registration evaluates.
 ///
 /// For a session's mean X_WV there is no single q: EvaluateOverConfigurations averages the point
 /// errors over the session's configurations and concatenates their landmark pairs.

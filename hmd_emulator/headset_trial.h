@@ -1,0 +1,70 @@
+#pragma once
+/// @file
+/// The emulated trial that orbed-hmd runs for each accepted SESSION_CONTROL REQUEST_TRIAL, as one
+/// pure function: any program that passes the same inputs gets the same TrialOutcome, bit for bit
+/// (the process publishes outcome.alignment.X_WV and .duration_s on ALIGNMENT_TRIAL).
+///
+/// The trial (viraal_trial.h): the emulated person of config.user walks config.walk with their own
+/// SLAM model (config.slam, its seed replaced by the trial's), the first num_mirrors displays of
+/// config.hmd.displays capture their frames at their waypoints, and the person aligns the virtual
+/// robot at config.hmd.align_waypoint (after config.hmd.settle_s, waiting up to
+/// config.hmd.max_wait_s for tracking), starting from X_WV_start, against the real robot at X_WR
+/// whose model points at the trial's q are p_RQ.
+///
+/// Seeds: every trial draws from its own seeds, derived from (process seed, session id, trial
+/// index, purpose) by TrialSeed(): purpose kSlamSeedPurpose for the SLAM walk, kTrialSeedPurpose
+/// for the person's per-trial randomness. The same process seed, session and index give the same
+/// trial whatever happened before it; another index or session gives an independent draw.
+///
+/// Frames: W world (= the SLAM map for estimates), R real robot base, V virtual robot base.
+/// Units: m, rad, s.
+/// Threading: pure functions of their arguments; reentrant. No LCM, no clock, no process state.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "hmd_emulator/hmd_config.h"
+#include "hmd_emulator/viraal_trial.h"
+
+namespace orbed::hmd {
+
+/// TrialSeed() purposes.
+inline constexpr std::uint64_t kSlamSeedPurpose = 1;
+inline constexpr std::uint64_t kTrialSeedPurpose = 2;
+
+/// Sebastiano Vigna's SplitMix64 finaliser: a bijective mix of the 64 bits of x.
+std::uint64_t SplitMix64(std::uint64_t x);
+
+/// The seed for one purpose of trial `index` of `session_id` in a process seeded with `seed`:
+/// SplitMix64 over the seed, the 64-bit FNV-1a hash of the session id, the index and the purpose.
+std::uint64_t TrialSeed(std::uint64_t seed, const std::string& session_id, std::int32_t index,
+                        std::uint64_t purpose);
+
+/// What one emulated headset trial is made of, besides the configuration.
+struct HeadsetTrialInputs {
+  /// Model points of the robot at the trial's joint vector q, in R (RobotModelPoints(model, q)) [m].
+  std::vector<Eigen::Vector3d> p_RQ;
+  /// The real robot base (truth) [m].
+  Eigen::Isometry3d X_WR{Eigen::Isometry3d::Identity()};
+  /// Where the hologram starts, in map coordinates (orbed-hmd: X_WR_nominal · user.X_RV_start).
+  Eigen::Isometry3d X_WV_start{Eigen::Isometry3d::Identity()};
+  std::uint64_t process_seed{1};  ///< --seed of orbed-hmd
+  std::string session_id;
+  std::int32_t trial_index{0};  ///< per session, from 0
+  /// Displays used (the session's num_mirrors): the first num_mirrors of config.hmd.displays.
+  std::int32_t num_mirrors{0};
+};
+
+/// The TrialSetup (viraal_trial.h) of a headset trial: the walk, the capture and alignment
+/// waypoints and times of `config`, the HoloLens PV intrinsics, and X_WR and p_RQ of `inputs`.
+/// Throws std::invalid_argument when num_mirrors is negative or exceeds the displays placed.
+TrialSetup MakeHeadsetTrialSetup(const HmdConfigSet& config, const HeadsetTrialInputs& inputs);
+
+/// Runs the trial (see the file comment). Throws std::invalid_argument as MakeHeadsetTrialSetup()
+/// and RunTrial() do.
+TrialOutcome RunHeadsetTrial(const HmdConfigSet& config, const HeadsetTrialInputs& inputs);
+
+}  // namespace orbed::hmd

@@ -1,0 +1,69 @@
+#include "hmd_emulator/hmd_cli.h"
+
+#include <cstdint>
+#include <exception>
+
+#include "hmd_emulator/hmd_process.h"
+
+namespace orbed::hmd {
+
+int RunHmd(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
+  CLI::App app{
+      "orbed-hmd: the emulated headset (SLAM pose stream, camera, gaze, reflective-AR displays,\n"
+      "AR view) and its wearer, who performs a ViRAAl alignment trial on each SESSION_CONTROL\n"
+      "REQUEST_TRIAL; --interactive puts a person in its place (OpenCV window)."};
+  orbed::CommonFlags common("orbed-hmd");
+  orbed::AddCommonFlags(&app, &common);
+  HmdOptions o;
+  app.add_option("--urdf", o.urdf_path,
+                 "Robot URDF (default: sim/models/iiwa7.urdf under $ORBED_SOURCE_DIR, else the source tree)");
+  app.add_option("--scene", o.scene_path,
+                 "Scene YAML (default: sim/models/scenes/trocar_or.yaml, found like --urdf)");
+  app.add_option(
+      "--config", o.config_paths,
+      "YAML file(s) with slam:, user:, head_trajectory: and/or hmd: mappings, applied in order after "
+      "the shipped hmd_emulator/config/{slam,user,viraal_walk,hmd}.yaml (repeatable)");
+  app.add_option_function<std::uint64_t>(
+      "--user-seed", [&o](const std::uint64_t& seed) { o.user_seed = seed; },
+      "The emulated person (overrides user.seed): a different seed is a different person");
+  app.add_option("--camera-hz", o.camera_hz, "HMD_CAMERA rate [Hz]")->capture_default_str();
+  app.add_option("--pose-hz", o.pose_hz, "HMD_POSE / HMD_POSE_TRUTH rate [Hz]")->capture_default_str();
+  app.add_option("--jpeg-quality", o.jpeg_quality, "JPEG quality of every image, 1..100")
+      ->capture_default_str();
+  app.add_option("--displays", o.displays,
+                 "Reflective displays published live (placed by hmd.displays in the config)")
+      ->capture_default_str();
+  app.add_flag("--interactive", o.interactive,
+               "A person aligns instead of the emulated user: a window with the AR view and a reflective "
+               "display; keys nudge the virtual robot, Enter submits, h shows the keys");
+  app.add_option("--screenshot", o.screenshot_path,
+                 "With --interactive: write the window's image here at exit (PNG)");
+  app.add_option("--scripted-keys", o.scripted_keys,
+                 "With --interactive: keys typed one per refresh before real ones (\\n = Enter, \\e = Esc)");
+  app.add_option("--iiwa-status-channel", o.iiwa_status_channel)->capture_default_str();
+  app.add_option("--robot-state-channel", o.robot_state_channel)->capture_default_str();
+  app.add_option("--session-control-channel", o.session_control_channel)->capture_default_str();
+  app.add_option("--registration-channel", o.registration_channel)->capture_default_str();
+  app.add_option("--hmd-pose-channel", o.hmd_pose_channel)->capture_default_str();
+  app.add_option("--hmd-pose-truth-channel", o.hmd_pose_truth_channel)->capture_default_str();
+  app.add_option("--camera-channel", o.camera_channel)->capture_default_str();
+  app.add_option("--gaze-channel", o.gaze_channel)->capture_default_str();
+  app.add_option("--reflective-channel", o.reflective_channel)->capture_default_str();
+  app.add_option("--ar-view-channel", o.ar_view_channel)->capture_default_str();
+  app.add_option("--trial-channel", o.trial_channel)->capture_default_str();
+  try {
+    app.parse(argc, argv);
+    orbed::ApplyCommonFlags(common);  // CLI::ValidationError on a bad --log-level
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e, out, err);  // as CLI11_PARSE: --help on `out` (0), errors on `err`
+  }
+  try {
+    HmdProcess hmd(common, o);
+    return hmd.Run();
+  } catch (const std::exception& e) {
+    err << "orbed-hmd: " << e.what() << "\n";
+    return 1;
+  }
+}
+
+}  // namespace orbed::hmd

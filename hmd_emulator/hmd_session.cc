@@ -1,0 +1,94 @@
+#include "hmd_emulator/hmd_session.h"
+
+#include <utility>
+#include <variant>
+
+#include <orbed/alignment_trial_t.hpp>
+
+namespace orbed::hmd {
+namespace {
+
+using Kind = SessionDecision::Kind;
+
+SessionDecision Refuse(std::string key, std::string reason) {
+  SessionDecision d;
+  d.kind = Kind::kRefuse;
+  d.refusal = Refusal{std::move(key), std::move(reason)};
+  return d;
+}
+
+SessionDecision Decide(Kind kind, std::string event = "") {
+  SessionDecision d;
+  d.kind = kind;
+  d.event = std::move(event);
+  return d;
+}
+
+}  // namespace
+
+const char* DisplayModeName(std::int8_t display_mode) {
+  return display_mode == orbed::alignment_trial_t::MODE_AR_REFLECTIVE ? "ar_reflective" : "ar";
+}
+
+std::string HmdSessionState::Describe() const {
+  return "session '" + id + "' (" + DisplayModeName(display_mode) + ", " + std::to_string(num_mirrors) +
+         " display(s))";
+}
+
+HmdSession::HmdSession(HmdSessionOptions options) : options_(std::move(options)) {}
+
+SessionDecision HmdSession::Handle(const orbed::session_control_t& msg, RobotKnown robot) {
+  auto checked = CheckSessionControl(msg);
+  if (const Refusal* refusal = std::get_if<Refusal>(&checked)) return Refuse(refusal->key, refusal->reason);
+  return Apply(std::get<SessionCommand>(checked), robot);
+}
+
+SessionDecision HmdSession::Apply(const SessionCommand& command, RobotKnown robot) {
+  using K = SessionCommand::Kind;
+  if (command.kind == K::kStart) {
+    if (command.num_mirrors > options_.displays_placed) {
+      return Refuse("num_mirrors", "SESSION_CONTROL START '" + command.session_id + "': num_mirrors " +
+                                       std::to_string(command.num_mirrors) + ", but hmd.displays places " +
+                                       std::to_string(options_.displays_placed) + " display(s)");
+    }
+    if (command.RepeatsStartOf(state_.id, state_.display_mode, state_.num_mirrors)) {
+      return Decide(Kind::kRepeatedStart);
+    }
+    state_ =
+        HmdSessionState{command.session_id, command.display_mode, command.num_mirrors, command.method, 0};
+    return Decide(Kind::kStart, "session '" + state_.id + "' started (" +
+                                    DisplayModeName(state_.display_mode) + ", " +
+                                    std::to_string(state_.num_mirrors) + " display(s))");
+  }
+  if (command.kind == K::kCompute) return Decide(Kind::kIgnore);
+  if (command.session_id != state_.id) {
+    return Refuse("unknown_session", std::string(SessionCommandName(command.kind)) + " for session '" +
+                                         command.session_id + "', the active session is '" +
+                                         (state_.active() ? state_.id : std::string("(none)")) + "'" +
+                                         (command.kind == K::kRequestTrial ? " (send START first)" : ""));
+  }
+  switch (command.kind) {
+    case K::kReset:
+      state_.next_index = 0;
+      return Decide(Kind::kReset);
+    case K::kStop: {
+      const std::string event =
+          "session '" + state_.id + "' stopped after " + std::to_string(state_.next_index) + " trial(s)";
+      state_ = HmdSessionState{};
+      return Decide(Kind::kStop, event);
+    }
+    default:  // kRequestTrial
+      break;
+  }
+  if (!(robot.q && robot.X_WR)) {
+    return Refuse("no_robot_state",
+                  "REQUEST_TRIAL for session '" + command.session_id + "' before any valid " +
+                      (robot.q ? "" : options_.iiwa_status_channel + (robot.X_WR ? "" : " and ")) +
+                      (robot.X_WR ? "" : options_.robot_state_channel) +
+                      ": the user cannot align without the robot's configuration and base pose (is "
+                      "orbed-iiwa-sim running?)");
+  }
+  return Decide(Kind::kRequestedTrial);
+}
+
+}  // namespace orbed::hmd

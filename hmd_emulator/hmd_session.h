@@ -1,0 +1,100 @@
+#pragma once
+/// @file
+/// The headset's session state machine (the contract with orbed-scenario), without a bus or a
+/// clock: SESSION_CONTROL commands in, decisions out. HmdProcess (hmd_process.h) feeds it what
+/// arrives and acts on the decision (refuse, forget the hologram pose, run or announce a trial).
+///
+/// Every message is first checked by the common validator (orbed::CheckSessionControl,
+/// procs/common/session_control.h: refusal keys session_id, command, display_mode, num_mirrors,
+/// method); the headset then adds its own checks:
+///   - START: num_mirrors <= the displays placed in hmd.yaml (key "num_mirrors");
+///   - RESET, STOP, REQUEST_TRIAL for a session that is not the active one (key "unknown_session");
+///   - REQUEST_TRIAL before a valid joint vector q and base pose X_WR are known (key
+///     "no_robot_state": the person cannot align without the robot).
+/// The emulated trial itself may still fail; the shell refuses that under "trial_failed".
+///
+/// Transitions: START opens session s (mode, mirrors, method), trial index 0, replacing any other;
+/// a repeated START of the active session with the same mode and mirrors is a no-op (e.g. the
+/// headset's own local START, echoed back); RESET sets the index to 0; STOP closes the session;
+/// COMPUTE is for the registration server (ignored); REQUEST_TRIAL accepted means "run trial
+/// next_index now", and the caller takes the index with TakeTrialIndex() when it publishes.
+///
+/// Threading: not synchronised; one thread (the Process::Run() thread).
+
+#include <cstdint>
+#include <string>
+
+#include <orbed/session_control_t.hpp>
+
+#include "procs/common/session_control.h"
+
+namespace orbed::hmd {
+
+/// "ar_reflective" for alignment_trial_t::MODE_AR_REFLECTIVE, else "ar".
+const char* DisplayModeName(std::int8_t display_mode);
+
+/// The active session ("" id = none).
+struct HmdSessionState {
+  std::string id;
+  std::int8_t display_mode{0};  ///< alignment_trial_t::MODE_*
+  std::int32_t num_mirrors{0};
+  std::int8_t method{0};  ///< registration_t::METHOD_*
+  std::int32_t next_index{0};
+
+  bool active() const { return !id.empty(); }
+  /// "session 's' (ar_reflective, 1 display(s))".
+  std::string Describe() const;
+};
+
+/// What the robot state is known to be, as far as the session cares.
+struct RobotKnown {
+  bool q{false};     ///< a valid IIWA_STATUS arrived
+  bool X_WR{false};  ///< a valid ROBOT_STATE arrived
+};
+
+struct SessionDecision {
+  enum class Kind {
+    kRefuse,          ///< refusal.key / refusal.reason; nothing changed
+    kStart,           ///< a new session is active (the previous one's hologram poses are stale)
+    kRepeatedStart,   ///< the active session again: nothing changed
+    kReset,           ///< the trial index is back at 0
+    kStop,            ///< the session closed
+    kIgnore,          ///< COMPUTE: not for the headset
+    kRequestedTrial,  ///< run (or ask the person for) trial state().next_index now
+  };
+  Kind kind{Kind::kIgnore};
+  Refusal refusal;    ///< kRefuse only
+  std::string event;  ///< kStart, kStop: one line for the log
+};
+
+struct HmdSessionOptions {
+  int displays_placed{0};  ///< hmd.displays.size(): START's num_mirrors bound
+  /// Named in the no_robot_state reason.
+  std::string iiwa_status_channel{"IIWA_STATUS"};
+  std::string robot_state_channel{"ROBOT_STATE"};
+};
+
+class HmdSession {
+ public:
+  explicit HmdSession(HmdSessionOptions options = {});
+
+  /// Checks `msg` with orbed::CheckSessionControl, then Apply().
+  SessionDecision Handle(const orbed::session_control_t& msg, RobotKnown robot);
+  /// Applies a checked command (see the file comment).
+  SessionDecision Apply(const SessionCommand& command, RobotKnown robot);
+
+  /// Opens `state` as the active session without a message (the interactive headset's local
+  /// session, which it announces itself); state.next_index is kept.
+  void Open(const HmdSessionState& state) { state_ = state; }
+
+  /// Returns the active session's next trial index and advances it.
+  std::int32_t TakeTrialIndex() { return state_.next_index++; }
+
+  const HmdSessionState& state() const { return state_; }
+
+ private:
+  HmdSessionOptions options_;
+  HmdSessionState state_;
+};
+
+}  // namespace orbed::hmd

@@ -1,0 +1,207 @@
+// The headset's session state machine on its own: every command path, the refusals with their keys
+// (the common validator's and the headset's own), repeated START as a no-op, and commands for a
+// session that is not the active one.
+#include "hmd_emulator/hmd_session.h"
+
+#include <string>
+
+#include <gtest/gtest.h>
+#include <orbed/alignment_trial_t.hpp>
+#include <orbed/registration_t.hpp>
+
+namespace orbed::hmd {
+namespace {
+
+using SC = orbed::session_control_t;
+using AT = orbed::alignment_trial_t;
+using Kind = SessionDecision::Kind;
+
+constexpr RobotKnown kRobot{true, true};
+constexpr RobotKnown kNoRobot{false, false};
+
+orbed::session_control_t Control(const std::string& id, int8_t command, int8_t mode = +AT::MODE_AR,
+                                 int32_t mirrors = 0,
+                                 int8_t method = +orbed::registration_t::METHOD_KARCHER) {
+  orbed::session_control_t m{};
+  m.utime = 1000;
+  m.session_id = id;
+  m.command = command;
+  m.display_mode = mode;
+  m.num_mirrors = mirrors;
+  m.method = method;
+  return m;
+}
+
+HmdSession TwoDisplays() { return HmdSession({2, "IIWA_STATUS", "ROBOT_STATE"}); }
+
+TEST(HmdSession, StartOpensTheSessionAtIndexZero) {
+  HmdSession session = TwoDisplays();
+  EXPECT_FALSE(session.state().active());
+  const SessionDecision d = session.Handle(Control("s", +SC::START, +AT::MODE_AR_REFLECTIVE, 2), kNoRobot);
+  EXPECT_EQ(d.kind, Kind::kStart);
+  EXPECT_EQ(d.event, "session 's' started (ar_reflective, 2 display(s))");
+  EXPECT_TRUE(session.state().active());
+  EXPECT_EQ(session.state().id, "s");
+  EXPECT_EQ(session.state().display_mode, +AT::MODE_AR_REFLECTIVE);
+  EXPECT_EQ(session.state().num_mirrors, 2);
+  EXPECT_EQ(session.state().method, +orbed::registration_t::METHOD_KARCHER);
+  EXPECT_EQ(session.state().next_index, 0);
+  EXPECT_EQ(session.state().Describe(), "session 's' (ar_reflective, 2 display(s))");
+}
+
+TEST(HmdSession, RepeatedStartIsANoOpAndAnotherStartReplaces) {
+  HmdSession session = TwoDisplays();
+  session.Handle(Control("s", +SC::START, +AT::MODE_AR_REFLECTIVE, 1), kRobot);
+  EXPECT_EQ(session.TakeTrialIndex(), 0);
+  EXPECT_EQ(session.TakeTrialIndex(), 1);
+  // The same session, mode and mirrors: nothing changes, the index keeps counting.
+  EXPECT_EQ(session.Handle(Control("s", +SC::START, +AT::MODE_AR_REFLECTIVE, 1), kRobot).kind,
+            Kind::kRepeatedStart);
+  EXPECT_EQ(session.state().next_index, 2);
+  // The same id with other mirrors is a new session.
+  EXPECT_EQ(session.Handle(Control("s", +SC::START, +AT::MODE_AR_REFLECTIVE, 2), kRobot).kind, Kind::kStart);
+  EXPECT_EQ(session.state().num_mirrors, 2);
+  EXPECT_EQ(session.state().next_index, 0);
+  // Another id replaces the active session.
+  EXPECT_EQ(session.Handle(Control("t", +SC::START), kRobot).kind, Kind::kStart);
+  EXPECT_EQ(session.state().id, "t");
+  EXPECT_EQ(session.state().display_mode, +AT::MODE_AR);
+}
+
+TEST(HmdSession, LocalSessionIsRepeatedByItsEchoedStart) {
+  HmdSession session = TwoDisplays();
+  session.Open({"interactive-1", +AT::MODE_AR_REFLECTIVE, 1, +orbed::registration_t::METHOD_KARCHER, 0});
+  session.TakeTrialIndex();
+  EXPECT_EQ(session.Handle(Control("interactive-1", +SC::START, +AT::MODE_AR_REFLECTIVE, 1), kRobot).kind,
+            Kind::kRepeatedStart);
+  EXPECT_EQ(session.state().next_index, 1);
+}
+
+TEST(HmdSession, ResetStopComputeAndRequestTrial) {
+  HmdSession session = TwoDisplays();
+  session.Handle(Control("s", +SC::START), kRobot);
+  EXPECT_EQ(session.Handle(Control("s", +SC::REQUEST_TRIAL), kRobot).kind, Kind::kRequestedTrial);
+  EXPECT_EQ(session.state().next_index, 0);  // the caller takes it when it publishes
+  session.TakeTrialIndex();
+  session.TakeTrialIndex();
+  EXPECT_EQ(session.Handle(Control("s", +SC::RESET), kNoRobot).kind, Kind::kReset);
+  EXPECT_EQ(session.state().next_index, 0);
+  EXPECT_EQ(session.state().id, "s");
+  // COMPUTE is the registration server's, whatever session it names.
+  EXPECT_EQ(session.Handle(Control("other", +SC::COMPUTE), kNoRobot).kind, Kind::kIgnore);
+  EXPECT_EQ(session.Handle(Control("s", +SC::COMPUTE), kNoRobot).kind, Kind::kIgnore);
+  session.TakeTrialIndex();
+  const SessionDecision stop = session.Handle(Control("s", +SC::STOP), kNoRobot);
+  EXPECT_EQ(stop.kind, Kind::kStop);
+  EXPECT_EQ(stop.event, "session 's' stopped after 1 trial(s)");
+  EXPECT_FALSE(session.state().active());
+  EXPECT_EQ(session.state().next_index, 0);
+}
+
+TEST(HmdSession, CommandsForAnUnknownSessionAreRefused) {
+  HmdSession session = TwoDisplays();
+  // No session at all.
+  for (int8_t command : {+SC::RESET, +SC::STOP, +SC::REQUEST_TRIAL}) {
+    const SessionDecision d = session.Handle(Control("s", command), kRobot);
+    EXPECT_EQ(d.kind, Kind::kRefuse) << int(command);
+    EXPECT_EQ(d.refusal.key, "unknown_session");
+    EXPECT_NE(d.refusal.reason.find("'(none)'"), std::string::npos) << d.refusal.reason;
+  }
+  // Another session is active: refused, and it stays active with its index.
+  session.Handle(Control("active", +SC::START), kRobot);
+  session.TakeTrialIndex();
+  for (int8_t command : {+SC::RESET, +SC::STOP, +SC::REQUEST_TRIAL}) {
+    const SessionDecision d = session.Handle(Control("other", command), kRobot);
+    EXPECT_EQ(d.kind, Kind::kRefuse);
+    EXPECT_EQ(d.refusal.key, "unknown_session");
+    EXPECT_NE(d.refusal.reason.find("'other'"), std::string::npos) << d.refusal.reason;
+    EXPECT_NE(d.refusal.reason.find("'active'"), std::string::npos) << d.refusal.reason;
+  }
+  EXPECT_NE(
+      session.Handle(Control("other", +SC::REQUEST_TRIAL), kRobot).refusal.reason.find("send START first"),
+      std::string::npos);
+  EXPECT_EQ(session.state().id, "active");
+  EXPECT_EQ(session.state().next_index, 1);
+  // An unknown session is refused as such even before the robot is known.
+  EXPECT_EQ(session.Handle(Control("other", +SC::REQUEST_TRIAL), kNoRobot).refusal.key, "unknown_session");
+}
+
+TEST(HmdSession, RequestTrialNeedsTheRobot) {
+  HmdSession session = TwoDisplays();
+  session.Handle(Control("s", +SC::START), kNoRobot);
+  const SessionDecision neither = session.Handle(Control("s", +SC::REQUEST_TRIAL), kNoRobot);
+  EXPECT_EQ(neither.kind, Kind::kRefuse);
+  EXPECT_EQ(neither.refusal.key, "no_robot_state");
+  EXPECT_NE(neither.refusal.reason.find("IIWA_STATUS and ROBOT_STATE"), std::string::npos);
+  const SessionDecision no_q = session.Handle(Control("s", +SC::REQUEST_TRIAL), RobotKnown{false, true});
+  EXPECT_EQ(no_q.refusal.key, "no_robot_state");
+  EXPECT_NE(no_q.refusal.reason.find("valid IIWA_STATUS:"), std::string::npos) << no_q.refusal.reason;
+  const SessionDecision no_pose = session.Handle(Control("s", +SC::REQUEST_TRIAL), RobotKnown{true, false});
+  EXPECT_EQ(no_pose.refusal.key, "no_robot_state");
+  EXPECT_NE(no_pose.refusal.reason.find("valid ROBOT_STATE:"), std::string::npos) << no_pose.refusal.reason;
+  EXPECT_EQ(session.state().next_index, 0);
+  EXPECT_EQ(session.Handle(Control("s", +SC::REQUEST_TRIAL), kRobot).kind, Kind::kRequestedTrial);
+}
+
+TEST(HmdSession, RefusalsOfTheCommonValidatorKeepTheirKeys) {
+  HmdSession session = TwoDisplays();
+  session.Handle(Control("s", +SC::START), kRobot);
+  struct Case {
+    orbed::session_control_t msg;
+    std::string key;
+  };
+  const Case cases[] = {
+      {Control("x", 9), "command"},
+      {Control("x", -1), "command"},
+      {Control("", +SC::START), "session_id"},
+      {Control("", +SC::REQUEST_TRIAL), "session_id"},
+      {Control(std::string(kMaxSessionIdLength + 1, 'x'), +SC::START), "session_id"},
+      {Control("x", +SC::START, 7), "display_mode"},
+      {Control("x", +SC::START, +AT::MODE_AR, 1), "num_mirrors"},
+      {Control("x", +SC::START, +AT::MODE_AR_REFLECTIVE, 0), "num_mirrors"},
+      {Control("x", +SC::START, +AT::MODE_AR_REFLECTIVE, 99), "num_mirrors"},
+      {Control("x", +SC::START, +AT::MODE_AR, 0, 42), "method"},
+  };
+  for (const Case& c : cases) {
+    const SessionDecision d = session.Handle(c.msg, kRobot);
+    EXPECT_EQ(d.kind, Kind::kRefuse) << c.key;
+    EXPECT_EQ(d.refusal.key, c.key) << d.refusal.reason;
+    EXPECT_FALSE(d.refusal.reason.empty());
+  }
+  EXPECT_EQ(session.state().id, "s");  // nothing changed
+}
+
+TEST(HmdSession, StartBeyondThePlacedDisplaysIsRefused) {
+  HmdSession session = TwoDisplays();
+  const SessionDecision d = session.Handle(Control("s", +SC::START, +AT::MODE_AR_REFLECTIVE, 3), kRobot);
+  EXPECT_EQ(d.kind, Kind::kRefuse);
+  EXPECT_EQ(d.refusal.key, "num_mirrors");
+  EXPECT_NE(d.refusal.reason.find("2 display(s)"), std::string::npos) << d.refusal.reason;
+  EXPECT_FALSE(session.state().active());
+  // A headset without displays takes MODE_AR only.
+  HmdSession bare({0});
+  EXPECT_EQ(bare.Handle(Control("s", +SC::START, +AT::MODE_AR_REFLECTIVE, 1), kRobot).refusal.key,
+            "num_mirrors");
+  EXPECT_EQ(bare.Handle(Control("s", +SC::START, +AT::MODE_AR, 0), kRobot).kind, Kind::kStart);
+}
+
+TEST(HmdSession, ApplyTakesACheckedCommand) {
+  HmdSession session = TwoDisplays();
+  SessionCommand start;
+  start.session_id = "s";
+  start.kind = SessionCommand::Kind::kStart;
+  start.display_mode = +AT::MODE_AR_REFLECTIVE;
+  start.num_mirrors = 1;
+  EXPECT_EQ(session.Apply(start, kRobot).kind, Kind::kStart);
+  SessionCommand request = start;
+  request.kind = SessionCommand::Kind::kRequestTrial;
+  EXPECT_EQ(session.Apply(request, kRobot).kind, Kind::kRequestedTrial);
+}
+
+TEST(HmdSession, DisplayModeNames) {
+  EXPECT_STREQ(DisplayModeName(+AT::MODE_AR), "ar");
+  EXPECT_STREQ(DisplayModeName(+AT::MODE_AR_REFLECTIVE), "ar_reflective");
+}
+
+}  // namespace
+}  // namespace orbed::hmd
