@@ -318,13 +318,18 @@ TEST(HmdProcess, RejectsBadInputsPerReasonAndKeepsRunning) {
   EXPECT_GT(got.est.size(), 10u);
 }
 
+// The pose and gaze timers' callbacks driven directly (no wall-clock run: how many ticks a busy
+// machine fits into half a second is not what this test is about).
 TEST(HmdProcess, PoseAndTruthShareSeqAndStartAtTheFirstWaypoint) {
-  HmdProcess hmd(MemqFlags(0.5), Inline());
+  HmdProcess hmd(MemqFlags(0), Inline());
   Collector got;
   got.Attach(hmd.process().lcm());
-  EXPECT_EQ(hmd.Run(), 0);
+  for (int i = 0; i < 30; ++i) {
+    hmd.PublishPose();
+    if (i % 6 == 0) hmd.PublishGaze();
+  }
   Drain(hmd.process().lcm());
-  ASSERT_GE(got.est.size(), 20u);  // 60 Hz for 0.5 s: ~30
+  ASSERT_EQ(got.est.size(), 30u);
   ASSERT_EQ(got.est.size(), got.truth.size());
   for (size_t i = 0; i < got.est.size(); ++i) {
     EXPECT_EQ(got.est[i].seq, static_cast<int64_t>(i));
@@ -342,8 +347,8 @@ TEST(HmdProcess, PoseAndTruthShareSeqAndStartAtTheFirstWaypoint) {
   EXPECT_NEAR(p_WH.z(), 1.70, 1e-9);
   // The map starts on W: the estimate is the truth up to jitter (slam.yaml: 0.5 mm std).
   EXPECT_LT((ToVector3(got.est.front().X_WH.position_m) - p_WH).norm(), 0.005);
-  // Gaze rays at 10 Hz from the head: unit direction, hit at the robot's middle distance (~2 m).
-  ASSERT_GE(got.gaze.size(), 3u);
+  // Gaze rays from the head: unit direction.
+  ASSERT_EQ(got.gaze.size(), 5u);
   EXPECT_NEAR(ToVector3(got.gaze.back().direction_W).norm(), 1.0, 1e-9);
 }
 
@@ -441,16 +446,25 @@ TEST(HmdProcess, CameraReflectiveAndArViewCarryTheirGeometry) {
   EXPECT_EQ(got.camera[1].pose_utime, got.est[1].utime);
 }
 
-TEST(HmdProcess, ThreadedPipelinePublishesTheSame) {
-  HmdProcess hmd(MemqFlags(0.6), HmdOptions{});
+// The shell on the worker thread: every request that is waited for (Flush) is published; what the
+// frames hold is compared with the inline path in image_pipeline_test.
+TEST(HmdProcess, ThreadedPipelinePublishesEveryFlushedRequest) {
+  HmdProcess hmd(MemqFlags(0), HmdOptions{});
   Collector got;
   got.Attach(hmd.process().lcm());
-  EXPECT_EQ(hmd.Run(), 0);
-  hmd.Flush();
+  for (int i = 0; i < 5; ++i) {
+    hmd.PublishPose();
+    hmd.RequestCamera();
+    hmd.RequestReflective();
+    hmd.RequestArView();
+    hmd.Flush();
+  }
   Drain(hmd.process().lcm());
-  EXPECT_GE(got.camera.size(), 8u);  // 30 Hz for 0.6 s: ~18
-  EXPECT_GE(got.reflective.size(), 8u);
+  EXPECT_EQ(got.camera.size(), 5u);
+  EXPECT_EQ(got.reflective.size(), 5u);  // one display (the default)
   EXPECT_GE(got.ar.size(), 1u);
+  EXPECT_EQ(hmd.skipped_frames(), 0);
+  for (size_t i = 0; i < got.camera.size(); ++i) EXPECT_EQ(got.camera[i].pose_utime, got.est[i].utime);
 }
 
 TEST(HmdProcess, InteractiveKeysMoveTheHologramAndEnterSubmits) {

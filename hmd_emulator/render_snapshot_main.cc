@@ -28,8 +28,6 @@
 
 namespace {
 
-using orbed::hmd::Intrinsics;
-using orbed::hmd::LookAt;
 
 void Caption(cv::Mat* image, const std::string& text) {
   cv::rectangle(*image, cv::Rect(0, 0, image->cols, 34), cv::Scalar(30, 30, 30), cv::FILLED);
@@ -67,18 +65,18 @@ int main(int argc, char** argv) {
     hmd::SceneGeometry g = hmd::SceneGeometry::MakeOperatingRoom(scene, robot, q, scene.X_WR);
     hmd::Mesh mesh;
     hmd::Tessellate(g, hmd::kRealWorld, {}, &mesh);
-    const geometry::Intrinsics K = geometry::Intrinsics::HoloLensPv();
+    const orbed::geometry::Intrinsics K = orbed::geometry::Intrinsics::HoloLensPv();
     hmd::Renderer renderer(K);
 
     // 1. A camera frame from the bedside.
     cv::Mat frame;
-    renderer.Render(mesh, geometry::LookAt({1.75, -2.15, 1.7}, {0.2, -0.35, 1.05}), &frame);
+    renderer.Render(mesh, orbed::geometry::LookAt({1.75, -2.15, 1.7}, {0.2, -0.35, 1.05}), &frame);
     cv::Mat shown = frame.clone();
     Caption(&shown, "HMD_CAMERA  1280x720, HoloLens PV intrinsics, rendered from the true head pose");
     if (!cv::imwrite(out + "/camera_frame.png", shown)) throw std::runtime_error("cannot write " + out);
 
     // 2. A reflective view: captured from the foot of the table, SLAM error at capture, X_WV off.
-    const Eigen::Isometry3d X_WC_true = geometry::LookAt({2.05, 0.55, 1.75}, {0.25, -0.4, 1.15});
+    const Eigen::Isometry3d X_WC_true = orbed::geometry::LookAt({2.05, 0.55, 1.75}, {0.25, -0.4, 1.15});
     Eigen::Isometry3d X_CtrueCest = Eigen::Isometry3d::Identity();
     X_CtrueCest.linear() =
         Eigen::AngleAxisd(0.8 * orbed::kDegToRad, Eigen::Vector3d(0.3, 1, 0).normalized()).toRotationMatrix();
