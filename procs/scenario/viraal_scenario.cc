@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <ostream>
 #include <stdexcept>
+#include <variant>
 
 #include "procs/common/conversions.h"
 #include "procs/common/log.h"
