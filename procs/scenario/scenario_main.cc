@@ -1,6 +1,7 @@
 /// @file
 /// orbed-scenario: runs the paper's ViRAAl experiment (Sec. III-B, Table 1) over the bus and exits:
-/// 0 when every session finished, 1 with a one-line reason otherwise (see viraal_scenario.h).
+/// 0 when every session finished, 1 with a one-line reason otherwise (flags in scenario_cli.h, the
+/// process in viraal_scenario.h, the run's phases in viraal_conductor.h).
 /// Subscribes: ROBOT_STATE, PLAN_CHECK_REPLY, ALIGNMENT_TRIAL, REGISTRATION, MISALIGNMENT.
 /// Publishes:  PLAN_CHECK_REQUEST, SESSION_CONTROL (START / REQUEST_TRIAL / COMPUTE / STOP),
 ///             IIWA_COMMAND, MISALIGNMENT_REQUEST, PROCESS_STATUS (1 Hz).
@@ -8,11 +9,10 @@
 /// prints a progress line per step and a table at the end on stdout.
 #include <cstdlib>
 #include <iostream>
-#include <string>
-#include <vector>
 
-#include "procs/scenario/viraal_scenario.h"
+#include "procs/scenario/scenario_cli.h"
 
+<<<<<<< HEAD
 int main(int argc, char** argv) {
   CLI::App app{
       "orbed-scenario: conducts the ViRAAl experiment: per display mode N alignment trials by\n"
@@ -85,3 +85,6 @@ int main(int argc, char** argv) {
     return 1;
   }
 }
+=======
+int main(int argc, char** argv) { return orbed::scenario::RunScenario(argc, argv, std::cout, std::cerr); }
+>>>>>>> scenario-core

@@ -241,8 +241,9 @@ TEST(ViraalResults, JsonHasTheDocumentedShape) {
 
 class FakeTestbed {
  public:
-  FakeTestbed(lcm::LCM* lcm, Eigen::Vector3d offset_W, bool user_answers)
-      : lcm_(lcm), offset_W_(offset_W), user_answers_(user_answers) {
+  // The user places the virtual robot at X_WV = X_WR·X_RV.
+  FakeTestbed(lcm::LCM* lcm, const Eigen::Isometry3d& X_RV, bool user_answers)
+      : lcm_(lcm), X_RV_(X_RV), user_answers_(user_answers) {
     lcm_->subscribe("IIWA_COMMAND", &FakeTestbed::OnCommand, this);
     lcm_->subscribe("PLAN_CHECK_REQUEST", &FakeTestbed::OnPlanCheck, this);
     lcm_->subscribe("SESSION_CONTROL", &FakeTestbed::OnSession, this);
@@ -297,9 +298,7 @@ class FakeTestbed {
       t.num_mirrors = mirrors_;
       t.num_joints = 7;
       t.joint_position = q_;
-      Eigen::Isometry3d X_WV = SceneBase();
-      X_WV.translation() += offset_W_;
-      t.X_WV = ToPose(X_WV);
+      t.X_WV = ToPose(SceneBase() * X_RV_);
       t.duration_s = 12.5;
       t.user_id = "fake";
       lcm_->publish("ALIGNMENT_TRIAL", &t);
@@ -362,7 +361,7 @@ class FakeTestbed {
 
  private:
   lcm::LCM* lcm_;
-  Eigen::Vector3d offset_W_;
+  Eigen::Isometry3d X_RV_;
   bool user_answers_;
   std::vector<double> q_;
   std::string session_;
@@ -375,11 +374,11 @@ class FakeTestbed {
 
 ScenarioOptions MemqOptions(const std::string& dir) {
   ScenarioOptions options;
-  options.config = LoadScenarioFile(Source(kDefaultScenarioRelativePath));
-  options.run_id = "memq";
+  options.conductor.config = LoadScenarioFile(Source(kDefaultScenarioRelativePath));
+  options.conductor.run_id = "memq";
   options.results_dir = dir;
-  options.trial_timeout_s = 1.0;
-  options.reply_timeout_s = 1.0;
+  options.conductor.trial_timeout_s = 1.0;
+  options.conductor.reply_timeout_s = 1.0;
   return options;
 }
 
@@ -397,33 +396,117 @@ std::string ReadFile(const std::string& path) {
   return ss.str();
 }
 
-TEST(ViraalScenario, AFullRunOnMemqGivesTheUsersKnownOffset) {
+// The trial configurations of the full run: q2 = q6 = 0, so the iiwa is a vertical column up to
+// the elbow and its forward kinematics is known by hand (HandForwardKinematics).
+const std::vector<std::vector<double>> kHandConfigurationsDeg = {
+    {0, 0, 0, -60, 0, 0, 0},
+    {90, 0, -30, 45, 0, 0, 0},
+    {-40, 0, 10, 90, 30, 0, 60},
+};
+
+// Hand forward kinematics of the iiwa 7 (sim/models/iiwa7.urdf) at q with q2 = q6 = 0, in the base
+// frame R [m]. Links 0 and 1 are at the base origin, links 2 and 3 at h₁ = (0, 0, 0.34), links 4 and
+// 5 (the elbow) at h₂ = (0, 0, 0.74). Joint 4 tilts the forearm to the unit direction
+// d = Rz(q1 + q3)·(−sin q4, 0, cos q4) (joints 1 and 3 both turn about the vertical); links 6 and 7
+// are 0.4 m along d from the elbow, the flange (iiwa_link_ee) 0.526 m. Joints 5 and 7 turn about d
+// and move no origin. The centroid is the mean of the 9 origins (links 0-7 and the flange):
+// p_RC = (0.68 ẑ + 5 h₂ + 1.326 d) / 9 = (4.38 ẑ + 1.326 d) / 9.
+struct HandPoints {
+  Eigen::Vector3d p_RC, p_RF;
+  std::vector<Eigen::Vector3d> p_RL;  // iiwa_link_4, iiwa_link_6, iiwa_link_ee (viraal.yaml)
+};
+HandPoints HandForwardKinematics(const std::vector<double>& q_deg) {
+  EXPECT_EQ(q_deg[1], 0.0);
+  EXPECT_EQ(q_deg[5], 0.0);
+  const double q4 = q_deg[3] * kDeg;
+  const Eigen::Vector3d d = Eigen::AngleAxisd((q_deg[0] + q_deg[2]) * kDeg, Eigen::Vector3d::UnitZ()) *
+                            Eigen::Vector3d(-std::sin(q4), 0, std::cos(q4));
+  const Eigen::Vector3d elbow(0, 0, 0.74);
+  HandPoints p;
+  p.p_RC = (4.38 * Eigen::Vector3d::UnitZ() + 1.326 * d) / 9;
+  p.p_RF = elbow + 0.526 * d;
+  p.p_RL = {elbow, elbow + 0.4 * d, p.p_RF};
+  return p;
+}
+
+TEST(ViraalScenario, AFullRunOnMemqGivesTheUsersKnownRotatedOffset) {
   const std::string dir = std::filesystem::temp_directory_path() / "orbed_scenario_test_ok";
   std::filesystem::remove_all(dir);
-  ViraalScenario scenario(MemqFlags(), MemqOptions(dir));
-  // The user puts the virtual robot 10 mm along W x from the truth, rotation exact.
-  FakeTestbed fake(&scenario.process().lcm(), Eigen::Vector3d(0.010, 0, 0), true);
+  ScenarioOptions options = MemqOptions(dir);
+  ASSERT_EQ(options.conductor.config.landmarks,
+            (std::vector<std::string>{"iiwa_link_4", "iiwa_link_6", "iiwa_link_ee"}));
+  options.conductor.config.configurations_deg = kHandConfigurationsDeg;
+  ViraalScenario scenario(MemqFlags(), options);
+  // The user misplaces the virtual robot by X_RV: 5 deg about the tilted axis u = (1, −2, 2)/3 and
+  // t = (4, −6, 3) mm, both in the base frame R: X_WV = X_WR·X_RV.
+  const Eigen::Vector3d u = Eigen::Vector3d(1, -2, 2) / 3;
+  const Eigen::Matrix3d R_RV = Eigen::AngleAxisd(5 * kDeg, u).toRotationMatrix();
+  const Eigen::Vector3d p_RV(0.004, -0.006, 0.003);
+  Eigen::Isometry3d X_RV = Eigen::Isometry3d::Identity();
+  X_RV.linear() = R_RV;
+  X_RV.translation() = p_RV;
+  FakeTestbed fake(&scenario.process().lcm(), X_RV, true);
   ASSERT_EQ(scenario.Run(), 0) << scenario.results().error;
   const RunResults& r = scenario.results();
   ASSERT_TRUE(r.ok);
   ASSERT_EQ(r.sessions.size(), 2u);
+
+  // A point p_RQ of the robot is at X_WR·p_RQ really and at X_WV·p_RQ = X_WR·(R_RV·p_RQ + p_RV)
+  // virtually: the error is R_WR·((R_RV − I)·p_RQ + p_RV), of norm ‖(R_RV − I)·p_RQ + p_RV‖.
+  const Eigen::Matrix3d R_WR = SceneBase().linear();
+  auto error_W = [&](const Eigen::Vector3d& p_RQ) -> Eigen::Vector3d {
+    return R_WR * ((R_RV - Eigen::Matrix3d::Identity()) * p_RQ + p_RV);
+  };
+  // The fake server's t̄: the mean over the pairs of |error| per W axis.
+  struct Expected {
+    double centroid_mm{0}, flange_mm{0};
+    Eigen::Vector3d t_bar_mm{Eigen::Vector3d::Zero()};
+  };
+  Expected mean;  // of the session mean, over the three configurations
+  std::vector<Expected> trials;
+  for (const std::vector<double>& q_deg : kHandConfigurationsDeg) {
+    const HandPoints p = HandForwardKinematics(q_deg);
+    Expected e;
+    e.centroid_mm = error_W(p.p_RC).norm() * 1e3;
+    e.flange_mm = error_W(p.p_RF).norm() * 1e3;
+    for (const Eigen::Vector3d& p_RL : p.p_RL) e.t_bar_mm += error_W(p_RL).cwiseAbs() * 1e3 / 3;
+    trials.push_back(e);
+    mean.centroid_mm += e.centroid_mm / 3;
+    mean.flange_mm += e.flange_mm / 3;
+    mean.t_bar_mm += e.t_bar_mm / 3;  // 9 pairs: the mean of the three means of 3
+  }
+  auto expect_measures = [&](const ErrorMeasures& got, const Expected& want, const std::string& what) {
+    SCOPED_TRACE(what);
+    EXPECT_NEAR(got.rotation_error_deg, 5.0, 1e-9);
+    EXPECT_NEAR(got.base_translation_error_mm, std::sqrt(61.0), 1e-9);  // ‖(4, −6, 3)‖ mm
+    EXPECT_NEAR(got.translation_error_mm, want.centroid_mm, 1e-9);
+    EXPECT_NEAR(got.flange_translation_error_mm, want.flange_mm, 1e-9);
+    EXPECT_NEAR((got.misalignment_axes_mm - want.t_bar_mm).norm(), 0.0, 1e-9);
+    EXPECT_NEAR(got.misalignment_mm, want.t_bar_mm.norm(), 1e-9);
+  };
+  // The expectations tell R_RV from its transpose (the turn the wrong way round): that would move
+  // some centroid or flange error by millimetres. A world pose inverted (X_VW for X_WV) would put
+  // the virtual robot about a metre away. Either fails the comparisons at 1e-9 mm.
+  double transposed_change_mm = 0;
+  for (const std::vector<double>& q_deg : kHandConfigurationsDeg) {
+    const HandPoints p = HandForwardKinematics(q_deg);
+    for (const Eigen::Vector3d& p_RQ : {p.p_RC, p.p_RF}) {
+      const double transposed_mm =
+          ((R_RV.transpose() - Eigen::Matrix3d::Identity()) * p_RQ + p_RV).norm() * 1e3;
+      transposed_change_mm =
+          std::max(transposed_change_mm, std::abs(transposed_mm - error_W(p_RQ).norm() * 1e3));
+    }
+  }
+  EXPECT_GT(transposed_change_mm, 2.0);
   for (const SessionResult& s : r.sessions) {
     ASSERT_EQ(s.trials.size(), 3u);
     ASSERT_TRUE(s.mean.has_value());
-    for (const ErrorMeasures& e :
-         {s.trials[0].errors, s.trials[1].errors, s.trials[2].errors, s.mean->errors}) {
-      // A pure 10 mm shift: every point is 10 mm off, no rotation; t̄ = (10, 0, 0) mm, ‖t̄‖ = 10 mm.
-      EXPECT_NEAR(e.translation_error_mm, 10.0, 1e-9);
-      EXPECT_NEAR(e.base_translation_error_mm, 10.0, 1e-9);
-      EXPECT_NEAR(e.flange_translation_error_mm, 10.0, 1e-9);
-      EXPECT_NEAR(e.rotation_error_deg, 0.0, 1e-6);
-      EXPECT_NEAR(e.misalignment_mm, 10.0, 1e-9);
-      EXPECT_NEAR(e.misalignment_axes_mm.x(), 10.0, 1e-9);
-    }
     for (int i = 0; i < 3; ++i) {
+      expect_measures(s.trials[i].errors, trials[i], s.mode + " trial " + std::to_string(i));
       EXPECT_EQ(s.trials[i].index, i);
-      for (int j = 0; j < 7; ++j) EXPECT_NEAR(s.trials[i].q_deg[j], r.configurations_deg[i][j], 1e-9);
+      for (int j = 0; j < 7; ++j) EXPECT_NEAR(s.trials[i].q_deg[j], kHandConfigurationsDeg[i][j], 1e-9);
     }
+    expect_measures(s.mean->errors, mean, s.mode + " mean");
   }
   EXPECT_EQ(r.sessions[0].session_id, "memq-ar_reflective");
   EXPECT_EQ(r.sessions[1].session_id, "memq-ar");
@@ -447,7 +530,7 @@ TEST(ViraalScenario, NoUserFailsNamingOrbedHmd) {
   const std::string dir = std::filesystem::temp_directory_path() / "orbed_scenario_test_no_user";
   std::filesystem::remove_all(dir);
   ViraalScenario scenario(MemqFlags(), MemqOptions(dir));
-  FakeTestbed fake(&scenario.process().lcm(), Eigen::Vector3d::Zero(), false);
+  FakeTestbed fake(&scenario.process().lcm(), Eigen::Isometry3d::Identity(), false);
   EXPECT_EQ(scenario.Run(), 1);
   EXPECT_NE(scenario.results().error.find("orbed-hmd"), std::string::npos) << scenario.results().error;
   EXPECT_NE(ReadFile(dir + "/results.json").find("\"status\": \"failed\""), std::string::npos);
@@ -456,7 +539,7 @@ TEST(ViraalScenario, NoUserFailsNamingOrbedHmd) {
 TEST(ViraalScenario, AnInfeasibleConfigurationFailsBeforeAnythingMoves) {
   const std::string dir = std::filesystem::temp_directory_path() / "orbed_scenario_test_infeasible";
   ViraalScenario scenario(MemqFlags(), MemqOptions(dir));
-  FakeTestbed fake(&scenario.process().lcm(), Eigen::Vector3d::Zero(), true);
+  FakeTestbed fake(&scenario.process().lcm(), Eigen::Isometry3d::Identity(), true);
   fake.infeasible_ = true;
   EXPECT_EQ(scenario.Run(), 1);
   EXPECT_NE(scenario.results().error.find("infeasible"), std::string::npos) << scenario.results().error;
@@ -467,7 +550,7 @@ TEST(ViraalScenario, AnInfeasibleConfigurationFailsBeforeAnythingMoves) {
 TEST(ViraalScenario, BadMessagesAreCountedAndIgnored) {
   const std::string dir = std::filesystem::temp_directory_path() / "orbed_scenario_test_bad";
   ViraalScenario scenario(MemqFlags(), MemqOptions(dir));
-  FakeTestbed fake(&scenario.process().lcm(), Eigen::Vector3d(0.010, 0, 0), true);
+  FakeTestbed fake(&scenario.process().lcm(), Eigen::Isometry3d::Identity(), true);
   // A ROBOT_STATE with a non-unit quaternion and one with 6 joints come first.
   orbed::robot_state_t bad{};
   bad.X_WR = ToPose(Eigen::Isometry3d::Identity());
@@ -491,7 +574,7 @@ TEST(ViraalScenario, BadMessagesAreCountedAndIgnored) {
 
 TEST(ViraalScenario, ConfigurationsOutsideTheLimitsAreRefusedAtConstruction) {
   ScenarioOptions options = MemqOptions(std::filesystem::temp_directory_path().string());
-  options.config.configurations_deg[1][1] = 130;  // joint 2 limit is ±120 deg
+  options.conductor.config.configurations_deg[1][1] = 130;  // joint 2 limit is ±120 deg
   try {
     ViraalScenario scenario(MemqFlags(), options);
     ADD_FAILURE() << "no error";

@@ -1,0 +1,87 @@
+#include "procs/scenario/scenario_cli.h"
+
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "procs/common/flags.h"
+#include "procs/scenario/scenario_config.h"
+#include "procs/scenario/viraal_scenario.h"
+
+namespace orbed::scenario {
+
+int RunScenario(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
+  CLI::App app{
+      "orbed-scenario: conducts the ViRAAl experiment: per display mode N alignment trials by\n"
+      "the user (orbed-hmd) at distinct robot configurations, the registration server's SE(3)\n"
+      "mean, and the errors of every trial and mean against the simulator's truth."};
+  orbed::CommonFlags common("orbed-scenario");
+  orbed::AddCommonFlags(&app, &common);
+  ScenarioOptions options;
+  ConductorOptions& run = options.conductor;
+  std::string scenario_path;
+  int trials = 0;
+  std::string modes;
+  std::vector<std::string> q_deg;
+  app.add_option("--scenario", scenario_path,
+                 "Scenario YAML (default: procs/scenario/viraal.yaml under $ORBED_SOURCE_DIR, else under "
+                 "the source tree it was built from)");
+  app.add_option("--trials", trials, "Trials per mode (overrides the file's trials)")
+      ->check(CLI::Range(1, 1000));
+  app.add_option("--modes", modes, "Comma-separated run order of ar_reflective, ar (overrides the file)");
+  app.add_option("--q-deg", q_deg,
+                 "A trial configuration q1,...,q7 [deg]; repeat for each (replaces the file's list)");
+  app.add_option("--run-id", run.run_id,
+                 "Run id; sessions are <run-id>-<mode> (default: $ORBED_RUN_ID if set and not empty, "
+                 "else viraal-<UTC time>)")
+      ->envname("ORBED_RUN_ID");
+  app.add_option("--results-dir", options.results_dir,
+                 "Folder of results.json (default: $ORBED_LOG_DIR, else the working directory)");
+  app.add_option("--urdf", options.urdf_path,
+                 "Robot URDF for the landmark FK (default: sim/models/iiwa7.urdf)");
+  app.add_option("--tolerance-deg", run.tolerance_deg, "Arrival tolerance per joint [deg]")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app.add_option("--startup-timeout-sec", run.startup_timeout_s, "Wait for the first ROBOT_STATE [s]")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app.add_option("--reply-timeout-sec", run.reply_timeout_s,
+                 "Wait for PLAN_CHECK_REPLY / REGISTRATION / MISALIGNMENT [s]")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app.add_option("--move-timeout-sec", run.move_timeout_s, "Wait for the arm to reach a configuration [s]")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app.add_option("--trial-timeout-sec", run.trial_timeout_s, "Wait for the user's ALIGNMENT_TRIAL [s]")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app.add_option("--robot-state-channel", run.robot_state_channel)->capture_default_str();
+  app.add_option("--iiwa-command-channel", run.iiwa_command_channel)->capture_default_str();
+  app.add_option("--plan-check-request-channel", run.plan_check_request_channel)->capture_default_str();
+  app.add_option("--plan-check-reply-channel", run.plan_check_reply_channel)->capture_default_str();
+  app.add_option("--session-control-channel", run.session_control_channel)->capture_default_str();
+  app.add_option("--trial-channel", run.trial_channel)->capture_default_str();
+  app.add_option("--registration-channel", run.registration_channel)->capture_default_str();
+  app.add_option("--misalignment-request-channel", run.misalignment_request_channel)->capture_default_str();
+  app.add_option("--misalignment-channel", run.misalignment_channel)->capture_default_str();
+  try {
+    app.parse(argc, argv);
+    orbed::ApplyCommonFlags(common);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e, out, err);
+  }
+  try {
+    if (scenario_path.empty()) scenario_path = ScenarioSourcePath(kDefaultScenarioRelativePath);
+    run.config = LoadScenarioFile(scenario_path);
+    ApplyOverrides(&run.config, trials, modes, q_deg);
+    options.out = &out;
+    ViraalScenario scenario(common, options);
+    return scenario.Run();
+  } catch (const std::exception& e) {
+    err << "orbed-scenario: " << e.what() << "\n";
+    return 1;
+  }
+}
+
+}  // namespace orbed::scenario

@@ -1,0 +1,112 @@
+// The orbed-scenario command line, run in-process: --help, bad flags, and the run id's sources
+// (--run-id > $ORBED_RUN_ID > viraal-<UTC time>) seen in results.json of a run on memq:// that
+// fails fast for want of a robot.
+#include "procs/scenario/scenario_cli.h"
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+namespace orbed::scenario {
+namespace {
+
+struct CliRun {
+  int code;
+  std::string out, err;
+};
+
+CliRun Cli(std::vector<std::string> args) {
+  args.insert(args.begin(), "orbed-scenario");
+  std::vector<const char*> argv;
+  for (const auto& a : args) argv.push_back(a.c_str());
+  std::ostringstream out, err;
+  const int code = RunScenario(static_cast<int>(argv.size()), argv.data(), out, err);
+  return {code, out.str(), err.str()};
+}
+
+bool Contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+std::string ReadFile(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+TEST(ScenarioCli, HelpPrintsTheUsageOnOut) {
+  const CliRun r = Cli({"--help"});
+  EXPECT_EQ(r.code, 0);
+  EXPECT_TRUE(Contains(r.out, "orbed-scenario: conducts the ViRAAl experiment")) << r.out;
+  for (const char* flag : {"--scenario", "--trials", "--modes", "--q-deg", "--run-id", "--results-dir",
+                           "--urdf", "--tolerance-deg", "--startup-timeout-sec", "--reply-timeout-sec",
+                           "--move-timeout-sec", "--trial-timeout-sec", "--robot-state-channel",
+                           "--misalignment-channel", "--lcm-url", "--seed", "--duration-sec"}) {
+    EXPECT_TRUE(Contains(r.out, flag)) << flag;
+  }
+  EXPECT_TRUE(Contains(r.out, "ORBED_RUN_ID"));
+  EXPECT_EQ(r.err, "");
+}
+
+TEST(ScenarioCli, BadFlagsExitNonZeroWithTheMessageOnErr) {
+  CliRun r = Cli({"--no-such-flag-xyz"});
+  EXPECT_NE(r.code, 0);
+  EXPECT_TRUE(Contains(r.err, "--no-such-flag-xyz")) << r.err;
+  EXPECT_EQ(r.out, "");
+  r = Cli({"--trials", "0"});
+  EXPECT_NE(r.code, 0);
+  EXPECT_TRUE(Contains(r.err, "--trials")) << r.err;
+  r = Cli({"--reply-timeout-sec", "-1"});
+  EXPECT_NE(r.code, 0);
+  EXPECT_TRUE(Contains(r.err, "--reply-timeout-sec")) << r.err;
+  r = Cli({"--log-level", "loud"});
+  EXPECT_NE(r.code, 0);
+  EXPECT_TRUE(Contains(r.err, "loud")) << r.err;
+}
+
+TEST(ScenarioCli, AScenarioThatCannotBeBuiltExitsOneWithTheReasonOnErr) {
+  const CliRun r = Cli({"--lcm-url", "memq://", "--q-deg", "0,130,0,0,0,0,0"});
+  EXPECT_EQ(r.code, 1);
+  EXPECT_TRUE(Contains(r.err, "orbed-scenario: configuration 0: ")) << r.err;
+}
+
+// Runs on memq:// with no robot: the run fails after 50 ms and writes results.json.
+std::string RunIdOfAFailedRun(const std::vector<std::string>& extra, CliRun* run) {
+  const std::string dir = std::filesystem::temp_directory_path() / "orbed_scenario_cli_test";
+  std::filesystem::remove_all(dir);
+  std::vector<std::string> args = {"--lcm-url", "memq://",       "--startup-timeout-sec",
+                                   "0.05",      "--results-dir", dir};
+  args.insert(args.end(), extra.begin(), extra.end());
+  *run = Cli(args);
+  const std::string json = ReadFile(dir + "/results.json");
+  const std::string key = "\"run_id\": \"";
+  const size_t begin = json.find(key);
+  if (begin == std::string::npos) return "<no run_id in results.json>";
+  const size_t end = json.find('"', begin + key.size());
+  return json.substr(begin + key.size(), end - begin - key.size());
+}
+
+TEST(ScenarioCli, TheRunIdComesFromTheFlagThenOrbedRunIdThenTheClock) {
+  CliRun run;
+  ::setenv("ORBED_RUN_ID", "from-env", 1);
+  EXPECT_EQ(RunIdOfAFailedRun({}, &run), "from-env");
+  EXPECT_EQ(run.code, 1);
+  EXPECT_TRUE(Contains(run.out, "ViRAAl run from-env: waiting for the robot (ROBOT_STATE)")) << run.out;
+  EXPECT_TRUE(Contains(run.out, "FAILED: no valid ROBOT_STATE on ROBOT_STATE within 0.1 s")) << run.out;
+  EXPECT_EQ(RunIdOfAFailedRun({"--run-id", "from-flag"}, &run), "from-flag");
+  ::setenv("ORBED_RUN_ID", "", 1);
+  EXPECT_EQ(RunIdOfAFailedRun({}, &run).rfind("viraal-", 0), 0u);
+  ::unsetenv("ORBED_RUN_ID");
+  const std::string id = RunIdOfAFailedRun({}, &run);
+  EXPECT_EQ(id.rfind("viraal-", 0), 0u) << id;
+  EXPECT_EQ(id.size(), std::string("viraal-20250101T000000Z").size()) << id;
+}
+
+}  // namespace
+}  // namespace orbed::scenario

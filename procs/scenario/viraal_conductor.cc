@@ -1,0 +1,602 @@
+#include "procs/scenario/viraal_conductor.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+#include <stdexcept>
+#include <utility>
+
+#include "procs/common/conversions.h"
+#include "procs/common/validation.h"
+
+namespace orbed::scenario {
+namespace {
+
+constexpr double kRadToDeg = 180.0 / M_PI;
+constexpr int kMaxJoints = 64;
+constexpr int kMaxLinks = 1000;
+constexpr int kMaxPairs = 10000;
+// Only a ROBOT_STATE received this long after the last IIWA_COMMAND counts as a stop [s].
+constexpr double kFreshStateAfterCommand_s = 0.050;
+
+std::string Fixed(double value, int digits) {
+  char text[64];
+  std::snprintf(text, sizeof(text), "%.*f", digits, value);
+  return text;
+}
+
+std::string JointList(const std::vector<double>& q_deg, int digits) {
+  std::string out = "(";
+  for (size_t i = 0; i < q_deg.size(); ++i) out += (i ? ", " : "") + Fixed(q_deg[i], digits);
+  return out + ")";
+}
+
+ErrorMeasures Measures(const AlignmentError& error, const orbed::misalignment_t& misalignment) {
+  ErrorMeasures m;
+  m.translation_error_mm = error.centroid_translation_m * 1e3;
+  m.rotation_error_deg = error.rotation_rad * kRadToDeg;
+  m.base_translation_error_mm = error.base_translation_m * 1e3;
+  m.flange_translation_error_mm = error.flange_translation_m * 1e3;
+  m.misalignment_mm = misalignment.mean_error_norm_m * 1e3;
+  m.misalignment_axes_mm = ToVector3(misalignment.mean_error_W_m) * 1e3;
+  m.misalignment_mean_pair_distance_mm = misalignment.mean_pair_distance_m * 1e3;
+  return m;
+}
+
+}  // namespace
+
+void CheckConductorOptions(const ConductorOptions& options) {
+  const std::pair<const char*, double> positive[] = {{"--tolerance-deg", options.tolerance_deg},
+                                                     {"--startup-timeout-sec", options.startup_timeout_s},
+                                                     {"--reply-timeout-sec", options.reply_timeout_s},
+                                                     {"--move-timeout-sec", options.move_timeout_s},
+                                                     {"--trial-timeout-sec", options.trial_timeout_s},
+                                                     {"--stopped-grace-sec", options.stopped_grace_s},
+                                                     {"command resend period", options.command_resend_s}};
+  for (const auto& [name, value] : positive) {
+    if (!(value > 0) || !std::isfinite(value)) {
+      throw std::invalid_argument(std::string(name) + " must be a finite number > 0");
+    }
+  }
+}
+
+ViraalConductor::ViraalConductor(ConductorOptions options, orbed::sim::RobotModel model)
+    : options_(std::move(options)), model_(std::make_unique<orbed::sim::RobotModel>(std::move(model))) {
+  CheckConductorOptions(options_);
+  if (options_.run_id.empty()) throw std::invalid_argument("the run id is empty");
+  const ScenarioConfig& config = options_.config;
+  ValidateScenarioConfig(config, model_->num_joints());
+  for (size_t k = 0; k < config.configurations_deg.size(); ++k) {
+    const std::string why =
+        model_->ValidateJointVector(orbed::sim::DegToRad(ToVectorX(config.configurations_deg[k])));
+    if (!why.empty()) throw std::invalid_argument("configuration " + std::to_string(k) + ": " + why);
+  }
+  points_ = std::make_unique<RobotPointSet>(*model_, config.landmarks);
+  results_.run_id = options_.run_id;
+  results_.seed = options_.seed;
+  results_.landmarks = config.landmarks;
+  results_.configurations_deg = config.configurations_deg;
+}
+
+ViraalConductor::~ViraalConductor() = default;
+
+ViraalConductor::Status ViraalConductor::status() const {
+  if (phase_ != Phase::kDone) return Status::kRunning;
+  return results_.ok ? Status::kSucceeded : Status::kFailed;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Calls
+
+void ViraalConductor::Begin(const ConductorTime& now) {
+  if (phase_ == Phase::kNotStarted) throw std::logic_error("ViraalConductor: an input before Start()");
+  now_ = now;
+  actions_.clear();
+}
+
+ConductorActions ViraalConductor::TakeActions() {
+  ConductorActions out;
+  out.swap(actions_);
+  return out;
+}
+
+ConductorActions ViraalConductor::Start(const ConductorTime& now) {
+  if (phase_ != Phase::kNotStarted) throw std::logic_error("ViraalConductor: Start() twice");
+  now_ = now;
+  actions_.clear();
+  run_start_s_ = phase_start_s_ = last_command_s_ = now.t_s;
+  results_.started_utime = now.utime;
+  phase_ = Phase::kWaitRobot;
+  Say("ViRAAl run " + options_.run_id + ": waiting for the robot (" + options_.robot_state_channel + ")");
+  return TakeActions();
+}
+
+ConductorActions ViraalConductor::Tick(const ConductorTime& now) {
+  Begin(now);
+  Step();
+  return TakeActions();
+}
+
+ConductorActions ViraalConductor::Abort(const std::string& reason, const ConductorTime& now) {
+  Begin(now);
+  FailRun(reason);
+  return TakeActions();
+}
+
+// ---------------------------------------------------------------------------------------------
+// Handlers: validate, record, advance.
+
+ConductorActions ViraalConductor::OnRobotState(const orbed::robot_state_t& msg, const ConductorTime& now) {
+  Begin(now);
+  const std::string problem = FirstError(
+      {CheckPose(msg.X_WR, "ROBOT_STATE.X_WR"),
+       CheckLength(msg.num_joints, msg.joint_position.size(), kMaxJoints, "ROBOT_STATE.num_joints"),
+       CheckSize(msg.num_joints, model_->num_joints(), "ROBOT_STATE.num_joints"),
+       CheckLength(msg.num_joints, msg.joint_limit_hit.size(), kMaxJoints, "ROBOT_STATE.joint_limit_hit"),
+       CheckFinite(msg.joint_position, "ROBOT_STATE.joint_position"),
+       CheckLength(msg.num_links, msg.X_RL.size(), kMaxLinks, "ROBOT_STATE.num_links"),
+       CheckEnum(msg.motion_state, orbed::robot_state_t::MOTION_IDLE,
+                 orbed::robot_state_t::MOTION_IN_COLLISION, "ROBOT_STATE.motion_state")});
+  if (!problem.empty()) {
+    Refuse(options_.robot_state_channel + "/field", problem);
+    return TakeActions();
+  }
+  robot_state_ = msg;
+  robot_state_received_s_ = now_.t_s;
+  if (phase_ == Phase::kWaitRobot || phase_ == Phase::kMove) Step();
+  return TakeActions();
+}
+
+ConductorActions ViraalConductor::OnPlanCheckReply(const orbed::plan_check_reply_t& msg,
+                                                   const ConductorTime& now) {
+  Begin(now);
+  const int64_t k = msg.request_id - plan_request_base_;
+  if (phase_ != Phase::kCheckPlans || k < 0 || k >= static_cast<int64_t>(plan_answered_.size()))
+    return TakeActions();  // not ours
+  const std::string problem =
+      CheckLength(msg.num_pairs, msg.pairs.size(), kMaxPairs, "PLAN_CHECK_REPLY.num_pairs");
+  if (!problem.empty()) {
+    Refuse(options_.plan_check_reply_channel + "/field", problem);
+    return TakeActions();
+  }
+  const auto& q_deg = options_.config.configurations_deg[k];
+  if (!msg.request_valid) {
+    FailRun("orbed-iiwa-sim refused the plan check of configuration " + std::to_string(k) + " " +
+            JointList(q_deg, 1) + " deg: " + msg.reason);
+    return TakeActions();
+  }
+  if (!msg.feasible) {
+    FailRun("configuration " + std::to_string(k) + " " + JointList(q_deg, 1) +
+            " deg is infeasible in the sim's scene: " + (msg.reason.empty() ? "not feasible" : msg.reason) +
+            " (change configurations_deg in the scenario file or --q-deg)");
+    return TakeActions();
+  }
+  if (!plan_answered_[k]) {
+    plan_answered_[k] = true;
+    std::ostringstream line;
+    line << "configuration " << k << " feasible, min distance " << msg.min_distance_m << " m";
+    Log(orbed::LogLevel::kInfo, line.str());
+  }
+  Step();
+  return TakeActions();
+}
+
+ConductorActions ViraalConductor::OnTrial(const orbed::alignment_trial_t& msg, const ConductorTime& now) {
+  Begin(now);
+  const std::string prefix = options_.run_id + "-";
+  const bool ours = msg.session_id.compare(0, prefix.size(), prefix) == 0;
+  if (!ours) return TakeActions();  // another run's trial
+  if (phase_ != Phase::kAwaitTrial || mode_index_ >= options_.config.modes.size() ||
+      msg.session_id != results_.sessions.back().session_id || msg.trial_index != trial_index_) {
+    Refuse(options_.trial_channel + "/unexpected", "ALIGNMENT_TRIAL for session '" + msg.session_id +
+                                                       "' trial " + std::to_string(msg.trial_index) +
+                                                       " was not requested now");
+    return TakeActions();
+  }
+  const ModeSpec& mode = options_.config.modes[mode_index_];
+  std::string problem = FirstError(
+      {CheckPose(msg.X_WV, "ALIGNMENT_TRIAL.X_WV"),
+       CheckLength(msg.num_joints, msg.joint_position.size(), kMaxJoints, "ALIGNMENT_TRIAL.num_joints"),
+       CheckSize(msg.num_joints, model_->num_joints(), "ALIGNMENT_TRIAL.num_joints"),
+       CheckFinite(msg.joint_position, "ALIGNMENT_TRIAL.joint_position"),
+       CheckFinite(&msg.duration_s, 1, "ALIGNMENT_TRIAL.duration_s"),
+       CheckEnum(msg.display_mode, mode.display_mode, mode.display_mode, "ALIGNMENT_TRIAL.display_mode")});
+  if (problem.empty() && msg.duration_s < 0) problem = "ALIGNMENT_TRIAL.duration_s is negative";
+  if (problem.empty()) {
+    const std::string limits = model_->ValidateJointVector(ToVectorX(msg.joint_position), 1e-6);
+    if (!limits.empty()) problem = "ALIGNMENT_TRIAL.joint_position: " + limits;
+  }
+  if (!problem.empty()) {
+    Refuse(options_.trial_channel + "/field", problem);
+    return TakeActions();
+  }
+  if (msg.num_mirrors != mode.num_mirrors) {
+    Log(orbed::LogLevel::kWarn, "trial " + std::to_string(msg.trial_index) + " reports " +
+                                    std::to_string(msg.num_mirrors) + " mirrors, the session has " +
+                                    std::to_string(mode.num_mirrors));
+  }
+  trial_ = msg;
+  const Eigen::VectorXd q = ToVectorX(msg.joint_position);
+  const Eigen::VectorXd q_target = orbed::sim::DegToRad(ToVectorX(TargetDeg()));
+  const double off_deg = (q - q_target).cwiseAbs().maxCoeff() * kRadToDeg;
+  if (off_deg > options_.tolerance_deg) {
+    Log(orbed::LogLevel::kWarn, "trial " + std::to_string(msg.trial_index) + " was made at a q " +
+                                    Fixed(off_deg, 3) +
+                                    " deg from the commanded configuration; its errors use the trial's q");
+  }
+  const RobotPoints points = points_->At(q);
+  session_points_.push_back(points);
+  pending_error_ = EvaluateAlignment(FromPose(robot_state_->X_WR), FromPose(msg.X_WV), points);
+  misalignment_.reset();
+  misalignment_request_id_ = SendMisalignment(pending_error_);
+  Enter(Phase::kAwaitTrialResults);
+  Step();
+  return TakeActions();
+}
+
+ConductorActions ViraalConductor::OnRegistration(const orbed::registration_t& msg, const ConductorTime& now) {
+  Begin(now);
+  if (results_.sessions.empty() || msg.session_id != results_.sessions.back().session_id)
+    return TakeActions();  // not ours
+  if (msg.reason == orbed::registration_t::REASON_PERIODIC) return TakeActions();
+  std::string problem = FirstError(
+      {CheckEnum(msg.reason, orbed::registration_t::REASON_TRIAL, orbed::registration_t::REASON_COMPUTE,
+                 "REGISTRATION.reason"),
+       CheckLength(msg.num_rejected, msg.rejected_indices.size(), kMaxPairs, "REGISTRATION.num_rejected"),
+       msg.valid ? CheckPose(msg.X_WV_mean, "REGISTRATION.X_WV_mean") : std::string()});
+  if (!problem.empty()) {
+    Refuse(options_.registration_channel + "/field", problem);
+    return TakeActions();
+  }
+  if (msg.reason == orbed::registration_t::REASON_TRIAL) {
+    last_trial_registration_ = msg;
+  } else if (phase_ == Phase::kAwaitMean) {
+    mean_registration_ = msg;
+  }
+  Step();
+  return TakeActions();
+}
+
+ConductorActions ViraalConductor::OnMisalignment(const orbed::misalignment_t& msg, const ConductorTime& now) {
+  Begin(now);
+  if (msg.request_id != misalignment_request_id_ || misalignment_request_id_ == 0)
+    return TakeActions();  // not ours
+  std::string problem;
+  if (msg.valid) {
+    problem =
+        FirstError({CheckLength(msg.num_pairs, msg.error_norm_m.size(), kMaxPairs, "MISALIGNMENT.num_pairs"),
+                    CheckFinite(msg.mean_error_W_m, 3, "MISALIGNMENT.mean_error_W_m"),
+                    CheckFinite(&msg.mean_error_norm_m, 1, "MISALIGNMENT.mean_error_norm_m"),
+                    CheckFinite(&msg.mean_pair_distance_m, 1, "MISALIGNMENT.mean_pair_distance_m")});
+    if (problem.empty() && msg.num_pairs != static_cast<int32_t>(pending_error_.p_W_real.size())) {
+      problem = "MISALIGNMENT.num_pairs is " + std::to_string(msg.num_pairs) + ", the request had " +
+                std::to_string(pending_error_.p_W_real.size());
+    }
+  }
+  if (!problem.empty()) {
+    Refuse(options_.misalignment_channel + "/field", problem);
+    return TakeActions();
+  }
+  if (!msg.valid) {
+    FailRun("orbed-registration refused the misalignment request: " + msg.reason);
+    return TakeActions();
+  }
+  misalignment_ = msg;
+  Step();
+  return TakeActions();
+}
+
+// ---------------------------------------------------------------------------------------------
+// The phases
+
+void ViraalConductor::Enter(Phase phase) {
+  phase_ = phase;
+  phase_start_s_ = now_.t_s;
+}
+
+void ViraalConductor::Step() {
+  const double waited = PhaseSeconds();
+  const std::string refusal = last_refusal_.empty() ? "" : " (last refused input: " + last_refusal_ + ")";
+  switch (phase_) {
+    case Phase::kNotStarted:
+      return;
+    case Phase::kWaitRobot:
+      if (robot_state_) {
+        results_.X_WR = FromPose(robot_state_->X_WR);
+        StartPlanChecks();
+      } else if (waited > options_.startup_timeout_s) {
+        FailRun("no valid ROBOT_STATE on " + options_.robot_state_channel + " within " +
+                Fixed(options_.startup_timeout_s, 1) + " s: is orbed-iiwa-sim running?" + refusal);
+      }
+      return;
+    case Phase::kCheckPlans: {
+      const size_t answered = std::count(plan_answered_.begin(), plan_answered_.end(), true);
+      if (answered == plan_answered_.size()) {
+        Say("[plan] " + std::to_string(answered) +
+            " configurations checked with orbed-iiwa-sim: within limits and collision-free");
+        StartSession();
+      } else if (waited > options_.reply_timeout_s) {
+        FailRun("orbed-iiwa-sim answered " + std::to_string(answered) + " of " +
+                std::to_string(plan_answered_.size()) + " PLAN_CHECK_REQUESTs within " +
+                Fixed(options_.reply_timeout_s, 1) + " s" + refusal);
+      }
+      return;
+    }
+    case Phase::kMove: {
+      const std::vector<double>& q_deg = TargetDeg();
+      const orbed::robot_state_t& state = *robot_state_;
+      double off_deg = 0;
+      for (int i = 0; i < model_->num_joints(); ++i) {
+        off_deg = std::max(off_deg, std::abs(state.joint_position[i] * kRadToDeg - q_deg[i]));
+      }
+      if (off_deg < options_.tolerance_deg && state.motion_state == orbed::robot_state_t::MOTION_IDLE) {
+        reach_s_ = waited;
+        RequestTrial();
+        return;
+      }
+      const bool stopped = state.motion_state != orbed::robot_state_t::MOTION_IDLE &&
+                           state.motion_state != orbed::robot_state_t::MOTION_MOVING;
+      // Only states the sim produced after it had the command count as a stop.
+      const bool fresh = robot_state_received_s_ - last_command_s_ > kFreshStateAfterCommand_s;
+      if (stopped && fresh) {
+        if (!stopped_since_s_) stopped_since_s_ = now_.t_s;
+        if (now_.t_s - *stopped_since_s_ > options_.stopped_grace_s) {
+          FailRun("the arm stopped " + Fixed(off_deg, 2) + " deg short of configuration " +
+                  JointList(q_deg, 1) +
+                  " deg: " + (state.stop_reason.empty() ? "stopped" : state.stop_reason));
+          return;
+        }
+      } else {
+        stopped_since_s_.reset();
+      }
+      if (waited > options_.move_timeout_s) {
+        std::vector<double> at_deg;
+        for (double v : state.joint_position) at_deg.push_back(v * kRadToDeg);
+        FailRun("the arm did not reach configuration " + JointList(q_deg, 1) + " deg within " +
+                Fixed(options_.move_timeout_s, 1) + " s (it is at " + JointList(at_deg, 2) + " deg, " +
+                Fixed(off_deg, 3) + " deg off, motion state " + std::to_string(state.motion_state) +
+                "): is orbed-iiwa-sim receiving " + options_.iiwa_command_channel + "?");
+        return;
+      }
+      if (now_.t_s - last_command_s_ > options_.command_resend_s) StartMove(false);
+      return;
+    }
+    case Phase::kAwaitTrial:
+      if (waited > options_.trial_timeout_s) {
+        FailRun("no ALIGNMENT_TRIAL for session '" + results_.sessions.back().session_id + "' trial " +
+                std::to_string(trial_index_) + " within " + Fixed(options_.trial_timeout_s, 1) +
+                " s of SESSION_CONTROL REQUEST_TRIAL: is orbed-hmd running (its emulated user answers "
+                "REQUEST_TRIAL on " +
+                options_.trial_channel + ")?" + refusal);
+      }
+      return;
+    case Phase::kAwaitTrialResults: {
+      const bool registered = last_trial_registration_ && last_trial_registration_->utime == trial_->utime &&
+                              last_trial_registration_->num_trials == trial_index_ + 1;
+      if (registered && misalignment_) {
+        FinishTrial();
+      } else if (waited > options_.reply_timeout_s) {
+        FailRun(std::string(registered ? "no MISALIGNMENT answer" : "no REGISTRATION (reason TRIAL)") +
+                " from orbed-registration for session '" + results_.sessions.back().session_id + "' trial " +
+                std::to_string(trial_index_) + " within " + Fixed(options_.reply_timeout_s, 1) +
+                " s (is it running? did it refuse the trial? see its PROCESS_STATUS rejections)" + refusal);
+      }
+      return;
+    }
+    case Phase::kAwaitMean:
+      if (mean_registration_) {
+        const orbed::registration_t& mean = *mean_registration_;
+        if (!mean.valid || mean.num_trials != options_.config.trials) {
+          FailRun("orbed-registration's mean for session '" + mean.session_id + "' holds " +
+                  std::to_string(mean.num_trials) + " trials (valid " + (mean.valid ? "true" : "false") +
+                  "), expected " + std::to_string(options_.config.trials));
+          return;
+        }
+        pending_error_ = EvaluateOverConfigurations(FromPose(robot_state_->X_WR), FromPose(mean.X_WV_mean),
+                                                    session_points_);
+        misalignment_.reset();
+        misalignment_request_id_ = SendMisalignment(pending_error_);
+        Enter(Phase::kAwaitMeanMisalignment);
+      } else if (waited > options_.reply_timeout_s) {
+        FailRun("no REGISTRATION (reason COMPUTE) from orbed-registration for session '" +
+                results_.sessions.back().session_id + "' within " + Fixed(options_.reply_timeout_s, 1) +
+                " s" + refusal);
+      }
+      return;
+    case Phase::kAwaitMeanMisalignment:
+      if (misalignment_) {
+        FinishSession();
+      } else if (waited > options_.reply_timeout_s) {
+        FailRun("no MISALIGNMENT answer from orbed-registration for the mean of session '" +
+                results_.sessions.back().session_id + "' within " + Fixed(options_.reply_timeout_s, 1) +
+                " s" + refusal);
+      }
+      return;
+    case Phase::kDone:
+      return;
+  }
+}
+
+void ViraalConductor::StartPlanChecks() {
+  const auto& configurations = options_.config.configurations_deg;
+  plan_request_base_ = now_.utime;  // distinct from another client's ids in practice
+  plan_answered_.assign(configurations.size(), false);
+  Enter(Phase::kCheckPlans);
+  for (size_t k = 0; k < configurations.size(); ++k) {
+    orbed::plan_check_request_t request{};
+    request.utime = now_.utime;
+    request.request_id = plan_request_base_ + static_cast<int64_t>(k);
+    request.num_joints = static_cast<int32_t>(configurations[k].size());
+    request.joint_position = FromVectorX(orbed::sim::DegToRad(ToVectorX(configurations[k])));
+    Publish(options_.plan_check_request_channel, request);
+  }
+}
+
+void ViraalConductor::SendSessionControl(int8_t command) {
+  const ModeSpec& mode = options_.config.modes[mode_index_];
+  orbed::session_control_t msg{};
+  msg.utime = now_.utime;
+  msg.session_id = results_.sessions.back().session_id;
+  msg.command = command;
+  msg.display_mode = mode.display_mode;
+  msg.num_mirrors = mode.num_mirrors;
+  msg.method = options_.config.method;
+  Publish(options_.session_control_channel, msg);
+}
+
+void ViraalConductor::StartSession() {
+  const ModeSpec& mode = options_.config.modes[mode_index_];
+  SessionResult session;
+  session.mode = mode.name;
+  session.session_id = options_.run_id + "-" + mode.name;
+  session.display_mode = mode.display_mode;
+  session.num_mirrors = mode.num_mirrors;
+  results_.sessions.push_back(session);
+  trial_index_ = 0;
+  session_points_.clear();
+  last_trial_registration_.reset();
+  mean_registration_.reset();
+  SendSessionControl(+orbed::session_control_t::START);
+  Say("[" + mode.name + "] session " + session.session_id +
+      " started: " + std::to_string(options_.config.trials) + " trials, " + std::to_string(mode.num_mirrors) +
+      " reflective display(s)");
+  StartMove(true);
+}
+
+void ViraalConductor::StartMove(bool first) {
+  const std::vector<double>& q_deg = TargetDeg();
+  orbed::iiwa_command_t command{};
+  command.utime = now_.utime;
+  command.num_joints = static_cast<int32_t>(q_deg.size());
+  command.joint_position = FromVectorX(orbed::sim::DegToRad(ToVectorX(q_deg)));
+  command.num_torques = 0;
+  Publish(options_.iiwa_command_channel, command);
+  last_command_s_ = now_.t_s;
+  if (first) {
+    stopped_since_s_.reset();
+    Enter(Phase::kMove);
+    Log(orbed::LogLevel::kInfo, StepLabel() + ": moving to q=" + JointList(q_deg, 1) + " deg");
+  }
+}
+
+void ViraalConductor::RequestTrial() {
+  trial_.reset();
+  SendSessionControl(+orbed::session_control_t::REQUEST_TRIAL);
+  Enter(Phase::kAwaitTrial);
+}
+
+int64_t ViraalConductor::SendMisalignment(const AlignmentError& error) {
+  orbed::misalignment_request_t request{};
+  request.utime = now_.utime;
+  request.request_id = now_.utime * 16 + (next_request_id_++ % 16);
+  request.session_id = results_.sessions.back().session_id;
+  request.num_pairs = static_cast<int32_t>(error.p_W_real.size());
+  for (size_t k = 0; k < error.p_W_real.size(); ++k) {
+    const Eigen::Vector3d& real = error.p_W_real[k];
+    const Eigen::Vector3d& virt = error.p_W_virtual[k];
+    request.p_W_real_m.push_back({real.x(), real.y(), real.z()});
+    request.p_W_virtual_m.push_back({virt.x(), virt.y(), virt.z()});
+  }
+  Publish(options_.misalignment_request_channel, request);
+  return request.request_id;
+}
+
+void ViraalConductor::FinishTrial() {
+  const orbed::alignment_trial_t& trial = *trial_;
+  TrialResult result;
+  result.index = trial.trial_index;
+  for (double q : trial.joint_position) result.q_deg.push_back(q * kRadToDeg);
+  result.errors = Measures(pending_error_, *misalignment_);
+  result.user_duration_s = trial.duration_s;
+  result.user_id = trial.user_id;
+  result.X_WV = FromPose(trial.X_WV);
+  result.X_WR = FromPose(robot_state_->X_WR);
+  results_.sessions.back().trials.push_back(result);
+  Say(StepLabel() + ": robot at q=" + JointList(result.q_deg, 1) + " deg (reached in " + Fixed(reach_s_, 1) +
+      " s); aligned in " + Fixed(trial.duration_s, 1) + " s of user time: " +
+      Fixed(result.errors.translation_error_mm, 1) + " mm, " + Fixed(result.errors.rotation_error_deg, 2) +
+      " deg, misalignment " + Fixed(result.errors.misalignment_mm, 1) + " mm");
+  ++trial_index_;
+  if (trial_index_ < options_.config.trials) {
+    StartMove(true);
+  } else {
+    mean_registration_.reset();
+    SendSessionControl(+orbed::session_control_t::COMPUTE);
+    Enter(Phase::kAwaitMean);
+  }
+}
+
+void ViraalConductor::FinishSession() {
+  const orbed::registration_t& reg = *mean_registration_;
+  MeanResult mean;
+  mean.errors = Measures(pending_error_, *misalignment_);
+  mean.X_WV = FromPose(reg.X_WV_mean);
+  mean.num_used = reg.num_used;
+  mean.rejected_indices.assign(reg.rejected_indices.begin(), reg.rejected_indices.end());
+  mean.rotation_rms_deg = reg.rotation_rms_deg;
+  mean.translation_rms_mm = reg.translation_rms_m * 1e3;
+  mean.iterations = reg.iterations;
+  mean.converged = reg.converged;
+  mean.unique = reg.unique;
+  SessionResult& session = results_.sessions.back();
+  session.mean = mean;
+  Say("[" + session.mode + "] mean of " + std::to_string(reg.num_used) + " trials (SE(3), " +
+      (reg.converged ? "converged" : "NOT converged") + "): " + Fixed(mean.errors.translation_error_mm, 1) +
+      " mm, " + Fixed(mean.errors.rotation_error_deg, 2) + " deg, misalignment " +
+      Fixed(mean.errors.misalignment_mm, 1) + " mm");
+  SendSessionControl(+orbed::session_control_t::STOP);
+  ++mode_index_;
+  if (mode_index_ < options_.config.modes.size()) {
+    StartSession();
+  } else {
+    FinishRun();
+  }
+}
+
+void ViraalConductor::FinishRun() {
+  results_.ok = true;
+  results_.duration_s = now_.t_s - run_start_s_;
+  results_.rejected_inputs = refusals_;
+  phase_ = Phase::kDone;
+}
+
+void ViraalConductor::FailRun(const std::string& reason) {
+  if (phase_ == Phase::kDone) return;
+  phase_ = Phase::kDone;
+  results_.ok = false;
+  results_.error = reason;
+  results_.duration_s = now_.t_s - run_start_s_;
+  results_.rejected_inputs = refusals_;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Small helpers
+
+const std::vector<double>& ViraalConductor::TargetDeg() const {
+  const auto& configurations = options_.config.configurations_deg;
+  return configurations[trial_index_ % configurations.size()];
+}
+
+std::string ViraalConductor::StepLabel() const {
+  const int total = static_cast<int>(options_.config.modes.size()) * options_.config.trials;
+  const int step = static_cast<int>(mode_index_) * options_.config.trials + trial_index_ + 1;
+  const std::string mode =
+      mode_index_ < options_.config.modes.size() ? options_.config.modes[mode_index_].name : "";
+  return "[" + std::to_string(step) + "/" + std::to_string(total) + "] " + mode + " trial " +
+         std::to_string(trial_index_);
+}
+
+void ViraalConductor::Refuse(const std::string& key, const std::string& reason) {
+  last_refusal_ = reason;
+  ++refusals_;
+  actions_.push_back(Refusal{key, reason});
+}
+
+void ViraalConductor::Say(const std::string& line) { actions_.push_back(ProgressLine{line}); }
+
+void ViraalConductor::Log(orbed::LogLevel level, const std::string& text) {
+  actions_.push_back(LogEntry{level, text});
+}
+
+}  // namespace orbed::scenario

@@ -1,0 +1,252 @@
+#pragma once
+/// @file
+/// The conductor of the paper's ViRAAl experiment (Sec. III-B, Table 1) as a phase machine without
+/// a bus or a clock. ViraalScenario (viraal_scenario.h) feeds it the decoded messages and the time
+/// and publishes what it asks for; tests drive it directly, in emulated time.
+///
+/// The run, for each mode (ar_reflective with its mirrors, ar with 0; order from the scenario file):
+///   wait for ROBOT_STATE → PLAN_CHECK_REQUEST for every configuration, wait for every
+///   PLAN_CHECK_REPLY → START(session "<run_id>-<mode>", method) → for trial i = 0..N−1:
+///   IIWA_COMMAND q_i (configuration i mod K), wait until ROBOT_STATE has every |q − q_i| <
+///   tolerance_deg and motion IDLE → REQUEST_TRIAL → the ALIGNMENT_TRIAL (session, index i) →
+///   MISALIGNMENT_REQUEST of the trial's landmark pairs, wait for the REGISTRATION (reason TRIAL, that
+///   trial's utime, num_trials i+1) and the MISALIGNMENT answer → after N trials COMPUTE → the
+///   REGISTRATION (reason COMPUTE) = the session mean → MISALIGNMENT_REQUEST of the mean's pairs →
+///   the answer → STOP. After the last mode the status is kSucceeded. A timeout, an infeasible
+///   configuration or a refused request makes it kFailed with a one-line reason naming the process
+///   that did not answer; results() then holds what was finished.
+///
+/// Errors against the truth (viraal_errors.h): X_WR from the latest ROBOT_STATE (the sim's truth);
+/// translation_error_mm at the robot centroid, rotation_error_deg the geodesic angle of
+/// R_WR^T R_WV, misalignment_mm = MISALIGNMENT.mean_error_norm_m (the paper's ‖t̄‖₂) of the landmark
+/// pairs real = X_WR·X_RL(q)·0, virtual = X_WV·X_RL(q)·0, q = the trial's joint_position [rad].
+/// A session mean X_WV_mean is measured over the session's trial configurations.
+///
+/// Inputs: each On*() takes a decoded message and the time it arrived; Tick() only the time. Every
+/// message is checked (sizes, finite values, unit quaternions, enum ranges); a bad one is refused
+/// (a Refusal action, key "<channel>/<class>"), and the last refusal is quoted if the phase then
+/// times out. Messages that belong to someone else (other request ids, other sessions, periodic
+/// REGISTRATION) are ignored, not refused. Handlers advance the phases at once where they can;
+/// Tick() enforces the timeouts and re-sends IIWA_COMMAND every command_resend_s while the arm is
+/// short of the target.
+///
+/// Outputs: every call returns the actions it produced, in order: messages to publish (with their
+/// channel), progress lines for the operator, log entries and refusals. The caller carries them out
+/// in that order. Nothing else leaves the machine.
+///
+/// Time: ConductorTime::t_s is monotonic [s] and times the phases, timeouts, resends and the
+/// stopped grace; ConductorTime::utime [µs since the epoch] stamps the messages out and seeds the
+/// request ids. Neither is read from a clock here: identical calls give identical actions.
+///
+/// Threading: not thread-safe; one thread makes every call.
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include <orbed/alignment_trial_t.hpp>
+#include <orbed/iiwa_command_t.hpp>
+#include <orbed/misalignment_request_t.hpp>
+#include <orbed/misalignment_t.hpp>
+#include <orbed/plan_check_reply_t.hpp>
+#include <orbed/plan_check_request_t.hpp>
+#include <orbed/registration_t.hpp>
+#include <orbed/robot_state_t.hpp>
+#include <orbed/session_control_t.hpp>
+
+#include "procs/common/channels.h"
+#include "procs/common/log.h"
+#include "procs/scenario/scenario_config.h"
+#include "procs/scenario/viraal_errors.h"
+#include "procs/scenario/viraal_results.h"
+#include "sim/robot_model.h"
+
+namespace orbed::scenario {
+
+/// The time of an input, as two clocks read together by the caller.
+struct ConductorTime {
+  /// Monotonic time [s], any origin (steady_clock on the bus, a fake clock in tests).
+  double t_s{0};
+  /// Wall-clock time [µs since the Unix epoch], for the utimes of messages out.
+  int64_t utime{0};
+};
+
+struct ConductorOptions {
+  ScenarioConfig config;
+  /// Session ids are "<run_id>-<mode>"; must not be empty.
+  std::string run_id;
+  /// Recorded in the results (the process's --seed).
+  uint64_t seed{0};
+  /// How close every joint must be to the configuration [deg] (with motion IDLE).
+  double tolerance_deg{0.1};
+  /// Waiting for the first ROBOT_STATE [s] (orbed-iiwa-sim).
+  double startup_timeout_s{10.0};
+  /// Waiting for the PLAN_CHECK_REPLYs, a REGISTRATION or a MISALIGNMENT [s].
+  double reply_timeout_s{5.0};
+  /// Waiting for the arm to reach a configuration [s].
+  double move_timeout_s{30.0};
+  /// Waiting for the user's ALIGNMENT_TRIAL after REQUEST_TRIAL [s] (orbed-hmd).
+  double trial_timeout_s{60.0};
+  /// An arm that reports a stop (limit / collision) this long while short of the target fails [s].
+  double stopped_grace_s{0.5};
+  /// Period of the IIWA_COMMAND re-sends while the arm moves [s].
+  double command_resend_s{0.25};
+  /// Channels: the machine names them in refusal keys and reasons, and addresses its messages.
+  std::string robot_state_channel{channels::kRobotState};
+  std::string iiwa_command_channel{channels::kIiwaCommand};
+  std::string plan_check_request_channel{channels::kPlanCheckRequest};
+  std::string plan_check_reply_channel{channels::kPlanCheckReply};
+  std::string session_control_channel{channels::kSessionControl};
+  std::string trial_channel{channels::kAlignmentTrial};
+  std::string registration_channel{channels::kRegistration};
+  std::string misalignment_request_channel{channels::kMisalignmentRequest};
+  std::string misalignment_channel{channels::kMisalignment};
+};
+
+/// Throws std::invalid_argument naming the flag of the first duration or tolerance in `options`
+/// that is not a finite number > 0.
+void CheckConductorOptions(const ConductorOptions& options);
+
+/// A message to publish on `channel`.
+struct Publication {
+  using Message = std::variant<orbed::plan_check_request_t, orbed::session_control_t, orbed::iiwa_command_t,
+                               orbed::misalignment_request_t>;
+  std::string channel;
+  Message message;
+};
+/// A line for the operator (orbed-scenario's stdout).
+struct ProgressLine {
+  std::string text;
+};
+/// A line for the process log.
+struct LogEntry {
+  orbed::LogLevel level{orbed::LogLevel::kInfo};
+  std::string text;
+};
+/// A refused input: class `key` ("<channel>/field", "<channel>/unexpected") and a one-line reason.
+struct Refusal {
+  std::string key;
+  std::string reason;
+};
+using ConductorAction = std::variant<Publication, ProgressLine, LogEntry, Refusal>;
+using ConductorActions = std::vector<ConductorAction>;
+
+class ViraalConductor {
+ public:
+  enum class Phase {
+    kNotStarted,
+    kWaitRobot,
+    kCheckPlans,
+    kMove,
+    kAwaitTrial,
+    kAwaitTrialResults,
+    kAwaitMean,
+    kAwaitMeanMisalignment,
+    kDone,
+  };
+  enum class Status { kRunning, kSucceeded, kFailed };
+
+  /// Checks `options` (CheckConductorOptions), the configurations against the model's joint limits
+  /// and the landmarks against its links; throws std::invalid_argument with the reason.
+  ViraalConductor(ConductorOptions options, orbed::sim::RobotModel model);
+  ~ViraalConductor();
+  ViraalConductor(const ViraalConductor&) = delete;
+  ViraalConductor& operator=(const ViraalConductor&) = delete;
+
+  /// Starts the run clock and waits for the robot. Call once, before any other input (they throw
+  /// std::logic_error before it).
+  ConductorActions Start(const ConductorTime& now);
+
+  ConductorActions OnRobotState(const orbed::robot_state_t& msg, const ConductorTime& now);
+  ConductorActions OnPlanCheckReply(const orbed::plan_check_reply_t& msg, const ConductorTime& now);
+  ConductorActions OnTrial(const orbed::alignment_trial_t& msg, const ConductorTime& now);
+  ConductorActions OnRegistration(const orbed::registration_t& msg, const ConductorTime& now);
+  ConductorActions OnMisalignment(const orbed::misalignment_t& msg, const ConductorTime& now);
+  /// Advances what waits on time: timeouts, arrival checks, IIWA_COMMAND re-sends.
+  ConductorActions Tick(const ConductorTime& now);
+  /// Fails a run that has not finished with `reason` (e.g. stopped from outside); else nothing.
+  ConductorActions Abort(const std::string& reason, const ConductorTime& now);
+
+  Phase phase() const { return phase_; }
+  Status status() const;
+  bool done() const { return phase_ == Phase::kDone; }
+  /// The results so far; final once done(). rejected_inputs counts this machine's refusals (the
+  /// shell replaces it with its process's total, which also counts undecodable messages).
+  const RunResults& results() const { return results_; }
+  const ConductorOptions& options() const { return options_; }
+  const orbed::sim::RobotModel& model() const { return *model_; }
+
+ private:
+  // Sets the time of the call and clears the action list; throws before Start().
+  void Begin(const ConductorTime& now);
+  ConductorActions TakeActions();
+  // The timer's work; handlers call it too once they recorded an input.
+  void Step();
+
+  // Phase entries: each emits what starts the phase.
+  void Enter(Phase phase);
+  void StartPlanChecks();
+  void StartSession();
+  // Emits the trial's IIWA_COMMAND; `first` enters kMove (else a re-send).
+  void StartMove(bool first);
+  void RequestTrial();
+  int64_t SendMisalignment(const AlignmentError& error);
+  void FinishTrial();
+  void FinishSession();
+  void FinishRun();
+  void FailRun(const std::string& reason);
+  void SendSessionControl(int8_t command);
+
+  double PhaseSeconds() const { return now_.t_s - phase_start_s_; }
+  const std::vector<double>& TargetDeg() const;
+  std::string StepLabel() const;
+  void Refuse(const std::string& key, const std::string& reason);
+  void Say(const std::string& line);
+  void Log(orbed::LogLevel level, const std::string& text);
+  template <class Msg>
+  void Publish(const std::string& channel, const Msg& msg) {
+    actions_.push_back(Publication{channel, msg});
+  }
+
+  ConductorOptions options_;
+  std::unique_ptr<const orbed::sim::RobotModel> model_;
+  std::unique_ptr<RobotPointSet> points_;
+
+  ConductorTime now_;
+  ConductorActions actions_;
+  Phase phase_{Phase::kNotStarted};
+  double run_start_s_{0};
+  double phase_start_s_{0};
+  double last_command_s_{0};
+  std::optional<double> stopped_since_s_;
+  std::string last_refusal_;
+  int64_t refusals_{0};
+
+  // Latest truth from the sim.
+  std::optional<orbed::robot_state_t> robot_state_;
+  double robot_state_received_s_{0};
+
+  // Plan checks: one request id per configuration.
+  int64_t plan_request_base_{0};
+  std::vector<bool> plan_answered_;
+
+  // Where the run is.
+  size_t mode_index_{0};
+  int trial_index_{0};
+  std::optional<orbed::alignment_trial_t> trial_;
+  std::optional<orbed::registration_t> last_trial_registration_;
+  double reach_s_{0};
+  int64_t misalignment_request_id_{0};
+  std::optional<orbed::misalignment_t> misalignment_;
+  std::optional<orbed::registration_t> mean_registration_;
+  AlignmentError pending_error_;
+  std::vector<RobotPoints> session_points_;
+  int64_t next_request_id_{1};
+
+  RunResults results_;
+};
+
+}  // namespace orbed::scenario

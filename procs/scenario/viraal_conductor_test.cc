@@ -1,0 +1,634 @@
+// ViraalConductor in emulated time: no bus, no clock, no sleeps. A fake clock stamps every input;
+// the tests answer the conductor's publications by hand (timeouts) or through a small event-driven
+// emulation of the sim, the user and the registration server (a whole run).
+#include "procs/scenario/viraal_conductor.h"
+
+#include <cmath>
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "procs/common/conversions.h"
+#include "sim/model_paths.h"
+
+namespace orbed::scenario {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+using Phase = ViraalConductor::Phase;
+using Status = ViraalConductor::Status;
+
+// The emulated clocks: t_s from 100 s, utime = 1.7e15 µs + t_s.
+class FakeClock {
+ public:
+  ConductorTime Now() const { return {t_s_, 1'700'000'000'000'000 + std::llround(t_s_ * 1e6)}; }
+  double t_s() const { return t_s_; }
+  void Set(double t_s) { t_s_ = t_s; }
+  void Advance(double dt_s) { t_s_ += dt_s; }
+
+ private:
+  double t_s_{100.0};
+};
+
+// The trocar_or scene's base: (0.25, -0.55, 0.75), yaw 90 deg.
+Eigen::Isometry3d SceneBase() {
+  Eigen::Isometry3d X_WR = Eigen::Isometry3d::Identity();
+  X_WR.linear() = Eigen::AngleAxisd(90 * kDeg, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  X_WR.translation() = Eigen::Vector3d(0.25, -0.55, 0.75);
+  return X_WR;
+}
+
+orbed::robot_state_t RobotState(const std::vector<double>& q_rad,
+                                int8_t motion = orbed::robot_state_t::MOTION_IDLE,
+                                const std::string& stop_reason = "") {
+  orbed::robot_state_t s{};
+  s.robot_name = "iiwa7";
+  s.X_WR = ToPose(SceneBase());
+  s.X_RF = ToPose(Eigen::Isometry3d::Identity());
+  s.X_RT = s.X_RF;
+  s.num_joints = static_cast<int32_t>(q_rad.size());
+  s.joint_position = q_rad;
+  s.joint_limit_hit.assign(q_rad.size(), 0);
+  s.num_links = 0;
+  s.motion_state = motion;
+  s.stop_reason = stop_reason;
+  return s;
+}
+
+std::vector<double> Rad(const std::vector<double>& q_deg) {
+  std::vector<double> q;
+  for (double v : q_deg) q.push_back(v * kDeg);
+  return q;
+}
+
+orbed::plan_check_reply_t PlanReply(int64_t request_id) {
+  orbed::plan_check_reply_t reply{};
+  reply.request_id = request_id;
+  reply.request_valid = reply.within_limits = reply.feasible = true;
+  reply.min_distance_m = 0.1;
+  return reply;
+}
+
+// A label per publication: the channel, and the command for SESSION_CONTROL.
+std::string Label(const Publication& p) {
+  if (const auto* control = std::get_if<orbed::session_control_t>(&p.message)) {
+    const char* names[] = {"START", "RESET", "COMPUTE", "STOP", "REQUEST_TRIAL"};
+    return p.channel + " " + names[control->command];
+  }
+  return p.channel;
+}
+
+// A conductor on the shipped scenario (2 modes x 3 trials, 3 configurations, 3 landmarks) with
+// the default timeouts, the fake clock and a record of everything it did.
+class Bench {
+ public:
+  explicit Bench(ConductorOptions options = Options())
+      : conductor_(options, orbed::sim::RobotModel::LoadFile(
+                                sim::SourceTreePath(orbed::sim::RobotModel::kDefaultUrdfRelativePath))) {}
+
+  static ConductorOptions Options() {
+    ConductorOptions options;
+    options.config = LoadScenarioFile(sim::SourceTreePath(kDefaultScenarioRelativePath));
+    options.run_id = "emu";
+    return options;
+  }
+
+  // Each input at the clock's time; its actions are recorded.
+  void Start() { Record(conductor_.Start(clock_.Now())); }
+  void Tick() { Record(conductor_.Tick(clock_.Now())); }
+  void TickAt(double t_s) {
+    clock_.Set(t_s);
+    Tick();
+  }
+  void Send(const orbed::robot_state_t& m) { Record(conductor_.OnRobotState(m, clock_.Now())); }
+  void Send(const orbed::plan_check_reply_t& m) { Record(conductor_.OnPlanCheckReply(m, clock_.Now())); }
+  void Send(const orbed::alignment_trial_t& m) { Record(conductor_.OnTrial(m, clock_.Now())); }
+  void Send(const orbed::registration_t& m) { Record(conductor_.OnRegistration(m, clock_.Now())); }
+  void Send(const orbed::misalignment_t& m) { Record(conductor_.OnMisalignment(m, clock_.Now())); }
+
+  // Started, the robot seen and every plan check answered: the first IIWA_COMMAND is out.
+  void StartAndCheckPlans() {
+    Start();
+    clock_.Advance(0.1);
+    Send(RobotState(std::vector<double>(7, 0.0)));
+    clock_.Advance(0.01);
+    for (const Publication& p : Sent("PLAN_CHECK_REQUEST")) {
+      Send(PlanReply(std::get<orbed::plan_check_request_t>(p.message).request_id));
+    }
+    ASSERT_EQ(conductor_.phase(), Phase::kMove);
+  }
+
+  std::vector<Publication> Sent(const std::string& channel) const {
+    std::vector<Publication> out;
+    for (const Publication& p : sent_)
+      if (p.channel == channel) out.push_back(p);
+    return out;
+  }
+  std::vector<std::string> Labels() const {
+    std::vector<std::string> out;
+    for (const Publication& p : sent_) out.push_back(Label(p));
+    return out;
+  }
+
+  ViraalConductor& conductor() { return conductor_; }
+  FakeClock& clock() { return clock_; }
+  const std::vector<Publication>& sent() const { return sent_; }
+  const std::vector<std::string>& lines() const { return lines_; }
+  const std::vector<Refusal>& refusals() const { return refusals_; }
+  // The publications of the last input only.
+  const std::vector<Publication>& last() const { return last_; }
+
+  void Record(const ConductorActions& actions) {
+    last_.clear();
+    for (const ConductorAction& action : actions) {
+      if (const auto* p = std::get_if<Publication>(&action)) {
+        sent_.push_back(*p);
+        last_.push_back(*p);
+      } else if (const auto* line = std::get_if<ProgressLine>(&action)) {
+        lines_.push_back(line->text);
+      } else if (const auto* refusal = std::get_if<Refusal>(&action)) {
+        refusals_.push_back(*refusal);
+      }
+    }
+  }
+
+ private:
+  ViraalConductor conductor_;
+  FakeClock clock_;
+  std::vector<Publication> sent_, last_;
+  std::vector<std::string> lines_;
+  std::vector<Refusal> refusals_;
+};
+
+bool Contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+TEST(ViraalConductor, InputsBeforeStartAreALogicError) {
+  Bench bench;
+  EXPECT_THROW(bench.Tick(), std::logic_error);
+  bench.Start();
+  EXPECT_THROW(bench.Start(), std::logic_error);
+}
+
+TEST(ViraalConductor, BadOptionsAreRefusedAtConstruction) {
+  ConductorOptions options = Bench::Options();
+  options.reply_timeout_s = 0;
+  EXPECT_THROW(Bench{options}, std::invalid_argument);
+  options = Bench::Options();
+  options.run_id = "";
+  EXPECT_THROW(Bench{options}, std::invalid_argument);
+  options = Bench::Options();
+  options.config.landmarks = {"iiwa_link_9"};
+  EXPECT_THROW(Bench{options}, std::invalid_argument);
+}
+
+TEST(ViraalConductor, NoRobotStateWithinTheStartupTimeoutNamesTheSim) {
+  Bench bench;
+  bench.Start();
+  ASSERT_EQ(bench.lines().size(), 1u);
+  EXPECT_EQ(bench.lines()[0], "ViRAAl run emu: waiting for the robot (ROBOT_STATE)");
+  // A ROBOT_STATE with a non-unit quaternion is refused, counted and later quoted.
+  orbed::robot_state_t bad = RobotState(std::vector<double>(7, 0.0));
+  bad.X_WR.quaternion_wxyz[0] = 0.5;
+  bench.Send(bad);
+  ASSERT_EQ(bench.refusals().size(), 1u);
+  EXPECT_EQ(bench.refusals()[0].key, "ROBOT_STATE/field");
+  bench.TickAt(100.0 + 9.99);
+  EXPECT_EQ(bench.conductor().status(), Status::kRunning);
+  bench.TickAt(100.0 + 10.01);
+  EXPECT_EQ(bench.conductor().status(), Status::kFailed);
+  const RunResults& r = bench.conductor().results();
+  EXPECT_FALSE(r.ok);
+  EXPECT_TRUE(
+      Contains(r.error, "no valid ROBOT_STATE on ROBOT_STATE within 10.0 s: is orbed-iiwa-sim running?"))
+      << r.error;
+  EXPECT_TRUE(Contains(r.error, "(last refused input: " + bench.refusals()[0].reason + ")")) << r.error;
+  EXPECT_NEAR(r.duration_s, 10.01, 1e-9);
+  EXPECT_EQ(r.started_utime, 1'700'000'100'000'000);
+  EXPECT_EQ(r.rejected_inputs, 1);
+  EXPECT_TRUE(bench.sent().empty());
+  // Done is final: later time and input change nothing.
+  bench.TickAt(200);
+  bench.Send(RobotState(std::vector<double>(7, 0.0)));
+  EXPECT_TRUE(bench.sent().empty());
+  EXPECT_EQ(bench.conductor().results().error, r.error);
+}
+
+TEST(ViraalConductor, MissingPlanCheckRepliesFailAfterTheReplyTimeout) {
+  Bench bench;
+  bench.Start();
+  bench.clock().Advance(0.5);
+  bench.Send(RobotState(std::vector<double>(7, 0.0)));
+  const std::vector<Publication> requests = bench.Sent("PLAN_CHECK_REQUEST");
+  ASSERT_EQ(requests.size(), 3u);
+  const double sent_s = bench.clock().t_s();
+  const auto& config = bench.conductor().options().config;
+  for (size_t k = 0; k < 3; ++k) {
+    const auto& request = std::get<orbed::plan_check_request_t>(requests[k].message);
+    EXPECT_EQ(request.request_id, bench.clock().Now().utime + static_cast<int64_t>(k));
+    EXPECT_EQ(request.utime, bench.clock().Now().utime);
+    ASSERT_EQ(request.num_joints, 7);
+    for (int j = 0; j < 7; ++j)
+      EXPECT_NEAR(request.joint_position[j], config.configurations_deg[k][j] * kDeg, 1e-15);
+  }
+  // Two answered (one of them twice), one reply for someone else's request.
+  const int64_t base = std::get<orbed::plan_check_request_t>(requests[0].message).request_id;
+  bench.Send(PlanReply(base));
+  bench.Send(PlanReply(base));
+  bench.Send(PlanReply(base + 2));
+  bench.Send(PlanReply(base + 7));
+  EXPECT_TRUE(bench.refusals().empty());
+  bench.TickAt(sent_s + 4.99);
+  EXPECT_EQ(bench.conductor().phase(), Phase::kCheckPlans);
+  bench.TickAt(sent_s + 5.01);
+  EXPECT_EQ(bench.conductor().status(), Status::kFailed);
+  EXPECT_EQ(bench.conductor().results().error,
+            "orbed-iiwa-sim answered 2 of 3 PLAN_CHECK_REQUESTs within 5.0 s");
+  EXPECT_EQ(bench.Labels(), std::vector<std::string>(3, "PLAN_CHECK_REQUEST"));  // nothing moved
+}
+
+TEST(ViraalConductor, AnInfeasibleConfigurationFailsAtOnce) {
+  Bench bench;
+  bench.Start();
+  bench.Send(RobotState(std::vector<double>(7, 0.0)));
+  orbed::plan_check_reply_t reply =
+      PlanReply(std::get<orbed::plan_check_request_t>(bench.sent()[1].message).request_id);
+  reply.feasible = false;
+  reply.reason = "in collision: iiwa_link_7 vs patient_torso";
+  bench.Send(reply);
+  EXPECT_EQ(bench.conductor().status(), Status::kFailed);
+  EXPECT_TRUE(
+      Contains(bench.conductor().results().error,
+               "configuration 1 (40.0, 20.0, -30.0, -80.0, 20.0, 50.0, 30.0) deg is infeasible in the "
+               "sim's scene: in collision: iiwa_link_7 vs patient_torso"))
+      << bench.conductor().results().error;
+}
+
+TEST(ViraalConductor, TheCommandIsResentUntilTheMoveTimeout) {
+  Bench bench;
+  bench.StartAndCheckPlans();
+  const double command_s = bench.clock().t_s();
+  EXPECT_EQ(bench.Labels().back(), "IIWA_COMMAND");
+  EXPECT_EQ(bench.Labels()[3], "SESSION_CONTROL START");
+  // The arm moves but never arrives: every tick past command_resend_s re-sends the command.
+  bench.clock().Advance(0.1);
+  bench.Send(RobotState(Rad({0, 10, 0, -20, 0, 15, 0}), orbed::robot_state_t::MOTION_MOVING));
+  bench.TickAt(command_s + 0.24);
+  EXPECT_TRUE(bench.last().empty());
+  bench.TickAt(command_s + 0.26);
+  ASSERT_EQ(bench.last().size(), 1u);
+  EXPECT_EQ(Label(bench.last()[0]), "IIWA_COMMAND");
+  EXPECT_EQ(std::get<orbed::iiwa_command_t>(bench.last()[0].message).utime, bench.clock().Now().utime);
+  bench.TickAt(command_s + 0.50);
+  EXPECT_TRUE(bench.last().empty());
+  bench.TickAt(command_s + 0.52);
+  EXPECT_EQ(bench.last().size(), 1u);
+  bench.TickAt(command_s + 29.99);
+  EXPECT_EQ(bench.conductor().phase(), Phase::kMove);
+  bench.TickAt(command_s + 30.01);
+  EXPECT_TRUE(bench.last().empty());  // failing, not re-sending
+  EXPECT_EQ(bench.conductor().status(), Status::kFailed);
+  EXPECT_EQ(
+      bench.conductor().results().error,
+      "the arm did not reach configuration (0.0, 30.0, 0.0, -60.0, 0.0, 45.0, 0.0) deg within 30.0 s (it is "
+      "at (0.00, 10.00, 0.00, -20.00, 0.00, 15.00, 0.00) deg, 40.000 deg off, motion state 1): is "
+      "orbed-iiwa-sim receiving IIWA_COMMAND?");
+  EXPECT_EQ(bench.Sent("IIWA_COMMAND").size(), 4u);
+}
+
+// The grace runs from the first fresh stopped state (received more than 50 ms after the last
+// IIWA_COMMAND). A re-send makes the states before it stale again, so the grace can only elapse
+// when command_resend_s exceeds it; here 2 s.
+TEST(ViraalConductor, AnArmThatStopsShortFailsAfterTheStoppedGrace) {
+  ConductorOptions options = Bench::Options();
+  options.command_resend_s = 2.0;
+  Bench bench(options);
+  bench.StartAndCheckPlans();
+  const double command_s = bench.clock().t_s();
+  const std::vector<double> short_q = Rad({0, 30, 0, -58, 0, 45, 0});
+  const auto stopped = orbed::robot_state_t::MOTION_STOPPED_BEFORE_COLLISION;
+  // A stopped state 10 ms after the command predates it: not a stop yet.
+  bench.clock().Set(command_s + 0.01);
+  bench.Send(RobotState(short_q, stopped, "iiwa_link_7 within 5 mm of patient_torso"));
+  bench.TickAt(command_s + 1.0);
+  EXPECT_EQ(bench.conductor().status(), Status::kRunning);
+  // A fresh one starts the grace.
+  bench.clock().Set(command_s + 1.1);
+  bench.Send(RobotState(short_q, stopped, "iiwa_link_7 within 5 mm of patient_torso"));
+  bench.TickAt(command_s + 1.59);
+  EXPECT_EQ(bench.conductor().status(), Status::kRunning);
+  bench.TickAt(command_s + 1.61);
+  EXPECT_EQ(bench.conductor().status(), Status::kFailed);
+  EXPECT_EQ(bench.conductor().results().error,
+            "the arm stopped 2.00 deg short of configuration (0.0, 30.0, 0.0, -60.0, 0.0, 45.0, 0.0) deg: "
+            "iiwa_link_7 within 5 mm of patient_torso");
+}
+
+// With the default re-send period (0.25 s) under the default grace (0.5 s), a streaming stopped
+// arm is caught by the move timeout instead: each re-send makes the next 50 ms of states stale,
+// which restarts the grace.
+TEST(ViraalConductor, WithTheDefaultResendPeriodAStoppedArmMeetsTheMoveTimeout) {
+  Bench bench;
+  bench.StartAndCheckPlans();
+  const double command_s = bench.clock().t_s();
+  const std::vector<double> short_q = Rad({0, 30, 0, -58, 0, 45, 0});
+  // ROBOT_STATE at 200 Hz and ticks at 100 Hz for 31 s, on an integer grid of 5 ms.
+  for (int k = 1; k <= 6200 && bench.conductor().status() == Status::kRunning; ++k) {
+    bench.clock().Set(command_s + k * 0.005);
+    bench.Send(RobotState(short_q, orbed::robot_state_t::MOTION_STOPPED_AT_LIMIT, "joint 4 at its limit"));
+    if (k % 2 == 0) bench.Tick();
+  }
+  EXPECT_EQ(bench.conductor().status(), Status::kFailed);
+  EXPECT_TRUE(Contains(bench.conductor().results().error, "did not reach configuration"))
+      << bench.conductor().results().error;
+}
+
+TEST(ViraalConductor, NoAlignmentTrialWithinTheTrialTimeoutNamesOrbedHmd) {
+  Bench bench;
+  bench.StartAndCheckPlans();
+  bench.clock().Advance(0.2);
+  bench.Send(RobotState(Rad(bench.conductor().options().config.configurations_deg[0])));
+  EXPECT_EQ(bench.Labels().back(), "SESSION_CONTROL REQUEST_TRIAL");
+  const double request_s = bench.clock().t_s();
+  // Another run's trial is ignored; a trial of ours for the wrong index is refused.
+  orbed::alignment_trial_t trial{};
+  trial.session_id = "other-ar_reflective";
+  bench.Send(trial);
+  EXPECT_TRUE(bench.refusals().empty());
+  trial.session_id = "emu-ar_reflective";
+  trial.trial_index = 2;
+  bench.Send(trial);
+  ASSERT_EQ(bench.refusals().size(), 1u);
+  EXPECT_EQ(bench.refusals()[0].key, "ALIGNMENT_TRIAL/unexpected");
+  bench.TickAt(request_s + 59.99);
+  EXPECT_EQ(bench.conductor().phase(), Phase::kAwaitTrial);
+  bench.TickAt(request_s + 60.01);
+  EXPECT_EQ(bench.conductor().status(), Status::kFailed);
+  EXPECT_EQ(
+      bench.conductor().results().error,
+      "no ALIGNMENT_TRIAL for session 'emu-ar_reflective' trial 0 within 60.0 s of SESSION_CONTROL "
+      "REQUEST_TRIAL: is orbed-hmd running (its emulated user answers REQUEST_TRIAL on ALIGNMENT_TRIAL)? "
+      "(last refused input: ALIGNMENT_TRIAL for session 'emu-ar_reflective' trial 2 was not requested "
+      "now)");
+  EXPECT_EQ(bench.conductor().results().sessions.size(), 1u);
+}
+
+// An ALIGNMENT_TRIAL as orbed-hmd would send it for the requested trial of `session`.
+orbed::alignment_trial_t Trial(const std::string& session, int index, const std::vector<double>& q_rad,
+                               const Eigen::Isometry3d& X_WV, int64_t utime, int8_t mode, int32_t mirrors) {
+  orbed::alignment_trial_t t{};
+  t.utime = utime;
+  t.session_id = session;
+  t.trial_index = index;
+  t.display_mode = mode;
+  t.num_mirrors = mirrors;
+  t.num_joints = static_cast<int32_t>(q_rad.size());
+  t.joint_position = q_rad;
+  t.X_WV = ToPose(X_WV);
+  t.duration_s = 12.5;
+  t.user_id = "emulated";
+  return t;
+}
+
+TEST(ViraalConductor, NoRegistrationOfTheTrialFailsAfterTheReplyTimeout) {
+  Bench bench;
+  bench.StartAndCheckPlans();
+  const auto& q0 = bench.conductor().options().config.configurations_deg[0];
+  bench.Send(RobotState(Rad(q0)));
+  bench.clock().Advance(1.0);
+  bench.Send(Trial("emu-ar_reflective", 0, Rad(q0), SceneBase(), bench.clock().Now().utime,
+                   orbed::alignment_trial_t::MODE_AR_REFLECTIVE, 1));
+  ASSERT_EQ(bench.Labels().back(), "MISALIGNMENT_REQUEST");
+  const double trial_s = bench.clock().t_s();
+  bench.TickAt(trial_s + 4.99);
+  EXPECT_EQ(bench.conductor().phase(), Phase::kAwaitTrialResults);
+  bench.TickAt(trial_s + 5.01);
+  EXPECT_EQ(bench.conductor().status(), Status::kFailed);
+  EXPECT_EQ(bench.conductor().results().error,
+            "no REGISTRATION (reason TRIAL) from orbed-registration for session 'emu-ar_reflective' trial 0 "
+            "within 5.0 s (is it running? did it refuse the trial? see its PROCESS_STATUS rejections)");
+}
+
+TEST(ViraalConductor, AbortEndsARunningRunOnly) {
+  Bench bench;
+  bench.StartAndCheckPlans();
+  bench.clock().Advance(3.0);
+  bench.Record(bench.conductor().Abort("interrupted before the run completed", bench.clock().Now()));
+  EXPECT_EQ(bench.conductor().status(), Status::kFailed);
+  EXPECT_EQ(bench.conductor().results().error, "interrupted before the run completed");
+  bench.conductor().Abort("again", bench.clock().Now());
+  EXPECT_EQ(bench.conductor().results().error, "interrupted before the run completed");
+}
+
+// ----------------------------------------------------------------------------------------------
+// A whole run against an event-driven emulation of orbed-iiwa-sim (teleports in 0.2 s),
+// orbed-hmd's user (answers REQUEST_TRIAL after 1 s, X_WV 10 mm along W x from the truth) and
+// orbed-registration (trial registrations, the mean, the misalignment of the pairs). Ticks every
+// 10 ms, as the shell does.
+
+class Emulation {
+ public:
+  explicit Emulation(Bench* bench) : bench_(bench) {}
+
+  // Runs until the conductor is done or `until_s`.
+  void Run(double until_s) {
+    bench_->Start();
+    const double start_s = bench_->clock().t_s();
+    At(start_s + 0.05, [this] { bench_->Send(RobotState(q_)); });
+    for (int k = 1; start_s + k * 0.01 <= until_s; ++k) At(start_s + k * 0.01, [this] { bench_->Tick(); });
+    while (!events_.empty() && !bench_->conductor().done()) {
+      const auto next = events_.begin();
+      bench_->clock().Set(next->first);
+      const std::function<void()> event = next->second;
+      events_.erase(next);
+      event();
+      for (const Publication& p : bench_->last()) Answer(p);
+    }
+  }
+
+ private:
+  void At(double t_s, std::function<void()> event) { events_.emplace(t_s, std::move(event)); }
+  double Now() const { return bench_->clock().t_s(); }
+
+  void Answer(const Publication& p) {
+    if (const auto* request = std::get_if<orbed::plan_check_request_t>(&p.message)) {
+      At(Now() + 0.002, [this, id = request->request_id] { bench_->Send(PlanReply(id)); });
+    } else if (const auto* command = std::get_if<orbed::iiwa_command_t>(&p.message)) {
+      const std::vector<double> target = command->joint_position;
+      At(Now() + 0.005, [this] { bench_->Send(RobotState(q_, orbed::robot_state_t::MOTION_MOVING)); });
+      At(Now() + 0.2, [this, target] {
+        q_ = target;
+        bench_->Send(RobotState(q_));
+      });
+    } else if (const auto* control = std::get_if<orbed::session_control_t>(&p.message)) {
+      OnSessionControl(*control);
+    } else if (const auto* request = std::get_if<orbed::misalignment_request_t>(&p.message)) {
+      At(Now() + 0.002, [this, m = Misalignment(*request)] { bench_->Send(m); });
+    }
+  }
+
+  void OnSessionControl(const orbed::session_control_t& msg) {
+    if (msg.command == orbed::session_control_t::START) {
+      trials_ = 0;
+    } else if (msg.command == orbed::session_control_t::REQUEST_TRIAL) {
+      At(Now() + 1.0, [this, msg] {
+        Eigen::Isometry3d X_WV = SceneBase();
+        X_WV.translation() += Eigen::Vector3d(0.010, 0, 0);
+        const orbed::alignment_trial_t trial =
+            Trial(msg.session_id, trials_, q_, X_WV, bench_->clock().Now().utime, msg.display_mode,
+                  msg.num_mirrors);
+        bench_->Send(trial);
+        ++trials_;
+        At(Now() + 0.003,
+           [this, trial] { bench_->Send(Registration(trial.session_id, trial.utime, trial.X_WV)); });
+      });
+    } else if (msg.command == orbed::session_control_t::COMPUTE) {
+      At(Now() + 0.003, [this, msg] {
+        Eigen::Isometry3d X_WV = SceneBase();
+        X_WV.translation() += Eigen::Vector3d(0.010, 0, 0);
+        orbed::registration_t mean = Registration(msg.session_id, msg.utime, ToPose(X_WV));
+        mean.reason = orbed::registration_t::REASON_COMPUTE;
+        bench_->Send(mean);
+      });
+    }
+  }
+
+  orbed::registration_t Registration(const std::string& session, int64_t utime, const orbed::pose_t& X_WV) {
+    orbed::registration_t r{};
+    r.utime = utime;
+    r.session_id = session;
+    r.reason = orbed::registration_t::REASON_TRIAL;
+    r.method = orbed::registration_t::METHOD_KARCHER;
+    r.valid = true;
+    r.X_WV_mean = X_WV;
+    r.num_trials = r.num_used = trials_;
+    r.converged = r.unique = true;
+    r.iterations = 4;
+    return r;
+  }
+
+  // The server's Table 1 evaluation: mean |virtual − real| per W axis and its norm.
+  static orbed::misalignment_t Misalignment(const orbed::misalignment_request_t& request) {
+    orbed::misalignment_t m{};
+    m.utime = request.utime;
+    m.request_id = request.request_id;
+    m.session_id = request.session_id;
+    m.valid = true;
+    m.num_pairs = request.num_pairs;
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    double distance = 0;
+    for (int k = 0; k < request.num_pairs; ++k) {
+      Eigen::Vector3d d;
+      for (int i = 0; i < 3; ++i) d[i] = request.p_W_virtual_m[k][i] - request.p_W_real_m[k][i];
+      m.error_W_m.push_back({std::abs(d.x()), std::abs(d.y()), std::abs(d.z())});
+      m.error_norm_m.push_back(d.norm());
+      mean += d.cwiseAbs() / request.num_pairs;
+      distance += d.norm() / request.num_pairs;
+    }
+    FromVector3(mean, m.mean_error_W_m);
+    m.mean_error_norm_m = mean.norm();
+    m.mean_pair_distance_m = distance;
+    return m;
+  }
+
+  Bench* bench_;
+  std::multimap<double, std::function<void()>> events_;
+  std::vector<double> q_ = std::vector<double>(7, 0.0);
+  int trials_ = 0;
+};
+
+TEST(ViraalConductor, AWholeRunInEmulatedTime) {
+  Bench bench;
+  Emulation(&bench).Run(200.0);
+  ASSERT_EQ(bench.conductor().status(), Status::kSucceeded) << bench.conductor().results().error;
+
+  // The actions, in order.
+  std::vector<std::string> expected(3, "PLAN_CHECK_REQUEST");
+  for (int mode = 0; mode < 2; ++mode) {
+    expected.push_back("SESSION_CONTROL START");
+    for (int i = 0; i < 3; ++i) {
+      for (const char* label : {"IIWA_COMMAND", "SESSION_CONTROL REQUEST_TRIAL", "MISALIGNMENT_REQUEST"})
+        expected.push_back(label);
+    }
+    for (const char* label : {"SESSION_CONTROL COMPUTE", "MISALIGNMENT_REQUEST", "SESSION_CONTROL STOP"})
+      expected.push_back(label);
+  }
+  EXPECT_EQ(bench.Labels(), expected);
+  EXPECT_TRUE(bench.refusals().empty());
+
+  // What the messages carry.
+  const ScenarioConfig& config = bench.conductor().options().config;
+  const std::vector<Publication> commands = bench.Sent("IIWA_COMMAND");
+  ASSERT_EQ(commands.size(), 6u);
+  for (size_t i = 0; i < commands.size(); ++i) {
+    const auto& command = std::get<orbed::iiwa_command_t>(commands[i].message);
+    for (int j = 0; j < 7; ++j)
+      EXPECT_NEAR(command.joint_position[j], config.configurations_deg[i % 3][j] * kDeg, 1e-15);
+  }
+  std::vector<int> pairs;
+  for (const Publication& p : bench.Sent("MISALIGNMENT_REQUEST"))
+    pairs.push_back(std::get<orbed::misalignment_request_t>(p.message).num_pairs);
+  EXPECT_EQ(pairs, (std::vector<int>{3, 3, 3, 9, 3, 3, 3, 9}));
+  for (const Publication& p : bench.Sent("SESSION_CONTROL")) {
+    const auto& control = std::get<orbed::session_control_t>(p.message);
+    EXPECT_TRUE(control.session_id == "emu-ar_reflective" || control.session_id == "emu-ar")
+        << control.session_id;
+    EXPECT_EQ(control.method, +orbed::registration_t::METHOD_KARCHER);
+  }
+
+  // The results: a pure 10 mm shift along W x is 10 mm everywhere, t̄ = (10, 0, 0) mm.
+  const RunResults& r = bench.conductor().results();
+  EXPECT_TRUE(r.ok);
+  EXPECT_EQ(r.run_id, "emu");
+  EXPECT_EQ(r.error, "");
+  EXPECT_EQ(r.rejected_inputs, 0);
+  EXPECT_EQ(r.started_utime, 1'700'000'100'000'000);
+  // Per trial: 0.2 s to arrive, 1 s of user, 3 ms to register; then 5 ms for the mean; per session
+  // a first 0.05 s for the robot and 2 ms for the plan checks.
+  EXPECT_NEAR(r.duration_s, 0.05 + 0.002 + 2 * (3 * (0.2 + 1.0 + 0.003) + 0.003 + 0.002), 1e-6);
+  ASSERT_EQ(r.sessions.size(), 2u);
+  EXPECT_EQ(r.sessions[0].session_id, "emu-ar_reflective");
+  EXPECT_EQ(r.sessions[1].session_id, "emu-ar");
+  EXPECT_EQ(r.sessions[1].num_mirrors, 0);
+  for (const SessionResult& s : r.sessions) {
+    ASSERT_EQ(s.trials.size(), 3u);
+    ASSERT_TRUE(s.mean.has_value());
+    EXPECT_EQ(s.mean->num_used, 3);
+    EXPECT_EQ(s.mean->iterations, 4);
+    for (const ErrorMeasures& e :
+         {s.trials[0].errors, s.trials[1].errors, s.trials[2].errors, s.mean->errors}) {
+      EXPECT_NEAR(e.translation_error_mm, 10.0, 1e-9);
+      EXPECT_NEAR(e.flange_translation_error_mm, 10.0, 1e-9);
+      EXPECT_NEAR(e.rotation_error_deg, 0.0, 1e-6);
+      EXPECT_NEAR(e.misalignment_mm, 10.0, 1e-9);
+      EXPECT_NEAR((e.misalignment_axes_mm - Eigen::Vector3d(10, 0, 0)).norm(), 0.0, 1e-9);
+    }
+    for (int i = 0; i < 3; ++i) {
+      EXPECT_EQ(s.trials[i].index, i);
+      EXPECT_EQ(s.trials[i].user_duration_s, 12.5);
+      EXPECT_EQ(s.trials[i].user_id, "emulated");
+      for (int j = 0; j < 7; ++j) EXPECT_NEAR(s.trials[i].q_deg[j], config.configurations_deg[i][j], 1e-9);
+    }
+  }
+  EXPECT_TRUE(Contains(ResultsJson(r), "\"status\": \"ok\""));
+
+  // The operator's lines.
+  const std::vector<std::string>& lines = bench.lines();
+  ASSERT_EQ(lines.size(), 1u + 1u + 2 * (1 + 3 + 1));
+  EXPECT_EQ(lines[1],
+            "[plan] 3 configurations checked with orbed-iiwa-sim: within limits and collision-free");
+  EXPECT_EQ(lines[2], "[ar_reflective] session emu-ar_reflective started: 3 trials, 1 reflective display(s)");
+  EXPECT_EQ(
+      lines[3],
+      "[1/6] ar_reflective trial 0: robot at q=(0.0, 30.0, 0.0, -60.0, 0.0, 45.0, 0.0) deg (reached in 0.2 "
+      "s); aligned in 12.5 s of user time: 10.0 mm, 0.00 deg, misalignment 10.0 mm");
+  EXPECT_EQ(lines[6],
+            "[ar_reflective] mean of 3 trials (SE(3), converged): 10.0 mm, 0.00 deg, misalignment 10.0 mm");
+}
+
+}  // namespace
+}  // namespace orbed::scenario
