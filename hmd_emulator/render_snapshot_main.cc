@@ -17,19 +17,16 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "base/source_paths.h"
+#include "base/units.h"
 #include "hmd_emulator/gaze.h"
 #include "hmd_emulator/reflective.h"
 #include "hmd_emulator/renderer.h"
 #include "hmd_emulator/scene_geometry.h"
-#include "base/source_paths.h"
 #include "sim/robot_model.h"
 #include "sim/scene.h"
-#include "base/units.h"
 
 namespace {
-
-using orbed::hmd::Intrinsics;
-using orbed::hmd::LookAt;
 
 void Caption(cv::Mat* image, const std::string& text) {
   cv::rectangle(*image, cv::Rect(0, 0, image->cols, 34), cv::Scalar(30, 30, 30), cv::FILLED);
@@ -56,6 +53,7 @@ int main(int argc, char** argv) {
     }
   }
   try {
+    namespace geometry = orbed::geometry;
     namespace hmd = orbed::hmd;
     namespace sim = orbed::sim;
     const sim::Scene scene = sim::LoadSceneFile(orbed::SourceTreePath(sim::kDefaultSceneRelativePath));
