@@ -1,58 +1,13 @@
 /// @file
 /// orbed-iiwa-sim: a simulated KUKA LBR iiwa 7 R800 in the OR scene, moved like a hand-guided arm
-/// in manual mode (speed- and limit-bounded, stops before a collision; see sim/iiwa_sim.h).
+/// in manual mode (speed- and limit-bounded, stops before a collision; see sim/iiwa_sim.h); flags
+/// and exit codes: sim/iiwa_sim_cli.h.
 /// Subscribes: IIWA_COMMAND (iiwa_command_t = Drake's lcmt_iiwa_command), PLAN_CHECK_REQUEST.
 /// Publishes:  IIWA_STATUS (iiwa_status_t = Drake's lcmt_iiwa_status), ROBOT_STATE and
 ///             COLLISION_STATUS every --period-sec (200 Hz by default); PLAN_CHECK_REPLY per
 ///             request; PROCESS_STATUS at 1 Hz. Channel names can be overridden by flags.
 #include <iostream>
 
-#include "sim/iiwa_sim.h"
+#include "sim/iiwa_sim_cli.h"
 
-int main(int argc, char** argv) {
-  CLI::App app{
-      "orbed-iiwa-sim: simulated iiwa 7 arm (URDF + Bullet collision world) executing\n"
-      "IIWA_COMMAND like a hand-guided arm; publishes IIWA_STATUS, ROBOT_STATE and\n"
-      "COLLISION_STATUS every tick and answers PLAN_CHECK_REQUEST."};
-  orbed::CommonFlags common("orbed-iiwa-sim");
-  orbed::AddCommonFlags(&app, &common);
-  orbed::sim::IiwaSimOptions options;
-  app.add_option("--urdf", options.urdf_path,
-                 "Robot URDF (default: sim/models/iiwa7.urdf under $ORBED_SOURCE_DIR, else under the "
-                 "source tree it was built from)");
-  app.add_option("--scene", options.scene_path,
-                 "Scene YAML (default: sim/models/scenes/trocar_or.yaml, found like --urdf)");
-  app.add_option("--period-sec", options.period_sec, "Tick and status period [s] (0.005 = 200 Hz)")
-      ->check(CLI::PositiveNumber)
-      ->capture_default_str();
-  app.add_option("--initial-q-deg", options.initial_q_deg,
-                 "Initial joint angles q1,...,q7 [deg] (default: all 0)")
-      ->delimiter(',');
-  app.add_option("--stale-command-sec", options.stale_command_sec,
-                 "Reject IIWA_COMMAND whose utime is further than this from the wall clock [s]; 0 = off")
-      ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
-  app.add_option("--stop-margin-m", options.stop_margin_m, "Stop this far before contact [m]")
-      ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
-  app.add_option("--report-distance-m", options.report_distance_m,
-                 "COLLISION_STATUS lists pairs closer than this [m]")
-      ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
-  app.add_option("--robot-name", options.robot_name, "robot_name on ROBOT_STATE")->capture_default_str();
-  app.add_option("--iiwa-status-channel", options.iiwa_status_channel)->capture_default_str();
-  app.add_option("--iiwa-command-channel", options.iiwa_command_channel)->capture_default_str();
-  app.add_option("--robot-state-channel", options.robot_state_channel)->capture_default_str();
-  app.add_option("--collision-status-channel", options.collision_status_channel)->capture_default_str();
-  app.add_option("--plan-check-request-channel", options.plan_check_request_channel)->capture_default_str();
-  app.add_option("--plan-check-reply-channel", options.plan_check_reply_channel)->capture_default_str();
-  CLI11_PARSE(app, argc, argv);
-  orbed::ApplyCommonFlags(common);
-  try {
-    orbed::sim::IiwaSim sim(common, options);
-    return sim.Run();
-  } catch (const std::exception& e) {
-    std::cerr << "orbed-iiwa-sim: " << e.what() << "\n";
-    return 1;
-  }
-}
+int main(int argc, char** argv) { return orbed::sim::RunIiwaSim(argc, argv, std::cout, std::cerr); }

@@ -5,6 +5,7 @@
 // within the iiwa 7's published joint speeds (DESIGN §4), and the published frames against the
 // scene file and the DH facts.
 #include "sim/iiwa_sim.h"
+#include "sim/iiwa_sim_cli.h"
 
 #include <algorithm>
 #include <chrono>
@@ -20,8 +21,9 @@
 #include <orbed/plan_check_reply_t.hpp>
 #include <orbed/robot_state_t.hpp>
 
-#include "procs/common/conversions.h"
+#include "base/test_command.h"
 #include "base/units.h"
+#include "procs/common/conversions.h"
 
 namespace orbed::sim {
 namespace {
@@ -333,7 +335,8 @@ TEST(IiwaSim, StampsTicksOnTheSimClockHoweverLateTheyRun) {
     EXPECT_NEAR(s.joint_velocity_estimated[0], 98 * kDegToRad, 1e-9) << "tick " << n;
     if (n > 1) {
       const double dq = s.joint_position_measured[0] - got.status[n - 2].joint_position_measured[0];
-      EXPECT_LE(dq / ((s.utime - got.status[n - 2].utime) * 1e-6), 98 * kDegToRad * (1 + 1e-9)) << "tick " << n;
+      EXPECT_LE(dq / ((s.utime - got.status[n - 2].utime) * 1e-6), 98 * kDegToRad * (1 + 1e-9))
+          << "tick " << n;
     }
   }
   EXPECT_EQ(got.state.back().utime, got.status.back().utime);
@@ -395,6 +398,34 @@ TEST(IiwaSim, BadOptionsAndFilesAreNamed) {
     period.period_sec = bad;
     EXPECT_THROW(IiwaSim(MemqFlags(0.1), period), std::invalid_argument) << bad;
   }
+}
+
+// The command line, in-process.
+TEST(IiwaSimCli, HelpGoesToOutAndExitsZero) {
+  const test::CommandRun r = test::RunCommand(RunIiwaSim, "orbed-iiwa-sim", {"--help"});
+  EXPECT_EQ(r.code, 0);
+  EXPECT_NE(r.out.find("--period-sec"), std::string::npos) << r.out;
+  EXPECT_TRUE(r.err.empty()) << r.err;
+}
+
+TEST(IiwaSimCli, RefusesAnUnknownFlagAndBadValues) {
+  test::CommandRun r = test::RunCommand(RunIiwaSim, "orbed-iiwa-sim", {"--no-such-flag"});
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.err.find("--no-such-flag"), std::string::npos) << r.err;
+  r = test::RunCommand(RunIiwaSim, "orbed-iiwa-sim", {"--period-sec", "-0.005"});
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.err.find("--period-sec"), std::string::npos) << r.err;
+  // Found when the sim starts, not by the parser: exit 1, the flag named.
+  r = test::RunCommand(RunIiwaSim, "orbed-iiwa-sim", {"--lcm-url", "memq://", "--initial-q-deg", "1,2,3"});
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("orbed-iiwa-sim: --initial-q-deg"), std::string::npos) << r.err;
+}
+
+TEST(IiwaSimCli, RunsForTheDurationAndExitsZero) {
+  const test::CommandRun r = test::RunCommand(
+      RunIiwaSim, "orbed-iiwa-sim",
+      {"--lcm-url", "memq://", "--duration-sec", "0.1", "--initial-q-deg", "0,30,0,-60,0,45,0"});
+  EXPECT_EQ(r.code, 0) << r.err;
 }
 
 }  // namespace

@@ -2,9 +2,9 @@
 #include "sim/robot_tool.h"
 
 #include "base/source_paths.h"
+#include "base/test_command.h"
 
 #include <cstdlib>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -13,18 +13,10 @@
 namespace orbed::sim {
 namespace {
 
-struct ToolRun {
-  int code;
-  std::string out, err;
-};
+using ToolRun = test::CommandRun;
 
-ToolRun Tool(std::vector<std::string> args) {
-  args.insert(args.begin(), "orbed-robot");
-  std::vector<const char*> argv;
-  for (const auto& a : args) argv.push_back(a.c_str());
-  std::ostringstream out, err;
-  const int code = RunRobotTool(static_cast<int>(argv.size()), argv.data(), out, err);
-  return {code, out.str(), err.str()};
+ToolRun Tool(const std::vector<std::string>& args) {
+  return test::RunCommand(RunRobotTool, "orbed-robot", args);
 }
 
 std::string Scene() { return orbed::SourceTreePath("sim/models/scenes/trocar_or.yaml"); }

@@ -1,12 +1,18 @@
 // Unit tests of orbed-launch's launch-file parser and child handling (no LCM needed). The
 // multi-process behaviour (readiness, respawn, ordered stop) is in tests/integration.
+#include <unistd.h>
+
 #include <csignal>
+#include <filesystem>
+#include <fstream>
 #include <thread>
 
 #include <gtest/gtest.h>
 
+#include "base/test_command.h"
 #include "procs/launcher/child.h"
 #include "procs/launcher/launch_file.h"
+#include "procs/launcher/launcher_cli.h"
 
 namespace orbed::launcher {
 namespace {
@@ -155,6 +161,47 @@ TEST(Child, MissingExecutableFailsBeforeFork) {
   EXPECT_FALSE(child.Start({"orbed-no-such-program"}, {}, "/nonexistent", &error));
   EXPECT_NE(error.find("cannot find executable 'orbed-no-such-program'"), std::string::npos);
   EXPECT_NE(ResolveExecutable("sh", ""), "");
+}
+
+// The command line, in-process (--dry-run: nothing is started).
+
+// `text` in a fresh file under the temporary folder; its path.
+std::string WriteTempFile(const std::string& name, const std::string& text) {
+  const std::filesystem::path path =
+      std::filesystem::temp_directory_path() / ("orbed_launcher_test_" + std::to_string(::getpid()) + name);
+  std::ofstream(path) << text;
+  return path.string();
+}
+
+TEST(LauncherCli, HelpGoesToOutAndExitsZero) {
+  const test::CommandRun r = test::RunCommand(RunLauncher, "orbed-launch", {"--help"});
+  EXPECT_EQ(r.code, 0);
+  EXPECT_NE(r.out.find("--dry-run"), std::string::npos) << r.out;
+  EXPECT_TRUE(r.err.empty()) << r.err;
+}
+
+TEST(LauncherCli, RefusesAnUnknownFlagAMissingFileAndABadFile) {
+  test::CommandRun r = test::RunCommand(RunLauncher, "orbed-launch", {"--no-such-flag"});
+  EXPECT_NE(r.code, 0);
+  EXPECT_FALSE(r.err.empty());
+  r = test::RunCommand(RunLauncher, "orbed-launch", {"--dry-run", "/no/such/launch.yaml"});
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.err.find("launch_file"), std::string::npos) << r.err;
+  const std::string bad = WriteTempFile("_bad.yaml", "groups: []\n");
+  r = test::RunCommand(RunLauncher, "orbed-launch", {"--dry-run", bad});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find(bad + ":1: 'groups' must be"), std::string::npos) << r.err;
+  std::filesystem::remove(bad);
+}
+
+TEST(LauncherCli, DryRunPrintsThePlan) {
+  const std::string good = WriteTempFile(
+      "_good.yaml",
+      "groups:\n  - name: g\n    processes:\n      - {name: a, command: x, args: [-v], respawn: true}\n");
+  const test::CommandRun r = test::RunCommand(RunLauncher, "orbed-launch", {"--dry-run", good});
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.out, "group g:\n  a: x -v  [respawn]  [required]\n");
+  std::filesystem::remove(good);
 }
 
 }  // namespace

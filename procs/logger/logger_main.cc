@@ -1,52 +1,10 @@
 /// @file
-/// orbed-logger: records LCM traffic to a standard LCM event log plus manifest.json.
+/// orbed-logger: records LCM traffic to a standard LCM event log plus manifest.json (flags and exit
+/// codes: procs/logger/logger_cli.h).
 /// Subscribes: every channel matching --channels (default all).
 /// Publishes: LOGGER_STATUS (logger_status_t, 1 Hz), PROCESS_STATUS (1 Hz).
 #include <iostream>
 
-#include "procs/common/log.h"
-#include "procs/logger/logger.h"
+#include "procs/logger/logger_cli.h"
 
-int main(int argc, char** argv) {
-  CLI::App app{
-      "orbed-logger: record LCM traffic to a standard LCM event log (playable with lcm-logplayer)\n"
-      "and write manifest.json beside it. Stops cleanly on SIGINT/SIGTERM."};
-  orbed::CommonFlags common("orbed-logger");
-  orbed::AddCommonFlags(&app, &common);
-  orbed::logger::LoggerOptions options;
-  app.add_option("--log-dir", options.log_dir, "Folder for the log; file named by start time")
-      ->capture_default_str();
-  app.add_option("--file", options.file, "Explicit log path (overrides --log-dir naming)");
-  app.add_option("--manifest", options.manifest,
-                 "Manifest path (default: manifest.json in the log's folder)");
-  app.add_option("--channels", options.channels, "Regular expression of channels to record")
-      ->capture_default_str();
-  app.add_option("--queue-events", options.queue_capacity_events,
-                 "Queue bound in events; overflow is dropped and counted")
-      ->check(CLI::PositiveNumber)
-      ->capture_default_str();
-  int64_t queue_mb = options.queue_capacity_bytes >> 20;
-  app.add_option("--queue-mb", queue_mb, "Queue bound in MiB")
-      ->check(CLI::PositiveNumber)
-      ->capture_default_str();
-  app.add_option("--flush-interval-sec", options.flush_interval_sec,
-                 "Flush period: after a SIGKILL the log is valid up to the last flush")
-      ->check(CLI::PositiveNumber)
-      ->capture_default_str();
-  app.add_option("--hash-file", options.hash_files,
-                 "File whose SHA-256 goes into the manifest (repeatable: URDF, scene, ...)");
-  CLI11_PARSE(app, argc, argv);
-  orbed::ApplyCommonFlags(common);
-  options.queue_capacity_bytes = queue_mb << 20;
-  for (int i = 0; i < argc; ++i) options.command_line += (i ? " " : "") + std::string(argv[i]);
-  try {
-    orbed::logger::Logger logger(common, options);
-    return logger.Run();
-  } catch (const std::invalid_argument& e) {  // a bad flag value (e.g. the --channels regex)
-    std::cerr << "orbed-logger: " << e.what() << "\n";
-    return 2;
-  } catch (const std::exception& e) {
-    std::cerr << "orbed-logger: " << e.what() << "\n";
-    return 1;
-  }
-}
+int main(int argc, char** argv) { return orbed::logger::RunLogger(argc, argv, std::cout, std::cerr); }

@@ -10,8 +10,10 @@
 #include <orbed/iiwa_status_t.hpp>
 
 #include "base/sha256.h"
+#include "base/test_command.h"
 #include "procs/logger/event_log_writer.h"
 #include "procs/logger/logger.h"
+#include "procs/logger/logger_cli.h"
 
 namespace orbed::logger {
 namespace {
@@ -212,6 +214,45 @@ TEST(Logger, ChannelRegexSelects) {
   ASSERT_EQ(events.size(), 2u);
   EXPECT_EQ(events[0].channel, "HMD_POSE");
   EXPECT_EQ(events[1].channel, "HMD_CAMERA");
+}
+
+// The command line, in-process.
+TEST(LoggerCli, HelpGoesToOutAndExitsZero) {
+  const test::CommandRun r = test::RunCommand(RunLogger, "orbed-logger", {"--help"});
+  EXPECT_EQ(r.code, 0);
+  EXPECT_NE(r.out.find("--flush-interval-sec"), std::string::npos) << r.out;
+  EXPECT_TRUE(r.err.empty()) << r.err;
+}
+
+TEST(LoggerCli, RefusesAnUnknownFlagAndABadValue) {
+  test::CommandRun r = test::RunCommand(RunLogger, "orbed-logger", {"--no-such-flag"});
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.err.find("--no-such-flag"), std::string::npos) << r.err;
+  r = test::RunCommand(RunLogger, "orbed-logger", {"--flush-interval-sec", "-1"});
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.err.find("--flush-interval-sec"), std::string::npos) << r.err;
+  // Found when the logger starts, not by the parser: exit 2, and no file is created.
+  const fs::path dir = TempDir("cli_regex");
+  r = test::RunCommand(RunLogger, "orbed-logger",
+                       {"--lcm-url", "memq://", "--file", (dir / "x.lcmlog").string(), "--channels", "("});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("orbed-logger: "), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "x.lcmlog"));
+}
+
+TEST(LoggerCli, RecordsUntilTheDurationAndWritesTheManifest) {
+  const fs::path dir = TempDir("cli_run");
+  const test::CommandRun r = test::RunCommand(
+      RunLogger, "orbed-logger",
+      {"--lcm-url", "memq://", "--duration-sec", "0.2", "--file", (dir / "run.lcmlog").string()});
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(dir / "run.lcmlog"));
+  std::ifstream manifest(dir / "manifest.json");
+  std::stringstream text;
+  text << manifest.rdbuf();
+  // The manifest records the command line as given.
+  EXPECT_NE(text.str().find("orbed-logger --lcm-url memq:// --duration-sec 0.2"), std::string::npos)
+      << text.str();
 }
 
 }  // namespace

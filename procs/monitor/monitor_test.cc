@@ -1,9 +1,11 @@
 // orbed-monitor on memq://: heartbeats in, a table out; stale heartbeats shown as SILENT.
 #include <gtest/gtest.h>
 
+#include "base/test_command.h"
 #include "procs/common/channels.h"
 #include "procs/common/conversions.h"
 #include "procs/monitor/monitor.h"
+#include "procs/monitor/monitor_cli.h"
 
 namespace orbed::monitor {
 namespace {
@@ -45,6 +47,30 @@ TEST(Monitor, TabulatesHeartbeatsAndFlagsSilentProcesses) {
   EXPECT_EQ(monitor.process().rejections().counts().at("PROCESS_STATUS/field"), 1);
   EXPECT_EQ(monitor.process().rejections().counts().at("PROCESS_STATUS/too_many"), 46);
   EXPECT_NE(monitor.Table(now + 10'000'000).find("SILENT"), std::string::npos);
+}
+
+// The command line, in-process.
+TEST(MonitorCli, HelpGoesToOutAndExitsZero) {
+  const test::CommandRun r = test::RunCommand(RunMonitor, "orbed-monitor", {"--help"});
+  EXPECT_EQ(r.code, 0);
+  EXPECT_NE(r.out.find("--silent-after-sec"), std::string::npos) << r.out;
+  EXPECT_TRUE(r.err.empty()) << r.err;
+}
+
+TEST(MonitorCli, RefusesAnUnknownFlagAndABadValue) {
+  test::CommandRun r = test::RunCommand(RunMonitor, "orbed-monitor", {"--no-such-flag"});
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.err.find("--no-such-flag"), std::string::npos) << r.err;
+  r = test::RunCommand(RunMonitor, "orbed-monitor", {"--print-period-sec", "-1"});
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.err.find("--print-period-sec"), std::string::npos) << r.err;
+  EXPECT_TRUE(r.out.empty()) << r.out;
+}
+
+TEST(MonitorCli, RunsForTheDurationAndExitsZero) {
+  const test::CommandRun r =
+      test::RunCommand(RunMonitor, "orbed-monitor", {"--lcm-url", "memq://", "--duration-sec", "0.1"});
+  EXPECT_EQ(r.code, 0) << r.err;
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 // memq:// (in-process LCM). Oracles: hand-computable means of trials on one axis, hand-computed
 // landmark and misalignment values, byte equality of replayed outputs.
 #include "procs/registration_server/registration_server.h"
+#include "procs/registration_server/registration_cli.h"
 
 #include <cmath>
 #include <map>
@@ -9,9 +10,11 @@
 
 #include <gtest/gtest.h>
 
-#include "procs/common/conversions.h"
-#include "geometry/test_rotations.h"
+#include "base/source_paths.h"
+#include "base/test_command.h"
 #include "base/units.h"
+#include "geometry/test_rotations.h"
+#include "procs/common/conversions.h"
 
 namespace orbed::registration {
 namespace {
@@ -85,8 +88,8 @@ TEST(RegistrationServiceTest, ThreeTrialsGiveTheClosedFormMean) {
   EXPECT_TRUE(state->unique);
   // On one axis the Karcher mean is the mean angle, 25°; translations average to (2, −1, 0.5).
   const Eigen::Quaterniond q_mean = QuaternionFromWxyz(state->X_WV_mean.quaternion_wxyz);
-  EXPECT_NEAR(Eigen::AngleAxisd(q_mean.conjugate() *
-                                Eigen::Quaterniond(Eigen::AngleAxisd(25 * kDegToRad, Eigen::Vector3d::UnitZ())))
+  EXPECT_NEAR(Eigen::AngleAxisd(q_mean.conjugate() * Eigen::Quaterniond(Eigen::AngleAxisd(
+                                                         25 * kDegToRad, Eigen::Vector3d::UnitZ())))
                   .angle(),
               0.0, 1e-12);
   EXPECT_NEAR(state->X_WV_mean.position_m[0], 2.0, 1e-15);
@@ -95,7 +98,8 @@ TEST(RegistrationServiceTest, ThreeTrialsGiveTheClosedFormMean) {
   EXPECT_NEAR(state->rotation_max_deg, 20.0, 1e-9);
   EXPECT_NEAR(state->rotation_median_deg, 15.0, 1e-9);
   EXPECT_NEAR(state->rotation_covariance_rad2[2][2],
-              (std::pow(15 * kDegToRad, 2) + std::pow(5 * kDegToRad, 2) + std::pow(20 * kDegToRad, 2)) / 3, 1e-12);
+              (std::pow(15 * kDegToRad, 2) + std::pow(5 * kDegToRad, 2) + std::pow(20 * kDegToRad, 2)) / 3,
+              1e-12);
   EXPECT_NEAR(state->translation_rms_m, std::sqrt(2.0 / 3.0), 1e-15);
   EXPECT_TRUE(f.rejections.empty());
 
@@ -352,6 +356,39 @@ TEST(RegistrationServerTest, ServesOverInProcessLcm) {
   EXPECT_FALSE(collector.landmarks[0].valid);
   EXPECT_NE(collector.landmarks[0].reason.find("at least 2"), std::string::npos);
   EXPECT_EQ(server.rejections().total(), 2);  // the landmark request and the undecodable trial
+}
+
+// The command line, in-process.
+TEST(RegistrationCliTest, HelpGoesToOutAndExitsZero) {
+  test::CommandRun r = test::RunCommand(RunRegistration, "orbed-registration", {"--help"});
+  EXPECT_EQ(r.code, 0);
+  EXPECT_NE(r.out.find("--state-period-sec"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("mean"), std::string::npos) << r.out;
+  EXPECT_TRUE(r.err.empty()) << r.err;
+  r = test::RunCommand(RunRegistration, "orbed-registration", {"send", "--help"});
+  EXPECT_EQ(r.code, 0);
+  EXPECT_NE(r.out.find("--timeout-sec"), std::string::npos) << r.out;
+}
+
+TEST(RegistrationCliTest, RefusesAnUnknownFlagAndBadValues) {
+  test::CommandRun r = test::RunCommand(RunRegistration, "orbed-registration", {"--no-such-flag"});
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.err.find("--no-such-flag"), std::string::npos) << r.err;
+  r = test::RunCommand(RunRegistration, "orbed-registration", {"--state-period-sec", "-1"});
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.err.find("--state-period-sec"), std::string::npos) << r.err;
+  r = test::RunCommand(RunRegistration, "orbed-registration", {"mean", "--json"});
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.err.find("--input"), std::string::npos) << r.err;
+  EXPECT_TRUE(r.out.empty()) << r.out;
+}
+
+TEST(RegistrationCliTest, MeanPrintsTheJsonOnOut) {
+  const std::string input = SourceTreePath("procs/registration_server/testdata/robust_trials.txt");
+  const test::CommandRun r = test::RunCommand(RunRegistration, "orbed-registration",
+                                              {"mean", "--input", input, "--robust", "--json"});
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("\"n_used\":10,\"rejected\":[10]"), std::string::npos) << r.out;
 }
 
 }  // namespace

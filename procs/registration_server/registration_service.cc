@@ -4,11 +4,11 @@
 #include <cmath>
 #include <utility>
 
+#include "geometry/misalignment.h"
+#include "geometry/se3_mean.h"
 #include "procs/common/conversions.h"
 #include "procs/common/session_control.h"
 #include "procs/common/validation.h"
-#include "geometry/misalignment.h"
-#include "geometry/se3_mean.h"
 
 namespace orbed::registration {
 namespace {
@@ -179,7 +179,8 @@ orbed::registration_t RegistrationService::MakeState(int64_t utime, int8_t reaso
   out.valid = true;
   out.X_WV_mean = ToPose(X_WV_mean);
   out.num_used = mean.dispersion.num_used;
-  for (const geometry::RejectedTrial& r : mean.rejected) out.rejected_indices.push_back(trials_[r.index].trial_index);
+  for (const geometry::RejectedTrial& r : mean.rejected)
+    out.rejected_indices.push_back(trials_[r.index].trial_index);
   out.num_rejected = static_cast<int32_t>(out.rejected_indices.size());
   out.rotation_rms_deg = mean.dispersion.rotation_rms_deg;
   out.rotation_median_deg = mean.dispersion.rotation_median_deg;
@@ -208,7 +209,8 @@ orbed::landmark_t RegistrationService::HandleLandmarkRequest(const orbed::landma
                        &directions);
   }
   if (problem.empty()) {
-    const geometry::TriangulationResult r = geometry::TriangulateRays(origins, directions, options_.triangulation);
+    const geometry::TriangulationResult r =
+        geometry::TriangulateRays(origins, directions, options_.triangulation);
     FromVector3(r.p_W, out.p_W_m);
     out.ray_angle_deg = r.ray_angle_deg;
     out.gap_m = r.gap_m;

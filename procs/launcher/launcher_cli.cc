@@ -1,0 +1,76 @@
+#include "procs/launcher/launcher_cli.h"
+
+#include <exception>
+#include <filesystem>
+#include <string>
+#include <system_error>
+#include <utility>
+
+#include <CLI/CLI.hpp>
+
+#include "procs/common/flags.h"
+#include "procs/launcher/launch_file.h"
+#include "procs/launcher/launcher.h"
+
+namespace orbed::launcher {
+namespace {
+
+void PrintPlan(const LaunchSpec& spec, std::ostream& out) {
+  for (const auto& group : spec.groups) {
+    out << "group " << group.name << ":\n";
+    for (const auto& p : group.processes) {
+      out << "  " << p.name << ": " << p.command;
+      for (const auto& a : p.args) out << " " << a;
+      out << (p.respawn ? "  [respawn]" : "") << (p.required ? "  [required]" : "") << "\n";
+    }
+  }
+}
+
+}  // namespace
+
+int RunLauncher(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
+  CLI::App app{
+      "orbed-launch: start the processes of a YAML launch file group by group (each group waits\n"
+      "for its processes' first heartbeat), prefix their output with their names, restart them\n"
+      "when asked, and stop everything in reverse order on SIGINT/SIGTERM or after --duration-sec."};
+  CommonFlags common("orbed-launch");
+  AddCommonFlags(&app, &common);
+  std::string launch_file;
+  app.add_option("launch_file", launch_file, "YAML launch file (see scripts/launch/)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  bool dry_run = false;
+  app.add_flag("--dry-run", dry_run, "Parse the file, print the plan and exit");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e, out, err);
+  }
+  ApplyCommonFlags(common);
+
+  // Commands without '/' are looked up beside this executable first.
+  std::error_code ec;
+  const std::string bin_dir = std::filesystem::read_symlink("/proc/self/exe", ec).parent_path().string();
+  auto environment = CurrentEnvironment();
+  environment.emplace("ORBED_BIN_DIR", bin_dir);
+  LaunchSpec spec;
+  try {
+    spec = LoadLaunchFile(launch_file, environment);
+  } catch (const LaunchFileError& e) {
+    err << "orbed-launch: " << e.what() << "\n";
+    return 2;
+  }
+  if (dry_run) {
+    PrintPlan(spec, out);
+    return 0;
+  }
+  try {
+    Launcher launcher(common, std::move(spec), bin_dir);
+    return launcher.Run();
+  } catch (const std::exception& e) {
+    err << "orbed-launch: " << e.what() << "\n";
+    return 1;
+  }
+}
+
+}  // namespace orbed::launcher

@@ -1,0 +1,41 @@
+#include "procs/monitor/monitor_cli.h"
+
+#include <exception>
+
+#include <CLI/CLI.hpp>
+
+#include "procs/common/flags.h"
+#include "procs/monitor/monitor.h"
+
+namespace orbed::monitor {
+
+int RunMonitor(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
+  CLI::App app{
+      "orbed-monitor: print a table of every orbed process's heartbeat and the logger's\n"
+      "state, flagging processes whose heartbeat stopped."};
+  CommonFlags common("orbed-monitor");
+  AddCommonFlags(&app, &common);
+  MonitorOptions options;
+  app.add_option("--print-period-sec", options.print_period_sec, "Table period")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app.add_option("--silent-after-sec", options.silent_after_sec,
+                 "Heartbeat age after which a process is shown as SILENT")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e, out, err);
+  }
+  ApplyCommonFlags(common);
+  try {
+    Monitor monitor(common, options);
+    return monitor.Run();
+  } catch (const std::exception& e) {
+    err << "orbed-monitor: " << e.what() << "\n";
+    return 1;
+  }
+}
+
+}  // namespace orbed::monitor
