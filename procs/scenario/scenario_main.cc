@@ -26,7 +26,7 @@ int main(int argc, char** argv) {
   std::string modes;
   std::vector<std::string> q_deg;
   app.add_option("--scenario", scenario_path,
-                 "Scenario YAML (default: procs/scenario/viraal.yaml under $ORBED_SOURCE_DIR, else under "
+                 "Scenario YAML (default: viraal/viraal.yaml under $ORBED_SOURCE_DIR, else under "
                  "the source tree it was built from)");
   app.add_option("--trials", trials, "Trials per mode (overrides the file's trials)")
       ->check(CLI::Range(1, 1000));
@@ -73,10 +73,10 @@ int main(int argc, char** argv) {
   }
   try {
     if (scenario_path.empty()) {
-      scenario_path = orbed::scenario::ScenarioSourcePath(orbed::scenario::kDefaultScenarioRelativePath);
+      scenario_path = orbed::scenario::ScenarioSourcePath(orbed::viraal::kDefaultScenarioRelativePath);
     }
-    options.config = orbed::scenario::LoadScenarioFile(scenario_path);
-    orbed::scenario::ApplyOverrides(&options.config, trials, modes, q_deg);
+    options.config = orbed::viraal::LoadScenarioFile(scenario_path);
+    orbed::viraal::ApplyOverrides(&options.config, trials, modes, q_deg);
     options.out = &std::cout;
     orbed::scenario::ViraalScenario scenario(common, options);
     return scenario.Run();

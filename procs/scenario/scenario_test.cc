@@ -21,9 +21,9 @@
 #include <orbed/session_control_t.hpp>
 
 #include "procs/common/conversions.h"
-#include "procs/scenario/scenario_config.h"
-#include "procs/scenario/viraal_errors.h"
-#include "procs/scenario/viraal_results.h"
+#include "viraal/protocol.h"
+#include "viraal/metrics.h"
+#include "viraal/results.h"
 #include "procs/scenario/viraal_scenario.h"
 
 namespace orbed::scenario {

@@ -55,9 +55,9 @@
 
 #include "procs/common/channels.h"
 #include "procs/common/process.h"
-#include "procs/scenario/scenario_config.h"
-#include "procs/scenario/viraal_errors.h"
-#include "procs/scenario/viraal_results.h"
+#include "viraal/protocol.h"
+#include "viraal/metrics.h"
+#include "viraal/results.h"
 #include "sim/robot_model.h"
 
 namespace orbed::scenario {

@@ -1,4 +1,4 @@
-#include "procs/scenario/scenario_config.h"
+#include "viraal/protocol.h"
 
 #include <cmath>
 #include <fstream>
@@ -12,7 +12,7 @@
 
 #include "base/number_list.h"
 
-namespace orbed::scenario {
+namespace orbed::viraal {
 namespace {
 
 // Every failure names the source, the line, the key and what was expected.
@@ -207,4 +207,4 @@ ScenarioConfig LoadScenarioString(const std::string& yaml_text, const std::strin
   return config;
 }
 
-}  // namespace orbed::scenario
+}  // namespace orbed::viraal
