@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -11,50 +12,9 @@
 #include <orbed/registration_t.hpp>
 
 #include "base/number_list.h"
+#include "base/yaml_fields.h"
 
 namespace orbed::viraal {
-namespace {
-
-// Every failure names the source, the line, the key and what was expected.
-[[noreturn]] void FailAt(const std::string& source, const YAML::Node& node, const std::string& key,
-                         const std::string& expected) {
-  std::string where = source;
-  if (node && node.Mark().line >= 0) where += ":" + std::to_string(node.Mark().line + 1);
-  throw std::runtime_error(where + ": " + key + ": " + expected);
-}
-
-double NumberAt(const std::string& source, const YAML::Node& node, const std::string& key) {
-  if (!node.IsScalar()) FailAt(source, node, key, "expected a number");
-  double v = 0;
-  try {
-    v = node.as<double>();
-  } catch (const YAML::Exception&) {
-    FailAt(source, node, key, "expected a number, got '" + node.Scalar() + "'");
-  }
-  if (!std::isfinite(v)) FailAt(source, node, key, "expected a finite number");
-  return v;
-}
-
-int IntAt(const std::string& source, const YAML::Node& node, const std::string& key, int lo) {
-  const double v = NumberAt(source, node, key);
-  if (v != std::floor(v) || v < lo || v > 1e6) {
-    FailAt(source, node, key, "expected a whole number >= " + std::to_string(lo) + ", got " + node.Scalar());
-  }
-  return static_cast<int>(v);
-}
-
-std::vector<std::string> StringsAt(const std::string& source, const YAML::Node& node,
-                                   const std::string& key) {
-  if (!node.IsSequence() || node.size() == 0) FailAt(source, node, key, "expected a non-empty list of names");
-  std::vector<std::string> out;
-  for (size_t i = 0; i < node.size(); ++i) {
-    if (!node[i].IsScalar()) FailAt(source, node[i], key + "[" + std::to_string(i) + "]", "expected a name");
-    out.push_back(node[i].Scalar());
-  }
-  return out;
-}
-
-}  // namespace
 
 void ApplyOverrides(ScenarioConfig* config, int trials, const std::string& modes,
                     const std::vector<std::string>& q_deg) {
@@ -125,45 +85,17 @@ void ValidateScenarioConfig(const ScenarioConfig& config, int num_joints) {
   if (config.landmarks.empty()) throw std::invalid_argument("landmarks: at least one is needed");
 }
 
-ScenarioConfig LoadScenarioFile(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error(path + ": cannot open the scenario file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return LoadScenarioString(ss.str(), path);
-}
+namespace {
 
-ScenarioConfig LoadScenarioString(const std::string& yaml_text, const std::string& source) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(yaml_text);
-  } catch (const YAML::Exception& e) {
-    throw std::runtime_error(source + ":" + std::to_string(e.mark.line + 1) + ": not valid YAML: " + e.msg);
-  }
-  if (!root.IsMap()) FailAt(source, root, "(top level)", "expected a mapping of trials, modes, ...");
-  const std::set<std::string> allowed = {
-      "trials", "modes", "reflective_mirrors", "method", "configurations_deg", "landmarks"};
-  for (const auto& kv : root) {
-    const std::string key = kv.first.as<std::string>();
-    if (!allowed.count(key)) {
-      FailAt(
-          source, kv.first, key,
-          "unknown key; expected one of: configurations_deg, landmarks, method, modes, reflective_mirrors, "
-          "trials");
-    }
-  }
-  const auto required = [&](const std::string& key) {
-    if (!root[key]) FailAt(source, root, key, "missing");
-    return root[key];
-  };
-
+ScenarioConfig LoadScenario(const YAML::Node& root, const std::string& source) {
+  const YamlFields f(source);
+  f.CheckKeys(root, "",
+              {"trials", "modes", "reflective_mirrors", "method", "configurations_deg", "landmarks"});
   ScenarioConfig config;
-  if (root["trials"]) config.trials = IntAt(source, root["trials"], "trials", 1);
-  const int mirrors =
-      root["reflective_mirrors"] ? IntAt(source, root["reflective_mirrors"], "reflective_mirrors", 1) : 1;
+  config.trials = static_cast<int>(f.IntegerOr(root, "trials", "", config.trials, 1, 1000000));
+  const int mirrors = static_cast<int>(f.IntegerOr(root, "reflective_mirrors", "", 1, 1, 1000000));
   if (root["method"]) {
-    const YAML::Node node = root["method"];
-    const std::string m = node.IsScalar() ? node.Scalar() : "";
+    const std::string m = f.String(root["method"], "method");
     if (m == "chordal") {
       config.method = orbed::registration_t::METHOD_CHORDAL;
     } else if (m == "karcher") {
@@ -171,40 +103,46 @@ ScenarioConfig LoadScenarioString(const std::string& yaml_text, const std::strin
     } else if (m == "robust") {
       config.method = orbed::registration_t::METHOD_ROBUST;
     } else {
-      FailAt(source, node, "method", "expected chordal, karcher or robust, got '" + m + "'");
+      f.Fail(root["method"], "method", "expected chordal, karcher or robust, got '" + m + "'");
     }
   }
   const YAML::Node modes = root["modes"];
   const std::vector<std::string> mode_names =
-      modes ? StringsAt(source, modes, "modes") : std::vector<std::string>{"ar_reflective", "ar"};
+      modes ? f.Strings(modes, "modes") : std::vector<std::string>{"ar_reflective", "ar"};
   for (size_t i = 0; i < mode_names.size(); ++i) {
     try {
       config.modes.push_back(ModeFromName(mode_names[i], mirrors));
     } catch (const std::invalid_argument& e) {
-      FailAt(source, modes[i], "modes[" + std::to_string(i) + "]", e.what());
+      f.Fail(modes[i], "modes[" + std::to_string(i) + "]", e.what());
     }
   }
-  const YAML::Node configurations = required("configurations_deg");
+  const YAML::Node configurations = f.Required(root, "configurations_deg", "configurations_deg");
   if (!configurations.IsSequence() || configurations.size() == 0) {
-    FailAt(source, configurations, "configurations_deg", "expected a non-empty list of joint vectors [deg]");
+    f.Fail(configurations, "configurations_deg", "expected a non-empty list of joint vectors [deg]");
   }
+  const double inf = std::numeric_limits<double>::infinity();
   for (size_t k = 0; k < configurations.size(); ++k) {
     const YAML::Node q = configurations[k];
     const std::string key = "configurations_deg[" + std::to_string(k) + "]";
-    if (!q.IsSequence()) FailAt(source, q, key, "expected a list of joint angles [deg]");
+    if (!q.IsSequence()) f.Fail(q, key, "expected a list of joint angles [deg]");
     std::vector<double> values;
-    for (size_t i = 0; i < q.size(); ++i)
-      values.push_back(NumberAt(source, q[i], key + "[" + std::to_string(i) + "]"));
+    for (size_t i = 0; i < q.size(); ++i) {
+      values.push_back(f.Number(q[i], key + "[" + std::to_string(i) + "]", -inf, inf, "deg"));
+    }
     config.configurations_deg.push_back(values);
   }
-  config.landmarks = StringsAt(source, required("landmarks"), "landmarks");
-  try {
-    // The iiwa has 7 joints; the model check in ViraalScenario repeats this against the URDF.
-    ValidateScenarioConfig(config, static_cast<int>(config.configurations_deg[0].size()));
-  } catch (const std::invalid_argument& e) {
-    FailAt(source, root, "configurations_deg", e.what());
-  }
+  config.landmarks = f.Strings(f.Required(root, "landmarks", "landmarks"), "landmarks");
   return config;
+}
+
+}  // namespace
+
+ScenarioConfig LoadScenarioFile(const std::string& path) {
+  return LoadScenario(YamlFields::LoadFile(path), path);
+}
+
+ScenarioConfig LoadScenarioString(const std::string& yaml_text, const std::string& source) {
+  return LoadScenario(YamlFields::LoadString(yaml_text, source), source);
 }
 
 }  // namespace orbed::viraal
