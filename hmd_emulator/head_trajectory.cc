@@ -5,7 +5,7 @@
 #include <cstdio>
 #include <stdexcept>
 
-#include "hmd_emulator/yaml_fields.h"
+#include "base/yaml_fields.h"
 
 namespace orbed::hmd {
 namespace {

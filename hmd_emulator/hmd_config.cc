@@ -4,7 +4,7 @@
 #include <limits>
 #include <stdexcept>
 
-#include "hmd_emulator/yaml_fields.h"
+#include "base/yaml_fields.h"
 #include "base/source_paths.h"
 
 namespace orbed::hmd {

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "hmd_emulator/yaml_fields.h"
+#include "base/yaml_fields.h"
 #include "sim/scene.h"
 #include "base/units.h"
 

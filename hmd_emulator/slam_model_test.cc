@@ -14,7 +14,7 @@
 
 #include "geometry/camera_model.h"
 #include "base/stats.h"
-#include "hmd_emulator/yaml_fields.h"
+#include "base/yaml_fields.h"
 #include "orbed/hmd_pose_t.hpp"
 #include "base/source_paths.h"
 

@@ -4,7 +4,7 @@
 #include <stdexcept>
 
 #include "hmd_emulator/random.h"
-#include "hmd_emulator/yaml_fields.h"
+#include "base/yaml_fields.h"
 #include "sim/scene.h"
 #include "base/units.h"
 

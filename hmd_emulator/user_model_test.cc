@@ -12,7 +12,7 @@
 
 #include "base/stats.h"
 #include "hmd_emulator/user_study.h"
-#include "hmd_emulator/yaml_fields.h"
+#include "base/yaml_fields.h"
 #include "sim/scene.h"
 
 namespace orbed::hmd {

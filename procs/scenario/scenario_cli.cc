@@ -6,7 +6,7 @@
 #include <CLI/CLI.hpp>
 
 #include "procs/common/flags.h"
-#include "procs/scenario/scenario_config.h"
+#include "viraal/protocol.h"
 #include "procs/scenario/viraal_scenario.h"
 
 namespace orbed::scenario {
@@ -25,7 +25,7 @@ int RunScenario(int argc, const char* const* argv, std::ostream& out, std::ostre
   std::string modes;
   std::vector<std::string> q_deg;
   app.add_option("--scenario", scenario_path,
-                 "Scenario YAML (default: procs/scenario/viraal.yaml under $ORBED_SOURCE_DIR, else under "
+                 "Scenario YAML (default: viraal/viraal.yaml under $ORBED_SOURCE_DIR, else under "
                  "the source tree it was built from)");
   app.add_option("--trials", trials, "Trials per mode (overrides the file's trials)")
       ->check(CLI::Range(1, 1000));
@@ -72,9 +72,9 @@ int RunScenario(int argc, const char* const* argv, std::ostream& out, std::ostre
     return app.exit(e, out, err);
   }
   try {
-    if (scenario_path.empty()) scenario_path = ScenarioSourcePath(kDefaultScenarioRelativePath);
-    run.config = LoadScenarioFile(scenario_path);
-    ApplyOverrides(&run.config, trials, modes, q_deg);
+    if (scenario_path.empty()) scenario_path = ScenarioSourcePath(viraal::kDefaultScenarioRelativePath);
+    run.config = viraal::LoadScenarioFile(scenario_path);
+    viraal::ApplyOverrides(&run.config, trials, modes, q_deg);
     options.out = &out;
     ViraalScenario scenario(common, options);
     return scenario.Run();

@@ -5,7 +5,7 @@
 /// exits: 0 when every session finished, 1 with a one-line reason otherwise.
 ///
 /// Flags: the common ones (flags.h: --lcm-url, --name, --seed, --duration-sec, --log-level), and
-///   --scenario FILE            scenario YAML (default procs/scenario/viraal.yaml of the source tree)
+///   --scenario FILE            scenario YAML (default viraal/viraal.yaml of the source tree)
 ///   --trials N, --modes a,b, --q-deg q1,...,q7 (repeatable)   overrides of the file
 ///   --run-id ID                sessions are <ID>-<mode>; default $ORBED_RUN_ID when it is set and not
 ///                              empty, else viraal-<UTC time>

@@ -21,9 +21,9 @@
 #include <orbed/session_control_t.hpp>
 
 #include "procs/common/conversions.h"
-#include "procs/scenario/scenario_config.h"
-#include "procs/scenario/viraal_errors.h"
-#include "procs/scenario/viraal_results.h"
+#include "viraal/protocol.h"
+#include "viraal/metrics.h"
+#include "viraal/results.h"
 #include "procs/scenario/viraal_scenario.h"
 
 namespace orbed::scenario {
@@ -44,12 +44,12 @@ std::string Source(const std::string& relative) { return ScenarioSourcePath(rela
 TEST(ViraalErrors, RotationAngleIsTheGeodesicAngle) {
   const Eigen::Matrix3d R = Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
   const Eigen::Matrix3d dR = Eigen::AngleAxisd(1 * kDeg, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  EXPECT_NEAR(RotationAngle(R, R * dR), 1 * kDeg, 1e-14);
-  EXPECT_NEAR(RotationAngle(R, dR * R), 1 * kDeg, 1e-14);
-  EXPECT_NEAR(RotationAngle(R, R), 0.0, 1e-15);
+  EXPECT_NEAR(viraal::RotationAngle(R, R * dR), 1 * kDeg, 1e-14);
+  EXPECT_NEAR(viraal::RotationAngle(R, dR * R), 1 * kDeg, 1e-14);
+  EXPECT_NEAR(viraal::RotationAngle(R, R), 0.0, 1e-15);
   // Near π the quaternion form keeps its precision.
   const Eigen::Matrix3d flip = Eigen::AngleAxisd(M_PI - 1e-7, Eigen::Vector3d::UnitX()).toRotationMatrix();
-  EXPECT_NEAR(RotationAngle(Eigen::Matrix3d::Identity(), flip), M_PI - 1e-7, 1e-12);
+  EXPECT_NEAR(viraal::RotationAngle(Eigen::Matrix3d::Identity(), flip), M_PI - 1e-7, 1e-12);
 }
 
 // X_WV = X_WR shifted 10 mm along the base's x and turned 1 deg about its z: X_RV = [Rz(1°), (0.01,0,0)].
@@ -59,11 +59,11 @@ TEST(ViraalErrors, TenMillimetresAndOneDegreeInTheBaseFrame) {
   X_RV.linear() = Eigen::AngleAxisd(1 * kDeg, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   X_RV.translation() = Eigen::Vector3d(0.01, 0, 0);
   const Eigen::Isometry3d X_WV = X_WR * X_RV;
-  RobotPoints points;
+  viraal::RobotPoints points;
   points.p_RC = Eigen::Vector3d(1, 0, 0);  // 1 m along the base x
   points.p_RF = Eigen::Vector3d(0, 0, 2);  // on the rotation axis: only the shift remains
   points.p_RL = {Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0, 0, 1)};
-  const AlignmentError e = EvaluateAlignment(X_WR, X_WV, points);
+  const viraal::AlignmentError e = viraal::EvaluateAlignment(X_WR, X_WV, points);
   EXPECT_NEAR(e.rotation_rad, 1 * kDeg, 1e-14);
   EXPECT_NEAR(e.base_translation_m, 0.010, 1e-15);
   // |(cos 1° − 1 + 0.01, sin 1°, 0)| = 0.020039051632882905 m (hand/calculator).
@@ -84,10 +84,10 @@ TEST(ViraalErrors, TenMillimetresAndOneDegreeInTheWorldFrame) {
   Eigen::Isometry3d X_WV = X_WR;
   X_WV.linear() = Eigen::AngleAxisd(1 * kDeg, Eigen::Vector3d::UnitZ()).toRotationMatrix() * X_WR.linear();
   X_WV.translation() += Eigen::Vector3d(0.01, 0, 0);
-  RobotPoints points;
+  viraal::RobotPoints points;
   points.p_RC = Eigen::Vector3d(0, 0, 0.634);  // on the (vertical) base z axis: only the shift
   points.p_RF = Eigen::Vector3d(0.5, 0, 0);    // 0.5 m out along base x = W y
-  const AlignmentError e = EvaluateAlignment(X_WR, X_WV, points);
+  const viraal::AlignmentError e = viraal::EvaluateAlignment(X_WR, X_WV, points);
   EXPECT_NEAR(e.rotation_rad, 1 * kDeg, 1e-14);
   EXPECT_NEAR(e.base_translation_m, 0.010, 1e-15);
   EXPECT_NEAR(e.centroid_translation_m, 0.010, 1e-14);
@@ -100,21 +100,21 @@ TEST(ViraalErrors, MeanOverConfigurationsAveragesPointErrorsAndPoolsLandmarks) {
   const Eigen::Isometry3d X_WR = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d X_WV = Eigen::Isometry3d::Identity();
   X_WV.linear() = Eigen::AngleAxisd(90 * kDeg, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  RobotPoints a, b;
+  viraal::RobotPoints a, b;
   a.p_RC = Eigen::Vector3d(1, 0, 0);  // moves to (0, 1, 0): sqrt(2)
   b.p_RC = Eigen::Vector3d(0, 0, 1);  // on the axis: 0
   a.p_RL = {Eigen::Vector3d(1, 0, 0)};
   b.p_RL = {Eigen::Vector3d(2, 0, 0), Eigen::Vector3d(0, 0, 3)};
-  const AlignmentError e = EvaluateOverConfigurations(X_WR, X_WV, {a, b});
+  const viraal::AlignmentError e = viraal::EvaluateOverConfigurations(X_WR, X_WV, {a, b});
   EXPECT_NEAR(e.centroid_translation_m, std::sqrt(2.0) / 2, 1e-15);
   EXPECT_EQ(e.p_W_real.size(), 3u);
-  EXPECT_THROW(EvaluateOverConfigurations(X_WR, X_WV, {}), std::invalid_argument);
+  EXPECT_THROW(viraal::EvaluateOverConfigurations(X_WR, X_WV, {}), std::invalid_argument);
 }
 
 TEST(ViraalErrors, RobotPointsOfTheIiwaUpright) {
   const auto model = orbed::sim::RobotModel::LoadFile(Source("sim/models/iiwa7.urdf"));
-  const RobotPointSet set(model, {"iiwa_link_4", "iiwa_link_6", "iiwa_link_ee"});
-  const RobotPoints p = set.At(Eigen::VectorXd::Zero(7));
+  const viraal::RobotPointSet set(model, {"iiwa_link_4", "iiwa_link_6", "iiwa_link_ee"});
+  const viraal::RobotPoints p = set.At(Eigen::VectorXd::Zero(7));
   // DH d = (0.34, 0, 0.4, 0, 0.4, 0, 0.126): origins of link 0..7 and the flange at z = 0, 0,
   // 0.34, 0.34, 0.74, 0.74, 1.14, 1.14, 1.266 → centroid z = 5.706 / 9 = 0.634.
   EXPECT_NEAR((p.p_RC - Eigen::Vector3d(0, 0, 0.634)).norm(), 0.0, 1e-12);
@@ -123,11 +123,11 @@ TEST(ViraalErrors, RobotPointsOfTheIiwaUpright) {
   EXPECT_NEAR(p.p_RL[0].z(), 0.74, 1e-12);
   EXPECT_NEAR(p.p_RL[1].z(), 1.14, 1e-12);
   EXPECT_NEAR(p.p_RL[2].z(), 1.266, 1e-12);
-  EXPECT_THROW(RobotPointSet(model, {"iiwa_link_9"}), std::invalid_argument);
+  EXPECT_THROW(viraal::RobotPointSet(model, {"iiwa_link_9"}), std::invalid_argument);
 }
 
-TEST(ScenarioConfig, TheShippedFileLoads) {
-  const ScenarioConfig c = LoadScenarioFile(Source(kDefaultScenarioRelativePath));
+TEST(viraal::ScenarioConfig, TheShippedFileLoads) {
+  const viraal::ScenarioConfig c = viraal::LoadScenarioFile(Source(viraal::kDefaultScenarioRelativePath));
   EXPECT_EQ(c.trials, 3);
   ASSERT_EQ(c.modes.size(), 2u);
   EXPECT_EQ(c.modes[0].name, "ar_reflective");
@@ -142,16 +142,16 @@ TEST(ScenarioConfig, TheShippedFileLoads) {
 
 void ExpectError(const std::string& yaml, const std::string& pattern) {
   try {
-    LoadScenarioString(yaml, "s.yaml");
+    viraal::LoadScenarioString(yaml, "s.yaml");
     ADD_FAILURE() << "no error for:\n" << yaml;
   } catch (const std::runtime_error& e) {
     EXPECT_TRUE(std::regex_search(std::string(e.what()), std::regex(pattern))) << e.what();
   }
 }
 
-TEST(ScenarioConfig, CommandLineOverrides) {
-  ScenarioConfig config = LoadScenarioFile(Source(kDefaultScenarioRelativePath));
-  ApplyOverrides(&config, 2, "ar,ar_reflective", {"0,10,0,-20,0,30,0", "5,10,0,-20,0,30,0"});
+TEST(viraal::ScenarioConfig, CommandLineOverrides) {
+  viraal::ScenarioConfig config = viraal::LoadScenarioFile(Source(viraal::kDefaultScenarioRelativePath));
+  viraal::ApplyOverrides(&config, 2, "ar,ar_reflective", {"0,10,0,-20,0,30,0", "5,10,0,-20,0,30,0"});
   EXPECT_EQ(config.trials, 2);
   ASSERT_EQ(config.modes.size(), 2u);
   EXPECT_EQ(config.modes[0].num_mirrors, 0);
@@ -159,19 +159,19 @@ TEST(ScenarioConfig, CommandLineOverrides) {
   ASSERT_EQ(config.configurations_deg.size(), 2u);
   EXPECT_EQ(config.configurations_deg[1][0], 5.0);
   EXPECT_EQ(config.configurations_deg[1][6], 0.0);
-  ScenarioConfig untouched = LoadScenarioFile(Source(kDefaultScenarioRelativePath));
+  viraal::ScenarioConfig untouched = viraal::LoadScenarioFile(Source(viraal::kDefaultScenarioRelativePath));
   const int trials = untouched.trials;
-  ApplyOverrides(&untouched, 0, "", {});
+  viraal::ApplyOverrides(&untouched, 0, "", {});
   EXPECT_EQ(untouched.trials, trials);
-  EXPECT_THROW(ApplyOverrides(&untouched, 0, "ar,mirror", {}), std::invalid_argument);
-  EXPECT_THROW(ApplyOverrides(&untouched, 0, "", {"1,x,3"}), std::invalid_argument);
-  ApplyOverrides(&untouched, 0, "", {"1,2,3"});  // parses; the size is checked with the rest:
-  EXPECT_THROW(ValidateScenarioConfig(untouched, 7), std::invalid_argument);
+  EXPECT_THROW(viraal::ApplyOverrides(&untouched, 0, "ar,mirror", {}), std::invalid_argument);
+  EXPECT_THROW(viraal::ApplyOverrides(&untouched, 0, "", {"1,x,3"}), std::invalid_argument);
+  viraal::ApplyOverrides(&untouched, 0, "", {"1,2,3"});  // parses; the size is checked with the rest:
+  EXPECT_THROW(viraal::ValidateScenarioConfig(untouched, 7), std::invalid_argument);
 }
 
-TEST(ScenarioConfig, ErrorsNameTheLineAndTheFix) {
+TEST(viraal::ScenarioConfig, ErrorsNameTheLineAndTheFix) {
   const std::string good = "configurations_deg:\n  - [0, 30, 0, -60, 0, 45, 0]\nlandmarks: [iiwa_link_ee]\n";
-  EXPECT_NO_THROW(LoadScenarioString(good, "s.yaml"));
+  EXPECT_NO_THROW(viraal::LoadScenarioString(good, "s.yaml"));
   ExpectError("trails: 3\n" + good, "s.yaml:1: trails: unknown key");
   ExpectError(good + "modes: [ar, vr]\n",
               "s.yaml:4: modes\\[1\\]: unknown mode 'vr', expected ar_reflective or ar");
@@ -183,15 +183,15 @@ TEST(ScenarioConfig, ErrorsNameTheLineAndTheFix) {
       "configurations_deg:\n  - [0, 30, 0, -60, 0, 45, 0]\n  - [0, 30, 0, -60, 0, 45, 0.5]\nlandmarks: [a]\n",
       "configurations 0 and 1 are the same");
   ExpectError("landmarks: [a]\n", "s.yaml:1: configurations_deg: missing");
-  EXPECT_THROW(ParseJointList("1,2,x", "--q-deg"), std::invalid_argument);
-  EXPECT_EQ(ParseJointList("1, 2.5,-3", "--q-deg"), (std::vector<double>{1, 2.5, -3}));
+  EXPECT_THROW(viraal::ParseJointList("1,2,x", "--q-deg"), std::invalid_argument);
+  EXPECT_EQ(viraal::ParseJointList("1, 2.5,-3", "--q-deg"), (std::vector<double>{1, 2.5, -3}));
 }
 
 TEST(ViraalResults, MeanStdWithTheSampleDenominator) {
-  const MeanStd s = ComputeMeanStd({1, 2, 3});
+  const viraal::MeanStd s = viraal::ComputeMeanStd({1, 2, 3});
   EXPECT_DOUBLE_EQ(s.mean, 2.0);
   EXPECT_DOUBLE_EQ(s.std, 1.0);
-  EXPECT_DOUBLE_EQ(ComputeMeanStd({5}).std, 0.0);
+  EXPECT_DOUBLE_EQ(viraal::ComputeMeanStd({5}).std, 0.0);
 }
 
 int Count(const std::string& text, const std::string& pattern) {
@@ -201,23 +201,23 @@ int Count(const std::string& text, const std::string& pattern) {
 }
 
 TEST(ViraalResults, JsonHasTheDocumentedShape) {
-  RunResults r;
+  viraal::RunResults r;
   r.run_id = "t";
   r.ok = true;
   for (const char* mode : {"ar_reflective", "ar"}) {
-    SessionResult s;
+    viraal::SessionResult s;
     s.mode = mode;
     for (int i = 0; i < 3; ++i) {
-      TrialResult t;
+      viraal::TrialResult t;
       t.index = i;
       t.q_deg = {0, 30, 0, -60, 0, 45, 0};
       t.errors.translation_error_mm = 10 + i;
       s.trials.push_back(t);
     }
-    s.mean = MeanResult{};
+    s.mean = viraal::MeanResult{};
     r.sessions.push_back(s);
   }
-  const std::string json = ResultsJson(r);
+  const std::string json = viraal::ResultsJson(r);
   EXPECT_EQ(Count(json, "\"mode\": \"ar_reflective\""), 1);
   EXPECT_EQ(Count(json, "\"mode\": \"ar\""), 1);
   EXPECT_EQ(Count(json, "\"index\": [0-2]"), 6);
@@ -232,7 +232,7 @@ TEST(ViraalResults, JsonHasTheDocumentedShape) {
   EXPECT_NE(json.find("\"translation_error_mm\": {\n          \"mean\": 11,\n          \"std\": 1"),
             std::string::npos)
       << json;
-  const std::string table = ResultsTable(r);
+  const std::string table = viraal::ResultsTable(r);
   EXPECT_NE(table.find("paper: 16.5 +/- 11.0 mm"), std::string::npos) << table;
 }
 
@@ -374,7 +374,7 @@ class FakeTestbed {
 
 ScenarioOptions MemqOptions(const std::string& dir) {
   ScenarioOptions options;
-  options.conductor.config = LoadScenarioFile(Source(kDefaultScenarioRelativePath));
+  options.conductor.config = viraal::LoadScenarioFile(Source(viraal::kDefaultScenarioRelativePath));
   options.conductor.run_id = "memq";
   options.results_dir = dir;
   options.conductor.trial_timeout_s = 1.0;
@@ -447,7 +447,7 @@ TEST(ViraalScenario, AFullRunOnMemqGivesTheUsersKnownRotatedOffset) {
   X_RV.translation() = p_RV;
   FakeTestbed fake(&scenario.process().lcm(), X_RV, true);
   ASSERT_EQ(scenario.Run(), 0) << scenario.results().error;
-  const RunResults& r = scenario.results();
+  const viraal::RunResults& r = scenario.results();
   ASSERT_TRUE(r.ok);
   ASSERT_EQ(r.sessions.size(), 2u);
 
@@ -475,7 +475,7 @@ TEST(ViraalScenario, AFullRunOnMemqGivesTheUsersKnownRotatedOffset) {
     mean.flange_mm += e.flange_mm / 3;
     mean.t_bar_mm += e.t_bar_mm / 3;  // 9 pairs: the mean of the three means of 3
   }
-  auto expect_measures = [&](const ErrorMeasures& got, const Expected& want, const std::string& what) {
+  auto expect_measures = [&](const viraal::ErrorMeasures& got, const Expected& want, const std::string& what) {
     SCOPED_TRACE(what);
     EXPECT_NEAR(got.rotation_error_deg, 5.0, 1e-9);
     EXPECT_NEAR(got.base_translation_error_mm, std::sqrt(61.0), 1e-9);  // ‖(4, −6, 3)‖ mm
@@ -498,7 +498,7 @@ TEST(ViraalScenario, AFullRunOnMemqGivesTheUsersKnownRotatedOffset) {
     }
   }
   EXPECT_GT(transposed_change_mm, 2.0);
-  for (const SessionResult& s : r.sessions) {
+  for (const viraal::SessionResult& s : r.sessions) {
     ASSERT_EQ(s.trials.size(), 3u);
     ASSERT_TRUE(s.mean.has_value());
     for (int i = 0; i < 3; ++i) {

@@ -32,8 +32,8 @@ std::string JointList(const std::vector<double>& q_deg, int digits) {
   return out + ")";
 }
 
-ErrorMeasures Measures(const AlignmentError& error, const orbed::misalignment_t& misalignment) {
-  ErrorMeasures m;
+viraal::ErrorMeasures Measures(const viraal::AlignmentError& error, const orbed::misalignment_t& misalignment) {
+  viraal::ErrorMeasures m;
   m.translation_error_mm = error.centroid_translation_m * 1e3;
   m.rotation_error_deg = error.rotation_rad * kRadToDeg;
   m.base_translation_error_mm = error.base_translation_m * 1e3;
@@ -65,14 +65,14 @@ ViraalConductor::ViraalConductor(ConductorOptions options, orbed::sim::RobotMode
     : options_(std::move(options)), model_(std::make_unique<orbed::sim::RobotModel>(std::move(model))) {
   CheckConductorOptions(options_);
   if (options_.run_id.empty()) throw std::invalid_argument("the run id is empty");
-  const ScenarioConfig& config = options_.config;
-  ValidateScenarioConfig(config, model_->num_joints());
+  const viraal::ScenarioConfig& config = options_.config;
+  viraal::ValidateScenarioConfig(config, model_->num_joints());
   for (size_t k = 0; k < config.configurations_deg.size(); ++k) {
     const std::string why =
         model_->ValidateJointVector(orbed::sim::DegToRad(ToVectorX(config.configurations_deg[k])));
     if (!why.empty()) throw std::invalid_argument("configuration " + std::to_string(k) + ": " + why);
   }
-  points_ = std::make_unique<RobotPointSet>(*model_, config.landmarks);
+  points_ = std::make_unique<viraal::RobotPointSet>(*model_, config.landmarks);
   results_.run_id = options_.run_id;
   results_.seed = options_.seed;
   results_.landmarks = config.landmarks;
@@ -194,7 +194,7 @@ ConductorActions ViraalConductor::OnTrial(const orbed::alignment_trial_t& msg, c
                                                        " was not requested now");
     return TakeActions();
   }
-  const ModeSpec& mode = options_.config.modes[mode_index_];
+  const viraal::ModeSpec& mode = options_.config.modes[mode_index_];
   std::string problem = FirstError(
       {CheckPose(msg.X_WV, "ALIGNMENT_TRIAL.X_WV"),
        CheckLength(msg.num_joints, msg.joint_position.size(), kMaxJoints, "ALIGNMENT_TRIAL.num_joints"),
@@ -225,9 +225,9 @@ ConductorActions ViraalConductor::OnTrial(const orbed::alignment_trial_t& msg, c
                                     Fixed(off_deg, 3) +
                                     " deg from the commanded configuration; its errors use the trial's q");
   }
-  const RobotPoints points = points_->At(q);
+  const viraal::RobotPoints points = points_->At(q);
   session_points_.push_back(points);
-  pending_error_ = EvaluateAlignment(FromPose(robot_state_->X_WR), FromPose(msg.X_WV), points);
+  pending_error_ = viraal::EvaluateAlignment(FromPose(robot_state_->X_WR), FromPose(msg.X_WV), points);
   misalignment_.reset();
   misalignment_request_id_ = SendMisalignment(pending_error_);
   Enter(Phase::kAwaitTrialResults);
@@ -393,7 +393,7 @@ void ViraalConductor::Step() {
                   "), expected " + std::to_string(options_.config.trials));
           return;
         }
-        pending_error_ = EvaluateOverConfigurations(FromPose(robot_state_->X_WR), FromPose(mean.X_WV_mean),
+        pending_error_ = viraal::EvaluateOverConfigurations(FromPose(robot_state_->X_WR), FromPose(mean.X_WV_mean),
                                                     session_points_);
         misalignment_.reset();
         misalignment_request_id_ = SendMisalignment(pending_error_);
@@ -434,7 +434,7 @@ void ViraalConductor::StartPlanChecks() {
 }
 
 void ViraalConductor::SendSessionControl(int8_t command) {
-  const ModeSpec& mode = options_.config.modes[mode_index_];
+  const viraal::ModeSpec& mode = options_.config.modes[mode_index_];
   orbed::session_control_t msg{};
   msg.utime = now_.utime;
   msg.session_id = results_.sessions.back().session_id;
@@ -446,8 +446,8 @@ void ViraalConductor::SendSessionControl(int8_t command) {
 }
 
 void ViraalConductor::StartSession() {
-  const ModeSpec& mode = options_.config.modes[mode_index_];
-  SessionResult session;
+  const viraal::ModeSpec& mode = options_.config.modes[mode_index_];
+  viraal::SessionResult session;
   session.mode = mode.name;
   session.session_id = options_.run_id + "-" + mode.name;
   session.display_mode = mode.display_mode;
@@ -486,7 +486,7 @@ void ViraalConductor::RequestTrial() {
   Enter(Phase::kAwaitTrial);
 }
 
-int64_t ViraalConductor::SendMisalignment(const AlignmentError& error) {
+int64_t ViraalConductor::SendMisalignment(const viraal::AlignmentError& error) {
   orbed::misalignment_request_t request{};
   request.utime = now_.utime;
   request.request_id = now_.utime * 16 + (next_request_id_++ % 16);
@@ -504,7 +504,7 @@ int64_t ViraalConductor::SendMisalignment(const AlignmentError& error) {
 
 void ViraalConductor::FinishTrial() {
   const orbed::alignment_trial_t& trial = *trial_;
-  TrialResult result;
+  viraal::TrialResult result;
   result.index = trial.trial_index;
   for (double q : trial.joint_position) result.q_deg.push_back(q * kRadToDeg);
   result.errors = Measures(pending_error_, *misalignment_);
@@ -529,7 +529,7 @@ void ViraalConductor::FinishTrial() {
 
 void ViraalConductor::FinishSession() {
   const orbed::registration_t& reg = *mean_registration_;
-  MeanResult mean;
+  viraal::MeanResult mean;
   mean.errors = Measures(pending_error_, *misalignment_);
   mean.X_WV = FromPose(reg.X_WV_mean);
   mean.num_used = reg.num_used;
@@ -539,7 +539,7 @@ void ViraalConductor::FinishSession() {
   mean.iterations = reg.iterations;
   mean.converged = reg.converged;
   mean.unique = reg.unique;
-  SessionResult& session = results_.sessions.back();
+  viraal::SessionResult& session = results_.sessions.back();
   session.mean = mean;
   Say("[" + session.mode + "] mean of " + std::to_string(reg.num_used) + " trials (SE(3), " +
       (reg.converged ? "converged" : "NOT converged") + "): " + Fixed(mean.errors.translation_error_mm, 1) +

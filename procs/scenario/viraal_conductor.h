@@ -59,9 +59,9 @@
 
 #include "procs/common/channels.h"
 #include "procs/common/log.h"
-#include "procs/scenario/scenario_config.h"
-#include "procs/scenario/viraal_errors.h"
-#include "procs/scenario/viraal_results.h"
+#include "viraal/protocol.h"
+#include "viraal/metrics.h"
+#include "viraal/results.h"
 #include "sim/robot_model.h"
 
 namespace orbed::scenario {
@@ -75,7 +75,7 @@ struct ConductorTime {
 };
 
 struct ConductorOptions {
-  ScenarioConfig config;
+  viraal::ScenarioConfig config;
   /// Session ids are "<run_id>-<mode>"; must not be empty.
   std::string run_id;
   /// Recorded in the results (the process's --seed).
@@ -175,7 +175,7 @@ class ViraalConductor {
   bool done() const { return phase_ == Phase::kDone; }
   /// The results so far; final once done(). rejected_inputs counts this machine's refusals (the
   /// shell replaces it with its process's total, which also counts undecodable messages).
-  const RunResults& results() const { return results_; }
+  const viraal::RunResults& results() const { return results_; }
   const ConductorOptions& options() const { return options_; }
   const orbed::sim::RobotModel& model() const { return *model_; }
 
@@ -193,7 +193,7 @@ class ViraalConductor {
   // Emits the trial's IIWA_COMMAND; `first` enters kMove (else a re-send).
   void StartMove(bool first);
   void RequestTrial();
-  int64_t SendMisalignment(const AlignmentError& error);
+  int64_t SendMisalignment(const viraal::AlignmentError& error);
   void FinishTrial();
   void FinishSession();
   void FinishRun();
@@ -213,7 +213,7 @@ class ViraalConductor {
 
   ConductorOptions options_;
   std::unique_ptr<const orbed::sim::RobotModel> model_;
-  std::unique_ptr<RobotPointSet> points_;
+  std::unique_ptr<viraal::RobotPointSet> points_;
 
   ConductorTime now_;
   ConductorActions actions_;
@@ -242,11 +242,11 @@ class ViraalConductor {
   int64_t misalignment_request_id_{0};
   std::optional<orbed::misalignment_t> misalignment_;
   std::optional<orbed::registration_t> mean_registration_;
-  AlignmentError pending_error_;
-  std::vector<RobotPoints> session_points_;
+  viraal::AlignmentError pending_error_;
+  std::vector<viraal::RobotPoints> session_points_;
   int64_t next_request_id_{1};
 
-  RunResults results_;
+  viraal::RunResults results_;
 };
 
 }  // namespace orbed::scenario

@@ -91,7 +91,7 @@ class Bench {
 
   static ConductorOptions Options() {
     ConductorOptions options;
-    options.config = LoadScenarioFile(sim::SourceTreePath(kDefaultScenarioRelativePath));
+    options.config = viraal::LoadScenarioFile(sim::SourceTreePath(viraal::kDefaultScenarioRelativePath));
     options.run_id = "emu";
     return options;
   }
@@ -201,7 +201,7 @@ TEST(ViraalConductor, NoRobotStateWithinTheStartupTimeoutNamesTheSim) {
   EXPECT_EQ(bench.conductor().status(), Status::kRunning);
   bench.TickAt(100.0 + 10.01);
   EXPECT_EQ(bench.conductor().status(), Status::kFailed);
-  const RunResults& r = bench.conductor().results();
+  const viraal::RunResults& r = bench.conductor().results();
   EXPECT_FALSE(r.ok);
   EXPECT_TRUE(
       Contains(r.error, "no valid ROBOT_STATE on ROBOT_STATE within 10.0 s: is orbed-iiwa-sim running?"))
@@ -561,7 +561,7 @@ TEST(ViraalConductor, AWholeRunInEmulatedTime) {
   EXPECT_TRUE(bench.refusals().empty());
 
   // What the messages carry.
-  const ScenarioConfig& config = bench.conductor().options().config;
+  const viraal::ScenarioConfig& config = bench.conductor().options().config;
   const std::vector<Publication> commands = bench.Sent("IIWA_COMMAND");
   ASSERT_EQ(commands.size(), 6u);
   for (size_t i = 0; i < commands.size(); ++i) {
@@ -581,7 +581,7 @@ TEST(ViraalConductor, AWholeRunInEmulatedTime) {
   }
 
   // The results: a pure 10 mm shift along W x is 10 mm everywhere, t̄ = (10, 0, 0) mm.
-  const RunResults& r = bench.conductor().results();
+  const viraal::RunResults& r = bench.conductor().results();
   EXPECT_TRUE(r.ok);
   EXPECT_EQ(r.run_id, "emu");
   EXPECT_EQ(r.error, "");
@@ -594,12 +594,12 @@ TEST(ViraalConductor, AWholeRunInEmulatedTime) {
   EXPECT_EQ(r.sessions[0].session_id, "emu-ar_reflective");
   EXPECT_EQ(r.sessions[1].session_id, "emu-ar");
   EXPECT_EQ(r.sessions[1].num_mirrors, 0);
-  for (const SessionResult& s : r.sessions) {
+  for (const viraal::SessionResult& s : r.sessions) {
     ASSERT_EQ(s.trials.size(), 3u);
     ASSERT_TRUE(s.mean.has_value());
     EXPECT_EQ(s.mean->num_used, 3);
     EXPECT_EQ(s.mean->iterations, 4);
-    for (const ErrorMeasures& e :
+    for (const viraal::ErrorMeasures& e :
          {s.trials[0].errors, s.trials[1].errors, s.trials[2].errors, s.mean->errors}) {
       EXPECT_NEAR(e.translation_error_mm, 10.0, 1e-9);
       EXPECT_NEAR(e.flange_translation_error_mm, 10.0, 1e-9);
@@ -614,7 +614,7 @@ TEST(ViraalConductor, AWholeRunInEmulatedTime) {
       for (int j = 0; j < 7; ++j) EXPECT_NEAR(s.trials[i].q_deg[j], config.configurations_deg[i][j], 1e-9);
     }
   }
-  EXPECT_TRUE(Contains(ResultsJson(r), "\"status\": \"ok\""));
+  EXPECT_TRUE(Contains(viraal::ResultsJson(r), "\"status\": \"ok\""));
 
   // The operator's lines.
   const std::vector<std::string>& lines = bench.lines();

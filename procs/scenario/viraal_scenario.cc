@@ -120,7 +120,7 @@ void ViraalScenario::Finish() {
   results_.rejected_inputs = process_->rejections().total();
   try {
     std::filesystem::create_directories(options_.results_dir);
-    results_path_ = WriteResultsFile(options_.results_dir, ResultsJson(results_));
+    results_path_ = viraal::WriteResultsFile(options_.results_dir, viraal::ResultsJson(results_));
   } catch (const std::exception& e) {
     if (results_.ok) {
       results_.ok = false;
@@ -131,7 +131,7 @@ void ViraalScenario::Finish() {
     ORBED_LOG(kError) << "cannot write the results: " << e.what();
   }
   if (results_.ok) {
-    if (options_.out) *options_.out << "\n" << ResultsTable(results_) << std::flush;
+    if (options_.out) *options_.out << "\n" << viraal::ResultsTable(results_) << std::flush;
     char duration[32];
     std::snprintf(duration, sizeof(duration), "%.1f", results_.duration_s);
     Say("results: " + results_path_ + " (" + duration + " s)");

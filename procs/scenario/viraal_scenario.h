@@ -29,7 +29,7 @@
 
 #include "procs/common/process.h"
 #include "procs/scenario/viraal_conductor.h"
-#include "procs/scenario/viraal_results.h"
+#include "viraal/results.h"
 
 namespace orbed::scenario {
 
@@ -64,7 +64,7 @@ class ViraalScenario {
   const ViraalConductor& conductor() const { return *conductor_; }
   /// The conductor's results; once it is done, as written to results.json (rejected_inputs =
   /// every input the process refused or could not decode).
-  const RunResults& results() const { return finished_ ? results_ : conductor_->results(); }
+  const viraal::RunResults& results() const { return finished_ ? results_ : conductor_->results(); }
   /// Path of the results.json written at the end ("" before).
   const std::string& results_path() const { return results_path_; }
 
@@ -83,7 +83,7 @@ class ViraalScenario {
   std::unique_ptr<orbed::Process> process_;
   std::chrono::steady_clock::time_point clock_origin_;
   bool finished_{false};
-  RunResults results_;
+  viraal::RunResults results_;
   std::string results_path_;
 };
 

@@ -1,10 +1,10 @@
-#include "hmd_emulator/yaml_fields.h"
+#include "base/yaml_fields.h"
 
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
 
-namespace orbed::hmd {
+namespace orbed {
 namespace {
 
 std::string Range(double lo, double hi, const std::string& unit) {
@@ -139,4 +139,19 @@ Eigen::Vector3d YamlFields::Vector3(const YAML::Node& node, const std::string& k
   return v;
 }
 
-}  // namespace orbed::hmd
+std::string YamlFields::String(const YAML::Node& node, const std::string& key) const {
+  if (!node.IsScalar()) Fail(node, key, "expected a text value");
+  return node.Scalar();
+}
+
+std::vector<std::string> YamlFields::Strings(const YAML::Node& node, const std::string& key) const {
+  if (!node.IsSequence() || node.size() == 0) Fail(node, key, "expected a non-empty list of names");
+  std::vector<std::string> out;
+  for (size_t i = 0; i < node.size(); ++i) {
+    if (!node[i].IsScalar()) Fail(node[i], key + "[" + std::to_string(i) + "]", "expected a name");
+    out.push_back(node[i].Scalar());
+  }
+  return out;
+}
+
+}  // namespace orbed

@@ -1,9 +1,9 @@
-#include "procs/scenario/viraal_errors.h"
+#include "viraal/metrics.h"
 
 #include <cmath>
 #include <stdexcept>
 
-namespace orbed::scenario {
+namespace orbed::viraal {
 
 RobotPointSet::RobotPointSet(const orbed::sim::RobotModel& model,
                              const std::vector<std::string>& landmark_links)
@@ -65,4 +65,4 @@ AlignmentError EvaluateOverConfigurations(const Eigen::Isometry3d& X_WR, const E
   return error;
 }
 
-}  // namespace orbed::scenario
+}  // namespace orbed::viraal

@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// The ViRAAl scenario file (procs/scenario/viraal.yaml): which display modes to run and in which
+/// The ViRAAl scenario file (viraal/viraal.yaml): which display modes to run and in which
 /// order, how many trials per mode, the joint configurations the robot takes for the trials, and
 /// the landmarks of the paper's misalignment protocol. Every key is checked; unknown keys and bad
 /// values are errors naming the file, the line and what was expected.
@@ -22,7 +22,7 @@
 #include <string>
 #include <vector>
 
-namespace orbed::scenario {
+namespace orbed::viraal {
 
 /// One display mode of the experiment.
 struct ModeSpec {
@@ -40,7 +40,7 @@ struct ScenarioConfig {
 };
 
 /// The file shipped in the source tree, relative to the repository root.
-inline constexpr const char* kDefaultScenarioRelativePath = "procs/scenario/viraal.yaml";
+inline constexpr const char* kDefaultScenarioRelativePath = "viraal/viraal.yaml";
 
 /// Loads and checks a scenario file; throws std::runtime_error "file:line: key: what, expected ...".
 ScenarioConfig LoadScenarioFile(const std::string& path);
@@ -64,4 +64,4 @@ void ApplyOverrides(ScenarioConfig* config, int trials, const std::string& modes
 /// the file.
 void ValidateScenarioConfig(const ScenarioConfig& config, int num_joints);
 
-}  // namespace orbed::scenario
+}  // namespace orbed::viraal

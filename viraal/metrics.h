@@ -33,7 +33,7 @@
 
 #include "sim/robot_model.h"
 
-namespace orbed::scenario {
+namespace orbed::viraal {
 
 /// The robot points used to measure an alignment at one configuration, in the base frame R [m].
 struct RobotPoints {
@@ -83,4 +83,4 @@ AlignmentError EvaluateAlignment(const Eigen::Isometry3d& X_WR, const Eigen::Iso
 AlignmentError EvaluateOverConfigurations(const Eigen::Isometry3d& X_WR, const Eigen::Isometry3d& X_WV,
                                           const std::vector<RobotPoints>& points);
 
-}  // namespace orbed::scenario
+}  // namespace orbed::viraal

@@ -1,4 +1,4 @@
-#include "procs/scenario/viraal_results.h"
+#include "viraal/results.h"
 
 #include <cmath>
 #include <cstdio>
@@ -9,14 +9,10 @@
 
 #include "base/format.h"
 #include "base/json.h"
+#include "viraal/paper_reference.h"
 
-namespace orbed::scenario {
+namespace orbed::viraal {
 namespace {
-
-// Paper, Table 1 and Sec. III-B: misalignment ‖t̄‖₂ and ‖σ_t‖₂ [mm] over 10 trials x 4 users.
-constexpr double kPaperReflectiveMm = 16.5, kPaperReflectiveStdMm = 11.0;
-constexpr double kPaperArMm = 30.2, kPaperArStdMm = 23.9;
-constexpr double kPaperReflectiveMeanMm = 11.3, kPaperReflectiveMeanStdMm = 1.01;
 
 void WritePose(JsonWriter* json, const Eigen::Isometry3d& X) {
   const Eigen::Quaterniond q(X.linear());
@@ -105,15 +101,15 @@ std::string ResultsJson(const RunResults& r) {
   }
   json.Key("rejected_inputs").Int(r.rejected_inputs);
   json.Key("paper_reference").BeginObject();
-  json.Key("source").String("Fotouhi et al., RA-L 2020, Table 1 and Sec. III-B (10 trials x 4 users)");
+  json.Key("source").String(kPaperSource);
   json.Key("ar_reflective").BeginObject();
-  json.Key("misalignment_mm").Number(kPaperReflectiveMm).Key("std_mm").Number(kPaperReflectiveStdMm);
+  json.Key("misalignment_mm").Number(kPaperArReflective.misalignment_mm).Key("std_mm").Number(kPaperArReflective.std_mm);
   json.EndObject();
   json.Key("ar").BeginObject();
-  json.Key("misalignment_mm").Number(kPaperArMm).Key("std_mm").Number(kPaperArStdMm);
+  json.Key("misalignment_mm").Number(kPaperAr.misalignment_mm).Key("std_mm").Number(kPaperAr.std_mm);
   json.EndObject();
   json.Key("ar_reflective_mean").BeginObject();
-  json.Key("misalignment_mm").Number(kPaperReflectiveMeanMm).Key("std_mm").Number(kPaperReflectiveMeanStdMm);
+  json.Key("misalignment_mm").Number(kPaperArReflectiveMean.misalignment_mm).Key("std_mm").Number(kPaperArReflectiveMean.std_mm);
   json.EndObject();
   json.EndObject();
 
@@ -198,11 +194,11 @@ std::string ResultsTable(const RunResults& r) {
     out << PadRight("", 23) << "trial misalignment " << Fixed(stats.mean, 1) << " +/- " << Fixed(stats.std, 1)
         << " mm";
     if (s.mode == "ar_reflective") {
-      out << "   (paper: " << Fixed(kPaperReflectiveMm, 1) << " +/- " << Fixed(kPaperReflectiveStdMm, 1)
-          << " mm; its mean " << Fixed(kPaperReflectiveMeanMm, 1) << " +/- "
-          << Fixed(kPaperReflectiveMeanStdMm, 2) << " mm)";
+      out << "   (paper: " << Fixed(kPaperArReflective.misalignment_mm, 1) << " +/- " << Fixed(kPaperArReflective.std_mm, 1)
+          << " mm; its mean " << Fixed(kPaperArReflectiveMean.misalignment_mm, 1) << " +/- "
+          << Fixed(kPaperArReflectiveMean.std_mm, 2) << " mm)";
     } else if (s.mode == "ar") {
-      out << "   (paper: " << Fixed(kPaperArMm, 1) << " +/- " << Fixed(kPaperArStdMm, 1) << " mm)";
+      out << "   (paper: " << Fixed(kPaperAr.misalignment_mm, 1) << " +/- " << Fixed(kPaperAr.std_mm, 1) << " mm)";
     }
     out << "\n";
   }
@@ -227,4 +223,4 @@ std::string WriteResultsFile(const std::string& dir, const std::string& text) {
   return path;
 }
 
-}  // namespace orbed::scenario
+}  // namespace orbed::viraal

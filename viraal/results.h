@@ -38,7 +38,7 @@
 
 #include <Eigen/Geometry>
 
-namespace orbed::scenario {
+namespace orbed::viraal {
 
 /// The error measures of one pose against the truth (see viraal_errors.h for the definitions).
 struct ErrorMeasures {
@@ -113,4 +113,4 @@ std::string ResultsTable(const RunResults& results);
 /// half-written file); returns the path. Throws std::runtime_error naming the path on failure.
 std::string WriteResultsFile(const std::string& dir, const std::string& text);
 
-}  // namespace orbed::scenario
+}  // namespace orbed::viraal

@@ -1,7 +1,7 @@
 #pragma once
 /// @file
-/// Typed, checked reads from YAML for the hmd_user_lib configuration files (slam.yaml, user.yaml,
-/// head trajectories). Every failure throws std::runtime_error naming the source file, the line, the
+/// The one checked YAML reader: typed reads for every configuration file of the project (scene,
+/// scenario, launch, headset, wearer, SLAM and walk files). Every failure throws std::runtime_error naming the source file, the line, the
 /// dotted key and the expected value, e.g.
 ///   "user.yaml:14: direct_view.depth_bias_fraction_std: expected a number >= 0, got '-1'".
 /// Unknown keys are errors (CheckKeys), so that typos in a config are caught, not ignored.
@@ -10,11 +10,12 @@
 
 #include <set>
 #include <string>
+#include <vector>
 
 #include <yaml-cpp/yaml.h>
 #include <Eigen/Core>
 
-namespace orbed::hmd {
+namespace orbed {
 
 class YamlFields {
  public:
@@ -49,6 +50,10 @@ class YamlFields {
   bool BoolOr(const YAML::Node& map, const std::string& name, const std::string& prefix, bool fallback) const;
   /// A list of three finite numbers.
   Eigen::Vector3d Vector3(const YAML::Node& node, const std::string& key, const std::string& unit) const;
+  /// A scalar as text (any scalar: names, paths, numbers as written).
+  std::string String(const YAML::Node& node, const std::string& key) const;
+  /// A non-empty list of scalars.
+  std::vector<std::string> Strings(const YAML::Node& node, const std::string& key) const;
 
  private:
   static std::string Join(const std::string& prefix, const std::string& name) {
@@ -57,4 +62,4 @@ class YamlFields {
   std::string source_;
 };
 
-}  // namespace orbed::hmd
+}  // namespace orbed
