@@ -11,7 +11,6 @@
 #include <gtest/gtest.h>
 
 #include "base/stats.h"
-#include "hmd_emulator/user_study.h"
 #include "base/yaml_fields.h"
 #include "sim/scene.h"
 
@@ -112,78 +111,6 @@ TEST(EmulatedUser, DepthMisjudgementMovesAlongTheRay) {
     EXPECT_GT(e.along_ray_m, beta * 1.0 - 1e-3) << rho;
     EXPECT_LT(e.along_ray_m, beta * 2.3 + 1e-3);
   }
-}
-
-// The paper's Table 1 claim, emerging from the mechanism: 200 seeded trials per mode.
-TEST(EmulatedUser, ReflectiveDisplayReducesErrorSignificantly) {
-  StudyOptions o;
-  o.source_dir = orbed::SourceDir();
-  o.trials_per_mode = 200;
-  const std::vector<StudyMode> modes = RunStudy(o);
-  ASSERT_EQ(modes.size(), 2u);
-  ASSERT_EQ(modes[0].name, "ar");
-  ASSERT_EQ(modes[1].name, "ar_reflective");
-  std::vector<double> reg[2], aug[2], along_ar, lateral_ar;
-  for (int m = 0; m < 2; ++m) {
-    for (const auto& t : modes[m].trials) {
-      reg[m].push_back(t.registration.translation_error_m);
-      aug[m].push_back(t.augmentation.translation_error_m);
-      if (m == 0) {
-        along_ar.push_back(t.augmentation.along_ray_m);
-        lateral_ar.push_back(t.augmentation.lateral_m);
-      }
-    }
-  }
-  // Lower mean error with the reflective display, significant by the rank test (one-sided).
-  EXPECT_LT(stats::Mean(reg[1]), stats::Mean(reg[0]));
-  const stats::MannWhitneyResult mw = stats::MannWhitneyU(reg[1], reg[0]);
-  ASSERT_TRUE(mw.valid);
-  EXPECT_LT(mw.p_x_less, 0.01);
-  // The modes are paired (the same person, SLAM error and biases in trial i of both): the gain
-  // holds trial by trial too.
-  const stats::SignedRankResult sr = stats::WilcoxonSignedRank(reg[1], reg[0]);
-  ASSERT_TRUE(sr.valid);
-  EXPECT_LT(sr.p_x_less, 0.01);
-  EXPECT_LT(stats::Mean(aug[1]), stats::Mean(aug[0]));
-  EXPECT_LT(stats::MannWhitneyU(aug[1], aug[0]).p_x_less, 0.01);
-  // Without the display, what the person leaves is mostly along the line of sight.
-  EXPECT_GT(stats::Mean(along_ar), 3.0 * stats::Mean(lateral_ar));
-  int along_dominates = 0;
-  for (std::size_t i = 0; i < along_ar.size(); ++i) along_dominates += along_ar[i] > lateral_ar[i];
-  EXPECT_GT(along_dominates, 0.8 * along_ar.size());
-  // Order of magnitude of Table 1 (30.2 ± 23.9 mm AR, 16.5 ± 11.0 mm with the display): within a
-  // factor of two.
-  EXPECT_GT(stats::Mean(reg[0]), 0.015);
-  EXPECT_LT(stats::Mean(reg[0]), 0.060);
-  EXPECT_GT(stats::Mean(reg[1]), 0.008);
-  EXPECT_LT(stats::Mean(reg[1]), 0.033);
-}
-
-// The negative control: a display whose frame is captured where the person aligns (the walk's
-// last waypoint) shows the robot from the person's own viewpoint. It adds no second viewpoint, so
-// it cannot resolve the depth along the line of sight, and it must not make the error
-// significantly smaller (the same rank test as the positive claim): the mechanism, not the mere
-// presence of a display, makes the gain. Paired trial by trial a small gain remains (about 2 %:
-// the camera sits a few cm off the eyes, a tiny baseline, and the display repeats the weak
-// non-uniform perspective cue that a size-blind person still has), far from the ~45 % of a
-// display from the other side.
-TEST(EmulatedUser, DisplayFromTheAlignmentViewpointDoesNotHelp) {
-  StudyOptions o;
-  o.source_dir = orbed::SourceDir();
-  o.trials_per_mode = 200;
-  o.display_waypoints = {
-      LoadHeadTrajectoryFile(orbed::SourceDir() + "/hmd_emulator/config/viraal_walk.yaml").waypoints.back().name};
-  const std::vector<StudyMode> modes = RunStudy(o);
-  ASSERT_EQ(modes.size(), 2u);
-  std::vector<double> reg[2];
-  for (int m = 0; m < 2; ++m) {
-    for (const auto& t : modes[m].trials) reg[m].push_back(t.registration.translation_error_m);
-  }
-  const stats::MannWhitneyResult mw = stats::MannWhitneyU(reg[1], reg[0]);
-  ASSERT_TRUE(mw.valid);
-  EXPECT_GT(mw.p_x_less, 0.05) << "same-viewpoint display: " << stats::Mean(reg[1]) << " vs "
-                               << stats::Mean(reg[0]);
-  EXPECT_GT(stats::Mean(reg[1]), 0.95 * stats::Mean(reg[0]));
 }
 
 TEST(EmulatedUser, SeedIsAPersonAndTrialsAreReproducible) {

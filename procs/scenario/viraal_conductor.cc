@@ -9,6 +9,7 @@
 
 #include "procs/common/conversions.h"
 #include "procs/common/validation.h"
+#include "viraal/exchange.h"
 
 namespace orbed::scenario {
 namespace {
@@ -30,18 +31,6 @@ std::string JointList(const std::vector<double>& q_deg, int digits) {
   std::string out = "(";
   for (size_t i = 0; i < q_deg.size(); ++i) out += (i ? ", " : "") + Fixed(q_deg[i], digits);
   return out + ")";
-}
-
-viraal::ErrorMeasures Measures(const viraal::AlignmentError& error, const orbed::misalignment_t& misalignment) {
-  viraal::ErrorMeasures m;
-  m.translation_error_mm = error.centroid_translation_m * 1e3;
-  m.rotation_error_deg = error.rotation_rad * kRadToDeg;
-  m.base_translation_error_mm = error.base_translation_m * 1e3;
-  m.flange_translation_error_mm = error.flange_translation_m * 1e3;
-  m.misalignment_mm = misalignment.mean_error_norm_m * 1e3;
-  m.misalignment_axes_mm = ToVector3(misalignment.mean_error_W_m) * 1e3;
-  m.misalignment_mean_pair_distance_mm = misalignment.mean_pair_distance_m * 1e3;
-  return m;
 }
 
 }  // namespace
@@ -225,9 +214,9 @@ ConductorActions ViraalConductor::OnTrial(const orbed::alignment_trial_t& msg, c
                                     Fixed(off_deg, 3) +
                                     " deg from the commanded configuration; its errors use the trial's q");
   }
-  const viraal::RobotPoints points = points_->At(q);
+  const viraal::RobotPoints points = viraal::TrialPoints(*points_, msg);
   session_points_.push_back(points);
-  pending_error_ = viraal::EvaluateAlignment(FromPose(robot_state_->X_WR), FromPose(msg.X_WV), points);
+  pending_error_ = viraal::TrialError(robot_state_->X_WR, msg, points);
   misalignment_.reset();
   misalignment_request_id_ = SendMisalignment(pending_error_);
   Enter(Phase::kAwaitTrialResults);
@@ -393,8 +382,7 @@ void ViraalConductor::Step() {
                   "), expected " + std::to_string(options_.config.trials));
           return;
         }
-        pending_error_ = viraal::EvaluateOverConfigurations(FromPose(robot_state_->X_WR), FromPose(mean.X_WV_mean),
-                                                    session_points_);
+        pending_error_ = viraal::MeanError(robot_state_->X_WR, mean, session_points_);
         misalignment_.reset();
         misalignment_request_id_ = SendMisalignment(pending_error_);
         Enter(Phase::kAwaitMeanMisalignment);
@@ -487,31 +475,16 @@ void ViraalConductor::RequestTrial() {
 }
 
 int64_t ViraalConductor::SendMisalignment(const viraal::AlignmentError& error) {
-  orbed::misalignment_request_t request{};
-  request.utime = now_.utime;
-  request.request_id = now_.utime * 16 + (next_request_id_++ % 16);
-  request.session_id = results_.sessions.back().session_id;
-  request.num_pairs = static_cast<int32_t>(error.p_W_real.size());
-  for (size_t k = 0; k < error.p_W_real.size(); ++k) {
-    const Eigen::Vector3d& real = error.p_W_real[k];
-    const Eigen::Vector3d& virt = error.p_W_virtual[k];
-    request.p_W_real_m.push_back({real.x(), real.y(), real.z()});
-    request.p_W_virtual_m.push_back({virt.x(), virt.y(), virt.z()});
-  }
+  const orbed::misalignment_request_t request = viraal::MisalignmentRequest(
+      error, results_.sessions.back().session_id, now_.utime, now_.utime * 16 + (next_request_id_++ % 16));
   Publish(options_.misalignment_request_channel, request);
   return request.request_id;
 }
 
 void ViraalConductor::FinishTrial() {
   const orbed::alignment_trial_t& trial = *trial_;
-  viraal::TrialResult result;
-  result.index = trial.trial_index;
-  for (double q : trial.joint_position) result.q_deg.push_back(q * kRadToDeg);
-  result.errors = Measures(pending_error_, *misalignment_);
-  result.user_duration_s = trial.duration_s;
-  result.user_id = trial.user_id;
-  result.X_WV = FromPose(trial.X_WV);
-  result.X_WR = FromPose(robot_state_->X_WR);
+  const viraal::TrialResult result =
+      viraal::TrialResultFrom(trial, robot_state_->X_WR, viraal::Measures(pending_error_, *misalignment_));
   results_.sessions.back().trials.push_back(result);
   Say(StepLabel() + ": robot at q=" + JointList(result.q_deg, 1) + " deg (reached in " + Fixed(reach_s_, 1) +
       " s); aligned in " + Fixed(trial.duration_s, 1) + " s of user time: " +
@@ -529,16 +502,8 @@ void ViraalConductor::FinishTrial() {
 
 void ViraalConductor::FinishSession() {
   const orbed::registration_t& reg = *mean_registration_;
-  viraal::MeanResult mean;
-  mean.errors = Measures(pending_error_, *misalignment_);
-  mean.X_WV = FromPose(reg.X_WV_mean);
-  mean.num_used = reg.num_used;
-  mean.rejected_indices.assign(reg.rejected_indices.begin(), reg.rejected_indices.end());
-  mean.rotation_rms_deg = reg.rotation_rms_deg;
-  mean.translation_rms_mm = reg.translation_rms_m * 1e3;
-  mean.iterations = reg.iterations;
-  mean.converged = reg.converged;
-  mean.unique = reg.unique;
+  const viraal::MeanResult mean =
+      viraal::MeanResultFrom(reg, viraal::Measures(pending_error_, *misalignment_));
   viraal::SessionResult& session = results_.sessions.back();
   session.mean = mean;
   Say("[" + session.mode + "] mean of " + std::to_string(reg.num_used) + " trials (SE(3), " +

@@ -18,6 +18,7 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "tests/integration/testbed_util.h"
+#include "tests/same_tree.h"
 
 namespace orbed::testing {
 namespace {
@@ -33,37 +34,6 @@ void ExpectErrors(const YAML::Node& node, const std::string& where) {
   // An emulated person is not perfect, and not absurd: within a metre and 10 degrees.
   EXPECT_LT(node["translation_error_mm"].as<double>(), 1000.0) << where;
   EXPECT_LT(node["rotation_error_deg"].as<double>(), 10.0) << where;
-}
-
-// Walks `expected` and `actual` together: same keys, same sequence lengths, numbers within a
-// relative 1e-9 (the run's arithmetic, not the JSON printing, decides), other scalars equal.
-// Keys in `skip` (times of the run) are not compared.
-void ExpectSameTree(const YAML::Node& expected, const YAML::Node& actual, const std::string& where,
-                    const std::set<std::string>& skip) {
-  ASSERT_EQ(expected.Type(), actual.Type()) << where;
-  if (expected.IsMap()) {
-    size_t compared = 0;
-    for (const auto& item : actual) compared += skip.count(item.first.as<std::string>()) == 0;
-    EXPECT_EQ(compared, expected.size()) << where << ": a key was added or removed";
-    for (const auto& item : expected) {
-      const std::string key = item.first.as<std::string>();
-      if (skip.count(key)) continue;
-      ASSERT_TRUE(actual[key]) << where << "." << key << " missing";
-      ExpectSameTree(item.second, actual[key], where + "." + key, skip);
-    }
-  } else if (expected.IsSequence()) {
-    ASSERT_EQ(expected.size(), actual.size()) << where;
-    for (size_t i = 0; i < expected.size(); ++i) {
-      ExpectSameTree(expected[i], actual[i], where + "[" + std::to_string(i) + "]", skip);
-    }
-  } else if (expected.IsScalar()) {
-    double e = 0, a = 0;
-    if (YAML::convert<double>::decode(expected, e) && YAML::convert<double>::decode(actual, a)) {
-      EXPECT_NEAR(a, e, 1e-9 * std::max(1.0, std::abs(e))) << where;
-    } else {
-      EXPECT_EQ(expected.as<std::string>(), actual.as<std::string>()) << where;
-    }
-  }
 }
 
 TEST(ViraalRun, LaunchFileRunsTheStudyAndWritesResults) {

@@ -1,0 +1,161 @@
+#include "study/study_cli.h"
+
+#include <cerrno>
+#include <climits>
+#include <cstdlib>
+#include <exception>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "base/format.h"
+#include "base/source_paths.h"
+#include "base/stats.h"
+#include "study/viraal_study.h"
+#include "viraal/paper_reference.h"
+
+namespace orbed::study {
+namespace {
+
+constexpr int kMaxTrialsInTable = 10;
+
+// A positive decimal integer that fits an int, the whole text; else false.
+bool ParsePositiveInt(const std::string& text, int* value) {
+  if (text.empty() || text[0] < '0' || text[0] > '9') return false;
+  char* end = nullptr;
+  errno = 0;
+  const long v = std::strtol(text.c_str(), &end, 10);
+  if (errno != 0 || *end != '\0' || v < 1 || v > INT_MAX) return false;
+  *value = static_cast<int>(v);
+  return true;
+}
+
+// --trials' transform: refuses what ParsePositiveInt refuses and hands CLI11 the plain decimal form
+// (CLI11's own integer parser would read "010" as octal and "0x10" as hex).
+CLI::Validator PositiveDecimalInt() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        int value = 0;
+        if (!ParsePositiveInt(text, &value)) return "needs a positive integer, got '" + text + "'";
+        text = std::to_string(value);
+        return "";
+      },
+      "POSITIVE");
+}
+
+std::string MeanStdText(const std::vector<double>& x, int digits) {
+  return Fixed(stats::Mean(x), digits) + " +/- " + Fixed(stats::StdDev(x), digits);
+}
+
+const viraal::PaperFigure* PaperFor(const std::string& mode) {
+  if (mode == "ar_reflective") return &viraal::kPaperArReflective;
+  if (mode == "ar") return &viraal::kPaperAr;
+  return nullptr;
+}
+
+// Per mode: the trials' errors, the SE(3) mean's; then the comparison of the first two modes.
+std::string Summary(const viraal::RunResults& results) {
+  std::string text;
+  std::vector<std::vector<double>> misalignment;
+  for (const viraal::SessionResult& s : results.sessions) {
+    std::vector<double> mis, trans, rot;
+    for (const viraal::TrialResult& t : s.trials) {
+      mis.push_back(t.errors.misalignment_mm);
+      trans.push_back(t.errors.translation_error_mm);
+      rot.push_back(t.errors.rotation_error_deg);
+    }
+    misalignment.push_back(mis);
+    text += s.mode + " (" + std::to_string(s.trials.size()) + " trials)\n";
+    text += "  misalignment [mm]  " + MeanStdText(mis, 1);
+    if (const viraal::PaperFigure* paper = PaperFor(s.mode)) {
+      text += "   (paper: " + Fixed(paper->misalignment_mm, 1) + " +/- " + Fixed(paper->std_mm, 1) + ")";
+    }
+    text += "\n  translation [mm]   " + MeanStdText(trans, 1) + "\n";
+    text += "  rotation [deg]     " + MeanStdText(rot, 2) + "\n";
+    if (s.mean) {
+      text += "  SE(3) mean of all its trials: misalignment " + Fixed(s.mean->errors.misalignment_mm, 1) +
+              " mm, translation " + Fixed(s.mean->errors.translation_error_mm, 1) + " mm\n";
+    }
+  }
+  if (misalignment.size() >= 2) {
+    const stats::MannWhitneyResult mw = stats::MannWhitneyU(misalignment[0], misalignment[1]);
+    const std::string a = results.sessions[0].mode, b = results.sessions[1].mode;
+    text += "Mann-Whitney U, trial misalignment, one-sided (" + a + " < " + b + "): ";
+    text += mw.valid
+                ? "U = " + Fixed(mw.u_x, 1) + ", z = " + Fixed(mw.z, 2) + ", p = " + Fixed(mw.p_x_less, 4)
+                : std::string("not defined for these samples");
+    text += "\n";
+  }
+  text += "paper, SE(3) mean of N = 3 trials with the display: " +
+          Fixed(viraal::kPaperArReflectiveMean.misalignment_mm, 1) + " +/- " +
+          Fixed(viraal::kPaperArReflectiveMean.std_mm, 2) + " mm\n";
+  return text;
+}
+
+}  // namespace
+
+int RunUserStudy(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
+  CLI::App app{
+      "orbed-user-study: the ViRAAl experiment of `scripts/orbed run` without the bus: the same\n"
+      "headset trials, registration and errors, for as many trials as wanted. Prints the table\n"
+      "(or, past 10 trials per mode, a summary and a rank test) beside the paper's Table 1."};
+  StudyOptions o;
+  std::string scenario_path = SourceTreePath(viraal::kDefaultScenarioRelativePath);
+  int trials = 0;
+  std::string modes, json_path;
+  bool quiet = false;
+  app.add_option("--trials", trials, "Trials per display mode (default: the scenario file's)")
+      ->transform(PositiveDecimalInt());
+  app.add_option("--modes", modes, "Comma-separated run order of ar_reflective, ar (default: the file's)");
+  app.add_option("--seed", o.seed, "orbed-hmd's --seed: every trial's seeds derive from it")
+      ->capture_default_str();
+  app.add_option("--run-id", o.run_id,
+                 "Run id; sessions are <run-id>-<mode> (the trials' seeds depend on it)")
+      ->capture_default_str();
+  app.add_option("--scenario", scenario_path, "Scenario YAML")->capture_default_str();
+  app.add_option("--config", o.headset_config_paths,
+                 "Headset config applied after the shipped ones, as orbed-hmd --config (repeatable)")
+      ->allow_extra_args(false);
+  app.add_option("--urdf", o.urdf_path, "Robot URDF (default: sim/models/iiwa7.urdf)");
+  app.add_option("--scene", o.scene_path, "Scene YAML (default: sim/models/scenes/trocar_or.yaml)");
+  app.add_option("--json", json_path, "Write the results.json the conductor would write to this file");
+  app.add_flag("--quiet", quiet, "No progress lines on stderr");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e, out, err);
+    return code == 0 ? 0 : 2;  // this tool's bad-argument code, not CLI11's
+  }
+  try {
+    o.scenario = viraal::LoadScenarioFile(scenario_path);
+    viraal::ApplyOverrides(&o.scenario, trials, modes, {});
+    if (!quiet) {
+      int last_tenth = -1;
+      o.progress = [&err, &last_tenth](int done, int total) {
+        const int tenth = 10 * done / total;
+        if (tenth == last_tenth) return;
+        last_tenth = tenth;
+        err << "orbed-user-study: " << done << "/" << total << " trials\n";
+      };
+    }
+    const viraal::RunResults results = RunViraalStudy(o);
+    if (results.sessions.empty() || results.sessions.front().trials.size() <= kMaxTrialsInTable) {
+      out << viraal::ResultsTable(results);
+    } else {
+      out << Summary(results);
+    }
+    if (!json_path.empty()) {
+      std::ofstream file(json_path);
+      file << viraal::ResultsJson(results);
+      if (!file) throw std::runtime_error("cannot write " + json_path);
+    }
+  } catch (const std::exception& e) {
+    err << "orbed-user-study: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace orbed::study

@@ -1,0 +1,77 @@
+#include "viraal/exchange.h"
+
+#include "base/units.h"
+#include "procs/common/conversions.h"
+
+namespace orbed::viraal {
+
+RobotPoints TrialPoints(const RobotPointSet& points, const orbed::alignment_trial_t& trial) {
+  return points.At(ToVectorX(trial.joint_position));
+}
+
+AlignmentError TrialError(const orbed::pose_t& X_WR, const orbed::alignment_trial_t& trial,
+                          const RobotPoints& points) {
+  return EvaluateAlignment(FromPose(X_WR), FromPose(trial.X_WV), points);
+}
+
+AlignmentError MeanError(const orbed::pose_t& X_WR, const orbed::registration_t& mean,
+                         const std::vector<RobotPoints>& session_points) {
+  return EvaluateOverConfigurations(FromPose(X_WR), FromPose(mean.X_WV_mean), session_points);
+}
+
+orbed::misalignment_request_t MisalignmentRequest(const AlignmentError& error, const std::string& session_id,
+                                                  int64_t utime, int64_t request_id) {
+  orbed::misalignment_request_t request{};
+  request.utime = utime;
+  request.request_id = request_id;
+  request.session_id = session_id;
+  request.num_pairs = static_cast<int32_t>(error.p_W_real.size());
+  for (size_t k = 0; k < error.p_W_real.size(); ++k) {
+    const Eigen::Vector3d& real = error.p_W_real[k];
+    const Eigen::Vector3d& virt = error.p_W_virtual[k];
+    request.p_W_real_m.push_back({real.x(), real.y(), real.z()});
+    request.p_W_virtual_m.push_back({virt.x(), virt.y(), virt.z()});
+  }
+  return request;
+}
+
+ErrorMeasures Measures(const AlignmentError& error, const orbed::misalignment_t& misalignment) {
+  ErrorMeasures m;
+  m.translation_error_mm = error.centroid_translation_m * 1e3;
+  m.rotation_error_deg = error.rotation_rad * kRadToDeg;
+  m.base_translation_error_mm = error.base_translation_m * 1e3;
+  m.flange_translation_error_mm = error.flange_translation_m * 1e3;
+  m.misalignment_mm = misalignment.mean_error_norm_m * 1e3;
+  m.misalignment_axes_mm = ToVector3(misalignment.mean_error_W_m) * 1e3;
+  m.misalignment_mean_pair_distance_mm = misalignment.mean_pair_distance_m * 1e3;
+  return m;
+}
+
+TrialResult TrialResultFrom(const orbed::alignment_trial_t& trial, const orbed::pose_t& X_WR,
+                            const ErrorMeasures& errors) {
+  TrialResult result;
+  result.index = trial.trial_index;
+  for (double q : trial.joint_position) result.q_deg.push_back(q * kRadToDeg);
+  result.errors = errors;
+  result.user_duration_s = trial.duration_s;
+  result.user_id = trial.user_id;
+  result.X_WV = FromPose(trial.X_WV);
+  result.X_WR = FromPose(X_WR);
+  return result;
+}
+
+MeanResult MeanResultFrom(const orbed::registration_t& reg, const ErrorMeasures& errors) {
+  MeanResult mean;
+  mean.errors = errors;
+  mean.X_WV = FromPose(reg.X_WV_mean);
+  mean.num_used = reg.num_used;
+  mean.rejected_indices.assign(reg.rejected_indices.begin(), reg.rejected_indices.end());
+  mean.rotation_rms_deg = reg.rotation_rms_deg;
+  mean.translation_rms_mm = reg.translation_rms_m * 1e3;
+  mean.iterations = reg.iterations;
+  mean.converged = reg.converged;
+  mean.unique = reg.unique;
+  return mean;
+}
+
+}  // namespace orbed::viraal

@@ -1,0 +1,56 @@
+#pragma once
+/// @file
+/// The ViRAAl protocol's messages turned into its results, one definition for every program that
+/// scores a run: the conductor (orbed-scenario, from the bus) and the offline study (orbed-user-study,
+/// from the same messages built in-process). Given the same messages, both get the same numbers.
+///
+///   trial:  ALIGNMENT_TRIAL (q, X_WV) and the truth X_WR (ROBOT_STATE) → TrialError → the landmark
+///           pairs as a MISALIGNMENT_REQUEST → orbed-registration's MISALIGNMENT → TrialResultFrom;
+///   mean:   REGISTRATION (reason COMPUTE, X_WV_mean) → MeanError over the session's configurations →
+///           MISALIGNMENT_REQUEST → MISALIGNMENT → MeanResultFrom.
+///
+/// Frames and units as in metrics.h: W world, R real base, V virtual base; messages in SI, results in
+/// mm and deg as results.h names them.
+/// Threading: pure functions.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <orbed/alignment_trial_t.hpp>
+#include <orbed/misalignment_request_t.hpp>
+#include <orbed/misalignment_t.hpp>
+#include <orbed/pose_t.hpp>
+#include <orbed/registration_t.hpp>
+
+#include "viraal/metrics.h"
+#include "viraal/results.h"
+
+namespace orbed::viraal {
+
+/// The robot points at the trial's own q (its joint_position [rad]).
+RobotPoints TrialPoints(const RobotPointSet& points, const orbed::alignment_trial_t& trial);
+
+/// The errors of a trial's X_WV at its points against the truth X_WR (as the messages carry them).
+AlignmentError TrialError(const orbed::pose_t& X_WR, const orbed::alignment_trial_t& trial,
+                          const RobotPoints& points);
+
+/// The errors of a session mean (REGISTRATION.X_WV_mean) over the session's trial points.
+AlignmentError MeanError(const orbed::pose_t& X_WR, const orbed::registration_t& mean,
+                         const std::vector<RobotPoints>& session_points);
+
+/// The landmark pairs of `error` as a request to orbed-registration.
+orbed::misalignment_request_t MisalignmentRequest(const AlignmentError& error, const std::string& session_id,
+                                                  int64_t utime, int64_t request_id);
+
+/// The measures of one pose: point errors from `error`, the paper's misalignment from `misalignment`.
+ErrorMeasures Measures(const AlignmentError& error, const orbed::misalignment_t& misalignment);
+
+/// One row of results.json for a trial.
+TrialResult TrialResultFrom(const orbed::alignment_trial_t& trial, const orbed::pose_t& X_WR,
+                            const ErrorMeasures& errors);
+
+/// The "mean" of a session in results.json.
+MeanResult MeanResultFrom(const orbed::registration_t& mean, const ErrorMeasures& errors);
+
+}  // namespace orbed::viraal
