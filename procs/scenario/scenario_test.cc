@@ -21,10 +21,10 @@
 #include <orbed/session_control_t.hpp>
 
 #include "procs/common/conversions.h"
-#include "viraal/protocol.h"
-#include "viraal/metrics.h"
-#include "viraal/results.h"
 #include "procs/scenario/viraal_scenario.h"
+#include "viraal/metrics.h"
+#include "viraal/protocol.h"
+#include "viraal/results.h"
 
 namespace orbed::scenario {
 namespace {
@@ -41,199 +41,10 @@ Eigen::Isometry3d SceneBase() {
 
 std::string Source(const std::string& relative) { return ScenarioSourcePath(relative); }
 
-TEST(ViraalErrors, RotationAngleIsTheGeodesicAngle) {
-  const Eigen::Matrix3d R = Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
-  const Eigen::Matrix3d dR = Eigen::AngleAxisd(1 * kDeg, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  EXPECT_NEAR(viraal::RotationAngle(R, R * dR), 1 * kDeg, 1e-14);
-  EXPECT_NEAR(viraal::RotationAngle(R, dR * R), 1 * kDeg, 1e-14);
-  EXPECT_NEAR(viraal::RotationAngle(R, R), 0.0, 1e-15);
-  // Near π the quaternion form keeps its precision.
-  const Eigen::Matrix3d flip = Eigen::AngleAxisd(M_PI - 1e-7, Eigen::Vector3d::UnitX()).toRotationMatrix();
-  EXPECT_NEAR(viraal::RotationAngle(Eigen::Matrix3d::Identity(), flip), M_PI - 1e-7, 1e-12);
-}
-
-// X_WV = X_WR shifted 10 mm along the base's x and turned 1 deg about its z: X_RV = [Rz(1°), (0.01,0,0)].
-TEST(ViraalErrors, TenMillimetresAndOneDegreeInTheBaseFrame) {
-  const Eigen::Isometry3d X_WR = SceneBase();
-  Eigen::Isometry3d X_RV = Eigen::Isometry3d::Identity();
-  X_RV.linear() = Eigen::AngleAxisd(1 * kDeg, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  X_RV.translation() = Eigen::Vector3d(0.01, 0, 0);
-  const Eigen::Isometry3d X_WV = X_WR * X_RV;
-  viraal::RobotPoints points;
-  points.p_RC = Eigen::Vector3d(1, 0, 0);  // 1 m along the base x
-  points.p_RF = Eigen::Vector3d(0, 0, 2);  // on the rotation axis: only the shift remains
-  points.p_RL = {Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0, 0, 1)};
-  const viraal::AlignmentError e = viraal::EvaluateAlignment(X_WR, X_WV, points);
-  EXPECT_NEAR(e.rotation_rad, 1 * kDeg, 1e-14);
-  EXPECT_NEAR(e.base_translation_m, 0.010, 1e-15);
-  // |(cos 1° − 1 + 0.01, sin 1°, 0)| = 0.020039051632882905 m (hand/calculator).
-  EXPECT_NEAR(e.centroid_translation_m, 0.020039051632882905, 1e-14);
-  EXPECT_NEAR(e.flange_translation_m, 0.010, 1e-14);
-  ASSERT_EQ(e.p_W_real.size(), 2u);
-  ASSERT_EQ(e.p_W_virtual.size(), 2u);
-  // Real landmark 0: base x = W +y (yaw 90°) → p_WR + (0, 1, 0).
-  EXPECT_NEAR((e.p_W_real[0] - Eigen::Vector3d(0.25, 0.45, 0.75)).norm(), 0.0, 1e-14);
-  // Virtual landmark 0 in R: (cos 1° + 0.01, sin 1°, 0) → in W: (−sin 1°, cos 1° + 0.01, 0) + p_WR.
-  const Eigen::Vector3d expected(0.25 - std::sin(1 * kDeg), -0.55 + std::cos(1 * kDeg) + 0.01, 0.75);
-  EXPECT_NEAR((e.p_W_virtual[0] - expected).norm(), 0.0, 1e-14);
-}
-
-// X_WV = X_WR shifted 10 mm along W x and turned 1 deg about W z at its own origin.
-TEST(ViraalErrors, TenMillimetresAndOneDegreeInTheWorldFrame) {
-  const Eigen::Isometry3d X_WR = SceneBase();
-  Eigen::Isometry3d X_WV = X_WR;
-  X_WV.linear() = Eigen::AngleAxisd(1 * kDeg, Eigen::Vector3d::UnitZ()).toRotationMatrix() * X_WR.linear();
-  X_WV.translation() += Eigen::Vector3d(0.01, 0, 0);
-  viraal::RobotPoints points;
-  points.p_RC = Eigen::Vector3d(0, 0, 0.634);  // on the (vertical) base z axis: only the shift
-  points.p_RF = Eigen::Vector3d(0.5, 0, 0);    // 0.5 m out along base x = W y
-  const viraal::AlignmentError e = viraal::EvaluateAlignment(X_WR, X_WV, points);
-  EXPECT_NEAR(e.rotation_rad, 1 * kDeg, 1e-14);
-  EXPECT_NEAR(e.base_translation_m, 0.010, 1e-15);
-  EXPECT_NEAR(e.centroid_translation_m, 0.010, 1e-14);
-  // W offset of the flange: (0.01 − 0.5 sin 1°, 0.5 (cos 1° − 1), 0).
-  EXPECT_NEAR(e.flange_translation_m,
-              std::hypot(0.01 - 0.5 * std::sin(1 * kDeg), 0.5 * (std::cos(1 * kDeg) - 1)), 1e-14);
-}
-
-TEST(ViraalErrors, MeanOverConfigurationsAveragesPointErrorsAndPoolsLandmarks) {
-  const Eigen::Isometry3d X_WR = Eigen::Isometry3d::Identity();
-  Eigen::Isometry3d X_WV = Eigen::Isometry3d::Identity();
-  X_WV.linear() = Eigen::AngleAxisd(90 * kDeg, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  viraal::RobotPoints a, b;
-  a.p_RC = Eigen::Vector3d(1, 0, 0);  // moves to (0, 1, 0): sqrt(2)
-  b.p_RC = Eigen::Vector3d(0, 0, 1);  // on the axis: 0
-  a.p_RL = {Eigen::Vector3d(1, 0, 0)};
-  b.p_RL = {Eigen::Vector3d(2, 0, 0), Eigen::Vector3d(0, 0, 3)};
-  const viraal::AlignmentError e = viraal::EvaluateOverConfigurations(X_WR, X_WV, {a, b});
-  EXPECT_NEAR(e.centroid_translation_m, std::sqrt(2.0) / 2, 1e-15);
-  EXPECT_EQ(e.p_W_real.size(), 3u);
-  EXPECT_THROW(viraal::EvaluateOverConfigurations(X_WR, X_WV, {}), std::invalid_argument);
-}
-
-TEST(ViraalErrors, RobotPointsOfTheIiwaUpright) {
-  const auto model = orbed::sim::RobotModel::LoadFile(Source("sim/models/iiwa7.urdf"));
-  const viraal::RobotPointSet set(model, {"iiwa_link_4", "iiwa_link_6", "iiwa_link_ee"});
-  const viraal::RobotPoints p = set.At(Eigen::VectorXd::Zero(7));
-  // DH d = (0.34, 0, 0.4, 0, 0.4, 0, 0.126): origins of link 0..7 and the flange at z = 0, 0,
-  // 0.34, 0.34, 0.74, 0.74, 1.14, 1.14, 1.266 → centroid z = 5.706 / 9 = 0.634.
-  EXPECT_NEAR((p.p_RC - Eigen::Vector3d(0, 0, 0.634)).norm(), 0.0, 1e-12);
-  EXPECT_NEAR((p.p_RF - Eigen::Vector3d(0, 0, 1.266)).norm(), 0.0, 1e-12);
-  ASSERT_EQ(p.p_RL.size(), 3u);
-  EXPECT_NEAR(p.p_RL[0].z(), 0.74, 1e-12);
-  EXPECT_NEAR(p.p_RL[1].z(), 1.14, 1e-12);
-  EXPECT_NEAR(p.p_RL[2].z(), 1.266, 1e-12);
-  EXPECT_THROW(viraal::RobotPointSet(model, {"iiwa_link_9"}), std::invalid_argument);
-}
-
-TEST(viraal::ScenarioConfig, TheShippedFileLoads) {
-  const viraal::ScenarioConfig c = viraal::LoadScenarioFile(Source(viraal::kDefaultScenarioRelativePath));
-  EXPECT_EQ(c.trials, 3);
-  ASSERT_EQ(c.modes.size(), 2u);
-  EXPECT_EQ(c.modes[0].name, "ar_reflective");
-  EXPECT_EQ(c.modes[0].display_mode, +orbed::alignment_trial_t::MODE_AR_REFLECTIVE);
-  EXPECT_EQ(c.modes[0].num_mirrors, 1);
-  EXPECT_EQ(c.modes[1].name, "ar");
-  EXPECT_EQ(c.modes[1].num_mirrors, 0);
-  EXPECT_EQ(c.method, +orbed::registration_t::METHOD_KARCHER);
-  EXPECT_EQ(c.configurations_deg.size(), 3u);
-  EXPECT_EQ(c.landmarks.size(), 3u);
-}
-
-void ExpectError(const std::string& yaml, const std::string& pattern) {
-  try {
-    viraal::LoadScenarioString(yaml, "s.yaml");
-    ADD_FAILURE() << "no error for:\n" << yaml;
-  } catch (const std::runtime_error& e) {
-    EXPECT_TRUE(std::regex_search(std::string(e.what()), std::regex(pattern))) << e.what();
-  }
-}
-
-TEST(viraal::ScenarioConfig, CommandLineOverrides) {
-  viraal::ScenarioConfig config = viraal::LoadScenarioFile(Source(viraal::kDefaultScenarioRelativePath));
-  viraal::ApplyOverrides(&config, 2, "ar,ar_reflective", {"0,10,0,-20,0,30,0", "5,10,0,-20,0,30,0"});
-  EXPECT_EQ(config.trials, 2);
-  ASSERT_EQ(config.modes.size(), 2u);
-  EXPECT_EQ(config.modes[0].num_mirrors, 0);
-  EXPECT_EQ(config.modes[1].num_mirrors, 1);
-  ASSERT_EQ(config.configurations_deg.size(), 2u);
-  EXPECT_EQ(config.configurations_deg[1][0], 5.0);
-  EXPECT_EQ(config.configurations_deg[1][6], 0.0);
-  viraal::ScenarioConfig untouched = viraal::LoadScenarioFile(Source(viraal::kDefaultScenarioRelativePath));
-  const int trials = untouched.trials;
-  viraal::ApplyOverrides(&untouched, 0, "", {});
-  EXPECT_EQ(untouched.trials, trials);
-  EXPECT_THROW(viraal::ApplyOverrides(&untouched, 0, "ar,mirror", {}), std::invalid_argument);
-  EXPECT_THROW(viraal::ApplyOverrides(&untouched, 0, "", {"1,x,3"}), std::invalid_argument);
-  viraal::ApplyOverrides(&untouched, 0, "", {"1,2,3"});  // parses; the size is checked with the rest:
-  EXPECT_THROW(viraal::ValidateScenarioConfig(untouched, 7), std::invalid_argument);
-}
-
-TEST(viraal::ScenarioConfig, ErrorsNameTheLineAndTheFix) {
-  const std::string good = "configurations_deg:\n  - [0, 30, 0, -60, 0, 45, 0]\nlandmarks: [iiwa_link_ee]\n";
-  EXPECT_NO_THROW(viraal::LoadScenarioString(good, "s.yaml"));
-  ExpectError("trails: 3\n" + good, "s.yaml:1: trails: unknown key");
-  ExpectError(good + "modes: [ar, vr]\n",
-              "s.yaml:4: modes\\[1\\]: unknown mode 'vr', expected ar_reflective or ar");
-  ExpectError(good + "trials: 0\n", "s.yaml:4: trials: expected a whole number >= 1");
-  ExpectError(good + "method: mean\n", "s.yaml:4: method: expected chordal, karcher or robust");
-  ExpectError("configurations_deg:\n  - [0, 30, 0, x, 0, 45, 0]\nlandmarks: [a]\n",
-              "s.yaml:2: configurations_deg\\[0\\]\\[3\\]: expected a number");
-  ExpectError(
-      "configurations_deg:\n  - [0, 30, 0, -60, 0, 45, 0]\n  - [0, 30, 0, -60, 0, 45, 0.5]\nlandmarks: [a]\n",
-      "configurations 0 and 1 are the same");
-  ExpectError("landmarks: [a]\n", "s.yaml:1: configurations_deg: missing");
-  EXPECT_THROW(viraal::ParseJointList("1,2,x", "--q-deg"), std::invalid_argument);
-  EXPECT_EQ(viraal::ParseJointList("1, 2.5,-3", "--q-deg"), (std::vector<double>{1, 2.5, -3}));
-}
-
-TEST(ViraalResults, MeanStdWithTheSampleDenominator) {
-  const viraal::MeanStd s = viraal::ComputeMeanStd({1, 2, 3});
-  EXPECT_DOUBLE_EQ(s.mean, 2.0);
-  EXPECT_DOUBLE_EQ(s.std, 1.0);
-  EXPECT_DOUBLE_EQ(viraal::ComputeMeanStd({5}).std, 0.0);
-}
-
 int Count(const std::string& text, const std::string& pattern) {
   const std::regex re(pattern);
   return static_cast<int>(
       std::distance(std::sregex_iterator(text.begin(), text.end(), re), std::sregex_iterator()));
-}
-
-TEST(ViraalResults, JsonHasTheDocumentedShape) {
-  viraal::RunResults r;
-  r.run_id = "t";
-  r.ok = true;
-  for (const char* mode : {"ar_reflective", "ar"}) {
-    viraal::SessionResult s;
-    s.mode = mode;
-    for (int i = 0; i < 3; ++i) {
-      viraal::TrialResult t;
-      t.index = i;
-      t.q_deg = {0, 30, 0, -60, 0, 45, 0};
-      t.errors.translation_error_mm = 10 + i;
-      s.trials.push_back(t);
-    }
-    s.mean = viraal::MeanResult{};
-    r.sessions.push_back(s);
-  }
-  const std::string json = viraal::ResultsJson(r);
-  EXPECT_EQ(Count(json, "\"mode\": \"ar_reflective\""), 1);
-  EXPECT_EQ(Count(json, "\"mode\": \"ar\""), 1);
-  EXPECT_EQ(Count(json, "\"index\": [0-2]"), 6);
-  EXPECT_EQ(Count(json, "\"q_deg\": \\["), 6);
-  EXPECT_EQ(Count(json, "\"mean\": \\{"), 2);
-  // Per trial and per mean, the three required measures.
-  EXPECT_EQ(Count(json, "\"translation_error_mm\": "), 6 + 2 + 2);  // + trial_statistics
-  EXPECT_EQ(Count(json, "\"rotation_error_deg\": "), 6 + 2 + 2);
-  EXPECT_EQ(Count(json, "\"misalignment_mm\": "), 6 + 2 + 2 + 3);  // + paper_reference
-  EXPECT_NE(json.find("\"status\": \"ok\""), std::string::npos);
-  // translation_error_mm 10, 11, 12: mean 11, std 1.
-  EXPECT_NE(json.find("\"translation_error_mm\": {\n          \"mean\": 11,\n          \"std\": 1"),
-            std::string::npos)
-      << json;
-  const std::string table = viraal::ResultsTable(r);
-  EXPECT_NE(table.find("paper: 16.5 +/- 11.0 mm"), std::string::npos) << table;
 }
 
 // ----------------------------------------------------------------------------------------------
@@ -475,7 +286,8 @@ TEST(ViraalScenario, AFullRunOnMemqGivesTheUsersKnownRotatedOffset) {
     mean.flange_mm += e.flange_mm / 3;
     mean.t_bar_mm += e.t_bar_mm / 3;  // 9 pairs: the mean of the three means of 3
   }
-  auto expect_measures = [&](const viraal::ErrorMeasures& got, const Expected& want, const std::string& what) {
+  auto expect_measures = [&](const viraal::ErrorMeasures& got, const Expected& want,
+                             const std::string& what) {
     SCOPED_TRACE(what);
     EXPECT_NEAR(got.rotation_error_deg, 5.0, 1e-9);
     EXPECT_NEAR(got.base_translation_error_mm, std::sqrt(61.0), 1e-9);  // ‖(4, −6, 3)‖ mm

@@ -12,7 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "procs/common/conversions.h"
-#include "sim/model_paths.h"
+#include "base/source_paths.h"
 
 namespace orbed::scenario {
 namespace {
@@ -87,11 +87,11 @@ class Bench {
  public:
   explicit Bench(ConductorOptions options = Options())
       : conductor_(options, orbed::sim::RobotModel::LoadFile(
-                                sim::SourceTreePath(orbed::sim::RobotModel::kDefaultUrdfRelativePath))) {}
+                                orbed::SourceTreePath(orbed::sim::RobotModel::kDefaultUrdfRelativePath))) {}
 
   static ConductorOptions Options() {
     ConductorOptions options;
-    options.config = viraal::LoadScenarioFile(sim::SourceTreePath(viraal::kDefaultScenarioRelativePath));
+    options.config = viraal::LoadScenarioFile(orbed::SourceTreePath(viraal::kDefaultScenarioRelativePath));
     options.run_id = "emu";
     return options;
   }

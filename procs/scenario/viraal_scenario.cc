@@ -11,7 +11,7 @@
 
 #include "procs/common/conversions.h"
 #include "procs/common/log.h"
-#include "sim/model_paths.h"
+#include "base/source_paths.h"
 
 namespace orbed::scenario {
 namespace {
@@ -44,7 +44,7 @@ ScenarioOptions Resolved(ScenarioOptions options, uint64_t seed) {
 
 }  // namespace
 
-std::string ScenarioSourcePath(const std::string& relative) { return sim::SourceTreePath(relative); }
+std::string ScenarioSourcePath(const std::string& relative) { return orbed::SourceTreePath(relative); }
 
 ViraalScenario::ViraalScenario(const orbed::CommonFlags& flags, const ScenarioOptions& options)
     : options_(Resolved(options, flags.seed)), clock_origin_(std::chrono::steady_clock::now()) {
