@@ -131,8 +131,8 @@ int RunUserStudy(int argc, const char* const* argv, std::ostream& out, std::ostr
   try {
     o.scenario = viraal::LoadScenarioFile(scenario_path);
     viraal::ApplyOverrides(&o.scenario, trials, modes, {});
+    int last_tenth = -1;  // outlives the study, which calls the callback
     if (!quiet) {
-      int last_tenth = -1;
       o.progress = [&err, &last_tenth](int done, int total) {
         const int tenth = 10 * done / total;
         if (tenth == last_tenth) return;

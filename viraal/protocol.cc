@@ -132,6 +132,12 @@ ScenarioConfig LoadScenario(const YAML::Node& root, const std::string& source) {
     config.configurations_deg.push_back(values);
   }
   config.landmarks = f.Strings(f.Required(root, "landmarks", "landmarks"), "landmarks");
+  try {
+    // The iiwa has 7 joints; the conductor repeats this check against the URDF.
+    ValidateScenarioConfig(config, static_cast<int>(config.configurations_deg[0].size()));
+  } catch (const std::invalid_argument& e) {
+    f.Fail(root, "configurations_deg", e.what());
+  }
   return config;
 }
 
