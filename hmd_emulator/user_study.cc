@@ -21,7 +21,7 @@ std::vector<double> TripleMeanErrors(const std::vector<TrialOutcome>& trials, co
       p.push_back(trials[k].alignment.X_WV.translation());
     }
     // Base origin averaging (eq. 3); rotation errors are ~0.1 deg, so the centroid matters little.
-    const registration::Se3MeanResult r = registration::ComputeSe3Mean(q, p, registration::Se3MeanOptions{});
+    const geometry::Se3MeanResult r = geometry::ComputeSe3Mean(q, p, geometry::Se3MeanOptions{});
     if (r.valid) errors.push_back((r.p_WV_mean - p_WR).norm());
   }
   return errors;
