@@ -95,16 +95,10 @@ ScenarioConfig LoadScenario(const YAML::Node& root, const std::string& source) {
   config.trials = static_cast<int>(f.IntegerOr(root, "trials", "", config.trials, 1, 1000000));
   const int mirrors = static_cast<int>(f.IntegerOr(root, "reflective_mirrors", "", 1, 1, 1000000));
   if (root["method"]) {
-    const std::string m = f.String(root["method"], "method");
-    if (m == "chordal") {
-      config.method = orbed::registration_t::METHOD_CHORDAL;
-    } else if (m == "karcher") {
-      config.method = orbed::registration_t::METHOD_KARCHER;
-    } else if (m == "robust") {
-      config.method = orbed::registration_t::METHOD_ROBUST;
-    } else {
-      f.Fail(root["method"], "method", "expected chordal, karcher or robust, got '" + m + "'");
-    }
+    const std::string m = f.OneOf(root["method"], "method", {"chordal", "karcher", "robust"});
+    config.method = m == "chordal"   ? orbed::registration_t::METHOD_CHORDAL
+                    : m == "karcher" ? orbed::registration_t::METHOD_KARCHER
+                                     : orbed::registration_t::METHOD_ROBUST;
   }
   const YAML::Node modes = root["modes"];
   const std::vector<std::string> mode_names =
