@@ -1,5 +1,7 @@
-// base/: formatting, units, SHA-256 (FIPS 180-4 vectors), number lists, the JSON writer.
+// base/: formatting, units, SHA-256 (FIPS 180-4 vectors), number lists, the JSON writer, the
+// checked YAML reader.
 #include <cmath>
+#include <fstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -11,6 +13,7 @@
 #include "base/number_list.h"
 #include "base/sha256.h"
 #include "base/units.h"
+#include "base/yaml_fields.h"
 
 namespace orbed {
 namespace {
@@ -27,7 +30,6 @@ TEST(Units, DegreesAndRadians) {
   EXPECT_DOUBLE_EQ(std::acos(-1.0) / 2 * kRadToDeg, 90.0);
   EXPECT_DOUBLE_EQ(kDegToRad * kRadToDeg, 1.0);
 }
-
 
 // FIPS 180-4 example vectors.
 TEST(Sha256, KnownVectors) {
@@ -62,6 +64,104 @@ TEST(Json, WritesEscapedCompactJson) {
   json.Key("empty").BeginArray().EndArray();
   json.EndObject();
   EXPECT_EQ(json.str(), R"({"name":"a\"b\n","v":[0.1,2,null],"ok":true,"n":-3,"empty":[]})");
+}
+
+// The message of what `read` throws, or "(no error)".
+template <class F>
+std::string ErrorOf(F read) {
+  try {
+    read();
+  } catch (const std::runtime_error& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+TEST(YamlFields, RequiredNamesWhatWasExpected) {
+  const YamlFields f("t.yaml");
+  const YAML::Node root = YamlFields::LoadString("a: 1\nb:\n", "t.yaml");
+  EXPECT_EQ(f.Required(root, "a", "a").as<int>(), 1);
+  EXPECT_EQ(ErrorOf([&] { f.Required(root, "b", "x.b"); }), "t.yaml:1: x.b: missing (required)");
+  EXPECT_EQ(ErrorOf([&] { f.Required(root, "c", "x.c", "a length > 0 [m]"); }),
+            "t.yaml:1: x.c: missing; expected a length > 0 [m]");
+}
+
+TEST(YamlFields, PositiveIsAnOpenLowerBound) {
+  const YamlFields f("t.yaml");
+  const YAML::Node root = YamlFields::LoadString("a: 0.25\nzero: 0\nneg: -1\nword: x\nnan: .nan\n", "t.yaml");
+  EXPECT_EQ(f.Positive(root["a"], "a", "m"), 0.25);
+  EXPECT_EQ(f.PositiveOr(root, "missing", "p", 3.0, "s"), 3.0);
+  EXPECT_EQ(f.PositiveOr(root, "a", "p", 3.0, "s"), 0.25);
+  EXPECT_EQ(ErrorOf([&] { f.Positive(root["zero"], "zero", "m"); }),
+            "t.yaml:2: zero: expected a number > 0 [m], got '0'");
+  EXPECT_EQ(ErrorOf([&] { f.PositiveOr(root, "neg", "p", 1.0); }),
+            "t.yaml:3: p.neg: expected a number > 0, got '-1'");
+  EXPECT_EQ(ErrorOf([&] { f.Positive(root["word"], "word"); }),
+            "t.yaml:4: word: expected a number > 0, got 'x'");
+  EXPECT_EQ(ErrorOf([&] { f.Positive(root["nan"], "nan"); }),
+            "t.yaml:5: nan: expected a number > 0, got '.nan'");
+}
+
+TEST(YamlFields, Vectors) {
+  const YamlFields f("t.yaml");
+  const YAML::Node root = YamlFields::LoadString("v: [1, -2, 3]\nshort: [1, 2]\n", "t.yaml");
+  EXPECT_TRUE(f.Vector3(root["v"], "v", "m").isApprox(Eigen::Vector3d(1, -2, 3)));
+  EXPECT_EQ(ErrorOf([&] { f.Vector3(root["short"], "short", ""); }),
+            "t.yaml:2: short: expected a list of 3 numbers");
+  EXPECT_EQ(ErrorOf([&] { f.PositiveVector3(root["short"], "short", "m"); }),
+            "t.yaml:2: short: expected a list of 3 numbers > 0 [m]");
+  EXPECT_EQ(ErrorOf([&] { f.PositiveVector3(root["v"], "v", "m"); }),
+            "t.yaml:1: v[1]: expected a number > 0 [m], got '-2'");
+}
+
+TEST(YamlFields, BoolsTextAndEnumerations) {
+  const YamlFields f("t.yaml");
+  const YAML::Node root = YamlFields::LoadString(
+      "yes_: true\nno_: off\nbad: maybe\nlist: [1]\nshape: cone\nname: bed\n", "t.yaml");
+  EXPECT_TRUE(f.Bool(root["yes_"], "yes_"));
+  EXPECT_FALSE(f.BoolOr(root, "no_", "", true));
+  EXPECT_TRUE(f.BoolOr(root, "absent", "", true));
+  EXPECT_EQ(ErrorOf([&] { f.BoolOr(root, "bad", "p", false); }),
+            "t.yaml:3: p.bad: expected true or false, got 'maybe'");
+  EXPECT_EQ(ErrorOf([&] { f.Bool(root["list"], "list"); }), "t.yaml:4: list: expected true or false");
+  EXPECT_EQ(f.StringOr(root, "name", "", "orbed"), "bed");
+  EXPECT_EQ(f.StringOr(root, "absent", "", "orbed"), "orbed");
+  EXPECT_EQ(ErrorOf([&] { f.StringOr(root, "list", "p", ""); }), "t.yaml:4: p.list: expected a text value");
+  const std::vector<std::string> shapes = {"box", "cylinder", "sphere"};
+  EXPECT_EQ(f.OneOfOr(root, "absent", "", "box", shapes), "box");
+  EXPECT_EQ(ErrorOf([&] { f.OneOf(root["shape"], "o.shape", shapes); }),
+            "t.yaml:5: o.shape: expected box, cylinder or sphere, got 'cone'");
+  EXPECT_EQ(ErrorOf([&] {
+              f.OneOfOr(root, "name", "p", "none", {"heartbeat", "none"});
+            }),
+            "t.yaml:6: p.name: expected heartbeat or none, got 'bed'");
+  EXPECT_EQ(ErrorOf([&] { f.OneOf(root["list"], "list", {"a"}); }), "t.yaml:4: list: expected a");
+}
+
+TEST(YamlFields, KeysMustBeKnownPlainWords) {
+  const YamlFields f("t.yaml");
+  EXPECT_EQ(ErrorOf([&] { f.CheckKeys(YamlFields::LoadString("a: 1\nb: 2\n", "t.yaml"), "m", {"a"}); }),
+            "t.yaml:2: m.b: unknown key; expected one of: a");
+  EXPECT_EQ(ErrorOf([&] { f.CheckKeys(YamlFields::LoadString("a: 1\n[x]: 2\n", "t.yaml"), "m", {"a"}); }),
+            "t.yaml:2: m: expected plain words as keys, got a list or mapping");
+  EXPECT_EQ(ErrorOf([&] { f.CheckKeys(YamlFields::LoadString("[1, 2]", "t.yaml"), "", {"a"}); }),
+            "t.yaml:1: (top level): expected a mapping");
+}
+
+TEST(YamlFields, DocBlockAndKeyPaths) {
+  const std::string path = ::testing::TempDir() + "/yaml_fields_doc.h";
+  std::ofstream(path)
+      << "#pragma once\n/// Defaults:\n/// @code{.yaml}\n/// slam:\n///   seed: 1   # the walk\n"
+         "///   jitter: {rotation_std_deg: 0.02}\n///   band: [0.003, 0.014]\n/// @endcode\n";
+  const YAML::Node doc = YamlFields::LoadDocBlock(path);
+  EXPECT_EQ(doc["slam"]["seed"].as<int>(), 1);
+  EXPECT_EQ(YamlFields::KeyPaths(doc), (std::set<std::string>{"slam", "slam.seed", "slam.jitter",
+                                                              "slam.jitter.rotation_std_deg", "slam.band"}));
+  std::ofstream(path) << "/// @code{.yaml}\n/// a: [1\n/// @endcode\n";
+  EXPECT_NE(ErrorOf([&] { YamlFields::LoadDocBlock(path); }).find("yaml_fields_doc.h:"), std::string::npos);
+  std::ofstream(path) << "// nothing documented\n";
+  EXPECT_NE(ErrorOf([&] { YamlFields::LoadDocBlock(path); }).find("expected a /// @code{.yaml}"),
+            std::string::npos);
 }
 
 }  // namespace

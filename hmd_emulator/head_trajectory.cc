@@ -37,7 +37,7 @@ HeadTrajectoryConfig ParseHeadTrajectory(const YAML::Node& node, const std::stri
     const YAML::Node w = wps[i];
     f.CheckKeys(w, k, {"name", "position_m", "dwell_s", "look_at_m"});
     HeadWaypoint wp;
-    wp.name = w["name"] ? w["name"].as<std::string>() : "waypoint" + std::to_string(i);
+    wp.name = f.StringOr(w, "name", k, "waypoint" + std::to_string(i));
     wp.p_WH = f.Vector3(f.Required(w, "position_m", k + ".position_m"), k + ".position_m", "m");
     wp.dwell_s = f.NumberOr(w, "dwell_s", k, 0.0, 0.0, 3600.0, "s");
     if (w["look_at_m"]) wp.p_W_look_at = f.Vector3(w["look_at_m"], k + ".look_at_m", "m");

@@ -14,14 +14,19 @@
 /// smoothly. After the last waypoint the head stays there, or, with loop: true, walks back to
 /// waypoint 0 and starts again (period duration_s()).
 ///
-/// YAML (a `head_trajectory:` mapping in a scenario or config file; unknown keys are errors):
-///   head_trajectory:
-///     speed_m_per_s: 0.8          # > 0
-///     look_at_m: [0.25, -0.45, 1.25]
-///     loop: false                 # optional
-///     waypoints:                  # >= 1
-///       - {name: bedside, position_m: [1.6, -1.2, 1.7], dwell_s: 2.0}
-///       - {name: head_end, position_m: [-0.9, -1.4, 1.7], dwell_s: 1.0, look_at_m: [x, y, z]}
+/// YAML (a `head_trajectory:` mapping in a scenario or config file; unknown keys are errors). A
+/// mapping read from a file replaces the walk as a whole: speed_m_per_s, look_at_m and waypoints
+/// are required there. HeadTrajectoryConfig's initial speed and target are those of the shipped walk
+/// below (config/viraal_walk.yaml; slam_model_test.cc checks that they agree):
+/// @code{.yaml}
+/// head_trajectory:
+///   speed_m_per_s: 0.8                # required, > 0 [m/s]
+///   look_at_m: [0.25, -0.45, 1.25]    # required: the target the head turns to [m]
+///   loop: false                       # optional (default false)
+///   waypoints:                        # required, >= 1; name optional (default "waypoint<i>")
+///     - {name: foot_end, position_m: [1.45, -1.20, 1.70], dwell_s: 2.0}   # dwell_s optional (0) [s]
+///     - {name: head_end, position_m: [-0.75, -1.40, 1.70], dwell_s: 60.0}  # look_at_m optional
+/// @endcode
 ///
 /// Threading: immutable after construction; const methods are thread-safe.
 
@@ -44,8 +49,8 @@ struct HeadWaypoint {
 };
 
 struct HeadTrajectoryConfig {
-  double speed_m_per_s{0.8};
-  Eigen::Vector3d p_W_look_at{Eigen::Vector3d::Zero()};
+  double speed_m_per_s{0.8};  ///< [m/s], > 0: a slow walk in a crowded OR
+  Eigen::Vector3d p_W_look_at{Eigen::Vector3d(0.25, -0.45, 1.25)};  ///< [m]: the robot's middle in trocar_or
   bool loop{false};
   std::vector<HeadWaypoint> waypoints;
 };

@@ -6,28 +6,35 @@
 ///   user:            the emulated ViRAAl user      (user_model.h,      config/user.yaml)
 ///   head_trajectory: the wearer's walk             (head_trajectory.h, config/viraal_walk.yaml)
 ///   hmd:             the process itself (below)    (this file,         config/hmd.yaml)
-/// Files are applied in order over the compiled-in defaults (which equal the shipped files). The
+/// Files are applied in order over the compiled-in defaults (which equal the shipped files, except
+/// the waypoint names of hmd: below; a walk comes from a file only). The
 /// slam:, user: and hmd: mappings merge key by key: a later file changes only the keys it has, so
 /// `user: {seed: 7}` makes a different person and keeps the start offset, the beliefs and all the
 /// rest of the earlier files (a list value, such as hmd.displays, is replaced as a whole). A
 /// head_trajectory: mapping replaces the walk as a whole (its speed, target and waypoints belong
 /// together). orbed-hmd loads the four shipped files first, then every --config file.
 ///
-/// The `hmd:` mapping (every key optional, every key checked):
-///   hmd:
-///     name: hololens1              # hmd_name on HMD_POSE and GAZE_RAY
-///     gaze_hz: 10                  # GAZE_RAY rate [Hz]
-///     reflective_hz: 30            # REFLECTIVE_VIEW rate per display [Hz]
-///     ar_view_hz: 5                # AR_VIEW rate [Hz]
-///     align_waypoint: head_end     # where the emulated user aligns ("" = the walk's last waypoint)
-///     settle_s: 0.5                # standing time at the alignment waypoint before aligning [s]
-///     max_wait_s: 30               # longest wait for tracking to recover before aligning [s]
-///     recapture_period_s: 0.5      # a display re-captures at most this often after the robot moved [s]
-///     gaze_fallback_distance_m: 1.5  # D when the gaze ray misses the robot [m]
-///     max_gaze_distance_m: 10      # ray-casting range [m]
-///     displays:                    # reflective displays, in order: where each captures its frame
-///       - {capture_waypoint: foot_end}
-///       - {capture_waypoint: head_end}
+/// The `hmd:` mapping: every key optional and checked; an absent key keeps the HmdConfig default,
+/// which is the value written here and the value config/hmd.yaml ships (hmd_config_test.cc checks
+/// that the three agree), except the two that name waypoints of a walk: the defaults follow
+/// whatever walk is loaded, config/hmd.yaml names the shipped walk's (align_waypoint: head_end,
+/// its last, and two displays: `displays: [{capture_waypoint: foot_end}, {capture_waypoint:
+/// head_end}]`, the second being the negative control that adds no viewpoint).
+/// @code{.yaml}
+/// hmd:
+///   name: hololens1              # hmd_name on HMD_POSE and GAZE_RAY
+///   gaze_hz: 10                  # GAZE_RAY rate [Hz]
+///   reflective_hz: 30            # REFLECTIVE_VIEW rate per display [Hz]
+///   ar_view_hz: 5                # AR_VIEW rate [Hz]
+///   align_waypoint: ""           # where the emulated user aligns ("" = the walk's last waypoint)
+///   settle_s: 0.5                # standing time at the alignment waypoint before aligning [s]
+///   max_wait_s: 30               # longest wait for tracking to recover before aligning [s]
+///   recapture_period_s: 0.5      # a display re-captures at most this often after the robot moved [s]
+///   gaze_fallback_distance_m: 1.5  # D when the gaze ray misses the robot [m]
+///   max_gaze_distance_m: 10      # ray-casting range [m]
+///   # displays: a list of {capture_waypoint: NAME}, where each reflective display captures its
+///   # frame, in order; default (absent): one display at the walk's first waypoint.
+/// @endcode
 /// Display i is placed at (captures its frame from) the camera pose at the arrival at its waypoint of
 /// the walk: live, and in every emulated trial that uses >= i + 1 displays.
 ///

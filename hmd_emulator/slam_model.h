@@ -37,6 +37,31 @@
 ///    stored map; 1 removes it), about the head, and a random jump (σ jump_translation_std_m, yaw
 ///    σ jump_yaw_std_deg) is applied; then TRACKING again.
 ///
+/// The `slam:` mapping and its defaults: every key optional and checked; an absent key keeps the
+/// SlamConfig default, which is the value written here and the value config/slam.yaml ships (the
+/// file gives the sources; slam_model_test.cc checks that the three agree):
+/// @code{.yaml}
+/// slam:
+///   seed: 1                  # the walk's randomness
+///   rate_hz: 60              # HMD_POSE rate [Hz]
+///   head_to_camera: {position_m: [0.0, -0.03, 0.06], rpy_deg: [0, 0, 0]}   # X_HC, HoloLens 1 PV camera
+///   jitter: {translation_std_m: 0.0005, rotation_std_deg: 0.02}
+///   drift:
+///     fraction_of_distance: 0.01       # translation drift per metre walked
+///     band_fraction: [0.003, 0.014]    # where the drift per metre is expected (tests only)
+///     yaw_deg_per_m: 0.05              # [deg/m]
+///     direction_correlation_m: 10.0    # [m]
+///   tracking_loss:
+///     rate_per_min: 0.5                # [1/min]
+///     limited_mean_s: 1.0              # [s]
+///     limited_drift_multiplier: 4.0
+///     lost_probability: 0.2
+///     lost_mean_s: 2.0                 # [s]
+///     relocalization_correction: 0.5   # share of the drift removed; 1 removes it
+///     jump_translation_std_m: 0.01     # [m]
+///     jump_yaw_std_deg: 0.5            # [deg]
+/// @endcode
+///
 /// TrackingState values equal orbed::hmd_pose_t's TRACKING/LIMITED/LOST/RELOCALIZED constants.
 /// Units: m, s, rad inside (deg only in names that say so). Threading: a SlamModel is
 /// single-threaded (it owns its random stream); configs are plain data.
@@ -59,8 +84,9 @@ const char* TrackingStateName(TrackingState state);
 struct SlamConfig {
   std::uint64_t seed{1};
   double rate_hz{60.0};
-  /// X_HC: the photo/video camera in the head frame.
-  Eigen::Isometry3d X_HC{Eigen::Isometry3d::Identity()};
+  /// X_HC: the photo/video camera in the head frame, ~3 cm above and ~6 cm in front of the eyes,
+  /// looking the same way (H: x right, y down, z forward) [m].
+  Eigen::Isometry3d X_HC{Eigen::Translation3d(0.0, -0.03, 0.06)};
   double jitter_translation_std_m{0.0005};
   double jitter_rotation_std_deg{0.02};
   double drift_fraction_of_distance{0.01};
@@ -80,7 +106,7 @@ struct SlamConfig {
 };
 
 /// Reads the `slam:` mapping (the node itself) over `base`, key by key: a key the mapping does not
-/// have keeps base's value (the compiled-in defaults above unless given). Every key is optional and
+/// have keeps base's value (the defaults above unless given). Every key is optional and
 /// checked; errors name `source`, the line and the key.
 SlamConfig ParseSlamConfig(const YAML::Node& node, const std::string& source, const std::string& key = "slam",
                            const SlamConfig& base = SlamConfig{});

@@ -8,15 +8,16 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <set>
 #include <string>
 
 #include <gtest/gtest.h>
 
-#include "geometry/camera_model.h"
+#include "base/source_paths.h"
 #include "base/stats.h"
 #include "base/yaml_fields.h"
+#include "geometry/camera_model.h"
 #include "orbed/hmd_pose_t.hpp"
-#include "base/source_paths.h"
 
 namespace orbed::hmd {
 namespace {
@@ -287,14 +288,77 @@ TEST(SlamModel, SameSeedSameWalk) {
   EXPECT_FALSE(SimulateWalk(walk, c, 10.0).back().X_WH_est.isApprox(a.back().X_WH_est, 1e-9));
 }
 
-TEST(SlamConfig, ShippedFilesLoad) {
-  const SlamConfig c = LoadSlamConfigFile(orbed::SourceTreePath(kDefaultSlamConfigRelativePath));
-  EXPECT_DOUBLE_EQ(c.rate_hz, 60.0);
-  EXPECT_DOUBLE_EQ(c.drift_fraction_of_distance, 0.01);
-  EXPECT_NEAR(c.X_HC.translation().z(), 0.06, 1e-12);
-  const HeadTrajectoryConfig w =
-      LoadHeadTrajectoryFile(orbed::SourceTreePath("hmd_emulator/config/viraal_walk.yaml"));
-  EXPECT_EQ(w.waypoints.size(), 2u);
+// Every key `file` sets is documented in the header's @code{.yaml} block.
+void ExpectDocumented(const YAML::Node& doc, const std::string& file, const std::string& header) {
+  const std::set<std::string> documented = YamlFields::KeyPaths(doc);
+  for (const std::string& k : YamlFields::KeyPaths(YamlFields::LoadFile(file))) {
+    EXPECT_TRUE(documented.count(k)) << k << ": set in " << file << ", not documented in " << header;
+  }
+}
+
+void ExpectSame(const SlamConfig& a, const SlamConfig& b, const std::string& what) {
+  SCOPED_TRACE(what);
+  EXPECT_EQ(a.seed, b.seed);
+  EXPECT_EQ(a.rate_hz, b.rate_hz);
+  EXPECT_TRUE(a.X_HC.isApprox(b.X_HC, 0)) << a.X_HC.matrix() << "\n" << b.X_HC.matrix();
+  EXPECT_EQ(a.jitter_translation_std_m, b.jitter_translation_std_m);
+  EXPECT_EQ(a.jitter_rotation_std_deg, b.jitter_rotation_std_deg);
+  EXPECT_EQ(a.drift_fraction_of_distance, b.drift_fraction_of_distance);
+  EXPECT_EQ(a.drift_yaw_deg_per_m, b.drift_yaw_deg_per_m);
+  EXPECT_EQ(a.drift_direction_correlation_m, b.drift_direction_correlation_m);
+  EXPECT_EQ(a.drift_band_min_fraction, b.drift_band_min_fraction);
+  EXPECT_EQ(a.drift_band_max_fraction, b.drift_band_max_fraction);
+  EXPECT_EQ(a.tracking_loss_rate_per_min, b.tracking_loss_rate_per_min);
+  EXPECT_EQ(a.limited_mean_s, b.limited_mean_s);
+  EXPECT_EQ(a.limited_drift_multiplier, b.limited_drift_multiplier);
+  EXPECT_EQ(a.lost_probability, b.lost_probability);
+  EXPECT_EQ(a.lost_mean_s, b.lost_mean_s);
+  EXPECT_EQ(a.relocalization_correction, b.relocalization_correction);
+  EXPECT_EQ(a.jump_translation_std_m, b.jump_translation_std_m);
+  EXPECT_EQ(a.jump_yaw_std_deg, b.jump_yaw_std_deg);
+}
+
+// The defaults live in three places that must agree: slam_model.h's @code{.yaml} block, SlamConfig's
+// member initializers and config/slam.yaml. Fails when one is edited without the others.
+TEST(SlamConfig, HeaderStructAndShippedFileAgree) {
+  const std::string header = orbed::SourceTreePath("hmd_emulator/slam_model.h");
+  const std::string file = orbed::SourceTreePath(kDefaultSlamConfigRelativePath);
+  const YAML::Node doc = YamlFields::LoadDocBlock(header);
+  ExpectDocumented(doc, file, header);
+  ExpectSame(ParseSlamConfig(doc["slam"], header), SlamConfig{}, "header vs SlamConfig");
+  ExpectSame(LoadSlamConfigFile(file), SlamConfig{}, "config/slam.yaml vs SlamConfig");
+}
+
+// head_trajectory.h shows the shipped walk; HeadTrajectoryConfig starts from its speed and target.
+TEST(HeadTrajectoryConfig, HeaderStructAndShippedWalkAgree) {
+  const std::string header = orbed::SourceTreePath("hmd_emulator/head_trajectory.h");
+  const std::string file = orbed::SourceTreePath("hmd_emulator/config/viraal_walk.yaml");
+  const YAML::Node doc = YamlFields::LoadDocBlock(header);
+  ExpectDocumented(doc, file, header);
+  const HeadTrajectoryConfig d;
+  const HeadTrajectoryConfig from_doc = ParseHeadTrajectory(doc["head_trajectory"], header);
+  const HeadTrajectoryConfig shipped = LoadHeadTrajectoryFile(file);
+  for (const HeadTrajectoryConfig* c : {&from_doc, &shipped}) {
+    EXPECT_EQ(c->speed_m_per_s, d.speed_m_per_s);
+    EXPECT_EQ(c->p_W_look_at, d.p_W_look_at);
+    EXPECT_EQ(c->loop, d.loop);
+  }
+  ASSERT_EQ(from_doc.waypoints.size(), shipped.waypoints.size());
+  for (std::size_t i = 0; i < shipped.waypoints.size(); ++i) {
+    EXPECT_EQ(from_doc.waypoints[i].name, shipped.waypoints[i].name);
+    EXPECT_EQ(from_doc.waypoints[i].p_WH, shipped.waypoints[i].p_WH);
+    EXPECT_EQ(from_doc.waypoints[i].dwell_s, shipped.waypoints[i].dwell_s);
+    EXPECT_EQ(from_doc.waypoints[i].p_W_look_at.has_value(), shipped.waypoints[i].p_W_look_at.has_value());
+  }
+  // The documented defaults of the optional keys.
+  const HeadTrajectoryConfig bare = ParseHeadTrajectory(
+      YamlFields::LoadString(
+          "speed_m_per_s: 1\nlook_at_m: [0, 0, 1]\nwaypoints: [{position_m: [2, 0, 1.7]}]\n", "bare.yaml"),
+      "bare.yaml");
+  EXPECT_EQ(bare.loop, d.loop);
+  EXPECT_EQ(bare.waypoints.at(0).dwell_s, HeadWaypoint{}.dwell_s);
+  EXPECT_EQ(bare.waypoints.at(0).name, "waypoint0");
+  EXPECT_FALSE(bare.waypoints.at(0).p_W_look_at.has_value());
 }
 
 TEST(SlamConfig, ErrorsNameFileKeyAndExpectation) {

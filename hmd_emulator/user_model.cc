@@ -3,10 +3,10 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "hmd_emulator/random.h"
-#include "base/yaml_fields.h"
-#include "sim/scene.h"
 #include "base/units.h"
+#include "base/yaml_fields.h"
+#include "hmd_emulator/random.h"
+#include "sim/scene.h"
 
 namespace orbed::hmd {
 namespace {
@@ -34,8 +34,8 @@ Eigen::Vector3d Centroid(const std::vector<Eigen::Vector3d>& p) {
 }
 
 // Pixel of p_W through the camera at X_WC with K, and du/dp_W (2×3). False behind the camera.
-bool ProjectWithJacobian(const geometry::Intrinsics& in, const Eigen::Isometry3d& X_CW, const Eigen::Vector3d& p_W,
-                         Eigen::Vector2d* uv, Eigen::Matrix<double, 2, 3>* J) {
+bool ProjectWithJacobian(const geometry::Intrinsics& in, const Eigen::Isometry3d& X_CW,
+                         const Eigen::Vector3d& p_W, Eigen::Vector2d* uv, Eigen::Matrix<double, 2, 3>* J) {
   const Eigen::Vector3d y = X_CW * p_W;
   if (!(y.z() > 1e-6)) return false;
   const double iz = 1.0 / y.z();
@@ -51,6 +51,13 @@ bool InImage(const geometry::Intrinsics& in, const Eigen::Vector2d& uv) {
 }
 
 }  // namespace
+
+Eigen::Isometry3d DefaultStartOffset() {
+  Eigen::Isometry3d X_RV = Eigen::Isometry3d::Identity();
+  X_RV.translation() = Eigen::Vector3d(0.10, -0.08, 0.05);
+  X_RV.linear() = sim::RotationFromRpyDeg(Eigen::Vector3d(2.0, -1.5, 4.0));
+  return X_RV;
+}
 
 UserConfig ParseUserConfig(const YAML::Node& node, const std::string& source, const std::string& key,
                            const UserConfig& base) {

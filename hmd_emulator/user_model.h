@@ -51,6 +51,35 @@
 ///
 /// Every parameter is in UserConfig, loaded from hmd_emulator/config/user.yaml (sources beside each
 /// default there). Units: m, rad inside; arcmin/deg/px/fraction only where the name says so.
+///
+/// The `user:` mapping and its defaults: every key optional and checked; an absent key keeps the
+/// UserConfig default, which is the value written here and the value config/user.yaml ships
+/// (user_model_test.cc checks that the three agree):
+/// @code{.yaml}
+/// user:
+///   seed: 1                    # the person
+///   start_offset: {position_m: [0.10, -0.08, 0.05], rpy_deg: [2.0, -1.5, 4.0]}   # X_RV_start
+///   direct_view:
+///     lateral_noise_arcmin: 1.5
+///     lateral_bias_arcmin: 1.0
+///     depth_bias_fraction_std: 0.012        # of the viewing distance, per trial
+///     depth_user_bias_fraction_std: 0.006   # per person
+///     depth_noise_fraction_std: 0.004       # per look, per point
+///     user_scale_log_sigma: 0.5
+///     size_blind: true
+///   reflective_display: {noise_px: 2.0, bias_px: 1.5}
+///   belief: {lateral_arcmin: 2.0, depth_fraction: 0.02, display_px: 3.0}
+///   nudging:
+///     gain: 0.6
+///     motor_noise_fraction: 0.15
+///     max_nudges: 40
+///     stop_lateral_arcmin: 3.0
+///     stop_depth_fraction: 0.01
+///     stop_display_px: 4.0
+///     min_step_m: 0.001
+///     min_step_deg: 0.1
+///   time: {look_s: 2.0, display_look_s: 4.0, nudge_s: 5.5}   # [s]
+/// @endcode
 /// Threading: an EmulatedUser is immutable after construction; Align is const and draws its
 /// randomness from the trial seed, so trials may run on several threads.
 
@@ -65,6 +94,10 @@
 #include "sim/robot_model.h"
 
 namespace orbed::hmd {
+
+/// The default X_RV_start: the virtual robot shown 10-15 cm and a few degrees from the real base,
+/// position [0.10, -0.08, 0.05] m, roll-pitch-yaw [2.0, -1.5, 4.0] deg (sim::RotationFromRpyDeg).
+Eigen::Isometry3d DefaultStartOffset();
 
 struct UserConfig {
   std::uint64_t seed{1};  ///< the person
@@ -100,12 +133,12 @@ struct UserConfig {
   double display_look_time_s{4.0};
   double nudge_time_s{5.5};
   // The virtual robot's known starting offset from the real base, X_RV0 (used by StartPose).
-  Eigen::Isometry3d X_RV_start{Eigen::Isometry3d::Identity()};
+  Eigen::Isometry3d X_RV_start{DefaultStartOffset()};
 };
 
 /// Reads the `user:` mapping over `base` (key by key: a key that the mapping does not have keeps
 /// base's value, e.g. a start_offset with only rpy_deg keeps base's position); every key optional
-/// and checked. The default base is the compiled-in defaults above.
+/// and checked. The default base is the defaults above.
 UserConfig ParseUserConfig(const YAML::Node& node, const std::string& source, const std::string& key = "user",
                            const UserConfig& base = UserConfig{});
 /// Loads the `user:` mapping of a YAML file (e.g. hmd_emulator/config/user.yaml).

@@ -3,15 +3,17 @@
 // with the rank test of stats.h (whose own oracles are hand computations).
 #include "hmd_emulator/user_model.h"
 
-#include "base/source_paths.h"
 #include <cmath>
 #include <cstdlib>
+#include <set>
 #include <string>
+#include "base/source_paths.h"
 
 #include <gtest/gtest.h>
 
 #include "base/stats.h"
 #include "base/yaml_fields.h"
+#include "hmd_emulator/user_study.h"
 #include "sim/scene.h"
 
 namespace orbed::hmd {
@@ -130,10 +132,51 @@ TEST(EmulatedUser, SeedIsAPersonAndTrialsAreReproducible) {
   EXPECT_EQ(r1.nudges, r2.nudges);
 }
 
-TEST(UserConfig, ShippedFileAndErrors) {
-  const UserConfig c = LoadUserConfigFile(orbed::SourceDir() + "/" + kDefaultUserConfigRelativePath);
-  EXPECT_DOUBLE_EQ(c.depth_bias_fraction_std, 0.012);
-  EXPECT_NEAR(c.X_RV_start.translation().x(), 0.10, 1e-12);
+void ExpectSame(const UserConfig& a, const UserConfig& b, const std::string& what) {
+  SCOPED_TRACE(what);
+  EXPECT_EQ(a.seed, b.seed);
+  EXPECT_EQ(a.lateral_noise_arcmin, b.lateral_noise_arcmin);
+  EXPECT_EQ(a.lateral_bias_arcmin, b.lateral_bias_arcmin);
+  EXPECT_EQ(a.depth_bias_fraction_std, b.depth_bias_fraction_std);
+  EXPECT_EQ(a.depth_user_bias_fraction_std, b.depth_user_bias_fraction_std);
+  EXPECT_EQ(a.depth_noise_fraction_std, b.depth_noise_fraction_std);
+  EXPECT_EQ(a.user_scale_log_sigma, b.user_scale_log_sigma);
+  EXPECT_EQ(a.size_blind, b.size_blind);
+  EXPECT_EQ(a.display_noise_px, b.display_noise_px);
+  EXPECT_EQ(a.display_bias_px, b.display_bias_px);
+  EXPECT_EQ(a.assumed_lateral_arcmin, b.assumed_lateral_arcmin);
+  EXPECT_EQ(a.assumed_depth_fraction, b.assumed_depth_fraction);
+  EXPECT_EQ(a.assumed_display_px, b.assumed_display_px);
+  EXPECT_EQ(a.gain, b.gain);
+  EXPECT_EQ(a.motor_noise_fraction, b.motor_noise_fraction);
+  EXPECT_EQ(a.max_nudges, b.max_nudges);
+  EXPECT_EQ(a.stop_lateral_arcmin, b.stop_lateral_arcmin);
+  EXPECT_EQ(a.stop_depth_fraction, b.stop_depth_fraction);
+  EXPECT_EQ(a.stop_display_px, b.stop_display_px);
+  EXPECT_EQ(a.min_step_m, b.min_step_m);
+  EXPECT_EQ(a.min_step_deg, b.min_step_deg);
+  EXPECT_EQ(a.look_time_s, b.look_time_s);
+  EXPECT_EQ(a.display_look_time_s, b.display_look_time_s);
+  EXPECT_EQ(a.nudge_time_s, b.nudge_time_s);
+  EXPECT_TRUE(a.X_RV_start.isApprox(b.X_RV_start, 0)) << a.X_RV_start.matrix() << "\n"
+                                                      << b.X_RV_start.matrix();
+}
+
+// The defaults live in three places that must agree: user_model.h's @code{.yaml} block, UserConfig's
+// member initializers and config/user.yaml. Fails when one is edited without the others.
+TEST(UserConfig, HeaderStructAndShippedFileAgree) {
+  const std::string header = orbed::SourceDir() + "/hmd_emulator/user_model.h";
+  const std::string file = orbed::SourceDir() + "/" + kDefaultUserConfigRelativePath;
+  const YAML::Node doc = YamlFields::LoadDocBlock(header);
+  const std::set<std::string> documented = YamlFields::KeyPaths(doc);
+  for (const std::string& k : YamlFields::KeyPaths(YamlFields::LoadFile(file))) {
+    EXPECT_TRUE(documented.count(k)) << k << ": set in " << file << ", not documented in " << header;
+  }
+  ExpectSame(ParseUserConfig(doc["user"], header), UserConfig{}, "header vs UserConfig");
+  ExpectSame(LoadUserConfigFile(file), UserConfig{}, "config/user.yaml vs UserConfig");
+}
+
+TEST(UserConfig, ErrorsNameFileLineAndKey) {
   try {
     ParseUserConfig(YamlFields::LoadString("user:\n  nudging:\n    gain: fast\n", "u.yaml")["user"],
                     "u.yaml");

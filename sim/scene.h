@@ -9,22 +9,30 @@
 /// axis along O's z; a sphere is centred on O. Orientations in the file are URDF-style fixed-axis
 /// roll-pitch-yaw in degrees: R = Rz(yaw) Ry(pitch) Rx(roll). Units: m, deg in the file.
 ///
-/// File format (every key is checked; unknown keys are errors, so typos are caught):
-///   name: trocar_or                      # optional
-///   robot:
-///     base_pose: {position_m: [x, y, z], rpy_deg: [r, p, y]}   # X_WR
-///     tool_length_m: 0.25                # flange F to tool tip T, > 0
-///   trocar:
-///     position_m: [x, y, z]              # p_WT*, where the tool tip docks onto the cannula
-///     insertion_direction: [x, y, z]     # unit vector in W (normalised if within 1 % of unit)
-///   objects:
-///     - name: operating_table
-///       shape: box                       # box | cylinder | sphere
-///       size_m: [lx, ly, lz]             # box
-///       radius_m: 0.1                    # cylinder, sphere
-///       length_m: 1.6                    # cylinder
-///       pose: {position_m: [...], rpy_deg: [...]}   # X_WO; rpy_deg optional (default 0)
-///       ignore_links: [iiwa_link_0]      # optional: robot links never checked against it (a mount)
+/// File format (read with base/yaml_fields.h: every key is checked, unknown keys are errors, so
+/// typos are caught), here with values of the shipped sim/models/scenes/trocar_or.yaml:
+/// @code{.yaml}
+/// name: trocar_or                    # optional (default: none; a file names itself)
+/// robot:                             # required
+///   base_pose: {position_m: [0.25, -0.55, 0.75], rpy_deg: [0, 0, 90]}   # required: X_WR
+///   tool_length_m: 0.25              # required: flange F to tool tip T [m], > 0
+/// trocar:                            # required
+///   position_m: [0.11294, 0.0, 1.06830]                # p_WT*, where the tip docks onto the cannula
+///   insertion_direction: [-0.258819, 0.0, -0.965926]   # unit vector in W (normalised if within 1 %)
+/// objects:                           # optional (default: none)
+///   - name: robot_cart               # required, unique
+///     shape: box                     # required: box | cylinder | sphere
+///     size_m: [0.5, 0.5, 0.75]       # box: full side lengths [m], > 0
+///     pose: {position_m: [0.25, -0.55, 0.375], rpy_deg: [0, 0, 0]}   # required: X_WO; rpy_deg optional (0)
+///     ignore_links: [iiwa_link_0, iiwa_link_1]   # optional: robot links never checked against it (a mount)
+///   - name: second_arm_column
+///     shape: cylinder
+///     radius_m: 0.12                 # cylinder, sphere [m], > 0
+///     length_m: 1.9                  # cylinder [m], > 0
+///     pose: {position_m: [0.55, 0.7, 0.95]}
+/// @endcode
+/// Scene's tool_length_m is the URDF's tool (0.25 m, sim/models/iiwa7.urdf), the length the shipped
+/// scene sets too (scene_test.cc checks that they agree).
 ///
 /// Threading: plain data; the loaders are reentrant.
 
@@ -57,7 +65,7 @@ struct Scene {
   std::string name;
   std::string source;  ///< file name or the name passed to the loader
   Eigen::Isometry3d X_WR{Eigen::Isometry3d::Identity()};
-  double tool_length_m{0.25};
+  double tool_length_m{0.25};  ///< [m]: the URDF's tool
   Trocar trocar;
   std::vector<SceneObject> objects;
 };

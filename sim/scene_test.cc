@@ -1,34 +1,92 @@
 // Tests of the scene loader: the shipped scene and the error messages for bad files.
 #include "sim/scene.h"
-#include "base/source_paths.h"
 
 #include <cmath>
 #include <cstdlib>
+#include <set>
+#include <stdexcept>
 #include <string>
 
 #include <gtest/gtest.h>
 
+#include "base/source_paths.h"
+#include "base/yaml_fields.h"
+
 namespace orbed::sim {
 namespace {
 
-TEST(SceneTest, ShippedSceneLoads) {
-  const Scene s = LoadSceneFile(orbed::SourceTreePath(kDefaultSceneRelativePath));
-  EXPECT_EQ(s.name, "trocar_or");
-  EXPECT_NEAR(s.tool_length_m, 0.25, 1e-12);
-  EXPECT_TRUE(s.X_WR.translation().isApprox(Eigen::Vector3d(0.25, -0.55, 0.75)));
-  // yaw 90 deg: the base's x axis is W's y.
-  EXPECT_TRUE(s.X_WR.linear().col(0).isApprox(Eigen::Vector3d::UnitY(), 1e-12));
-  EXPECT_NEAR(s.trocar.insertion_direction_W.norm(), 1.0, 1e-12);
-  // The docking point is 0.05 m back along the insertion direction from the umbilicus on the torso.
-  const Eigen::Vector3d skin = s.trocar.p_WT + 0.05 * s.trocar.insertion_direction_W;
-  EXPECT_NEAR(skin.z(), 1.02, 1e-4);
-  bool has_table = false, has_column = false, has_cart = false;
-  for (const auto& o : s.objects) {
-    has_table |= o.name == "table_top";
-    has_column |= o.name == "second_arm_column" && o.shape == SceneObject::Shape::kCylinder;
-    has_cart |= o.name == "anaesthesia_cart";
+const SceneObject& Find(const Scene& s, const std::string& name) {
+  for (const SceneObject& o : s.objects) {
+    if (o.name == name) return o;
   }
-  EXPECT_TRUE(has_table && has_column && has_cart);
+  throw std::runtime_error("no object " + name);
+}
+
+// The shipped scene is consistent with itself: the robot stands on its cart facing the table, and
+// the docking point is 0.05 m out of the patient's skin along the insertion direction.
+TEST(SceneTest, ShippedSceneHangsTogether) {
+  const Scene s = LoadSceneFile(orbed::SourceTreePath(kDefaultSceneRelativePath));
+  const SceneObject& cart = Find(s, "robot_cart");
+  const Eigen::Vector3d cart_top = cart.X_WO.translation() + Eigen::Vector3d(0, 0, cart.size_m.z() / 2);
+  EXPECT_TRUE(s.X_WR.translation().isApprox(cart_top, 1e-12));
+  // The base's x axis points at the table: along it the base reaches the table's long axis within
+  // the table's length.
+  const SceneObject& table = Find(s, "table_top");
+  const Eigen::Vector3d x_axis = s.X_WR.linear().col(0);
+  const Eigen::Vector3d to_table = table.X_WO.translation() - s.X_WR.translation();
+  ASSERT_GT(x_axis.dot(to_table), 0);
+  const Eigen::Vector3d reach = s.X_WR.translation() + to_table.y() / x_axis.y() * x_axis;
+  EXPECT_LT(std::abs(reach.x() - table.X_WO.translation().x()), table.size_m.x() / 2);
+  EXPECT_TRUE(s.X_WR.linear().col(2).isApprox(Eigen::Vector3d::UnitZ(), 1e-12));
+  EXPECT_NEAR(s.trocar.insertion_direction_W.norm(), 1.0, 1e-12);
+  // The skin point is on the top face of the torso.
+  const SceneObject& torso = Find(s, "patient_torso");
+  const Eigen::Vector3d skin = s.trocar.p_WT + 0.05 * s.trocar.insertion_direction_W;
+  const Eigen::Vector3d skin_O = torso.X_WO.inverse() * skin;
+  EXPECT_NEAR(skin_O.z(), torso.size_m.z() / 2, 1e-4);
+  EXPECT_LT(std::abs(skin_O.x()), torso.size_m.x() / 2);
+  EXPECT_LT(std::abs(skin_O.y()), torso.size_m.y() / 2);
+}
+
+// scene.h documents the format with the shipped scene's values; Scene's tool length is the URDF's
+// tool and the shipped scene's. Fails when one of them is edited without the others.
+TEST(SceneTest, HeaderStructUrdfAndShippedSceneAgree) {
+  const std::string path = orbed::SourceTreePath(kDefaultSceneRelativePath);
+  const YAML::Node doc = YamlFields::LoadDocBlock(orbed::SourceTreePath("sim/scene.h"));
+  const std::set<std::string> documented = YamlFields::KeyPaths(doc);
+  for (const std::string& k : YamlFields::KeyPaths(YamlFields::LoadFile(path))) {
+    EXPECT_TRUE(documented.count(k)) << k << ": set in " << path << ", not documented in scene.h";
+  }
+  const Scene from_doc = LoadSceneString(YAML::Dump(doc), "scene.h");
+  const Scene shipped = LoadSceneFile(path);
+  const RobotModel robot = RobotModel::LoadFile(orbed::SourceTreePath(RobotModel::kDefaultUrdfRelativePath));
+  EXPECT_EQ(Scene{}.tool_length_m, robot.tool_length_m());
+  EXPECT_EQ(shipped.tool_length_m, Scene{}.tool_length_m);
+  EXPECT_EQ(from_doc.tool_length_m, Scene{}.tool_length_m);
+  // The header shows the shipped values.
+  EXPECT_EQ(from_doc.name, shipped.name);
+  EXPECT_TRUE(from_doc.X_WR.isApprox(shipped.X_WR, 0));
+  EXPECT_TRUE(from_doc.trocar.p_WT.isApprox(shipped.trocar.p_WT, 0));
+  EXPECT_TRUE(from_doc.trocar.insertion_direction_W.isApprox(shipped.trocar.insertion_direction_W, 0));
+  for (const SceneObject& o : from_doc.objects) {
+    const SceneObject& s = Find(shipped, o.name);
+    EXPECT_EQ(o.shape, s.shape) << o.name;
+    EXPECT_TRUE(o.X_WO.isApprox(s.X_WO, 0)) << o.name;
+    EXPECT_EQ(o.size_m, s.size_m) << o.name;
+    EXPECT_EQ(o.radius_m, s.radius_m) << o.name;
+    EXPECT_EQ(o.length_m, s.length_m) << o.name;
+    EXPECT_EQ(o.ignore_links, s.ignore_links) << o.name;
+  }
+  // The documented defaults of the optional keys: no name, rpy 0, no ignored links, no objects.
+  const Scene bare = LoadSceneString(
+      "robot: {base_pose: {position_m: [0, 0, 0]}, tool_length_m: 0.2}\n"
+      "trocar: {position_m: [0, 0, 0], insertion_direction: [0, 0, -1]}\n",
+      "bare.yaml");
+  EXPECT_EQ(bare.name, Scene{}.name);
+  EXPECT_TRUE(bare.X_WR.linear().isIdentity(0));
+  EXPECT_TRUE(bare.objects.empty());
+  // The shipped scene is named after its file.
+  EXPECT_EQ(shipped.name + ".yaml", path.substr(path.rfind('/') + 1));
 }
 
 TEST(SceneTest, RpyIsFixedAxisRollPitchYaw) {

@@ -93,22 +93,20 @@ ScenarioConfig LoadScenario(const YAML::Node& root, const std::string& source) {
               {"trials", "modes", "reflective_mirrors", "method", "configurations_deg", "landmarks"});
   ScenarioConfig config;
   config.trials = static_cast<int>(f.IntegerOr(root, "trials", "", config.trials, 1, 1000000));
-  const int mirrors = static_cast<int>(f.IntegerOr(root, "reflective_mirrors", "", 1, 1, 1000000));
+  const int mirrors =
+      static_cast<int>(f.IntegerOr(root, "reflective_mirrors", "", kDefaultReflectiveMirrors, 1, 1000000));
   if (root["method"]) {
-    const std::string m = f.String(root["method"], "method");
-    if (m == "chordal") {
-      config.method = orbed::registration_t::METHOD_CHORDAL;
-    } else if (m == "karcher") {
-      config.method = orbed::registration_t::METHOD_KARCHER;
-    } else if (m == "robust") {
-      config.method = orbed::registration_t::METHOD_ROBUST;
-    } else {
-      f.Fail(root["method"], "method", "expected chordal, karcher or robust, got '" + m + "'");
-    }
+    const std::string m = f.OneOf(root["method"], "method", {"chordal", "karcher", "robust"});
+    config.method = m == "chordal"   ? orbed::registration_t::METHOD_CHORDAL
+                    : m == "karcher" ? orbed::registration_t::METHOD_KARCHER
+                                     : orbed::registration_t::METHOD_ROBUST;
   }
+  // Without `modes`, the default modes by name (reflective_mirrors still applies).
   const YAML::Node modes = root["modes"];
-  const std::vector<std::string> mode_names =
-      modes ? f.Strings(modes, "modes") : std::vector<std::string>{"ar_reflective", "ar"};
+  std::vector<std::string> mode_names;
+  for (const ModeSpec& m : config.modes) mode_names.push_back(m.name);
+  if (modes) mode_names = f.Strings(modes, "modes");
+  config.modes.clear();
   for (size_t i = 0; i < mode_names.size(); ++i) {
     try {
       config.modes.push_back(ModeFromName(mode_names[i], mirrors));

@@ -5,13 +5,18 @@
 /// the landmarks of the paper's misalignment protocol. Every key is checked; unknown keys and bad
 /// values are errors naming the file, the line and what was expected.
 ///
-///   trials: 3                              # per mode, >= 1 (trial i uses configuration i mod K)
-///   modes: [ar_reflective, ar]             # run order; each of ar_reflective | ar, no repeats
-///   reflective_mirrors: 1                  # num_mirrors of the ar_reflective mode, >= 1
-///   method: karcher                        # chordal | karcher | robust (registration_t.METHOD_*)
-///   configurations_deg:                    # K >= 1 joint vectors q1..q7 [deg], pairwise distinct
-///     - [0, 30, 0, -60, 0, 45, 0]
-///   landmarks: [iiwa_link_4, iiwa_link_6, iiwa_link_ee]   # link origins, >= 1 (paper: 3)
+/// trials, modes, reflective_mirrors and method are optional: an absent key keeps the
+/// ScenarioConfig default, which is the value written here and the value viraal/viraal.yaml ships
+/// (protocol_test.cc checks that the three agree); configurations_deg and landmarks are required.
+/// @code{.yaml}
+/// trials: 3                        # per mode, >= 1 (trial i uses configuration i mod K)
+/// modes: [ar_reflective, ar]       # run order; each of ar_reflective | ar, no repeats
+/// reflective_mirrors: 1            # num_mirrors of the ar_reflective mode, >= 1
+/// method: karcher                  # chordal | karcher | robust (registration_t.METHOD_*)
+/// configurations_deg:              # required: K >= 1 joint vectors q1..q7 [deg], pairwise distinct
+///   - [0, 30, 0, -60, 0, 45, 0]
+/// landmarks: [iiwa_link_4, iiwa_link_6, iiwa_link_ee]   # required: link origins, >= 1 (paper: 3)
+/// @endcode
 ///
 /// Joint limits and collisions are not checked here (no model): ViraalScenario checks the limits
 /// against the URDF and asks orbed-iiwa-sim (PLAN_CHECK_REQUEST) about collisions before use.
@@ -22,6 +27,9 @@
 #include <string>
 #include <vector>
 
+#include <orbed/alignment_trial_t.hpp>
+#include <orbed/registration_t.hpp>
+
 namespace orbed::viraal {
 
 /// One display mode of the experiment.
@@ -31,10 +39,16 @@ struct ModeSpec {
   int32_t num_mirrors{0};
 };
 
+/// num_mirrors of the ar_reflective mode when the file does not say (reflective_mirrors).
+inline constexpr int kDefaultReflectiveMirrors = 1;
+
 struct ScenarioConfig {
   int trials{3};
-  std::vector<ModeSpec> modes;
-  int8_t method{1};  ///< registration_t::METHOD_KARCHER
+  /// In run order: AR with a reflective display first, then AR alone.
+  std::vector<ModeSpec> modes{
+      {"ar_reflective", orbed::alignment_trial_t::MODE_AR_REFLECTIVE, kDefaultReflectiveMirrors},
+      {"ar", orbed::alignment_trial_t::MODE_AR, 0}};
+  int8_t method{orbed::registration_t::METHOD_KARCHER};
   std::vector<std::vector<double>> configurations_deg;
   std::vector<std::string> landmarks;
 };

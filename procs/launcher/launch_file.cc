@@ -2,120 +2,106 @@
 
 #include <csignal>
 #include <fstream>
+#include <limits>
 #include <set>
 #include <sstream>
 
 #include <yaml-cpp/yaml.h>
+
+#include "base/yaml_fields.h"
 
 extern char** environ;
 
 namespace orbed::launcher {
 namespace {
 
-std::string Where(const std::string& path, const YAML::Node& node) {
-  const YAML::Mark mark = node.Mark();
-  if (mark.line < 0) return path;
-  return path + ":" + std::to_string(mark.line + 1);
-}
+const std::vector<std::string> kSignalNames = {"SIGINT",  "SIGTERM", "SIGHUP", "SIGQUIT",
+                                               "SIGUSR1", "SIGUSR2", "SIGKILL"};
 
-[[noreturn]] void Fail(const std::string& path, const YAML::Node& node, const std::string& what) {
-  throw LaunchFileError(Where(path, node) + ": " + what);
-}
-
-void CheckKeys(const std::string& path, const YAML::Node& map, const std::set<std::string>& allowed,
-               const std::string& context) {
-  for (const auto& item : map) {
-    if (!item.first.IsScalar()) Fail(path, item.first, "a key in " + context + " must be a plain word");
-    const std::string key = item.first.as<std::string>();
-    if (allowed.count(key) == 0) {
-      std::string list;
-      for (const std::string& k : allowed) list += (list.empty() ? "" : ", ") + k;
-      Fail(path, item.first, "unknown key '" + key + "' in " + context + "; expected one of: " + list);
-    }
-  }
-}
-
-std::string GetString(const std::string& path, const YAML::Node& node, const std::string& key,
-                      const std::string& context) {
-  const YAML::Node value = node[key];
-  if (!value) Fail(path, node, context + " needs '" + key + "' (a string)");
-  if (!value.IsScalar()) Fail(path, value, "'" + key + "' in " + context + " must be a string");
-  return value.as<std::string>();
-}
-
-template <class T>
-T GetScalar(const std::string& path, const YAML::Node& node, const std::string& key, T fallback,
-            const std::string& expected) {
-  const YAML::Node value = node[key];
-  if (!value) return fallback;
-  try {
-    if (!value.IsScalar()) throw YAML::Exception(value.Mark(), "not a scalar");
-    return value.as<T>();
-  } catch (const YAML::Exception&) {
-    Fail(path, value, "'" + key + "' must be " + expected);
-  }
-}
-
-ProcessSpec ParseProcess(const std::string& path, const YAML::Node& node,
+// `key` is the process's dotted path, e.g. "groups[0].processes[1]".
+ProcessSpec ParseProcess(const YamlFields& f, const YAML::Node& node, const std::string& key,
                          const std::map<std::string, std::string>& environment) {
-  if (!node.IsMap()) Fail(path, node, "a process must be a map with at least name and command");
+  if (!node.IsMap()) f.Fail(node, key, "expected a mapping with at least name and command");
+  f.CheckKeys(node, key,
+              {"name", "command", "args", "env", "required", "respawn", "stop_signal", "stop_timeout_sec",
+               "ready", "ready_timeout_sec", "exit_stops_all"});
   ProcessSpec spec;
-  spec.name = GetString(path, node, "name", "process");
-  const std::string context = "process '" + spec.name + "'";
-  CheckKeys(path, node,
-            {"name", "command", "args", "env", "required", "respawn", "stop_signal", "stop_timeout_sec",
-             "ready", "ready_timeout_sec", "exit_stops_all"},
-            context);
+  spec.name = f.String(f.Required(node, "name", key + ".name", "a string"), key + ".name");
   if (spec.name.empty() || spec.name.find_first_of(" \t/") != std::string::npos) {
-    Fail(path, node["name"], "process name '" + spec.name + "' must be non-empty, no spaces or '/'");
+    f.Fail(node["name"], key + ".name",
+           "expected a non-empty name without spaces or '/', got '" + spec.name + "'");
   }
-  auto expand = [&](const std::string& text, const YAML::Node& where) {
+  auto expand = [&](const std::string& text, const YAML::Node& where, const std::string& where_key) {
     try {
       return ExpandVariables(text, environment);
     } catch (const std::invalid_argument& e) {
-      Fail(path, where, std::string(e.what()) + " (in " + context + ")");
+      f.Fail(where, where_key, std::string(e.what()) + " (in process '" + spec.name + "')");
     }
   };
-  spec.command = expand(GetString(path, node, "command", context), node["command"]);
+  const YAML::Node command = f.Required(node, "command", key + ".command", "a string");
+  spec.command = expand(f.String(command, key + ".command"), command, key + ".command");
   if (const YAML::Node args = node["args"]) {
-    if (!args.IsSequence()) Fail(path, args, "'args' of " + context + " must be a list of strings");
-    for (const auto& arg : args) {
-      if (!arg.IsScalar()) Fail(path, arg, "each arg of " + context + " must be a string");
-      spec.args.push_back(expand(arg.as<std::string>(), arg));
+    if (!args.IsSequence()) f.Fail(args, key + ".args", "expected a list of strings");
+    for (std::size_t i = 0; i < args.size(); ++i) {
+      const std::string k = key + ".args[" + std::to_string(i) + "]";
+      spec.args.push_back(expand(f.String(args[i], k), args[i], k));
     }
   }
   if (const YAML::Node env = node["env"]) {
-    if (!env.IsMap()) Fail(path, env, "'env' of " + context + " must be a map of strings");
+    if (!env.IsMap()) f.Fail(env, key + ".env", "expected a mapping of strings");
     for (const auto& item : env) {
-      if (!item.first.IsScalar()) Fail(path, item.first, "env names must be plain words");
-      if (!item.second.IsScalar()) Fail(path, item.second, "env values must be strings");
-      spec.env[item.first.as<std::string>()] = expand(item.second.as<std::string>(), item.second);
+      if (!item.first.IsScalar()) f.Fail(item.first, key + ".env", "expected plain words as variable names");
+      const std::string k = key + ".env." + item.first.Scalar();
+      spec.env[item.first.Scalar()] = expand(f.String(item.second, k), item.second, k);
     }
   }
-  spec.required = GetScalar<bool>(path, node, "required", true, "true or false");
-  spec.respawn = GetScalar<bool>(path, node, "respawn", false, "true or false");
-  spec.exit_stops_all = GetScalar<bool>(path, node, "exit_stops_all", false, "true or false");
-  const std::string signal_name =
-      GetScalar<std::string>(path, node, "stop_signal", "SIGINT", "a signal name");
-  spec.stop_signal = SignalFromName(signal_name);
-  if (spec.stop_signal < 0) {
-    Fail(path, node["stop_signal"],
-         "unknown stop_signal '" + signal_name +
-             "'; expected SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGUSR1, "
-             "SIGUSR2 or SIGKILL");
+  spec.required = f.BoolOr(node, "required", key, spec.required);
+  spec.respawn = f.BoolOr(node, "respawn", key, spec.respawn);
+  spec.exit_stops_all = f.BoolOr(node, "exit_stops_all", key, spec.exit_stops_all);
+  spec.stop_signal = SignalFromName(f.OneOfOr(node, "stop_signal", key, "SIGINT", kSignalNames));
+  spec.stop_timeout_sec = f.NumberOr(node, "stop_timeout_sec", key, spec.stop_timeout_sec, 0,
+                                     std::numeric_limits<double>::infinity(), "s");
+  spec.ready_timeout_sec = f.PositiveOr(node, "ready_timeout_sec", key, spec.ready_timeout_sec, "s");
+  const std::string ready = f.OneOfOr(node, "ready", key, "heartbeat", {"heartbeat", "none"});
+  spec.ready = ready == "heartbeat" ? ReadyCheck::kHeartbeat : ReadyCheck::kNone;
+  return spec;
+}
+
+LaunchSpec ParseLaunch(const YAML::Node& root, const std::string& path,
+                       const std::map<std::string, std::string>& environment) {
+  const YamlFields f(path);
+  if (!root.IsMap()) f.Fail(root, "(top level)", "expected a mapping with a 'groups' list");
+  f.CheckKeys(root, "", {"name", "groups"});
+  LaunchSpec spec;
+  spec.path = path;
+  spec.name = f.StringOr(root, "name", "", "orbed");
+  const YAML::Node groups = root["groups"];
+  if (!groups || !groups.IsSequence() || groups.size() == 0) {
+    f.Fail(groups ? groups : root, "groups", "expected a non-empty list of {name, processes}");
   }
-  spec.stop_timeout_sec = GetScalar<double>(path, node, "stop_timeout_sec", 5.0, "a number of seconds");
-  spec.ready_timeout_sec = GetScalar<double>(path, node, "ready_timeout_sec", 10.0, "a number of seconds");
-  if (!(spec.stop_timeout_sec >= 0) || !(spec.ready_timeout_sec > 0)) {
-    Fail(path, node, "stop_timeout_sec must be >= 0 and ready_timeout_sec > 0 in " + context);
-  }
-  const std::string ready = GetScalar<std::string>(path, node, "ready", "heartbeat", "a string");
-  if (ready == "heartbeat") {
-    spec.ready = ReadyCheck::kHeartbeat;
-  } else if (ready == "none") {
-    spec.ready = ReadyCheck::kNone;
-  } else {
-    Fail(path, node["ready"], "unknown ready '" + ready + "'; expected heartbeat or none");
+  std::set<std::string> names;
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    const YAML::Node group_node = groups[g];
+    const std::string key = "groups[" + std::to_string(g) + "]";
+    if (!group_node.IsMap()) f.Fail(group_node, key, "expected a mapping {name, processes}");
+    f.CheckKeys(group_node, key, {"name", "processes"});
+    GroupSpec group;
+    group.name = f.String(f.Required(group_node, "name", key + ".name", "a string"), key + ".name");
+    const YAML::Node processes = group_node["processes"];
+    if (!processes || !processes.IsSequence() || processes.size() == 0) {
+      f.Fail(processes ? processes : group_node, key + ".processes",
+             "expected a non-empty list of processes (group '" + group.name + "')");
+    }
+    for (std::size_t p = 0; p < processes.size(); ++p) {
+      const std::string process_key = key + ".processes[" + std::to_string(p) + "]";
+      ProcessSpec process = ParseProcess(f, processes[p], process_key, environment);
+      if (!names.insert(process.name).second) {
+        f.Fail(processes[p]["name"], process_key + ".name",
+               "expected a name not used by another process, got '" + process.name + "' (used twice)");
+      }
+      group.processes.push_back(std::move(process));
+    }
+    spec.groups.push_back(std::move(group));
   }
   return spec;
 }
@@ -161,56 +147,17 @@ std::map<std::string, std::string> CurrentEnvironment() {
   return env;
 }
 
-LaunchSpec ParseLaunchYamlUnchecked(const std::string& yaml, const std::string& path,
-                                    const std::map<std::string, std::string>& environment);
-
 LaunchSpec ParseLaunchYaml(const std::string& yaml, const std::string& path,
                            const std::map<std::string, std::string>& environment) {
   try {
-    return ParseLaunchYamlUnchecked(yaml, path, environment);
+    return ParseLaunch(YamlFields::LoadString(yaml, path), path, environment);
   } catch (const YAML::Exception& e) {
-    // Anything the explicit checks did not anticipate (a map used as a key, ...).
+    // Anything the explicit checks did not anticipate.
     throw LaunchFileError(path + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
+  } catch (const std::runtime_error& e) {
+    // YamlFields' "file:line: key: expected ..." as the launcher's error type.
+    throw LaunchFileError(e.what());
   }
-}
-
-LaunchSpec ParseLaunchYamlUnchecked(const std::string& yaml, const std::string& path,
-                                    const std::map<std::string, std::string>& environment) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(yaml);
-  } catch (const YAML::ParserException& e) {
-    throw LaunchFileError(path + ":" + std::to_string(e.mark.line + 1) + ": YAML syntax: " + e.msg);
-  }
-  if (!root.IsMap()) Fail(path, root, "a launch file must be a map with a 'groups' list");
-  CheckKeys(path, root, {"name", "groups"}, "the launch file");
-  LaunchSpec spec;
-  spec.path = path;
-  spec.name = GetScalar<std::string>(path, root, "name", "orbed", "a string");
-  const YAML::Node groups = root["groups"];
-  if (!groups || !groups.IsSequence() || groups.size() == 0) {
-    Fail(path, root, "'groups' must be a non-empty list of {name, processes}");
-  }
-  std::set<std::string> names;
-  for (const auto& group_node : groups) {
-    if (!group_node.IsMap()) Fail(path, group_node, "each group must be a map {name, processes}");
-    CheckKeys(path, group_node, {"name", "processes"}, "a group");
-    GroupSpec group;
-    group.name = GetString(path, group_node, "name", "group");
-    const YAML::Node processes = group_node["processes"];
-    if (!processes || !processes.IsSequence() || processes.size() == 0) {
-      Fail(path, group_node, "group '" + group.name + "' needs a non-empty 'processes' list");
-    }
-    for (const auto& process_node : processes) {
-      ProcessSpec process = ParseProcess(path, process_node, environment);
-      if (!names.insert(process.name).second) {
-        Fail(path, process_node, "process name '" + process.name + "' is used twice");
-      }
-      group.processes.push_back(std::move(process));
-    }
-    spec.groups.push_back(std::move(group));
-  }
-  return spec;
 }
 
 LaunchSpec LoadLaunchFile(const std::string& path, const std::map<std::string, std::string>& environment) {

@@ -20,7 +20,9 @@
 ///           exit_stops_all: false      # when it exits, stop the testbed with its exit status
 ///
 /// ${VAR} in command, args and env values expands from the environment; an unset variable is an
-/// error. Errors throw LaunchFileError with "file:line: what, expected ...".
+/// error. The file is read with the project's checked YAML reader (base/yaml_fields.h): errors
+/// throw LaunchFileError with "file:line: dotted.key: expected ..., got ...", e.g.
+///   "testbed.yaml:12: groups[1].processes[0].stop_signal: expected SIGINT, ... or SIGKILL, got 'SIGFOO'".
 
 #include <map>
 #include <stdexcept>

@@ -72,38 +72,41 @@ groups:
 }
 
 TEST(LaunchFile, ErrorsNameFileLineKeyAndFix) {
-  EXPECT_EQ(ErrorOf("groups: []"), "test.yaml:1: 'groups' must be a non-empty list of {name, processes}");
+  EXPECT_EQ(ErrorOf("groups: []"), "test.yaml:1: groups: expected a non-empty list of {name, processes}");
   const std::string typo = ErrorOf(
       "groups:\n  - name: g\n    processes:\n      - name: a\n        command: x\n        "
       "respawm: true\n");
-  EXPECT_NE(typo.find("test.yaml:6: unknown key 'respawm' in process 'a'"), std::string::npos) << typo;
+  EXPECT_NE(typo.find("test.yaml:6: groups[0].processes[0].respawm: unknown key"), std::string::npos) << typo;
   EXPECT_NE(typo.find("respawn"), std::string::npos);
-  EXPECT_NE(
-      ErrorOf("groups:\n  - name: g\n    processes:\n      - name: a\n").find("process 'a' needs 'command'"),
-      std::string::npos);
-  EXPECT_NE(ErrorOf("groups:\n  - name: g\n    processes:\n      - {name: a, command: x, "
-                    "stop_signal: SIGFOO}\n")
-                .find("unknown stop_signal 'SIGFOO'"),
+  EXPECT_NE(ErrorOf("groups:\n  - name: g\n    processes:\n      - name: a\n")
+                .find("test.yaml:4: groups[0].processes[0].command: missing; expected a string"),
             std::string::npos);
+  EXPECT_NE(
+      ErrorOf("groups:\n  - name: g\n    processes:\n      - {name: a, command: x, "
+              "stop_signal: SIGFOO}\n")
+          .find("test.yaml:4: groups[0].processes[0].stop_signal: expected SIGINT, SIGTERM, SIGHUP, SIGQUIT, "
+                "SIGUSR1, SIGUSR2 or SIGKILL, got 'SIGFOO'"),
+      std::string::npos);
   EXPECT_NE(ErrorOf("groups:\n  - name: g\n    processes:\n      - {name: a, command: x}\n"
                     "      - {name: a, command: y}\n")
-                .find("test.yaml:5: process name 'a' is used twice"),
+                .find("test.yaml:5: groups[0].processes[1].name: expected a name not used by another "
+                      "process, got 'a'"),
             std::string::npos);
   EXPECT_NE(ErrorOf("groups:\n  - name: g\n    processes:\n      - {name: a, command: "
                     "\"${NOPE}/x\"}\n")
-                .find("variable ${NOPE} is not set"),
+                .find("test.yaml:4: groups[0].processes[0].command: variable ${NOPE} is not set"),
             std::string::npos);
   EXPECT_NE(ErrorOf("groups:\n  - name: g\n    processes:\n      - {name: a, command: x, "
                     "respawn: maybe}\n")
-                .find("'respawn' must be true or false"),
+                .find("test.yaml:4: groups[0].processes[0].respawn: expected true or false, got 'maybe'"),
             std::string::npos);
-  EXPECT_NE(ErrorOf("groups: [\n").find("YAML syntax"), std::string::npos);
+  EXPECT_NE(ErrorOf("groups: [\n").find("test.yaml:2: not valid YAML"), std::string::npos);
   // Hostile structure: maps and lists where words belong.
   EXPECT_NE(ErrorOf("groups:\n  - name: g\n    processes:\n      - {name: a, command: x, [1, 2]: 3}\n")
-                .find("must be a plain word"),
+                .find("test.yaml:4: groups[0].processes[0]: expected plain words as keys"),
             std::string::npos);
   EXPECT_NE(ErrorOf("groups:\n  - name: g\n    processes:\n      - {name: a, command: x, env: {[1]: b}}\n")
-                .find("env names must be plain words"),
+                .find("test.yaml:4: groups[0].processes[0].env: expected plain words as variable names"),
             std::string::npos);
   EXPECT_NE(ErrorOf("groups:\n  - name: [g]\n    processes: []\n"), "");
   EXPECT_NE(ErrorOf("{[a]: 1}"), "");
