@@ -13,7 +13,6 @@
 
 #include "base/stats.h"
 #include "base/yaml_fields.h"
-#include "hmd_emulator/user_study.h"
 #include "sim/scene.h"
 
 namespace orbed::hmd {
