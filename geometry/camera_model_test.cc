@@ -7,10 +7,10 @@
 
 #include <gtest/gtest.h>
 
+#include "base/units.h"
+
 namespace orbed::geometry {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 // A generic camera pose: rotation from an axis-angle written out with Rodrigues' formula by hand.
 Eigen::Matrix3d Rodrigues(Eigen::Vector3d axis, double angle) {

@@ -7,6 +7,7 @@
 #include "geometry/rotation_mean.h"
 #include "geometry/so3.h"
 #include "base/units.h"
+#include "base/stats.h"
 
 namespace orbed::geometry {
 namespace {
@@ -67,21 +68,11 @@ Eigen::Vector3d WeiszfeldStep(size_t n, const std::vector<double>& weights, doub
 
 }  // namespace
 
-double Median(std::vector<double> values) {
-  if (values.empty()) return 0.0;
-  const size_t mid = values.size() / 2;
-  std::nth_element(values.begin(), values.begin() + mid, values.end());
-  const double upper = values[mid];
-  if (values.size() % 2 == 1) return upper;
-  const double lower = *std::max_element(values.begin(), values.begin() + mid);
-  return 0.5 * (lower + upper);
-}
-
-RotationL1MedianResult ComputeRotationL1Median(const std::vector<Eigen::Quaterniond>& q_WV,
+RotationL1MedianResult ComputeRotationL1Median(const std::vector<Eigen::Quaterniond>& quat_WV,
                                                const std::vector<double>& weights,
                                                const L1MedianOptions& options) {
   RotationL1MedianResult result;
-  const ChordalMeanResult start = ComputeChordalMean(q_WV, weights);
+  const ChordalMeanResult start = ComputeChordalMean(quat_WV, weights);
   if (!start.valid) {
     result.reason = start.reason;
     return result;
@@ -91,8 +82,8 @@ RotationL1MedianResult ComputeRotationL1Median(const std::vector<Eigen::Quaterni
     const Eigen::Quaterniond y_conj = y.conjugate();
     bool at_median = false;
     const Eigen::Vector3d step = WeiszfeldStep(
-        q_WV.size(), weights, options.coincidence_tolerance,
-        [&](size_t i) { return LogQuaternion(y_conj * q_WV[i]); }, &at_median);
+        quat_WV.size(), weights, options.coincidence_tolerance,
+        [&](size_t i) { return LogQuaternion(y_conj * quat_WV[i]); }, &at_median);
     result.iterations = k + 1;
     if (at_median) {
       result.converged = true;
@@ -151,11 +142,11 @@ PointL1MedianResult ComputePointL1Median(const std::vector<Eigen::Vector3d>& p_W
   return result;
 }
 
-OutlierResult RejectOutliers(const std::vector<Eigen::Quaterniond>& q_WV,
+OutlierResult RejectOutliers(const std::vector<Eigen::Quaterniond>& quat_WV,
                              const std::vector<Eigen::Vector3d>& p_WV, const OutlierOptions& options) {
   OutlierResult result;
-  if (q_WV.size() != p_WV.size()) {
-    result.reason = "got " + std::to_string(q_WV.size()) + " rotations but " + std::to_string(p_WV.size()) +
+  if (quat_WV.size() != p_WV.size()) {
+    result.reason = "got " + std::to_string(quat_WV.size()) + " rotations but " + std::to_string(p_WV.size()) +
                     " translations";
     return result;
   }
@@ -164,7 +155,7 @@ OutlierResult RejectOutliers(const std::vector<Eigen::Quaterniond>& q_WV,
     result.reason = "outlier options need k_mad > 0 and non-negative threshold floors";
     return result;
   }
-  const RotationL1MedianResult rotation_median = ComputeRotationL1Median(q_WV, {}, options.median);
+  const RotationL1MedianResult rotation_median = ComputeRotationL1Median(quat_WV, {}, options.median);
   if (!rotation_median.valid) {
     result.reason = rotation_median.reason;
     return result;
@@ -177,17 +168,17 @@ OutlierResult RejectOutliers(const std::vector<Eigen::Quaterniond>& q_WV,
   result.q_WV_median = rotation_median.q_WV_median;
   result.p_WV_median = point_median.p_W_median;
 
-  const size_t n = q_WV.size();
+  const size_t n = quat_WV.size();
   std::vector<double> rotation_deg(n), translation_m(n);
   for (size_t i = 0; i < n; ++i) {
-    rotation_deg[i] = kRadToDeg * GeodesicDistance(result.q_WV_median, q_WV[i]);
+    rotation_deg[i] = kRadToDeg * GeodesicDistance(result.q_WV_median, quat_WV[i]);
     translation_m[i] = (p_WV[i] - result.p_WV_median).norm();
   }
   auto threshold = [&](const std::vector<double>& d, double floor) {
-    const double med = Median(d);
+    const double med = stats::Median(d);
     std::vector<double> deviation(d.size());
     for (size_t i = 0; i < d.size(); ++i) deviation[i] = std::abs(d[i] - med);
-    return std::max(floor, med + options.k_mad * kMadToSigma * Median(deviation));
+    return std::max(floor, med + options.k_mad * kMadToSigma * stats::Median(deviation));
   };
   result.rotation_threshold_deg = threshold(rotation_deg, options.min_rotation_threshold_deg);
   result.translation_threshold_m = threshold(translation_m, options.min_translation_threshold_m);

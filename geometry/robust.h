@@ -50,7 +50,7 @@ struct RotationL1MedianResult {
 
 /// Geodesic L1 median on SO(3), started from the chordal mean. Samples/weights as in
 /// rotation_mean.h (validated the same way).
-RotationL1MedianResult ComputeRotationL1Median(const std::vector<Eigen::Quaterniond>& q_WV,
+RotationL1MedianResult ComputeRotationL1Median(const std::vector<Eigen::Quaterniond>& quat_WV,
                                                const std::vector<double>& weights = {},
                                                const L1MedianOptions& options = {});
 
@@ -103,11 +103,9 @@ struct OutlierResult {
   double translation_threshold_m = 0.0;
 };
 
-/// Median/MAD rejection over trials X_WV_i = (q_WV[i], p_WV[i]); sizes must match.
-OutlierResult RejectOutliers(const std::vector<Eigen::Quaterniond>& q_WV,
+/// Median/MAD rejection over trials X_WV_i = (quat_WV[i], p_WV[i]); sizes must match.
+OutlierResult RejectOutliers(const std::vector<Eigen::Quaterniond>& quat_WV,
                              const std::vector<Eigen::Vector3d>& p_WV, const OutlierOptions& options = {});
 
-/// The median of values (mean of the two middle ones for an even count); 0 for none.
-double Median(std::vector<double> values);
 
 }  // namespace orbed::geometry

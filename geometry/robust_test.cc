@@ -17,12 +17,6 @@ namespace {
 using testing::AngleBetween;
 using testing::Rot;
 
-TEST(RobustTest, MedianOfValues) {
-  EXPECT_EQ(Median({3.0, 1.0, 2.0}), 2.0);
-  EXPECT_EQ(Median({4.0, 1.0, 3.0, 2.0}), 2.5);
-  EXPECT_EQ(Median({}), 0.0);
-}
-
 TEST(RobustTest, RotationL1MedianOnOneGeodesicIsTheMiddleSample) {
   // On one axis the geodesic L1 median is the ordinary median of the angles: exactly on a sample,
   // where the plain Weiszfeld step divides by zero.

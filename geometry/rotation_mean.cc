@@ -6,13 +6,13 @@
 #include <Eigen/Eigenvalues>
 
 #include "geometry/so3.h"
+#include "base/units.h"
 
 namespace orbed::geometry {
 namespace {
 
 constexpr double kUnitTolerance = 1e-6;
 constexpr double kHalfPi = 1.5707963267948966;
-constexpr double kPi = 3.141592653589793;
 
 // Rotation vector of the residual conj(q_bar)·q_i, hemisphere-fixed (θ ∈ [0, π]).
 inline Eigen::Vector3d Residual(const Eigen::Quaterniond& q_bar_conj, const Eigen::Quaterniond& q_i) {
@@ -21,15 +21,15 @@ inline Eigen::Vector3d Residual(const Eigen::Quaterniond& q_bar_conj, const Eige
 
 }  // namespace
 
-std::string ValidateRotationSamples(const std::vector<Eigen::Quaterniond>& q_WV,
+std::string ValidateRotationSamples(const std::vector<Eigen::Quaterniond>& quat_WV,
                                     const std::vector<double>& weights) {
-  if (q_WV.empty()) return "no rotations to average";
-  if (!weights.empty() && weights.size() != q_WV.size()) {
-    return "got " + std::to_string(weights.size()) + " weights for " + std::to_string(q_WV.size()) +
+  if (quat_WV.empty()) return "no rotations to average";
+  if (!weights.empty() && weights.size() != quat_WV.size()) {
+    return "got " + std::to_string(weights.size()) + " weights for " + std::to_string(quat_WV.size()) +
            " rotations";
   }
-  for (size_t i = 0; i < q_WV.size(); ++i) {
-    const Eigen::Quaterniond& q = q_WV[i];
+  for (size_t i = 0; i < quat_WV.size(); ++i) {
+    const Eigen::Quaterniond& q = quat_WV[i];
     if (!q.coeffs().allFinite()) return "rotation " + std::to_string(i) + " has a non-finite component";
     if (std::abs(q.norm() - 1.0) > kUnitTolerance) {
       return "rotation " + std::to_string(i) + " is not a unit quaternion (norm " + std::to_string(q.norm()) +
@@ -49,18 +49,18 @@ std::string ValidateRotationSamples(const std::vector<Eigen::Quaterniond>& q_WV,
   return "";
 }
 
-ChordalMeanResult ComputeChordalMean(const std::vector<Eigen::Quaterniond>& q_WV,
+ChordalMeanResult ComputeChordalMean(const std::vector<Eigen::Quaterniond>& quat_WV,
                                      const std::vector<double>& weights) {
   ChordalMeanResult result;
-  result.reason = ValidateRotationSamples(q_WV, weights);
+  result.reason = ValidateRotationSamples(quat_WV, weights);
   if (!result.reason.empty()) return result;
 
   // M = Σ w_i q_i q_iᵀ / Σ w_i, with q as the 4-vector (x, y, z, w); the sign of q cancels.
   Eigen::Matrix4d M = Eigen::Matrix4d::Zero();
   double weight_sum = 0.0;
-  for (size_t i = 0; i < q_WV.size(); ++i) {
+  for (size_t i = 0; i < quat_WV.size(); ++i) {
     const double w = weights.empty() ? 1.0 : weights[i];
-    const Eigen::Vector4d c = q_WV[i].coeffs();
+    const Eigen::Vector4d c = quat_WV[i].coeffs();
     M.selfadjointView<Eigen::Lower>().rankUpdate(c, w);
     weight_sum += w;
   }
@@ -78,14 +78,14 @@ ChordalMeanResult ComputeChordalMean(const std::vector<Eigen::Quaterniond>& q_WV
   return result;
 }
 
-KarcherMeanResult ComputeKarcherMean(const std::vector<Eigen::Quaterniond>& q_WV,
+KarcherMeanResult ComputeKarcherMean(const std::vector<Eigen::Quaterniond>& quat_WV,
                                      const std::vector<double>& weights, const KarcherOptions& options) {
   KarcherMeanResult result;
   if (!(options.step_tolerance_rad > 0.0) || options.max_iterations < 1) {
     result.reason = "Karcher options need step_tolerance_rad > 0 and max_iterations >= 1";
     return result;
   }
-  const ChordalMeanResult start = ComputeChordalMean(q_WV, weights);
+  const ChordalMeanResult start = ComputeChordalMean(quat_WV, weights);
   if (!start.valid) {
     result.reason = start.reason;
     return result;
@@ -95,7 +95,7 @@ KarcherMeanResult ComputeKarcherMean(const std::vector<Eigen::Quaterniond>& q_WV
 
   double weight_sum = 0.0;
   if (weights.empty()) {
-    weight_sum = static_cast<double>(q_WV.size());
+    weight_sum = static_cast<double>(quat_WV.size());
   } else {
     for (double w : weights) weight_sum += w;
   }
@@ -109,8 +109,8 @@ KarcherMeanResult ComputeKarcherMean(const std::vector<Eigen::Quaterniond>& q_WV
     const Eigen::Quaterniond q_bar_conj = q_bar.conjugate();
     Eigen::Vector3d step = Eigen::Vector3d::Zero();
     double max_sq = 0.0;
-    for (size_t i = 0; i < q_WV.size(); ++i) {
-      const Eigen::Vector3d r = Residual(q_bar_conj, q_WV[i]);
+    for (size_t i = 0; i < quat_WV.size(); ++i) {
+      const Eigen::Vector3d r = Residual(q_bar_conj, quat_WV[i]);
       const double w = weights.empty() ? 1.0 : weights[i];
       step += w * r;
       // Only samples with weight contribute to the certificate (zero weight = not in the set).
@@ -132,9 +132,9 @@ KarcherMeanResult ComputeKarcherMean(const std::vector<Eigen::Quaterniond>& q_WV
   if (!residuals_current) {
     const Eigen::Quaterniond q_bar_conj = q_bar.conjugate();
     double max_sq = 0.0;
-    for (size_t i = 0; i < q_WV.size(); ++i) {
+    for (size_t i = 0; i < quat_WV.size(); ++i) {
       if (!weights.empty() && weights[i] <= 0.0) continue;
-      max_sq = std::max(max_sq, Residual(q_bar_conj, q_WV[i]).squaredNorm());
+      max_sq = std::max(max_sq, Residual(q_bar_conj, quat_WV[i]).squaredNorm());
     }
     max_residual = std::sqrt(max_sq);
     max_residual_seen = std::max(max_residual_seen, max_residual);

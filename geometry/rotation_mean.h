@@ -34,7 +34,7 @@
 namespace orbed::geometry {
 
 /// Checks samples and weights as described above. Returns "" when usable, else the reason.
-std::string ValidateRotationSamples(const std::vector<Eigen::Quaterniond>& q_WV,
+std::string ValidateRotationSamples(const std::vector<Eigen::Quaterniond>& quat_WV,
                                     const std::vector<double>& weights);
 
 /// The chordal L2 mean: the unit eigenvector of the largest eigenvalue of M = Σ w_i q_i q_iᵀ / Σ w_i
@@ -49,7 +49,7 @@ struct ChordalMeanResult {
   double eigen_gap = 0.0;
 };
 
-ChordalMeanResult ComputeChordalMean(const std::vector<Eigen::Quaterniond>& q_WV,
+ChordalMeanResult ComputeChordalMean(const std::vector<Eigen::Quaterniond>& quat_WV,
                                      const std::vector<double>& weights = {});
 
 struct KarcherOptions {
@@ -86,7 +86,7 @@ struct KarcherMeanResult {
   bool ambiguous = false;
 };
 
-KarcherMeanResult ComputeKarcherMean(const std::vector<Eigen::Quaterniond>& q_WV,
+KarcherMeanResult ComputeKarcherMean(const std::vector<Eigen::Quaterniond>& quat_WV,
                                      const std::vector<double>& weights = {},
                                      const KarcherOptions& options = {});
 

@@ -5,6 +5,7 @@
 
 #include "geometry/so3.h"
 #include "base/units.h"
+#include "base/stats.h"
 
 namespace orbed::geometry {
 namespace {
@@ -25,22 +26,22 @@ const char* AveragingMethodName(AveragingMethod method) {
   return "unknown";
 }
 
-Se3MeanResult ComputeSe3Mean(const std::vector<Eigen::Quaterniond>& q_WV,
+Se3MeanResult ComputeSe3Mean(const std::vector<Eigen::Quaterniond>& quat_WV,
                              const std::vector<Eigen::Vector3d>& p_WV, const Se3MeanOptions& options) {
   Se3MeanResult result;
   result.method = options.method;
-  result.num_trials = static_cast<int>(q_WV.size());
+  result.num_trials = static_cast<int>(quat_WV.size());
   if (options.method != AveragingMethod::kChordal && options.method != AveragingMethod::kKarcher &&
       options.method != AveragingMethod::kRobust) {
     result.reason = "unknown averaging method " + std::to_string(static_cast<int>(options.method));
     return result;
   }
-  if (q_WV.size() != p_WV.size()) {
-    result.reason = "got " + std::to_string(q_WV.size()) + " rotations but " + std::to_string(p_WV.size()) +
+  if (quat_WV.size() != p_WV.size()) {
+    result.reason = "got " + std::to_string(quat_WV.size()) + " rotations but " + std::to_string(p_WV.size()) +
                     " translations";
     return result;
   }
-  if (q_WV.empty()) {
+  if (quat_WV.empty()) {
     result.reason = "no trials to average";
     return result;
   }
@@ -54,7 +55,7 @@ Se3MeanResult ComputeSe3Mean(const std::vector<Eigen::Quaterniond>& q_WV,
     result.reason = "model centroid p_VC has a non-finite coordinate";
     return result;
   }
-  const std::string rotation_problem = ValidateRotationSamples(q_WV, {});
+  const std::string rotation_problem = ValidateRotationSamples(quat_WV, {});
   if (!rotation_problem.empty()) {
     result.reason = rotation_problem;
     return result;
@@ -62,7 +63,7 @@ Se3MeanResult ComputeSe3Mean(const std::vector<Eigen::Quaterniond>& q_WV,
 
   // 1. Which trials to use.
   if (options.method == AveragingMethod::kRobust) {
-    const OutlierResult outliers = RejectOutliers(q_WV, p_WV, options.outlier);
+    const OutlierResult outliers = RejectOutliers(quat_WV, p_WV, options.outlier);
     if (!outliers.valid) {
       result.reason = outliers.reason;
       return result;
@@ -70,15 +71,15 @@ Se3MeanResult ComputeSe3Mean(const std::vector<Eigen::Quaterniond>& q_WV,
     result.used = outliers.inliers;
     result.rejected = outliers.rejected;
   } else {
-    result.used.resize(q_WV.size());
-    for (size_t i = 0; i < q_WV.size(); ++i) result.used[i] = static_cast<int>(i);
+    result.used.resize(quat_WV.size());
+    for (size_t i = 0; i < quat_WV.size(); ++i) result.used[i] = static_cast<int>(i);
   }
   std::vector<Eigen::Quaterniond> q_used;
   std::vector<Eigen::Vector3d> p_used;
   q_used.reserve(result.used.size());
   p_used.reserve(result.used.size());
   for (int i : result.used) {
-    q_used.push_back(q_WV[i]);
+    q_used.push_back(quat_WV[i]);
     p_used.push_back(p_WV[i]);
   }
 
@@ -138,7 +139,7 @@ Se3MeanResult ComputeSe3Mean(const std::vector<Eigen::Quaterniond>& q_WV,
     d.translation_covariance_m2 += e * e.transpose();
   }
   d.rotation_rms_deg = kRadToDeg * std::sqrt(sum_sq_angle * inv_n);
-  d.rotation_median_deg = Median(angles_deg);
+  d.rotation_median_deg = stats::Median(angles_deg);
   d.rotation_max_deg = kRadToDeg * max_angle;
   d.rotation_covariance_rad2 *= inv_n;
   d.translation_rms_m = std::sqrt(sum_sq_translation * inv_n);

@@ -78,9 +78,9 @@ struct Se3MeanResult {
   Se3Dispersion dispersion;
 };
 
-/// Averages trials X_WV_i = (q_WV[i], p_WV[i]). Validates sizes, finiteness and unit quaternions;
+/// Averages trials X_WV_i = (quat_WV[i], p_WV[i]). Validates sizes, finiteness and unit quaternions;
 /// on failure valid = false with the reason.
-Se3MeanResult ComputeSe3Mean(const std::vector<Eigen::Quaterniond>& q_WV,
+Se3MeanResult ComputeSe3Mean(const std::vector<Eigen::Quaterniond>& quat_WV,
                              const std::vector<Eigen::Vector3d>& p_WV, const Se3MeanOptions& options = {});
 
 }  // namespace orbed::geometry

@@ -47,10 +47,10 @@ Eigen::Quaterniond ExpQuaternion(const Eigen::Vector3d& w) {
 
 Eigen::Matrix3d ExpSO3(const Eigen::Vector3d& w) { return ExpQuaternion(w).toRotationMatrix(); }
 
-Eigen::Vector3d LogQuaternion(const Eigen::Quaterniond& q) {
-  // q = (cos(θ/2), sin(θ/2)·a) up to sign and scale; pick the w ≥ 0 hemisphere so θ ∈ [0, π].
-  double w = q.w();
-  Eigen::Vector3d v = q.vec();
+Eigen::Vector3d LogQuaternion(const Eigen::Quaterniond& quat) {
+  // quat = (cos(θ/2), sin(θ/2)·a) up to sign and scale; pick the w ≥ 0 hemisphere so θ ∈ [0, π].
+  double w = quat.w();
+  Eigen::Vector3d v = quat.vec();
   if (w < 0.0) {
     w = -w;
     v = -v;
@@ -67,23 +67,23 @@ Eigen::Vector3d LogQuaternion(const Eigen::Quaterniond& q) {
 
 Eigen::Vector3d LogSO3(const Eigen::Matrix3d& R) { return LogQuaternion(Eigen::Quaterniond(R)); }
 
-double RotationAngle(const Eigen::Quaterniond& q) {
-  return 2.0 * std::atan2(q.vec().norm(), std::abs(q.w()));
+double RotationAngle(const Eigen::Quaterniond& quat) {
+  return 2.0 * std::atan2(quat.vec().norm(), std::abs(quat.w()));
 }
 
-double GeodesicDistance(const Eigen::Quaterniond& q_a, const Eigen::Quaterniond& q_b) {
-  return RotationAngle(q_a.conjugate() * q_b);
+double GeodesicDistance(const Eigen::Quaterniond& quat_a, const Eigen::Quaterniond& quat_b) {
+  return RotationAngle(quat_a.conjugate() * quat_b);
 }
 
-Eigen::Quaterniond CanonicalQuaternion(const Eigen::Quaterniond& q) {
+Eigen::Quaterniond CanonicalQuaternion(const Eigen::Quaterniond& quat) {
   double sign = 1.0;
-  if (q.w() < 0.0) {
+  if (quat.w() < 0.0) {
     sign = -1.0;
-  } else if (q.w() == 0.0) {
-    const double first = q.x() != 0.0 ? q.x() : (q.y() != 0.0 ? q.y() : q.z());
+  } else if (quat.w() == 0.0) {
+    const double first = quat.x() != 0.0 ? quat.x() : (quat.y() != 0.0 ? quat.y() : quat.z());
     if (first < 0.0) sign = -1.0;
   }
-  return Eigen::Quaterniond(sign * q.w(), sign * q.x(), sign * q.y(), sign * q.z());
+  return Eigen::Quaterniond(sign * quat.w(), sign * quat.x(), sign * quat.y(), sign * quat.z());
 }
 
 RotationCheck ValidateRotationMatrix(const Eigen::Matrix3d& R, const RotationTolerance& tolerance) {
@@ -114,7 +114,7 @@ RotationCheck ValidateRotationMatrix(const Eigen::Matrix3d& R, const RotationTol
     check.projected = true;
     check.message = Format("rotation matrix projected to SO(3): |R^T R - I|_F was %.3g", check.error);
   }
-  check.q = Eigen::Quaterniond(R_use).normalized();
+  check.quat = Eigen::Quaterniond(R_use).normalized();
   check.valid = true;
   return check;
 }
@@ -132,12 +132,12 @@ RotationCheck ValidateQuaternionWxyz(const Eigen::Vector4d& wxyz, const Rotation
         Format("quaternion norm %.9g is not 1 (off by more than %.3g)", norm, tolerance.projectable);
     return check;
   }
-  check.q = Eigen::Quaterniond(wxyz[0], wxyz[1], wxyz[2], wxyz[3]);
+  check.quat = Eigen::Quaterniond(wxyz[0], wxyz[1], wxyz[2], wxyz[3]);
   if (check.error > tolerance.exact) {
     check.projected = true;
     check.message = Format("quaternion normalized: its norm was %.9g", norm);
   }
-  check.q.normalize();
+  check.quat.normalize();
   check.valid = true;
   return check;
 }

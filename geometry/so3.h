@@ -35,20 +35,20 @@ Eigen::Matrix3d ExpSO3(const Eigen::Vector3d& w);
 /// log: unit quaternion (either sign) → rotation vector θ·a [rad], θ ∈ [0, π]. At exactly θ = π
 /// the axis sign is the one carried by the quaternion's vector part (both are valid logs).
 /// The quaternion need not be exactly unit: only its direction matters.
-Eigen::Vector3d LogQuaternion(const Eigen::Quaterniond& q);
+Eigen::Vector3d LogQuaternion(const Eigen::Quaterniond& quat);
 
 /// log: rotation matrix (must already be in SO(3); see ValidateRotationMatrix) → θ·a [rad].
 Eigen::Vector3d LogSO3(const Eigen::Matrix3d& R);
 
 /// Rotation angle of q [rad], in [0, π].
-double RotationAngle(const Eigen::Quaterniond& q);
+double RotationAngle(const Eigen::Quaterniond& quat);
 
-/// Geodesic distance between two rotations, the angle of q_a⁻¹·q_b [rad], in [0, π].
-double GeodesicDistance(const Eigen::Quaterniond& q_a, const Eigen::Quaterniond& q_b);
+/// Geodesic distance between two rotations, the angle of quat_a⁻¹·quat_b [rad], in [0, π].
+double GeodesicDistance(const Eigen::Quaterniond& quat_a, const Eigen::Quaterniond& quat_b);
 
 /// The representative of ±q with w > 0; when w == 0 the first non-zero of (x, y, z) is made
 /// positive. Gives every rotation a single printed form.
-Eigen::Quaterniond CanonicalQuaternion(const Eigen::Quaterniond& q);
+Eigen::Quaterniond CanonicalQuaternion(const Eigen::Quaterniond& quat);
 
 /// Tolerances for accepting rotations from outside.
 struct RotationTolerance {
@@ -67,7 +67,7 @@ struct RotationCheck {
   /// ‖RᵀR − I‖_F for matrices, |‖q‖ − 1| for quaternions.
   double error = 0.0;
   /// The usable rotation (identity when !valid).
-  Eigen::Quaterniond q = Eigen::Quaterniond::Identity();
+  Eigen::Quaterniond quat = Eigen::Quaterniond::Identity();
   /// Why it was rejected, or what projection did ("" when valid and untouched).
   std::string message;
 };

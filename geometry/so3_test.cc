@@ -7,10 +7,10 @@
 
 #include <gtest/gtest.h>
 
+#include "base/units.h"
+
 namespace orbed::geometry {
 namespace {
-
-constexpr double kPi = 3.141592653589793;
 
 // Exact quaternion for angle θ about unit axis a.
 Eigen::Quaterniond AxisAngleQuaternion(double theta, const Eigen::Vector3d& a) {
@@ -98,7 +98,7 @@ TEST(So3Test, ValidRotationMatrixIsAcceptedUntouched) {
   const RotationCheck check = ValidateRotationMatrix(R);
   ASSERT_TRUE(check.valid) << check.message;
   EXPECT_FALSE(check.projected);
-  EXPECT_TRUE(check.q.toRotationMatrix().isApprox(R, 1e-14));
+  EXPECT_TRUE(check.quat.toRotationMatrix().isApprox(R, 1e-14));
 }
 
 TEST(So3Test, SlightlyOffRotationIsProjectedAndSaysSo) {
@@ -110,7 +110,7 @@ TEST(So3Test, SlightlyOffRotationIsProjectedAndSaysSo) {
   ASSERT_TRUE(check.valid) << check.message;
   EXPECT_TRUE(check.projected);
   EXPECT_NE(check.message.find("projected"), std::string::npos);
-  EXPECT_LT(GeodesicDistance(check.q, Eigen::Quaterniond(R)), 2e-5);
+  EXPECT_LT(GeodesicDistance(check.quat, Eigen::Quaterniond(R)), 2e-5);
 }
 
 TEST(So3Test, GarbageRotationsAreRejectedWithAReason) {
@@ -140,7 +140,7 @@ TEST(So3Test, QuaternionValidation) {
   check = ValidateQuaternionWxyz(Eigen::Vector4d(1.0001, 0, 0, 0));
   EXPECT_TRUE(check.valid);
   EXPECT_TRUE(check.projected);
-  EXPECT_DOUBLE_EQ(check.q.w(), 1.0);
+  EXPECT_DOUBLE_EQ(check.quat.w(), 1.0);
   check = ValidateQuaternionWxyz(Eigen::Vector4d(2, 0, 0, 0));
   EXPECT_FALSE(check.valid);
   EXPECT_NE(check.message.find("norm"), std::string::npos);

@@ -12,8 +12,6 @@
 namespace orbed::geometry {
 namespace {
 
-constexpr double kPi = 3.141592653589793;
-
 // Angle between unit vectors [rad] in [0, π], from atan2 (accurate at 0 and π).
 double AngleBetween(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   return std::atan2(a.cross(b).norm(), a.dot(b));

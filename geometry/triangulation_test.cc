@@ -6,10 +6,10 @@
 
 #include <gtest/gtest.h>
 
+#include "base/units.h"
+
 namespace orbed::geometry {
 namespace {
-
-constexpr double kPi = 3.141592653589793;
 
 TEST(TriangulationTest, TwoRaysThroughAKnownPointRecoverIt) {
   const Eigen::Vector3d p_WX(0.3, -0.2, 1.5);

@@ -12,11 +12,10 @@
 
 #include "sim/robot_model.h"
 #include "sim/scene.h"
+#include "base/units.h"
 
 namespace orbed::hmd {
 namespace {
-
-constexpr double kDeg = M_PI / 180.0;
 
 HmdConfigSet ShippedConfigs() {
   std::vector<std::string> paths;
@@ -29,7 +28,7 @@ HeadsetTrialInputs Inputs(const HmdConfigSet& config) {
   const sim::RobotModel robot =
       sim::LoadRobotForScene(HmdSourcePath(sim::RobotModel::kDefaultUrdfRelativePath), scene);
   Eigen::VectorXd q(7);
-  q << 0, 30 * kDeg, 0, -60 * kDeg, 0, 45 * kDeg, 0;
+  q << 0, 30 * kDegToRad, 0, -60 * kDegToRad, 0, 45 * kDegToRad, 0;
   HeadsetTrialInputs in;
   in.p_RQ = RobotModelPoints(robot, q);
   in.X_WR = scene.X_WR;

@@ -29,11 +29,11 @@
 #include "hmd_emulator/headset_trial.h"
 #include "hmd_emulator/renderer.h"
 #include "procs/common/conversions.h"
+#include "base/units.h"
 
 namespace orbed::hmd {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
 using SC = orbed::session_control_t;
 using AT = orbed::alignment_trial_t;
 
@@ -103,7 +103,7 @@ orbed::iiwa_status_t Status(const std::vector<double>& q_deg) {
   orbed::iiwa_status_t m{};
   m.utime = NowMicros();
   m.num_joints = static_cast<int32_t>(q_deg.size());
-  for (double q : q_deg) m.joint_position_measured.push_back(q * kDeg);
+  for (double q : q_deg) m.joint_position_measured.push_back(q * kDegToRad);
   m.joint_velocity_estimated.assign(q_deg.size(), 0.0);
   m.joint_position_commanded = m.joint_position_measured;
   m.joint_position_ipo = m.joint_position_measured;
@@ -172,7 +172,7 @@ TEST(HmdProcess, AnswersEachRequestTrialWithOneAlignmentTrial) {
     EXPECT_EQ(t.display_mode, refl ? +AT::MODE_AR_REFLECTIVE : +AT::MODE_AR);
     EXPECT_EQ(t.num_mirrors, refl ? 1 : 0);
     ASSERT_EQ(t.num_joints, 7);
-    for (int j = 0; j < 7; ++j) EXPECT_NEAR(t.joint_position[j], kQDeg[j] * kDeg, 1e-12);
+    for (int j = 0; j < 7; ++j) EXPECT_NEAR(t.joint_position[j], kQDeg[j] * kDegToRad, 1e-12);
     EXPECT_EQ(t.user_id, "emulated-seed-1");
     EXPECT_GT(t.duration_s, 5.0);  // at least a look and a nudge (user.yaml: 2 s + 5.5 s)
     EXPECT_TRUE(CheckPose(t.X_WV, "X_WV").empty());
@@ -412,7 +412,7 @@ TEST(HmdProcess, CameraReflectiveAndArViewCarryTheirGeometry) {
       sim::RobotModel::LoadFile(HmdSourcePath(sim::RobotModel::kDefaultUrdfRelativePath));
   SceneGeometry robot_only;
   Eigen::VectorXd q(kQDeg.size());
-  for (std::size_t i = 0; i < kQDeg.size(); ++i) q[i] = kQDeg[i] * kDeg;
+  for (std::size_t i = 0; i < kQDeg.size(); ++i) q[i] = kQDeg[i] * kDegToRad;
   robot_only.PoseRobot(robot_only.AddRobot(robot, BodyKind::kRealRobot), q, SceneX_WR());
   ASSERT_EQ(got.truth.size(), 1u);
   const Eigen::Isometry3d X_WH_true = FromPose(got.truth[0].X_WH);
@@ -482,7 +482,7 @@ TEST(HmdProcess, InteractiveKeysMoveTheHologramAndEnterSubmits) {
   EXPECT_NEAR((hmd.CurrentX_WV().translation() - X_WV0.translation()).y(), 0.010, 1e-12);
   hmd.HandleKey('l');  // yaw +0.5 deg about z_W
   const Eigen::Matrix3d R = X_WV0.linear().transpose() * hmd.CurrentX_WV().linear();
-  EXPECT_NEAR(Eigen::AngleAxisd(R).angle(), 0.5 * kDeg, 1e-12);
+  EXPECT_NEAR(Eigen::AngleAxisd(R).angle(), 0.5 * kDegToRad, 1e-12);
   const Eigen::Matrix3d dR = hmd.CurrentX_WV().linear() * X_WV0.linear().transpose();
   EXPECT_NEAR(Eigen::AngleAxisd(dR).axis().z(), 1.0, 1e-9);
 
@@ -571,7 +571,7 @@ TEST(HmdConfig, OverlaysMergeKeyByKey) {
   EXPECT_DOUBLE_EQ(set.slam.jitter_translation_std_m, 0.004);
   EXPECT_DOUBLE_EQ(set.hmd.gaze_hz, 20);
   EXPECT_DOUBLE_EQ(set.user.gain, 0.5);
-  EXPECT_NEAR(Eigen::AngleAxisd(set.user.X_RV_start.linear()).angle(), 10 * M_PI / 180, 1e-12);
+  EXPECT_NEAR(Eigen::AngleAxisd(set.user.X_RV_start.linear()).angle(), 10 * kDegToRad, 1e-12);
   // What they leave: the start offset's position (shipped: 0.10, -0.08, 0.05), the rest of the
   // user, the SLAM model and the process as the shipped files set them.
   EXPECT_TRUE(set.user.X_RV_start.translation().isApprox(shipped.user.X_RV_start.translation(), 0));

@@ -18,11 +18,10 @@
 #include "hmd_emulator/hmd_config.h"
 #include "hmd_emulator/pose_stream.h"
 #include "procs/common/conversions.h"
+#include "base/units.h"
 
 namespace orbed::hmd {
 namespace {
-
-constexpr double kDeg = M_PI / 180.0;
 
 template <class Msg>
 std::vector<std::uint8_t> Bytes(const Msg& msg) {
@@ -77,7 +76,7 @@ RobotState Robot(const std::vector<double>& q_deg, const Eigen::Isometry3d& X_WR
   RobotState robot;
   robot.have_q = robot.have_X_WR = true;
   robot.q_rad.resize(static_cast<int>(q_deg.size()));
-  for (std::size_t i = 0; i < q_deg.size(); ++i) robot.q_rad[i] = q_deg[i] * kDeg;
+  for (std::size_t i = 0; i < q_deg.size(); ++i) robot.q_rad[i] = q_deg[i] * kDegToRad;
   robot.X_WR = X_WR;
   return robot;
 }

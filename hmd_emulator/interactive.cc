@@ -236,7 +236,7 @@ cv::Mat InteractiveSession::Window(const cv::Mat& ar_view, const cv::Mat& reflec
   const Eigen::Isometry3d& X_WV = X_WV_shown;
   const Eigen::Vector3d dp_mm = (X_WV.translation() - X_WV_start_.translation()) * 1e3;
   const double dtheta_deg =
-      Eigen::AngleAxisd(X_WV_start_.linear().transpose() * X_WV.linear()).angle() * 180.0 / M_PI;
+      Eigen::AngleAxisd(X_WV_start_.linear().transpose() * X_WV.linear()).angle() * kRadToDeg;
   char text[256];
   std::snprintf(text, sizeof(text),
                 "X_WV from the start pose: (%+.1f, %+.1f, %+.1f) mm, %.2f deg   robot: %s   tracking: %s",

@@ -5,10 +5,10 @@
 #include <stdexcept>
 #include <utility>
 
+#include "base/units.h"
+
 namespace orbed::hmd {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 // Muted OR colours for scene objects (BGR), cycled by object index.
 constexpr ColorBgr kScenePalette[] = {

@@ -2,6 +2,7 @@
 // sphere-sphere, and hand-computed robot poses.
 #include "sim/collision_world.h"
 #include "base/source_paths.h"
+#include "base/units.h"
 
 #include <algorithm>
 #include <cmath>
@@ -17,7 +18,6 @@
 namespace orbed::sim {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 using Kind = CollisionPrimitive::Kind;
 
 RobotModel LoadIiwa() {
@@ -27,7 +27,7 @@ RobotModel LoadIiwa() {
 Eigen::VectorXd Deg(std::initializer_list<double> v) {
   Eigen::VectorXd q(v.size());
   int i = 0;
-  for (double x : v) q[i++] = x * kPi / 180.0;
+  for (double x : v) q[i++] = x * kDegToRad;
   return q;
 }
 

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "base/format.h"
+#include "base/units.h"
 
 namespace orbed::sim {
 namespace {
@@ -81,9 +82,9 @@ void ManualArm::SetCommand(const Eigen::VectorXd& q_command_rad) {
     if (target[i] == q_command_rad[i]) continue;
     const bool upper = q_command_rad[i] > upper_[i];
     if (!clamp_reason_.empty()) clamp_reason_ += "; ";
-    clamp_reason_ += model().joints()[i].name + " commanded " + Fixed(q_command_rad[i] * 180 / M_PI, 1) +
+    clamp_reason_ += model().joints()[i].name + " commanded " + Fixed(q_command_rad[i] * kRadToDeg, 1) +
                      " deg, stopped at its " + (upper ? "upper" : "lower") + " limit " +
-                     Fixed((upper ? upper_[i] : lower_[i]) * 180 / M_PI, 1) + " deg";
+                     Fixed((upper ? upper_[i] : lower_[i]) * kRadToDeg, 1) + " deg";
   }
   if (target != target_) blocked_ = false;  // a new target: the old refusal no longer applies
   target_ = target;

@@ -9,10 +9,10 @@
 
 #include <urdf_parser/urdf_parser.h>
 
+#include "base/units.h"
+
 namespace orbed::sim {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 std::string Fmt(double v, int precision = 3) {
   std::ostringstream os;
@@ -68,8 +68,8 @@ std::vector<CollisionPrimitive> FuseCapsules(const std::vector<CollisionPrimitiv
   return out;
 }
 
-Eigen::VectorXd DegToRad(const Eigen::VectorXd& q_deg) { return q_deg * (kPi / 180.0); }
-Eigen::VectorXd RadToDeg(const Eigen::VectorXd& q_rad) { return q_rad * (180.0 / kPi); }
+Eigen::VectorXd DegToRad(const Eigen::VectorXd& q_deg) { return q_deg * kDegToRad; }
+Eigen::VectorXd RadToDeg(const Eigen::VectorXd& q_rad) { return q_rad * kRadToDeg; }
 
 RobotModel RobotModel::LoadFile(const std::string& path, const std::string& flange_link,
                                 const std::string& tool_tip_link) {
@@ -321,8 +321,8 @@ std::string RobotModel::ValidateJointVector(const Eigen::VectorXd& q_rad, double
     const JointInfo& j = joints_[i];
     if (!std::isfinite(q_rad[i])) return j.name + " is not a finite number";
     if (q_rad[i] < j.lower_rad - tolerance_rad || q_rad[i] > j.upper_rad + tolerance_rad) {
-      return j.name + " = " + Fmt(q_rad[i] * 180.0 / kPi) + " deg is outside [" +
-             Fmt(j.lower_rad * 180.0 / kPi, 1) + ", " + Fmt(j.upper_rad * 180.0 / kPi, 1) + "] deg";
+      return j.name + " = " + Fmt(q_rad[i] * kRadToDeg) + " deg is outside [" +
+             Fmt(j.lower_rad * kRadToDeg, 1) + ", " + Fmt(j.upper_rad * kRadToDeg, 1) + "] deg";
     }
   }
   return "";

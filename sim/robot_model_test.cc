@@ -1,6 +1,7 @@
 // Tests of the URDF robot model against an independent standard-DH evaluation of the iiwa 7.
 #include "sim/robot_model.h"
 #include "base/source_paths.h"
+#include "base/units.h"
 
 #include <cmath>
 #include <cstdlib>
@@ -10,8 +11,6 @@
 
 namespace orbed::sim {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 RobotModel LoadIiwa() {
   return RobotModel::LoadFile(orbed::SourceTreePath(RobotModel::kDefaultUrdfRelativePath));

@@ -16,6 +16,7 @@
 #include "sim/scene.h"
 #include "sim/trocar_clearance.h"
 #include "sim/trocar_ik.h"
+#include "base/units.h"
 
 namespace orbed::sim {
 namespace {
@@ -189,7 +190,7 @@ int RunIk(const std::string& scene_path, const std::string& urdf, uint64_t seed,
     j.Key("clearance_m").Number(MakeTrocarArmClearanceFunction(model, scene)(ik.q_rad));
     j.Key("objective").Number(ik.clearance_m);
     j.Key("position_error_m").Number(ik.position_error_m);
-    j.Key("angle_error_deg").Number(ik.angle_error_rad * 180.0 / M_PI);
+    j.Key("angle_error_deg").Number(ik.angle_error_rad * kRadToDeg);
     const Eigen::Isometry3d X_WT = scene.X_WR * model.CalcToolTipPose(ik.q_rad);
     j.Key("p_WT");
     WriteVec(j, X_WT.translation());

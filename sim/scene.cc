@@ -5,11 +5,10 @@
 #include <stdexcept>
 
 #include "base/yaml_fields.h"
+#include "base/units.h"
 
 namespace orbed::sim {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 Eigen::Isometry3d Pose(const YamlFields& f, const YAML::Node& node, const std::string& key) {
   f.CheckKeys(node, key, {"position_m", "rpy_deg"});
@@ -106,7 +105,7 @@ Scene LoadScene(const YAML::Node& root, const std::string& source) {
 }  // namespace
 
 Eigen::Matrix3d RotationFromRpyDeg(const Eigen::Vector3d& rpy_deg) {
-  const Eigen::Vector3d r = rpy_deg * (kPi / 180.0);
+  const Eigen::Vector3d r = rpy_deg * kDegToRad;
   return (Eigen::AngleAxisd(r.z(), Eigen::Vector3d::UnitZ()) *
           Eigen::AngleAxisd(r.y(), Eigen::Vector3d::UnitY()) *
           Eigen::AngleAxisd(r.x(), Eigen::Vector3d::UnitX()))

@@ -60,7 +60,7 @@ int RunMeanCommand(const MeanCommandOptions& options, std::ostream& out, std::os
         << "\n";
     return 2;
   }
-  if (file.q_WV.empty()) {
+  if (file.quat_WV.empty()) {
     err << name << ": error: no trials (expected lines qw,qx,qy,qz,tx,ty,tz)\n";
     return 2;
   }
@@ -72,7 +72,7 @@ int RunMeanCommand(const MeanCommandOptions& options, std::ostream& out, std::os
   geometry::Se3MeanOptions mean_options;
   mean_options.method = options.robust ? geometry::AveragingMethod::kRobust : geometry::AveragingMethod::kKarcher;
   mean_options.p_VC = options.p_VC;
-  const geometry::Se3MeanResult result = geometry::ComputeSe3Mean(file.q_WV, file.p_WV, mean_options);
+  const geometry::Se3MeanResult result = geometry::ComputeSe3Mean(file.quat_WV, file.p_WV, mean_options);
   if (!result.valid) {
     err << name << ": error: " << result.reason << "\n";
     return 1;

@@ -163,7 +163,7 @@ orbed::registration_t RegistrationService::MakeState(int64_t utime, int8_t reaso
   std::vector<Eigen::Quaterniond> q;
   std::vector<Eigen::Vector3d> p;
   for (const Trial& t : trials_) {
-    q.push_back(t.q_WV);
+    q.push_back(t.quat_WV);
     p.push_back(t.p_WV);
   }
   geometry::Se3MeanOptions options;

@@ -83,7 +83,7 @@ class RegistrationService {
  private:
   struct Trial {
     int32_t trial_index;
-    Eigen::Quaterniond q_WV;
+    Eigen::Quaterniond quat_WV;
     Eigen::Vector3d p_WV;
   };
 

@@ -61,7 +61,7 @@ int RunSendCommand(const SendCommandOptions& options, std::ostream& out, std::os
     err << options.input_path << ":" << trials.error_line << ": error: " << trials.error << "\n";
     return 2;
   }
-  if (trials.q_WV.empty()) {
+  if (trials.quat_WV.empty()) {
     err << options.input_path << ": error: no trials in the file\n";
     return 2;
   }
@@ -83,7 +83,7 @@ int RunSendCommand(const SendCommandOptions& options, std::ostream& out, std::os
   control.method =
       options.robust ? orbed::registration_t::METHOD_ROBUST : orbed::registration_t::METHOD_KARCHER;
   lcm.publish(options.session_control_channel, &control);
-  for (size_t i = 0; i < trials.q_WV.size(); ++i) {
+  for (size_t i = 0; i < trials.quat_WV.size(); ++i) {
     orbed::alignment_trial_t trial{};
     trial.utime = t0 + 1 + static_cast<int64_t>(i);
     trial.session_id = options.session_id;
@@ -91,12 +91,12 @@ int RunSendCommand(const SendCommandOptions& options, std::ostream& out, std::os
     trial.display_mode = orbed::alignment_trial_t::MODE_AR;
     // The file's numbers as they are (no round trip through a matrix), so that the server sees
     // exactly what the offline mean sees.
-    QuaternionToWxyz(trials.q_WV[i], trial.X_WV.quaternion_wxyz);
+    QuaternionToWxyz(trials.quat_WV[i], trial.X_WV.quaternion_wxyz);
     FromVector3(trials.p_WV[i], trial.X_WV.position_m);
     trial.user_id = "file:" + options.input_path + ":" + std::to_string(trials.line[i]);
     lcm.publish(options.trial_channel, &trial);
   }
-  control.utime = t0 + 1 + static_cast<int64_t>(trials.q_WV.size());
+  control.utime = t0 + 1 + static_cast<int64_t>(trials.quat_WV.size());
   control.command = orbed::session_control_t::COMPUTE;
   lcm.publish(options.session_control_channel, &control);
 
@@ -109,9 +109,9 @@ int RunSendCommand(const SendCommandOptions& options, std::ostream& out, std::os
     return 1;
   }
   // UDP may lose a trial; a mean of fewer trials than the file holds must not pass silently.
-  if (waiter.answer.num_trials != static_cast<int32_t>(trials.q_WV.size())) {
+  if (waiter.answer.num_trials != static_cast<int32_t>(trials.quat_WV.size())) {
     err << "orbed-registration send: the server holds " << waiter.answer.num_trials << " trials of session '"
-        << options.session_id << "', the file " << trials.q_WV.size()
+        << options.session_id << "', the file " << trials.quat_WV.size()
         << " (messages lost, or another sender on the session?)\n";
     return 1;
   }

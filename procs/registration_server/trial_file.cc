@@ -22,7 +22,7 @@ std::string Trim(const std::string& s) {
 
 }  // namespace
 
-std::string ParseTrialLine(const std::string& text, Eigen::Quaterniond* q_WV, Eigen::Vector3d* p_WV,
+std::string ParseTrialLine(const std::string& text, Eigen::Quaterniond* quat_WV, Eigen::Vector3d* p_WV,
                            double* norm_error) {
   const std::string content = Trim(text.substr(0, text.find('#')));
   if (content.empty()) return "skip";
@@ -58,7 +58,7 @@ std::string ParseTrialLine(const std::string& text, Eigen::Quaterniond* q_WV, Ei
   }
   const geometry::RotationCheck check = geometry::ValidateQuaternionWxyz(Eigen::Vector4d(v[0], v[1], v[2], v[3]));
   if (!check.valid) return check.message;
-  *q_WV = check.q;
+  *quat_WV = check.quat;
   *p_WV = Eigen::Vector3d(v[4], v[5], v[6]);
   *norm_error = check.error;
   return "";
@@ -84,7 +84,7 @@ TrialFile ParseTrialFile(std::istream& in) {
       ++file.normalized;
       file.max_norm_error = std::max(file.max_norm_error, norm_error);
     }
-    file.q_WV.push_back(q);
+    file.quat_WV.push_back(q);
     file.p_WV.push_back(p);
     file.line.push_back(line_number);
   }

@@ -27,7 +27,7 @@ struct TrialFile {
   int error_line = 0;
   std::string error;
   /// The trials in file order, and the 1-based line each came from.
-  std::vector<Eigen::Quaterniond> q_WV;
+  std::vector<Eigen::Quaterniond> quat_WV;
   std::vector<Eigen::Vector3d> p_WV;
   std::vector<int> line;
   /// Quaternions that were normalized, and the largest |‖q‖ − 1| among them.
@@ -40,7 +40,7 @@ TrialFile ParseTrialFile(std::istream& in);
 
 /// Parses one line (without the newline) into q and p. Returns "" on success, "skip" for a blank or
 /// comment-only line, else the reason. `norm_error` receives |‖q‖ − 1| before normalization.
-std::string ParseTrialLine(const std::string& text, Eigen::Quaterniond* q_WV, Eigen::Vector3d* p_WV,
+std::string ParseTrialLine(const std::string& text, Eigen::Quaterniond* quat_WV, Eigen::Vector3d* p_WV,
                            double* norm_error);
 
 }  // namespace orbed::registration

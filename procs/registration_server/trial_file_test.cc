@@ -22,11 +22,11 @@ TEST(TrialFileTest, ParsesTrialsCommentsAndBlankLines) {
       "\t# indented comment\r\n");
   const TrialFile f = ParseTrialFile(in);
   ASSERT_TRUE(f.ok) << f.error;
-  ASSERT_EQ(f.q_WV.size(), 2u);
+  ASSERT_EQ(f.quat_WV.size(), 2u);
   EXPECT_EQ(f.line, (std::vector<int>{3, 4}));
   EXPECT_TRUE(f.p_WV[0].isApprox(Eigen::Vector3d(0.1, 0.2, 0.3)));
   EXPECT_TRUE(f.p_WV[1].isApprox(Eigen::Vector3d(-1, 2, 0.003)));
-  EXPECT_NEAR(f.q_WV[1].z(), std::sqrt(0.5), 1e-15);
+  EXPECT_NEAR(f.quat_WV[1].z(), std::sqrt(0.5), 1e-15);
   EXPECT_EQ(f.normalized, 0);
 }
 
@@ -61,7 +61,7 @@ TEST(TrialFileTest, SlightlyNonUnitQuaternionIsNormalizedAndCounted) {
   ASSERT_TRUE(f.ok) << f.error;
   EXPECT_EQ(f.normalized, 1);
   EXPECT_NEAR(f.max_norm_error, 2e-4, 1e-12);
-  EXPECT_DOUBLE_EQ(f.q_WV[0].w(), 1.0);
+  EXPECT_DOUBLE_EQ(f.quat_WV[0].w(), 1.0);
 }
 
 TEST(MeanCommandTest, MalformedFileExitsTwoNamingTheLine) {

@@ -25,16 +25,15 @@
 #include "viraal/metrics.h"
 #include "viraal/protocol.h"
 #include "viraal/results.h"
+#include "base/units.h"
 
 namespace orbed::scenario {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
-
 // The trocar_or scene's base: (0.25, -0.55, 0.75), yaw 90 deg.
 Eigen::Isometry3d SceneBase() {
   Eigen::Isometry3d X_WR = Eigen::Isometry3d::Identity();
-  X_WR.linear() = Eigen::AngleAxisd(90 * kDeg, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  X_WR.linear() = Eigen::AngleAxisd(90 * kDegToRad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   X_WR.translation() = Eigen::Vector3d(0.25, -0.55, 0.75);
   return X_WR;
 }
@@ -229,8 +228,8 @@ struct HandPoints {
 HandPoints HandForwardKinematics(const std::vector<double>& q_deg) {
   EXPECT_EQ(q_deg[1], 0.0);
   EXPECT_EQ(q_deg[5], 0.0);
-  const double q4 = q_deg[3] * kDeg;
-  const Eigen::Vector3d d = Eigen::AngleAxisd((q_deg[0] + q_deg[2]) * kDeg, Eigen::Vector3d::UnitZ()) *
+  const double q4 = q_deg[3] * kDegToRad;
+  const Eigen::Vector3d d = Eigen::AngleAxisd((q_deg[0] + q_deg[2]) * kDegToRad, Eigen::Vector3d::UnitZ()) *
                             Eigen::Vector3d(-std::sin(q4), 0, std::cos(q4));
   const Eigen::Vector3d elbow(0, 0, 0.74);
   HandPoints p;
@@ -251,7 +250,7 @@ TEST(ViraalScenario, AFullRunOnMemqGivesTheUsersKnownRotatedOffset) {
   // The user misplaces the virtual robot by X_RV: 5 deg about the tilted axis u = (1, −2, 2)/3 and
   // t = (4, −6, 3) mm, both in the base frame R: X_WV = X_WR·X_RV.
   const Eigen::Vector3d u = Eigen::Vector3d(1, -2, 2) / 3;
-  const Eigen::Matrix3d R_RV = Eigen::AngleAxisd(5 * kDeg, u).toRotationMatrix();
+  const Eigen::Matrix3d R_RV = Eigen::AngleAxisd(5 * kDegToRad, u).toRotationMatrix();
   const Eigen::Vector3d p_RV(0.004, -0.006, 0.003);
   Eigen::Isometry3d X_RV = Eigen::Isometry3d::Identity();
   X_RV.linear() = R_RV;

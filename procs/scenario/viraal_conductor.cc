@@ -10,22 +10,17 @@
 #include "procs/common/conversions.h"
 #include "procs/common/validation.h"
 #include "viraal/exchange.h"
+#include "base/format.h"
+#include "base/units.h"
 
 namespace orbed::scenario {
 namespace {
 
-constexpr double kRadToDeg = 180.0 / M_PI;
 constexpr int kMaxJoints = 64;
 constexpr int kMaxLinks = 1000;
 constexpr int kMaxPairs = 10000;
 // Only a ROBOT_STATE received this long after the last IIWA_COMMAND counts as a stop [s].
 constexpr double kFreshStateAfterCommand_s = 0.050;
-
-std::string Fixed(double value, int digits) {
-  char text[64];
-  std::snprintf(text, sizeof(text), "%.*f", digits, value);
-  return text;
-}
 
 std::string JointList(const std::vector<double>& q_deg, int digits) {
   std::string out = "(";

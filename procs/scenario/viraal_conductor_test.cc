@@ -13,11 +13,11 @@
 
 #include "procs/common/conversions.h"
 #include "base/source_paths.h"
+#include "base/units.h"
 
 namespace orbed::scenario {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
 using Phase = ViraalConductor::Phase;
 using Status = ViraalConductor::Status;
 
@@ -36,7 +36,7 @@ class FakeClock {
 // The trocar_or scene's base: (0.25, -0.55, 0.75), yaw 90 deg.
 Eigen::Isometry3d SceneBase() {
   Eigen::Isometry3d X_WR = Eigen::Isometry3d::Identity();
-  X_WR.linear() = Eigen::AngleAxisd(90 * kDeg, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  X_WR.linear() = Eigen::AngleAxisd(90 * kDegToRad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   X_WR.translation() = Eigen::Vector3d(0.25, -0.55, 0.75);
   return X_WR;
 }
@@ -60,7 +60,7 @@ orbed::robot_state_t RobotState(const std::vector<double>& q_rad,
 
 std::vector<double> Rad(const std::vector<double>& q_deg) {
   std::vector<double> q;
-  for (double v : q_deg) q.push_back(v * kDeg);
+  for (double v : q_deg) q.push_back(v * kDegToRad);
   return q;
 }
 
@@ -233,7 +233,7 @@ TEST(ViraalConductor, MissingPlanCheckRepliesFailAfterTheReplyTimeout) {
     EXPECT_EQ(request.utime, bench.clock().Now().utime);
     ASSERT_EQ(request.num_joints, 7);
     for (int j = 0; j < 7; ++j)
-      EXPECT_NEAR(request.joint_position[j], config.configurations_deg[k][j] * kDeg, 1e-15);
+      EXPECT_NEAR(request.joint_position[j], config.configurations_deg[k][j] * kDegToRad, 1e-15);
   }
   // Two answered (one of them twice), one reply for someone else's request.
   const int64_t base = std::get<orbed::plan_check_request_t>(requests[0].message).request_id;
@@ -567,7 +567,7 @@ TEST(ViraalConductor, AWholeRunInEmulatedTime) {
   for (size_t i = 0; i < commands.size(); ++i) {
     const auto& command = std::get<orbed::iiwa_command_t>(commands[i].message);
     for (int j = 0; j < 7; ++j)
-      EXPECT_NEAR(command.joint_position[j], config.configurations_deg[i % 3][j] * kDeg, 1e-15);
+      EXPECT_NEAR(command.joint_position[j], config.configurations_deg[i % 3][j] * kDegToRad, 1e-15);
   }
   std::vector<int> pairs;
   for (const Publication& p : bench.Sent("MISALIGNMENT_REQUEST"))

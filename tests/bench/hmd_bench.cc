@@ -26,6 +26,7 @@
 
 #include "procs/common/flags.h"
 #include "tests/bench/bench_util.h"
+#include "base/units.h"
 
 namespace {
 
@@ -87,7 +88,7 @@ void RunHmd(benchmark::State& state, bool walking_and_moving) {
                         .count();
         cmd.num_joints = 7;
         for (double q : targets[next_target++ % targets.size()])
-          cmd.joint_position.push_back(q * M_PI / 180.0);
+          cmd.joint_position.push_back(q * orbed::kDegToRad);
         cmd.num_torques = 0;
         lcm.publish("IIWA_COMMAND", &cmd);
         next_command += std::chrono::milliseconds(1500);

@@ -24,6 +24,7 @@
 #include <orbed/iiwa_command_t.hpp>
 
 #include "tests/bench/bench_util.h"
+#include "base/units.h"
 
 namespace {
 
@@ -46,7 +47,7 @@ orbed::iiwa_command_t CommandDeg(const std::vector<double>& q_deg) {
                   std::chrono::system_clock::now().time_since_epoch())
                   .count();
   cmd.num_joints = 7;
-  for (double q : q_deg) cmd.joint_position.push_back(q * M_PI / 180.0);
+  for (double q : q_deg) cmd.joint_position.push_back(q * orbed::kDegToRad);
   cmd.num_torques = 0;
   return cmd;
 }

@@ -29,6 +29,7 @@
 #include "procs/common/conversions.h"
 #include "procs/common/flags.h"
 #include "tests/integration/testbed_util.h"
+#include "base/units.h"
 
 namespace orbed::testing {
 namespace {
@@ -216,7 +217,7 @@ TEST(OrbedHmd, RatesImagesAndOneTrialOverRealLcm) {
   ASSERT_EQ(trial.num_joints, 7);
   const orbed::iiwa_status_t status = client.status();
   for (int j = 0; j < 7; ++j) EXPECT_NEAR(trial.joint_position[j], status.joint_position_measured[j], 1e-9);
-  EXPECT_NEAR(trial.joint_position[1], 30.0 * M_PI / 180.0, 1e-9);
+  EXPECT_NEAR(trial.joint_position[1], 30.0 * kDegToRad, 1e-9);
 
   hmd.Signal(SIGINT);
   sim.Signal(SIGINT);
