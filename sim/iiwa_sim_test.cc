@@ -2,7 +2,7 @@
 // on it): bad commands rejected and counted per class, plan checks answered (invalid ones too), a
 // command beyond a limit stops on the limit along positions worked out by hand, the outputs stamped
 // on the sim clock (tick k at start + k P, late or not) so that speeds read from the stamps stay
-// within the iiwa 7's published joint speeds (DESIGN §4), and the published frames against the
+// within the iiwa 7's published joint speeds, and the published frames against the
 // scene file and the DH facts.
 #include "sim/iiwa_sim.h"
 #include "sim/iiwa_sim_cli.h"
@@ -28,7 +28,7 @@
 namespace orbed::sim {
 namespace {
 
-const double kSpeedDegPerS[7] = {98, 98, 100, 130, 140, 180, 180};  // DESIGN §4
+const double kSpeedDegPerS[7] = {98, 98, 100, 130, 140, 180, 180};  // iiwa 7 R800 data sheet
 
 // Everything the sim publishes, as received on the same memq instance.
 struct Collector {
@@ -345,7 +345,7 @@ TEST(IiwaSim, StampsTicksOnTheSimClockHoweverLateTheyRun) {
 
 // The published frames against independent facts: X_WR from the scene file (position
 // (0.25, -0.55, 0.75), yaw 90 deg), the upright flange at z = 0.34 + 0.4 + 0.4 + 0.126 = 1.266 m
-// in R (DESIGN's DH d), the tool tip 0.25 m (scene tool_length_m) above it.
+// in R (the data sheet's DH d), the tool tip 0.25 m (scene tool_length_m) above it.
 TEST(IiwaSim, PublishesTrueFramesAndClearances) {
   IiwaSim sim(MemqFlags(0.1), IiwaSimOptions{});
   Collector got;

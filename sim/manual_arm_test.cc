@@ -1,4 +1,4 @@
-// The sim's motion law without a bus: speeds from DESIGN §4 (not from the URDF), synchronised
+// The sim's motion law without a bus: speeds from the iiwa 7 data sheet (not from the URDF), synchronised
 // straight joint-space moves, commands clamped to the joint limits, steps refused before a
 // collision in the trocar OR scene, and the way back out of a stop.
 #include "sim/manual_arm.h"
@@ -15,7 +15,7 @@ namespace orbed::sim {
 namespace {
 
 constexpr double kPeriodS = 0.005;
-// iiwa 7 R800 joint speeds [deg/s] and limits [deg] as published (DESIGN §4).
+// iiwa 7 R800 joint speeds [deg/s] and limits [deg] as published in the iiwa 7 R800 data sheet.
 const double kSpeedDegPerS[7] = {98, 98, 100, 130, 140, 180, 180};
 const double kLimitDeg[7] = {170, 120, 170, 120, 170, 120, 175};
 

@@ -16,7 +16,7 @@ RobotModel LoadIiwa() {
   return RobotModel::LoadFile(orbed::SourceTreePath(RobotModel::kDefaultUrdfRelativePath));
 }
 
-// The iiwa 7 R800 data-sheet DH parameters (DESIGN §4), evaluated by hand:
+// The iiwa 7 R800 data-sheet DH parameters, evaluated by hand:
 // T_{i-1,i} = Rz(theta_i) Tz(d_i) Tx(a_i) Rx(alpha_i).
 Eigen::Matrix4d DhTransform(double theta, double d, double a, double alpha) {
   const double ct = std::cos(theta), st = std::sin(theta), ca = std::cos(alpha), sa = std::sin(alpha);

@@ -21,7 +21,9 @@ TEST(Monitor, TabulatesHeartbeatsAndFlagsSilentProcesses) {
   orbed::process_status_t status{};
   status.name = "sim";
   status.state = orbed::process_status_t::STATE_RUNNING;
+  status.uptime_s = 42.25;
   status.messages_in = 12;
+  status.messages_out = 345;
   status.rejected_inputs = 2;
   status.last_error = "IIWA_COMMAND/num_joints: num_joints is 6, expected 7";
   monitor.process().lcm().publish(channels::kProcessStatus, &status);
@@ -38,15 +40,20 @@ TEST(Monitor, TabulatesHeartbeatsAndFlagsSilentProcesses) {
   monitor.Run();
   const int64_t now = NowMicros();
   const std::string table = monitor.Table(now);
-  EXPECT_NE(table.find("sim"), std::string::npos);
-  EXPECT_NE(table.find("running"), std::string::npos);
-  EXPECT_NE(table.find("num_joints is 6"), std::string::npos);
+  // The sim's row, field by field: name, state, uptime [s] to 0.1, messages in and out, rejected
+  // inputs, the last error (cut at 60 characters).
+  const std::string sim_row =
+      "sim                   running       42.2       12       345         2  "
+      "IIWA_COMMAND/num_joints: num_joints is 6, expected 7\n";
+  EXPECT_NE(table.find(sim_row), std::string::npos) << table;
   EXPECT_EQ(table.find("liar"), std::string::npos);  // rejected: state out of range
   // "liar" (state 9); beyond the bound of 256 names (sim + 255 fakes): 45 fakes and the monitor's
   // own heartbeat, which is published after them.
   EXPECT_EQ(monitor.process().rejections().counts().at("PROCESS_STATUS/field"), 1);
   EXPECT_EQ(monitor.process().rejections().counts().at("PROCESS_STATUS/too_many"), 46);
-  EXPECT_NE(monitor.Table(now + 10'000'000).find("SILENT"), std::string::npos);
+  // 10 s later, past silent_after_sec = 3 s, the same row says SILENT.
+  EXPECT_NE(monitor.Table(now + 10'000'000).find("sim                   SILENT        42.2       12       345"),
+            std::string::npos);
 }
 
 // The command line, in-process.

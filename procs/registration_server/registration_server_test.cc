@@ -128,7 +128,8 @@ TEST(RegistrationServiceTest, BadTrialsAndCommandsAreRejectedCountedAndChangeNot
   nan_position.X_WV.position_m[1] = std::nan("");
   EXPECT_FALSE(f.service.HandleTrial(nan_position));
   auto wrong_mode = Trial("s1", 4, 0, Eigen::Vector3d::Zero(), 8);
-  wrong_mode.display_mode = orbed::alignment_trial_t::MODE_AR;
+  wrong_mode.display_mode = orbed::alignment_trial_t::MODE_AR;  // a valid AR trial, in a reflective session
+  wrong_mode.num_mirrors = 0;
   EXPECT_FALSE(f.service.HandleTrial(wrong_mode));
   auto bad_joints = Trial("s1", 5, 0, Eigen::Vector3d::Zero(), 9);
   bad_joints.joint_position[3] = INFINITY;
@@ -144,8 +145,10 @@ TEST(RegistrationServiceTest, BadTrialsAndCommandsAreRejectedCountedAndChangeNot
   EXPECT_EQ(f.service.session_id(), "s1");
   EXPECT_EQ(f.rejections["ALIGNMENT_TRIAL/session"], 2);
   EXPECT_EQ(f.rejections["ALIGNMENT_TRIAL/trial_index"], 1);
-  EXPECT_EQ(f.rejections["ALIGNMENT_TRIAL/field"], 4);
-  EXPECT_EQ(f.rejections["ALIGNMENT_TRIAL/display_mode"], 1);
+  // The message's contract (procs/common/alignment_trial.h), by field; then the session's rules.
+  EXPECT_EQ(f.rejections["ALIGNMENT_TRIAL/X_WV"], 3);
+  EXPECT_EQ(f.rejections["ALIGNMENT_TRIAL/joint_position"], 1);
+  EXPECT_EQ(f.rejections["ALIGNMENT_TRIAL/session_mode"], 1);
   EXPECT_EQ(f.rejections["SESSION_CONTROL/method"], 1);
   EXPECT_EQ(f.rejections["SESSION_CONTROL/session"], 1);
   for (const auto& reason : f.reasons) EXPECT_FALSE(reason.empty());

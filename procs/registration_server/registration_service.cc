@@ -9,6 +9,7 @@
 #include "procs/common/conversions.h"
 #include "procs/common/session_control.h"
 #include "procs/common/validation.h"
+#include "procs/common/alignment_trial.h"
 
 namespace orbed::registration {
 namespace {
@@ -96,32 +97,15 @@ std::optional<orbed::registration_t> RegistrationService::HandleTrial(const orbe
                         : std::string("no session is active (send SESSION_CONTROL START)")));
     return std::nullopt;
   }
-  std::string problem =
-      FirstError({CheckPose(msg.X_WV, "ALIGNMENT_TRIAL.X_WV"),
-                  CheckBounded(msg.X_WV.position_m, 3, kMaxCoordinate_m, "ALIGNMENT_TRIAL.X_WV.position_m"),
-                  CheckEnum(msg.display_mode, orbed::alignment_trial_t::MODE_AR,
-                            orbed::alignment_trial_t::MODE_AR_REFLECTIVE, "ALIGNMENT_TRIAL.display_mode"),
-                  CheckEnum(msg.num_mirrors, 0, 64, "ALIGNMENT_TRIAL.num_mirrors"),
-                  CheckLength(msg.num_joints, msg.joint_position.size(), options_.max_joints,
-                              "ALIGNMENT_TRIAL.num_joints"),
-                  CheckFinite(msg.joint_position, "ALIGNMENT_TRIAL.joint_position"),
-                  CheckFinite(&msg.duration_s, 1, "ALIGNMENT_TRIAL.duration_s")});
-  if (!problem.empty()) {
-    Reject("ALIGNMENT_TRIAL/field", problem);
+  const auto checked = CheckAlignmentTrial(msg, options_.max_joints);
+  if (const auto* refusal = std::get_if<Refusal>(&checked)) {
+    Reject("ALIGNMENT_TRIAL/" + refusal->key, refusal->reason);
     return std::nullopt;
   }
   if (msg.display_mode != display_mode_) {
-    Reject("ALIGNMENT_TRIAL/display_mode", "trial " + std::to_string(msg.trial_index) + " has display_mode " +
+    Reject("ALIGNMENT_TRIAL/session_mode", "trial " + std::to_string(msg.trial_index) + " has display_mode " +
                                                std::to_string(msg.display_mode) + " but the session's is " +
                                                std::to_string(display_mode_));
-    return std::nullopt;
-  }
-  if (msg.duration_s < 0.0) {
-    Reject("ALIGNMENT_TRIAL/field", "ALIGNMENT_TRIAL.duration_s is negative");
-    return std::nullopt;
-  }
-  if (msg.trial_index < 0) {
-    Reject("ALIGNMENT_TRIAL/trial_index", "trial_index " + std::to_string(msg.trial_index) + " is negative");
     return std::nullopt;
   }
   for (const Trial& t : trials_) {

@@ -12,6 +12,7 @@
 #include "viraal/exchange.h"
 #include "base/format.h"
 #include "base/units.h"
+#include "procs/common/alignment_trial.h"
 
 namespace orbed::scenario {
 namespace {
@@ -179,14 +180,15 @@ ConductorActions ViraalConductor::OnTrial(const orbed::alignment_trial_t& msg, c
     return TakeActions();
   }
   const viraal::ModeSpec& mode = options_.config.modes[mode_index_];
-  std::string problem = FirstError(
-      {CheckPose(msg.X_WV, "ALIGNMENT_TRIAL.X_WV"),
-       CheckLength(msg.num_joints, msg.joint_position.size(), kMaxJoints, "ALIGNMENT_TRIAL.num_joints"),
-       CheckSize(msg.num_joints, model_->num_joints(), "ALIGNMENT_TRIAL.num_joints"),
-       CheckFinite(msg.joint_position, "ALIGNMENT_TRIAL.joint_position"),
-       CheckFinite(&msg.duration_s, 1, "ALIGNMENT_TRIAL.duration_s"),
-       CheckEnum(msg.display_mode, mode.display_mode, mode.display_mode, "ALIGNMENT_TRIAL.display_mode")});
-  if (problem.empty() && msg.duration_s < 0) problem = "ALIGNMENT_TRIAL.duration_s is negative";
+  const auto checked = CheckAlignmentTrial(msg, kMaxJoints);
+  if (const auto* refusal = std::get_if<Refusal>(&checked)) {
+    Refuse(options_.trial_channel + "/" + refusal->key, refusal->reason);
+    return TakeActions();
+  }
+  // The conductor's own rules: the session's mode, the robot model's joints and limits.
+  std::string problem =
+      FirstError({CheckSize(msg.num_joints, model_->num_joints(), "ALIGNMENT_TRIAL.num_joints"),
+                  CheckEnum(msg.display_mode, mode.display_mode, mode.display_mode, "ALIGNMENT_TRIAL.display_mode")});
   if (problem.empty()) {
     const std::string limits = model_->ValidateJointVector(ToVectorX(msg.joint_position), 1e-6);
     if (!limits.empty()) problem = "ALIGNMENT_TRIAL.joint_position: " + limits;

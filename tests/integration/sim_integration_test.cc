@@ -6,7 +6,7 @@
 //   - a command whose straight joint-space path runs into the table (established at run time with
 //     `orbed-robot check` along the path) stops short of contact;
 //   - joint speeds measured from the status stamps (the sim clock: tick k at start + k x 5 ms) never
-//     exceed the iiwa 7's published speeds (DESIGN §4), message to message and over 0.5 s;
+//     exceed the iiwa 7's published speeds (data sheet), message to message and over 0.5 s;
 //   - IIWA_STATUS arrives at 200 Hz within 5 % over 5 s, as the subscriber counts it;
 //   - stale and wrong-size commands are rejected and counted on the heartbeat.
 #include <chrono>
@@ -35,7 +35,7 @@ namespace {
 constexpr double kPeriodS = 0.005;  // the sim's default tick
 constexpr int64_t kPeriodUs = 5000;
 constexpr double kStopMarginM = 0.01;                               // the sim's default --stop-margin-m
-const double kSpeedDegPerS[7] = {98, 98, 100, 130, 140, 180, 180};  // iiwa 7 R800, DESIGN §4
+const double kSpeedDegPerS[7] = {98, 98, 100, 130, 140, 180, 180};  // iiwa 7 R800 data sheet
 
 // Everything the sim publishes, seen by a Drake-typed client (IIWA_STATUS) and orbed types.
 class SimClient {

@@ -1,0 +1,42 @@
+#pragma once
+/// @file
+/// The one check of ALIGNMENT_TRIAL (alignment_trial_t), which the registration server and the
+/// conductor both read: the message's own contract, before either applies its own rules (the
+/// server: the active session, unique indices, the session's mode; the conductor: the trial it
+/// asked for, the robot model's joint count and limits).
+///
+/// The contract:
+///   - session_id: 1..kMaxSessionIdLength bytes; trial_index >= 0;
+///   - display_mode MODE_AR with num_mirrors 0, or MODE_AR_REFLECTIVE with 1..kMaxMirrors;
+///   - num_joints == joint_position's length, at most `max_joints`; every joint angle finite [rad];
+///   - X_WV: finite position within kMaxAlignmentCoordinate_m of the origin, unit quaternion;
+///   - duration_s: finite and >= 0.
+/// Refusal keys are the field names (session_id, trial_index, display_mode, num_mirrors,
+/// num_joints, joint_position, X_WV, duration_s); processes count them as "<channel>/<key>".
+///
+/// Threading: pure functions.
+
+#include <cstdint>
+#include <string>
+#include <variant>
+
+#include <Eigen/Geometry>
+#include <orbed/alignment_trial_t.hpp>
+
+#include "procs/common/session_control.h"
+
+namespace orbed {
+
+/// A base pose farther than this from the world origin is not an operating room [m].
+inline constexpr double kMaxAlignmentCoordinate_m = 1e4;
+
+/// A checked ALIGNMENT_TRIAL: the message (as received) with its pose and joint vector decoded.
+struct AlignmentTrial {
+  orbed::alignment_trial_t msg;
+  Eigen::Isometry3d X_WV{Eigen::Isometry3d::Identity()};
+  Eigen::VectorXd q_rad;
+};
+
+std::variant<AlignmentTrial, Refusal> CheckAlignmentTrial(const orbed::alignment_trial_t& msg, int max_joints);
+
+}  // namespace orbed

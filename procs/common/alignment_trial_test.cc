@@ -1,0 +1,88 @@
+// The one ALIGNMENT_TRIAL check: each rule of the contract by a hand-built message.
+#include "procs/common/alignment_trial.h"
+
+#include <cmath>
+#include <limits>
+
+#include <gtest/gtest.h>
+
+namespace orbed {
+namespace {
+
+using AT = orbed::alignment_trial_t;
+
+AT Good() {
+  AT msg{};
+  msg.session_id = "run-ar_reflective";
+  msg.trial_index = 2;
+  msg.display_mode = AT::MODE_AR_REFLECTIVE;
+  msg.num_mirrors = 1;
+  msg.num_joints = 7;
+  msg.joint_position = {0, 0.5, 0, -1, 0, 0.8, 0};
+  msg.X_WV.position_m[0] = 0.25;
+  msg.X_WV.quaternion_wxyz[0] = std::sqrt(0.5);
+  msg.X_WV.quaternion_wxyz[3] = std::sqrt(0.5);  // 90 deg about z
+  msg.duration_s = 41.5;
+  return msg;
+}
+
+std::string Key(const AT& msg) {
+  const auto checked = CheckAlignmentTrial(msg, 64);
+  const auto* refusal = std::get_if<Refusal>(&checked);
+  if (refusal == nullptr) return "";
+  EXPECT_FALSE(refusal->reason.empty());
+  return refusal->key;
+}
+
+TEST(AlignmentTrial, AValidTrialIsDecoded) {
+  const auto checked = CheckAlignmentTrial(Good(), 64);
+  ASSERT_TRUE(std::holds_alternative<AlignmentTrial>(checked));
+  const AlignmentTrial& t = std::get<AlignmentTrial>(checked);
+  EXPECT_EQ(t.q_rad.size(), 7);
+  EXPECT_DOUBLE_EQ(t.q_rad[5], 0.8);
+  EXPECT_NEAR(t.X_WV.translation().x(), 0.25, 1e-15);
+  // 90 deg about z: x of V is y of W.
+  EXPECT_NEAR((t.X_WV.linear() * Eigen::Vector3d::UnitX() - Eigen::Vector3d::UnitY()).norm(), 0, 1e-12);
+}
+
+TEST(AlignmentTrial, EachRuleRefusesByFieldName) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  AT m = Good();
+  m.session_id = "";
+  EXPECT_EQ(Key(m), "session_id");
+  m = Good();
+  m.trial_index = -1;
+  EXPECT_EQ(Key(m), "trial_index");
+  m = Good();
+  m.display_mode = 2;
+  EXPECT_EQ(Key(m), "display_mode");
+  m = Good();
+  m.display_mode = AT::MODE_AR;  // with one mirror
+  EXPECT_EQ(Key(m), "num_mirrors");
+  m.num_mirrors = 0;
+  EXPECT_EQ(Key(m), "");
+  m = Good();
+  m.num_joints = 6;  // the array holds 7
+  EXPECT_EQ(Key(m), "num_joints");
+  m = Good();
+  m.num_joints = 65;
+  m.joint_position.assign(65, 0.0);
+  EXPECT_EQ(Key(m), "num_joints");  // beyond max_joints
+  m = Good();
+  m.joint_position[3] = nan;
+  EXPECT_EQ(Key(m), "joint_position");
+  m = Good();
+  m.X_WV.quaternion_wxyz[0] = 1.0;  // norm sqrt(1.5)
+  EXPECT_EQ(Key(m), "X_WV");
+  m = Good();
+  m.X_WV.position_m[2] = 2e4;  // finite, not an operating room
+  EXPECT_EQ(Key(m), "X_WV");
+  m = Good();
+  m.duration_s = -0.1;
+  EXPECT_EQ(Key(m), "duration_s");
+  m.duration_s = INFINITY;
+  EXPECT_EQ(Key(m), "duration_s");
+}
+
+}  // namespace
+}  // namespace orbed
