@@ -181,7 +181,7 @@ ConductorActions ViraalConductor::OnTrial(const orbed::alignment_trial_t& msg, c
   }
   const viraal::ModeSpec& mode = options_.config.modes[mode_index_];
   const auto checked = CheckAlignmentTrial(msg, kMaxJoints);
-  if (const auto* refusal = std::get_if<Refusal>(&checked)) {
+  if (const auto* refusal = std::get_if<orbed::Refusal>(&checked)) {
     Refuse(options_.trial_channel + "/" + refusal->key, refusal->reason);
     return TakeActions();
   }
