@@ -4,10 +4,10 @@
 #include <cmath>
 #include <cstdio>
 
+#include "base/stats.h"
+#include "base/units.h"
 #include "geometry/rotation_mean.h"
 #include "geometry/so3.h"
-#include "base/units.h"
-#include "base/stats.h"
 
 namespace orbed::geometry {
 namespace {
@@ -146,8 +146,8 @@ OutlierResult RejectOutliers(const std::vector<Eigen::Quaterniond>& quat_WV,
                              const std::vector<Eigen::Vector3d>& p_WV, const OutlierOptions& options) {
   OutlierResult result;
   if (quat_WV.size() != p_WV.size()) {
-    result.reason = "got " + std::to_string(quat_WV.size()) + " rotations but " + std::to_string(p_WV.size()) +
-                    " translations";
+    result.reason = "got " + std::to_string(quat_WV.size()) + " rotations but " +
+                    std::to_string(p_WV.size()) + " translations";
     return result;
   }
   if (!(options.k_mad > 0.0) || !(options.min_rotation_threshold_deg >= 0.0) ||

@@ -107,5 +107,4 @@ struct OutlierResult {
 OutlierResult RejectOutliers(const std::vector<Eigen::Quaterniond>& quat_WV,
                              const std::vector<Eigen::Vector3d>& p_WV, const OutlierOptions& options = {});
 
-
 }  // namespace orbed::geometry

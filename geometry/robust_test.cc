@@ -7,9 +7,9 @@
 
 #include <gtest/gtest.h>
 
+#include "base/units.h"
 #include "geometry/rotation_mean.h"
 #include "geometry/test_rotations.h"
-#include "base/units.h"
 
 namespace orbed::geometry {
 namespace {

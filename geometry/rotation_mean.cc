@@ -5,8 +5,8 @@
 
 #include <Eigen/Eigenvalues>
 
-#include "geometry/so3.h"
 #include "base/units.h"
+#include "geometry/so3.h"
 
 namespace orbed::geometry {
 namespace {

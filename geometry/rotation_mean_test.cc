@@ -7,8 +7,8 @@
 
 #include <gtest/gtest.h>
 
-#include "geometry/test_rotations.h"
 #include "base/units.h"
+#include "geometry/test_rotations.h"
 
 namespace orbed::geometry {
 namespace {
@@ -179,7 +179,8 @@ TEST(RotationMeanTest, SignFlippedQuaternionsGiveTheSameMean) {
 }
 
 TEST(RotationMeanTest, IterationCapLeavesConvergedFalse) {
-  const std::vector<Eigen::Quaterniond> q = RandomCluster(20, 50 * kDegToRad, 9, Eigen::Quaterniond::Identity());
+  const std::vector<Eigen::Quaterniond> q =
+      RandomCluster(20, 50 * kDegToRad, 9, Eigen::Quaterniond::Identity());
   KarcherOptions options;
   options.max_iterations = 1;
   const KarcherMeanResult r = ComputeKarcherMean(q, {}, options);

@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
-#include "geometry/so3.h"
-#include "base/units.h"
 #include "base/stats.h"
+#include "base/units.h"
+#include "geometry/so3.h"
 
 namespace orbed::geometry {
 namespace {
@@ -37,8 +37,8 @@ Se3MeanResult ComputeSe3Mean(const std::vector<Eigen::Quaterniond>& quat_WV,
     return result;
   }
   if (quat_WV.size() != p_WV.size()) {
-    result.reason = "got " + std::to_string(quat_WV.size()) + " rotations but " + std::to_string(p_WV.size()) +
-                    " translations";
+    result.reason = "got " + std::to_string(quat_WV.size()) + " rotations but " +
+                    std::to_string(p_WV.size()) + " translations";
     return result;
   }
   if (quat_WV.empty()) {

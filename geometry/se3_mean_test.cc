@@ -6,8 +6,8 @@
 
 #include <gtest/gtest.h>
 
-#include "geometry/test_rotations.h"
 #include "base/units.h"
+#include "geometry/test_rotations.h"
 
 namespace orbed::geometry {
 namespace {
@@ -48,8 +48,8 @@ TEST(Se3MeanTest, ChordalMethodReportsNoIterations) {
   const Eigen::Vector3d z = Eigen::Vector3d::UnitZ();
   Se3MeanOptions options;
   options.method = AveragingMethod::kChordal;
-  const Se3MeanResult r =
-      ComputeSe3Mean({Rot(0, z), Rot(0, z), Rot(90 * kDegToRad, z)}, {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}}, options);
+  const Se3MeanResult r = ComputeSe3Mean({Rot(0, z), Rot(0, z), Rot(90 * kDegToRad, z)},
+                                         {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}}, options);
   ASSERT_TRUE(r.valid);
   EXPECT_EQ(r.iterations, 0);
   EXPECT_TRUE(r.converged);

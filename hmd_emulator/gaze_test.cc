@@ -10,8 +10,8 @@
 
 #include <gtest/gtest.h>
 
-#include "hmd_emulator/renderer.h"
 #include "base/source_paths.h"
+#include "hmd_emulator/renderer.h"
 #include "sim/robot_model.h"
 #include "sim/scene.h"
 

@@ -10,9 +10,9 @@
 
 #include <gtest/gtest.h>
 
+#include "base/units.h"
 #include "sim/robot_model.h"
 #include "sim/scene.h"
-#include "base/units.h"
 
 namespace orbed::hmd {
 namespace {

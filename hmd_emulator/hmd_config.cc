@@ -4,8 +4,8 @@
 #include <limits>
 #include <stdexcept>
 
-#include "base/yaml_fields.h"
 #include "base/source_paths.h"
+#include "base/yaml_fields.h"
 
 namespace orbed::hmd {
 namespace {

@@ -7,11 +7,11 @@
 #include <opencv2/highgui.hpp>
 #include <opencv2/imgcodecs.hpp>
 
+#include "base/format.h"
 #include "hmd_emulator/headset_trial.h"
 #include "procs/common/conversions.h"
 #include "procs/common/log.h"
 #include "procs/common/validation.h"
-#include "base/format.h"
 
 namespace orbed::hmd {
 namespace {

@@ -25,11 +25,11 @@
 #include <orbed/image_t.hpp>
 #include <orbed/reflective_view_t.hpp>
 
+#include "base/units.h"
 #include "hmd_emulator/gaze.h"
 #include "hmd_emulator/headset_trial.h"
 #include "hmd_emulator/renderer.h"
 #include "procs/common/conversions.h"
-#include "base/units.h"
 
 namespace orbed::hmd {
 namespace {

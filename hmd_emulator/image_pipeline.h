@@ -70,7 +70,7 @@ struct FrameInputs {
 
 struct ImagePipelineOptions {
   geometry::Intrinsics intrinsics{geometry::Intrinsics::HoloLensPv()};  ///< K_o of the camera
-  int jpeg_quality{85};                             ///< 1..100
+  int jpeg_quality{85};                                                 ///< 1..100
   /// One entry per live display: the walk time at which it captures its frame [s].
   std::vector<double> display_capture_t_s;
   double recapture_period_s{0.5};

@@ -15,10 +15,10 @@
 
 #include <gtest/gtest.h>
 
+#include "base/units.h"
 #include "hmd_emulator/hmd_config.h"
 #include "hmd_emulator/pose_stream.h"
 #include "procs/common/conversions.h"
-#include "base/units.h"
 
 namespace orbed::hmd {
 namespace {

@@ -14,8 +14,8 @@ bool SameIntrinsics(const geometry::Intrinsics& a, const geometry::Intrinsics& b
 
 }  // namespace
 
-ReflectiveGeometry MakeReflectiveGeometry(const geometry::Intrinsics& intrinsics, const Eigen::Isometry3d& X_WC,
-                                          double D_m) {
+ReflectiveGeometry MakeReflectiveGeometry(const geometry::Intrinsics& intrinsics,
+                                          const Eigen::Isometry3d& X_WC, double D_m) {
   if (!std::isfinite(D_m) || !(D_m > 0))
     throw std::invalid_argument("reflective display: D must be finite and > 0, got " + std::to_string(D_m));
   ReflectiveGeometry g;

@@ -56,7 +56,7 @@ namespace orbed::hmd {
 
 /// A camera frame as the device holds it.
 struct CapturedFrame {
-  cv::Mat bgr;            ///< CV_8UC3, rendered from the TRUE capture pose
+  cv::Mat bgr;                      ///< CV_8UC3, rendered from the TRUE capture pose
   geometry::Intrinsics intrinsics;  ///< K_o of the frame
   Eigen::Isometry3d X_WC_est{Eigen::Isometry3d::Identity()};  ///< SLAM estimate at capture
   Eigen::VectorXd q_rad;  ///< robot joint vector at capture (IIWA_STATUS) [rad]
@@ -65,12 +65,12 @@ struct CapturedFrame {
 
 /// Imaging geometry of one reflective display (what reflective_view_t carries).
 struct ReflectiveGeometry {
-  Eigen::Matrix3d K_o{Eigen::Matrix3d::Identity()};       ///< observer (capture) intrinsics [px]
-  Eigen::Matrix3d K_m{Eigen::Matrix3d::Identity()};       ///< diag(1, −1, 1) · K_o [px]
-  Eigen::Isometry3d X_WC{Eigen::Isometry3d::Identity()};  ///< capture pose used (the estimate)
-  Eigen::Isometry3d X_WM{Eigen::Isometry3d::Identity()};  ///< reversed frustum, X_WC · X_CM(D)
-  double distance_m{0};                                   ///< D [m]
-  geometry::CameraMatrix P_o{geometry::CameraMatrix::Zero()};                 ///< K_o [R_CW | p_CW]: draws the content
+  Eigen::Matrix3d K_o{Eigen::Matrix3d::Identity()};            ///< observer (capture) intrinsics [px]
+  Eigen::Matrix3d K_m{Eigen::Matrix3d::Identity()};            ///< diag(1, −1, 1) · K_o [px]
+  Eigen::Isometry3d X_WC{Eigen::Isometry3d::Identity()};       ///< capture pose used (the estimate)
+  Eigen::Isometry3d X_WM{Eigen::Isometry3d::Identity()};       ///< reversed frustum, X_WC · X_CM(D)
+  double distance_m{0};                                        ///< D [m]
+  geometry::CameraMatrix P_o{geometry::CameraMatrix::Zero()};  ///< K_o [R_CW | p_CW]: draws the content
   /// K_m [R_MW | p_MW] = K_m · P · X_CM · X_CW: the reversed frustum of the paper's Sec. II-B, in
   /// the geometric order (the file comment; the paper's printed product order differs). Places the
   /// display; the content is drawn with P_o.
@@ -79,8 +79,8 @@ struct ReflectiveGeometry {
 
 /// The geometry for a frame captured at X_WC with gaze distance D. Throws std::invalid_argument
 /// unless D is finite and > 0.
-ReflectiveGeometry MakeReflectiveGeometry(const geometry::Intrinsics& intrinsics, const Eigen::Isometry3d& X_WC,
-                                          double D_m);
+ReflectiveGeometry MakeReflectiveGeometry(const geometry::Intrinsics& intrinsics,
+                                          const Eigen::Isometry3d& X_WC, double D_m);
 
 /// Where the display shows pixel (u, v), in W: p_M = s ((u − cx)/fx, −(v − cy)/fy, 1) with
 /// s = `depth_in_M_m` (default, when <= 0: D/2, the mirror plane).
@@ -109,16 +109,16 @@ class Compositor {
 
   /// AR view: the virtual robot at (q, X_WV) over a live frame, drawn from the current estimate
   /// X_WC_est. `out` may alias `live_bgr`'s buffer only if it is the same Mat object.
-  void ComposeArView(const cv::Mat& live_bgr, const geometry::Intrinsics& intrinsics, const Eigen::Isometry3d& X_WC_est,
-                     const Eigen::VectorXd& q_rad, const Eigen::Isometry3d& X_WV, cv::Mat* out,
-                     cv::Mat* body_id = nullptr);
+  void ComposeArView(const cv::Mat& live_bgr, const geometry::Intrinsics& intrinsics,
+                     const Eigen::Isometry3d& X_WC_est, const Eigen::VectorXd& q_rad,
+                     const Eigen::Isometry3d& X_WV, cv::Mat* out, cv::Mat* body_id = nullptr);
 
   /// The virtual robot's bodies (names "virtual/<link>"), posed at the last call.
   const SceneGeometry& virtual_geometry() const { return virtual_robot_; }
 
  private:
-  void Overlay(const geometry::Intrinsics& intrinsics, const Eigen::Isometry3d& X_WC, const Eigen::VectorXd& q_rad,
-               const Eigen::Isometry3d& X_WV, cv::Mat* image, cv::Mat* body_id);
+  void Overlay(const geometry::Intrinsics& intrinsics, const Eigen::Isometry3d& X_WC,
+               const Eigen::VectorXd& q_rad, const Eigen::Isometry3d& X_WV, cv::Mat* image, cv::Mat* body_id);
 
   const sim::RobotModel& robot_;
   OverlayStyle style_;

@@ -10,11 +10,11 @@
 
 #include <gtest/gtest.h>
 
+#include "base/source_paths.h"
 #include "geometry/camera_model.h"
 #include "hmd_emulator/gaze.h"
 #include "hmd_emulator/renderer.h"
 #include "hmd_emulator/scene_geometry.h"
-#include "base/source_paths.h"
 #include "sim/scene.h"
 
 namespace orbed::hmd {
@@ -116,8 +116,8 @@ TEST_F(ReflectiveTest, HologramLandsWhereProjectSaysWithTheEstimatedCapturePose)
   ASSERT_GE(real_wrist, 0);
   Eigen::Vector2d uv_est, uv_true;
   ASSERT_TRUE(geometry::Project(P_est, WristCentre(X_WV), &uv_est));
-  ASSERT_TRUE(
-      geometry::Project(geometry::MakeCameraMatrix(frame.intrinsics.K(), X_WC_true_), WristCentre(scene_.X_WR), &uv_true));
+  ASSERT_TRUE(geometry::Project(geometry::MakeCameraMatrix(frame.intrinsics.K(), X_WC_true_),
+                                WristCentre(scene_.X_WR), &uv_true));
   int n_holo = 0, n_real = 0;
   const Eigen::Vector2d c_holo = Centroid(holo_ids, holo_wrist, &n_holo);
   const Eigen::Vector2d c_real = Centroid(real_ids, real_wrist, &n_real);

@@ -12,8 +12,8 @@
 
 #include <gtest/gtest.h>
 
-#include "hmd_emulator/scene_geometry.h"
 #include "base/source_paths.h"
+#include "hmd_emulator/scene_geometry.h"
 #include "sim/robot_model.h"
 #include "sim/scene.h"
 
@@ -29,7 +29,8 @@ Primitive Box(const Eigen::Vector3d& size, const Eigen::Isometry3d& X_WG) {
 }
 
 // Independent pinhole projection (no camera_model.h): K (R_CW p + p_CW).
-Eigen::Vector2d HandProject(const geometry::Intrinsics& K, const Eigen::Isometry3d& X_WC, const Eigen::Vector3d& p_W) {
+Eigen::Vector2d HandProject(const geometry::Intrinsics& K, const Eigen::Isometry3d& X_WC,
+                            const Eigen::Vector3d& p_W) {
   const Eigen::Matrix3d R_CW = X_WC.linear().transpose();
   const Eigen::Vector3d p_C = R_CW * (p_W - X_WC.translation());
   return {K.fx_px * p_C.x() / p_C.z() + K.cx_px, K.fy_px * p_C.y() / p_C.z() + K.cy_px};

@@ -3,9 +3,9 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "base/units.h"
 #include "base/yaml_fields.h"
 #include "sim/scene.h"
-#include "base/units.h"
 
 namespace orbed::hmd {
 namespace {

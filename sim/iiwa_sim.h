@@ -57,10 +57,10 @@
 #include <orbed/iiwa_command_t.hpp>
 #include <orbed/plan_check_request_t.hpp>
 
+#include "base/source_paths.h"
 #include "procs/common/channels.h"
 #include "procs/common/process.h"
 #include "sim/manual_arm.h"
-#include "base/source_paths.h"
 #include "sim/robot_model.h"
 #include "sim/scene.h"
 

@@ -10,13 +10,13 @@
 
 #include "base/json.h"
 #include "base/number_list.h"
-#include "sim/collision_world.h"
 #include "base/source_paths.h"
+#include "base/units.h"
+#include "sim/collision_world.h"
 #include "sim/robot_model.h"
 #include "sim/scene.h"
 #include "sim/trocar_clearance.h"
 #include "sim/trocar_ik.h"
-#include "base/units.h"
 
 namespace orbed::sim {
 namespace {

@@ -4,8 +4,8 @@
 #include <set>
 #include <stdexcept>
 
-#include "base/yaml_fields.h"
 #include "base/units.h"
+#include "base/yaml_fields.h"
 
 namespace orbed::sim {
 namespace {

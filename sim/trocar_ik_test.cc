@@ -10,8 +10,8 @@
 
 #include <gtest/gtest.h>
 
-#include "sim/collision_world.h"
 #include "base/source_paths.h"
+#include "sim/collision_world.h"
 #include "sim/scene.h"
 #include "sim/trocar_clearance.h"
 
@@ -53,8 +53,7 @@ TEST(TrocarIkTest, DocksAtTheTrocarCollisionFree) {
 }
 
 TEST(TrocarIkTest, UnreachableTargetFailsHonestly) {
-  const RobotModel model =
-      RobotModel::LoadFile(orbed::SourceTreePath(RobotModel::kDefaultUrdfRelativePath));
+  const RobotModel model = RobotModel::LoadFile(orbed::SourceTreePath(RobotModel::kDefaultUrdfRelativePath));
   TrocarIkTarget far;
   far.p_RT = Eigen::Vector3d(3.0, 0, 0.5);
   far.axis_R = -Eigen::Vector3d::UnitZ();
@@ -68,8 +67,7 @@ TEST(TrocarIkTest, UnreachableTargetFailsHonestly) {
 }
 
 TEST(TrocarIkTest, ReachableWithoutScoreSucceedsOnlyIfAllowed) {
-  const RobotModel model =
-      RobotModel::LoadFile(orbed::SourceTreePath(RobotModel::kDefaultUrdfRelativePath));
+  const RobotModel model = RobotModel::LoadFile(orbed::SourceTreePath(RobotModel::kDefaultUrdfRelativePath));
   TrocarIkTarget t;
   t.p_RT = Eigen::Vector3d(0.5, 0.1, 0.3);
   t.axis_R = -Eigen::Vector3d::UnitZ();

@@ -23,6 +23,7 @@ inline constexpr PaperFigure kPaperAr{30.2, 23.9};
 /// The SE(3) mean of N = 3 trials with the display (Sec. III-B).
 inline constexpr PaperFigure kPaperArReflectiveMean{11.3, 1.01};
 /// Where the figures come from, as results.json states it.
-inline constexpr char kPaperSource[] = "Fotouhi et al., RA-L 2020, Table 1 and Sec. III-B (10 trials x 4 users)";
+inline constexpr char kPaperSource[] =
+    "Fotouhi et al., RA-L 2020, Table 1 and Sec. III-B (10 trials x 4 users)";
 
 }  // namespace orbed::viraal

@@ -103,13 +103,19 @@ std::string ResultsJson(const RunResults& r) {
   json.Key("paper_reference").BeginObject();
   json.Key("source").String(kPaperSource);
   json.Key("ar_reflective").BeginObject();
-  json.Key("misalignment_mm").Number(kPaperArReflective.misalignment_mm).Key("std_mm").Number(kPaperArReflective.std_mm);
+  json.Key("misalignment_mm")
+      .Number(kPaperArReflective.misalignment_mm)
+      .Key("std_mm")
+      .Number(kPaperArReflective.std_mm);
   json.EndObject();
   json.Key("ar").BeginObject();
   json.Key("misalignment_mm").Number(kPaperAr.misalignment_mm).Key("std_mm").Number(kPaperAr.std_mm);
   json.EndObject();
   json.Key("ar_reflective_mean").BeginObject();
-  json.Key("misalignment_mm").Number(kPaperArReflectiveMean.misalignment_mm).Key("std_mm").Number(kPaperArReflectiveMean.std_mm);
+  json.Key("misalignment_mm")
+      .Number(kPaperArReflectiveMean.misalignment_mm)
+      .Key("std_mm")
+      .Number(kPaperArReflectiveMean.std_mm);
   json.EndObject();
   json.EndObject();
 
@@ -194,11 +200,13 @@ std::string ResultsTable(const RunResults& r) {
     out << PadRight("", 23) << "trial misalignment " << Fixed(stats.mean, 1) << " +/- " << Fixed(stats.std, 1)
         << " mm";
     if (s.mode == "ar_reflective") {
-      out << "   (paper: " << Fixed(kPaperArReflective.misalignment_mm, 1) << " +/- " << Fixed(kPaperArReflective.std_mm, 1)
-          << " mm; its mean " << Fixed(kPaperArReflectiveMean.misalignment_mm, 1) << " +/- "
+      out << "   (paper: " << Fixed(kPaperArReflective.misalignment_mm, 1) << " +/- "
+          << Fixed(kPaperArReflective.std_mm, 1) << " mm; its mean "
+          << Fixed(kPaperArReflectiveMean.misalignment_mm, 1) << " +/- "
           << Fixed(kPaperArReflectiveMean.std_mm, 2) << " mm)";
     } else if (s.mode == "ar") {
-      out << "   (paper: " << Fixed(kPaperAr.misalignment_mm, 1) << " +/- " << Fixed(kPaperAr.std_mm, 1) << " mm)";
+      out << "   (paper: " << Fixed(kPaperAr.misalignment_mm, 1) << " +/- " << Fixed(kPaperAr.std_mm, 1)
+          << " mm)";
     }
     out << "\n";
   }

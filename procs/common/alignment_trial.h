@@ -37,6 +37,7 @@ struct AlignmentTrial {
   Eigen::VectorXd q_rad;
 };
 
-std::variant<AlignmentTrial, Refusal> CheckAlignmentTrial(const orbed::alignment_trial_t& msg, int max_joints);
+std::variant<AlignmentTrial, Refusal> CheckAlignmentTrial(const orbed::alignment_trial_t& msg,
+                                                          int max_joints);
 
 }  // namespace orbed

@@ -193,7 +193,7 @@ TEST(LauncherCli, RefusesAnUnknownFlagAMissingFileAndABadFile) {
   const std::string bad = WriteTempFile("_bad.yaml", "groups: []\n");
   r = test::RunCommand(RunLauncher, "orbed-launch", {"--dry-run", bad});
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find(bad + ":1: 'groups' must be"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(bad + ":1: groups: expected a non-empty list"), std::string::npos) << r.err;
   std::filesystem::remove(bad);
 }
 

@@ -8,10 +8,10 @@
 #include <fstream>
 #include <stdexcept>
 
-#include "procs/common/conversions.h"
 #include "base/json.h"
-#include "procs/common/log.h"
 #include "base/sha256.h"
+#include "procs/common/conversions.h"
+#include "procs/common/log.h"
 
 namespace orbed::logger {
 namespace {

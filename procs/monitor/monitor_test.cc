@@ -52,8 +52,9 @@ TEST(Monitor, TabulatesHeartbeatsAndFlagsSilentProcesses) {
   EXPECT_EQ(monitor.process().rejections().counts().at("PROCESS_STATUS/field"), 1);
   EXPECT_EQ(monitor.process().rejections().counts().at("PROCESS_STATUS/too_many"), 46);
   // 10 s later, past silent_after_sec = 3 s, the same row says SILENT.
-  EXPECT_NE(monitor.Table(now + 10'000'000).find("sim                   SILENT        42.2       12       345"),
-            std::string::npos);
+  EXPECT_NE(
+      monitor.Table(now + 10'000'000).find("sim                   SILENT        42.2       12       345"),
+      std::string::npos);
 }
 
 // The command line, in-process.

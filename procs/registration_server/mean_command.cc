@@ -70,7 +70,8 @@ int RunMeanCommand(const MeanCommandOptions& options, std::ostream& out, std::os
   }
 
   geometry::Se3MeanOptions mean_options;
-  mean_options.method = options.robust ? geometry::AveragingMethod::kRobust : geometry::AveragingMethod::kKarcher;
+  mean_options.method =
+      options.robust ? geometry::AveragingMethod::kRobust : geometry::AveragingMethod::kKarcher;
   mean_options.p_VC = options.p_VC;
   const geometry::Se3MeanResult result = geometry::ComputeSe3Mean(file.quat_WV, file.p_WV, mean_options);
   if (!result.valid) {

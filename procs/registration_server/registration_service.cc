@@ -6,10 +6,10 @@
 
 #include "geometry/misalignment.h"
 #include "geometry/se3_mean.h"
+#include "procs/common/alignment_trial.h"
 #include "procs/common/conversions.h"
 #include "procs/common/session_control.h"
 #include "procs/common/validation.h"
-#include "procs/common/alignment_trial.h"
 
 namespace orbed::registration {
 namespace {

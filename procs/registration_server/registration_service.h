@@ -12,9 +12,9 @@
 ///
 /// Sessions (commands checked by procs/common/session_control.h): START(session_id, display_mode,
 /// num_mirrors, method) opens a session (replacing any other; a repeated START of the active session
-/// with the same mode and mirrors changes nothing); trials for it are collected until STOP; RESET drops its trials; COMPUTE asks for the
-/// full state now. The last session's state stays available (periodic state, COMPUTE) after STOP
-/// until the next START.
+/// with the same mode and mirrors changes nothing); trials for it are collected until STOP; RESET drops its
+/// trials; COMPUTE asks for the full state now. The last session's state stays available (periodic state,
+/// COMPUTE) after STOP until the next START.
 ///
 /// Frames and units: trials carry X_WV (virtual robot base V in the OR world W) [m]; the mean is
 /// X_WV_mean; rays and landmarks are in W [m]; angles in messages are [deg] where named.

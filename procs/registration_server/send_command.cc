@@ -9,8 +9,8 @@
 #include <orbed/registration_t.hpp>
 #include <orbed/session_control_t.hpp>
 
-#include "procs/common/conversions.h"
 #include "base/json.h"
+#include "procs/common/conversions.h"
 #include "procs/registration_server/trial_file.h"
 
 namespace orbed::registration {

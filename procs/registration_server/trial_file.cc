@@ -56,7 +56,8 @@ std::string ParseTrialLine(const std::string& text, Eigen::Quaterniond* quat_WV,
       return std::string("field ") + std::to_string(k + 1) + " (" + kFieldNames[k] + ") is not finite";
     }
   }
-  const geometry::RotationCheck check = geometry::ValidateQuaternionWxyz(Eigen::Vector4d(v[0], v[1], v[2], v[3]));
+  const geometry::RotationCheck check =
+      geometry::ValidateQuaternionWxyz(Eigen::Vector4d(v[0], v[1], v[2], v[3]));
   if (!check.valid) return check.message;
   *quat_WV = check.quat;
   *p_WV = Eigen::Vector3d(v[4], v[5], v[6]);

@@ -6,8 +6,8 @@
 #include <CLI/CLI.hpp>
 
 #include "procs/common/flags.h"
-#include "viraal/protocol.h"
 #include "procs/scenario/viraal_scenario.h"
+#include "viraal/protocol.h"
 
 namespace orbed::scenario {
 

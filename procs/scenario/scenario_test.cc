@@ -20,12 +20,12 @@
 #include <orbed/robot_state_t.hpp>
 #include <orbed/session_control_t.hpp>
 
+#include "base/units.h"
 #include "procs/common/conversions.h"
 #include "procs/scenario/viraal_scenario.h"
 #include "viraal/metrics.h"
 #include "viraal/protocol.h"
 #include "viraal/results.h"
-#include "base/units.h"
 
 namespace orbed::scenario {
 namespace {

@@ -7,12 +7,12 @@
 #include <stdexcept>
 #include <utility>
 
-#include "procs/common/conversions.h"
-#include "procs/common/validation.h"
-#include "viraal/exchange.h"
 #include "base/format.h"
 #include "base/units.h"
 #include "procs/common/alignment_trial.h"
+#include "procs/common/conversions.h"
+#include "procs/common/validation.h"
+#include "viraal/exchange.h"
 
 namespace orbed::scenario {
 namespace {
@@ -186,9 +186,9 @@ ConductorActions ViraalConductor::OnTrial(const orbed::alignment_trial_t& msg, c
     return TakeActions();
   }
   // The conductor's own rules: the session's mode, the robot model's joints and limits.
-  std::string problem =
-      FirstError({CheckSize(msg.num_joints, model_->num_joints(), "ALIGNMENT_TRIAL.num_joints"),
-                  CheckEnum(msg.display_mode, mode.display_mode, mode.display_mode, "ALIGNMENT_TRIAL.display_mode")});
+  std::string problem = FirstError(
+      {CheckSize(msg.num_joints, model_->num_joints(), "ALIGNMENT_TRIAL.num_joints"),
+       CheckEnum(msg.display_mode, mode.display_mode, mode.display_mode, "ALIGNMENT_TRIAL.display_mode")});
   if (problem.empty()) {
     const std::string limits = model_->ValidateJointVector(ToVectorX(msg.joint_position), 1e-6);
     if (!limits.empty()) problem = "ALIGNMENT_TRIAL.joint_position: " + limits;

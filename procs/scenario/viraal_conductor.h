@@ -59,10 +59,10 @@
 
 #include "procs/common/channels.h"
 #include "procs/common/log.h"
-#include "viraal/protocol.h"
-#include "viraal/metrics.h"
-#include "viraal/results.h"
 #include "sim/robot_model.h"
+#include "viraal/metrics.h"
+#include "viraal/protocol.h"
+#include "viraal/results.h"
 
 namespace orbed::scenario {
 

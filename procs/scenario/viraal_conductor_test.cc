@@ -11,9 +11,9 @@
 
 #include <gtest/gtest.h>
 
-#include "procs/common/conversions.h"
 #include "base/source_paths.h"
 #include "base/units.h"
+#include "procs/common/conversions.h"
 
 namespace orbed::scenario {
 namespace {

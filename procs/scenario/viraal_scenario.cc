@@ -9,9 +9,9 @@
 #include <stdexcept>
 #include <variant>
 
+#include "base/source_paths.h"
 #include "procs/common/conversions.h"
 #include "procs/common/log.h"
-#include "base/source_paths.h"
 
 namespace orbed::scenario {
 namespace {

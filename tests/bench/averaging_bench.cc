@@ -19,10 +19,10 @@
 
 #include <benchmark/benchmark.h>
 
+#include "base/units.h"
 #include "geometry/robust.h"
 #include "geometry/rotation_mean.h"
 #include "geometry/so3.h"
-#include "base/units.h"
 
 namespace orbed::geometry {
 namespace {
@@ -106,9 +106,8 @@ int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   // Colour only on a terminal (ConsoleReporter itself ignores --benchmark_color when given to us).
-  orbed::geometry::RatioReporter reporter(isatty(fileno(stdout))
-                                                  ? benchmark::ConsoleReporter::OO_ColorTabular
-                                                  : benchmark::ConsoleReporter::OO_Tabular);
+  orbed::geometry::RatioReporter reporter(isatty(fileno(stdout)) ? benchmark::ConsoleReporter::OO_ColorTabular
+                                                                 : benchmark::ConsoleReporter::OO_Tabular);
   benchmark::RunSpecifiedBenchmarks(&reporter);
   benchmark::Shutdown();
   return 0;

@@ -22,8 +22,8 @@
 #include <fcl/narrowphase/collision_object.h>
 #include <fcl/narrowphase/distance.h>
 
-#include "sim/collision_world.h"
 #include "base/source_paths.h"
+#include "sim/collision_world.h"
 #include "sim/robot_model.h"
 #include "sim/scene.h"
 

@@ -12,21 +12,21 @@
 // (user + system from wait4 over its wall time), its peak RSS [MB] (goal <= 400 MB), the received
 // rates, and the HMD_POSE jitter: percentiles of |inter-arrival − 1/60 s| [ms].
 // Run in a private network namespace: scripts/orbed bench hmd_bench.
-#include "base/source_paths.h"
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <string>
 #include <vector>
+#include "base/source_paths.h"
 
 #include <benchmark/benchmark.h>
 #include <lcm/lcm-cpp.hpp>
 #include <orbed/iiwa_command_t.hpp>
 
+#include "base/units.h"
 #include "procs/common/flags.h"
 #include "tests/bench/bench_util.h"
-#include "base/units.h"
 
 namespace {
 

@@ -19,11 +19,11 @@
 
 #include <benchmark/benchmark.h>
 
+#include "base/source_paths.h"
 #include "hmd_emulator/gaze.h"
 #include "hmd_emulator/reflective.h"
 #include "hmd_emulator/renderer.h"
 #include "hmd_emulator/scene_geometry.h"
-#include "base/source_paths.h"
 #include "sim/robot_model.h"
 #include "sim/scene.h"
 

@@ -23,8 +23,8 @@
 #include <lcm/lcm-cpp.hpp>
 #include <orbed/iiwa_command_t.hpp>
 
-#include "tests/bench/bench_util.h"
 #include "base/units.h"
+#include "tests/bench/bench_util.h"
 
 namespace {
 

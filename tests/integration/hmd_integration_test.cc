@@ -26,10 +26,10 @@
 #include <orbed/registration_t.hpp>
 #include <orbed/session_control_t.hpp>
 
+#include "base/units.h"
 #include "procs/common/conversions.h"
 #include "procs/common/flags.h"
 #include "tests/integration/testbed_util.h"
-#include "base/units.h"
 
 namespace orbed::testing {
 namespace {

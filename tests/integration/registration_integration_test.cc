@@ -19,8 +19,8 @@
 #include <orbed/registration_t.hpp>
 #include <orbed/session_control_t.hpp>
 
-#include "tests/integration/testbed_util.h"
 #include "base/units.h"
+#include "tests/integration/testbed_util.h"
 
 namespace orbed::testing {
 namespace {

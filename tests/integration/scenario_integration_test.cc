@@ -20,9 +20,9 @@
 #include <orbed/robot_state_t.hpp>
 #include <orbed/session_control_t.hpp>
 
+#include "base/units.h"
 #include "procs/common/conversions.h"
 #include "tests/integration/testbed_util.h"
-#include "base/units.h"
 
 namespace orbed::testing {
 namespace {
@@ -76,7 +76,8 @@ class FakeUser {
     const Eigen::Isometry3d X_WR = FromPose(state_.X_WR);
     Eigen::Isometry3d X_WV = X_WR;
     X_WV.linear() =
-        Eigen::AngleAxisd(offset.yaw_deg * kDegToRad, Eigen::Vector3d::UnitZ()).toRotationMatrix() * X_WR.linear();
+        Eigen::AngleAxisd(offset.yaw_deg * kDegToRad, Eigen::Vector3d::UnitZ()).toRotationMatrix() *
+        X_WR.linear();
     X_WV.translation() += offset.p_W;
     orbed::alignment_trial_t trial{};
     trial.utime = NowMicros();

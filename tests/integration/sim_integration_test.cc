@@ -25,9 +25,9 @@
 #include <orbed/collision_status_t.hpp>
 #include <orbed/robot_state_t.hpp>
 
+#include "base/units.h"
 #include "procs/common/conversions.h"
 #include "tests/integration/testbed_util.h"
-#include "base/units.h"
 
 namespace orbed::testing {
 namespace {
@@ -274,7 +274,8 @@ TEST(IiwaSim, CommandIntoTheTableStopsShortOfContact) {
   EXPECT_GT(fraction, 0.5);
   EXPECT_LT(fraction, first_contact);
   for (int i = 0; i < 7; ++i) {
-    EXPECT_NEAR(last.joint_position_measured[i], fraction * target_deg[i] * kDegToRad, 1e-9) << "joint " << i + 1;
+    EXPECT_NEAR(last.joint_position_measured[i], fraction * target_deg[i] * kDegToRad, 1e-9)
+        << "joint " << i + 1;
   }
   ExpectWithinJointSpeeds(status);
   std::printf("stopped at %.1f %% of the path (first contact at %.0f %%), clearance %.4f m: %s\n",
