@@ -1,6 +1,7 @@
 #include "study/study_cli.h"
 
 #include <cerrno>
+#include <cstdio>
 #include <climits>
 #include <cstdlib>
 #include <exception>
@@ -49,14 +50,23 @@ std::string MeanStdText(const std::vector<double>& x, int digits) {
   return Fixed(stats::Mean(x), digits) + " +/- " + Fixed(stats::StdDev(x), digits);
 }
 
+// p-values as people read them: four decimals, or the power of ten when smaller.
+std::string PValue(double p) {
+  if (p >= 1e-4) return Fixed(p, 4);
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.1e", p);
+  return text;
+}
+
 const viraal::PaperFigure* PaperFor(const std::string& mode) {
   if (mode == "ar_reflective") return &viraal::kPaperArReflective;
   if (mode == "ar") return &viraal::kPaperAr;
   return nullptr;
 }
 
-// Per mode: the trials' errors, the SE(3) mean's; then the comparison of the first two modes.
-std::string Summary(const viraal::RunResults& results) {
+// Per mode: the trials' errors, the SE(3) means of consecutive triples (the paper's N = 3); then
+// the comparison of the first two modes.
+std::string Summary(const StudyOptions& options, const viraal::RunResults& results) {
   std::string text;
   std::vector<std::vector<double>> misalignment;
   for (const viraal::SessionResult& s : results.sessions) {
@@ -74,17 +84,16 @@ std::string Summary(const viraal::RunResults& results) {
     }
     text += "\n  translation [mm]   " + MeanStdText(trans, 1) + "\n";
     text += "  rotation [deg]     " + MeanStdText(rot, 2) + "\n";
-    if (s.mean) {
-      text += "  SE(3) mean of all its trials: misalignment " + Fixed(s.mean->errors.misalignment_mm, 1) +
-              " mm, translation " + Fixed(s.mean->errors.translation_error_mm, 1) + " mm\n";
-    }
+    const std::vector<double> triples = GroupMeanMisalignment_mm(options, s, 3);
+    text += "  SE(3) means of N = 3 consecutive trials (" + std::to_string(triples.size()) +
+            "): misalignment " + MeanStdText(triples, 1) + " mm\n";
   }
   if (misalignment.size() >= 2) {
     const stats::MannWhitneyResult mw = stats::MannWhitneyU(misalignment[0], misalignment[1]);
     const std::string a = results.sessions[0].mode, b = results.sessions[1].mode;
     text += "Mann-Whitney U, trial misalignment, one-sided (" + a + " < " + b + "): ";
     text += mw.valid
-                ? "U = " + Fixed(mw.u_x, 1) + ", z = " + Fixed(mw.z, 2) + ", p = " + Fixed(mw.p_x_less, 4)
+                ? "U = " + Fixed(mw.u_x, 1) + ", z = " + Fixed(mw.z, 2) + ", p = " + PValue(mw.p_x_less)
                 : std::string("not defined for these samples");
     text += "\n";
   }
@@ -144,7 +153,7 @@ int RunUserStudy(int argc, const char* const* argv, std::ostream& out, std::ostr
     if (results.sessions.empty() || results.sessions.front().trials.size() <= kMaxTrialsInTable) {
       out << viraal::ResultsTable(results);
     } else {
-      out << Summary(results);
+      out << Summary(o, results);
     }
     if (!json_path.empty()) {
       std::ofstream file(json_path);

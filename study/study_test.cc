@@ -49,6 +49,19 @@ TEST(ViraalStudy, EqualsThePinnedLiveRun) {
                                  {"started_utime", "duration_s"});
 }
 
+// One group of three is the session itself: its mean is the session mean the conductor scored.
+TEST(ViraalStudy, AGroupOfAllTheTrialsIsTheSessionMean) {
+  const StudyOptions o = Shipped(3, "pinned");
+  const viraal::RunResults results = RunViraalStudy(o);
+  for (const viraal::SessionResult& s : results.sessions) {
+    const std::vector<double> groups = GroupMeanMisalignment_mm(o, s, 3);
+    ASSERT_EQ(groups.size(), 1u);
+    ASSERT_TRUE(s.mean.has_value());
+    EXPECT_NEAR(groups[0], s.mean->errors.misalignment_mm, 1e-9) << s.mode;
+  }
+  EXPECT_EQ(GroupMeanMisalignment_mm(o, results.sessions[0], 2).size(), 1u);  // the third trial left out
+}
+
 TEST(ViraalStudy, SeedAndRunIdChooseTheTrials) {
   const viraal::RunResults a = RunViraalStudy(Shipped(2, "a"));
   const viraal::RunResults a_again = RunViraalStudy(Shipped(2, "a"));

@@ -150,4 +150,53 @@ viraal::RunResults RunViraalStudy(const StudyOptions& options) {
   return results;
 }
 
+std::vector<double> GroupMeanMisalignment_mm(const StudyOptions& options, const viraal::SessionResult& session,
+                                             int group_size) {
+  if (group_size < 1) throw std::invalid_argument("group size must be >= 1");
+  const viraal::ScenarioConfig& scenario = options.scenario;
+  const std::string urdf_path = options.urdf_path.empty()
+                                    ? SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath)
+                                    : options.urdf_path;
+  const std::string scene_path =
+      options.scene_path.empty() ? SourceTreePath(sim::kDefaultSceneRelativePath) : options.scene_path;
+  const sim::RobotModel model = sim::RobotModel::LoadFile(urdf_path);
+  const viraal::RobotPointSet points(model, scenario.landmarks);
+  const orbed::pose_t X_WR = ToPose(sim::LoadSceneFile(scene_path).X_WR);
+  viraal::ModeSpec mode{session.mode, static_cast<int8_t>(session.display_mode), session.num_mirrors};
+
+  std::vector<double> out;
+  const int groups = static_cast<int>(session.trials.size()) / group_size;
+  for (int g = 0; g < groups; ++g) {
+    registration::RegistrationService service = MakeService();
+    const std::string id = session.session_id + "-group-" + std::to_string(g);
+    service.HandleSessionControl(Control(orbed::session_control_t::START, id, mode, scenario.method));
+    std::vector<viraal::RobotPoints> group_points;
+    for (int k = 0; k < group_size; ++k) {
+      const int i = g * group_size + k;
+      const viraal::TrialResult& result = session.trials[i];
+      orbed::alignment_trial_t trial{};
+      trial.session_id = id;
+      trial.trial_index = k;
+      trial.display_mode = mode.display_mode;
+      trial.num_mirrors = mode.num_mirrors;
+      const Eigen::VectorXd q_rad =
+          sim::DegToRad(ToVectorX(scenario.configurations_deg[i % scenario.configurations_deg.size()]));
+      trial.num_joints = static_cast<int32_t>(q_rad.size());
+      trial.joint_position = FromVectorX(q_rad);
+      trial.X_WV = ToPose(result.X_WV);
+      trial.duration_s = result.user_duration_s;
+      service.HandleTrial(trial);
+      group_points.push_back(viraal::TrialPoints(points, trial));
+    }
+    const auto mean =
+        service.HandleSessionControl(Control(orbed::session_control_t::COMPUTE, id, mode, scenario.method));
+    if (!mean || !mean->valid) throw std::runtime_error("group '" + id + "': no valid mean");
+    const viraal::AlignmentError error = viraal::MeanError(X_WR, *mean, group_points);
+    const orbed::misalignment_t misalignment =
+        Checked(service.HandleMisalignmentRequest(viraal::MisalignmentRequest(error, id, 0, g)));
+    out.push_back(misalignment.mean_error_norm_m * 1e3);
+  }
+  return out;
+}
+
 }  // namespace orbed::study

@@ -51,4 +51,11 @@ struct StudyOptions {
 /// files, a configuration outside the joint limits or a refused message (naming it).
 viraal::RunResults RunViraalStudy(const StudyOptions& options);
 
+/// The paper's registration statistic: the trials of `session` taken `group_size` at a time in
+/// order (the last incomplete group left out), each group averaged on SE(3) by the registration
+/// server's core with the scenario's method, and scored over the group's configurations as the
+/// conductor scores a session mean. Returns each group mean's misalignment [mm].
+std::vector<double> GroupMeanMisalignment_mm(const StudyOptions& options, const viraal::SessionResult& session,
+                                             int group_size);
+
 }  // namespace orbed::study
