@@ -1,8 +1,8 @@
 #include "study/study_cli.h"
 
 #include <cerrno>
-#include <cstdio>
 #include <climits>
+#include <cstdio>
 #include <cstdlib>
 #include <exception>
 #include <fstream>
@@ -92,9 +92,8 @@ std::string Summary(const StudyOptions& options, const viraal::RunResults& resul
     const stats::MannWhitneyResult mw = stats::MannWhitneyU(misalignment[0], misalignment[1]);
     const std::string a = results.sessions[0].mode, b = results.sessions[1].mode;
     text += "Mann-Whitney U, trial misalignment, one-sided (" + a + " < " + b + "): ";
-    text += mw.valid
-                ? "U = " + Fixed(mw.u_x, 1) + ", z = " + Fixed(mw.z, 2) + ", p = " + PValue(mw.p_x_less)
-                : std::string("not defined for these samples");
+    text += mw.valid ? "U = " + Fixed(mw.u_x, 1) + ", z = " + Fixed(mw.z, 2) + ", p = " + PValue(mw.p_x_less)
+                     : std::string("not defined for these samples");
     text += "\n";
   }
   text += "paper, SE(3) mean of N = 3 trials with the display: " +

@@ -150,8 +150,8 @@ viraal::RunResults RunViraalStudy(const StudyOptions& options) {
   return results;
 }
 
-std::vector<double> GroupMeanMisalignment_mm(const StudyOptions& options, const viraal::SessionResult& session,
-                                             int group_size) {
+std::vector<double> GroupMeanMisalignment_mm(const StudyOptions& options,
+                                             const viraal::SessionResult& session, int group_size) {
   if (group_size < 1) throw std::invalid_argument("group size must be >= 1");
   const viraal::ScenarioConfig& scenario = options.scenario;
   const std::string urdf_path = options.urdf_path.empty()

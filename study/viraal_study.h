@@ -55,7 +55,7 @@ viraal::RunResults RunViraalStudy(const StudyOptions& options);
 /// order (the last incomplete group left out), each group averaged on SE(3) by the registration
 /// server's core with the scenario's method, and scored over the group's configurations as the
 /// conductor scores a session mean. Returns each group mean's misalignment [mm].
-std::vector<double> GroupMeanMisalignment_mm(const StudyOptions& options, const viraal::SessionResult& session,
-                                             int group_size);
+std::vector<double> GroupMeanMisalignment_mm(const StudyOptions& options,
+                                             const viraal::SessionResult& session, int group_size);
 
 }  // namespace orbed::study
