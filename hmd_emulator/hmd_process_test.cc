@@ -83,10 +83,10 @@ struct Collector {
   }
 };
 
-CommonFlags MemqFlags(double duration_sec) {
+CommonFlags MemqFlags(double duration_s) {
   CommonFlags flags("orbed-hmd");
   flags.lcm_url = "memq://";
-  flags.duration_sec = duration_sec;
+  flags.duration_s = duration_s;
   flags.log_level = "warn";
   return flags;
 }

@@ -32,17 +32,16 @@ static_assert(static_cast<int>(MotionState::kIdle) == orbed::robot_state_t::MOTI
 IiwaSimOptions Resolved(IiwaSimOptions options) {
   if (options.urdf_path.empty()) options.urdf_path = SourceTreePath(RobotModel::kDefaultUrdfRelativePath);
   if (options.scene_path.empty()) options.scene_path = SourceTreePath(kDefaultSceneRelativePath);
-  // The sim clock counts whole microseconds (utime): the tick is P = period_sec rounded to them, and
+  // The sim clock counts whole microseconds (utime): the tick is P = period_s rounded to them, and
   // the arm steps by exactly P, so that stamps and steps agree.
-  if (!(options.period_sec > 0) || !(options.period_sec <= 3600) ||
-      std::llround(options.period_sec * 1e6) < 1) {
+  if (!(options.period_s > 0) || !(options.period_s <= 3600) || std::llround(options.period_s * 1e6) < 1) {
     throw std::invalid_argument(
-        "--period-sec must be a number of seconds in [1e-6, 3600] (it is rounded to "
+        "--period-s must be a number of seconds in [1e-6, 3600] (it is rounded to "
         "whole microseconds)");
   }
-  options.period_sec = static_cast<double>(std::llround(options.period_sec * 1e6)) / 1e6;
-  if (!(options.stale_command_sec >= 0) || !std::isfinite(options.stale_command_sec)) {
-    throw std::invalid_argument("--stale-command-sec must be a finite number >= 0 (0 disables the check)");
+  options.period_s = static_cast<double>(std::llround(options.period_s * 1e6)) / 1e6;
+  if (!(options.stale_command_s >= 0) || !std::isfinite(options.stale_command_s)) {
+    throw std::invalid_argument("--stale-command-s must be a finite number >= 0 (0 disables the check)");
   }
   if (!(options.stop_margin_m >= 0) || !std::isfinite(options.stop_margin_m)) {
     throw std::invalid_argument("--stop-margin-m must be a finite number >= 0");
@@ -81,7 +80,7 @@ orbed::contact_t ToContact(const PairDistance& pair) {
 IiwaSim::IiwaSim(const orbed::CommonFlags& flags, const IiwaSimOptions& options)
     : options_(Resolved(options)),
       scene_(LoadSceneFile(options_.scene_path)),
-      period_us_(std::llround(options_.period_sec * 1e6)) {
+      period_us_(std::llround(options_.period_s * 1e6)) {
   const RobotModel model = LoadRobotForScene(options_.urdf_path, scene_);
   ManualArmOptions arm_options;
   arm_options.stop_margin_m = options_.stop_margin_m;
@@ -108,9 +107,9 @@ IiwaSim::IiwaSim(const orbed::CommonFlags& flags, const IiwaSimOptions& options)
   // The sim clock starts with the timer: tick k is due k * P after start_mono_.
   start_utime_ = NowMicros();
   start_mono_ = std::chrono::steady_clock::now();
-  process_->AddTimer(options_.period_sec, [this] { Tick(); });
+  process_->AddTimer(options_.period_s, [this] { Tick(); });
   ORBED_LOG(kInfo) << "robot " << options_.urdf_path << " (" << model.num_joints() << " joints), scene "
-                   << options_.scene_path << ", tick " << options_.period_sec * 1e3 << " ms";
+                   << options_.scene_path << ", tick " << options_.period_s * 1e3 << " ms";
 }
 
 IiwaSim::~IiwaSim() = default;
@@ -136,14 +135,14 @@ void IiwaSim::OnCommand(const orbed::iiwa_command_t& msg, const std::string& cha
     process_->Reject(channel + "/non_finite", error);
     return;
   }
-  if (options_.stale_command_sec > 0) {
+  if (options_.stale_command_s > 0) {
     // In double: a wild utime (e.g. INT64_MIN) must not overflow the subtraction.
     const double age_s = (static_cast<double>(NowMicros()) - static_cast<double>(msg.utime)) * 1e-6;
-    if (std::abs(age_s) > options_.stale_command_sec) {
+    if (std::abs(age_s) > options_.stale_command_s) {
       process_->Reject(channel + "/stale",
                        "utime " + std::to_string(msg.utime) + " is " + Fixed(std::abs(age_s), 3) + " s " +
                            (age_s > 0 ? "older than" : "ahead of") + " the wall clock (limit " +
-                           Fixed(options_.stale_command_sec, 3) + " s)");
+                           Fixed(options_.stale_command_s, 3) + " s)");
       return;
     }
   }
@@ -192,7 +191,7 @@ void IiwaSim::OnPlanCheck(const orbed::plan_check_request_t& msg, const std::str
 }
 
 void IiwaSim::Tick() {
-  arm_->Step(options_.period_sec);
+  arm_->Step(options_.period_s);
   ++ticks_;
   // After a stall the loop skipped deadlines rather than run them: tick k jumps to the last deadline
   // passed, so the sim clock does not fall behind for good. The arm made one step of P: the speed

@@ -7,7 +7,7 @@
 ///
 ///   Subscribes: IIWA_COMMAND (iiwa_command_t, Drake's lcmt_iiwa_command layout) — the target;
 ///               PLAN_CHECK_REQUEST (plan_check_request_t).
-///   Publishes, every tick (period_sec, default 5 ms = 200 Hz), all with the same utime (the sim
+///   Publishes, every tick (period_s, default 5 ms = 200 Hz), all with the same utime (the sim
 ///   clock, below):
 ///               IIWA_STATUS (iiwa_status_t, Drake's lcmt_iiwa_status layout), ROBOT_STATE
 ///               (robot_state_t: true X_WR from the scene, X_RF, X_RT, every link's X_RL, limit
@@ -25,12 +25,12 @@
 ///
 /// Rejected commands (Process::Reject, keys "<channel>/<class>"), the process keeps running:
 ///   num_joints (!= the arm's), num_torques (neither 0 nor num_joints), non_finite (a NaN or inf
-///   position or torque), stale (utime more than stale_command_sec away from the wall clock, older
+///   position or torque), stale (utime more than stale_command_s away from the wall clock, older
 ///   or ahead; 0 disables), decode (undecodable bytes, by Process).
 /// A command beyond a joint limit is not rejected: it is clamped, and the arm stops at the limit
 /// with motion_state STOPPED_AT_LIMIT and the joint named in stop_reason.
 ///
-/// Clocks: IIWA_STATUS, ROBOT_STATE and COLLISION_STATUS carry the sim clock. P = period_sec
+/// Clocks: IIWA_STATUS, ROBOT_STATE and COLLISION_STATUS carry the sim clock. P = period_s
 /// rounded to whole microseconds (>= 1 us). Tick k steps the arm by exactly P and stamps its outputs
 ///     utime_k = start_utime + k * P,
 /// start_utime being the wall clock (NowMicros) when the constructor set up the tick timer, whose
@@ -71,11 +71,11 @@ struct IiwaSimOptions {
   std::string urdf_path;
   std::string scene_path;
   /// Tick = status period [s]; rounded to whole microseconds, which must leave >= 1 us.
-  double period_sec{0.005};
+  double period_s{0.005};
   /// Initial joint vector [deg]; empty = all zero (the arm upright). Must be within the limits.
   std::vector<double> initial_q_deg;
   /// Commands whose utime is further than this from the wall clock are rejected [s]; 0 = never.
-  double stale_command_sec{1.0};
+  double stale_command_s{1.0};
   /// Motion stops this far before contact [m] (ManualArmOptions::stop_margin_m).
   double stop_margin_m{0.01};
   /// COLLISION_STATUS lists pairs closer than this [m].
@@ -100,7 +100,7 @@ class IiwaSim {
 
   int Run() { return process_->Run(); }
   orbed::Process& process() { return *process_; }
-  /// The options with the file paths resolved and period_sec = P (whole microseconds).
+  /// The options with the file paths resolved and period_s = P (whole microseconds).
   const IiwaSimOptions& options() const { return options_; }
   /// The sim clock (see Clocks): P [us], start_utime [us since the epoch], k of the last tick (the
   /// number of Tick() calls, plus any deadlines skipped after a stall); the last outputs carry

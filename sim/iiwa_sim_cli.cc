@@ -22,13 +22,13 @@ int RunIiwaSim(int argc, const char* const* argv, std::ostream& out, std::ostrea
                  "source tree it was built from)");
   app.add_option("--scene", options.scene_path,
                  "Scene YAML (default: sim/models/scenes/trocar_or.yaml, found like --urdf)");
-  app.add_option("--period-sec", options.period_sec, "Tick and status period [s] (0.005 = 200 Hz)")
+  app.add_option("--period-s", options.period_s, "Tick and status period [s] (0.005 = 200 Hz)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   app.add_option("--initial-q-deg", options.initial_q_deg,
                  "Initial joint angles q1,...,q7 [deg] (default: all 0)")
       ->delimiter(',');
-  app.add_option("--stale-command-sec", options.stale_command_sec,
+  app.add_option("--stale-command-s", options.stale_command_s,
                  "Reject IIWA_COMMAND whose utime is further than this from the wall clock [s]; 0 = off")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();

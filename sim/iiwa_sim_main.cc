@@ -4,7 +4,7 @@
 /// and exit codes: sim/iiwa_sim_cli.h.
 /// Subscribes: IIWA_COMMAND (iiwa_command_t = Drake's lcmt_iiwa_command), PLAN_CHECK_REQUEST.
 /// Publishes:  IIWA_STATUS (iiwa_status_t = Drake's lcmt_iiwa_status), ROBOT_STATE and
-///             COLLISION_STATUS every --period-sec (200 Hz by default); PLAN_CHECK_REPLY per
+///             COLLISION_STATUS every --period-s (200 Hz by default); PLAN_CHECK_REPLY per
 ///             request; PROCESS_STATUS at 1 Hz. Channel names can be overridden by flags.
 #include <iostream>
 

@@ -56,10 +56,10 @@ struct Collector {
   }
 };
 
-CommonFlags MemqFlags(double duration_sec) {
+CommonFlags MemqFlags(double duration_s) {
   CommonFlags flags("orbed-iiwa-sim");
   flags.lcm_url = "memq://";
-  flags.duration_sec = duration_sec;
+  flags.duration_s = duration_s;
   return flags;
 }
 
@@ -203,7 +203,7 @@ TEST(IiwaSim, AnswersPlanChecksIncludingInvalidOnes) {
 // (e.g. the wall clock at the tick), fails here.
 TEST(IiwaSim, CommandBeyondALimitStopsAtTheLimitWithinTheJointSpeeds) {
   IiwaSimOptions options;
-  options.period_sec = 0.005;
+  options.period_s = 0.005;
   IiwaSim sim(MemqFlags(2.0), options);
   ASSERT_EQ(sim.period_us(), 5000);
   Collector got;
@@ -281,7 +281,7 @@ TEST(IiwaSim, CommandBeyondALimitStopsAtTheLimitWithinTheJointSpeeds) {
   EXPECT_FALSE(got.collision.back().in_collision);
 }
 
-// The sim clock driven by hand (Tick(), no loop). P is period_sec rounded to whole microseconds
+// The sim clock driven by hand (Tick(), no loop). P is period_s rounded to whole microseconds
 // (12.344 ms here, so a tick may run up to max(100 ms, 20 P) = 246.88 ms late before the clock
 // skips). Tick k is stamped start_utime + k P: tick 5, run 30 ms (2.4 periods) late, keeps its
 // stamp, exactly P after tick 4; tick 8, run after a 400 ms stall, jumps to the last deadline
@@ -290,13 +290,13 @@ TEST(IiwaSim, CommandBeyondALimitStopsAtTheLimitWithinTheJointSpeeds) {
 // speed read from the stamps is 98 deg/s at most, however late the tick.
 TEST(IiwaSim, StampsTicksOnTheSimClockHoweverLateTheyRun) {
   IiwaSimOptions options;
-  options.period_sec = 0.0123444;
+  options.period_s = 0.0123444;
   const int64_t before = NowMicros();
   IiwaSim sim(MemqFlags(0.1), options);
   const int64_t after = NowMicros();
   constexpr int64_t kP = 12344;
   EXPECT_EQ(sim.period_us(), kP);
-  EXPECT_EQ(sim.options().period_sec, 0.012344);
+  EXPECT_EQ(sim.options().period_s, 0.012344);
   EXPECT_EQ(sim.MaxLagMicros(), 20 * kP);
   EXPECT_GE(sim.start_utime(), before);
   EXPECT_LE(sim.start_utime(), after);
@@ -395,7 +395,7 @@ TEST(IiwaSim, BadOptionsAndFilesAreNamed) {
   }
   IiwaSimOptions period;
   for (double bad : {0.0, -0.005, 4e-7, std::nan(""), double{INFINITY}}) {  // 4e-7 s rounds to 0 us
-    period.period_sec = bad;
+    period.period_s = bad;
     EXPECT_THROW(IiwaSim(MemqFlags(0.1), period), std::invalid_argument) << bad;
   }
 }
@@ -404,7 +404,7 @@ TEST(IiwaSim, BadOptionsAndFilesAreNamed) {
 TEST(IiwaSimCli, HelpGoesToOutAndExitsZero) {
   const test::CommandRun r = test::RunCommand(RunIiwaSim, "orbed-iiwa-sim", {"--help"});
   EXPECT_EQ(r.code, 0);
-  EXPECT_NE(r.out.find("--period-sec"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("--period-s"), std::string::npos) << r.out;
   EXPECT_TRUE(r.err.empty()) << r.err;
 }
 
@@ -412,9 +412,9 @@ TEST(IiwaSimCli, RefusesAnUnknownFlagAndBadValues) {
   test::CommandRun r = test::RunCommand(RunIiwaSim, "orbed-iiwa-sim", {"--no-such-flag"});
   EXPECT_NE(r.code, 0);
   EXPECT_NE(r.err.find("--no-such-flag"), std::string::npos) << r.err;
-  r = test::RunCommand(RunIiwaSim, "orbed-iiwa-sim", {"--period-sec", "-0.005"});
+  r = test::RunCommand(RunIiwaSim, "orbed-iiwa-sim", {"--period-s", "-0.005"});
   EXPECT_NE(r.code, 0);
-  EXPECT_NE(r.err.find("--period-sec"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--period-s"), std::string::npos) << r.err;
   // Found when the sim starts, not by the parser: exit 1, the flag named.
   r = test::RunCommand(RunIiwaSim, "orbed-iiwa-sim", {"--lcm-url", "memq://", "--initial-q-deg", "1,2,3"});
   EXPECT_EQ(r.code, 1);
@@ -424,7 +424,7 @@ TEST(IiwaSimCli, RefusesAnUnknownFlagAndBadValues) {
 TEST(IiwaSimCli, RunsForTheDurationAndExitsZero) {
   const test::CommandRun r = test::RunCommand(
       RunIiwaSim, "orbed-iiwa-sim",
-      {"--lcm-url", "memq://", "--duration-sec", "0.1", "--initial-q-deg", "0,30,0,-60,0,45,0"});
+      {"--lcm-url", "memq://", "--duration-s", "0.1", "--initial-q-deg", "0,30,0,-60,0,45,0"});
   EXPECT_EQ(r.code, 0) << r.err;
 }
 

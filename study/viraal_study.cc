@@ -44,15 +44,21 @@ const orbed::misalignment_t& Checked(const orbed::misalignment_t& reply) {
   return reply;
 }
 
+std::string UrdfPath(const StudyOptions& options) {
+  return options.urdf_path.empty() ? SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath)
+                                   : options.urdf_path;
+}
+
+std::string ScenePath(const StudyOptions& options) {
+  return options.scene_path.empty() ? SourceTreePath(sim::kDefaultSceneRelativePath) : options.scene_path;
+}
+
 }  // namespace
 
 viraal::RunResults RunViraalStudy(const StudyOptions& options) {
   const viraal::ScenarioConfig& scenario = options.scenario;
-  const std::string urdf_path = options.urdf_path.empty()
-                                    ? SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath)
-                                    : options.urdf_path;
-  const std::string scene_path =
-      options.scene_path.empty() ? SourceTreePath(sim::kDefaultSceneRelativePath) : options.scene_path;
+  const std::string urdf_path = UrdfPath(options);
+  const std::string scene_path = ScenePath(options);
 
   // The conductor's model (landmarks and centroid) and the headset's (with the scene's tool).
   const sim::RobotModel conductor_model = sim::RobotModel::LoadFile(urdf_path);
@@ -154,11 +160,8 @@ std::vector<double> GroupMeanMisalignment_mm(const StudyOptions& options,
                                              const viraal::SessionResult& session, int group_size) {
   if (group_size < 1) throw std::invalid_argument("group size must be >= 1");
   const viraal::ScenarioConfig& scenario = options.scenario;
-  const std::string urdf_path = options.urdf_path.empty()
-                                    ? SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath)
-                                    : options.urdf_path;
-  const std::string scene_path =
-      options.scene_path.empty() ? SourceTreePath(sim::kDefaultSceneRelativePath) : options.scene_path;
+  const std::string urdf_path = UrdfPath(options);
+  const std::string scene_path = ScenePath(options);
   const sim::RobotModel model = sim::RobotModel::LoadFile(urdf_path);
   const viraal::RobotPointSet points(model, scenario.landmarks);
   const orbed::pose_t X_WR = ToPose(sim::LoadSceneFile(scene_path).X_WR);

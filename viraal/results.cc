@@ -9,6 +9,7 @@
 
 #include "base/format.h"
 #include "base/json.h"
+#include "base/stats.h"
 #include "viraal/paper_reference.h"
 
 namespace orbed::viraal {
@@ -58,15 +59,8 @@ std::string PadRight(const std::string& text, size_t width) {
 }  // namespace
 
 MeanStd ComputeMeanStd(const std::vector<double>& values) {
-  MeanStd out;
-  if (values.empty()) return out;
-  for (double v : values) out.mean += v;
-  out.mean /= static_cast<double>(values.size());
-  if (values.size() < 2) return out;
-  double ss = 0;
-  for (double v : values) ss += (v - out.mean) * (v - out.mean);
-  out.std = std::sqrt(ss / static_cast<double>(values.size() - 1));
-  return out;
+  if (values.empty()) return {};
+  return {stats::Mean(values), stats::StdDev(values)};
 }
 
 std::string ResultsJson(const RunResults& r) {

@@ -130,11 +130,11 @@ TEST(Flags, HelpAndUnknownFlags) {
   CLI::App app{"test"};
   CommonFlags flags("orbed-test");
   AddCommonFlags(&app, &flags);
-  const char* argv[] = {"x", "--seed", "42", "--name", "n1", "--duration-sec", "2.5"};
+  const char* argv[] = {"x", "--seed", "42", "--name", "n1", "--duration-s", "2.5"};
   app.parse(7, const_cast<char**>(argv));
   EXPECT_EQ(flags.seed, 42u);
   EXPECT_EQ(flags.name, "n1");
-  EXPECT_EQ(flags.duration_sec, 2.5);
+  EXPECT_EQ(flags.duration_s, 2.5);
   CLI::App app2{"test"};
   CommonFlags flags2("orbed-test");
   AddCommonFlags(&app2, &flags2);
@@ -148,7 +148,7 @@ TEST(Flags, HelpAndUnknownFlags) {
 TEST(Process, CountsMessagesRejectionsAndPublishesHeartbeat) {
   CommonFlags flags("orbed-test");
   flags.lcm_url = "memq://";
-  flags.duration_sec = 1.3;
+  flags.duration_s = 1.3;
   Process process(flags);
   std::vector<process_status_t> heartbeats;
   int accepted = 0;
@@ -205,7 +205,7 @@ TEST(Process, CountsMessagesRejectionsAndPublishesHeartbeat) {
 TEST(Process, TimerFiresAtItsPeriod) {
   CommonFlags flags("orbed-test");
   flags.lcm_url = "memq://";
-  flags.duration_sec = 0.5;
+  flags.duration_s = 0.5;
   Process process(flags);
   int ticks = 0;
   process.AddTimer(0.1, [&] { ++ticks; });
@@ -220,7 +220,7 @@ TEST(Process, TimerFiresAtItsPeriod) {
 TEST(Process, TimerCatchesUpAfterAShortStall) {
   CommonFlags flags("orbed-test");
   flags.lcm_url = "memq://";
-  flags.duration_sec = 1.05;
+  flags.duration_s = 1.05;
   Process process(flags);
   int ticks = 0;
   process.AddTimer(0.1, [&] {
@@ -234,7 +234,7 @@ TEST(Process, TimerCatchesUpAfterAShortStall) {
 TEST(Process, ExceptionsInTimersAndHandlersAreCountedNotFatal) {
   CommonFlags flags("orbed-test");
   flags.lcm_url = "memq://";
-  flags.duration_sec = 0.35;
+  flags.duration_s = 0.35;
   Process process(flags);
   int ticks = 0;
   process.AddTimer(0.1, [&] {

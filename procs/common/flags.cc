@@ -34,7 +34,7 @@ void AddCommonFlags(CLI::App* app, CommonFlags* flags) {
       ->capture_default_str();
   app->add_option("--seed", flags->seed, "Seed of every random generator in this process")
       ->capture_default_str();
-  app->add_option("--duration-sec", flags->duration_sec,
+  app->add_option("--duration-s", flags->duration_s,
                   "Stop cleanly after this many seconds (0: run until SIGINT/SIGTERM)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();

@@ -4,7 +4,7 @@
 ///   --lcm-url URL      LCM provider URL (default: $ORBED_LCM_URL, else udpm://239.255.76.67:7667?ttl=0)
 ///   --name NAME        process name on PROCESS_STATUS and in log lines
 ///   --seed N           seed of every random generator in the process
-///   --duration-sec S   stop cleanly after S seconds (0 = run until SIGINT/SIGTERM)
+///   --duration-s S   stop cleanly after S seconds (0 = run until SIGINT/SIGTERM)
 ///   --log-level L      debug | info | warn | error
 /// Usage in a thin main:
 ///   CLI::App app{"what it does"};
@@ -29,7 +29,7 @@ struct CommonFlags {
   std::string lcm_url;
   std::string name;
   uint64_t seed = 1;
-  double duration_sec = 0.0;
+  double duration_s = 0.0;
   std::string log_level = "info";
 };
 

@@ -56,7 +56,7 @@ std::string UrlWithReceiveBuffer(const std::string& url) {
 Process::Process(const CommonFlags& flags)
     : name_(flags.name),
       seed_(flags.seed),
-      duration_sec_(flags.duration_sec),
+      duration_sec_(flags.duration_s),
       lcm_(std::make_unique<lcm::LCM>(UrlWithReceiveBuffer(flags.lcm_url))),
       start_(std::chrono::steady_clock::now()) {
   // Before any slow set-up (models, meshes, hashes), so that a stop request during it is a clean
@@ -162,7 +162,7 @@ int Process::Run() {
   while (!stop_requested_ && !StopSignalled()) {
     auto now = std::chrono::steady_clock::now();
     if (now >= deadline) {
-      ORBED_LOG(kInfo) << "--duration-sec reached";
+      ORBED_LOG(kInfo) << "--duration-s reached";
       break;
     }
     for (size_t i = 0; i < timers_.size(); ++i) {

@@ -3,7 +3,7 @@
 /// The scaffold every orbed process runs on: one LCM instance, typed subscriptions that decode,
 /// count and reject (a message that fails to decode is a counted rejection, never a silent drop),
 /// periodic timers, the 1 Hz PROCESS_STATUS heartbeat, and a clean stop on SIGINT/SIGTERM or after
-/// --duration-sec.
+/// --duration-s.
 ///
 /// Threading: Run() is a single-threaded loop. Message handlers and timers are called on the thread
 /// that calls Run(), never concurrently with each other. Counters are atomic, so other threads a
@@ -79,7 +79,7 @@ class Process {
   /// Records an error that is not a rejected input (shown as last_error on the heartbeat).
   void SetLastError(const std::string& error);
 
-  /// Runs until a stop signal, RequestStop() or --duration-sec. Returns the process exit code
+  /// Runs until a stop signal, RequestStop() or --duration-s. Returns the process exit code
   /// (0 unless Fail() was called).
   int Run();
   void RequestStop() { stop_requested_ = true; }

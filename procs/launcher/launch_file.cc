@@ -23,8 +23,8 @@ ProcessSpec ParseProcess(const YamlFields& f, const YAML::Node& node, const std:
                          const std::map<std::string, std::string>& environment) {
   if (!node.IsMap()) f.Fail(node, key, "expected a mapping with at least name and command");
   f.CheckKeys(node, key,
-              {"name", "command", "args", "env", "required", "respawn", "stop_signal", "stop_timeout_sec",
-               "ready", "ready_timeout_sec", "exit_stops_all"});
+              {"name", "command", "args", "env", "required", "respawn", "stop_signal", "stop_timeout_s",
+               "ready", "ready_timeout_s", "exit_stops_all"});
   ProcessSpec spec;
   spec.name = f.String(f.Required(node, "name", key + ".name", "a string"), key + ".name");
   if (spec.name.empty() || spec.name.find_first_of(" \t/") != std::string::npos) {
@@ -59,9 +59,9 @@ ProcessSpec ParseProcess(const YamlFields& f, const YAML::Node& node, const std:
   spec.respawn = f.BoolOr(node, "respawn", key, spec.respawn);
   spec.exit_stops_all = f.BoolOr(node, "exit_stops_all", key, spec.exit_stops_all);
   spec.stop_signal = SignalFromName(f.OneOfOr(node, "stop_signal", key, "SIGINT", kSignalNames));
-  spec.stop_timeout_sec = f.NumberOr(node, "stop_timeout_sec", key, spec.stop_timeout_sec, 0,
-                                     std::numeric_limits<double>::infinity(), "s");
-  spec.ready_timeout_sec = f.PositiveOr(node, "ready_timeout_sec", key, spec.ready_timeout_sec, "s");
+  spec.stop_timeout_s = f.NumberOr(node, "stop_timeout_s", key, spec.stop_timeout_s, 0,
+                                   std::numeric_limits<double>::infinity(), "s");
+  spec.ready_timeout_s = f.PositiveOr(node, "ready_timeout_s", key, spec.ready_timeout_s, "s");
   const std::string ready = f.OneOfOr(node, "ready", key, "heartbeat", {"heartbeat", "none"});
   spec.ready = ready == "heartbeat" ? ReadyCheck::kHeartbeat : ReadyCheck::kNone;
   return spec;

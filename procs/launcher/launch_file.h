@@ -14,9 +14,9 @@
 ///           required: true             # its failure stops the testbed, exit != 0 (default true)
 ///           respawn: false             # restart when it dies (default false)
 ///           stop_signal: SIGINT        # SIGINT | SIGTERM | SIGHUP | SIGQUIT | SIGUSR1 | SIGUSR2 | SIGKILL
-///           stop_timeout_sec: 5        # then SIGKILL (default 5)
+///           stop_timeout_s: 5        # then SIGKILL (default 5)
 ///           ready: heartbeat           # heartbeat (first PROCESS_STATUS) | none (default heartbeat)
-///           ready_timeout_sec: 10      # (default 10)
+///           ready_timeout_s: 10      # (default 10)
 ///           exit_stops_all: false      # when it exits, stop the testbed with its exit status
 ///
 /// ${VAR} in command, args and env values expands from the environment; an unset variable is an
@@ -46,9 +46,9 @@ struct ProcessSpec {
   bool required = true;
   bool respawn = false;
   int stop_signal = 2;  // SIGINT
-  double stop_timeout_sec = 5.0;
+  double stop_timeout_s = 5.0;
   ReadyCheck ready = ReadyCheck::kHeartbeat;
-  double ready_timeout_sec = 10.0;
+  double ready_timeout_s = 10.0;
   bool exit_stops_all = false;
 };
 

@@ -171,9 +171,9 @@ void Launcher::Tick() {
     group_ready = false;
     // Measured from the group's start, not the last respawn: a child that keeps dying before
     // its first heartbeat must still time out.
-    if (SecondsSince(group_started_at_) > m.spec.ready_timeout_sec) {
+    if (SecondsSince(group_started_at_) > m.spec.ready_timeout_s) {
       FailTestbed("process '" + m.spec.name + "' sent no heartbeat on PROCESS_STATUS within " +
-                  std::to_string(m.spec.ready_timeout_sec) +
+                  std::to_string(m.spec.ready_timeout_s) +
                   " s (if it is not an orbed process, set `ready: none` in " + spec_.path + ")");
       return;
     }
@@ -202,7 +202,7 @@ void Launcher::StopEverything() {
     double timeout = 0;
     for (Managed* m : group) {
       m->child->Signal(m->spec.stop_signal);
-      timeout = std::max(timeout, m->spec.stop_timeout_sec);
+      timeout = std::max(timeout, m->spec.stop_timeout_s);
     }
     const auto begin = Clock::now();
     bool killed = false;
@@ -217,7 +217,7 @@ void Launcher::StopEverything() {
       if (!killed && SecondsSince(begin) > timeout) {
         for (Managed* m : group) {
           if (m->child->running()) {
-            ORBED_LOG(kWarn) << m->spec.name << " did not stop within " << m->spec.stop_timeout_sec
+            ORBED_LOG(kWarn) << m->spec.name << " did not stop within " << m->spec.stop_timeout_s
                              << " s: SIGKILL";
             m->child->Signal(SIGKILL);
           }

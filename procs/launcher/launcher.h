@@ -6,8 +6,8 @@
 /// testbed with an error naming it. While running it re-emits each child's output prefixed with
 /// the child's name, restarts children marked `respawn` (at once, then with a growing back-off if
 /// they keep dying within a second), and stops the testbed when a required child fails or a child
-/// marked `exit_stops_all` exits. On SIGINT/SIGTERM or after --duration-sec it stops the groups in
-/// reverse order: each child gets its stop_signal, then SIGKILL after stop_timeout_sec.
+/// marked `exit_stops_all` exits. On SIGINT/SIGTERM or after --duration-s it stops the groups in
+/// reverse order: each child gets its stop_signal, then SIGKILL after stop_timeout_s.
 ///
 /// Children get: --name <name> appended (heartbeat-ready processes, unless args have --name),
 /// ORBED_LCM_URL = the launcher's LCM URL, ORBED_LOG_PREFIXED=1 (their log lines then omit the

@@ -32,7 +32,7 @@ int RunLauncher(int argc, const char* const* argv, std::ostream& out, std::ostre
   CLI::App app{
       "orbed-launch: start the processes of a YAML launch file group by group (each group waits\n"
       "for its processes' first heartbeat), prefix their output with their names, restart them\n"
-      "when asked, and stop everything in reverse order on SIGINT/SIGTERM or after --duration-sec."};
+      "when asked, and stop everything in reverse order on SIGINT/SIGTERM or after --duration-s."};
   CommonFlags common("orbed-launch");
   AddCommonFlags(&app, &common);
   std::string launch_file;

@@ -45,7 +45,7 @@ groups:
         respawn: true
         required: false
         stop_signal: SIGTERM
-        stop_timeout_sec: 2.5
+        stop_timeout_s: 2.5
         ready: none
         exit_stops_all: true
 )",
@@ -58,7 +58,7 @@ groups:
   EXPECT_TRUE(logger.required);
   EXPECT_FALSE(logger.respawn);
   EXPECT_EQ(logger.stop_signal, SIGINT);
-  EXPECT_EQ(logger.stop_timeout_sec, 5.0);
+  EXPECT_EQ(logger.stop_timeout_s, 5.0);
   EXPECT_EQ(logger.ready, ReadyCheck::kHeartbeat);
   const ProcessSpec& tool = spec.groups[1].processes.at(0);
   EXPECT_EQ(tool.command, "/opt/b/tool");
@@ -66,7 +66,7 @@ groups:
   EXPECT_TRUE(tool.respawn);
   EXPECT_FALSE(tool.required);
   EXPECT_EQ(tool.stop_signal, SIGTERM);
-  EXPECT_EQ(tool.stop_timeout_sec, 2.5);
+  EXPECT_EQ(tool.stop_timeout_s, 2.5);
   EXPECT_EQ(tool.ready, ReadyCheck::kNone);
   EXPECT_TRUE(tool.exit_stops_all);
 }

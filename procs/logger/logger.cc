@@ -46,7 +46,7 @@ Logger::Logger(const CommonFlags& flags, LoggerOptions options)
   if (options_.queue_capacity_events <= 0 || options_.queue_capacity_bytes <= 0) {
     throw std::invalid_argument("queue capacities must be > 0");
   }
-  if (!(options_.flush_interval_sec > 0)) {
+  if (!(options_.flush_interval_s > 0)) {
     throw std::invalid_argument("flush interval must be > 0 s");
   }
   // Subscribe first: a malformed --channels regex throws before any file is created.
@@ -114,7 +114,7 @@ void Logger::OnMessage(const lcm::ReceiveBuffer& rbuf, const std::string& channe
 void Logger::WriterLoop() {
   using Clock = std::chrono::steady_clock;
   const auto flush_period =
-      std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(options_.flush_interval_sec));
+      std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(options_.flush_interval_s));
   auto next_flush = Clock::now() + flush_period;
   std::deque<Event> batch;
   for (;;) {

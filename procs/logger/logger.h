@@ -7,7 +7,7 @@
 /// Threads: the receive thread (Process::Run, LCM's handler) stamps each message with LCM's
 /// receive time and appends it to a bounded in-memory queue, or counts a drop when the queue is
 /// full (by events or bytes) — never a silent loss. The writer thread drains the queue into the
-/// file and flushes every `flush_interval_sec`, so after a SIGKILL the log is valid up to the last
+/// file and flushes every `flush_interval_s`, so after a SIGKILL the log is valid up to the last
 /// flush. SIGINT/SIGTERM stop the receive loop, the writer drains what is queued, flushes, closes,
 /// and the manifest is rewritten with complete = true.
 ///
@@ -45,7 +45,7 @@ struct LoggerOptions {
   int64_t queue_capacity_events = 100000;
   int64_t queue_capacity_bytes = 128ll << 20;
   /// Period of the writer's fflush [s].
-  double flush_interval_sec = 0.25;
+  double flush_interval_s = 0.25;
   /// Files whose SHA-256 the manifest records (URDF, scene, launch file, ...).
   std::vector<std::string> hash_files;
   /// The command line, for the manifest.

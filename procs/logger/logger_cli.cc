@@ -34,7 +34,7 @@ int RunLogger(int argc, const char* const* argv, std::ostream& out, std::ostream
   app.add_option("--queue-mb", queue_mb, "Queue bound in MiB")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  app.add_option("--flush-interval-sec", options.flush_interval_sec,
+  app.add_option("--flush-interval-s", options.flush_interval_s,
                  "Flush period: after a SIGKILL the log is valid up to the last flush")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();

@@ -4,10 +4,10 @@
 /// tests can run it in-process.
 ///
 /// Flags: the common process flags (procs/common/flags.h) and --log-dir, --file, --manifest,
-/// --channels (a regular expression), --queue-events, --queue-mb, --flush-interval-sec,
+/// --channels (a regular expression), --queue-events, --queue-mb, --flush-interval-s,
 /// --hash-file (repeatable); see --help for their defaults and logger.h for what they do.
 ///
-/// Exit codes: 0 after --help or a clean stop (SIGINT/SIGTERM, --duration-sec); CLI11's code
+/// Exit codes: 0 after --help or a clean stop (SIGINT/SIGTERM, --duration-s); CLI11's code
 /// (non-zero) for an unknown flag or a bad flag value (the message names the flag); 2 for a bad
 /// value found when the logger starts (e.g. a --channels that is no regular expression); 1 when
 /// the log cannot be written. Help goes to `out`, flag errors to `err`.

@@ -112,7 +112,7 @@ TEST(Logger, RecordsEveryChannelWritesManifestAndCountsDrops) {
   { std::ofstream(hashed) << "<robot name='x'/>"; }
   CommonFlags flags("orbed-logger");
   flags.lcm_url = "memq://";
-  flags.duration_sec = 1.2;
+  flags.duration_s = 1.2;
   LoggerOptions options;
   options.log_dir = dir.string();
   options.hash_files = {hashed.string(), (dir / "missing.yaml").string()};
@@ -174,11 +174,11 @@ TEST(Logger, RecordsEveryChannelWritesManifestAndCountsDrops) {
 TEST(Logger, WriteErrorsFailTheLogger) {
   CommonFlags flags("orbed-logger");
   flags.lcm_url = "memq://";
-  flags.duration_sec = 2.0;
+  flags.duration_s = 2.0;
   LoggerOptions options;
   options.file = "/dev/full";
   options.manifest = (TempDir("full") / "manifest.json").string();
-  options.flush_interval_sec = 0.05;
+  options.flush_interval_s = 0.05;
   Logger logger(flags, options);
   const std::string payload(100000, 'x');
   for (int i = 0; i < 20; ++i) logger.process().lcm().publish("BLOB", payload.data(), payload.size());
@@ -201,7 +201,7 @@ TEST(Logger, ChannelRegexSelects) {
   const fs::path dir = TempDir("regex");
   CommonFlags flags("orbed-logger");
   flags.lcm_url = "memq://";
-  flags.duration_sec = 0.3;
+  flags.duration_s = 0.3;
   LoggerOptions options;
   options.file = (dir / "only_hmd.lcmlog").string();
   options.channels = "HMD_.*";
@@ -220,7 +220,7 @@ TEST(Logger, ChannelRegexSelects) {
 TEST(LoggerCli, HelpGoesToOutAndExitsZero) {
   const test::CommandRun r = test::RunCommand(RunLogger, "orbed-logger", {"--help"});
   EXPECT_EQ(r.code, 0);
-  EXPECT_NE(r.out.find("--flush-interval-sec"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("--flush-interval-s"), std::string::npos) << r.out;
   EXPECT_TRUE(r.err.empty()) << r.err;
 }
 
@@ -228,9 +228,9 @@ TEST(LoggerCli, RefusesAnUnknownFlagAndABadValue) {
   test::CommandRun r = test::RunCommand(RunLogger, "orbed-logger", {"--no-such-flag"});
   EXPECT_NE(r.code, 0);
   EXPECT_NE(r.err.find("--no-such-flag"), std::string::npos) << r.err;
-  r = test::RunCommand(RunLogger, "orbed-logger", {"--flush-interval-sec", "-1"});
+  r = test::RunCommand(RunLogger, "orbed-logger", {"--flush-interval-s", "-1"});
   EXPECT_NE(r.code, 0);
-  EXPECT_NE(r.err.find("--flush-interval-sec"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--flush-interval-s"), std::string::npos) << r.err;
   // Found when the logger starts, not by the parser: exit 2, and no file is created.
   const fs::path dir = TempDir("cli_regex");
   r = test::RunCommand(RunLogger, "orbed-logger",
@@ -244,14 +244,14 @@ TEST(LoggerCli, RecordsUntilTheDurationAndWritesTheManifest) {
   const fs::path dir = TempDir("cli_run");
   const test::CommandRun r = test::RunCommand(
       RunLogger, "orbed-logger",
-      {"--lcm-url", "memq://", "--duration-sec", "0.2", "--file", (dir / "run.lcmlog").string()});
+      {"--lcm-url", "memq://", "--duration-s", "0.2", "--file", (dir / "run.lcmlog").string()});
   EXPECT_EQ(r.code, 0) << r.err;
   EXPECT_TRUE(fs::exists(dir / "run.lcmlog"));
   std::ifstream manifest(dir / "manifest.json");
   std::stringstream text;
   text << manifest.rdbuf();
   // The manifest records the command line as given.
-  EXPECT_NE(text.str().find("orbed-logger --lcm-url memq:// --duration-sec 0.2"), std::string::npos)
+  EXPECT_NE(text.str().find("orbed-logger --lcm-url memq:// --duration-s 0.2"), std::string::npos)
       << text.str();
 }
 

@@ -55,7 +55,7 @@ Monitor::Monitor(const CommonFlags& flags, MonitorOptions options) : options_(op
         logger_ = msg;
         have_logger_ = true;
       });
-  process_.AddTimer(options_.print_period_sec, [this] { std::cout << Table(NowMicros()) << std::flush; });
+  process_.AddTimer(options_.print_period_s, [this] { std::cout << Table(NowMicros()) << std::flush; });
 }
 
 std::string Monitor::Table(int64_t now_utime) const {
@@ -64,7 +64,7 @@ std::string Monitor::Table(int64_t now_utime) const {
   for (const auto& [name, seen] : processes_) {
     const orbed::process_status_t& s = seen.status;
     const double age_s = (now_utime - seen.recv_utime) * 1e-6;
-    const std::string state = age_s > options_.silent_after_sec ? "SILENT" : StateName(s.state);
+    const std::string state = age_s > options_.silent_after_s ? "SILENT" : StateName(s.state);
     std::snprintf(line, sizeof(line), "%-20s  %-8s  %8.1f  %7lld  %8lld  %8lld  %s\n", name.c_str(),
                   state.c_str(), s.uptime_s, static_cast<long long>(s.messages_in),
                   static_cast<long long>(s.messages_out), static_cast<long long>(s.rejected_inputs),

@@ -1,8 +1,8 @@
 #pragma once
 /// @file
 /// orbed-monitor's engine: watches the testbed's health. Keeps the latest PROCESS_STATUS of every
-/// process and the latest LOGGER_STATUS, prints a compact table every `print_period_sec`, and
-/// flags a process as silent when its heartbeat is older than `silent_after_sec`.
+/// process and the latest LOGGER_STATUS, prints a compact table every `print_period_s`, and
+/// flags a process as silent when its heartbeat is older than `silent_after_s`.
 ///
 /// Threading: everything on the Process::Run thread.
 
@@ -17,8 +17,8 @@
 namespace orbed::monitor {
 
 struct MonitorOptions {
-  double print_period_sec = 5.0;
-  double silent_after_sec = 3.0;
+  double print_period_s = 5.0;
+  double silent_after_s = 3.0;
 };
 
 class Monitor {

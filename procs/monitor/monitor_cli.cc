@@ -16,10 +16,10 @@ int RunMonitor(int argc, const char* const* argv, std::ostream& out, std::ostrea
   CommonFlags common("orbed-monitor");
   AddCommonFlags(&app, &common);
   MonitorOptions options;
-  app.add_option("--print-period-sec", options.print_period_sec, "Table period")
+  app.add_option("--print-period-s", options.print_period_s, "Table period")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  app.add_option("--silent-after-sec", options.silent_after_sec,
+  app.add_option("--silent-after-s", options.silent_after_s,
                  "Heartbeat age after which a process is shown as SILENT")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();

@@ -13,10 +13,10 @@ namespace {
 TEST(Monitor, TabulatesHeartbeatsAndFlagsSilentProcesses) {
   CommonFlags flags("orbed-monitor");
   flags.lcm_url = "memq://";
-  flags.duration_sec = 0.2;
+  flags.duration_s = 0.2;
   MonitorOptions options;
-  options.print_period_sec = 10;
-  options.silent_after_sec = 3;
+  options.print_period_s = 10;
+  options.silent_after_s = 3;
   Monitor monitor(flags, options);
   orbed::process_status_t status{};
   status.name = "sim";
@@ -51,7 +51,7 @@ TEST(Monitor, TabulatesHeartbeatsAndFlagsSilentProcesses) {
   // own heartbeat, which is published after them.
   EXPECT_EQ(monitor.process().rejections().counts().at("PROCESS_STATUS/field"), 1);
   EXPECT_EQ(monitor.process().rejections().counts().at("PROCESS_STATUS/too_many"), 46);
-  // 10 s later, past silent_after_sec = 3 s, the same row says SILENT.
+  // 10 s later, past silent_after_s = 3 s, the same row says SILENT.
   EXPECT_NE(
       monitor.Table(now + 10'000'000).find("sim                   SILENT        42.2       12       345"),
       std::string::npos);
@@ -61,7 +61,7 @@ TEST(Monitor, TabulatesHeartbeatsAndFlagsSilentProcesses) {
 TEST(MonitorCli, HelpGoesToOutAndExitsZero) {
   const test::CommandRun r = test::RunCommand(RunMonitor, "orbed-monitor", {"--help"});
   EXPECT_EQ(r.code, 0);
-  EXPECT_NE(r.out.find("--silent-after-sec"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("--silent-after-s"), std::string::npos) << r.out;
   EXPECT_TRUE(r.err.empty()) << r.err;
 }
 
@@ -69,15 +69,15 @@ TEST(MonitorCli, RefusesAnUnknownFlagAndABadValue) {
   test::CommandRun r = test::RunCommand(RunMonitor, "orbed-monitor", {"--no-such-flag"});
   EXPECT_NE(r.code, 0);
   EXPECT_NE(r.err.find("--no-such-flag"), std::string::npos) << r.err;
-  r = test::RunCommand(RunMonitor, "orbed-monitor", {"--print-period-sec", "-1"});
+  r = test::RunCommand(RunMonitor, "orbed-monitor", {"--print-period-s", "-1"});
   EXPECT_NE(r.code, 0);
-  EXPECT_NE(r.err.find("--print-period-sec"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--print-period-s"), std::string::npos) << r.err;
   EXPECT_TRUE(r.out.empty()) << r.out;
 }
 
 TEST(MonitorCli, RunsForTheDurationAndExitsZero) {
   const test::CommandRun r =
-      test::RunCommand(RunMonitor, "orbed-monitor", {"--lcm-url", "memq://", "--duration-sec", "0.1"});
+      test::RunCommand(RunMonitor, "orbed-monitor", {"--lcm-url", "memq://", "--duration-s", "0.1"});
   EXPECT_EQ(r.code, 0) << r.err;
 }
 

@@ -24,8 +24,7 @@ int RunRegistration(int argc, const char* const* argv, std::ostream& out, std::o
   AddCommonFlags(&app, &common);
   RegistrationServerOptions server;
   std::vector<double> server_centroid_m;
-  app.add_option("--state-period-sec", server.state_period_s,
-                 "Period of the full-state REGISTRATION (0 = off)")
+  app.add_option("--state-period-s", server.state_period_s, "Period of the full-state REGISTRATION (0 = off)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--model-centroid-m", server_centroid_m,
@@ -71,7 +70,7 @@ int RunRegistration(int argc, const char* const* argv, std::ostream& out, std::o
       ->required();
   send->add_option("--session-id", send_options.session_id, "Session id to use")->capture_default_str();
   send->add_flag("--robust", send_options.robust, "Ask for the robust mean");
-  send->add_option("--timeout-sec", send_options.timeout_s, "How long to wait for the answer")
+  send->add_option("--timeout-s", send_options.timeout_s, "How long to wait for the answer")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
 

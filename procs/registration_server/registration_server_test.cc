@@ -308,7 +308,7 @@ TEST(RegistrationServiceTest, ReplayIsBitIdentical) {
 TEST(RegistrationServerTest, ServesOverInProcessLcm) {
   orbed::CommonFlags flags("orbed-registration-test");
   flags.lcm_url = "memq://";
-  flags.duration_sec = 0.35;
+  flags.duration_s = 0.35;
   RegistrationServerOptions options;
   options.state_period_s = 0.1;
   RegistrationServer server(flags, options);
@@ -365,21 +365,21 @@ TEST(RegistrationServerTest, ServesOverInProcessLcm) {
 TEST(RegistrationCliTest, HelpGoesToOutAndExitsZero) {
   test::CommandRun r = test::RunCommand(RunRegistration, "orbed-registration", {"--help"});
   EXPECT_EQ(r.code, 0);
-  EXPECT_NE(r.out.find("--state-period-sec"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("--state-period-s"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("mean"), std::string::npos) << r.out;
   EXPECT_TRUE(r.err.empty()) << r.err;
   r = test::RunCommand(RunRegistration, "orbed-registration", {"send", "--help"});
   EXPECT_EQ(r.code, 0);
-  EXPECT_NE(r.out.find("--timeout-sec"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("--timeout-s"), std::string::npos) << r.out;
 }
 
 TEST(RegistrationCliTest, RefusesAnUnknownFlagAndBadValues) {
   test::CommandRun r = test::RunCommand(RunRegistration, "orbed-registration", {"--no-such-flag"});
   EXPECT_NE(r.code, 0);
   EXPECT_NE(r.err.find("--no-such-flag"), std::string::npos) << r.err;
-  r = test::RunCommand(RunRegistration, "orbed-registration", {"--state-period-sec", "-1"});
+  r = test::RunCommand(RunRegistration, "orbed-registration", {"--state-period-s", "-1"});
   EXPECT_NE(r.code, 0);
-  EXPECT_NE(r.err.find("--state-period-sec"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--state-period-s"), std::string::npos) << r.err;
   r = test::RunCommand(RunRegistration, "orbed-registration", {"mean", "--json"});
   EXPECT_NE(r.code, 0);
   EXPECT_NE(r.err.find("--input"), std::string::npos) << r.err;

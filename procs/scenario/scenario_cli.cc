@@ -43,17 +43,17 @@ int RunScenario(int argc, const char* const* argv, std::ostream& out, std::ostre
   app.add_option("--tolerance-deg", run.tolerance_deg, "Arrival tolerance per joint [deg]")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  app.add_option("--startup-timeout-sec", run.startup_timeout_s, "Wait for the first ROBOT_STATE [s]")
+  app.add_option("--startup-timeout-s", run.startup_timeout_s, "Wait for the first ROBOT_STATE [s]")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  app.add_option("--reply-timeout-sec", run.reply_timeout_s,
+  app.add_option("--reply-timeout-s", run.reply_timeout_s,
                  "Wait for PLAN_CHECK_REPLY / REGISTRATION / MISALIGNMENT [s]")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  app.add_option("--move-timeout-sec", run.move_timeout_s, "Wait for the arm to reach a configuration [s]")
+  app.add_option("--move-timeout-s", run.move_timeout_s, "Wait for the arm to reach a configuration [s]")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  app.add_option("--trial-timeout-sec", run.trial_timeout_s, "Wait for the user's ALIGNMENT_TRIAL [s]")
+  app.add_option("--trial-timeout-s", run.trial_timeout_s, "Wait for the user's ALIGNMENT_TRIAL [s]")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   app.add_option("--robot-state-channel", run.robot_state_channel)->capture_default_str();

@@ -4,15 +4,15 @@
 /// can run it in-process. It conducts the ViRAAl experiment over the bus (viraal_scenario.h) and
 /// exits: 0 when every session finished, 1 with a one-line reason otherwise.
 ///
-/// Flags: the common ones (flags.h: --lcm-url, --name, --seed, --duration-sec, --log-level), and
+/// Flags: the common ones (flags.h: --lcm-url, --name, --seed, --duration-s, --log-level), and
 ///   --scenario FILE            scenario YAML (default viraal/viraal.yaml of the source tree)
 ///   --trials N, --modes a,b, --q-deg q1,...,q7 (repeatable)   overrides of the file
 ///   --run-id ID                sessions are <ID>-<mode>; default $ORBED_RUN_ID when it is set and not
 ///                              empty, else viraal-<UTC time>
 ///   --results-dir DIR          folder of results.json (default $ORBED_LOG_DIR, else the working dir)
 ///   --urdf FILE                robot model for the landmark FK (default sim/models/iiwa7.urdf)
-///   --tolerance-deg, --startup-timeout-sec, --reply-timeout-sec, --move-timeout-sec,
-///   --trial-timeout-sec        see ConductorOptions (viraal_conductor.h)
+///   --tolerance-deg, --startup-timeout-s, --reply-timeout-s, --move-timeout-s,
+///   --trial-timeout-s        see ConductorOptions (viraal_conductor.h)
 ///   --<name>-channel           the nine channels, defaults from channels.h
 ///
 /// Streams: --help's usage and the run's progress lines and table go to `out`; flag errors and a

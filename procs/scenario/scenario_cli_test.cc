@@ -45,9 +45,9 @@ TEST(ScenarioCli, HelpPrintsTheUsageOnOut) {
   EXPECT_EQ(r.code, 0);
   EXPECT_TRUE(Contains(r.out, "orbed-scenario: conducts the ViRAAl experiment")) << r.out;
   for (const char* flag : {"--scenario", "--trials", "--modes", "--q-deg", "--run-id", "--results-dir",
-                           "--urdf", "--tolerance-deg", "--startup-timeout-sec", "--reply-timeout-sec",
-                           "--move-timeout-sec", "--trial-timeout-sec", "--robot-state-channel",
-                           "--misalignment-channel", "--lcm-url", "--seed", "--duration-sec"}) {
+                           "--urdf", "--tolerance-deg", "--startup-timeout-s", "--reply-timeout-s",
+                           "--move-timeout-s", "--trial-timeout-s", "--robot-state-channel",
+                           "--misalignment-channel", "--lcm-url", "--seed", "--duration-s"}) {
     EXPECT_TRUE(Contains(r.out, flag)) << flag;
   }
   EXPECT_TRUE(Contains(r.out, "ORBED_RUN_ID"));
@@ -62,9 +62,9 @@ TEST(ScenarioCli, BadFlagsExitNonZeroWithTheMessageOnErr) {
   r = Cli({"--trials", "0"});
   EXPECT_NE(r.code, 0);
   EXPECT_TRUE(Contains(r.err, "--trials")) << r.err;
-  r = Cli({"--reply-timeout-sec", "-1"});
+  r = Cli({"--reply-timeout-s", "-1"});
   EXPECT_NE(r.code, 0);
-  EXPECT_TRUE(Contains(r.err, "--reply-timeout-sec")) << r.err;
+  EXPECT_TRUE(Contains(r.err, "--reply-timeout-s")) << r.err;
   r = Cli({"--log-level", "loud"});
   EXPECT_NE(r.code, 0);
   EXPECT_TRUE(Contains(r.err, "loud")) << r.err;
@@ -80,7 +80,7 @@ TEST(ScenarioCli, AScenarioThatCannotBeBuiltExitsOneWithTheReasonOnErr) {
 std::string RunIdOfAFailedRun(const std::vector<std::string>& extra, CliRun* run) {
   const std::string dir = std::filesystem::temp_directory_path() / "orbed_scenario_cli_test";
   std::filesystem::remove_all(dir);
-  std::vector<std::string> args = {"--lcm-url", "memq://",       "--startup-timeout-sec",
+  std::vector<std::string> args = {"--lcm-url", "memq://",       "--startup-timeout-s",
                                    "0.05",      "--results-dir", dir};
   args.insert(args.end(), extra.begin(), extra.end());
   *run = Cli(args);

@@ -23,6 +23,7 @@
 #include "base/units.h"
 #include "procs/common/conversions.h"
 #include "procs/scenario/viraal_scenario.h"
+#include "sim/scene.h"
 #include "viraal/metrics.h"
 #include "viraal/protocol.h"
 #include "viraal/results.h"
@@ -30,15 +31,10 @@
 namespace orbed::scenario {
 namespace {
 
-// The trocar_or scene's base: (0.25, -0.55, 0.75), yaw 90 deg.
-Eigen::Isometry3d SceneBase() {
-  Eigen::Isometry3d X_WR = Eigen::Isometry3d::Identity();
-  X_WR.linear() = Eigen::AngleAxisd(90 * kDegToRad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  X_WR.translation() = Eigen::Vector3d(0.25, -0.55, 0.75);
-  return X_WR;
-}
-
 std::string Source(const std::string& relative) { return ScenarioSourcePath(relative); }
+
+// The shipped scene's robot base X_WR (the fake sim's truth).
+Eigen::Isometry3d SceneBase() { return sim::LoadSceneFile(Source(sim::kDefaultSceneRelativePath)).X_WR; }
 
 int Count(const std::string& text, const std::string& pattern) {
   const std::regex re(pattern);
@@ -195,7 +191,7 @@ ScenarioOptions MemqOptions(const std::string& dir) {
 CommonFlags MemqFlags() {
   CommonFlags flags("orbed-scenario-test");
   flags.lcm_url = "memq://";
-  flags.duration_sec = 30;  // a safety net: the run itself takes well under a second
+  flags.duration_s = 30;  // a safety net: the run itself takes well under a second
   return flags;
 }
 

@@ -32,13 +32,11 @@ std::string JointList(const std::vector<double>& q_deg, int digits) {
 }  // namespace
 
 void CheckConductorOptions(const ConductorOptions& options) {
-  const std::pair<const char*, double> positive[] = {{"--tolerance-deg", options.tolerance_deg},
-                                                     {"--startup-timeout-sec", options.startup_timeout_s},
-                                                     {"--reply-timeout-sec", options.reply_timeout_s},
-                                                     {"--move-timeout-sec", options.move_timeout_s},
-                                                     {"--trial-timeout-sec", options.trial_timeout_s},
-                                                     {"--stopped-grace-sec", options.stopped_grace_s},
-                                                     {"command resend period", options.command_resend_s}};
+  const std::pair<const char*, double> positive[] = {
+      {"--tolerance-deg", options.tolerance_deg},         {"--startup-timeout-s", options.startup_timeout_s},
+      {"--reply-timeout-s", options.reply_timeout_s},     {"--move-timeout-s", options.move_timeout_s},
+      {"--trial-timeout-s", options.trial_timeout_s},     {"--stopped-grace-s", options.stopped_grace_s},
+      {"command resend period", options.command_resend_s}};
   for (const auto& [name, value] : positive) {
     if (!(value > 0) || !std::isfinite(value)) {
       throw std::invalid_argument(std::string(name) + " must be a finite number > 0");

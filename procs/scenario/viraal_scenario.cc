@@ -84,7 +84,7 @@ int ViraalScenario::Run() {
   Apply(conductor_->Start(Now()));
   const int code = process_->Run();
   if (!finished_) {
-    // Stopped from outside (signal, --duration-sec) before the run completed.
+    // Stopped from outside (signal, --duration-s) before the run completed.
     Apply(conductor_->Abort("interrupted before the run completed", Now()));
     return 1;
   }

@@ -16,7 +16,7 @@
 /// table is printed and the process stops with exit code 0; on a failure "FAILED: <reason>" is
 /// printed, the reason goes on the heartbeat and the exit code is 1 (results.json is still
 /// written, status "failed", with what was finished). A stop from outside (signal,
-/// --duration-sec) before the end fails the run as "interrupted".
+/// --duration-s) before the end fails the run as "interrupted".
 ///
 /// Clocks: the conductor's t_s is std::chrono::steady_clock (seconds since construction), its
 /// utime the wall clock (NowMicros()).

@@ -1,4 +1,4 @@
-// orbed-iiwa-sim as a process at 1 kHz status (--period-sec 0.001: IIWA_STATUS, ROBOT_STATE and
+// orbed-iiwa-sim as a process at 1 kHz status (--period-s 0.001: IIWA_STATUS, ROBOT_STATE and
 // COLLISION_STATUS every millisecond) for ORBED_BENCH_SECONDS (default 30) s, while a client keeps
 // it busy: every 1.5 s a new IIWA_COMMAND cycling upright -> a far pose -> upright -> a pose whose
 // path runs into the table (the arm stops before it) -> upright ..., so most ticks move the arm
@@ -69,8 +69,8 @@ void BM_IiwaSimAt1kHz(benchmark::State& state) {
     StatusCounter counter;
     lcm.subscribe("IIWA_STATUS", &StatusCounter::On, &counter);
     const auto spawned = Clock::now();
-    const pid_t sim = Spawn({BinDir() + "/orbed-iiwa-sim", "--period-sec", "0.001", "--name", "sim_bench",
-                             "--log-level", "warn"});
+    const pid_t sim = Spawn(
+        {BinDir() + "/orbed-iiwa-sim", "--period-s", "0.001", "--name", "sim_bench", "--log-level", "warn"});
     // Wait for the first status, then measure over `seconds`.
     while (counter.count == 0 && Clock::now() - spawned < std::chrono::seconds(10)) lcm.handleTimeout(50);
     counter.count = 0;

@@ -131,7 +131,7 @@ TEST(Launcher, RequiredProcessWithoutHeartbeatFailsTheLaunch) {
                                 "  - name: g\n"
                                 "    processes:\n"
                                 "      - {name: mute, command: sh, args: [-c, 'sleep 30'], "
-                                "ready_timeout_sec: 1, stop_signal: SIGTERM}\n";
+                                "ready_timeout_s: 1, stop_signal: SIGTERM}\n";
   const auto begin = std::chrono::steady_clock::now();
   RunningProcess launcher({BinPath("orbed-launch"), launch_file});
   ASSERT_TRUE(launcher.Wait(15));
@@ -149,8 +149,8 @@ TEST(Launcher, CrashLoopingChildFailsReadinessDespiteRespawn) {
                                 "  - name: g\n"
                                 "    processes:\n"
                                 "      - {name: crashy, command: sh, args: [-c, 'sleep 0.3; exit 3'], "
-                                "respawn: true, ready_timeout_sec: 2}\n";
-  RunningProcess launcher({BinPath("orbed-launch"), launch_file, "--duration-sec", "30"});
+                                "respawn: true, ready_timeout_s: 2}\n";
+  RunningProcess launcher({BinPath("orbed-launch"), launch_file, "--duration-s", "30"});
   ASSERT_TRUE(launcher.Wait(20)) << "the launcher hung on a crash-looping child";
   EXPECT_EQ(launcher.exit_code(), 1);
 }
@@ -163,13 +163,13 @@ TEST(Launcher, OptionalProcessThatEndsEarlyDoesNotBlockTheLaunch) {
                                 "  - name: first\n"
                                 "    processes:\n"
                                 "      - {name: quick, command: sh, args: [-c, 'exit 0'], "
-                                "required: false, ready_timeout_sec: 5}\n"
+                                "required: false, ready_timeout_s: 5}\n"
                                 "  - name: second\n"
                                 "    processes:\n"
                                 "      - {name: monitor, command: orbed-monitor}\n";
   BusWatcher bus;
   bus.Start();
-  RunningProcess launcher({BinPath("orbed-launch"), launch_file, "--duration-sec", "4"});
+  RunningProcess launcher({BinPath("orbed-launch"), launch_file, "--duration-s", "4"});
   EXPECT_TRUE(WaitFor([&] { return !bus.Heartbeats("monitor").empty(); }, 4))
       << "the second group never started";
   ASSERT_TRUE(launcher.Wait(15));
@@ -247,7 +247,7 @@ TEST(Logger, SigkilledLoggerLeavesAReadableLog) {
   BusWatcher bus;
   bus.Start();
   RunningProcess logger({BinPath("orbed-logger"), "--file", path, "--channels", "IIWA_STATUS|BLOB",
-                         "--flush-interval-sec", "0.1", "--name", "killed-logger"});
+                         "--flush-interval-s", "0.1", "--name", "killed-logger"});
   lcm::LCM lcm("");
   ASSERT_TRUE(WaitFor([&] { return !bus.Heartbeats("killed-logger").empty(); }, 10));
   PublishTraffic(&lcm, 60, 200.0);

@@ -173,13 +173,13 @@ std::vector<std::string> ScenarioArgs(const std::string& dir) {
           "it",
           "--results-dir",
           dir,
-          "--trial-timeout-sec",
+          "--trial-timeout-s",
           "5",
-          "--reply-timeout-sec",
+          "--reply-timeout-s",
           "5",
-          "--move-timeout-sec",
+          "--move-timeout-s",
           "20",
-          "--startup-timeout-sec",
+          "--startup-timeout-s",
           "10"};
 }
 
@@ -253,7 +253,7 @@ TEST(Scenario, WithoutAUserItFailsNamingOrbedHmd) {
   std::vector<std::string> args = ScenarioArgs(dir);
   args.push_back("--trials");
   args.push_back("1");
-  args[std::find(args.begin(), args.end(), "--trial-timeout-sec") - args.begin() + 1] = "2";
+  args[std::find(args.begin(), args.end(), "--trial-timeout-s") - args.begin() + 1] = "2";
   RunningProcess scenario(args);
   ASSERT_TRUE(scenario.Wait(60));
   EXPECT_EQ(scenario.exit_code(), 1);

@@ -39,7 +39,7 @@ void ExpectErrors(const YAML::Node& node, const std::string& where) {
 TEST(ViraalRun, LaunchFileRunsTheStudyAndWritesResults) {
   const std::string log_dir = MakeTempDir("viraal_e2e");
   RunningProcess launcher(
-      {BinPath("orbed-launch"), SourcePath("scripts/launch/viraal.yaml"), "--duration-sec", "240"},
+      {BinPath("orbed-launch"), SourcePath("scripts/launch/viraal.yaml"), "--duration-s", "240"},
       {{"ORBED_LOG_DIR", log_dir}, {"ORBED_RUN_ID", "pinned"}});
   ASSERT_TRUE(launcher.Wait(240)) << "the run did not finish";
   EXPECT_EQ(launcher.term_signal(), 0);
