@@ -15,6 +15,7 @@
 #include "procs/common/conversions.h"
 #include "procs/common/log.h"
 #include "procs/common/validation.h"
+#include "procs/common/requests.h"
 
 namespace orbed::sim {
 namespace {
@@ -115,26 +116,12 @@ IiwaSim::IiwaSim(const orbed::CommonFlags& flags, const IiwaSimOptions& options)
 IiwaSim::~IiwaSim() = default;
 
 void IiwaSim::OnCommand(const orbed::iiwa_command_t& msg, const std::string& channel) {
-  const int n = arm_->num_joints();
-  std::string error = CheckSize(msg.num_joints, n, "num_joints");
-  if (!error.empty()) {
-    process_->Reject(channel + "/num_joints", error);
+  const auto checked = CheckIiwaCommand(msg, arm_->num_joints());
+  if (const auto* refusal = std::get_if<Refusal>(&checked)) {
+    process_->Reject(channel + "/" + refusal->key, refusal->reason);
     return;
   }
-  if (!(msg.num_torques == 0 || msg.num_torques == msg.num_joints) ||
-      static_cast<size_t>(msg.num_torques) != msg.joint_torque.size()) {
-    process_->Reject(channel + "/num_torques", "num_torques is " + std::to_string(msg.num_torques) +
-                                                   " with " + std::to_string(msg.joint_torque.size()) +
-                                                   " torques, expected 0 or num_joints (" +
-                                                   std::to_string(n) + ")");
-    return;
-  }
-  error = FirstError(
-      {CheckFinite(msg.joint_position, "joint_position"), CheckFinite(msg.joint_torque, "joint_torque")});
-  if (!error.empty()) {
-    process_->Reject(channel + "/non_finite", error);
-    return;
-  }
+  const IiwaCommand& command = std::get<IiwaCommand>(checked);
   if (options_.stale_command_s > 0) {
     // In double: a wild utime (e.g. INT64_MIN) must not overflow the subtraction.
     const double age_s = (static_cast<double>(NowMicros()) - static_cast<double>(msg.utime)) * 1e-6;
@@ -146,30 +133,23 @@ void IiwaSim::OnCommand(const orbed::iiwa_command_t& msg, const std::string& cha
       return;
     }
   }
-  arm_->SetCommand(ToVectorX(msg.joint_position));
+  arm_->SetCommand(command.q_rad);
 }
 
 void IiwaSim::OnPlanCheck(const orbed::plan_check_request_t& msg, const std::string& channel) {
   orbed::plan_check_reply_t reply{};
   reply.request_id = msg.request_id;
-  const int n = arm_->num_joints();
-  std::string key;
-  std::string error = CheckSize(msg.num_joints, n, "num_joints");
-  if (!error.empty()) {
-    key = "num_joints";
-  } else if (!(error = CheckFinite(msg.joint_position, "joint_position")).empty()) {
-    key = "non_finite";
-  }
-  if (!error.empty()) {
-    process_->Reject(channel + "/" + key, error);
+  const auto checked = CheckPlanCheckRequest(msg, arm_->num_joints());
+  if (const auto* refusal = std::get_if<Refusal>(&checked)) {
+    process_->Reject(channel + "/" + refusal->key, refusal->reason);
     reply.utime = NowMicros();
     reply.request_valid = false;
     reply.min_distance_m = std::nan("");
-    reply.reason = "invalid request: " + error;
+    reply.reason = "invalid request: " + refusal->reason;
     process_->Publish(options_.plan_check_reply_channel, reply);
     return;
   }
-  const Eigen::VectorXd q = ToVectorX(msg.joint_position);
+  const Eigen::VectorXd& q = std::get<PlanCheckRequest>(checked).q_rad;
   const std::string limits = arm_->model().ValidateJointVector(q);
   const CollisionResult r = arm_->Check(q);
   reply.request_valid = true;

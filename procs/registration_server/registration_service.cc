@@ -10,31 +10,10 @@
 #include "procs/common/conversions.h"
 #include "procs/common/session_control.h"
 #include "procs/common/validation.h"
+#include "procs/common/requests.h"
 
 namespace orbed::registration {
 namespace {
-
-// Rows of an N×3 message array (already sized by the decoder) as Eigen vectors.
-// Coordinates and direction components beyond this are not an operating room [m]; bounding them
-// keeps sums of squares finite.
-constexpr double kMaxCoordinate_m = 1e4;
-
-std::string ReadRows(const std::vector<std::vector<double>>& rows, int32_t count, int max,
-                     const std::string& what, std::vector<Eigen::Vector3d>* out) {
-  if (count < 0 || count > max || static_cast<size_t>(count) != rows.size()) {
-    return what + ": count " + std::to_string(count) + " is outside [0, " + std::to_string(max) +
-           "] or does not match the array";
-  }
-  out->clear();
-  for (size_t i = 0; i < rows.size(); ++i) {
-    if (rows[i].size() != 3) return what + "[" + std::to_string(i) + "]: expected 3 values";
-    const std::string bounded =
-        CheckBounded(rows[i].data(), 3, kMaxCoordinate_m, what + "[" + std::to_string(i) + "]");
-    if (!bounded.empty()) return bounded;
-    out->emplace_back(rows[i][0], rows[i][1], rows[i][2]);
-  }
-  return "";
-}
 
 }  // namespace
 
@@ -185,16 +164,13 @@ orbed::landmark_t RegistrationService::HandleLandmarkRequest(const orbed::landma
   out.request_id = msg.request_id;
   out.name = msg.name;
   out.valid = false;
-  std::vector<Eigen::Vector3d> origins, directions;
-  std::string problem =
-      ReadRows(msg.origin_W_m, msg.num_rays, options_.max_rays, "LANDMARK_REQUEST.origin_W_m", &origins);
+  const auto checked = CheckLandmarkRequest(msg, options_.max_rays);
+  const auto* refusal = std::get_if<Refusal>(&checked);
+  std::string problem = refusal ? refusal->reason : "";
   if (problem.empty()) {
-    problem = ReadRows(msg.direction_W, msg.num_rays, options_.max_rays, "LANDMARK_REQUEST.direction_W",
-                       &directions);
-  }
-  if (problem.empty()) {
+    const LandmarkRequest& request = std::get<LandmarkRequest>(checked);
     const geometry::TriangulationResult r =
-        geometry::TriangulateRays(origins, directions, options_.triangulation);
+        geometry::TriangulateRays(request.origin_W_m, request.direction_W, options_.triangulation);
     FromVector3(r.p_W, out.p_W_m);
     out.ray_angle_deg = r.ray_angle_deg;
     out.gap_m = r.gap_m;
@@ -216,15 +192,12 @@ orbed::misalignment_t RegistrationService::HandleMisalignmentRequest(
   out.session_id = msg.session_id;
   out.valid = false;
   out.num_pairs = 0;
-  std::vector<Eigen::Vector3d> real, virt;
-  std::string problem =
-      ReadRows(msg.p_W_real_m, msg.num_pairs, options_.max_pairs, "MISALIGNMENT_REQUEST.p_W_real_m", &real);
+  const auto checked = CheckMisalignmentRequest(msg, options_.max_pairs);
+  const auto* refusal = std::get_if<Refusal>(&checked);
+  std::string problem = refusal ? refusal->reason : "";
   if (problem.empty()) {
-    problem = ReadRows(msg.p_W_virtual_m, msg.num_pairs, options_.max_pairs,
-                       "MISALIGNMENT_REQUEST.p_W_virtual_m", &virt);
-  }
-  if (problem.empty()) {
-    const geometry::MisalignmentResult r = geometry::EvaluateMisalignment(real, virt);
+    const MisalignmentRequest& request = std::get<MisalignmentRequest>(checked);
+    const geometry::MisalignmentResult r = geometry::EvaluateMisalignment(request.p_W_real_m, request.p_W_virtual_m);
     if (r.valid) {
       out.valid = true;
       out.num_pairs = static_cast<int32_t>(r.error_W_m.size());

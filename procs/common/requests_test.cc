@@ -1,0 +1,78 @@
+// The one check of each single-reader request and command: valid messages decode, each rule
+// refuses by its key.
+#include "procs/common/requests.h"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+namespace orbed {
+namespace {
+
+template <class T, class V>
+std::string Key(const V& checked) {
+  if (std::holds_alternative<T>(checked)) return "";
+  return std::get<Refusal>(checked).key;
+}
+
+TEST(Requests, IiwaCommand) {
+  orbed::iiwa_command_t m{};
+  m.utime = 5;
+  m.num_joints = 7;
+  m.joint_position = {0, 0.1, 0, -1, 0, 0.5, 0};
+  const auto ok = CheckIiwaCommand(m, 7);
+  ASSERT_TRUE(std::holds_alternative<IiwaCommand>(ok));
+  EXPECT_DOUBLE_EQ(std::get<IiwaCommand>(ok).q_rad[3], -1.0);
+  EXPECT_EQ(std::get<IiwaCommand>(ok).utime, 5);
+  EXPECT_EQ(Key<IiwaCommand>(CheckIiwaCommand(m, 6)), "num_joints");
+  orbed::iiwa_command_t t = m;
+  t.num_torques = 3;
+  t.joint_torque = {1, 2, 3};
+  EXPECT_EQ(Key<IiwaCommand>(CheckIiwaCommand(t, 7)), "num_torques");
+  t.num_torques = 7;
+  t.joint_torque.assign(7, 0.0);
+  EXPECT_EQ(Key<IiwaCommand>(CheckIiwaCommand(t, 7)), "");
+  t.joint_torque[2] = NAN;
+  EXPECT_EQ(Key<IiwaCommand>(CheckIiwaCommand(t, 7)), "non_finite");
+  m.joint_position[0] = INFINITY;
+  EXPECT_EQ(Key<IiwaCommand>(CheckIiwaCommand(m, 7)), "non_finite");
+}
+
+TEST(Requests, PlanCheckRequest) {
+  orbed::plan_check_request_t m{};
+  m.request_id = 42;
+  m.num_joints = 7;
+  m.joint_position.assign(7, 0.2);
+  const auto ok = CheckPlanCheckRequest(m, 7);
+  ASSERT_TRUE(std::holds_alternative<PlanCheckRequest>(ok));
+  EXPECT_EQ(std::get<PlanCheckRequest>(ok).request_id, 42);
+  EXPECT_EQ(Key<PlanCheckRequest>(CheckPlanCheckRequest(m, 8)), "num_joints");
+  m.joint_position[6] = NAN;
+  EXPECT_EQ(Key<PlanCheckRequest>(CheckPlanCheckRequest(m, 7)), "non_finite");
+}
+
+TEST(Requests, LandmarkAndMisalignmentRows) {
+  orbed::landmark_request_t l{};
+  l.num_rays = 2;
+  l.origin_W_m = {{0, 0, 1}, {1, 0, 1}};
+  l.direction_W = {{1, 0, 0}, {0, 1, 0}};
+  const auto ok = CheckLandmarkRequest(l, 10);
+  ASSERT_TRUE(std::holds_alternative<LandmarkRequest>(ok));
+  EXPECT_EQ(std::get<LandmarkRequest>(ok).origin_W_m[1], Eigen::Vector3d(1, 0, 1));
+  EXPECT_EQ(Key<LandmarkRequest>(CheckLandmarkRequest(l, 1)), "invalid");  // beyond max_rays
+  l.direction_W[1] = {0, 2e4, 0};  // finite, not an operating room
+  EXPECT_EQ(Key<LandmarkRequest>(CheckLandmarkRequest(l, 10)), "invalid");
+  orbed::misalignment_request_t m{};
+  m.num_pairs = 1;
+  m.p_W_real_m = {{0, 0, 0}};
+  m.p_W_virtual_m = {{0, 0, 0.01}};
+  EXPECT_EQ(Key<MisalignmentRequest>(CheckMisalignmentRequest(m, 10)), "");
+  m.num_pairs = 2;  // the arrays hold one pair
+  EXPECT_EQ(Key<MisalignmentRequest>(CheckMisalignmentRequest(m, 10)), "invalid");
+  m.num_pairs = 1;
+  m.p_W_virtual_m = {{0, NAN, 0}};
+  EXPECT_EQ(Key<MisalignmentRequest>(CheckMisalignmentRequest(m, 10)), "invalid");
+}
+
+}  // namespace
+}  // namespace orbed
