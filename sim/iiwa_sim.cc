@@ -14,8 +14,8 @@
 #include "base/format.h"
 #include "procs/common/conversions.h"
 #include "procs/common/log.h"
-#include "procs/common/validation.h"
 #include "procs/common/requests.h"
+#include "procs/common/validation.h"
 
 namespace orbed::sim {
 namespace {

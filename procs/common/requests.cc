@@ -7,8 +7,8 @@ namespace orbed {
 namespace {
 
 // Rows of an N×3 message array (sized by the decoder) as vectors; "" or the reason.
-std::string ReadRows(const std::vector<std::vector<double>>& rows, int32_t count, int max, const std::string& what,
-                     std::vector<Eigen::Vector3d>* out) {
+std::string ReadRows(const std::vector<std::vector<double>>& rows, int32_t count, int max,
+                     const std::string& what, std::vector<Eigen::Vector3d>* out) {
   if (count < 0 || count > max || static_cast<size_t>(count) != rows.size()) {
     return what + ": count " + std::to_string(count) + " is outside [0, " + std::to_string(max) +
            "] or does not match the array";
@@ -28,13 +28,15 @@ std::string ReadRows(const std::vector<std::vector<double>>& rows, int32_t count
 
 std::variant<IiwaCommand, Refusal> CheckIiwaCommand(const orbed::iiwa_command_t& msg, int num_joints) {
   std::string error = CheckSize(msg.num_joints, num_joints, "num_joints");
-  if (error.empty()) error = CheckSize(static_cast<int64_t>(msg.joint_position.size()), num_joints, "joint_position");
+  if (error.empty())
+    error = CheckSize(static_cast<int64_t>(msg.joint_position.size()), num_joints, "joint_position");
   if (!error.empty()) return Refusal{"num_joints", error};
   if (!(msg.num_torques == 0 || msg.num_torques == msg.num_joints) ||
       static_cast<size_t>(msg.num_torques) != msg.joint_torque.size()) {
     return Refusal{"num_torques", "num_torques is " + std::to_string(msg.num_torques) + " with " +
                                       std::to_string(msg.joint_torque.size()) +
-                                      " torques, expected 0 or num_joints (" + std::to_string(num_joints) + ")"};
+                                      " torques, expected 0 or num_joints (" + std::to_string(num_joints) +
+                                      ")"};
   }
   error = FirstError(
       {CheckFinite(msg.joint_position, "joint_position"), CheckFinite(msg.joint_torque, "joint_torque")});
@@ -45,19 +47,22 @@ std::variant<IiwaCommand, Refusal> CheckIiwaCommand(const orbed::iiwa_command_t&
 std::variant<PlanCheckRequest, Refusal> CheckPlanCheckRequest(const orbed::plan_check_request_t& msg,
                                                               int num_joints) {
   std::string error = CheckSize(msg.num_joints, num_joints, "num_joints");
-  if (error.empty()) error = CheckSize(static_cast<int64_t>(msg.joint_position.size()), num_joints, "joint_position");
+  if (error.empty())
+    error = CheckSize(static_cast<int64_t>(msg.joint_position.size()), num_joints, "joint_position");
   if (!error.empty()) return Refusal{"num_joints", error};
   error = CheckFinite(msg.joint_position, "joint_position");
   if (!error.empty()) return Refusal{"non_finite", error};
   return PlanCheckRequest{msg.utime, msg.request_id, ToVectorX(msg.joint_position)};
 }
 
-std::variant<LandmarkRequest, Refusal> CheckLandmarkRequest(const orbed::landmark_request_t& msg, int max_rays) {
+std::variant<LandmarkRequest, Refusal> CheckLandmarkRequest(const orbed::landmark_request_t& msg,
+                                                            int max_rays) {
   LandmarkRequest request{msg.utime, msg.request_id, msg.name, {}, {}};
   std::string problem =
       ReadRows(msg.origin_W_m, msg.num_rays, max_rays, "LANDMARK_REQUEST.origin_W_m", &request.origin_W_m);
   if (problem.empty()) {
-    problem = ReadRows(msg.direction_W, msg.num_rays, max_rays, "LANDMARK_REQUEST.direction_W", &request.direction_W);
+    problem = ReadRows(msg.direction_W, msg.num_rays, max_rays, "LANDMARK_REQUEST.direction_W",
+                       &request.direction_W);
   }
   if (!problem.empty()) return Refusal{"invalid", problem};
   return request;

@@ -57,10 +57,11 @@ struct LandmarkRequest {
   int64_t utime{0};
   int64_t request_id{0};
   std::string name;
-  std::vector<Eigen::Vector3d> origin_W_m;  ///< ray origins in W [m]
+  std::vector<Eigen::Vector3d> origin_W_m;   ///< ray origins in W [m]
   std::vector<Eigen::Vector3d> direction_W;  ///< ray directions in W (any length > 0)
 };
-std::variant<LandmarkRequest, Refusal> CheckLandmarkRequest(const orbed::landmark_request_t& msg, int max_rays);
+std::variant<LandmarkRequest, Refusal> CheckLandmarkRequest(const orbed::landmark_request_t& msg,
+                                                            int max_rays);
 
 struct MisalignmentRequest {
   int64_t utime{0};

@@ -60,7 +60,7 @@ TEST(Requests, LandmarkAndMisalignmentRows) {
   ASSERT_TRUE(std::holds_alternative<LandmarkRequest>(ok));
   EXPECT_EQ(std::get<LandmarkRequest>(ok).origin_W_m[1], Eigen::Vector3d(1, 0, 1));
   EXPECT_EQ(Key<LandmarkRequest>(CheckLandmarkRequest(l, 1)), "invalid");  // beyond max_rays
-  l.direction_W[1] = {0, 2e4, 0};  // finite, not an operating room
+  l.direction_W[1] = {0, 2e4, 0};                                          // finite, not an operating room
   EXPECT_EQ(Key<LandmarkRequest>(CheckLandmarkRequest(l, 10)), "invalid");
   orbed::misalignment_request_t m{};
   m.num_pairs = 1;

@@ -8,14 +8,12 @@
 #include "geometry/se3_mean.h"
 #include "procs/common/alignment_trial.h"
 #include "procs/common/conversions.h"
+#include "procs/common/requests.h"
 #include "procs/common/session_control.h"
 #include "procs/common/validation.h"
-#include "procs/common/requests.h"
 
 namespace orbed::registration {
-namespace {
-
-}  // namespace
+namespace {}  // namespace
 
 RegistrationService::RegistrationService(RegistrationServiceOptions options, RejectFn reject)
     : options_(std::move(options)), reject_(std::move(reject)) {}
@@ -197,7 +195,8 @@ orbed::misalignment_t RegistrationService::HandleMisalignmentRequest(
   std::string problem = refusal ? refusal->reason : "";
   if (problem.empty()) {
     const MisalignmentRequest& request = std::get<MisalignmentRequest>(checked);
-    const geometry::MisalignmentResult r = geometry::EvaluateMisalignment(request.p_W_real_m, request.p_W_virtual_m);
+    const geometry::MisalignmentResult r =
+        geometry::EvaluateMisalignment(request.p_W_real_m, request.p_W_virtual_m);
     if (r.valid) {
       out.valid = true;
       out.num_pairs = static_cast<int32_t>(r.error_W_m.size());
