@@ -18,7 +18,7 @@
 /// landmarks: [iiwa_link_4, iiwa_link_6, iiwa_link_ee]   # required: link origins, >= 1 (paper: 3)
 /// @endcode
 ///
-/// Joint limits and collisions are not checked here (no model): ViraalScenario checks the limits
+/// Joint limits and collisions are not checked here (no model): ViraalConductor checks the limits
 /// against the URDF and asks orbed-iiwa-sim (PLAN_CHECK_REQUEST) about collisions before use.
 ///
 /// Threading: plain data; the loaders are reentrant.

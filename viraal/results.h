@@ -40,7 +40,7 @@
 
 namespace orbed::viraal {
 
-/// The error measures of one pose against the truth (see viraal_errors.h for the definitions).
+/// The error measures of one pose against the truth (see viraal/metrics.h for the definitions).
 struct ErrorMeasures {
   double translation_error_mm{0};  ///< at the robot's centroid
   double rotation_error_deg{0};

@@ -12,7 +12,7 @@
 ///
 /// Each decoded message goes to the conductor with the time it was handled, and a timer calls its
 /// Tick() every tick_s; the actions it returns are carried out at once, in order. When the
-/// conductor is done, results.json (viraal_results.h) is written to results_dir: on success the
+/// conductor is done, results.json (viraal/results.h) is written to results_dir: on success the
 /// table is printed and the process stops with exit code 0; on a failure "FAILED: <reason>" is
 /// printed, the reason goes on the heartbeat and the exit code is 1 (results.json is still
 /// written, status "failed", with what was finished). A stop from outside (signal,
