@@ -16,8 +16,8 @@
 ///   configuration or a refused request makes it kFailed with a one-line reason naming the process
 ///   that did not answer; results() then holds what was finished.
 ///
-/// Errors against the truth (viraal/metrics.h, scored by viraal/exchange.h): X_WR from the latest ROBOT_STATE (the sim's truth);
-/// translation_error_mm at the robot centroid, rotation_error_deg the geodesic angle of
+/// Errors against the truth (viraal/metrics.h, scored by viraal/exchange.h): X_WR from the latest ROBOT_STATE
+/// (the sim's truth); translation_error_mm at the robot centroid, rotation_error_deg the geodesic angle of
 /// R_WR^T R_WV, misalignment_mm = MISALIGNMENT.mean_error_norm_m (the paper's ‖t̄‖₂) of the landmark
 /// pairs real = X_WR·X_RL(q)·0, virtual = X_WV·X_RL(q)·0, q = the trial's joint_position [rad].
 /// A session mean X_WV_mean is measured over the session's trial configurations.
