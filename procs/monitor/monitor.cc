@@ -55,7 +55,9 @@ Monitor::Monitor(const CommonFlags& flags, MonitorOptions options) : options_(op
         logger_ = msg;
         have_logger_ = true;
       });
-  process_.AddTimer(options_.print_period_s, [this] { std::cout << Table(NowMicros()) << std::flush; });
+  process_.AddTimer(options_.print_period_s, [this] {
+    if (options_.out != nullptr) *options_.out << Table(NowMicros()) << std::flush;
+  });
 }
 
 std::string Monitor::Table(int64_t now_utime) const {

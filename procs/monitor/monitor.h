@@ -6,6 +6,7 @@
 ///
 /// Threading: everything on the Process::Run thread.
 
+#include <iostream>
 #include <map>
 #include <string>
 
@@ -19,6 +20,8 @@ namespace orbed::monitor {
 struct MonitorOptions {
   double print_period_s = 5.0;
   double silent_after_s = 3.0;
+  /// Where the table is printed every print_period_s (nullptr: nowhere).
+  std::ostream* out = &std::cout;
 };
 
 class Monitor {

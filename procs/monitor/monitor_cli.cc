@@ -16,6 +16,7 @@ int RunMonitor(int argc, const char* const* argv, std::ostream& out, std::ostrea
   CommonFlags common("orbed-monitor");
   AddCommonFlags(&app, &common);
   MonitorOptions options;
+  options.out = &out;
   app.add_option("--print-period-s", options.print_period_s, "Table period")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
