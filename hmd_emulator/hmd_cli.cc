@@ -51,12 +51,7 @@ int RunHmd(int argc, const char* const* argv, std::ostream& out, std::ostream& e
   app.add_option("--reflective-channel", o.reflective_channel)->capture_default_str();
   app.add_option("--ar-view-channel", o.ar_view_channel)->capture_default_str();
   app.add_option("--trial-channel", o.trial_channel)->capture_default_str();
-  try {
-    app.parse(argc, argv);
-    orbed::ApplyCommonFlags(common);  // CLI::ValidationError on a bad --log-level
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e, out, err);  // as CLI11_PARSE: --help on `out` (0), errors on `err`
-  }
+  if (const auto code = ParseCommandLine(&app, common, argc, argv, out, err)) return *code;
   try {
     HmdProcess hmd(common, o);
     return hmd.Run();

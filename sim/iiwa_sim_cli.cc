@@ -46,12 +46,7 @@ int RunIiwaSim(int argc, const char* const* argv, std::ostream& out, std::ostrea
   app.add_option("--collision-status-channel", options.collision_status_channel)->capture_default_str();
   app.add_option("--plan-check-request-channel", options.plan_check_request_channel)->capture_default_str();
   app.add_option("--plan-check-reply-channel", options.plan_check_reply_channel)->capture_default_str();
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e, out, err);
-  }
-  ApplyCommonFlags(common);
+  if (const auto code = ParseCommandLine(&app, common, argc, argv, out, err)) return *code;
   try {
     IiwaSim sim(common, options);
     return sim.Run();

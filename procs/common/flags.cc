@@ -52,4 +52,15 @@ void ApplyCommonFlags(const CommonFlags& flags) {
   SetLogLevel(level);
 }
 
+std::optional<int> ParseCommandLine(CLI::App* app, const CommonFlags& flags, int argc,
+                                    const char* const* argv, std::ostream& out, std::ostream& err) {
+  try {
+    app->parse(argc, argv);
+    ApplyCommonFlags(flags);
+  } catch (const CLI::ParseError& e) {
+    return app->exit(e, out, err);
+  }
+  return std::nullopt;
+}
+
 }  // namespace orbed

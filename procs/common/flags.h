@@ -15,6 +15,8 @@
 ///   orbed::ApplyCommonFlags(common);
 
 #include <cstdint>
+#include <optional>
+#include <ostream>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -45,5 +47,12 @@ void AddCommonFlags(CLI::App* app, CommonFlags* flags);
 
 /// Sets the log name and level; throws CLI::ValidationError on a bad level.
 void ApplyCommonFlags(const CommonFlags& flags);
+
+/// The start of every command line's Run…(): parses `argv` into `app` (AddCommonFlags called on
+/// it) and applies the common flags. Returns std::nullopt to go on, else the exit code to return
+/// now: 0 after --help (the usage on `out`), CLI11's code after a bad flag or value (the message on
+/// `err`).
+std::optional<int> ParseCommandLine(CLI::App* app, const CommonFlags& flags, int argc,
+                                    const char* const* argv, std::ostream& out, std::ostream& err);
 
 }  // namespace orbed

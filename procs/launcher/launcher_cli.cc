@@ -41,12 +41,7 @@ int RunLauncher(int argc, const char* const* argv, std::ostream& out, std::ostre
       ->check(CLI::ExistingFile);
   bool dry_run = false;
   app.add_flag("--dry-run", dry_run, "Parse the file, print the plan and exit");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e, out, err);
-  }
-  ApplyCommonFlags(common);
+  if (const auto code = ParseCommandLine(&app, common, argc, argv, out, err)) return *code;
 
   // Commands without '/' are looked up beside this executable first.
   std::error_code ec;

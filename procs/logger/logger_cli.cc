@@ -40,12 +40,7 @@ int RunLogger(int argc, const char* const* argv, std::ostream& out, std::ostream
       ->capture_default_str();
   app.add_option("--hash-file", options.hash_files,
                  "File whose SHA-256 goes into the manifest (repeatable: URDF, scene, ...)");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e, out, err);
-  }
-  ApplyCommonFlags(common);
+  if (const auto code = ParseCommandLine(&app, common, argc, argv, out, err)) return *code;
   options.queue_capacity_bytes = queue_mb << 20;
   for (int i = 0; i < argc; ++i) options.command_line += (i ? " " : "") + std::string(argv[i]);
   try {

@@ -24,12 +24,7 @@ int RunMonitor(int argc, const char* const* argv, std::ostream& out, std::ostrea
                  "Heartbeat age after which a process is shown as SILENT")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e, out, err);
-  }
-  ApplyCommonFlags(common);
+  if (const auto code = ParseCommandLine(&app, common, argc, argv, out, err)) return *code;
   try {
     Monitor monitor(common, options);
     return monitor.Run();

@@ -74,11 +74,7 @@ int RunRegistration(int argc, const char* const* argv, std::ostream& out, std::o
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
 
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e, out, err);
-  }
+  if (const auto code = ParseCommandLine(&app, common, argc, argv, out, err)) return *code;
 
   if (send->parsed()) {
     send_options.lcm_url = common.lcm_url;
@@ -95,11 +91,6 @@ int RunRegistration(int argc, const char* const* argv, std::ostream& out, std::o
     return RunMeanCommand(mean_options, out, err);
   }
 
-  try {
-    ApplyCommonFlags(common);
-  } catch (const CLI::Error& e) {
-    return app.exit(e, out, err);
-  }
   if (server_centroid_m.size() == 3) {
     server.service.p_VC = Eigen::Vector3d(server_centroid_m[0], server_centroid_m[1], server_centroid_m[2]);
   }

@@ -65,12 +65,7 @@ int RunScenario(int argc, const char* const* argv, std::ostream& out, std::ostre
   app.add_option("--registration-channel", run.registration_channel)->capture_default_str();
   app.add_option("--misalignment-request-channel", run.misalignment_request_channel)->capture_default_str();
   app.add_option("--misalignment-channel", run.misalignment_channel)->capture_default_str();
-  try {
-    app.parse(argc, argv);
-    orbed::ApplyCommonFlags(common);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e, out, err);
-  }
+  if (const auto code = ParseCommandLine(&app, common, argc, argv, out, err)) return *code;
   try {
     if (scenario_path.empty()) scenario_path = ScenarioSourcePath(viraal::kDefaultScenarioRelativePath);
     run.config = viraal::LoadScenarioFile(scenario_path);
