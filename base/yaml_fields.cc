@@ -141,9 +141,7 @@ YAML::Node YamlFields::Section(const YAML::Node& map, const std::string& name, c
   return child;
 }
 
-double YamlFields::Number(const YAML::Node& node, const std::string& key, double lo, double hi,
-                          const std::string& unit) const {
-  const std::string expected = Range(lo, hi, unit);
+double YamlFields::Scalar(const YAML::Node& node, const std::string& key, const std::string& expected) const {
   if (!node.IsScalar()) Fail(node, key, "expected " + expected);
   double v = 0.0;
   try {
@@ -151,8 +149,15 @@ double YamlFields::Number(const YAML::Node& node, const std::string& key, double
   } catch (const YAML::Exception&) {
     Fail(node, key, "expected " + expected + ", got '" + node.Scalar() + "'");
   }
-  if (!std::isfinite(v) || v < lo || v > hi)
-    Fail(node, key, "expected " + expected + ", got '" + node.Scalar() + "'");
+  if (!std::isfinite(v)) Fail(node, key, "expected " + expected + ", got '" + node.Scalar() + "'");
+  return v;
+}
+
+double YamlFields::Number(const YAML::Node& node, const std::string& key, double lo, double hi,
+                          const std::string& unit) const {
+  const std::string expected = Range(lo, hi, unit);
+  const double v = Scalar(node, key, expected);
+  if (v < lo || v > hi) Fail(node, key, "expected " + expected + ", got '" + node.Scalar() + "'");
   return v;
 }
 
@@ -165,15 +170,8 @@ double YamlFields::NumberOr(const YAML::Node& map, const std::string& name, cons
 
 double YamlFields::Positive(const YAML::Node& node, const std::string& key, const std::string& unit) const {
   const std::string expected = WithUnit("a number > 0", unit);
-  if (!node.IsScalar()) Fail(node, key, "expected " + expected);
-  double v = 0.0;
-  try {
-    v = node.as<double>();
-  } catch (const YAML::Exception&) {
-    Fail(node, key, "expected " + expected + ", got '" + node.Scalar() + "'");
-  }
-  if (!std::isfinite(v) || !(v > 0))
-    Fail(node, key, "expected " + expected + ", got '" + node.Scalar() + "'");
+  const double v = Scalar(node, key, expected);
+  if (!(v > 0)) Fail(node, key, "expected " + expected + ", got '" + node.Scalar() + "'");
   return v;
 }
 

@@ -84,6 +84,8 @@ class YamlFields {
   std::vector<std::string> Strings(const YAML::Node& node, const std::string& key) const;
 
  private:
+  /// A finite number; failures say `expected`.
+  double Scalar(const YAML::Node& node, const std::string& key, const std::string& expected) const;
   static std::string Join(const std::string& prefix, const std::string& name) {
     return prefix.empty() ? name : prefix + "." + name;
   }

@@ -11,7 +11,7 @@
 ///     1..kMaxMirrors mirrors; method one of registration_t's METHOD_*. The other commands name a
 ///     session that START opened; their mode, mirror and method fields are not read.
 /// A repeated START of the session that is already active with the same mode and mirrors is a
-/// no-op for every reader (SessionCommand::SameSessionAs tells it): it neither clears trials nor
+/// no-op for every reader (SessionCommand::RepeatsStartOf tells it): it neither clears trials nor
 /// restarts the trial count. How many displays a headset has placed is that headset's own check.
 ///
 /// Refusal keys are "<field>" (session_id, command, display_mode, num_mirrors, method); processes
