@@ -18,6 +18,13 @@
 namespace orbed {
 namespace {
 
+TEST(Format, EscapeTextKeepsPrintableAsciiAndHexesTheRest) {
+  EXPECT_EQ(EscapeText("run-42 ok"), "run-42 ok");
+  EXPECT_EQ(EscapeText(std::string("a\x1b[2Jb\n\0c", 9)), "a\\x1b[2Jb\\x0a\\x00c");
+  EXPECT_EQ(EscapeText("back\\slash"), "back\\\\slash");
+  EXPECT_EQ(EscapeText("\xc3\xa9"), "\\xc3\\xa9");  // UTF-8 too: bytes from the bus are not trusted text
+}
+
 TEST(Format, FixedRoundsToTheGivenDecimals) {
   EXPECT_EQ(Fixed(2.345, 1), "2.3");
   EXPECT_EQ(Fixed(-0.5, 0), "-0");  // printf's round-half-even of the binary value

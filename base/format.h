@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// Number formatting for log lines, tables and reports.
+/// Number and text formatting for log lines, tables and reports.
 ///
 /// Threading: pure functions.
 
@@ -10,5 +10,10 @@ namespace orbed {
 
 /// `value` with exactly `digits` decimals ("%.*f"): Fixed(2.345, 1) == "2.3".
 std::string Fixed(double value, int digits);
+
+/// `text` safe to print on a terminal: printable ASCII as is, a backslash as "\\", every other byte
+/// as "\xNN" (so a corrupted id from the bus cannot move the cursor or fake a log line). For text
+/// that came from the bus or a file.
+std::string EscapeText(const std::string& text);
 
 }  // namespace orbed

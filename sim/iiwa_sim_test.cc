@@ -118,7 +118,7 @@ TEST(IiwaSim, RejectsBadCommandsPerReasonAndKeepsRunning) {
   EXPECT_EQ(counts.at("IIWA_COMMAND/non_finite"), 2);
   EXPECT_EQ(counts.at("IIWA_COMMAND/stale"), 2);
   EXPECT_EQ(counts.at("IIWA_COMMAND/num_torques"), 1);
-  EXPECT_EQ(counts.at("IIWA_COMMAND/decode"), 1);
+  EXPECT_EQ(counts.at("IIWA_COMMAND/decode/truncated"), 1);  // 7 bytes: not even a fingerprint
   EXPECT_EQ(sim.process().rejections().total(), 7);
   const orbed::process_status_t heartbeat = sim.process().MakeStatus();
   EXPECT_EQ(heartbeat.rejected_inputs, 7);

@@ -118,6 +118,19 @@ TEST(Validation, RejectionCounterCountsPerKey) {
   EXPECT_EQ(counter.last_reason(), "B/nan: nan");
 }
 
+TEST(Validation, RejectionClassesAreBoundedAgainstMadeUpChannels) {
+  RejectionCounter counter;
+  for (int i = 0; i < 1000; ++i) counter.Reject("CHANNEL_" + std::to_string(i) + "/handler", "x");
+  counter.Reject("CHANNEL_0/handler", "x");  // a known class keeps counting on its own
+  const auto counts = counter.counts();
+  EXPECT_EQ(counts.size(), kMaxRejectionClasses);
+  EXPECT_EQ(counts.at("CHANNEL_0/handler"), 2);
+  EXPECT_EQ(counts.at(kOtherRejectionClass), 1000 - static_cast<int64_t>(kMaxRejectionClasses - 1));
+  EXPECT_EQ(counter.total(), 1001);
+  counter.Reject("late", std::string(10000, 'r'));
+  EXPECT_EQ(counter.last_reason(), "late: " + std::string(kMaxReasonLength, 'r'));
+}
+
 TEST(Flags, RecvBufSizeIsAddedOrReplaced) {
   EXPECT_EQ(WithRecvBufSize("udpm://239.255.76.67:7667?ttl=0", 1000),
             "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=1000");
@@ -184,7 +197,8 @@ TEST(Process, CountsMessagesRejectionsAndPublishesHeartbeat) {
   EXPECT_EQ(process.Run(), 0);
   EXPECT_EQ(accepted, 1);
   EXPECT_EQ(process.rejections().total(), 3);
-  EXPECT_EQ(process.rejections().counts().at("IIWA_COMMAND/decode"), 2);
+  EXPECT_EQ(process.rejections().counts().at("IIWA_COMMAND/decode/truncated"), 1);  // 5 bytes
+  EXPECT_EQ(process.rejections().counts().at("IIWA_COMMAND/decode/count"), 1);      // num_joints -1
   EXPECT_EQ(process.rejections().counts().at("IIWA_COMMAND/num_joints"), 1);
   // Heartbeats: at start, at 1 s, at stop (the stop one is published after the loop and is not
   // received). At least the start and the 1 s heartbeat arrive.
@@ -193,7 +207,7 @@ TEST(Process, CountsMessagesRejectionsAndPublishesHeartbeat) {
   EXPECT_EQ(last.name, "orbed-test");
   EXPECT_EQ(last.state, +process_status_t::STATE_RUNNING);
   EXPECT_EQ(last.rejected_inputs, 3);
-  EXPECT_EQ(last.num_reasons, 2);
+  EXPECT_EQ(last.num_reasons, 3);  // decode/truncated, decode/count, num_joints
   EXPECT_GE(last.uptime_s, 0.99);
   // 4 commands + the heartbeats received before the last one.
   EXPECT_GE(last.messages_in, 4);

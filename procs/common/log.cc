@@ -5,6 +5,8 @@
 #include <cstdlib>
 #include <mutex>
 
+#include "base/format.h"
+
 namespace orbed {
 namespace {
 std::mutex g_mutex;
@@ -50,11 +52,13 @@ void Log(LogLevel level, const std::string& message) {
   if (static_cast<int>(level) < g_level.load()) return;
   // Under orbed-launch every output line is already prefixed with the process name.
   static const bool prefixed = std::getenv("ORBED_LOG_PREFIXED") != nullptr;
+  // Messages quote text from the bus and from files: one escaped line each, whatever the bytes.
+  const std::string line = EscapeText(message);
   std::lock_guard<std::mutex> lock(g_mutex);
   if (prefixed) {
-    std::fprintf(stderr, "%s %s\n", LevelName(level), message.c_str());
+    std::fprintf(stderr, "%s %s\n", LevelName(level), line.c_str());
   } else {
-    std::fprintf(stderr, "[%s] %s %s\n", g_name.c_str(), LevelName(level), message.c_str());
+    std::fprintf(stderr, "[%s] %s %s\n", g_name.c_str(), LevelName(level), line.c_str());
   }
   std::fflush(stderr);
 }

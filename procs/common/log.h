@@ -3,7 +3,9 @@
 /// Minimal leveled logging to stderr, one line per call: "[name] LEVEL message" ("LEVEL message"
 /// when ORBED_LOG_PREFIXED is set, as orbed-launch does since it prefixes lines itself). The launcher
 /// prefixes each child's output again with its name, so lines stay attributable in a merged
-/// stream. Thread-safe (one mutex around each write).
+/// stream. The message is written through EscapeText (base/format.h): bytes outside printable
+/// ASCII, from the bus or a file, appear as \xNN and can never break the line or drive the
+/// terminal. Thread-safe (one mutex around each write).
 
 #include <sstream>
 #include <string>

@@ -24,6 +24,7 @@
 #include <lcm/lcm-cpp.hpp>
 #include <orbed/process_status_t.hpp>
 
+#include "lcmtypes/bounded_decode.h"
 #include "procs/common/flags.h"
 #include "procs/common/validation.h"
 
@@ -48,8 +49,10 @@ class Process {
   uint64_t seed() const { return seed_; }
   lcm::LCM& lcm() { return *lcm_; }
 
-  /// Subscribes `handler(msg, channel, receive_utime)` to `channel`. Messages that fail to decode
-  /// (wrong type, fingerprint, truncated) are rejected under key "<channel>/decode".
+  /// Subscribes `handler(msg, channel, receive_utime)` to `channel`. Every message is decoded with
+  /// DecodeBounded (lcmtypes/bounded_decode.h: array counts checked against the bytes before LCM's
+  /// decode allocates); one that is not exactly a well-formed Msg is rejected under key
+  /// "<channel>/decode/<why>" (why: truncated, fingerprint, count, string, trailing, ...).
   template <class Msg>
   void Subscribe(const std::string& channel,
                  std::function<void(const Msg&, const std::string&, int64_t)> handler);
@@ -134,17 +137,11 @@ struct Process::TypedSubscription : Process::SubscriptionBase {
   void OnRaw(const lcm::ReceiveBuffer* rbuf, const std::string& channel) override {
     ++process->messages_in_;
     Msg msg;
-    int decoded = -1;
-    try {
-      decoded = msg.decode(rbuf->data, 0, rbuf->data_size);
-    } catch (const std::exception&) {
-      // lcm-gen's decoders resize vectors from length fields in the bytes: a negative or huge
-      // length throws (length_error, bad_alloc) instead of failing.
-      decoded = -1;
-    }
-    if (decoded != static_cast<int>(rbuf->data_size)) {
-      process->Reject(channel + "/decode",
-                      "cannot decode " + std::to_string(rbuf->data_size) + " bytes as " + Msg::getTypeName());
+    const DecodeResult decoded = DecodeBounded(rbuf->data, rbuf->data_size, &msg);
+    if (!decoded.ok()) {
+      process->Reject(channel + "/decode/" + wire::KindName(decoded.kind),
+                      "cannot decode " + std::to_string(rbuf->data_size) + " bytes as " + Msg::getTypeName() +
+                          ": " + decoded.error);
       return;
     }
     try {

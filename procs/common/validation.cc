@@ -107,8 +107,11 @@ void RejectionCounter::Reject(const std::string& key, const std::string& reason)
   {
     std::lock_guard<std::mutex> lock(mutex_);
     ++total_;
-    count = ++counts_[key];
-    last_reason_ = key + ": " + reason;
+    // Keys can carry channel names from the bus: past kMaxRejectionClasses they share one class, so
+    // a flood of made-up channels cannot grow the table (or PROCESS_STATUS) without bound.
+    const bool known = counts_.count(key) > 0 || counts_.size() < kMaxRejectionClasses - 1;
+    count = ++counts_[known ? key : kOtherRejectionClass];
+    last_reason_ = key + ": " + reason.substr(0, kMaxReasonLength);
   }
   // The first five of each class in full, then every 100th, so floods stay readable.
   if (count <= 5 || count % 100 == 0) {

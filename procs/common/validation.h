@@ -46,6 +46,12 @@ std::string FirstError(std::initializer_list<std::string> reasons);
 
 /// Counts rejected inputs per class (a short key such as "IIWA_COMMAND/num_joints") and logs the
 /// full reason.
+/// At most this many reason classes are kept; further ones are counted under kOtherRejectionClass.
+constexpr size_t kMaxRejectionClasses = 64;
+constexpr const char* kOtherRejectionClass = "other";
+/// last_reason() keeps at most this many characters of the reason text.
+constexpr size_t kMaxReasonLength = 200;
+
 class RejectionCounter {
  public:
   /// Records one rejection: `key` groups it for counting, `reason` is logged.

@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <iostream>
 
+#include "base/format.h"
 #include "procs/common/channels.h"
 #include "procs/common/conversions.h"
 
@@ -67,15 +68,16 @@ std::string Monitor::Table(int64_t now_utime) const {
     const orbed::process_status_t& s = seen.status;
     const double age_s = (now_utime - seen.recv_utime) * 1e-6;
     const std::string state = age_s > options_.silent_after_s ? "SILENT" : StateName(s.state);
-    std::snprintf(line, sizeof(line), "%-20s  %-8s  %8.1f  %7lld  %8lld  %8lld  %s\n", name.c_str(),
-                  state.c_str(), s.uptime_s, static_cast<long long>(s.messages_in),
+    // Names and errors come from the bus: escaped before they reach a terminal.
+    std::snprintf(line, sizeof(line), "%-20s  %-8s  %8.1f  %7lld  %8lld  %8lld  %s\n",
+                  EscapeText(name).c_str(), state.c_str(), s.uptime_s, static_cast<long long>(s.messages_in),
                   static_cast<long long>(s.messages_out), static_cast<long long>(s.rejected_inputs),
-                  s.last_error.substr(0, 60).c_str());
+                  EscapeText(s.last_error.substr(0, 60)).c_str());
     out += line;
   }
   if (have_logger_) {
     std::snprintf(line, sizeof(line), "log: %s  events %lld  bytes %lld  drops %lld  queue %d/%d\n",
-                  logger_.file.c_str(), static_cast<long long>(logger_.events_written),
+                  EscapeText(logger_.file).c_str(), static_cast<long long>(logger_.events_written),
                   static_cast<long long>(logger_.bytes_written), static_cast<long long>(logger_.drops),
                   logger_.queue_depth, logger_.queue_capacity);
     out += line;
