@@ -28,4 +28,12 @@ inline constexpr char kGuidance[] = "GUIDANCE";                         // guida
 inline constexpr char kProcessStatus[] = "PROCESS_STATUS";              // process_status_t, 1 Hz each
 inline constexpr char kLoggerStatus[] = "LOGGER_STATUS";                // logger_status_t, 1 Hz
 
+/// Every channel above, in this order (tools that address channels by index: the fuzz targets).
+inline constexpr const char* kAllChannels[] = {
+    kIiwaStatus,      kIiwaCommand,    kRobotState,          kCollisionStatus, kPlanCheckRequest,
+    kPlanCheckReply,  kHmdPose,        kHmdPoseTruth,        kHmdCamera,       kArView,
+    kGazeRay,         kReflectiveView, kAlignmentTrial,      kRegistration,    kSessionControl,
+    kLandmarkRequest, kLandmark,       kMisalignmentRequest, kMisalignment,    kGuidance,
+    kProcessStatus,   kLoggerStatus};
+
 }  // namespace orbed::channels

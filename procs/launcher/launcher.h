@@ -38,6 +38,8 @@ class Launcher {
   ~Launcher();
 
   int Run();
+  /// The launcher's own bus scaffold (its PROCESS_STATUS subscription: tests and fuzz targets).
+  Process& process() { return process_; }
 
  private:
   using Clock = std::chrono::steady_clock;

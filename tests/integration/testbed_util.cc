@@ -90,7 +90,8 @@ bool RunningProcess::running() {
 
 BusWatcher::BusWatcher() : lcm_("") {
   if (!lcm_.good()) throw std::runtime_error("LCM not available (multicast route?)");
-  lcm_.subscribe("PROCESS_STATUS", &BusWatcher::OnStatus, this);
+  // Decoded with DecodeBounded: tests publish hostile heartbeats too.
+  lcm_.subscribe("PROCESS_STATUS", &BusWatcher::OnRaw, this);
 }
 
 void BusWatcher::Start() {
@@ -104,9 +105,11 @@ BusWatcher::~BusWatcher() {
   if (thread_.joinable()) thread_.join();
 }
 
-void BusWatcher::OnStatus(const lcm::ReceiveBuffer*, const std::string&, const orbed::process_status_t* msg) {
+void BusWatcher::OnRaw(const lcm::ReceiveBuffer* rbuf, const std::string&) {
+  orbed::process_status_t msg;
+  if (!DecodeBounded(rbuf->data, rbuf->data_size, &msg).ok()) return;
   std::lock_guard<std::mutex> lock(mutex_);
-  beats_[msg->name].push_back(Beat{*msg, std::chrono::steady_clock::now()});
+  beats_[msg.name].push_back(Beat{msg, std::chrono::steady_clock::now()});
 }
 
 std::vector<BusWatcher::Beat> BusWatcher::Heartbeats(const std::string& name) const {

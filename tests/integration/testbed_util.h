@@ -19,6 +19,7 @@
 #include <lcm/lcm-cpp.hpp>
 #include <orbed/process_status_t.hpp>
 
+#include "lcmtypes/bounded_decode.h"
 #include "procs/launcher/child.h"
 
 namespace orbed::testing {
@@ -53,7 +54,8 @@ class RunningProcess {
   std::string prefix_;
 };
 
-/// Listens to PROCESS_STATUS (and anything else subscribed) on the default bus.
+/// Listens to PROCESS_STATUS (and anything else subscribed) on the default bus; heartbeats that are
+/// not exactly one process_status_t are ignored.
 class BusWatcher {
  public:
   BusWatcher();
@@ -69,7 +71,7 @@ class BusWatcher {
   void Start();
 
  private:
-  void OnStatus(const lcm::ReceiveBuffer*, const std::string&, const orbed::process_status_t* msg);
+  void OnRaw(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
   lcm::LCM lcm_;
   mutable std::mutex mutex_;
   std::map<std::string, std::vector<Beat>> beats_;

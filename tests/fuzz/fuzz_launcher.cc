@@ -1,0 +1,19 @@
+// libFuzzer: orbed-launch's heartbeat handler (PROCESS_STATUS), with the ViRAAl launch file's
+// processes known (none started).
+#include "base/source_paths.h"
+#include "procs/launcher/launch_file.h"
+#include "procs/launcher/launcher.h"
+#include "tests/fuzz/fuzz_util.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  static auto* launcher = [] {
+    std::map<std::string, std::string> environment = orbed::launcher::CurrentEnvironment();
+    environment["ORBED_LOG_DIR"] = "/tmp";
+    environment["ORBED_SOURCE_DIR"] = orbed::SourceDir();
+    orbed::launcher::LaunchSpec spec =
+        orbed::launcher::LoadLaunchFile(orbed::SourceTreePath("scripts/launch/viraal.yaml"), environment);
+    return new orbed::launcher::Launcher(orbed::fuzz::FuzzFlags("orbed-launch"), spec, "/nonexistent");
+  }();
+  orbed::fuzz::FeedToProcess(launcher->process(), data, size);
+  return 0;
+}
