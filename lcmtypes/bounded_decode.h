@@ -35,12 +35,14 @@ DecodeResult CheckEncoding(const void* data, size_t size) {
   int64_t fingerprint = 0;
   DecodeResult result;
   if (size > static_cast<size_t>(std::numeric_limits<int>::max())) {
-    reader.Fail(wire::WireError::kTooLarge, Msg::getTypeName(), "message of " + std::to_string(size) + " bytes");
+    reader.Fail(wire::WireError::kTooLarge, Msg::getTypeName(),
+                "message of " + std::to_string(size) + " bytes");
   } else if (!reader.ReadInteger(8, &fingerprint, "fingerprint")) {
   } else if (fingerprint != Msg::getHash()) {
     reader.Fail(wire::WireError::kFingerprint, Msg::getTypeName(), "not this type's fingerprint");
   } else if (wire::CheckBody(static_cast<const Msg*>(nullptr), reader) && reader.remaining() > 0) {
-    reader.Fail(wire::WireError::kTrailing, Msg::getTypeName(), std::to_string(reader.remaining()) + " bytes left over");
+    reader.Fail(wire::WireError::kTrailing, Msg::getTypeName(),
+                std::to_string(reader.remaining()) + " bytes left over");
   }
   result.kind = reader.kind();
   result.error = reader.error();

@@ -120,7 +120,8 @@ void ExpectBoundedAndExact(const Msg& original, const char* label) {
     EXPECT_LE(allocated, 64 * mutated.size() + 4096) << "trial " << trial;
     if (result.ok()) {
       Msg again;
-      ASSERT_EQ(again.decode(mutated.data(), 0, static_cast<int>(mutated.size())), static_cast<int>(mutated.size()));
+      ASSERT_EQ(again.decode(mutated.data(), 0, static_cast<int>(mutated.size())),
+                static_cast<int>(mutated.size()));
       EXPECT_EQ(Encode(again), mutated) << "trial " << trial;
     } else {
       EXPECT_NE(result.kind, WireError::kDecode) << result.error;
@@ -131,7 +132,8 @@ void ExpectBoundedAndExact(const Msg& original, const char* label) {
 
 #define ORBED_EXPECT_DEFAULT_TYPE(type) ExpectBoundedAndExact(orbed::type{}, #type);
 
-TEST(BoundedDecodeTest, EveryTypeAtItsDefaultPassesAndRefusesDamage) { ORBED_FOR_EACH_LCM_TYPE(ORBED_EXPECT_DEFAULT_TYPE) }
+TEST(BoundedDecodeTest,
+     EveryTypeAtItsDefaultPassesAndRefusesDamage){ORBED_FOR_EACH_LCM_TYPE(ORBED_EXPECT_DEFAULT_TYPE)}
 
 process_status_t StatusWithReasons() {
   process_status_t status{};
@@ -185,7 +187,8 @@ TEST(BoundedDecodeTest, AHugeCountIsRefusedBeforeAnyAllocation) {
   const size_t count_at = bytes.size() - 9;
   for (const uint32_t count : {0x7fffffffu, 0x80000000u, 0xffffffffu, 6u}) {
     SCOPED_TRACE(count);
-    for (int i = 0; i < 4; ++i) bytes[count_at + static_cast<size_t>(i)] = static_cast<uint8_t>(count >> (24 - 8 * i));
+    for (int i = 0; i < 4; ++i)
+      bytes[count_at + static_cast<size_t>(i)] = static_cast<uint8_t>(count >> (24 - 8 * i));
     size_t allocated = 0;
     const DecodeResult result = CountedDecode<process_status_t>(bytes, &allocated);
     EXPECT_EQ(result.kind, WireError::kCount) << result.error;
@@ -208,7 +211,8 @@ TEST(BoundedDecodeTest, StringLengthsMustBePositiveAndNulTerminated) {
   EXPECT_EQ(CheckEncoding<process_status_t>(negative.data(), negative.size()).kind, WireError::kString);
   Bytes unterminated = bytes;
   unterminated[22] = 'c';
-  EXPECT_EQ(CheckEncoding<process_status_t>(unterminated.data(), unterminated.size()).kind, WireError::kString);
+  EXPECT_EQ(CheckEncoding<process_status_t>(unterminated.data(), unterminated.size()).kind,
+            WireError::kString);
   Bytes embedded = bytes;
   embedded[20] = 0;  // LCM would decode "\0b" and encode "": not one message
   EXPECT_EQ(CheckEncoding<process_status_t>(embedded.data(), embedded.size()).kind, WireError::kString);

@@ -64,14 +64,16 @@ class WireReader {
 
   /// Skips `bytes` bytes of `field`.
   bool Skip(size_t bytes, const char* field) {
-    if (bytes > remaining()) return Fail(WireError::kTruncated, field, "needs " + std::to_string(bytes) + " bytes");
+    if (bytes > remaining())
+      return Fail(WireError::kTruncated, field, "needs " + std::to_string(bytes) + " bytes");
     pos_ += bytes;
     return true;
   }
 
   /// Reads a big-endian signed integer of 1, 2, 4 or 8 bytes (an array dimension).
   bool ReadInteger(size_t bytes, int64_t* value, const char* field) {
-    if (bytes > remaining()) return Fail(WireError::kTruncated, field, "needs " + std::to_string(bytes) + " bytes");
+    if (bytes > remaining())
+      return Fail(WireError::kTruncated, field, "needs " + std::to_string(bytes) + " bytes");
     uint64_t bits = 0;
     for (size_t i = 0; i < bytes; ++i) bits = (bits << 8) | data_[pos_ + i];
     pos_ += bytes;
@@ -86,15 +88,17 @@ class WireReader {
   bool SkipString(const char* field) {
     int64_t length = 0;
     if (!ReadInteger(4, &length, field)) return false;
-    if (length < 1) return Fail(WireError::kString, field, "string length " + std::to_string(length) + " < 1");
+    if (length < 1)
+      return Fail(WireError::kString, field, "string length " + std::to_string(length) + " < 1");
     if (static_cast<uint64_t>(length) > remaining()) {
       return Fail(WireError::kTruncated, field, "string of " + std::to_string(length) + " bytes");
     }
     // LCM's decode keeps bytes after an embedded NUL that its encode (strlen) drops: refuse them.
     const void* first_nul = std::memchr(data_ + pos_, 0, static_cast<size_t>(length));
     if (first_nul != data_ + pos_ + length - 1) {
-      return Fail(WireError::kString, field,
-                  first_nul == nullptr ? "string without its terminating NUL" : "string with an embedded NUL");
+      return Fail(
+          WireError::kString, field,
+          first_nul == nullptr ? "string without its terminating NUL" : "string with an embedded NUL");
     }
     pos_ += static_cast<size_t>(length);
     return true;
@@ -107,8 +111,9 @@ class WireReader {
     for (const int64_t dim : dims) {
       if (dim < 0) return Fail(WireError::kCount, field, "negative dimension " + std::to_string(dim));
       if (dim > 0 && n > static_cast<int64_t>(remaining()) / dim) {
-        return Fail(WireError::kCount, field, "dimension " + std::to_string(dim) + " cannot fit in " +
-                                                  std::to_string(remaining()) + " bytes");
+        return Fail(
+            WireError::kCount, field,
+            "dimension " + std::to_string(dim) + " cannot fit in " + std::to_string(remaining()) + " bytes");
       }
       n *= dim;
     }
@@ -121,8 +126,9 @@ class WireReader {
     int64_t count = 0;
     if (!Count(dims, &count, field)) return false;
     if (static_cast<uint64_t>(count) > remaining() / element_bytes) {
-      return Fail(WireError::kCount, field, std::to_string(count) + " elements of " + std::to_string(element_bytes) +
-                                                " bytes cannot fit in " + std::to_string(remaining()) + " bytes");
+      return Fail(WireError::kCount, field,
+                  std::to_string(count) + " elements of " + std::to_string(element_bytes) +
+                      " bytes cannot fit in " + std::to_string(remaining()) + " bytes");
     }
     pos_ += static_cast<size_t>(count) * element_bytes;
     return true;
