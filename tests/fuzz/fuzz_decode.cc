@@ -15,7 +15,8 @@ void CheckOne(const uint8_t* data, size_t size) {
   Msg msg;
   if (!orbed::DecodeBounded(data, size, &msg).ok()) return;
   std::vector<uint8_t> again(static_cast<size_t>(msg.getEncodedSize()));
-  if (again.size() != size || msg.encode(again.data(), 0, static_cast<int>(again.size())) != static_cast<int>(size) ||
+  if (again.size() != size ||
+      msg.encode(again.data(), 0, static_cast<int>(again.size())) != static_cast<int>(size) ||
       std::memcmp(again.data(), data, size) != 0) {
     std::abort();  // the wire check let through bytes that are not one message
   }

@@ -23,6 +23,11 @@ void RefuseOrAccept(F parse) {
   }
 }
 
+/// The input as text.
+inline std::string AsText(const uint8_t* data, size_t size) {
+  return std::string(reinterpret_cast<const char*>(data), size);
+}
+
 /// A file this process rewrites per input (for loaders that only take paths), in a private folder.
 inline const std::string& ScratchFile(const char* name) {
   static const std::string dir = [] {

@@ -3,7 +3,6 @@
 #include "base/source_paths.h"
 #include "hmd_emulator/hmd_config.h"
 #include "tests/fuzz/fuzz_files.h"
-#include "tests/fuzz/fuzz_util.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   static const std::vector<std::string> shipped = [] {

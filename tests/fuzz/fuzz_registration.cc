@@ -4,8 +4,8 @@
 #include "tests/fuzz/fuzz_util.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  static auto* server = new orbed::registration::RegistrationServer(orbed::fuzz::FuzzFlags("orbed-registration"),
-                                                                     orbed::registration::RegistrationServerOptions{});
+  static auto* server = new orbed::registration::RegistrationServer(
+      orbed::fuzz::FuzzFlags("orbed-registration"), orbed::registration::RegistrationServerOptions{});
   orbed::fuzz::FeedToProcess(*server, data, size);
   return 0;
 }

@@ -4,13 +4,14 @@
 //   DIR/bus/       for the process targets: the channel's index in channels::kAllChannels, then the
 //                  message (fuzz_util.h), PER_CHANNEL messages of each channel (default 3);
 //   DIR/types/     for fuzz_decode: the type's index in ORBED_FOR_EACH_LCM_TYPE, then the message;
-//   DIR/event_log/ for fuzz_event_log: the log's first events as a small log of their own.
+//   DIR/event_log/ for fuzz_event_log: the log's first 100 events under kMaxSeedBytes, as a small
+//                  log of their own.
 #include <algorithm>
 #include <cstdio>
-#include <iterator>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <string>
 #include <vector>
@@ -20,6 +21,7 @@
 #include "lcmtypes/bounded_decode.h"
 #include "procs/common/channels.h"
 #include "procs/logger/event_log_reader.h"
+#include "procs/logger/event_log_writer.h"
 
 namespace {
 
@@ -31,7 +33,7 @@ constexpr size_t kMaxSeedBytes = 16384;
 int TypeIndex(const uint8_t* data, size_t size) {
   int index = 0;
   int found = -1;
-#define ORBED_SEED_TYPE(type) \
+#define ORBED_SEED_TYPE(type)                                            \
   if (orbed::CheckEncoding<orbed::type>(data, size).ok()) found = index; \
   ++index;
   ORBED_FOR_EACH_LCM_TYPE(ORBED_SEED_TYPE)
@@ -63,14 +65,20 @@ int main(int argc, char** argv) {
   std::map<std::string, int> taken;  // seeds written per channel
   orbed::logger::EventLogScanner scanner = log.Scanner();
   orbed::logger::LogEvent event;
-  size_t first_events_end = 0;
+  orbed::logger::EventLogWriter head((dir / "event_log" / "first_events.lcmlog").string());
+  int head_events = 0;
   int events = 0;
   int seeds = 0;
   while (scanner.Next(&event)) {
-    if (++events <= 200) first_events_end = event.offset + 28 + event.channel.size() + event.size;
+    ++events;
+    if (head_events < 100 && event.size <= kMaxSeedBytes) {
+      head.Write(event.timestamp_us, event.channel, event.data, event.size);
+      ++head_events;
+    }
     if (taken[event.channel] >= per_channel || event.size > kMaxSeedBytes) continue;
     const auto& all = orbed::channels::kAllChannels;
-    const auto found = std::find_if(std::begin(all), std::end(all), [&](const char* c) { return event.channel == c; });
+    const auto found =
+        std::find_if(std::begin(all), std::end(all), [&](const char* c) { return event.channel == c; });
     const int type_index = TypeIndex(event.data, event.size);
     if (found == std::end(all) || type_index < 0) continue;
     const int n = taken[event.channel]++;
@@ -79,9 +87,8 @@ int main(int argc, char** argv) {
     WriteSeed(dir / "types" / stem, static_cast<uint8_t>(type_index), event.data, event.size);
     ++seeds;
   }
-  std::ofstream head(dir / "event_log" / "first_events.lcmlog", std::ios::binary);
-  head.write(reinterpret_cast<const char*>(log.data()), static_cast<std::streamsize>(first_events_end));
+  head.Close();
   std::printf("orbed-fuzz-seeds: %d seeds from %d events of %zu channels; %d events in event_log/\n", seeds,
-              events, taken.size(), std::min(events, 200));
+              events, taken.size(), head_events);
   return 0;
 }

@@ -3,7 +3,6 @@
 
 #include "procs/registration_server/trial_file.h"
 #include "tests/fuzz/fuzz_files.h"
-#include "tests/fuzz/fuzz_util.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   std::istringstream in(orbed::fuzz::AsText(data, size));

@@ -2,7 +2,6 @@
 // collision shapes).
 #include "sim/robot_model.h"
 #include "tests/fuzz/fuzz_files.h"
-#include "tests/fuzz/fuzz_util.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string text = orbed::fuzz::AsText(data, size);

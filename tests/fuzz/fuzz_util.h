@@ -43,9 +43,4 @@ inline void FeedToProcess(Process& process, const uint8_t* data, size_t size) {
   }
 }
 
-/// The input as text (file parsers).
-inline std::string AsText(const uint8_t* data, size_t size) {
-  return std::string(reinterpret_cast<const char*>(data), size);
-}
-
 }  // namespace orbed::fuzz
