@@ -15,16 +15,31 @@ function(orbed_add_gtest)
   if(T_LABELS)
     set_tests_properties(${T_NAME} PROPERTIES LABELS "${T_LABELS}")
   endif()
+  orbed_sanitizer_test_properties(${T_NAME})
 endfunction()
 
 # orbed_add_process(NAME orbed-foo MAIN main.cc LIBS foo_lib)
-#   A thin main; also registered as two smoke tests: `--help` exits 0, an unknown flag exits != 0.
+#   A thin main; also registered as two smoke tests: `--help` exits 0, an unknown flag exits with an
+#   error code (1-125; 126-127: the shell could not run it, above: a signal). Checked by the shell,
+#   not by WILL_FAIL, which would also turn a sanitizer report in the output (a failure) into a pass.
 function(orbed_add_process)
   cmake_parse_arguments(P "" "NAME;MAIN" "LIBS" ${ARGN})
   add_executable(${P_NAME} ${P_MAIN})
   target_link_libraries(${P_NAME} PRIVATE ${P_LIBS})
   add_test(NAME ${P_NAME}.help COMMAND ${P_NAME} --help)
-  add_test(NAME ${P_NAME}.unknown_flag COMMAND ${P_NAME} --no-such-flag-xyz)
-  set_tests_properties(${P_NAME}.unknown_flag PROPERTIES WILL_FAIL TRUE)
+  add_test(NAME ${P_NAME}.unknown_flag
+    COMMAND sh -c "\"$0\" --no-such-flag-xyz; c=$?; test $c -ge 1 -a $c -le 125" $<TARGET_FILE:${P_NAME}>)
   set_tests_properties(${P_NAME}.help ${P_NAME}.unknown_flag PROPERTIES TIMEOUT 20 LABELS smoke)
+  orbed_sanitizer_test_properties(${P_NAME}.help ${P_NAME}.unknown_flag)
+endfunction()
+
+# orbed_sanitizer_test_properties(TEST...)
+#   In a sanitizer build (cmake/OrbedSanitizers.cmake): the runtime options into the tests'
+#   environment (appended: call it after setting ENVIRONMENT), and a sanitizer report anywhere in
+#   their output a failure. Every test that runs an orbed program calls it. Nothing otherwise.
+function(orbed_sanitizer_test_properties)
+  if(ORBED_SANITIZE)
+    set_property(TEST ${ARGN} APPEND PROPERTY ENVIRONMENT ${ORBED_SANITIZER_ENV})
+    set_property(TEST ${ARGN} PROPERTY FAIL_REGULAR_EXPRESSION ${ORBED_SANITIZER_REPORT})
+  endif()
 endfunction()

@@ -3,7 +3,8 @@
 /// A small seeded random source for the emulators (SLAM, user): std::mt19937_64, whose output
 /// sequence the C++ standard fixes, with uniform and normal variates computed here (not by
 /// <random>'s distributions, whose algorithms are implementation-defined) so that a seed gives the
-/// same person and the same walk with any standard library.
+/// same person and the same walk with any standard library. With any compiler too, as long as
+/// callers draw once per statement: the arguments of one call are evaluated in an unspecified order.
 ///
 /// Threading: one Random per thread (not synchronised).
 

@@ -172,8 +172,11 @@ SlamSample SlamModel::Step(const Eigen::Isometry3d& X_WH_true, double t_s) {
     const double keep = 1.0 - config_.relocalization_correction;
     const Eigen::Vector3d e_head = E_ * p_WH - p_WH;  // the head's position error before
     const Eigen::Isometry3d shrunk = YawAboutPoint(p_WH, keep * YawOf(E_), keep * e_head);
-    const Eigen::Isometry3d jump = YawAboutPoint(p_WH, config_.jump_yaw_std_deg * kDegToRad * rng_.Normal(),
-                                                 config_.jump_translation_std_m * rng_.Normal3());
+    // The translation drawn before the yaw, one per statement (as the pinned runs: the order of a
+    // call's arguments is unspecified, and GCC evaluates them last first).
+    const Eigen::Vector3d jump_t_W = config_.jump_translation_std_m * rng_.Normal3();
+    const double jump_yaw = config_.jump_yaw_std_deg * kDegToRad * rng_.Normal();
+    const Eigen::Isometry3d jump = YawAboutPoint(p_WH, jump_yaw, jump_t_W);
     E_ = jump * shrunk;
   } else if (state_ != TrackingState::kLost) {
     Drift(p_WH, ds, state_ == TrackingState::kLimited ? config_.limited_drift_multiplier : 1.0);

@@ -178,15 +178,21 @@ AlignmentResult EmulatedUser::Align(const ViewingContext& ctx, const std::vector
                                     const Eigen::Isometry3d& X_WV_start, std::uint64_t trial_seed) const {
   if (p_RQ.empty()) throw std::invalid_argument("EmulatedUser::Align: no model points");
   const UserConfig& c = config_;
+  // One draw per statement: the arguments of one call are evaluated in an unspecified order (GCC
+  // last first, clang first first), so two draws in one call would make another person with another
+  // compiler. The order is the one the pinned runs were drawn in: last component first.
   Random rng(trial_seed);
 
   // Biases held through the trial.
-  const Eigen::Vector2d alpha_rad(c.lateral_bias_arcmin * kArcminToRad * rng.Normal(),
-                                  c.lateral_bias_arcmin * kArcminToRad * rng.Normal());
+  const double alpha_y = c.lateral_bias_arcmin * kArcminToRad * rng.Normal();
+  const double alpha_x = c.lateral_bias_arcmin * kArcminToRad * rng.Normal();
+  const Eigen::Vector2d alpha_rad(alpha_x, alpha_y);
   const double beta = depth_scale_ * (depth_user_bias_ + c.depth_bias_fraction_std * rng.Normal());
   std::vector<Eigen::Vector2d> display_bias_px;
   for (std::size_t j = 0; j < ctx.displays.size(); ++j) {
-    display_bias_px.emplace_back(c.display_bias_px * rng.Normal(), c.display_bias_px * rng.Normal());
+    const double bias_y = c.display_bias_px * rng.Normal();
+    const double bias_x = c.display_bias_px * rng.Normal();
+    display_bias_px.emplace_back(bias_x, bias_y);
   }
 
   // The scene as it is: real points, the eye, the hologram's apparent-pose map A.
@@ -261,10 +267,12 @@ AlignmentResult EmulatedUser::Align(const ViewingContext& ctx, const std::vector
       a = a.norm() > 1e-6 ? Eigen::Vector3d(a.normalized()) : nr.unitOrthogonal();
       const Eigen::Vector3d b = nr.cross(a);
       const Eigen::Vector3d d = h - r[k];
-      const Eigen::Vector3d perceived(
-          a.dot(d) + rho * (alpha_rad.x() + c.lateral_noise_arcmin * kArcminToRad * rng.Normal()),
-          b.dot(d) + rho * (alpha_rad.y() + c.lateral_noise_arcmin * kArcminToRad * rng.Normal()),
-          nr.dot(d) + rho * (beta + depth_scale_ * c.depth_noise_fraction_std * rng.Normal()));
+      const double noise_depth = depth_scale_ * c.depth_noise_fraction_std * rng.Normal();
+      const double noise_b = c.lateral_noise_arcmin * kArcminToRad * rng.Normal();
+      const double noise_a = c.lateral_noise_arcmin * kArcminToRad * rng.Normal();
+      const Eigen::Vector3d perceived(a.dot(d) + rho * (alpha_rad.x() + noise_a),
+                                      b.dot(d) + rho * (alpha_rad.y() + noise_b),
+                                      nr.dot(d) + rho * (beta + noise_depth));
       depth2 += perceived.z() * perceived.z() / (rho * rho);
       Eigen::Matrix3d B;
       B.row(0) = a.transpose();
@@ -295,8 +303,10 @@ AlignmentResult EmulatedUser::Align(const ViewingContext& ctx, const std::vector
         Eigen::Vector2d u_virtual;
         Eigen::Matrix<double, 2, 3> du_dx;
         if (!ProjectWithJacobian(ctx.displays[j].intrinsics, s.X_CW_est, x, &u_virtual, &du_dx)) continue;
+        const double noise_y = rng.Normal();
+        const double noise_x = rng.Normal();
         const Eigen::Vector2d perceived = u_virtual - s.u_real[k] + display_bias_px[j] +
-                                          c.display_noise_px * Eigen::Vector2d(rng.Normal(), rng.Normal());
+                                          c.display_noise_px * Eigen::Vector2d(noise_x, noise_y);
         Eigen::MatrixXd J = Eigen::MatrixXd::Zero(2, num_unknowns);
         J.leftCols<6>() = du_dx * PointJacobian(x, c_W);
         // The display is a picture too: a hologram moved along the capture camera's line of sight

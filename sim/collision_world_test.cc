@@ -171,12 +171,15 @@ std::vector<Seg> ArmCapsules(const RobotModel& m, const Eigen::VectorXd& q) {
   return s;
 }
 
+// The pair a-b in r.contacts, or nullptr. The pointer points into `r`, so a temporary result is
+// refused at compile time (it would be destroyed at the end of the caller's statement).
 const PairDistance* FindPair(const CollisionResult& r, const std::string& a, const std::string& b) {
   for (const auto& p : r.contacts) {
     if ((p.body_a == a && p.body_b == b) || (p.body_a == b && p.body_b == a)) return &p;
   }
   return nullptr;
 }
+const PairDistance* FindPair(CollisionResult&&, const std::string&, const std::string&) = delete;
 
 TEST(CollisionWorldTest, SelfDistancesMatchSegmentDistancesAndSelfCollisionExists) {
   const RobotModel m = LoadIiwa();
@@ -262,7 +265,8 @@ TEST(CollisionWorldTest, LinksTwoApartNeverTouchWithinLimits) {
     for (double x = j.lower_rad; x <= j.upper_rad + 1e-12; x += 0.05 * kPi / 180) {
       Eigen::VectorXd q = Deg({0, 0, 0, 0, 0, 0, 0});
       q[c.joint] = std::min(x, j.upper_rad);
-      const PairDistance* p = FindPair(world.Check(q), c.a, c.b);
+      const CollisionResult r = world.Check(q);
+      const PairDistance* p = FindPair(r, c.a, c.b);
       ASSERT_NE(p, nullptr);
       min_d = std::min(min_d, p->distance_m);
     }

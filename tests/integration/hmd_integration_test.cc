@@ -224,6 +224,7 @@ TEST(OrbedHmd, RatesImagesAndOneTrialOverRealLcm) {
   EXPECT_TRUE(hmd.Wait(10));
   EXPECT_TRUE(sim.Wait(10));
   EXPECT_EQ(hmd.exit_code(), 0);
+  EXPECT_EQ(sim.exit_code(), 0);
 }
 
 }  // namespace

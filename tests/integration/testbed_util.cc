@@ -67,9 +67,17 @@ RunningProcess::RunningProcess(const std::vector<std::string>& argv,
 }
 
 RunningProcess::~RunningProcess() {
-  if (child_.running()) {
-    child_.Signal(SIGKILL);
-    Wait(5);
+  if (!child_.Poll()) {
+    child_.Signal(SIGTERM);
+    if (Wait(kStopTimeoutS)) {
+      // Killed by the SIGTERM itself: it was still starting, before its handler was installed.
+      const bool clean = child_.exit_code() == 0 || child_.term_signal() == SIGTERM;
+      if (!clean) ADD_FAILURE() << prefix_ << child_.DescribeExit() << " on SIGTERM";
+    } else {
+      ADD_FAILURE() << prefix_ << "did not stop within " << kStopTimeoutS << " s of SIGTERM: SIGKILL";
+      child_.Signal(SIGKILL);
+      Wait(5);
+    }
   }
   child_.Drain(prefix_, true);
 }

@@ -35,9 +35,12 @@ std::string MakeTempDir(const std::string& tag);
 bool WaitFor(const std::function<bool()>& condition, double timeout_s);
 
 /// Runs a command as a child (own process group); its output goes to this test's stdout with a
-/// prefix. Destruction SIGKILLs it if still running.
+/// prefix. Destruction stops it if still running as a user would, with SIGTERM, so that it runs
+/// its exit path (and in a sanitizer build its leak check); an exit code other than 0 then, a
+/// crash, or no exit within kStopTimeoutS (then SIGKILL) is a test failure.
 class RunningProcess {
  public:
+  static constexpr double kStopTimeoutS = 20;
   explicit RunningProcess(const std::vector<std::string>& argv,
                           const std::map<std::string, std::string>& env = {});
   ~RunningProcess();
