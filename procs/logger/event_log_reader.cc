@@ -25,7 +25,8 @@ constexpr uint8_t kSyncBytes[4] = {0xED, 0xA1, 0xDA, 0x01};
 
 std::string EventLogScanner::CheckHeader(size_t pos) const {
   const size_t left = size_ - pos;
-  if (left < EventLogWriter::kHeaderBytes) return "header cut short (" + std::to_string(left) + " bytes left)";
+  if (left < EventLogWriter::kHeaderBytes)
+    return "header cut short (" + std::to_string(left) + " bytes left)";
   const uint8_t* p = data_ + pos;
   if (BigEndian(p, 4) != EventLogWriter::kSyncWord) return "no sync word";
   const auto channel_bytes = static_cast<int32_t>(BigEndian(p + 20, 4));
@@ -54,8 +55,10 @@ bool EventLogScanner::Next(LogEvent* event) {
     const std::string problem = CheckHeader(pos_);
     if (!problem.empty()) {
       // Resync: the next sync word after this byte, or the end.
-      const void* next = size_ - pos_ > 1 ? memmem(data_ + pos_ + 1, size_ - pos_ - 1, kSyncBytes, 4) : nullptr;
-      const size_t to = next == nullptr ? size_ : static_cast<size_t>(static_cast<const uint8_t*>(next) - data_);
+      const void* next =
+          size_ - pos_ > 1 ? memmem(data_ + pos_ + 1, size_ - pos_ - 1, kSyncBytes, 4) : nullptr;
+      const size_t to =
+          next == nullptr ? size_ : static_cast<size_t>(static_cast<const uint8_t*>(next) - data_);
       RecordDamage(pos_, to, problem);
       pos_ = to;
       continue;

@@ -49,8 +49,8 @@ std::vector<uint8_t> WriteWithLcm(const std::vector<Written>& events) {
 std::vector<Written> SomeEvents() {
   std::vector<Written> events;
   for (int i = 0; i < 20; ++i) {
-    events.push_back({"CHANNEL_" + std::to_string(i % 3), std::string(static_cast<size_t>(10 + 37 * i), 'a' + i),
-                      1700000000000000 + 1000 * i});
+    events.push_back({"CHANNEL_" + std::to_string(i % 3),
+                      std::string(static_cast<size_t>(10 + 37 * i), 'a' + i), 1700000000000000 + 1000 * i});
   }
   events.push_back({"EMPTY", "", 1700000000100000});
   return events;
@@ -93,7 +93,8 @@ TEST(EventLogScanner, SkipsACorruptedEventAndReportsItsOffset) {
   ASSERT_EQ(scanner.damage().size(), 1u);
   EXPECT_EQ(scanner.damage()[0].offset, offset);
   EXPECT_EQ(scanner.damage()[0].bytes, 28 + written[5].channel.size() + written[5].data.size());
-  EXPECT_NE(scanner.damage()[0].reason.find("channel length"), std::string::npos) << scanner.damage()[0].reason;
+  EXPECT_NE(scanner.damage()[0].reason.find("channel length"), std::string::npos)
+      << scanner.damage()[0].reason;
 }
 
 TEST(EventLogScanner, ACutLogEndsAtItsLastWholeEventAndGarbageBeforeIsSkipped) {

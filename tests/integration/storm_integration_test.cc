@@ -64,9 +64,10 @@ std::vector<uint8_t> Mutate(const std::vector<uint8_t>& original, std::mt19937& 
         bytes.resize(at);
         break;
       case 2:  // extension
-        for (int i = 0; i < 1 + static_cast<int>(rng() % 16); ++i) bytes.push_back(static_cast<uint8_t>(rng()));
+        for (int i = 0; i < 1 + static_cast<int>(rng() % 16); ++i)
+          bytes.push_back(static_cast<uint8_t>(rng()));
         break;
-      case 3:  // a huge count (int32 2^31 - 1) anywhere after the fingerprint
+      case 3:    // a huge count (int32 2^31 - 1) anywhere after the fingerprint
       case 4: {  // a negative one
         if (bytes.size() < 12) break;
         const size_t pos = 8 + rng() % (bytes.size() - 11);
@@ -127,8 +128,9 @@ TEST(Storm, MutatedTrafficIsRefusedAndTheTestbedKeepsWorking) {
   const std::string log_dir = MakeTempDir("storm");
   BusWatcher watcher;
   watcher.Start();
-  RunningProcess launcher({BinPath("orbed-launch"), SourcePath("scripts/launch/testbed.yaml"), "--duration-s", "600"},
-                          {{"ORBED_LOG_DIR", log_dir}});
+  RunningProcess launcher(
+      {BinPath("orbed-launch"), SourcePath("scripts/launch/testbed.yaml"), "--duration-s", "600"},
+      {{"ORBED_LOG_DIR", log_dir}});
   // The testbed's own heartbeats are those from the launcher's children (the storm replays
   // heartbeats of the recorded run, mutated, under the same names).
   std::map<std::string, int> children;
@@ -167,7 +169,8 @@ TEST(Storm, MutatedTrafficIsRefusedAndTheTestbedKeepsWorking) {
     const Sample& sample = pick_large ? *large[rng() % large.size()] : *small[rng() % small.size()];
     const std::vector<uint8_t> bytes = Mutate(sample.bytes, rng);
     publisher.publish(sample.channel, bytes.data(), static_cast<unsigned int>(bytes.size()));
-    if (i % 10 == 9) std::this_thread::sleep_for(std::chrono::milliseconds(1));  // pacing, not synchronisation
+    if (i % 10 == 9)
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));  // pacing, not synchronisation
   }
 
   // Refusals appear in the heartbeats of every process that subscribes to something.
