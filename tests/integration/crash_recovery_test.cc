@@ -24,6 +24,7 @@
 #include <atomic>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <functional>
 #include <map>
 #include <mutex>
@@ -34,6 +35,7 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 #include <lcm/lcm-cpp.hpp>
 #include <orbed/alignment_trial_t.hpp>
 #include <orbed/logger_status_t.hpp>
@@ -41,7 +43,6 @@
 #include <orbed/registration_t.hpp>
 #include <orbed/robot_state_t.hpp>
 #include <orbed/session_control_t.hpp>
-#include <yaml-cpp/yaml.h>
 
 #include "base/units.h"
 #include "lcmtypes/bounded_decode.h"
@@ -59,16 +60,17 @@ namespace fs = std::filesystem;
 // The protocol's messages: what the conductor, the server and the headset exchange. (IIWA_COMMAND
 // is re-sent every 0.25 s and REGISTRATION also comes periodically: neither is in this list's
 // check of the log, since some are sent while the logger is down.)
-const std::set<std::string> kProtocolChannels = {"PLAN_CHECK_REQUEST", "PLAN_CHECK_REPLY", "SESSION_CONTROL",
-                                                 "ALIGNMENT_TRIAL",    "MISALIGNMENT_REQUEST", "MISALIGNMENT",
-                                                 "REGISTRATION"};
+const std::set<std::string> kProtocolChannels = {
+    "PLAN_CHECK_REQUEST",   "PLAN_CHECK_REPLY", "SESSION_CONTROL", "ALIGNMENT_TRIAL",
+    "MISALIGNMENT_REQUEST", "MISALIGNMENT",     "REGISTRATION"};
 
 // The pinned scenario's configurations [deg] (viraal/viraal.yaml).
 const std::vector<std::vector<double>> kConfigurationsDeg = {
     {0, 30, 0, -60, 0, 45, 0}, {40, 20, -30, -80, 20, 50, 30}, {-35, 30, 20, -65, -15, 50, -40}};
 
 int64_t WallMicros() {
-  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
+  return std::chrono::duration_cast<std::chrono::microseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
       .count();
 }
 
@@ -93,9 +95,10 @@ class Recorder {
   Recorder() : lcm_(WithRecvBufSize(DefaultLcmUrl(), 8 << 20)) {
     if (!lcm_.good()) throw std::runtime_error("LCM not available (multicast route?)");
     // Not the images: only what the test looks at, with a queue that holds a busy moment's worth.
-    lcm_.subscribe("ROBOT_STATE|LOGGER_STATUS|PROCESS_STATUS|PLAN_CHECK_REQUEST|PLAN_CHECK_REPLY|SESSION_CONTROL|"
-                   "ALIGNMENT_TRIAL|MISALIGNMENT_REQUEST|MISALIGNMENT|REGISTRATION",
-                   &Recorder::OnMessage, this)
+    lcm_.subscribe(
+            "ROBOT_STATE|LOGGER_STATUS|PROCESS_STATUS|PLAN_CHECK_REQUEST|PLAN_CHECK_REPLY|SESSION_CONTROL|"
+            "ALIGNMENT_TRIAL|MISALIGNMENT_REQUEST|MISALIGNMENT|REGISTRATION",
+            &Recorder::OnMessage, this)
         ->setQueueCapacity(100000);
     thread_ = std::thread([this] {
       while (!stop_) lcm_.handleTimeout(20);
@@ -252,7 +255,8 @@ TEST(CrashRecovery, KilledProcessesComeBackAndTheRunEndsWithTheUninterruptedResu
   std::atomic<bool> sim_killed{false};
   std::atomic<int64_t> sim_killed_wall{0};
   bus.on_robot = [&](const Recorder::Robot& robot) {
-    if (sim_killed || bus.Count("MISALIGNMENT") != 2 || robot.motion != orbed::robot_state_t::MOTION_MOVING) return;
+    if (sim_killed || bus.Count("MISALIGNMENT") != 2 || robot.motion != orbed::robot_state_t::MOTION_MOVING)
+      return;
     const double s = (robot.q[0] * kRadToDeg - 40.0) / (-35.0 - 40.0);
     if (s < 0.2 || s > 0.8) return;
     const int pid = LatestPid(bus, "sim");
@@ -260,8 +264,9 @@ TEST(CrashRecovery, KilledProcessesComeBackAndTheRunEndsWithTheUninterruptedResu
     sim_killed = kill(pid, SIGKILL) == 0;
   };
 
-  RunningProcess launcher({BinPath("orbed-launch"), SourcePath("scripts/launch/viraal.yaml"), "--duration-s", "240"},
-                          {{"ORBED_LOG_DIR", dir}, {"ORBED_RUN_ID", "pinned"}});
+  RunningProcess launcher(
+      {BinPath("orbed-launch"), SourcePath("scripts/launch/viraal.yaml"), "--duration-s", "240"},
+      {{"ORBED_LOG_DIR", dir}, {"ORBED_RUN_ID", "pinned"}});
 
   // 1. The registration server, after trial 0 of session 0 is registered (MISALIGNMENT 1).
   ASSERT_TRUE(WaitFor([&] { return hold.held() && bus.Count("MISALIGNMENT") >= 1; }, 120)) << "no trial 0";
@@ -285,10 +290,12 @@ TEST(CrashRecovery, KilledProcessesComeBackAndTheRunEndsWithTheUninterruptedResu
   // MISALIGNMENT (everything before it is then in its part).
   ASSERT_TRUE(WaitFor([&] { return hold.held() && bus.Count("MISALIGNMENT") >= 6; }, 60)) << "no trial 1";
   const int64_t flushed_after = WallMicros() + 1'000'000;
-  ASSERT_TRUE(WaitFor([&] { return bus.LastFlushUtime() > flushed_after; }, 30)) << "the logger did not flush";
+  ASSERT_TRUE(WaitFor([&] { return bus.LastFlushUtime() > flushed_after; }, 30))
+      << "the logger did not flush";
   const size_t protocol_before_logger_kill = bus.Protocol().size();
   KillAndWaitForRespawn(bus, "logger");
-  ASSERT_EQ(bus.Protocol().size(), protocol_before_logger_kill) << "protocol traffic while the logger was down";
+  ASSERT_EQ(bus.Protocol().size(), protocol_before_logger_kill)
+      << "protocol traffic while the logger was down";
   hold.Release();
 
   ASSERT_TRUE(launcher.Wait(180)) << "the run did not finish";
@@ -312,11 +319,13 @@ TEST(CrashRecovery, KilledProcessesComeBackAndTheRunEndsWithTheUninterruptedResu
   const auto same_q = std::find_if(robot.begin(), first_new, [&](const Recorder::Robot& r) {
     return r.q == first_new->q && r.utime >= last_old_utime - 150'000;
   });
-  EXPECT_NE(same_q, first_new) << "the respawned sim's first configuration is not one the old sim published last";
+  EXPECT_NE(same_q, first_new)
+      << "the respawned sim's first configuration is not one the old sim published last";
   EXPECT_GT(std::abs(first_new->q[0]), 10 * kDegToRad) << "the respawned sim started at zero";
 
   // Every respawned process heartbeated from two pids.
-  for (const char* name : {"registration", "sim", "hmd", "logger"}) EXPECT_EQ(bus.Pids(name).size(), 2u) << name;
+  for (const char* name : {"registration", "sim", "hmd", "logger"})
+    EXPECT_EQ(bus.Pids(name).size(), 2u) << name;
   EXPECT_TRUE(fs::exists(dir + "/sim.state") && fs::exists(dir + "/hmd.state") &&
               fs::exists(dir + "/registration.journal"));
 
@@ -374,7 +383,8 @@ TEST(CrashRecovery, AKilledConductorLeavesPartialResultsAndResumeCompletesTheRun
     Recorder bus;
     std::atomic<bool> killed{false};
     bus.on_trial = [&](const orbed::alignment_trial_t& trial) {
-      if (trial.session_id == "pinned-ar" && trial.trial_index == 0) killed = kill(LatestPid(bus, "scenario"), SIGKILL) == 0;
+      if (trial.session_id == "pinned-ar" && trial.trial_index == 0)
+        killed = kill(LatestPid(bus, "scenario"), SIGKILL) == 0;
     };
     RunningProcess launcher(
         {BinPath("orbed-launch"), SourcePath("scripts/launch/viraal.yaml"), "--duration-s", "240"},
@@ -392,8 +402,9 @@ TEST(CrashRecovery, AKilledConductorLeavesPartialResultsAndResumeCompletesTheRun
   EXPECT_LE(partial["sessions"][1]["trials"].size(), 1u);
 
   const std::string second = MakeTempDir("conductor_resumed");
-  RunningProcess launcher({BinPath("orbed-launch"), SourcePath("scripts/launch/viraal.yaml"), "--duration-s", "240"},
-                          {{"ORBED_LOG_DIR", second}, {"ORBED_RESUME", first}});
+  RunningProcess launcher(
+      {BinPath("orbed-launch"), SourcePath("scripts/launch/viraal.yaml"), "--duration-s", "240"},
+      {{"ORBED_LOG_DIR", second}, {"ORBED_RESUME", first}});
   ASSERT_TRUE(launcher.Wait(180)) << "the resumed run did not finish";
   ASSERT_EQ(launcher.exit_code(), 0);
   const YAML::Node results = YAML::LoadFile(second + "/results.json");
@@ -401,6 +412,32 @@ TEST(CrashRecovery, AKilledConductorLeavesPartialResultsAndResumeCompletesTheRun
   EXPECT_EQ(results["resumed_from"].as<std::string>(), first);
   ExpectSameTree(YAML::LoadFile(SourcePath("tests/integration/testdata/viraal_pinned_results.json")), results,
                  "results", {"started_utime", "duration_s", "resumed_from"});
+}
+
+// A required process that is respawned but never heartbeats again (it exits at once from its
+// second start on) stops the launch with exit code 1 after its ready_timeout_s, rather than being
+// respawned for ever.
+TEST(CrashRecovery, ARespawnedProcessThatNeverGetsReadyAgainStopsTheLaunch) {
+  const std::string dir = MakeTempDir("crash_loop");
+  const std::string launch_file = dir + "/launch.yaml";
+  std::ofstream(launch_file)
+      << "name: crash_loop\n"
+         "groups:\n"
+         "  - name: g\n"
+         "    processes:\n"
+         "      - name: flaky\n"
+         "        command: sh\n"
+         "        args: [-c, 'if [ -e \"$0\" ]; then exit 3; fi; touch \"$0\"; exec \"$1\" \"$2\" \"$3\"', \""
+      << dir << "/started\", \"" << BinPath("orbed-monitor")
+      << "\"]\n"
+         "        respawn: true\n"
+         "        ready_timeout_s: 2\n";
+  Recorder bus;
+  RunningProcess launcher({BinPath("orbed-launch"), launch_file});
+  ASSERT_TRUE(WaitFor([&] { return LatestPid(bus, "flaky") > 0; }, 30)) << "no first heartbeat";
+  ASSERT_EQ(kill(LatestPid(bus, "flaky"), SIGKILL), 0);
+  ASSERT_TRUE(launcher.Wait(30)) << "the launcher kept respawning";
+  EXPECT_EQ(launcher.exit_code(), 1);
 }
 
 }  // namespace
