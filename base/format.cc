@@ -1,6 +1,7 @@
 #include "base/format.h"
 
 #include <cstdio>
+#include <ctime>
 
 namespace orbed {
 
@@ -26,6 +27,14 @@ std::string EscapeText(const std::string& text) {
     }
   }
   return out;
+}
+
+std::string FormatUtc(int64_t utime, const char* format) {
+  const std::time_t seconds = static_cast<std::time_t>(utime / 1000000);
+  std::tm tm{};
+  gmtime_r(&seconds, &tm);
+  char buffer[64];
+  return std::string(buffer, std::strftime(buffer, sizeof(buffer), format, &tm));
 }
 
 }  // namespace orbed

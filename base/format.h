@@ -4,6 +4,7 @@
 ///
 /// Threading: pure functions.
 
+#include <cstdint>
 #include <string>
 
 namespace orbed {
@@ -15,5 +16,8 @@ std::string Fixed(double value, int digits);
 /// as "\xNN" (so a corrupted id from the bus cannot move the cursor or fake a log line). For text
 /// that came from the bus or a file.
 std::string EscapeText(const std::string& text);
+
+/// A utime [µs since the Unix epoch] as UTC text by strftime's `format`, e.g. "%Y-%m-%dT%H:%M:%SZ".
+std::string FormatUtc(int64_t utime, const char* format);
 
 }  // namespace orbed

@@ -40,6 +40,9 @@ int RunHmd(int argc, const char* const* argv, std::ostream& out, std::ostream& e
                  "With --interactive: write the window's image here at exit (PNG)");
   app.add_option("--scripted-keys", o.scripted_keys,
                  "With --interactive: keys typed one per refresh before real ones (\\n = Enter, \\e = Esc)");
+  app.add_option("--state-file", o.state_file,
+                 "Keep the session and its last trial in this file and continue from it when it exists "
+                 "(crash recovery)");
   app.add_option("--iiwa-status-channel", o.iiwa_status_channel)->capture_default_str();
   app.add_option("--robot-state-channel", o.robot_state_channel)->capture_default_str();
   app.add_option("--session-control-channel", o.session_control_channel)->capture_default_str();

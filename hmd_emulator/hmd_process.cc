@@ -9,6 +9,7 @@
 
 #include "base/format.h"
 #include "hmd_emulator/headset_trial.h"
+#include "procs/common/alignment_trial.h"
 #include "procs/common/conversions.h"
 #include "procs/common/log.h"
 #include "procs/common/validation.h"
@@ -58,6 +59,13 @@ HmdProcess::HmdProcess(const orbed::CommonFlags& flags, const HmdOptions& option
   user_id_ = "emulated-seed-" + std::to_string(config_.user.seed);
   X_WV_start_ = EmulatedUser(config_.user).StartPose(scene.X_WR);
   session_ = HmdSession({placed, options_.iiwa_status_channel, options_.robot_state_channel});
+  if (!options_.state_file.empty()) {
+    saved_ = RestoreSession(options_.state_file, &session_);
+    if (session_.state().active()) {
+      ORBED_LOG(kInfo) << "continuing " << session_.state().Describe() << " at trial "
+                       << session_.state().next_index << " (state file " << options_.state_file << ")";
+    }
+  }
   interactive_.emplace(options_.displays, X_WV_start_, options_.scripted_keys, MonotonicSeconds());
   stream_ = std::make_unique<PoseStream>(config_, scene, *robot_model_);
 
@@ -74,6 +82,9 @@ HmdProcess::HmdProcess(const orbed::CommonFlags& flags, const HmdOptions& option
   process_->Subscribe<orbed::registration_t>(
       options_.registration_channel,
       [this](const orbed::registration_t& m, const std::string& ch, int64_t) { OnRegistration(m, ch); });
+  process_->Subscribe<orbed::alignment_trial_t>(
+      options_.trial_channel,
+      [this](const orbed::alignment_trial_t& m, const std::string& ch, int64_t) { OnTrial(m, ch); });
 
   ImagePipelineOptions images;
   images.jpeg_quality = options_.jpeg_quality;
@@ -198,12 +209,20 @@ void HmdProcess::OnSessionControl(const orbed::session_control_t& msg, const std
     case SessionDecision::Kind::kRefuse:
       return process_->Reject(channel + "/" + decision.refusal.key, decision.refusal.reason);
     case SessionDecision::Kind::kStart:
+      saved_ = SavedSession{msg, std::nullopt};
+      SaveState();
       X_WV_registration_.reset();
       X_WV_user_.reset();
       interactive_->SetEvent(decision.event);
       ORBED_LOG(kInfo) << decision.event;
       return;
+    case SessionDecision::Kind::kReset:
+      saved_.last_trial.reset();
+      SaveState();
+      return;
     case SessionDecision::Kind::kStop:
+      saved_ = SavedSession{};
+      SaveState();
       ORBED_LOG(kInfo) << decision.event;
       return;
     case SessionDecision::Kind::kRequestedTrial:
@@ -258,6 +277,30 @@ void HmdProcess::PublishTrial(const Eigen::Isometry3d& X_WV, double duration_s, 
   msg.duration_s = duration_s;
   msg.user_id = user_id;
   process_->Publish(options_.trial_channel, msg);
+  // Saved after it went out: a crash in between repeats this index (the same trial), never skips it.
+  saved_.last_trial = msg;
+  SaveState();
+}
+
+void HmdProcess::OnTrial(const orbed::alignment_trial_t& msg, const std::string& channel) {
+  if (!session_.state().active() || msg.session_id != session_.state().id) return;  // not ours
+  const auto checked = CheckAlignmentTrial(msg, robot_model_->num_joints());
+  if (const auto* refusal = std::get_if<Refusal>(&checked)) {
+    return process_->Reject(channel + "/" + refusal->key, refusal->reason);
+  }
+  if (!session_.ObserveTrial(msg)) return;  // our own, or one the session is already past
+  saved_.last_trial = msg;
+  SaveState();
+  ORBED_LOG(kInfo) << "trial " << msg.trial_index << " of '" << msg.session_id
+                   << "' came from elsewhere: the next trial is " << session_.state().next_index;
+}
+
+void HmdProcess::SaveState() {
+  if (options_.state_file.empty()) return;
+  std::string error;
+  if (SaveSession(options_.state_file, saved_, &error)) return;
+  process_->SetLastError(error);
+  ORBED_LOG(kError) << error;
 }
 
 void HmdProcess::HandleKey(int key) {
@@ -291,6 +334,7 @@ void HmdProcess::SubmitInteractiveTrial() {
     start.num_mirrors = options_.displays;
     start.method = orbed::registration_t::METHOD_KARCHER;
     session_.Open({start.session_id, start.display_mode, start.num_mirrors, start.method, 0});
+    saved_ = SavedSession{start, std::nullopt};
     process_->Publish(options_.session_control_channel, start);
   }
   const std::string session_id = session_.state().id;

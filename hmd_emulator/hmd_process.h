@@ -12,7 +12,9 @@
 ///   Subscribes: IIWA_STATUS (iiwa_status_t): q of the real robot [rad] (drawn, and the trial's q);
 ///               ROBOT_STATE (robot_state_t): X_WR, the true robot base (drawn, and the trial's truth);
 ///               SESSION_CONTROL (session_control_t): START / RESET / STOP / REQUEST_TRIAL;
-///               REGISTRATION (registration_t): X_WV_mean, where the hologram is drawn when valid.
+///               REGISTRATION (registration_t): X_WV_mean, where the hologram is drawn when valid;
+///               ALIGNMENT_TRIAL (alignment_trial_t): another's trial of the active session moves
+///               the next trial index past it (HmdSession::ObserveTrial).
 ///   Publishes:  HMD_POSE and HMD_POSE_TRUTH (hmd_pose_t) at pose_hz (pose_stream.h);
 ///               HMD_CAMERA (image_t, JPEG) at camera_hz, REFLECTIVE_VIEW (reflective_view_t) at
 ///               hmd.reflective_hz per display (--displays), AR_VIEW (image_t, JPEG) at
@@ -34,11 +36,16 @@
 /// num_mirrors, q, X_WV, duration_s = the emulated alignment time, user_id "emulated-seed-<user
 /// seed>"}. In interactive mode REQUEST_TRIAL only tells the person.
 ///
+/// Crash recovery (options.state_file, session_file.h): the session and its last trial are saved on
+/// every change (a trial after it is published), and a headset started on the file continues the
+/// session with the next index.
+///
 /// Rejections (Process::Reject, key "<channel>/<class>"; the process keeps running):
 ///   IIWA_STATUS/num_joints, /non_finite, /limits (beyond a joint limit by > 0.01 rad);
 ///   ROBOT_STATE/pose (X_WR not finite or not a unit quaternion);
 ///   REGISTRATION/pose (a valid mean with a bad X_WV_mean);
 ///   SESSION_CONTROL/<key> with the keys of hmd_session.h, and /trial_failed;
+///   ALIGNMENT_TRIAL/<key> (orbed::CheckAlignmentTrial's keys) for a bad trial of the active session;
 ///   and <channel>/decode for undecodable bytes (Process).
 ///
 /// Threading: handlers and timers run on the Process::Run() thread. With options.threaded (the
@@ -72,6 +79,7 @@
 #include "hmd_emulator/interactive.h"
 #include "hmd_emulator/pose_stream.h"
 #include "hmd_emulator/robot_state.h"
+#include "hmd_emulator/session_file.h"
 #include "procs/common/channels.h"
 #include "procs/common/process.h"
 #include "sim/robot_model.h"
@@ -95,6 +103,8 @@ struct HmdOptions {
   /// Interactive: key codes fed as if typed, one per window refresh, before real keys (tests, demos).
   std::string scripted_keys;
   bool threaded{true};  ///< images on a worker thread (see the file comment)
+  /// The session's state file (session_file.h): restored at start, saved on every change; "" = none.
+  std::string state_file;
   std::string iiwa_status_channel{channels::kIiwaStatus};
   std::string robot_state_channel{channels::kRobotState};
   std::string session_control_channel{channels::kSessionControl};
@@ -151,6 +161,8 @@ class HmdProcess {
   void OnRobotState(const orbed::robot_state_t& msg, const std::string& channel);
   void OnSessionControl(const orbed::session_control_t& msg, const std::string& channel);
   void OnRegistration(const orbed::registration_t& msg, const std::string& channel);
+  void OnTrial(const orbed::alignment_trial_t& msg, const std::string& channel);
+  void SaveState();
   void EmulateTrial(const std::string& channel);
   void SubmitInteractiveTrial();
   void PublishTrial(const Eigen::Isometry3d& X_WV, double duration_s, const std::string& user_id);
@@ -164,6 +176,7 @@ class HmdProcess {
   std::unique_ptr<PoseStream> stream_;
   std::unique_ptr<ImagePipeline> pipeline_;
   HmdSession session_;
+  SavedSession saved_;                             // what the state file holds
   std::optional<InteractiveSession> interactive_;  // always set; the person only with --interactive
   std::chrono::steady_clock::time_point t0_;       // the walk's t = 0: the first pose tick
   bool started_{false};

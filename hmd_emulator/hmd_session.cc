@@ -1,9 +1,8 @@
 #include "hmd_emulator/hmd_session.h"
 
+#include <limits>
 #include <utility>
 #include <variant>
-
-#include <orbed/alignment_trial_t.hpp>
 
 namespace orbed::hmd {
 namespace {
@@ -89,6 +88,16 @@ SessionDecision HmdSession::Apply(const SessionCommand& command, RobotKnown robo
                       "orbed-iiwa-sim running?)");
   }
   return Decide(Kind::kRequestedTrial);
+}
+
+bool HmdSession::ObserveTrial(const orbed::alignment_trial_t& msg) {
+  if (!state_.active() || msg.session_id != state_.id || msg.display_mode != state_.display_mode ||
+      msg.num_mirrors != state_.num_mirrors || msg.trial_index < state_.next_index ||
+      msg.trial_index == std::numeric_limits<std::int32_t>::max()) {
+    return false;
+  }
+  state_.next_index = msg.trial_index + 1;
+  return true;
 }
 
 }  // namespace orbed::hmd

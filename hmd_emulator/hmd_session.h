@@ -17,13 +17,17 @@
 /// a repeated START of the active session with the same mode and mirrors is a no-op (e.g. the
 /// headset's own local START, echoed back); RESET sets the index to 0; STOP closes the session;
 /// COMPUTE is for the registration server (ignored); REQUEST_TRIAL accepted means "run trial
-/// next_index now", and the caller takes the index with TakeTrialIndex() when it publishes.
+/// next_index now", and the caller takes the index with TakeTrialIndex() when it publishes. An
+/// ALIGNMENT_TRIAL of the active session (same mode and mirrors) with an index at or beyond
+/// next_index, published by someone else (a resumed conductor re-sending the trials it kept), moves
+/// next_index past it (ObserveTrial), so the next trial gets the next index.
 ///
 /// Threading: not synchronised; one thread (the Process::Run() thread).
 
 #include <cstdint>
 #include <string>
 
+#include <orbed/alignment_trial_t.hpp>
 #include <orbed/session_control_t.hpp>
 
 #include "procs/common/session_control.h"
@@ -89,6 +93,10 @@ class HmdSession {
 
   /// Returns the active session's next trial index and advances it.
   std::int32_t TakeTrialIndex() { return state_.next_index++; }
+  /// A trial seen on ALIGNMENT_TRIAL, already checked (orbed::CheckAlignmentTrial): advances
+  /// next_index past it when it is one of the active session's at or beyond next_index. Returns
+  /// whether it did.
+  bool ObserveTrial(const orbed::alignment_trial_t& msg);
 
   const HmdSessionState& state() const { return state_; }
 

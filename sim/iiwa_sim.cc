@@ -16,6 +16,7 @@
 #include "procs/common/log.h"
 #include "procs/common/requests.h"
 #include "procs/common/validation.h"
+#include "sim/sim_state.h"
 
 namespace orbed::sim {
 namespace {
@@ -49,6 +50,9 @@ IiwaSimOptions Resolved(IiwaSimOptions options) {
   }
   if (!(options.report_distance_m >= 0) || !std::isfinite(options.report_distance_m)) {
     throw std::invalid_argument("--report-distance-m must be a finite number >= 0");
+  }
+  if (!(options.state_save_period_s > 0) || !std::isfinite(options.state_save_period_s)) {
+    throw std::invalid_argument("--state-save-period-s must be a finite number > 0");
   }
   return options;
 }
@@ -86,7 +90,16 @@ IiwaSim::IiwaSim(const orbed::CommonFlags& flags, const IiwaSimOptions& options)
   ManualArmOptions arm_options;
   arm_options.stop_margin_m = options_.stop_margin_m;
   arm_options.report_distance_m = options_.report_distance_m;
-  arm_ = std::make_unique<ManualArm>(model, &scene_, InitialQ(model, options_.initial_q_deg), arm_options);
+  std::optional<Eigen::VectorXd> q0;
+  if (!options_.state_file.empty()) q0 = ReadSimState(options_.state_file, model);
+  if (q0) {
+    ORBED_LOG(kInfo) << "starting at the last measured configuration in " << options_.state_file;
+  } else {
+    q0 = InitialQ(model, options_.initial_q_deg);
+  }
+  arm_ = std::make_unique<ManualArm>(model, &scene_, *q0, arm_options);
+  saved_q_ = FromVectorX(*q0);
+  save_every_ticks_ = std::max<int64_t>(1, std::llround(options_.state_save_period_s * 1e6 / period_us_));
   for (int i = 0; i < model.num_links(); ++i) {
     if (!arm_->world().LinkPrimitives(i).empty() && std::isfinite(arm_->collision().link_clearance_m[i])) {
       reported_links_.push_back(i);
@@ -210,6 +223,7 @@ void IiwaSim::PublishAll(int64_t utime) {
   status.joint_torque_commanded.assign(n, 0.0);
   status.joint_torque_external.assign(n, 0.0);
   process_->Publish(options_.iiwa_status_channel, status);
+  SaveState(status);
 
   model.CalcLinkPoses(arm_->q_rad(), &X_RL_);
   orbed::robot_state_t state{};
@@ -244,6 +258,19 @@ void IiwaSim::PublishAll(int64_t utime) {
   collision.num_links = static_cast<int32_t>(collision.link_names.size());
   collision.check_duration_us = static_cast<int64_t>(std::llround(arm_->collision_check_us()));
   process_->Publish(options_.collision_status_channel, collision);
+}
+
+void IiwaSim::SaveState(const orbed::iiwa_status_t& status) {
+  if (options_.state_file.empty() || status.joint_position_measured == saved_q_) return;
+  if (arm_->state() == MotionState::kMoving && ticks_ < next_save_tick_) return;
+  std::string error;
+  if (!WriteSimState(options_.state_file, status, &error)) {
+    process_->SetLastError(error);
+    if (save_failures_++ % 1000 == 0) ORBED_LOG(kError) << error << " (" << save_failures_ << " time(s))";
+    return;
+  }
+  saved_q_ = status.joint_position_measured;
+  next_save_tick_ = ticks_ + save_every_ticks_;
 }
 
 }  // namespace orbed::sim

@@ -47,6 +47,13 @@
 /// one per call the same way. Wall clock: the stale-command check (senders stamp commands with their wall
 /// clocks), PLAN_CHECK_REPLY and PROCESS_STATUS.
 ///
+/// Crash recovery (state_file, sim_state.h): the sim saves its measured q while the arm moves, at most
+/// every state_save_period_s of sim time and whenever the arm comes to rest, and a sim started on an
+/// existing state file starts there instead of at initial_q_deg (a damaged file: it does not start).
+/// A respawned sim therefore resumes at most one save period of motion behind where the arm was, at
+/// rest exactly where it was; the next IIWA_COMMAND (the conductor re-sends it while the arm is short
+/// of the target) moves it on.
+///
 /// Threading: everything on the Process::Run() thread.
 
 #include <chrono>
@@ -55,6 +62,7 @@
 #include <vector>
 
 #include <orbed/iiwa_command_t.hpp>
+#include <orbed/iiwa_status_t.hpp>
 #include <orbed/plan_check_request_t.hpp>
 
 #include "base/source_paths.h"
@@ -74,6 +82,11 @@ struct IiwaSimOptions {
   double period_s{0.005};
   /// Initial joint vector [deg]; empty = all zero (the arm upright). Must be within the limits.
   std::vector<double> initial_q_deg;
+  /// The state file (sim_state.h): read at start (over initial_q_deg) and written as the arm moves;
+  /// "" = none.
+  std::string state_file;
+  /// Longest time between two saves while the arm moves [s of sim time], > 0.
+  double state_save_period_s{0.1};
   /// Commands whose utime is further than this from the wall clock are rejected [s]; 0 = never.
   double stale_command_s{1.0};
   /// Motion stops this far before contact [m] (ManualArmOptions::stop_margin_m).
@@ -122,6 +135,7 @@ class IiwaSim {
   void OnCommand(const orbed::iiwa_command_t& msg, const std::string& channel);
   void OnPlanCheck(const orbed::plan_check_request_t& msg, const std::string& channel);
   void PublishAll(int64_t utime);
+  void SaveState(const orbed::iiwa_status_t& status);
 
   IiwaSimOptions options_;
   Scene scene_;
@@ -135,6 +149,10 @@ class IiwaSim {
   int64_t ticks_{0};
   int64_t skipped_ticks_{0};  // since the last warning
   std::chrono::steady_clock::time_point last_skip_warning_{};
+  std::vector<double> saved_q_;  // q in the state file
+  int64_t save_every_ticks_{1};
+  int64_t next_save_tick_{0};
+  int64_t save_failures_{0};
 };
 
 }  // namespace orbed::sim

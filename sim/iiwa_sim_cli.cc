@@ -28,6 +28,13 @@ int RunIiwaSim(int argc, const char* const* argv, std::ostream& out, std::ostrea
   app.add_option("--initial-q-deg", options.initial_q_deg,
                  "Initial joint angles q1,...,q7 [deg] (default: all 0)")
       ->delimiter(',');
+  app.add_option("--state-file", options.state_file,
+                 "Keep the arm's measured configuration in this file and start from it when it exists "
+                 "(crash recovery)");
+  app.add_option("--state-save-period-s", options.state_save_period_s,
+                 "Longest time between two saves of the state file while the arm moves [s]")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   app.add_option("--stale-command-s", options.stale_command_s,
                  "Reject IIWA_COMMAND whose utime is further than this from the wall clock [s]; 0 = off")
       ->check(CLI::NonNegativeNumber)

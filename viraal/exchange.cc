@@ -60,6 +60,22 @@ TrialResult TrialResultFrom(const orbed::alignment_trial_t& trial, const orbed::
   return result;
 }
 
+orbed::alignment_trial_t TrialMessageFrom(const TrialResult& trial, const SessionResult& session,
+                                          int64_t utime) {
+  orbed::alignment_trial_t msg{};
+  msg.utime = utime;
+  msg.session_id = session.session_id;
+  msg.trial_index = trial.index;
+  msg.display_mode = static_cast<int8_t>(session.display_mode);
+  msg.num_mirrors = session.num_mirrors;
+  msg.num_joints = static_cast<int32_t>(trial.q_deg.size());
+  for (double q : trial.q_deg) msg.joint_position.push_back(q * kDegToRad);
+  msg.X_WV = ToPose(trial.X_WV);
+  msg.duration_s = trial.user_duration_s;
+  msg.user_id = trial.user_id;
+  return msg;
+}
+
 MeanResult MeanResultFrom(const orbed::registration_t& reg, const ErrorMeasures& errors) {
   MeanResult mean;
   mean.errors = errors;

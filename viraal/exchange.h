@@ -50,6 +50,12 @@ ErrorMeasures Measures(const AlignmentError& error, const orbed::misalignment_t&
 TrialResult TrialResultFrom(const orbed::alignment_trial_t& trial, const orbed::pose_t& X_WR,
                             const ErrorMeasures& errors);
 
+/// The ALIGNMENT_TRIAL a row of results.json came from (TrialResultFrom's inverse, up to the round
+/// trips of X_WV through a rotation matrix and q through degrees), stamped `utime`: how a resumed
+/// conductor hands the trials it kept back to the registration server and the headset.
+orbed::alignment_trial_t TrialMessageFrom(const TrialResult& trial, const SessionResult& session,
+                                          int64_t utime);
+
 /// The "mean" of a session in results.json.
 MeanResult MeanResultFrom(const orbed::registration_t& mean, const ErrorMeasures& errors);
 

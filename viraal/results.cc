@@ -2,13 +2,16 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
 #include "base/format.h"
 #include "base/json.h"
+#include "base/json_fields.h"
 #include "base/stats.h"
 #include "viraal/paper_reference.h"
 
@@ -67,8 +70,9 @@ std::string ResultsJson(const RunResults& r) {
   JsonWriter json(2);
   json.BeginObject();
   json.Key("run_id").String(r.run_id);
-  json.Key("status").String(r.ok ? "ok" : "failed");
+  json.Key("status").String(r.ok ? "ok" : r.partial ? "partial" : "failed");
   json.Key("error").String(r.error);
+  if (!r.resumed_from.empty()) json.Key("resumed_from").String(r.resumed_from);
   json.Key("seed").Int(static_cast<int64_t>(r.seed));
   json.Key("started_utime").Int(r.started_utime);
   json.Key("duration_s").Number(r.duration_s);
@@ -207,6 +211,135 @@ std::string ResultsTable(const RunResults& r) {
   out << "t = translation error at the robot centroid, R = rotation error, mis = landmark misalignment "
          "||t_bar||_2 (paper Table 1), base = translation error at the base origin\n";
   return out.str();
+}
+
+namespace {
+
+constexpr size_t kMaxResultsBytes = 16 << 20;
+constexpr int kMaxDepth = 8;
+constexpr size_t kMaxName = 256;
+constexpr size_t kMaxSessions = 16;
+constexpr size_t kMaxTrials = 100000;
+constexpr size_t kMaxJoints = 64;
+constexpr double kMaxMeasure = 1e9;  // mm or deg: anything beyond is not a measure
+constexpr double kMaxCoordinate = 1e4;
+
+Eigen::Isometry3d ReadPose(const JsonFields& f, const JsonAt& at) {
+  const std::vector<double> p = f.Numbers(f.Member(at, "position_m"), 3, -kMaxCoordinate, kMaxCoordinate);
+  const JsonAt q_at = f.Member(at, "quaternion_wxyz");
+  const std::vector<double> q = f.Numbers(q_at, 4, -1.0, 1.0);
+  const Eigen::Quaterniond quat(q[0], q[1], q[2], q[3]);
+  if (std::abs(quat.norm() - 1.0) > 1e-6) f.Fail(q_at.key, "a unit quaternion");
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  X.linear() = quat.normalized().toRotationMatrix();
+  X.translation() = Eigen::Vector3d(p[0], p[1], p[2]);
+  return X;
+}
+
+ErrorMeasures ReadMeasures(const JsonFields& f, const JsonAt& at) {
+  ErrorMeasures e;
+  e.translation_error_mm = f.Number(f.Member(at, "translation_error_mm"), 0, kMaxMeasure);
+  e.rotation_error_deg = f.Number(f.Member(at, "rotation_error_deg"), 0, 180);
+  e.misalignment_mm = f.Number(f.Member(at, "misalignment_mm"), 0, kMaxMeasure);
+  e.base_translation_error_mm = f.Number(f.Member(at, "base_translation_error_mm"), 0, kMaxMeasure);
+  e.flange_translation_error_mm = f.Number(f.Member(at, "flange_translation_error_mm"), 0, kMaxMeasure);
+  const std::vector<double> axes = f.Numbers(f.Member(at, "misalignment_axes_mm"), 3, 0, kMaxMeasure);
+  e.misalignment_axes_mm = Eigen::Vector3d(axes[0], axes[1], axes[2]);
+  e.misalignment_mean_pair_distance_mm =
+      f.Number(f.Member(at, "misalignment_mean_pair_distance_mm"), 0, kMaxMeasure);
+  return e;
+}
+
+std::vector<double> ReadJoints(const JsonFields& f, const JsonAt& at) {
+  return f.Numbers(at, f.ArraySize(at, kMaxJoints), -360, 360);
+}
+
+}  // namespace
+
+RunResults ParseResultsJson(const std::string& text, const std::string& source) {
+  const JsonFields f(source);
+  const nlohmann::json doc = f.Parse(text, kMaxResultsBytes, kMaxDepth);
+  const JsonAt root{doc, ""};
+  RunResults r;
+  r.run_id = f.String(f.Member(root, "run_id"), kMaxName);
+  const JsonAt status = f.Member(root, "status");
+  const std::string status_text = f.String(status, kMaxName);
+  if (status_text != "ok" && status_text != "failed" && status_text != "partial") {
+    f.Fail(status.key, "ok, failed or partial", &status.value);
+  }
+  r.ok = status_text == "ok";
+  r.partial = status_text == "partial";
+  r.error = f.String(f.Member(root, "error"), 1 << 16);
+  if (const auto from = f.OptionalMember(root, "resumed_from")) r.resumed_from = f.String(*from, 1 << 12);
+  r.seed = static_cast<uint64_t>(f.Integer(f.Member(root, "seed"), std::numeric_limits<int64_t>::min(),
+                                           std::numeric_limits<int64_t>::max()));
+  // The run's times (absent from a pinned file, which leaves them out).
+  if (const auto started = f.OptionalMember(root, "started_utime")) {
+    r.started_utime = f.Integer(*started, 0, std::numeric_limits<int64_t>::max());
+  }
+  if (const auto duration = f.OptionalMember(root, "duration_s")) r.duration_s = f.Number(*duration, 0, 1e9);
+  const JsonAt landmarks = f.Member(root, "landmarks");
+  for (size_t i = 0, n = f.ArraySize(landmarks, kMaxName); i < n; ++i) {
+    r.landmarks.push_back(f.String(f.Element(landmarks, i), kMaxName));
+  }
+  const JsonAt configurations = f.Member(root, "configurations_deg");
+  for (size_t i = 0, n = f.ArraySize(configurations, kMaxTrials); i < n; ++i) {
+    r.configurations_deg.push_back(ReadJoints(f, f.Element(configurations, i)));
+  }
+  if (const auto X_WR = f.OptionalMember(root, "X_WR")) r.X_WR = ReadPose(f, *X_WR);
+  r.rejected_inputs = f.Integer(f.Member(root, "rejected_inputs"), 0, std::numeric_limits<int64_t>::max());
+  const JsonAt sessions = f.Member(root, "sessions");
+  for (size_t i = 0, n = f.ArraySize(sessions, kMaxSessions); i < n; ++i) {
+    const JsonAt at = f.Element(sessions, i);
+    SessionResult s;
+    s.mode = f.String(f.Member(at, "mode"), kMaxName);
+    s.session_id = f.String(f.Member(at, "session_id"), kMaxName);
+    s.display_mode = static_cast<int>(f.Integer(f.Member(at, "display_mode"), 0, 1));
+    s.num_mirrors = static_cast<int>(f.Integer(f.Member(at, "num_mirrors"), 0, 64));
+    const JsonAt trials = f.Member(at, "trials");
+    for (size_t k = 0, m = f.ArraySize(trials, kMaxTrials); k < m; ++k) {
+      const JsonAt t_at = f.Element(trials, k);
+      TrialResult t;
+      t.index = static_cast<int>(f.Integer(f.Member(t_at, "index"), 0, kMaxTrials));
+      t.q_deg = ReadJoints(f, f.Member(t_at, "q_deg"));
+      t.errors = ReadMeasures(f, t_at);
+      t.user_duration_s = f.Number(f.Member(t_at, "user_duration_s"), 0, 1e9);
+      t.user_id = f.String(f.Member(t_at, "user_id"), kMaxName);
+      t.X_WV = ReadPose(f, f.Member(t_at, "X_WV"));
+      t.X_WR = ReadPose(f, f.Member(t_at, "X_WR"));
+      s.trials.push_back(t);
+    }
+    if (const auto mean_at = f.OptionalMember(at, "mean")) {
+      MeanResult mean;
+      mean.errors = ReadMeasures(f, *mean_at);
+      mean.X_WV = ReadPose(f, f.Member(*mean_at, "X_WV"));
+      mean.num_used = static_cast<int>(f.Integer(f.Member(*mean_at, "num_used"), 0, kMaxTrials));
+      const JsonAt rejected = f.Member(*mean_at, "rejected_indices");
+      for (size_t k = 0, m = f.ArraySize(rejected, kMaxTrials); k < m; ++k) {
+        mean.rejected_indices.push_back(static_cast<int>(f.Integer(f.Element(rejected, k), 0, kMaxTrials)));
+      }
+      mean.rotation_rms_deg = f.Number(f.Member(*mean_at, "rotation_rms_deg"), 0, 180);
+      mean.translation_rms_mm = f.Number(f.Member(*mean_at, "translation_rms_mm"), 0, kMaxMeasure);
+      mean.iterations = static_cast<int>(f.Integer(f.Member(*mean_at, "iterations"), 0, 1 << 20));
+      mean.converged = f.Bool(f.Member(*mean_at, "converged"));
+      mean.unique = f.Bool(f.Member(*mean_at, "unique"));
+      s.mean = mean;
+    }
+    r.sessions.push_back(s);
+  }
+  return r;
+}
+
+RunResults ReadResultsFile(const std::string& path) {
+  std::string file = path;
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) file = (std::filesystem::path(path) / "results.json").string();
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw JsonReadError(file + ": cannot read it");
+  std::string text(kMaxResultsBytes + 1, '\0');
+  in.read(text.data(), static_cast<std::streamsize>(text.size()));
+  text.resize(static_cast<size_t>(in.gcount()));
+  return ParseResultsJson(text, file);
 }
 
 std::string WriteResultsFile(const std::string& dir, const std::string& text) {

@@ -7,7 +7,9 @@
 /// {"position_m":[x,y,z],"quaternion_wxyz":[w,x,y,z]} in the world W.
 ///
 /// results.json, top level:
-///   "run_id", "status" ("ok" | "failed"), "error" (one line, "" when ok), "seed",
+///   "run_id", "status" ("ok" | "failed" | "partial": written while the run goes on, so a conductor
+///   that is killed leaves what it finished), "error" (one line, "" when ok or partial),
+///   "resumed_from" (only in a run resumed from an earlier one's results: that file), "seed",
 ///   "started_utime" [µs since the epoch], "duration_s" (wall clock of the run),
 ///   "translation_error_point" (what "translation_error_mm" measures), "misalignment_definition",
 ///   "landmarks" (link names), "X_WR" (truth at the first trial), "configurations_deg",
@@ -26,8 +28,13 @@
 ///                           "misalignment_axes_mm", "misalignment_mean_pair_distance_mm",
 ///                           "X_WV", "num_used", "rejected_indices", "rotation_rms_deg",
 ///                           "translation_rms_mm", "iterations", "converged", "unique"} } ]
-/// A failed run still writes what it had: the sessions and trials finished so far ("mean" is null
-/// for a session that did not get one).
+/// A failed or partial run still writes what it had: the sessions and trials finished so far ("mean"
+/// is null for a session that did not get one).
+///
+/// ReadResultsFile reads the document back (the conductor resuming a run), checked like any input
+/// from outside (base/json_fields.h): every field with its type and range, bounded counts, unit
+/// quaternions; "trial_statistics" are derived, not read; "started_utime" and "duration_s" may be
+/// absent (a pinned file leaves them out).
 ///
 /// Threading: plain data and pure functions.
 
@@ -85,7 +92,9 @@ struct SessionResult {
 struct RunResults {
   std::string run_id;
   bool ok{false};
+  bool partial{false};  ///< not ok, not failed: the run goes on (status "partial")
   std::string error;
+  std::string resumed_from;  ///< the results this run resumed ("" = none)
   uint64_t seed{0};
   int64_t started_utime{0};
   double duration_s{0};
@@ -108,6 +117,11 @@ std::string ResultsJson(const RunResults& results);
 
 /// The end-of-run table: one row per trial and per mean, then the paper's figures for comparison.
 std::string ResultsTable(const RunResults& results);
+
+/// Reads results.json back; `path` is the file or the folder holding it. Throws JsonReadError
+/// (base/json_fields.h) naming the key of the first problem.
+RunResults ReadResultsFile(const std::string& path);
+RunResults ParseResultsJson(const std::string& text, const std::string& source);
 
 /// Writes `text` to `dir`/results.json through a temporary file and a rename (a reader never sees a
 /// half-written file); returns the path. Throws std::runtime_error naming the path on failure.

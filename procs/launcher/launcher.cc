@@ -98,9 +98,16 @@ void Launcher::OnHeartbeat(const orbed::process_status_t& status, int64_t) {
   }
   for (Managed& m : managed_) {
     if (m.spec.name != status.name || !m.child->running() || m.ready) continue;
+    // A heartbeat still on its way from an instance that died is not the new instance's.
+    if (status.pid > 0 && status.pid != m.child->pid()) continue;
     m.ready = true;
-    ORBED_LOG(kInfo) << m.spec.name << " is ready (first heartbeat after " << SecondsSince(m.started_at)
-                     << " s)";
+    if (m.restarts == 0) {
+      ORBED_LOG(kInfo) << m.spec.name << " is ready (first heartbeat after " << SecondsSince(m.started_at)
+                       << " s)";
+    } else {
+      ORBED_LOG(kInfo) << m.spec.name << " is ready again (" << SecondsSince(m.unready_since)
+                       << " s after it died; restart " << m.restarts << ")";
+    }
   }
 }
 
@@ -110,13 +117,18 @@ void Launcher::HandleExit(Managed* m) {
   const bool success = m->child->exit_code() == 0 && m->child->term_signal() == 0;
   if (stopping_) return;
   if (m->spec.exit_stops_all) {
-    ORBED_LOG(kInfo) << m->spec.name << " " << m->last_exit << ": stopping the testbed";
+    if (m->child->term_signal() != 0) {
+      ORBED_LOG(kError) << m->spec.name << " " << m->last_exit << " before it finished: stopping the testbed";
+    } else {
+      ORBED_LOG(kInfo) << m->spec.name << " " << m->last_exit << ": stopping the testbed";
+    }
     m->finished = true;
     if (!success && exit_code_ == 0) exit_code_ = m->child->exit_code() > 0 ? m->child->exit_code() : 1;
     process_.RequestStop();
     return;
   }
   if (m->spec.respawn) {
+    if (m->ready) m->unready_since = Clock::now();
     const bool fast = SecondsSince(m->started_at) < 1.0;
     m->fast_failures = fast ? m->fast_failures + 1 : 0;
     // Immediately the first time; 0.25, 0.5, ... up to 5 s while it keeps dying at once.
@@ -162,7 +174,19 @@ void Launcher::Tick() {
       }
     }
   }
-  if (all_started_ || stopping_ || exit_code_ != 0) return;
+  if (stopping_ || exit_code_ != 0) return;
+  // Readiness of respawned processes in the groups already up.
+  for (const Managed& m : managed_) {
+    if (m.restarts == 0 || m.ready || !m.spec.required || (!all_started_ && m.group >= starting_group_))
+      continue;
+    if (SecondsSince(m.unready_since) > m.spec.ready_timeout_s) {
+      FailTestbed("process '" + m.spec.name + "' was respawned " + std::to_string(m.restarts) +
+                  " time(s) and sent no heartbeat within " + std::to_string(m.spec.ready_timeout_s) +
+                  " s of dying (" + m.last_exit + ")");
+      return;
+    }
+  }
+  if (all_started_) return;
   // Readiness of the group being started.
   bool group_ready = true;
   for (Managed& m : managed_) {

@@ -1,12 +1,15 @@
 #pragma once
 /// @file
 /// orbed-launch's engine: starts a launch file's groups in order, each group's processes together,
-/// and waits for every process to be ready (its first PROCESS_STATUS heartbeat, unless
-/// `ready: none`) before starting the next group; a process that is not ready in time stops the
-/// testbed with an error naming it. While running it re-emits each child's output prefixed with
+/// and waits for every process to be ready (its first PROCESS_STATUS heartbeat from its own pid,
+/// unless `ready: none`) before starting the next group; a process that is not ready in time stops
+/// the testbed with an error naming it. While running it re-emits each child's output prefixed with
 /// the child's name, restarts children marked `respawn` (at once, then with a growing back-off if
 /// they keep dying within a second), and stops the testbed when a required child fails or a child
-/// marked `exit_stops_all` exits. On SIGINT/SIGTERM or after --duration-s it stops the groups in
+/// marked `exit_stops_all` exits (one killed by a signal: an error, "before it finished"). A
+/// respawned process is ready again at its new instance's first heartbeat; a required one that is
+/// not ready again within its ready_timeout_s of dying (e.g. it keeps dying at start) stops the
+/// testbed with an error naming it. On SIGINT/SIGTERM or after --duration-s it stops the groups in
 /// reverse order: each child gets its stop_signal, then SIGKILL after stop_timeout_s.
 ///
 /// Children get: --name <name> appended (heartbeat-ready processes, unless args have --name),
@@ -54,6 +57,7 @@ class Launcher {
     int restarts = 0;
     int fast_failures = 0;  // consecutive deaths within 1 s of starting
     Clock::time_point started_at;
+    Clock::time_point unready_since;  // when it died after its last readiness (respawns)
     Clock::time_point respawn_at;
     bool respawn_pending = false;
     std::string last_exit;

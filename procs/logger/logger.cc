@@ -2,16 +2,17 @@
 
 #include <lcm/lcm.h>
 
+#include <algorithm>
 #include <chrono>
-#include <ctime>
 #include <filesystem>
-#include <fstream>
+#include <optional>
 #include <stdexcept>
 
-#include "base/json.h"
+#include "base/format.h"
 #include "base/sha256.h"
 #include "procs/common/conversions.h"
 #include "procs/common/log.h"
+#include "procs/logger/event_log_reader.h"
 
 namespace orbed::logger {
 namespace {
@@ -20,23 +21,60 @@ namespace fs = std::filesystem;
 
 constexpr char kLcmSelfTestChannel[] = "LCM_SELF_TEST";
 
-std::string UtcStamp(int64_t utime, const char* format) {
-  const std::time_t seconds = static_cast<std::time_t>(utime / 1000000);
-  std::tm tm{};
-  gmtime_r(&seconds, &tm);
-  char buffer[64];
-  std::strftime(buffer, sizeof(buffer), format, &tm);
-  return buffer;
-}
-
 std::string ChooseLogPath(const LoggerOptions& options, int64_t start_utime) {
   if (!options.file.empty()) return options.file;
-  const std::string stem = "orbed-" + UtcStamp(start_utime, "%Y%m%dT%H%M%SZ");
+  const std::string stem = "orbed-" + FormatUtc(start_utime, "%Y%m%dT%H%M%SZ");
   fs::path path = fs::path(options.log_dir) / (stem + ".lcmlog");
   for (int i = 1; fs::exists(path); ++i) {
     path = fs::path(options.log_dir) / (stem + "-" + std::to_string(i) + ".lcmlog");
   }
   return path.string();
+}
+
+// The folder of the log's parts.
+fs::path LogFolder(const LoggerOptions& options) {
+  return options.file.empty() ? fs::path(options.log_dir) : fs::path(options.file).parent_path();
+}
+
+// What is really in a part whose logger died: its whole events, per channel, and the bytes that
+// are not a whole event (a torn tail). Throws when the file cannot be read.
+void Recount(const fs::path& path, ManifestPart* part) {
+  const MappedLog log(path.string());
+  if (!log.ok()) throw std::runtime_error("cannot continue the recording: " + log.error());
+  EventLogScanner scanner = log.Scanner();
+  ManifestPart recounted;
+  recounted.file = part->file;
+  recounted.start_utime = part->start_utime;
+  recounted.drops = part->drops;
+  LogEvent event;
+  while (scanner.Next(&event)) {
+    ++recounted.events;
+    recounted.bytes += static_cast<int64_t>(EventLogWriter::kHeaderBytes + event.channel.size() + event.size);
+    ChannelStats one{1, static_cast<int64_t>(event.size), event.timestamp_us, event.timestamp_us};
+    Accumulate(one, &recounted.channels[event.channel]);
+    recounted.stop_utime = std::max(recounted.stop_utime.value_or(part->start_utime), event.timestamp_us);
+  }
+  recounted.damaged_bytes = static_cast<int64_t>(scanner.damaged_bytes());
+  if (!recounted.stop_utime) recounted.stop_utime = part->start_utime;
+  *part = recounted;
+}
+
+// The unfinished recording at `manifest_path` that this logger continues, if any.
+std::optional<Manifest> RecordingToContinue(const std::string& manifest_path, const LoggerOptions& options) {
+  std::error_code ec;
+  if (!fs::exists(manifest_path, ec)) return std::nullopt;
+  Manifest previous;
+  try {
+    previous = ReadManifestFile(manifest_path);
+  } catch (const JsonReadError& e) {
+    throw std::runtime_error(std::string("cannot continue the recording: ") + e.what() +
+                             " (move the manifest away to start a new recording)");
+  }
+  if (previous.complete) return std::nullopt;
+  if (!options.file.empty() && previous.parts.front().file != fs::path(options.file).filename().string()) {
+    return std::nullopt;
+  }
+  return previous;
 }
 
 }  // namespace
@@ -55,18 +93,45 @@ Logger::Logger(const CommonFlags& flags, LoggerOptions options)
       [this](const lcm::ReceiveBuffer& rbuf, const std::string& channel) { OnMessage(rbuf, channel); });
   subscription->setQueueCapacity(options_.lcm_queue_capacity);
 
-  log_path_ = ChooseLogPath(options_, start_utime_);
+  const fs::path folder = LogFolder(options_);
+  if (std::optional<Manifest> previous = RecordingToContinue(manifest_path(), options_)) {
+    manifest_ = *previous;
+    ManifestPart& last = manifest_.parts.back();
+    Recount(folder / last.file, &last);
+    int number = static_cast<int>(manifest_.parts.size()) + 1;
+    while (fs::exists(folder / PartFileName(manifest_.parts.front().file, number))) ++number;
+    log_path_ = (folder / PartFileName(manifest_.parts.front().file, number)).string();
+    ORBED_LOG(kWarn) << "continuing the unfinished recording " << manifest_.parts.front().file << " in part "
+                     << number << ": its part " << last.file << " holds " << last.events << " events"
+                     << (last.damaged_bytes > 0
+                             ? " and " + std::to_string(last.damaged_bytes) + " damaged bytes"
+                             : "");
+  } else {
+    log_path_ = ChooseLogPath(options_, start_utime_);
+    manifest_.start_utime = start_utime_;
+  }
   const fs::path parent = fs::path(log_path_).parent_path();
   std::error_code ec;
   if (!parent.empty()) fs::create_directories(parent, ec);
   if (ec) throw std::runtime_error("cannot create " + parent.string() + ": " + ec.message());
   file_ = std::make_unique<EventLogWriter>(log_path_);
   if (!file_->ok()) throw std::runtime_error(file_->error());
+  ManifestPart part;
+  part.file = fs::path(log_path_).filename().string();
+  part.start_utime = start_utime_;
+  manifest_.parts.push_back(part);
+  manifest_.command_line = options_.command_line;
+  manifest_.orbed_version = ORBED_VERSION;
+  manifest_.lcm_version = std::to_string(LCM_MAJOR_VERSION) + "." + std::to_string(LCM_MINOR_VERSION) + "." +
+                          std::to_string(LCM_MICRO_VERSION);
+  manifest_.lcm_url = flags_.lcm_url;
+  manifest_.channels_regex = options_.channels;
   // The files do not change while we record: hash them once.
+  manifest_.files.clear();
   for (const std::string& path : options_.hash_files) {
     std::string error;
     const std::string hash = Sha256FileHex(path, &error);
-    file_hashes_.push_back({path, hash, hash.empty() ? error : ""});
+    manifest_.files.push_back({path, hash, hash.empty() ? error : ""});
   }
   process_.AddTimer(1.0, [this] { process_.Publish(options_.status_channel, MakeStatus()); });
   process_.AddTimer(5.0, [this] { WriteManifest(false); });
@@ -85,7 +150,7 @@ Logger::~Logger() {
 
 std::string Logger::manifest_path() const {
   if (!options_.manifest.empty()) return options_.manifest;
-  return (fs::path(log_path_).parent_path() / "manifest.json").string();
+  return (LogFolder(options_) / "manifest.json").string();
 }
 
 void Logger::OnMessage(const lcm::ReceiveBuffer& rbuf, const std::string& channel) {
@@ -214,62 +279,27 @@ std::map<std::string, ChannelStats> Logger::channel_stats() const {
   return stats_;
 }
 
-void Logger::WriteManifest(bool complete) const {
+Manifest Logger::MakeManifest(bool complete) const {
+  Manifest m = manifest_;
+  ManifestPart& part = m.parts.back();
   const orbed::logger_status_t status = MakeStatus();
-  JsonWriter json(2);
-  json.BeginObject();
-  json.Key("log_file").String(fs::path(log_path_).filename().string());
-  json.Key("complete").Bool(complete);
-  json.Key("start_utime").Int(start_utime_);
-  json.Key("start_time_utc").String(UtcStamp(start_utime_, "%Y-%m-%dT%H:%M:%SZ"));
-  if (complete) {
-    json.Key("stop_utime").Int(stop_utime_);
-    json.Key("stop_time_utc").String(UtcStamp(stop_utime_, "%Y-%m-%dT%H:%M:%SZ"));
-  }
-  json.Key("command_line").String(options_.command_line);
-  json.Key("versions").BeginObject();
-  json.Key("orbed").String(ORBED_VERSION);
-  json.Key("lcm").String(std::to_string(LCM_MAJOR_VERSION) + "." + std::to_string(LCM_MINOR_VERSION) + "." +
-                         std::to_string(LCM_MICRO_VERSION));
-  json.EndObject();
-  json.Key("lcm_url").String(flags_.lcm_url);
-  json.Key("channels_regex").String(options_.channels);
-  json.Key("files").BeginArray();
-  for (const FileHash& file : file_hashes_) {
-    json.BeginObject();
-    json.Key("path").String(file.path);
-    if (file.sha256.empty()) {
-      json.Key("error").String(file.error);
-    } else {
-      json.Key("sha256").String(file.sha256);
-    }
-    json.EndObject();
-  }
-  json.EndArray();
-  json.Key("events_written").Int(status.events_written);
-  json.Key("bytes_written").Int(status.bytes_written);
-  json.Key("drops").Int(status.drops);
-  json.Key("channels").BeginObject();
-  for (const auto& [channel, stats] : channel_stats()) {
-    json.Key(channel).BeginObject();
-    json.Key("events").Int(stats.events);
-    json.Key("bytes").Int(stats.bytes);
-    json.Key("first_utime").Int(stats.first_utime);
-    json.Key("last_utime").Int(stats.last_utime);
-    json.EndObject();
-  }
-  json.EndObject();
-  json.EndObject();
-  // Write-then-rename so a reader never sees half a manifest.
-  const std::string path = manifest_path();
-  const std::string tmp = path + ".tmp";
+  part.drops = status.drops;
   {
-    std::ofstream out(tmp);
-    out << json.str() << "\n";
+    std::lock_guard<std::mutex> lock(stats_mutex_);
+    part.events = events_written_;
+    part.bytes = bytes_written_;
+    part.channels = stats_;
   }
-  std::error_code ec;
-  fs::rename(tmp, path, ec);
-  if (ec) ORBED_LOG(kWarn) << "cannot write " << path << ": " << ec.message();
+  if (complete) {
+    m.complete = part.complete = true;
+    m.stop_utime = part.stop_utime = stop_utime_;
+  }
+  return m;
+}
+
+void Logger::WriteManifest(bool complete) const {
+  std::string error;
+  if (!WriteManifestFile(manifest_path(), MakeManifest(complete), &error)) ORBED_LOG(kWarn) << error;
 }
 
 }  // namespace orbed::logger

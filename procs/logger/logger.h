@@ -11,9 +11,19 @@
 /// flush. SIGINT/SIGTERM stop the receive loop, the writer drains what is queued, flushes, closes,
 /// and the manifest is rewritten with complete = true.
 ///
-/// Outputs: the log file, `manifest.json` beside it (start/stop time, command line, versions,
-/// SHA-256 of the files given with --hash-file, per-channel events and bytes), LOGGER_STATUS at
-/// 1 Hz and the PROCESS_STATUS heartbeat.
+/// Outputs: the log file, `manifest.json` beside it (manifest.h: start/stop time, command line,
+/// versions, SHA-256 of the files given with --hash-file, the parts with their per-channel events
+/// and bytes; rewritten at start, every 5 s and at the end), LOGGER_STATUS at 1 Hz (this part's
+/// counts) and the PROCESS_STATUS heartbeat.
+///
+/// Crash recovery: a logger whose manifest already exists and says the recording is not complete
+/// (its logger died: SIGKILL, power) continues that recording in a new part, <stem>.part<N>.lcmlog
+/// beside the first (with --file only if the recording's first part is that file; otherwise, and
+/// after a complete recording, it starts a new recording and a new manifest). The earlier parts are
+/// not touched: the part whose logger died is re-counted from its file (event_log_reader.h), so the
+/// manifest lists what is really there, valid up to its last flush, a torn last event counted as
+/// damaged bytes. A manifest that does not read back (manifest.h) or names a part file that is
+/// missing is an error: the logger does not start.
 
 #include <condition_variable>
 #include <cstdint>
@@ -28,6 +38,7 @@
 
 #include "procs/common/process.h"
 #include "procs/logger/event_log_writer.h"
+#include "procs/logger/manifest.h"
 
 namespace orbed::logger {
 
@@ -56,26 +67,24 @@ struct LoggerOptions {
   std::string status_channel = "LOGGER_STATUS";
 };
 
-/// Per-channel totals (written events).
-struct ChannelStats {
-  int64_t events = 0;
-  int64_t bytes = 0;  // payload bytes
-  int64_t first_utime = 0;
-  int64_t last_utime = 0;
-};
-
 class Logger {
  public:
-  /// Opens the log; throws std::runtime_error naming the path when it cannot.
+  /// Opens the log (a new recording, or the next part of an unfinished one); throws
+  /// std::runtime_error naming the path when it cannot, or when the recording to continue does not
+  /// read back.
   Logger(const CommonFlags& flags, LoggerOptions options);
   ~Logger();
 
   /// Records until stopped; returns the exit code.
   int Run();
 
+  /// This logger's part.
   const std::string& log_path() const { return log_path_; }
   std::string manifest_path() const;
+  /// The manifest as it would be written now.
+  Manifest MakeManifest(bool complete) const;
   orbed::logger_status_t MakeStatus() const;
+  /// This part's per-channel counts.
   std::map<std::string, ChannelStats> channel_stats() const;
   Process& process() { return process_; }
 
@@ -93,6 +102,7 @@ class Logger {
   CommonFlags flags_;
   Process process_;
   std::string log_path_;
+  Manifest manifest_;  // the recording: earlier parts as found, this part's static fields last
   int64_t start_utime_;
   int64_t stop_utime_ = 0;
 
@@ -110,11 +120,6 @@ class Logger {
   int64_t last_flush_utime_ = 0;               // guarded by stats_mutex_
   std::string write_error_;                    // guarded by stats_mutex_
   int64_t lost_events_ = 0;                    // guarded by stats_mutex_ (after a write error)
-
-  struct FileHash {
-    std::string path, sha256, error;
-  };
-  std::vector<FileHash> file_hashes_;  // computed once in the constructor
 
   std::unique_ptr<EventLogWriter> file_;  // used by the writer thread only, after Run() starts
   std::thread writer_;

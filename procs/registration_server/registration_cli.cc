@@ -27,6 +27,9 @@ int RunRegistration(int argc, const char* const* argv, std::ostream& out, std::o
   app.add_option("--state-period-s", server.state_period_s, "Period of the full-state REGISTRATION (0 = off)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  app.add_option("--journal", server.journal_path,
+                 "Session journal: replayed at start, so a restarted server continues its session "
+                 "(created if missing)");
   app.add_option("--model-centroid-m", server_centroid_m,
                  "Average translations about this model centroid p_VC (3 numbers, metres, in V)")
       ->expected(3);

@@ -10,14 +10,20 @@ RegistrationServer::RegistrationServer(const orbed::CommonFlags& flags,
       options_(options),
       service_(options.service,
                [this](const std::string& key, const std::string& reason) { Reject(key, reason); }) {
+  if (!options_.journal_path.empty()) {
+    journal_ = std::make_unique<SessionJournal>(
+        options_.journal_path, &service_,
+        [this](const std::string& key, const std::string& reason) { Reject(key, reason); });
+    ORBED_LOG(kInfo) << journal_->replay_summary();
+  }
   Subscribe<orbed::session_control_t>(
       options_.session_control_channel,
       [this](const orbed::session_control_t& msg, const std::string&, int64_t) {
-        if (auto state = service_.HandleSessionControl(msg)) Publish(options_.registration_channel, *state);
+        if (auto state = HandleSessionControl(msg)) Publish(options_.registration_channel, *state);
       });
   Subscribe<orbed::alignment_trial_t>(
       options_.trial_channel, [this](const orbed::alignment_trial_t& msg, const std::string&, int64_t) {
-        if (auto state = service_.HandleTrial(msg)) Publish(options_.registration_channel, *state);
+        if (auto state = HandleTrial(msg)) Publish(options_.registration_channel, *state);
       });
   Subscribe<orbed::landmark_request_t>(
       options_.landmark_request_channel,
@@ -35,6 +41,15 @@ RegistrationServer::RegistrationServer(const orbed::CommonFlags& flags,
     });
   }
   ORBED_LOG(kInfo) << "serving " << options_.trial_channel << " -> " << options_.registration_channel;
+}
+
+std::optional<orbed::registration_t> RegistrationServer::HandleSessionControl(
+    const orbed::session_control_t& msg) {
+  return journal_ ? journal_->HandleSessionControl(msg) : service_.HandleSessionControl(msg);
+}
+
+std::optional<orbed::registration_t> RegistrationServer::HandleTrial(const orbed::alignment_trial_t& msg) {
+  return journal_ ? journal_->HandleTrial(msg) : service_.HandleTrial(msg);
 }
 
 }  // namespace orbed::registration

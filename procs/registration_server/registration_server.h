@@ -9,14 +9,19 @@
 /// Bad inputs are counted per class on PROCESS_STATUS and logged (Process::Reject); the process
 /// keeps serving. Outputs take their utime from inputs (see registration_service.h), so a replayed
 /// log gives the same REGISTRATION bytes.
+/// With a journal (journal_path, session_journal.h) the session survives a crash: the constructor
+/// replays the journal, so a respawned server answers as if it had never stopped.
 ///
 /// Threading: everything runs on the Run() thread (Process).
 
+#include <memory>
+#include <optional>
 #include <string>
 
 #include "procs/common/channels.h"
 #include "procs/common/process.h"
 #include "procs/registration_server/registration_service.h"
+#include "procs/registration_server/session_journal.h"
 
 namespace orbed::registration {
 
@@ -24,6 +29,8 @@ struct RegistrationServerOptions {
   RegistrationServiceOptions service;
   /// Period of the full-state REGISTRATION [s]; 0 disables it.
   double state_period_s = 1.0;
+  /// The session journal (session_journal.h); "" = none.
+  std::string journal_path;
   std::string session_control_channel = channels::kSessionControl;
   std::string trial_channel = channels::kAlignmentTrial;
   std::string registration_channel = channels::kRegistration;
@@ -35,14 +42,20 @@ struct RegistrationServerOptions {
 
 class RegistrationServer : public orbed::Process {
  public:
-  /// Throws std::runtime_error (from Process) when LCM cannot start on flags.lcm_url.
+  /// Throws std::runtime_error when LCM cannot start on flags.lcm_url (from Process) or the journal
+  /// cannot be read or written.
   RegistrationServer(const orbed::CommonFlags& flags, const RegistrationServerOptions& options);
 
   const RegistrationService& service() const { return service_; }
 
  private:
+  // The service's session handlers, through the journal when there is one.
+  std::optional<orbed::registration_t> HandleSessionControl(const orbed::session_control_t& msg);
+  std::optional<orbed::registration_t> HandleTrial(const orbed::alignment_trial_t& msg);
+
   RegistrationServerOptions options_;
   RegistrationService service_;
+  std::unique_ptr<SessionJournal> journal_;
 };
 
 }  // namespace orbed::registration

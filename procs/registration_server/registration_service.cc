@@ -44,6 +44,7 @@ std::optional<orbed::registration_t> RegistrationService::HandleSessionControl(
     method_ = command.method;
     trials_.clear();
     last_utime_ = command.utime;
+    ++changes_;
     return std::nullopt;
   }
   if (!has_session_ || command.session_id != session_id_) {
@@ -54,12 +55,16 @@ std::optional<orbed::registration_t> RegistrationService::HandleSessionControl(
   }
   switch (command.kind) {
     case Kind::kReset:
+      if (trials_.empty()) return std::nullopt;
       trials_.clear();
       last_utime_ = command.utime;
+      ++changes_;
       return std::nullopt;
     case Kind::kStop:
+      if (!active_) return std::nullopt;
       active_ = false;
       last_utime_ = command.utime;
+      ++changes_;
       return std::nullopt;
     default:  // COMPUTE
       return MakeState(command.utime, orbed::registration_t::REASON_COMPUTE);
@@ -100,6 +105,7 @@ std::optional<orbed::registration_t> RegistrationService::HandleTrial(const orbe
   trials_.push_back({msg.trial_index, QuaternionFromWxyz(msg.X_WV.quaternion_wxyz).normalized(),
                      ToVector3(msg.X_WV.position_m)});
   last_utime_ = msg.utime;
+  ++changes_;
   return MakeState(msg.utime, orbed::registration_t::REASON_TRIAL);
 }
 

@@ -14,7 +14,9 @@
 /// num_mirrors, method) opens a session (replacing any other; a repeated START of the active session
 /// with the same mode and mirrors changes nothing); trials for it are collected until STOP; RESET drops its
 /// trials; COMPUTE asks for the full state now. The last session's state stays available (periodic state,
-/// COMPUTE) after STOP until the next START.
+/// COMPUTE) after STOP until the next START. A STOP of a stopped session and a RESET of a session without
+/// trials change nothing either, so every input that changes the state changes the session (what the
+/// journal of session_journal.h relies on to stay bounded).
 ///
 /// Frames and units: trials carry X_WV (virtual robot base V in the OR world W) [m]; the mean is
 /// X_WV_mean; rays and landmarks are in W [m]; angles in messages are [deg] where named.
@@ -75,6 +77,9 @@ class RegistrationService {
   /// The full state (reason PERIODIC) once a session has been started, else nothing.
   std::optional<orbed::registration_t> PeriodicState() const;
 
+  /// Counts the inputs that changed the state (START, RESET, STOP, accepted trials); a caller compares
+  /// it before and after a call to know whether the call changed anything.
+  int64_t changes() const { return changes_; }
   bool has_session() const { return has_session_; }
   bool session_active() const { return active_; }
   const std::string& session_id() const { return session_id_; }
@@ -100,6 +105,7 @@ class RegistrationService {
   int8_t method_ = orbed::registration_t::METHOD_KARCHER;
   std::vector<Trial> trials_;
   int64_t last_utime_ = 0;
+  int64_t changes_ = 0;
 };
 
 }  // namespace orbed::registration

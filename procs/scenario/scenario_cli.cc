@@ -36,6 +36,10 @@ int RunScenario(int argc, const char* const* argv, std::ostream& out, std::ostre
                  "Run id; sessions are <run-id>-<mode> (default: $ORBED_RUN_ID if set and not empty, "
                  "else viraal-<UTC time>)")
       ->envname("ORBED_RUN_ID");
+  app.add_option("--resume", options.resume_path,
+                 "Continue the run whose results.json (or run folder) this is: its finished trials and means "
+                 "are kept, the rest is run (default: $ORBED_RESUME if set and not empty)")
+      ->envname("ORBED_RESUME");
   app.add_option("--results-dir", options.results_dir,
                  "Folder of results.json (default: $ORBED_LOG_DIR, else the working directory)");
   app.add_option("--urdf", options.urdf_path,

@@ -60,6 +60,9 @@ ViraalConductor::ViraalConductor(ConductorOptions options, orbed::sim::RobotMode
   results_.seed = options_.seed;
   results_.landmarks = config.landmarks;
   results_.configurations_deg = config.configurations_deg;
+  results_.resumed_from = options_.resumed_from;
+  results_.sessions = options_.kept_sessions;
+  while (mode_index_ < results_.sessions.size() && results_.sessions[mode_index_].mean) ++mode_index_;
 }
 
 ViraalConductor::~ViraalConductor() = default;
@@ -170,6 +173,10 @@ ConductorActions ViraalConductor::OnTrial(const orbed::alignment_trial_t& msg, c
   const std::string prefix = options_.run_id + "-";
   const bool ours = msg.session_id.compare(0, prefix.size(), prefix) == 0;
   if (!ours) return TakeActions();  // another run's trial
+  if (!results_.sessions.empty() && msg.session_id == results_.sessions.back().session_id &&
+      msg.trial_index < trial_index_) {
+    return TakeActions();  // one it has (e.g. a kept trial it re-sent)
+  }
   if (phase_ != Phase::kAwaitTrial || mode_index_ >= options_.config.modes.size() ||
       msg.session_id != results_.sessions.back().session_id || msg.trial_index != trial_index_) {
     Refuse(options_.trial_channel + "/unexpected", "ALIGNMENT_TRIAL for session '" + msg.session_id +
@@ -430,21 +437,34 @@ void ViraalConductor::SendSessionControl(int8_t command) {
 
 void ViraalConductor::StartSession() {
   const viraal::ModeSpec& mode = options_.config.modes[mode_index_];
-  viraal::SessionResult session;
-  session.mode = mode.name;
-  session.session_id = options_.run_id + "-" + mode.name;
-  session.display_mode = mode.display_mode;
-  session.num_mirrors = mode.num_mirrors;
-  results_.sessions.push_back(session);
-  trial_index_ = 0;
+  if (results_.sessions.size() <= mode_index_) {  // else a kept session in progress (resuming)
+    viraal::SessionResult session;
+    session.mode = mode.name;
+    session.session_id = options_.run_id + "-" + mode.name;
+    session.display_mode = mode.display_mode;
+    session.num_mirrors = mode.num_mirrors;
+    results_.sessions.push_back(session);
+  }
+  const viraal::SessionResult& session = results_.sessions.back();
+  trial_index_ = static_cast<int>(session.trials.size());
   session_points_.clear();
   last_trial_registration_.reset();
   mean_registration_.reset();
   SendSessionControl(+orbed::session_control_t::START);
+  for (const viraal::TrialResult& kept : session.trials) {
+    const orbed::alignment_trial_t trial = viraal::TrialMessageFrom(kept, session, now_.utime);
+    session_points_.push_back(viraal::TrialPoints(*points_, trial));
+    Publish(options_.trial_channel, trial);
+  }
   Say("[" + mode.name + "] session " + session.session_id +
       " started: " + std::to_string(options_.config.trials) + " trials, " + std::to_string(mode.num_mirrors) +
-      " reflective display(s)");
-  StartMove(true);
+      " reflective display(s)" +
+      (trial_index_ > 0 ? "; resumed with the " + std::to_string(trial_index_) + " trial(s) kept" : ""));
+  if (trial_index_ < options_.config.trials) {
+    StartMove(true);
+  } else {
+    RequestMean();
+  }
 }
 
 void ViraalConductor::StartMove(bool first) {
@@ -489,10 +509,14 @@ void ViraalConductor::FinishTrial() {
   if (trial_index_ < options_.config.trials) {
     StartMove(true);
   } else {
-    mean_registration_.reset();
-    SendSessionControl(+orbed::session_control_t::COMPUTE);
-    Enter(Phase::kAwaitMean);
+    RequestMean();
   }
+}
+
+void ViraalConductor::RequestMean() {
+  mean_registration_.reset();
+  SendSessionControl(+orbed::session_control_t::COMPUTE);
+  Enter(Phase::kAwaitMean);
 }
 
 void ViraalConductor::FinishSession() {

@@ -16,6 +16,12 @@
 ///   configuration or a refused request makes it kFailed with a one-line reason naming the process
 ///   that did not answer; results() then holds what was finished.
 ///
+/// Resuming (ConductorOptions::kept_sessions, from an earlier run's results.json checked by
+/// resume.h): the kept sessions that have their mean are not run again; the session in progress
+/// starts with START, then its kept trials re-sent on ALIGNMENT_TRIAL (the registration server
+/// averages them, the headset moves its next index past them), then its next trial; the trials it
+/// re-sent, coming back, are ignored.
+///
 /// Errors against the truth (viraal/metrics.h, scored by viraal/exchange.h): X_WR from the latest ROBOT_STATE
 /// (the sim's truth); translation_error_mm at the robot centroid, rotation_error_deg the geodesic angle of
 /// R_WR^T R_WV, misalignment_mm = MISALIGNMENT.mean_error_norm_m (the paper's ‖t̄‖₂) of the landmark
@@ -94,6 +100,11 @@ struct ConductorOptions {
   double stopped_grace_s{0.5};
   /// Period of the IIWA_COMMAND re-sends while the arm moves [s].
   double command_resend_s{0.25};
+  /// Sessions kept from an earlier run (resume.h): the finished ones first, then at most one in
+  /// progress; empty = a new run.
+  std::vector<viraal::SessionResult> kept_sessions;
+  /// The results file they came from (results.json "resumed_from").
+  std::string resumed_from;
   /// Channels: the machine names them in refusal keys and reasons, and addresses its messages.
   std::string robot_state_channel{channels::kRobotState};
   std::string iiwa_command_channel{channels::kIiwaCommand};
@@ -113,7 +124,7 @@ void CheckConductorOptions(const ConductorOptions& options);
 /// A message to publish on `channel`.
 struct Publication {
   using Message = std::variant<orbed::plan_check_request_t, orbed::session_control_t, orbed::iiwa_command_t,
-                               orbed::misalignment_request_t>;
+                               orbed::misalignment_request_t, orbed::alignment_trial_t>;
   std::string channel;
   Message message;
 };
@@ -193,6 +204,7 @@ class ViraalConductor {
   // Emits the trial's IIWA_COMMAND; `first` enters kMove (else a re-send).
   void StartMove(bool first);
   void RequestTrial();
+  void RequestMean();
   int64_t SendMisalignment(const viraal::AlignmentError& error);
   void FinishTrial();
   void FinishSession();

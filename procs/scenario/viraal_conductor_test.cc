@@ -14,6 +14,7 @@
 #include "base/source_paths.h"
 #include "base/units.h"
 #include "procs/common/conversions.h"
+#include "procs/scenario/resume.h"
 
 namespace orbed::scenario {
 namespace {
@@ -440,7 +441,7 @@ class Emulation {
     const double start_s = bench_->clock().t_s();
     At(start_s + 0.05, [this] { bench_->Send(RobotState(q_)); });
     for (int k = 1; start_s + k * 0.01 <= until_s; ++k) At(start_s + k * 0.01, [this] { bench_->Tick(); });
-    while (!events_.empty() && !bench_->conductor().done()) {
+    while (!events_.empty() && !bench_->conductor().done() && events_.begin()->first <= until_s) {
       const auto next = events_.begin();
       bench_->clock().Set(next->first);
       const std::function<void()> event = next->second;
@@ -468,6 +469,11 @@ class Emulation {
       OnSessionControl(*control);
     } else if (const auto* request = std::get_if<orbed::misalignment_request_t>(&p.message)) {
       At(Now() + 0.002, [this, m = Misalignment(*request)] { bench_->Send(m); });
+    } else if (const auto* trial = std::get_if<orbed::alignment_trial_t>(&p.message)) {
+      // A kept trial re-sent by a resumed conductor: the server and the user count it, and the
+      // conductor hears its own message back, as on LCM.
+      trials_ = std::max(trials_, trial->trial_index + 1);
+      At(Now() + 0.001, [this, t = *trial] { bench_->Send(t); });
     }
   }
 
@@ -628,6 +634,93 @@ TEST(ViraalConductor, AWholeRunInEmulatedTime) {
       "s); aligned in 12.5 s of user time: 10.0 mm, 0.00 deg, misalignment 10.0 mm");
   EXPECT_EQ(lines[6],
             "[ar_reflective] mean of 3 trials (SE(3), converged): 10.0 mm, 0.00 deg, misalignment 10.0 mm");
+}
+
+// Resuming: a run stopped after some trials, resumed from its results with the sessions it kept
+// (resume.h), ends with the results of the run that was never stopped, having re-sent the kept
+// trials and run only the rest.
+TEST(ViraalConductor, AResumedRunRunsOnlyWhatWasLeftAndEndsWithTheSameResults) {
+  Bench uninterrupted;
+  Emulation(&uninterrupted).Run(200.0);
+  ASSERT_EQ(uninterrupted.conductor().status(), Status::kSucceeded);
+  const viraal::RunResults& expected = uninterrupted.conductor().results();
+
+  // Stopped in session 0 after 2 trials, and in session 1 after 1 trial (session 0 with its mean).
+  const double one_trial_s = 0.2 + 1.0 + 0.003;
+  for (const double stop_after_s :
+       {0.052 + 2 * one_trial_s + 0.1, 0.052 + 3 * one_trial_s + 0.005 + one_trial_s + 0.1}) {
+    Bench stopped;
+    Emulation(&stopped).Run(100.0 + stop_after_s);
+    ASSERT_EQ(stopped.conductor().status(), Status::kRunning);
+    ConductorOptions options = Bench::Options();
+    options.kept_sessions = KeptSessions(stopped.conductor().results(), "emu", 0, options.config);
+    options.resumed_from = "/runs/1/results.json";
+    const size_t kept_sessions = options.kept_sessions.size();
+    const size_t kept_trials = options.kept_sessions.back().trials.size();
+    Bench resumed(options);
+    Emulation(&resumed).Run(200.0);
+    ASSERT_EQ(resumed.conductor().status(), Status::kSucceeded) << resumed.conductor().results().error;
+    EXPECT_TRUE(resumed.refusals().empty());
+
+    // START, the kept trials re-sent, then only the trials that were left.
+    std::vector<std::string> labels(3, "PLAN_CHECK_REQUEST");
+    labels.push_back("SESSION_CONTROL START");
+    for (size_t i = 0; i < kept_trials; ++i) labels.push_back("ALIGNMENT_TRIAL");
+    for (size_t mode = kept_sessions - 1; mode < 2; ++mode) {
+      if (mode == kept_sessions) labels.push_back("SESSION_CONTROL START");
+      for (size_t i = mode == kept_sessions - 1 ? kept_trials : 0; i < 3; ++i) {
+        for (const char* label : {"IIWA_COMMAND", "SESSION_CONTROL REQUEST_TRIAL", "MISALIGNMENT_REQUEST"})
+          labels.push_back(label);
+      }
+      for (const char* label : {"SESSION_CONTROL COMPUTE", "MISALIGNMENT_REQUEST", "SESSION_CONTROL STOP"})
+        labels.push_back(label);
+    }
+    EXPECT_EQ(resumed.Labels(), labels);
+    const std::vector<Publication> resent = resumed.Sent("ALIGNMENT_TRIAL");
+    for (size_t i = 0; i < resent.size(); ++i) {
+      const auto& trial = std::get<orbed::alignment_trial_t>(resent[i].message);
+      EXPECT_EQ(trial.session_id, options.kept_sessions.back().session_id);
+      EXPECT_EQ(trial.trial_index, static_cast<int>(i));
+    }
+
+    const viraal::RunResults& got = resumed.conductor().results();
+    EXPECT_EQ(got.resumed_from, "/runs/1/results.json");
+    ASSERT_EQ(got.sessions.size(), expected.sessions.size());
+    for (size_t m = 0; m < got.sessions.size(); ++m) {
+      ASSERT_EQ(got.sessions[m].trials.size(), 3u);
+      ASSERT_TRUE(got.sessions[m].mean.has_value());
+      const auto same = [&](const viraal::ErrorMeasures& a, const viraal::ErrorMeasures& b,
+                            const std::string& what) {
+        EXPECT_NEAR(a.translation_error_mm, b.translation_error_mm, 1e-9) << what;
+        EXPECT_NEAR(a.misalignment_mm, b.misalignment_mm, 1e-9) << what;
+        EXPECT_NEAR(a.misalignment_mean_pair_distance_mm, b.misalignment_mean_pair_distance_mm, 1e-9) << what;
+      };
+      for (size_t i = 0; i < 3; ++i) {
+        same(got.sessions[m].trials[i].errors, expected.sessions[m].trials[i].errors,
+             "session " + std::to_string(m) + " trial " + std::to_string(i));
+      }
+      same(got.sessions[m].mean->errors, expected.sessions[m].mean->errors, "mean " + std::to_string(m));
+    }
+  }
+}
+
+TEST(ViraalConductor, AResumedSessionWithAllItsTrialsAsksForItsMeanAtOnce) {
+  Bench stopped;
+  Emulation(&stopped).Run(100.0 + 0.052 + 3 * (0.2 + 1.0 + 0.003) + 0.001);  // before the mean
+  ASSERT_EQ(stopped.conductor().results().sessions[0].trials.size(), 3u);
+  ConductorOptions options = Bench::Options();
+  options.kept_sessions = KeptSessions(stopped.conductor().results(), "emu", 0, options.config);
+  Bench resumed(options);
+  resumed.Start();
+  resumed.Send(RobotState(std::vector<double>(7, 0.0)));
+  for (const Publication& p : resumed.Sent("PLAN_CHECK_REQUEST")) {
+    resumed.Send(PlanReply(std::get<orbed::plan_check_request_t>(p.message).request_id));
+  }
+  const std::vector<std::string> labels = resumed.Labels();
+  EXPECT_EQ(std::vector<std::string>(labels.begin() + 3, labels.end()),
+            (std::vector<std::string>{"SESSION_CONTROL START", "ALIGNMENT_TRIAL", "ALIGNMENT_TRIAL",
+                                      "ALIGNMENT_TRIAL", "SESSION_CONTROL COMPUTE"}));
+  EXPECT_EQ(resumed.conductor().phase(), Phase::kAwaitMean);
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 #include "base/source_paths.h"
 #include "procs/common/conversions.h"
 #include "procs/common/log.h"
+#include "procs/scenario/resume.h"
 
 namespace orbed::scenario {
 namespace {
@@ -29,6 +30,13 @@ std::string UtcStamp() {
 ScenarioOptions Resolved(ScenarioOptions options, uint64_t seed) {
   if (options.urdf_path.empty())
     options.urdf_path = ScenarioSourcePath(orbed::sim::RobotModel::kDefaultUrdfRelativePath);
+  if (!options.resume_path.empty()) {
+    const viraal::RunResults earlier = viraal::ReadResultsFile(options.resume_path);
+    if (options.conductor.run_id.empty()) options.conductor.run_id = earlier.run_id;
+    options.conductor.kept_sessions =
+        KeptSessions(earlier, options.conductor.run_id, seed, options.conductor.config);
+    options.conductor.resumed_from = options.resume_path;
+  }
   if (options.conductor.run_id.empty()) options.conductor.run_id = "viraal-" + UtcStamp();
   if (options.results_dir.empty()) {
     const char* env = std::getenv("ORBED_LOG_DIR");
@@ -82,6 +90,7 @@ ViraalScenario::~ViraalScenario() = default;
 
 int ViraalScenario::Run() {
   Apply(conductor_->Start(Now()));
+  WriteProgress();
   const int code = process_->Run();
   if (!finished_) {
     // Stopped from outside (signal, --duration-s) before the run completed.
@@ -111,7 +120,30 @@ void ViraalScenario::Apply(const ConductorActions& actions) {
       process_->Reject(refusal->key, refusal->reason);
     }
   }
-  if (conductor_->done() && !finished_) Finish();
+  if (conductor_->done() && !finished_) {
+    Finish();
+  } else if (!finished_) {
+    WriteProgress();
+  }
+}
+
+void ViraalScenario::WriteProgress() {
+  viraal::RunResults results = conductor_->results();
+  int64_t progress = 0;
+  for (const viraal::SessionResult& session : results.sessions) {
+    progress += static_cast<int64_t>(session.trials.size()) + (session.mean ? 1 : 0);
+  }
+  if (progress == progress_written_) return;
+  progress_written_ = progress;
+  results.partial = true;
+  results.duration_s = Now().t_s;
+  results.rejected_inputs = process_->rejections().total();
+  try {
+    std::filesystem::create_directories(options_.results_dir);
+    results_path_ = viraal::WriteResultsFile(options_.results_dir, viraal::ResultsJson(results));
+  } catch (const std::exception& e) {
+    ORBED_LOG(kWarn) << "cannot write the results so far: " << e.what();
+  }
 }
 
 void ViraalScenario::Finish() {

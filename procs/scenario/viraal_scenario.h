@@ -11,12 +11,18 @@
 ///               PROCESS_STATUS at 1 Hz (Process), where the conductor's refusals are counted.
 ///
 /// Each decoded message goes to the conductor with the time it was handled, and a timer calls its
-/// Tick() every tick_s; the actions it returns are carried out at once, in order. When the
-/// conductor is done, results.json (viraal/results.h) is written to results_dir: on success the
-/// table is printed and the process stops with exit code 0; on a failure "FAILED: <reason>" is
-/// printed, the reason goes on the heartbeat and the exit code is 1 (results.json is still
-/// written, status "failed", with what was finished). A stop from outside (signal,
-/// --duration-s) before the end fails the run as "interrupted".
+/// Tick() every tick_s; the actions it returns are carried out at once, in order. While the run
+/// goes on, results.json (viraal/results.h) in results_dir is rewritten with status "partial" at
+/// the start and whenever a trial or a mean is finished, so a conductor killed mid-run (SIGKILL)
+/// leaves what it finished. When the conductor is done, results.json is written once more: on
+/// success the table is printed and the process stops with exit code 0; on a failure "FAILED:
+/// <reason>" is printed, the reason goes on the heartbeat and the exit code is 1 (results.json
+/// says "failed", with what was finished). A stop from outside (signal, --duration-s) before the
+/// end fails the run as "interrupted".
+///
+/// Resuming (resume_path, a results.json or the folder holding it): the earlier run's results are
+/// read (viraal/results.h) and checked against this run (resume.h); the run id is the earlier
+/// run's unless one is given (it must then be the same); the conductor keeps what they hold.
 ///
 /// Clocks: the conductor's t_s is std::chrono::steady_clock (seconds since construction), its
 /// utime the wall clock (NowMicros()).
@@ -39,6 +45,8 @@ struct ScenarioOptions {
   ConductorOptions conductor;
   /// Folder of results.json; "" = $ORBED_LOG_DIR if set, else the working directory.
   std::string results_dir;
+  /// An earlier run's results.json (or its folder) to resume; "" = a new run.
+  std::string resume_path;
   /// Robot model for the landmark and centroid FK; "" = sim/models/iiwa7.urdf under
   /// $ORBED_SOURCE_DIR, else under the source tree this library was built from.
   std::string urdf_path;
@@ -76,6 +84,9 @@ class ViraalScenario {
   /// Carries out the conductor's actions in order, then finishes the run once it is done.
   void Apply(const ConductorActions& actions);
   void Finish();
+  /// Rewrites results.json with status "partial" when a trial or a mean was finished since the last
+  /// time (and at the first call).
+  void WriteProgress();
   void Say(const std::string& line);
 
   ScenarioOptions options_;
@@ -85,6 +96,7 @@ class ViraalScenario {
   bool finished_{false};
   viraal::RunResults results_;
   std::string results_path_;
+  int64_t progress_written_{-1};  // finished trials + means in the last results.json written
 };
 
 }  // namespace orbed::scenario
