@@ -1,7 +1,9 @@
 // base/: formatting, units, SHA-256 (FIPS 180-4 vectors), number lists, the JSON writer, the
 // checked YAML reader.
 #include <cmath>
+#include <cstdio>
 #include <fstream>
+#include <iterator>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -11,6 +13,7 @@
 #include "base/format.h"
 #include "base/json.h"
 #include "base/number_list.h"
+#include "base/replace_file.h"
 #include "base/sha256.h"
 #include "base/units.h"
 #include "base/yaml_fields.h"
@@ -23,6 +26,20 @@ TEST(Format, EscapeTextKeepsPrintableAsciiAndHexesTheRest) {
   EXPECT_EQ(EscapeText(std::string("a\x1b[2Jb\n\0c", 9)), "a\\x1b[2Jb\\x0a\\x00c");
   EXPECT_EQ(EscapeText("back\\slash"), "back\\\\slash");
   EXPECT_EQ(EscapeText("\xc3\xa9"), "\\xc3\\xa9");  // UTF-8 too: bytes from the bus are not trusted text
+}
+
+TEST(ReplaceFile, ReplacesWholeAndNamesTheFileWhenItCannot) {
+  const std::string path = ::testing::TempDir() + "orbed_replace_file_test.txt";
+  std::string error;
+  ASSERT_TRUE(ReplaceFile(path, "first version, longer", &error)) << error;
+  ASSERT_TRUE(ReplaceFile(path, std::string("second\0", 7), &error)) << error;
+  std::ifstream in(path, std::ios::binary);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(text, std::string("second\0", 7));
+  EXPECT_FALSE(std::ifstream(path + ".tmp").good());  // the temporary is gone
+  std::remove(path.c_str());
+  EXPECT_FALSE(ReplaceFile("/nonexistent-dir/x.json", "{}", &error));
+  EXPECT_NE(error.find("/nonexistent-dir/x.json.tmp"), std::string::npos) << error;
 }
 
 TEST(Format, FixedRoundsToTheGivenDecimals) {

@@ -12,6 +12,7 @@
 #include "base/format.h"
 #include "base/json.h"
 #include "base/json_fields.h"
+#include "base/replace_file.h"
 #include "base/stats.h"
 #include "viraal/paper_reference.h"
 
@@ -344,17 +345,8 @@ RunResults ReadResultsFile(const std::string& path) {
 
 std::string WriteResultsFile(const std::string& dir, const std::string& text) {
   const std::string path = (dir.empty() ? std::string(".") : dir) + "/results.json";
-  const std::string temporary = path + ".tmp";
-  {
-    std::ofstream out(temporary, std::ios::trunc);
-    if (!out) throw std::runtime_error("cannot write " + temporary);
-    out << text;
-    out.flush();
-    if (!out) throw std::runtime_error("cannot write " + temporary);
-  }
-  if (std::rename(temporary.c_str(), path.c_str()) != 0) {
-    throw std::runtime_error("cannot rename " + temporary + " to " + path);
-  }
+  std::string error;
+  if (!ReplaceFile(path, text, &error)) throw std::runtime_error(error);
   return path;
 }
 

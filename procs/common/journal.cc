@@ -9,6 +9,7 @@
 #include <fstream>
 #include <stdexcept>
 
+#include "base/replace_file.h"
 #include "base/sha256.h"
 
 namespace orbed {
@@ -121,21 +122,7 @@ bool WriteJournalFile(const std::string& path, const std::vector<JournalRecord>&
   std::string bytes;
   for (const JournalRecord& r : records)
     bytes += EncodeJournalRecord(r.channel, r.data.data(), r.data.size());
-  const std::string temporary = path + ".tmp";
-  {
-    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-    out.flush();
-    if (!out) {
-      *error = "cannot write " + temporary;
-      return false;
-    }
-  }
-  if (std::rename(temporary.c_str(), path.c_str()) != 0) {
-    *error = "cannot rename " + temporary + " to " + path + ": " + std::strerror(errno);
-    return false;
-  }
-  return true;
+  return ReplaceFile(path, bytes, error);
 }
 
 Journal::Journal(std::string path, JournalLimits limits) : path_(std::move(path)), limits_(limits) {

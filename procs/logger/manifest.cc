@@ -8,6 +8,7 @@
 
 #include "base/format.h"
 #include "base/json.h"
+#include "base/replace_file.h"
 #include "procs/logger/event_log_reader.h"
 #include "procs/logger/event_log_writer.h"
 
@@ -264,21 +265,7 @@ Manifest ReadManifestFile(const std::string& path) {
 }
 
 bool WriteManifestFile(const std::string& path, const Manifest& manifest, std::string* error) {
-  const std::string temporary = path + ".tmp";
-  {
-    std::ofstream out(temporary, std::ios::trunc);
-    out << ManifestJson(manifest);
-    out.flush();
-    if (!out) {
-      *error = "cannot write " + temporary;
-      return false;
-    }
-  }
-  if (std::rename(temporary.c_str(), path.c_str()) != 0) {
-    *error = "cannot rename " + temporary + " to " + path;
-    return false;
-  }
-  return true;
+  return ReplaceFile(path, ManifestJson(manifest), error);
 }
 
 std::string PartFileName(const std::string& first_file, int number) {
