@@ -2,10 +2,13 @@
 // REGISTRATION, MISALIGNMENT, ...) on a conductor that has started its run.
 #include "procs/scenario/viraal_scenario.h"
 #include "tests/fuzz/fuzz_util.h"
+#include "viraal/protocol.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   static auto* scenario = [] {
     orbed::scenario::ScenarioOptions options;
+    options.conductor.config = orbed::viraal::LoadScenarioFile(
+        orbed::scenario::ScenarioSourcePath(orbed::viraal::kDefaultScenarioRelativePath));
     options.conductor.run_id = "fuzz";
     options.results_dir = "/tmp";
     return new orbed::scenario::ViraalScenario(orbed::fuzz::FuzzFlags("orbed-scenario"), options);
