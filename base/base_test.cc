@@ -1,5 +1,5 @@
-// base/: formatting, units, SHA-256 (FIPS 180-4 vectors), number lists, the JSON writer, the
-// checked YAML reader.
+// base/: formatting, units, the seed hashes, SHA-256 (FIPS 180-4 vectors), number lists, the JSON
+// writer, the checked YAML reader.
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "base/format.h"
+#include "base/hash.h"
 #include "base/json.h"
 #include "base/number_list.h"
 #include "base/replace_file.h"
@@ -53,6 +54,17 @@ TEST(Units, DegreesAndRadians) {
   EXPECT_DOUBLE_EQ(180.0 * kDegToRad, std::acos(-1.0));
   EXPECT_DOUBLE_EQ(std::acos(-1.0) / 2 * kRadToDeg, 90.0);
   EXPECT_DOUBLE_EQ(kDegToRad * kRadToDeg, 1.0);
+}
+
+TEST(Hash, SplitMix64AndTheProjectsFnv1a) {
+  // SplitMix64's published first output for state 0 (x = 0 advanced once).
+  EXPECT_EQ(SplitMix64(0), 0xe220a8397b1dcdafULL);
+  // FNV-1a from the pinned offset basis (base/hash.h): "" is the basis itself, "a" one round.
+  EXPECT_EQ(Fnv1a64(""), 1469598103934665603ULL);
+  EXPECT_EQ(Fnv1a64("a"), (1469598103934665603ULL ^ 'a') * 1099511628211ULL);
+  EXPECT_EQ(Fnv1a64("a"), 0x44bd8ad473cd9906ULL);
+  EXPECT_EQ(UnitInterval(0), 0.0);
+  EXPECT_EQ(UnitInterval(~0ULL), 1.0 - 0x1.0p-53);
 }
 
 // FIPS 180-4 example vectors.

@@ -2,19 +2,13 @@
 
 #include <stdexcept>
 
-namespace orbed::hmd {
+#include "base/hash.h"
 
-std::uint64_t SplitMix64(std::uint64_t x) {
-  x += 0x9e3779b97f4a7c15ULL;
-  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
-  return x ^ (x >> 31);
-}
+namespace orbed::hmd {
 
 std::uint64_t TrialSeed(std::uint64_t seed, const std::string& session_id, std::int32_t index,
                         std::uint64_t purpose) {
-  std::uint64_t h = 1469598103934665603ULL;  // FNV-1a offset basis
-  for (unsigned char c : session_id) h = (h ^ c) * 1099511628211ULL;
+  const std::uint64_t h = Fnv1a64(session_id);
   return SplitMix64(SplitMix64(SplitMix64(seed ^ h) ^ static_cast<std::uint64_t>(index)) ^ purpose);
 }
 

@@ -35,11 +35,9 @@ namespace orbed::hmd {
 inline constexpr std::uint64_t kSlamSeedPurpose = 1;
 inline constexpr std::uint64_t kTrialSeedPurpose = 2;
 
-/// Sebastiano Vigna's SplitMix64 finaliser: a bijective mix of the 64 bits of x.
-std::uint64_t SplitMix64(std::uint64_t x);
-
 /// The seed for one purpose of trial `index` of `session_id` in a process seeded with `seed`:
-/// SplitMix64 over the seed, the 64-bit FNV-1a hash of the session id, the index and the purpose.
+/// SplitMix64 over the seed, the FNV-1a hash of the session id, the index and the purpose
+/// (base/hash.h).
 std::uint64_t TrialSeed(std::uint64_t seed, const std::string& session_id, std::int32_t index,
                         std::uint64_t purpose);
 
