@@ -225,10 +225,16 @@ void HmdProcess::OnSessionControl(const orbed::session_control_t& msg, const std
       SaveState();
       ORBED_LOG(kInfo) << decision.event;
       return;
+    case SessionDecision::Kind::kRepeatedRequest:
+      // A retried or duplicated request: the same answer again (a trial is never made twice).
+      if (decision.answer) process_->Publish(options_.trial_channel, *decision.answer);
+      return;
     case SessionDecision::Kind::kRequestedTrial:
       if (options_.interactive) {
         const HmdSessionState& s = session_.state();
-        ORBED_LOG(kInfo) << interactive_->TrialRequested(s.id, s.next_index, MonotonicSeconds());
+        if (!decision.already_requested) {
+          ORBED_LOG(kInfo) << interactive_->TrialRequested(s.id, s.next_index, MonotonicSeconds());
+        }
         return;
       }
       return EmulateTrial(channel);
@@ -276,10 +282,12 @@ void HmdProcess::PublishTrial(const Eigen::Isometry3d& X_WV, double duration_s, 
   msg.X_WV = ToPose(X_WV);
   msg.duration_s = duration_s;
   msg.user_id = user_id;
+  msg.request_id = session_.state().requested_id;
   process_->Publish(options_.trial_channel, msg);
   // Saved after it went out: a crash in between repeats this index (the same trial), never skips it.
   saved_.last_trial = msg;
   SaveState();
+  session_.RecordTrial(msg);
 }
 
 void HmdProcess::OnTrial(const orbed::alignment_trial_t& msg, const std::string& channel) {

@@ -34,7 +34,10 @@
 /// once, in emulated time, at the latest q against the latest X_WR from the start offset, seeded
 /// from (--seed, session, index); then ALIGNMENT_TRIAL {session, index (per session from 0), mode,
 /// num_mirrors, q, X_WV, duration_s = the emulated alignment time, user_id "emulated-seed-<user
-/// seed>"}. In interactive mode REQUEST_TRIAL only tells the person.
+/// seed>", request_id = the REQUEST_TRIAL's}. In interactive mode REQUEST_TRIAL only tells the
+/// person, and the trial submitted next answers it. A repeated request id (a retry, a duplicated
+/// datagram) is answered by publishing the same ALIGNMENT_TRIAL again, byte for byte; a repeated
+/// START / RESET / STOP changes nothing (hmd_session.h).
 ///
 /// Crash recovery (options.state_file, session_file.h): the session and its last trial are saved on
 /// every change (a trial after it is published), and a headset started on the file continues the

@@ -196,6 +196,52 @@ TEST(HmdProcess, AnswersEachRequestTrialWithOneAlignmentTrial) {
   EXPECT_TRUE(hmd.CurrentX_WV().isApprox(FromPose(got.trials.back().X_WV)));
 }
 
+// Retries and duplicated datagrams: a REQUEST_TRIAL whose request id was answered is answered with
+// the very same ALIGNMENT_TRIAL (never a second, different trial), and a repeated START (of the
+// active session, or late, of the previous one) changes nothing.
+TEST(HmdProcess, ARepeatedRequestIdGetsTheSameTrialAgain) {
+  HmdProcess hmd(MemqFlags(0.5), Inline());
+  Collector got;
+  lcm::LCM& lcm = hmd.process().lcm();
+  got.Attach(lcm);
+  const orbed::iiwa_status_t status = Status(kQDeg);
+  const orbed::robot_state_t state = State(SceneX_WR());
+  auto start = Control("s1", +SC::START, +AT::MODE_AR_REFLECTIVE, 1);
+  start.request_id = 101;
+  auto request = Control("s1", +SC::REQUEST_TRIAL);
+  request.request_id = 102;
+  auto next = Control("s1", +SC::REQUEST_TRIAL);
+  next.request_id = 103;
+  auto other = Control("s2", +SC::START, +AT::MODE_AR, 0);
+  other.request_id = 104;
+  lcm.publish("IIWA_STATUS", &status);
+  lcm.publish("ROBOT_STATE", &state);
+  lcm.publish("SESSION_CONTROL", &start);
+  lcm.publish("SESSION_CONTROL", &request);
+  lcm.publish("SESSION_CONTROL", &start);    // a retry's START: no reset
+  lcm.publish("SESSION_CONTROL", &request);  // the retried request: the same trial again
+  lcm.publish("SESSION_CONTROL", &next);
+  lcm.publish("SESSION_CONTROL", &request);  // a late duplicate: still the first trial
+  lcm.publish("SESSION_CONTROL", &other);
+  lcm.publish("SESSION_CONTROL", &start);  // late, after another session started: ignored
+  EXPECT_EQ(hmd.Run(), 0);
+
+  ASSERT_EQ(got.trials.size(), 4u);
+  auto bytes = [](const orbed::alignment_trial_t& t) {
+    std::vector<uint8_t> out(t.getEncodedSize());
+    t.encode(out.data(), 0, static_cast<int>(out.size()));
+    return out;
+  };
+  EXPECT_EQ(got.trials[0].request_id, 102);
+  EXPECT_EQ(got.trials[0].trial_index, 0);
+  EXPECT_EQ(bytes(got.trials[1]), bytes(got.trials[0]));
+  EXPECT_EQ(got.trials[2].request_id, 103);
+  EXPECT_EQ(got.trials[2].trial_index, 1);
+  EXPECT_EQ(bytes(got.trials[3]), bytes(got.trials[0]));
+  EXPECT_EQ(hmd.active_session(), "s2");
+  EXPECT_EQ(hmd.process().rejections().total(), 0);
+}
+
 TEST(HmdProcess, SameSeedSameSessionGivesTheSameTrial) {
   std::vector<orbed::alignment_trial_t> runs;
   for (int k = 0; k < 2; ++k) {

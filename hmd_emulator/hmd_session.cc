@@ -43,6 +43,35 @@ SessionDecision HmdSession::Handle(const orbed::session_control_t& msg, RobotKno
 }
 
 SessionDecision HmdSession::Apply(const SessionCommand& command, RobotKnown robot) {
+  if (const auto* answer = answers_.Find(command.request_id)) {
+    SessionDecision d = Decide(Kind::kRepeatedRequest);
+    d.answer = *answer;
+    return d;
+  }
+  SessionDecision d = Transition(command, robot);
+  switch (d.kind) {
+    case Kind::kStart:
+    case Kind::kRepeatedStart:
+    case Kind::kReset:
+    case Kind::kStop:
+      answers_.Remember(command.request_id, std::nullopt);
+      break;
+    case Kind::kRequestedTrial:
+      d.already_requested = command.request_id != 0 && command.request_id == state_.requested_id;
+      state_.requested_id = command.request_id;
+      break;
+    default:
+      break;
+  }
+  return d;
+}
+
+void HmdSession::RecordTrial(const orbed::alignment_trial_t& trial) {
+  answers_.Remember(trial.request_id, trial);
+  if (trial.request_id == state_.requested_id) state_.requested_id = 0;
+}
+
+SessionDecision HmdSession::Transition(const SessionCommand& command, RobotKnown robot) {
   using K = SessionCommand::Kind;
   if (command.kind == K::kStart) {
     if (command.num_mirrors > options_.displays_placed) {

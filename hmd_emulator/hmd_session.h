@@ -17,19 +17,30 @@
 /// a repeated START of the active session with the same mode and mirrors is a no-op (e.g. the
 /// headset's own local START, echoed back); RESET sets the index to 0; STOP closes the session;
 /// COMPUTE is for the registration server (ignored); REQUEST_TRIAL accepted means "run trial
-/// next_index now", and the caller takes the index with TakeTrialIndex() when it publishes. An
-/// ALIGNMENT_TRIAL of the active session (same mode and mirrors) with an index at or beyond
-/// next_index, published by someone else (a resumed conductor re-sending the trials it kept), moves
-/// next_index past it (ObserveTrial), so the next trial gets the next index.
+/// next_index now" for request state().requested_id, and the caller takes the index with
+/// TakeTrialIndex() and hands the published trial to RecordTrial(). An ALIGNMENT_TRIAL of the
+/// active session (same mode and mirrors) with an index at or beyond next_index, published by
+/// someone else (a resumed conductor re-sending the trials it kept), moves next_index past it
+/// (ObserveTrial), so the next trial gets the next index.
+///
+/// Repeats (procs/common/recent_answers.h): a command whose nonzero request_id was acted on is a
+/// kRepeatedRequest and changes nothing: for a REQUEST_TRIAL its answer is the very ALIGNMENT_TRIAL
+/// published for it (the caller publishes it again: a retried request never makes a second,
+/// different trial); for START / RESET / STOP there is nothing to answer. A REQUEST_TRIAL whose id
+/// is the one still being worked on (a person aligning) is kRequestedTrial with already_requested.
+/// Refused commands are not remembered, so their retries are judged afresh. A headset restored from
+/// its state file remembers the saved START and last trial the same way (session_file.h).
 ///
 /// Threading: not synchronised; one thread (the Process::Run() thread).
 
 #include <cstdint>
+#include <optional>
 #include <string>
 
 #include <orbed/alignment_trial_t.hpp>
 #include <orbed/session_control_t.hpp>
 
+#include "procs/common/recent_answers.h"
 #include "procs/common/session_control.h"
 
 namespace orbed::hmd {
@@ -44,6 +55,8 @@ struct HmdSessionState {
   std::int32_t num_mirrors{0};
   std::int8_t method{0};  ///< registration_t::METHOD_*
   std::int32_t next_index{0};
+  /// The request_id of the REQUEST_TRIAL being answered (0: none, or it had no id).
+  std::int64_t requested_id{0};
 
   bool active() const { return !id.empty(); }
   /// "session 's' (ar_reflective, 1 display(s))".
@@ -58,17 +71,22 @@ struct RobotKnown {
 
 struct SessionDecision {
   enum class Kind {
-    kRefuse,          ///< refusal.key / refusal.reason; nothing changed
-    kStart,           ///< a new session is active (the previous one's hologram poses are stale)
-    kRepeatedStart,   ///< the active session again: nothing changed
-    kReset,           ///< the trial index is back at 0
-    kStop,            ///< the session closed
-    kIgnore,          ///< COMPUTE: not for the headset
-    kRequestedTrial,  ///< run (or ask the person for) trial state().next_index now
+    kRefuse,           ///< refusal.key / refusal.reason; nothing changed
+    kStart,            ///< a new session is active (the previous one's hologram poses are stale)
+    kRepeatedStart,    ///< the active session again: nothing changed
+    kReset,            ///< the trial index is back at 0
+    kStop,             ///< the session closed
+    kIgnore,           ///< COMPUTE: not for the headset
+    kRequestedTrial,   ///< run (or ask the person for) trial state().next_index now
+    kRepeatedRequest,  ///< a request id acted on before: publish `answer` again, if any
   };
   Kind kind{Kind::kIgnore};
   Refusal refusal;    ///< kRefuse only
   std::string event;  ///< kStart, kStop: one line for the log
+  /// kRepeatedRequest: the ALIGNMENT_TRIAL that answered the request (REQUEST_TRIAL), else none.
+  std::optional<orbed::alignment_trial_t> answer;
+  /// kRequestedTrial: this request id is the one already being worked on (do not ask twice).
+  bool already_requested{false};
 };
 
 struct HmdSessionOptions {
@@ -97,12 +115,20 @@ class HmdSession {
   /// next_index past it when it is one of the active session's at or beyond next_index. Returns
   /// whether it did.
   bool ObserveTrial(const orbed::alignment_trial_t& msg);
+  /// Remembers the published `trial` as the answer to its request_id (the pending request is then
+  /// answered); a trial without a request id is not remembered.
+  void RecordTrial(const orbed::alignment_trial_t& trial);
 
   const HmdSessionState& state() const { return state_; }
 
  private:
+  // The command's effect on the session (Apply() without the repeats).
+  SessionDecision Transition(const SessionCommand& command, RobotKnown robot);
+
   HmdSessionOptions options_;
   HmdSessionState state_;
+  // What each request id acted on was answered with (a trial for REQUEST_TRIAL, else nothing).
+  RecentAnswers<std::optional<orbed::alignment_trial_t>> answers_;
 };
 
 }  // namespace orbed::hmd

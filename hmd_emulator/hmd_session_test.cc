@@ -1,6 +1,6 @@
 // The headset's session state machine on its own: every command path, the refusals with their keys
-// (the common validator's and the headset's own), repeated START as a no-op, and commands for a
-// session that is not the active one.
+// (the common validator's and the headset's own), repeated START as a no-op, commands for a
+// session that is not the active one, and repeated request ids answered with their first answer.
 #include "hmd_emulator/hmd_session.h"
 
 #include <string>
@@ -196,6 +196,49 @@ TEST(HmdSession, ApplyTakesACheckedCommand) {
   SessionCommand request = start;
   request.kind = SessionCommand::Kind::kRequestTrial;
   EXPECT_EQ(session.Apply(request, kRobot).kind, Kind::kRequestedTrial);
+}
+
+orbed::session_control_t WithId(orbed::session_control_t msg, int64_t request_id) {
+  msg.request_id = request_id;
+  return msg;
+}
+
+TEST(HmdSession, ARepeatedRequestIdGetsItsFirstAnswerAndChangesNothing) {
+  HmdSession session = TwoDisplays();
+  EXPECT_EQ(session.Handle(WithId(Control("s", +SC::START), 1), kRobot).kind, Kind::kStart);
+  // Refused (no robot yet): not remembered, so the retry is judged afresh and accepted.
+  const auto request = WithId(Control("s", +SC::REQUEST_TRIAL), 2);
+  EXPECT_EQ(session.Handle(request, kNoRobot).kind, Kind::kRefuse);
+  SessionDecision d = session.Handle(request, kRobot);
+  EXPECT_EQ(d.kind, Kind::kRequestedTrial);
+  EXPECT_FALSE(d.already_requested);
+  EXPECT_EQ(session.state().requested_id, 2);
+  // Asked again before the trial is out (a person still aligning): the same request.
+  d = session.Handle(request, kRobot);
+  EXPECT_EQ(d.kind, Kind::kRequestedTrial);
+  EXPECT_TRUE(d.already_requested);
+  orbed::alignment_trial_t trial{};
+  trial.session_id = "s";
+  trial.trial_index = session.TakeTrialIndex();
+  trial.request_id = 2;
+  session.RecordTrial(trial);
+  EXPECT_EQ(session.state().requested_id, 0);
+  // Answered: repeats get the trial back; the index does not move.
+  d = session.Handle(request, kRobot);
+  EXPECT_EQ(d.kind, Kind::kRepeatedRequest);
+  ASSERT_TRUE(d.answer.has_value());
+  EXPECT_EQ(d.answer->request_id, 2);
+  EXPECT_EQ(d.answer->trial_index, 0);
+  EXPECT_EQ(session.state().next_index, 1);
+  // START's id repeated after another START: nothing to answer, nothing changes.
+  EXPECT_EQ(session.Handle(WithId(Control("t", +SC::START), 3), kRobot).kind, Kind::kStart);
+  d = session.Handle(WithId(Control("s", +SC::START), 1), kRobot);
+  EXPECT_EQ(d.kind, Kind::kRepeatedRequest);
+  EXPECT_FALSE(d.answer.has_value());
+  EXPECT_EQ(session.state().id, "t");
+  // Id 0 is no id: acted on every time.
+  EXPECT_EQ(session.Handle(Control("t", +SC::REQUEST_TRIAL), kRobot).kind, Kind::kRequestedTrial);
+  EXPECT_EQ(session.Handle(Control("t", +SC::REQUEST_TRIAL), kRobot).kind, Kind::kRequestedTrial);
 }
 
 TEST(HmdSession, DisplayModeNames) {

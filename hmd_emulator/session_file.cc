@@ -50,6 +50,7 @@ SavedSession RestoreSession(const std::string& path, HmdSession* session) {
       throw fail("trial " + std::to_string(trial.trial_index) + " of '" + trial.session_id +
                  "' is not one of " + session->state().Describe());
     }
+    session->RecordTrial(trial);  // a retry of its request gets this trial again, not a new one
     saved.last_trial = trial;
   }
   return saved;

@@ -8,10 +8,12 @@
 /// rename): no records when no session is active; otherwise "SESSION_CONTROL", the START that
 /// opened the session, and, once the session has a trial, "ALIGNMENT_TRIAL", its last trial (as
 /// the headset published it, or as it observed it on the bus). RestoreSession replays the records
-/// through the session machine's own entry points (HmdSession::Handle, ObserveTrial) after checking
-/// them like input from the bus (DecodeBounded, orbed::CheckAlignmentTrial); a file that is
-/// damaged, or whose records the machine refuses, is refused with the reason and the headset does
-/// not start (it would run trials with the wrong index).
+/// through the session machine's own entry points (HmdSession::Handle, ObserveTrial, RecordTrial)
+/// after checking them like input from the bus (DecodeBounded, orbed::CheckAlignmentTrial); a file
+/// that is damaged, or whose records the machine refuses, is refused with the reason and the headset
+/// does not start (it would run trials with the wrong index). The START's and the trial's request
+/// ids are remembered as before the crash: a retried REQUEST_TRIAL of the saved trial gets that
+/// trial again, never a new one.
 ///
 /// Threading: plain functions.
 

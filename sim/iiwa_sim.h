@@ -15,7 +15,9 @@
 ///               closer than report_distance_m, per-link clearance, the duration of the query that
 ///               produced it — made when the arm last moved; the scene is static);
 ///               PLAN_CHECK_REPLY (plan_check_reply_t) answering each request, echoing request_id —
-///               an invalid request gets request_valid = false and a reason, never silence;
+///               an invalid request gets request_valid = false and a reason, never silence; the
+///               answer is a pure function of the request's q and the static scene, so a repeated
+///               request (a client's retry) gets the same answer (only its utime differs);
 ///               PROCESS_STATUS at 1 Hz (Process), with rejections counted per class.
 ///
 /// IIWA_STATUS fields: joint_position_measured = q after this tick's step; joint_velocity_estimated

@@ -36,6 +36,7 @@ struct Collector {
   std::vector<orbed::robot_state_t> state;
   std::vector<orbed::collision_status_t> collision;
   std::map<int64_t, orbed::plan_check_reply_t> replies;
+  std::vector<orbed::plan_check_reply_t> every_reply;
   void OnStatus(const lcm::ReceiveBuffer*, const std::string&, const orbed::iiwa_status_t* m) {
     status.push_back(*m);
   }
@@ -47,6 +48,7 @@ struct Collector {
   }
   void OnReply(const lcm::ReceiveBuffer*, const std::string&, const orbed::plan_check_reply_t* m) {
     replies[m->request_id] = *m;
+    every_reply.push_back(*m);
   }
   void Attach(lcm::LCM& lcm) {
     lcm.subscribe("IIWA_STATUS", &Collector::OnStatus, this);
@@ -190,6 +192,26 @@ TEST(IiwaSim, AnswersPlanChecksIncludingInvalidOnes) {
   }
   EXPECT_EQ(sim.process().rejections().counts().at("PLAN_CHECK_REQUEST/num_joints"), 1);
   EXPECT_EQ(sim.process().rejections().counts().at("PLAN_CHECK_REQUEST/non_finite"), 1);
+}
+
+// A retried request (the same message again) gets the same answer: the check is a pure function of
+// q and the static scene. Only the reply's utime (when it was computed) differs.
+TEST(IiwaSim, AnswersARepeatedPlanCheckTheSame) {
+  IiwaSim sim(MemqFlags(0.1), IiwaSimOptions{});
+  Collector got;
+  got.Attach(sim.process().lcm());
+  const orbed::plan_check_request_t request = Request(21, {0, 110, 0, 0, 0, 0, 0});
+  for (int i = 0; i < 3; ++i) sim.process().lcm().publish("PLAN_CHECK_REQUEST", &request);
+  sim.Run();
+  ASSERT_EQ(got.every_reply.size(), 3u);
+  for (orbed::plan_check_reply_t reply : got.every_reply) {
+    reply.utime = got.every_reply[0].utime;
+    std::vector<uint8_t> bytes(reply.getEncodedSize()), first(got.every_reply[0].getEncodedSize());
+    reply.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+    got.every_reply[0].encode(first.data(), 0, static_cast<int>(first.size()));
+    EXPECT_EQ(bytes, first);
+  }
+  EXPECT_EQ(sim.process().rejections().total(), 0);
 }
 
 // Joint 7 commanded to 200 deg (limit 175) and joint 1 to -30 deg, at P = 5 ms. Worked out by hand

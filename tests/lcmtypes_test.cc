@@ -1,9 +1,13 @@
 // The message contract: orbed's iiwa types are wire-compatible with Drake's (same LCM
-// fingerprint, and bytes written by one decode as the other), and every type round-trips.
+// fingerprint, and bytes written by one decode as the other), every type round-trips, and every
+// type's fingerprint is pinned, so that no change of the contract passes unnoticed.
 #include <gtest/gtest.h>
+#include <cstdio>
 #include <drake/lcmt_iiwa_command.hpp>
 #include <drake/lcmt_iiwa_status.hpp>
+#include <map>
 #include <orbed/all_types.hpp>
+#include <string>
 
 namespace {
 
@@ -70,6 +74,53 @@ TEST(LcmTypes, EveryTypeRoundTripsAndHasAUniqueFingerprint) {
   ORBED_FOR_EACH_LCM_TYPE(ORBED_CHECK)
 #undef ORBED_CHECK
   EXPECT_GE(count, 20);
+}
+
+// LCM's fingerprint covers every field's name, type and order, and a receiver refuses bytes with
+// another fingerprint ("<channel>/decode/fingerprint"): any change of a type is a breaking change
+// on the wire. docs/design.md §3 "Changing the contract" says how one is made: fields appended at the
+// end, the change listed there with the old and new fingerprints, and this table updated in the same
+// commit. Last change: contract change 1 (request_id appended to session_control_t,
+// alignment_trial_t and registration_t).
+TEST(LcmTypes, FingerprintsArePinned) {
+  const std::map<std::string, uint64_t> pinned = {{"alignment_trial_t", 0x6a16657f0082f985ULL},
+                                                  {"collision_status_t", 0x9f78934234cce93fULL},
+                                                  {"contact_t", 0x2d8c8a472f48e7e9ULL},
+                                                  {"gaze_ray_t", 0x65a37e31d5a2eea1ULL},
+                                                  {"guidance_t", 0x00fc655bb50b4853ULL},
+                                                  {"hmd_pose_t", 0xdafcd85796f0e809ULL},
+                                                  {"iiwa_command_t", 0xddc7c7738c815334ULL},
+                                                  {"iiwa_status_t", 0xf16fb804284abca3ULL},
+                                                  {"image_t", 0xc1d60fc65b87f013ULL},
+                                                  {"landmark_request_t", 0x3188225146589311ULL},
+                                                  {"landmark_t", 0xf3c71cad48c8b4fdULL},
+                                                  {"logger_status_t", 0xfd805aae7883ea7bULL},
+                                                  {"misalignment_request_t", 0x9814e62c0e8405c3ULL},
+                                                  {"misalignment_t", 0x62c181d75e5aaae9ULL},
+                                                  {"plan_check_reply_t", 0x08220670e46ad680ULL},
+                                                  {"plan_check_request_t", 0xf954868fc0afdd74ULL},
+                                                  {"pose_t", 0xcefe2d89aeb7c79fULL},
+                                                  {"process_status_t", 0x55fb0b02b4934d06ULL},
+                                                  {"reflective_view_t", 0xba9d743e2da58034ULL},
+                                                  {"registration_t", 0xa59c0b3d053d0d83ULL},
+                                                  {"robot_state_t", 0x3af0ecdeab2a6837ULL},
+                                                  {"session_control_t", 0xcdbe036ad16d76feULL}};
+  std::map<std::string, uint64_t> actual;
+#define ORBED_HASH(type) actual[#type] = static_cast<uint64_t>(orbed::type::getHash());
+  ORBED_FOR_EACH_LCM_TYPE(ORBED_HASH)
+#undef ORBED_HASH
+  auto hex = [](uint64_t v) {
+    char text[32];
+    std::snprintf(text, sizeof(text), "0x%016llx", static_cast<unsigned long long>(v));
+    return std::string(text);
+  };
+  EXPECT_EQ(actual.size(), pinned.size()) << "a type was added or removed: pin it (docs/design.md §3)";
+  for (const auto& [type, hash] : actual) {
+    const auto it = pinned.find(type);
+    ASSERT_NE(it, pinned.end()) << type << " is not pinned (its fingerprint is " << hex(hash) << ")";
+    EXPECT_EQ(hex(hash), hex(it->second))
+        << type << " changed: follow docs/design.md §3, Changing the contract";
+  }
 }
 
 }  // namespace

@@ -1,7 +1,12 @@
 // Unit tests of the process scaffold on memq:// (in-process LCM): conversions, validators,
-// typed subscriptions, rejection counting and the heartbeat.
+// typed subscriptions, rejection counting, the heartbeat, the fault injection's place in the
+// receive path, and the remembered answers of idempotent receivers.
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
+#include <optional>
+#include <sstream>
 #include <thread>
 
 #include <gtest/gtest.h>
@@ -11,6 +16,7 @@
 #include "procs/common/conversions.h"
 #include "procs/common/flags.h"
 #include "procs/common/process.h"
+#include "procs/common/recent_answers.h"
 #include "procs/common/validation.h"
 
 namespace orbed {
@@ -264,6 +270,95 @@ TEST(Process, ExceptionsInTimersAndHandlersAreCountedNotFatal) {
   EXPECT_EQ(ticks, 3);  // it kept ticking after the first exception
   EXPECT_EQ(process.rejections().counts().at("IIWA_COMMAND/handler"), 1);
   EXPECT_EQ(process.rejections().counts().at("timer/1"), 3);  // timer 0 is the heartbeat
+}
+
+TEST(Flags, ChaosComesFromTheEnvironmentAndIsChecked) {
+  ASSERT_EQ(setenv("ORBED_CHAOS", "drop=0.25,channels=X", 1), 0);
+  CommonFlags from_env("orbed-test");
+  unsetenv("ORBED_CHAOS");
+  EXPECT_EQ(from_env.chaos, "drop=0.25,channels=X");
+  EXPECT_EQ(CommonFlags("orbed-test").chaos, "");
+  CLI::App app{"test"};
+  CommonFlags flags("orbed-test");
+  AddCommonFlags(&app, &flags);
+  const char* argv[] = {"x", "--chaos", "drop=2"};
+  std::ostringstream out, err;
+  EXPECT_NE(ParseCommandLine(&app, flags, 3, argv, out, err), std::nullopt);
+  EXPECT_NE(err.str().find("--chaos"), std::string::npos) << err.str();
+  EXPECT_NE(err.str().find("chaos spec drop: expected one number in [0, 1], got '2'"), std::string::npos)
+      << err.str();
+}
+
+// The fault injection sits before decoding, on the channels it names only: every IIWA_COMMAND is
+// delayed (up to 50 ms, delivered from the Run() loop) and duplicated; PROCESS_STATUS is untouched.
+TEST(Process, ChaosDuplicatesAndDelaysTheNamedChannelsOnly) {
+  CommonFlags flags("orbed-test");
+  flags.lcm_url = "memq://";
+  flags.duration_s = 1.3;
+  flags.chaos = "dup=1,delay_ms=50,channels=IIWA_COMMAND";
+  Process process(flags);
+  ASSERT_NE(process.chaos(), nullptr);
+  std::vector<int64_t> received;
+  int heartbeats = 0;
+  process.Subscribe<iiwa_command_t>(channels::kIiwaCommand, [&](const iiwa_command_t& msg, const std::string&,
+                                                                int64_t) { received.push_back(msg.utime); });
+  process.Subscribe<process_status_t>(
+      channels::kProcessStatus, [&](const process_status_t&, const std::string&, int64_t) { ++heartbeats; });
+  for (int64_t utime : {1, 2, 3}) {
+    iiwa_command_t command{};
+    command.utime = utime;
+    process.lcm().publish(channels::kIiwaCommand, &command);
+  }
+  EXPECT_EQ(process.Run(), 0);
+  std::vector<int64_t> sorted = received;
+  std::sort(sorted.begin(), sorted.end());
+  EXPECT_EQ(sorted, (std::vector<int64_t>{1, 1, 2, 2, 3, 3}));
+  EXPECT_EQ(process.chaos()->counts().datagrams, 3);
+  EXPECT_EQ(process.chaos()->counts().duplicated, 3);
+  EXPECT_EQ(process.chaos()->counts().delayed, 3);
+  EXPECT_EQ(process.chaos()->counts().dropped, 0);
+  EXPECT_GE(heartbeats, 1);  // at start and (unless the machine is very busy) at 1 s: never twice
+  EXPECT_LE(heartbeats, 2);
+  EXPECT_EQ(process.rejections().total(), 0);  // injected faults are not rejections
+}
+
+TEST(Process, ChaosDropsBeforeDecodingAndWithoutASpecThereIsNone) {
+  CommonFlags flags("orbed-test");
+  flags.lcm_url = "memq://";
+  flags.duration_s = 0.2;
+  flags.chaos = "drop=1,channels=IIWA_.*";
+  Process process(flags);
+  int received = 0;
+  process.Subscribe<iiwa_command_t>(channels::kIiwaCommand,
+                                    [&](const iiwa_command_t&, const std::string&, int64_t) { ++received; });
+  const uint8_t garbage[3] = {1, 2, 3};
+  process.lcm().publish(channels::kIiwaCommand, garbage, sizeof(garbage));  // dropped, so never refused
+  iiwa_command_t command{};
+  process.lcm().publish(channels::kIiwaCommand, &command);
+  EXPECT_EQ(process.Run(), 0);
+  EXPECT_EQ(received, 0);
+  EXPECT_EQ(process.chaos()->counts().dropped, 2);
+  EXPECT_EQ(process.rejections().total(), 0);
+  flags.chaos = "";
+  EXPECT_EQ(Process(flags).chaos(), nullptr);
+  flags.chaos = "drop=0,channels=.*";
+  EXPECT_EQ(Process(flags).chaos(), nullptr);
+}
+
+TEST(RecentAnswers, RepeatsTheFirstAnswerAndForgetsTheOldest) {
+  RecentAnswers<std::string> answers(2);
+  EXPECT_EQ(answers.Find(7), nullptr);
+  answers.Remember(7, "seven");
+  answers.Remember(0, "no id");  // id 0 is never remembered
+  EXPECT_EQ(answers.Find(0), nullptr);
+  ASSERT_NE(answers.Find(7), nullptr);
+  EXPECT_EQ(*answers.Find(7), "seven");
+  answers.Remember(8, "eight");
+  answers.Remember(9, "nine");
+  EXPECT_EQ(answers.Find(7), nullptr);  // beyond the capacity
+  EXPECT_EQ(*answers.Find(8), "eight");
+  EXPECT_EQ(*answers.Find(9), "nine");
+  EXPECT_EQ(answers.size(), 2u);
 }
 
 TEST(Process, MalformedChannelRegexIsAnErrorNotACrash) {

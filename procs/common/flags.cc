@@ -3,17 +3,26 @@
 #include <cstdlib>
 #include <regex>
 
+#include "procs/common/chaos.h"
 #include "procs/common/log.h"
 
 namespace orbed {
 
+namespace {
+
+std::string Environment(const char* name) {
+  const char* value = std::getenv(name);
+  return value != nullptr ? value : "";
+}
+
+}  // namespace
+
 CommonFlags::CommonFlags(std::string default_name)
-    : lcm_url(DefaultLcmUrl()), name(std::move(default_name)) {}
+    : lcm_url(DefaultLcmUrl()), name(std::move(default_name)), chaos(Environment("ORBED_CHAOS")) {}
 
 std::string DefaultLcmUrl() {
-  const char* env = std::getenv("ORBED_LCM_URL");
-  if (env != nullptr && env[0] != '\0') return env;
-  return kDefaultLcmUrl;
+  const std::string env = Environment("ORBED_LCM_URL");
+  return env.empty() ? kDefaultLcmUrl : env;
 }
 
 std::string WithRecvBufSize(const std::string& url, int64_t bytes) {
@@ -41,12 +50,20 @@ void AddCommonFlags(CLI::App* app, CommonFlags* flags) {
   app->add_option("--log-level", flags->log_level, "debug | info | warn | error")
       ->check(CLI::IsMember({"debug", "info", "warn", "error"}))
       ->capture_default_str();
+  app->add_option("--chaos", flags->chaos,
+                  "Fault injection on received datagrams, e.g. drop=0.1,dup=0.05,delay_ms=30,reorder=0.05,"
+                  "seed=1,channels=REGEX (default: $ORBED_CHAOS; none when empty)");
 }
 
 void ApplyCommonFlags(const CommonFlags& flags) {
   LogLevel level;
   if (!ParseLogLevel(flags.log_level, &level)) {
     throw CLI::ValidationError("--log-level", "expected debug, info, warn or error");
+  }
+  try {
+    ParseChaosSpec(flags.chaos);
+  } catch (const std::invalid_argument& e) {
+    throw CLI::ValidationError("--chaos", e.what());
   }
   SetLogName(flags.name);
   SetLogLevel(level);

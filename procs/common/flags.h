@@ -6,6 +6,7 @@
 ///   --seed N           seed of every random generator in the process
 ///   --duration-s S   stop cleanly after S seconds (0 = run until SIGINT/SIGTERM)
 ///   --log-level L      debug | info | warn | error
+///   --chaos SPEC       fault injection on received datagrams (default: $ORBED_CHAOS; chaos.h)
 /// Usage in a thin main:
 ///   CLI::App app{"what it does"};
 ///   orbed::CommonFlags common("orbed-foo");
@@ -33,6 +34,8 @@ struct CommonFlags {
   uint64_t seed = 1;
   double duration_s = 0.0;
   std::string log_level = "info";
+  /// Fault injection spec (procs/common/chaos.h); "" = none.
+  std::string chaos;
 };
 
 /// The URL a process uses when --lcm-url is not given.
@@ -45,7 +48,7 @@ std::string WithRecvBufSize(const std::string& url, int64_t bytes);
 
 void AddCommonFlags(CLI::App* app, CommonFlags* flags);
 
-/// Sets the log name and level; throws CLI::ValidationError on a bad level.
+/// Sets the log name and level; throws CLI::ValidationError on a bad level or chaos spec.
 void ApplyCommonFlags(const CommonFlags& flags);
 
 /// The start of every command line's Run…(): parses `argv` into `app` (AddCommonFlags called on

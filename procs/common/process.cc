@@ -3,6 +3,7 @@
 #include <poll.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <csignal>
 #include <regex>
 #include <stdexcept>
@@ -68,6 +69,11 @@ Process::Process(const CommonFlags& flags)
                              "add one: ip route add 224.0.0.0/4 dev lo)");
   }
   AddTimer(1.0, [this] { PublishStatus(); });
+  const ChaosSpec chaos = ParseChaosSpec(flags.chaos);
+  if (chaos.active()) {
+    chaos_ = std::make_unique<ChaosQueue>(chaos, name_);
+    ORBED_LOG(kWarn) << "chaos: fault injection on received datagrams: " << FormatChaosSpec(chaos);
+  }
 }
 
 Process::~Process() = default;
@@ -79,6 +85,37 @@ void Process::AddTimer(double period_s, std::function<void()> callback) {
   timer.next = std::chrono::steady_clock::now() + timer.period;
   timer.callback = std::move(callback);
   timers_.push_back(std::move(timer));
+}
+
+lcm::Subscription* Process::Add(std::unique_ptr<SubscriptionBase> subscription, const std::string& channel) {
+  subscription->process = this;
+  subscription->index = static_cast<int>(subscriptions_.size());
+  lcm::Subscription* lcm_subscription =
+      lcm_->subscribe(channel, &SubscriptionBase::OnRaw, subscription.get());
+  subscriptions_.push_back(std::move(subscription));
+  return lcm_subscription;
+}
+
+void Process::Receive(SubscriptionBase* subscription, const lcm::ReceiveBuffer* rbuf,
+                      const std::string& channel) {
+  if (!chaos_ || !chaos_->Applies(channel)) {
+    subscription->Deliver(*rbuf, channel);
+    return;
+  }
+  const auto* bytes = static_cast<const uint8_t*>(rbuf->data);
+  chaos_->Receive(
+      {subscription->index, channel, std::vector<uint8_t>(bytes, bytes + rbuf->data_size), rbuf->recv_utime},
+      UptimeSeconds());
+  DeliverDueDatagrams();
+}
+
+void Process::DeliverDueDatagrams() {
+  if (!chaos_) return;
+  for (ChaosQueue::Datagram& datagram : chaos_->TakeDue(UptimeSeconds())) {
+    lcm::ReceiveBuffer rbuf{datagram.data.data(), static_cast<uint32_t>(datagram.data.size()),
+                            datagram.recv_utime};
+    subscriptions_[datagram.target]->Deliver(rbuf, datagram.channel);
+  }
 }
 
 lcm::Subscription* Process::SubscribeRaw(
@@ -93,12 +130,8 @@ lcm::Subscription* Process::SubscribeRaw(
     throw std::invalid_argument("invalid channel regular expression '" + channel_regex + "': " + e.what());
   }
   auto sub = std::make_unique<RawSubscription>();
-  sub->process = this;
   sub->handler = std::move(handler);
-  lcm::Subscription* subscription =
-      lcm_->subscribe(channel_regex, &SubscriptionBase::OnRaw, static_cast<SubscriptionBase*>(sub.get()));
-  subscriptions_.push_back(std::move(sub));
-  return subscription;
+  return Add(std::move(sub), channel_regex);
 }
 
 void Process::SetLastError(const std::string& error) {
@@ -184,8 +217,11 @@ int Process::Run() {
         }
       }
     }
+    DeliverDueDatagrams();
     auto next = std::min(deadline, now + max_wait);
     for (const Timer& timer : timers_) next = std::min(next, timer.next);
+    if (chaos_ && std::isfinite(chaos_->NextDue()))
+      next = std::min(next, start_ + Seconds(chaos_->NextDue()));
     const auto wait_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(next - now).count();
     // Wait on LCM's file descriptor with ppoll (nanosecond timeout) rather than handleTimeout,
     // whose millisecond rounding would make a 1 kHz timer drift late and skip ticks.
@@ -208,6 +244,7 @@ int Process::Run() {
   PublishStatus();  // says STOPPING (or FAILED)
   ORBED_LOG(kInfo) << "stopped: " << messages_in_ << " in, " << messages_out_ << " out, "
                    << rejections_.total() << " rejected";
+  if (chaos_) ORBED_LOG(kInfo) << "chaos: " << FormatChaosCounts(chaos_->counts());
   return failed_ ? 1 : 0;
 }
 

@@ -12,6 +12,13 @@
 ///
 /// Clock: timers and uptime use the monotonic clock; message utimes use the wall clock
 /// (NowMicros()).
+///
+/// Fault injection: with a chaos spec (CommonFlags::chaos, i.e. --chaos or $ORBED_CHAOS;
+/// procs/common/chaos.h) every datagram of a matching channel passes, before decoding, through a
+/// ChaosQueue seeded with the spec and the process name: it may be dropped, duplicated, delayed or
+/// reordered. Delayed and held datagrams are delivered later from the Run() loop, on the same
+/// thread, with their original receive utime. What was done is logged at start and at exit
+/// ("chaos: N datagrams: ... dropped, ..."); it is not a rejection and not counted as one.
 
 #include <atomic>
 #include <chrono>
@@ -25,6 +32,7 @@
 #include <orbed/process_status_t.hpp>
 
 #include "lcmtypes/bounded_decode.h"
+#include "procs/common/chaos.h"
 #include "procs/common/flags.h"
 #include "procs/common/validation.h"
 
@@ -49,10 +57,11 @@ class Process {
   uint64_t seed() const { return seed_; }
   lcm::LCM& lcm() { return *lcm_; }
 
-  /// Subscribes `handler(msg, channel, receive_utime)` to `channel`. Every message is decoded with
-  /// DecodeBounded (lcmtypes/bounded_decode.h: array counts checked against the bytes before LCM's
-  /// decode allocates); one that is not exactly a well-formed Msg is rejected under key
-  /// "<channel>/decode/<why>" (why: truncated, fingerprint, count, string, trailing, ...).
+  /// Subscribes `handler(msg, channel, receive_utime)` to `channel`. Every message (after the fault
+  /// injection, if any) is decoded with DecodeBounded (lcmtypes/bounded_decode.h: array counts
+  /// checked against the bytes before LCM's decode allocates); one that is not exactly a well-formed
+  /// Msg is rejected under key "<channel>/decode/<why>" (why: truncated, fingerprint, count, string,
+  /// trailing, ...).
   template <class Msg>
   void Subscribe(const std::string& channel,
                  std::function<void(const Msg&, const std::string&, int64_t)> handler);
@@ -95,6 +104,11 @@ class Process {
   int64_t messages_out() const { return messages_out_; }
   const RejectionCounter& rejections() const { return rejections_; }
   double UptimeSeconds() const;
+  /// The fault injection's queue, or nullptr when the process runs without one.
+  const ChaosQueue* chaos() const { return chaos_.get(); }
+  /// Delivers the delayed and held datagrams that are due now (the Run() loop does this; public so
+  /// that tests driving LCM by hand can too).
+  void DeliverDueDatagrams();
 
  private:
   struct Timer {
@@ -102,15 +116,25 @@ class Process {
     std::chrono::steady_clock::time_point next;
     std::function<void()> callback;
   };
-  // Raw LCM handler: decodes into the typed handler.
+  // One subscription: LCM calls OnRaw(), which hands the datagram to the process (Receive: the
+  // fault injection, if any); Deliver() decodes into the typed handler, or passes the bytes on.
   struct SubscriptionBase {
     virtual ~SubscriptionBase() = default;
-    virtual void OnRaw(const lcm::ReceiveBuffer* rbuf, const std::string& channel) = 0;
+    void OnRaw(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+      process->Receive(this, rbuf, channel);
+    }
+    virtual void Deliver(const lcm::ReceiveBuffer& rbuf, const std::string& channel) = 0;
+    Process* process{nullptr};
+    int index{0};  // in subscriptions_
   };
   template <class Msg>
   struct TypedSubscription;
   struct RawSubscription;
 
+  // Every datagram from LCM: straight to the subscription, or through the chaos queue.
+  void Receive(SubscriptionBase* subscription, const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  // Registers a subscription (sets its process and index) and subscribes it to LCM.
+  lcm::Subscription* Add(std::unique_ptr<SubscriptionBase> subscription, const std::string& channel);
   void PublishStatus();
 
   std::string name_;
@@ -126,26 +150,26 @@ class Process {
   std::atomic<int64_t> messages_in_{0};
   std::atomic<int64_t> messages_out_{0};
   RejectionCounter rejections_;
+  std::unique_ptr<ChaosQueue> chaos_;  // null without a chaos spec
   mutable std::mutex error_mutex_;
   std::string last_error_;  // guarded by error_mutex_
 };
 
 template <class Msg>
 struct Process::TypedSubscription : Process::SubscriptionBase {
-  Process* process;
   std::function<void(const Msg&, const std::string&, int64_t)> handler;
-  void OnRaw(const lcm::ReceiveBuffer* rbuf, const std::string& channel) override {
+  void Deliver(const lcm::ReceiveBuffer& rbuf, const std::string& channel) override {
     ++process->messages_in_;
     Msg msg;
-    const DecodeResult decoded = DecodeBounded(rbuf->data, rbuf->data_size, &msg);
+    const DecodeResult decoded = DecodeBounded(rbuf.data, rbuf.data_size, &msg);
     if (!decoded.ok()) {
       process->Reject(channel + "/decode/" + wire::KindName(decoded.kind),
-                      "cannot decode " + std::to_string(rbuf->data_size) + " bytes as " + Msg::getTypeName() +
+                      "cannot decode " + std::to_string(rbuf.data_size) + " bytes as " + Msg::getTypeName() +
                           ": " + decoded.error);
       return;
     }
     try {
-      handler(msg, channel, rbuf->recv_utime);
+      handler(msg, channel, rbuf.recv_utime);
     } catch (const std::exception& e) {
       process->Reject(channel + "/handler", std::string("exception: ") + e.what());
     }
@@ -153,12 +177,11 @@ struct Process::TypedSubscription : Process::SubscriptionBase {
 };
 
 struct Process::RawSubscription : Process::SubscriptionBase {
-  Process* process;
   std::function<void(const lcm::ReceiveBuffer&, const std::string&)> handler;
-  void OnRaw(const lcm::ReceiveBuffer* rbuf, const std::string& channel) override {
+  void Deliver(const lcm::ReceiveBuffer& rbuf, const std::string& channel) override {
     ++process->messages_in_;
     try {
-      handler(*rbuf, channel);
+      handler(rbuf, channel);
     } catch (const std::exception& e) {
       process->Reject(channel + "/handler", std::string("exception: ") + e.what());
     }
@@ -169,10 +192,8 @@ template <class Msg>
 void Process::Subscribe(const std::string& channel,
                         std::function<void(const Msg&, const std::string&, int64_t)> handler) {
   auto sub = std::make_unique<TypedSubscription<Msg>>();
-  sub->process = this;
   sub->handler = std::move(handler);
-  lcm_->subscribe(channel, &SubscriptionBase::OnRaw, static_cast<SubscriptionBase*>(sub.get()));
-  subscriptions_.push_back(std::move(sub));
+  Add(std::move(sub), channel);
 }
 
 }  // namespace orbed

@@ -60,6 +60,7 @@ std::variant<SessionCommand, Refusal> CheckSessionControl(const orbed::session_c
   command.display_mode = msg.display_mode;
   command.num_mirrors = msg.num_mirrors;
   command.method = msg.method;
+  command.request_id = msg.request_id;
   if (command.kind != SessionCommand::Kind::kStart) return command;
 
   error = CheckEnum(msg.display_mode, AT::MODE_AR, AT::MODE_AR_REFLECTIVE, "SESSION_CONTROL.display_mode");

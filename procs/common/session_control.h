@@ -17,6 +17,9 @@
 /// Refusal keys are "<field>" (session_id, command, display_mode, num_mirrors, method); processes
 /// count them as "<channel>/<field>" on PROCESS_STATUS.
 ///
+/// request_id is not checked (any value): a reader acts on a nonzero id once and answers a repeat
+/// with its first answer, changing nothing (procs/common/recent_answers.h); 0 is acted on every time.
+///
 /// Threading: pure functions.
 
 #include <cstdint>
@@ -44,6 +47,7 @@ struct SessionCommand {
   int8_t display_mode{0};  ///< alignment_trial_t::MODE_* (START; else as sent)
   int32_t num_mirrors{0};  ///< (START; else as sent)
   int8_t method{0};        ///< registration_t::METHOD_* (START; else as sent)
+  int64_t request_id{0};   ///< the sender's request id; 0 = none
 
   /// True when this START names the active session `session_id` with the same mode and mirrors.
   bool RepeatsStartOf(const std::string& active_session_id, int8_t active_display_mode,

@@ -31,13 +31,16 @@ std::string RefusalKey(const SC& msg) {
 }
 
 TEST(SessionControl, ValidStartBecomesACommandWithItsFields) {
-  const auto checked = CheckSessionControl(Start(AT::MODE_AR_REFLECTIVE, 2));
+  SC msg = Start(AT::MODE_AR_REFLECTIVE, 2);
+  msg.request_id = -77;  // any value: the id is the sender's
+  const auto checked = CheckSessionControl(msg);
   ASSERT_TRUE(std::holds_alternative<SessionCommand>(checked));
   const SessionCommand& command = std::get<SessionCommand>(checked);
   EXPECT_EQ(command.kind, SessionCommand::Kind::kStart);
   EXPECT_EQ(command.utime, 42);
   EXPECT_EQ(command.session_id, "run-ar");
   EXPECT_EQ(command.num_mirrors, 2);
+  EXPECT_EQ(command.request_id, -77);
   EXPECT_TRUE(command.RepeatsStartOf("run-ar", AT::MODE_AR_REFLECTIVE, 2));
   EXPECT_FALSE(command.RepeatsStartOf("run-ar", AT::MODE_AR_REFLECTIVE, 1));
   EXPECT_FALSE(command.RepeatsStartOf("other", AT::MODE_AR_REFLECTIVE, 2));

@@ -6,6 +6,10 @@
 ///   Publishes:  REGISTRATION (registration_t) after every accepted trial, on COMPUTE, and every
 ///               state_period_s as the full state; LANDMARK (landmark_t) and MISALIGNMENT
 ///               (misalignment_t) answering each request; PROCESS_STATUS at 1 Hz (Process).
+/// Every request is answered idempotently: a repeated COMPUTE or a repeat of the latest trial gets
+/// its first REGISTRATION again (registration_service.h), and a repeated LANDMARK_REQUEST or
+/// MISALIGNMENT_REQUEST the same answer, which is a pure function of the request (its utime
+/// included), so a client may retry any request with the same request_id.
 /// Bad inputs are counted per class on PROCESS_STATUS and logged (Process::Reject); the process
 /// keeps serving. Outputs take their utime from inputs (see registration_service.h), so a replayed
 /// log gives the same REGISTRATION bytes.

@@ -113,6 +113,61 @@ TEST(RegistrationServiceTest, ThreeTrialsGiveTheClosedFormMean) {
   EXPECT_EQ(Bytes(*f.service.PeriodicState()).size(), Bytes(*state).size());
 }
 
+// Retries and duplicated datagrams: a command id acted on is answered with its first answer and
+// changes nothing; a trial the session holds is registered once, its repeat answered with its
+// REGISTRATION again (the latest trial) or ignored (an older one). None of it is a rejection.
+TEST(RegistrationServiceTest, RepeatsAreAnsweredAsTheFirstTimeAndChangeNothing) {
+  Fixture f;
+  auto start = Control(orbed::session_control_t::START, "s1", 100);
+  start.request_id = 11;
+  f.service.HandleSessionControl(start);
+  auto trial0 = Trial("s1", 0, 0.1, Eigen::Vector3d(1, 0, 0), 1000);
+  trial0.request_id = 21;
+  auto trial1 = Trial("s1", 1, 0.3, Eigen::Vector3d(3, 0, 0), 1001);
+  trial1.request_id = 22;
+  const auto first = f.service.HandleTrial(trial0);
+  ASSERT_TRUE(first.has_value());
+  EXPECT_EQ(first->request_id, 21);  // echoes the trial's request
+  const auto repeat = f.service.HandleTrial(trial0);
+  ASSERT_TRUE(repeat.has_value());
+  EXPECT_EQ(Bytes(*repeat), Bytes(*first));
+  const auto second = f.service.HandleTrial(trial1);
+  ASSERT_TRUE(second.has_value());
+  EXPECT_EQ(second->num_trials, 2);
+  EXPECT_FALSE(f.service.HandleTrial(trial0).has_value());  // an older trial's late repeat: ignored
+  EXPECT_EQ(Bytes(*f.service.HandleTrial(trial1)), Bytes(*second));
+  EXPECT_EQ(f.service.num_trials(), 2);
+  // A retried START of the session keeps its trials.
+  f.service.HandleSessionControl(start);
+  EXPECT_EQ(f.service.num_trials(), 2);
+  // COMPUTE answered once, its repeat with the same bytes even after the state moved on.
+  auto compute = Control(orbed::session_control_t::COMPUTE, "s1", 5000);
+  compute.request_id = 31;
+  const auto mean = f.service.HandleSessionControl(compute);
+  ASSERT_TRUE(mean.has_value());
+  EXPECT_EQ(mean->request_id, 31);
+  EXPECT_EQ(mean->num_trials, 2);
+  auto trial2 = Trial("s1", 2, 0.2, Eigen::Vector3d(2, 0, 0), 1002);
+  trial2.request_id = 23;
+  ASSERT_TRUE(f.service.HandleTrial(trial2).has_value());
+  EXPECT_EQ(Bytes(*f.service.HandleSessionControl(compute)), Bytes(*mean));
+  // A late START of this session, after another one started, is not a new START.
+  auto other = Control(orbed::session_control_t::START, "s2", 6000);
+  other.request_id = 12;
+  f.service.HandleSessionControl(other);
+  f.service.HandleSessionControl(start);
+  EXPECT_EQ(f.service.session_id(), "s2");
+  // The periodic state answers no request.
+  EXPECT_EQ(f.service.PeriodicState()->request_id, 0);
+  // The same index with other content is not a repeat: refused as before.
+  f.service.HandleSessionControl(Control(orbed::session_control_t::START, "s3", 7000));
+  auto trial = Trial("s3", 0, 0.1, Eigen::Vector3d(1, 0, 0), 7001);
+  ASSERT_TRUE(f.service.HandleTrial(trial).has_value());
+  trial.X_WV.position_m[0] = 1.5;
+  EXPECT_FALSE(f.service.HandleTrial(trial).has_value());
+  EXPECT_EQ(f.rejections, (std::map<std::string, int>{{"ALIGNMENT_TRIAL/trial_index", 1}}));
+}
+
 TEST(RegistrationServiceTest, BadTrialsAndCommandsAreRejectedCountedAndChangeNothing) {
   Fixture f;
   EXPECT_FALSE(f.service.PeriodicState().has_value());

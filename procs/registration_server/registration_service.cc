@@ -13,7 +13,6 @@
 #include "procs/common/validation.h"
 
 namespace orbed::registration {
-namespace {}  // namespace
 
 RegistrationService::RegistrationService(RegistrationServiceOptions options, RejectFn reject)
     : options_(std::move(options)), reject_(std::move(reject)) {}
@@ -33,45 +32,65 @@ std::optional<orbed::registration_t> RegistrationService::HandleSessionControl(
   using Kind = SessionCommand::Kind;
   // A trial request is for the user, not for the server.
   if (command.kind == Kind::kRequestTrial) return std::nullopt;
+  // A request acted on before: its first answer, and nothing changes.
+  if (const auto* answer = command_answers_.Find(command.request_id)) return *answer;
+  std::optional<orbed::registration_t> answer;
   if (command.kind == Kind::kStart) {
     // A repeated START of the active session changes nothing (its trials stay).
-    if (active_ && command.RepeatsStartOf(session_id_, display_mode_, num_mirrors_)) return std::nullopt;
-    has_session_ = true;
-    active_ = true;
-    session_id_ = command.session_id;
-    display_mode_ = command.display_mode;
-    num_mirrors_ = command.num_mirrors;
-    method_ = command.method;
-    trials_.clear();
-    last_utime_ = command.utime;
-    ++changes_;
-    return std::nullopt;
-  }
-  if (!has_session_ || command.session_id != session_id_) {
+    if (!(active_ && command.RepeatsStartOf(session_id_, display_mode_, num_mirrors_))) {
+      has_session_ = true;
+      active_ = true;
+      session_id_ = command.session_id;
+      display_mode_ = command.display_mode;
+      num_mirrors_ = command.num_mirrors;
+      method_ = command.method;
+      trials_.clear();
+      latest_trial_state_.reset();
+      last_utime_ = command.utime;
+      ++changes_;
+    }
+  } else if (!has_session_ || command.session_id != session_id_) {
     Reject("SESSION_CONTROL/session", std::string("SESSION_CONTROL ") + SessionCommandName(command.kind) +
                                           " for session '" + command.session_id + "', but the session is '" +
                                           (has_session_ ? session_id_ : std::string("<none>")) + "'");
-    return std::nullopt;
-  }
-  switch (command.kind) {
-    case Kind::kReset:
-      if (trials_.empty()) return std::nullopt;
+    return std::nullopt;  // refused: not remembered, so a retry is judged afresh
+  } else if (command.kind == Kind::kReset) {
+    if (!trials_.empty()) {  // an empty RESET changes nothing
       trials_.clear();
+      latest_trial_state_.reset();
       last_utime_ = command.utime;
       ++changes_;
-      return std::nullopt;
-    case Kind::kStop:
-      if (!active_) return std::nullopt;
+    }
+  } else if (command.kind == Kind::kStop) {
+    if (active_) {  // a repeated STOP changes nothing
       active_ = false;
       last_utime_ = command.utime;
       ++changes_;
-      return std::nullopt;
-    default:  // COMPUTE
-      return MakeState(command.utime, orbed::registration_t::REASON_COMPUTE);
+    }
+  } else {  // COMPUTE
+    answer = MakeState(command.utime, orbed::registration_t::REASON_COMPUTE, command.request_id);
   }
+  command_answers_.Remember(command.request_id, answer);
+  return answer;
+}
+
+const RegistrationService::Trial* RegistrationService::FindRepeat(const orbed::alignment_trial_t& msg) const {
+  if (!has_session_ || msg.session_id != session_id_) return nullptr;
+  for (const Trial& t : trials_) {
+    if (t.trial_index == msg.trial_index && t.utime == msg.utime && t.request_id == msg.request_id &&
+        std::equal(t.X_WV.position_m, t.X_WV.position_m + 3, msg.X_WV.position_m) &&
+        std::equal(t.X_WV.quaternion_wxyz, t.X_WV.quaternion_wxyz + 4, msg.X_WV.quaternion_wxyz)) {
+      return &t;
+    }
+  }
+  return nullptr;
 }
 
 std::optional<orbed::registration_t> RegistrationService::HandleTrial(const orbed::alignment_trial_t& msg) {
+  if (const Trial* repeat = FindRepeat(msg)) {
+    if (repeat == &trials_.back() && latest_trial_state_) return latest_trial_state_;
+    return std::nullopt;
+  }
   if (!active_ || msg.session_id != session_id_) {
     Reject("ALIGNMENT_TRIAL/session",
            "trial " + std::to_string(msg.trial_index) + " for session '" + msg.session_id + "', but " +
@@ -103,20 +122,22 @@ std::optional<orbed::registration_t> RegistrationService::HandleTrial(const orbe
     return std::nullopt;
   }
   trials_.push_back({msg.trial_index, QuaternionFromWxyz(msg.X_WV.quaternion_wxyz).normalized(),
-                     ToVector3(msg.X_WV.position_m)});
+                     ToVector3(msg.X_WV.position_m), msg.utime, msg.request_id, msg.X_WV});
   last_utime_ = msg.utime;
   ++changes_;
-  return MakeState(msg.utime, orbed::registration_t::REASON_TRIAL);
+  latest_trial_state_ = MakeState(msg.utime, orbed::registration_t::REASON_TRIAL, msg.request_id);
+  return latest_trial_state_;
 }
 
 std::optional<orbed::registration_t> RegistrationService::PeriodicState() const {
   if (!has_session_) return std::nullopt;
-  return MakeState(last_utime_, orbed::registration_t::REASON_PERIODIC);
+  return MakeState(last_utime_, orbed::registration_t::REASON_PERIODIC, 0);
 }
 
-orbed::registration_t RegistrationService::MakeState(int64_t utime, int8_t reason) const {
+orbed::registration_t RegistrationService::MakeState(int64_t utime, int8_t reason, int64_t request_id) const {
   orbed::registration_t out{};
   out.utime = utime;
+  out.request_id = request_id;
   out.session_id = session_id_;
   out.reason = reason;
   out.method = method_;

@@ -21,6 +21,16 @@
 /// Frames and units: trials carry X_WV (virtual robot base V in the OR world W) [m]; the mean is
 /// X_WV_mean; rays and landmarks are in W [m]; angles in messages are [deg] where named.
 ///
+/// Repeats (procs/common/recent_answers.h): a SESSION_CONTROL command whose nonzero request_id was
+/// already acted on changes nothing and returns its first answer (a COMPUTE its REGISTRATION, the
+/// others nothing); the answers to the last 64 ids are kept. A trial identical to one the session
+/// holds (same index, utime, request_id and X_WV: a re-sent or duplicated datagram) changes nothing:
+/// the latest trial's repeat returns its REGISTRATION again, an older one's nothing. Neither is a
+/// rejection, and neither counts in changes() (so neither is journaled). A REGISTRATION echoes the
+/// request it answers (request_id: the COMPUTE's, the trial's, 0 for the periodic state). After a
+/// journal replay the START's id and the trials are known again; a COMPUTE is not journaled, and a
+/// repeated one, answered afresh from the same state, gets the same bytes.
+///
 /// Rejections: a trial or command that fails validation changes nothing; the reject callback gets
 /// a class key ("ALIGNMENT_TRIAL/pose") and a one-line reason. Invalid landmark / misalignment
 /// requests are answered with valid = false and the reason, and also reported as rejections.
@@ -45,6 +55,7 @@
 
 #include "geometry/robust.h"
 #include "geometry/triangulation.h"
+#include "procs/common/recent_answers.h"
 
 namespace orbed::registration {
 
@@ -68,9 +79,11 @@ class RegistrationService {
 
   RegistrationService(RegistrationServiceOptions options, RejectFn reject);
 
-  /// START / RESET / STOP return nothing; COMPUTE returns the full state (reason COMPUTE).
+  /// START / RESET / STOP return nothing; COMPUTE returns the full state (reason COMPUTE); a
+  /// repeated request id its first answer.
   std::optional<orbed::registration_t> HandleSessionControl(const orbed::session_control_t& msg);
-  /// An accepted trial returns the new state (reason TRIAL); a rejected one nothing.
+  /// An accepted trial returns the new state (reason TRIAL); a rejected one nothing; a repeat of
+  /// the latest trial its state again, of an older one nothing.
   std::optional<orbed::registration_t> HandleTrial(const orbed::alignment_trial_t& msg);
   orbed::landmark_t HandleLandmarkRequest(const orbed::landmark_request_t& msg);
   orbed::misalignment_t HandleMisalignmentRequest(const orbed::misalignment_request_t& msg);
@@ -90,9 +103,15 @@ class RegistrationService {
     int32_t trial_index;
     Eigen::Quaterniond quat_WV;
     Eigen::Vector3d p_WV;
+    // As received, to recognise a repeat.
+    int64_t utime;
+    int64_t request_id;
+    orbed::pose_t X_WV;
   };
 
-  orbed::registration_t MakeState(int64_t utime, int8_t reason) const;
+  // The repeated trial of the session equal to `msg`, if there is one.
+  const Trial* FindRepeat(const orbed::alignment_trial_t& msg) const;
+  orbed::registration_t MakeState(int64_t utime, int8_t reason, int64_t request_id) const;
   void Reject(const std::string& key, const std::string& reason) const;
 
   RegistrationServiceOptions options_;
@@ -106,6 +125,9 @@ class RegistrationService {
   std::vector<Trial> trials_;
   int64_t last_utime_ = 0;
   int64_t changes_ = 0;
+  // The REGISTRATION of the latest accepted trial, answered again to its repeats.
+  std::optional<orbed::registration_t> latest_trial_state_;
+  RecentAnswers<std::optional<orbed::registration_t>> command_answers_;
 };
 
 }  // namespace orbed::registration

@@ -60,6 +60,13 @@ int RunScenario(int argc, const char* const* argv, std::ostream& out, std::ostre
   app.add_option("--trial-timeout-s", run.trial_timeout_s, "Wait for the user's ALIGNMENT_TRIAL [s]")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  app.add_option("--retry-initial-s", run.retry_initial_s,
+                 "Re-send an unanswered request after this long, then after doubling intervals [s]")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app.add_option("--retry-max-s", run.retry_max_s, "Longest interval between re-sends of a request [s]")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   app.add_option("--robot-state-channel", run.robot_state_channel)->capture_default_str();
   app.add_option("--iiwa-command-channel", run.iiwa_command_channel)->capture_default_str();
   app.add_option("--plan-check-request-channel", run.plan_check_request_channel)->capture_default_str();

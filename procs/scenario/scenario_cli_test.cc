@@ -44,10 +44,26 @@ TEST(ScenarioCli, HelpPrintsTheUsageOnOut) {
   const CliRun r = Cli({"--help"});
   EXPECT_EQ(r.code, 0);
   EXPECT_TRUE(Contains(r.out, "orbed-scenario: conducts the ViRAAl experiment")) << r.out;
-  for (const char* flag : {"--scenario", "--trials", "--modes", "--q-deg", "--run-id", "--results-dir",
-                           "--urdf", "--tolerance-deg", "--startup-timeout-s", "--reply-timeout-s",
-                           "--move-timeout-s", "--trial-timeout-s", "--robot-state-channel",
-                           "--misalignment-channel", "--lcm-url", "--seed", "--duration-s"}) {
+  for (const char* flag : {"--scenario",
+                           "--trials",
+                           "--modes",
+                           "--q-deg",
+                           "--run-id",
+                           "--results-dir",
+                           "--urdf",
+                           "--tolerance-deg",
+                           "--startup-timeout-s",
+                           "--reply-timeout-s",
+                           "--move-timeout-s",
+                           "--trial-timeout-s",
+                           "--retry-initial-s",
+                           "--retry-max-s",
+                           "--robot-state-channel",
+                           "--misalignment-channel",
+                           "--lcm-url",
+                           "--seed",
+                           "--duration-s",
+                           "--chaos"}) {
     EXPECT_TRUE(Contains(r.out, flag)) << flag;
   }
   EXPECT_TRUE(Contains(r.out, "ORBED_RUN_ID"));
@@ -65,6 +81,12 @@ TEST(ScenarioCli, BadFlagsExitNonZeroWithTheMessageOnErr) {
   r = Cli({"--reply-timeout-s", "-1"});
   EXPECT_NE(r.code, 0);
   EXPECT_TRUE(Contains(r.err, "--reply-timeout-s")) << r.err;
+  r = Cli({"--retry-initial-s", "1", "--retry-max-s", "0.5", "--lcm-url", "memq://"});
+  EXPECT_NE(r.code, 0);
+  EXPECT_TRUE(Contains(r.err, "--retry-max-s must be >= --retry-initial-s")) << r.err;
+  r = Cli({"--chaos", "drop=0.1,lose=1"});
+  EXPECT_NE(r.code, 0);
+  EXPECT_TRUE(Contains(r.err, "--chaos")) << r.err;
   r = Cli({"--log-level", "loud"});
   EXPECT_NE(r.code, 0);
   EXPECT_TRUE(Contains(r.err, "loud")) << r.err;

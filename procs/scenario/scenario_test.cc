@@ -6,6 +6,8 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <map>
 #include <regex>
 #include <sstream>
 
@@ -87,7 +89,14 @@ class FakeTestbed {
     reply.reason = infeasible_ ? "in collision: iiwa_link_7 vs patient_torso" : "";
     lcm_->publish("PLAN_CHECK_REPLY", &reply);
   }
+  // Like the real headset and server: a repeated request id (a retry, should an answer be late)
+  // gets its first answer again and changes nothing.
   void OnSession(const lcm::ReceiveBuffer*, const std::string&, const orbed::session_control_t* msg) {
+    if (const auto it = answers_.find(msg->request_id); it != answers_.end()) {
+      if (it->second) it->second();
+      return;
+    }
+    answers_[msg->request_id] = nullptr;
     commands_.push_back(msg->command);
     if (msg->command == orbed::session_control_t::START) {
       session_ = msg->session_id;
@@ -107,23 +116,35 @@ class FakeTestbed {
       t.X_WV = ToPose(SceneBase() * X_RV_);
       t.duration_s = 12.5;
       t.user_id = "fake";
+      t.request_id = msg->request_id;
+      answers_[msg->request_id] = [this, t] { lcm_->publish("ALIGNMENT_TRIAL", &t); };
       lcm_->publish("ALIGNMENT_TRIAL", &t);
     } else if (msg->command == orbed::session_control_t::COMPUTE) {
-      orbed::registration_t r = Registration(msg->utime, orbed::registration_t::REASON_COMPUTE);
+      orbed::registration_t r =
+          Registration(msg->utime, orbed::registration_t::REASON_COMPUTE, msg->request_id);
+      answers_[msg->request_id] = [this, r] { lcm_->publish("REGISTRATION", &r); };
       lcm_->publish("REGISTRATION", &r);
     }
   }
   // Stands in for orbed-registration: the trials all share one rotation, so the mean is theirs.
+  // A repeated trial is registered once and answered with its first registration.
   void OnTrial(const lcm::ReceiveBuffer*, const std::string&, const orbed::alignment_trial_t* msg) {
-    ++trials_;
-    p_sum_ += ToVector3(msg->X_WV.position_m);
-    q_WV_ = msg->X_WV;
-    orbed::registration_t r = Registration(msg->utime, orbed::registration_t::REASON_TRIAL);
-    lcm_->publish("REGISTRATION", &r);
+    auto it = registrations_.find(msg->request_id);
+    if (it == registrations_.end()) {
+      ++trials_;
+      p_sum_ += ToVector3(msg->X_WV.position_m);
+      q_WV_ = msg->X_WV;
+      it = registrations_
+               .emplace(msg->request_id,
+                        Registration(msg->utime, orbed::registration_t::REASON_TRIAL, msg->request_id))
+               .first;
+    }
+    lcm_->publish("REGISTRATION", &it->second);
   }
-  orbed::registration_t Registration(int64_t utime, int8_t reason) {
+  orbed::registration_t Registration(int64_t utime, int8_t reason, int64_t request_id) {
     orbed::registration_t r{};
     r.utime = utime;
+    r.request_id = request_id;
     r.session_id = session_;
     r.reason = reason;
     r.method = orbed::registration_t::METHOD_KARCHER;
@@ -176,6 +197,8 @@ class FakeTestbed {
   int trials_ = 0;
   Eigen::Vector3d p_sum_ = Eigen::Vector3d::Zero();
   orbed::pose_t q_WV_{};
+  std::map<int64_t, std::function<void()>> answers_;        // by SESSION_CONTROL request id
+  std::map<int64_t, orbed::registration_t> registrations_;  // by the trial's request id
 };
 
 ScenarioOptions MemqOptions(const std::string& dir) {

@@ -32,15 +32,22 @@ std::string JointList(const std::vector<double>& q_deg, int digits) {
 }  // namespace
 
 void CheckConductorOptions(const ConductorOptions& options) {
-  const std::pair<const char*, double> positive[] = {
-      {"--tolerance-deg", options.tolerance_deg},         {"--startup-timeout-s", options.startup_timeout_s},
-      {"--reply-timeout-s", options.reply_timeout_s},     {"--move-timeout-s", options.move_timeout_s},
-      {"--trial-timeout-s", options.trial_timeout_s},     {"--stopped-grace-s", options.stopped_grace_s},
-      {"command resend period", options.command_resend_s}};
+  const std::pair<const char*, double> positive[] = {{"--tolerance-deg", options.tolerance_deg},
+                                                     {"--startup-timeout-s", options.startup_timeout_s},
+                                                     {"--reply-timeout-s", options.reply_timeout_s},
+                                                     {"--move-timeout-s", options.move_timeout_s},
+                                                     {"--trial-timeout-s", options.trial_timeout_s},
+                                                     {"--stopped-grace-s", options.stopped_grace_s},
+                                                     {"command resend period", options.command_resend_s},
+                                                     {"--retry-initial-s", options.retry_initial_s},
+                                                     {"--retry-max-s", options.retry_max_s}};
   for (const auto& [name, value] : positive) {
     if (!(value > 0) || !std::isfinite(value)) {
       throw std::invalid_argument(std::string(name) + " must be a finite number > 0");
     }
+  }
+  if (options.retry_max_s < options.retry_initial_s) {
+    throw std::invalid_argument("--retry-max-s must be >= --retry-initial-s");
   }
 }
 
@@ -93,6 +100,7 @@ ConductorActions ViraalConductor::Start(const ConductorTime& now) {
   actions_.clear();
   run_start_s_ = phase_start_s_ = last_command_s_ = now.t_s;
   results_.started_utime = now.utime;
+  request_id_base_ = now.utime;
   phase_ = Phase::kWaitRobot;
   Say("ViRAAl run " + options_.run_id + ": waiting for the robot (" + options_.robot_state_channel + ")");
   return TakeActions();
@@ -137,9 +145,10 @@ ConductorActions ViraalConductor::OnRobotState(const orbed::robot_state_t& msg, 
 ConductorActions ViraalConductor::OnPlanCheckReply(const orbed::plan_check_reply_t& msg,
                                                    const ConductorTime& now) {
   Begin(now);
-  const int64_t k = msg.request_id - plan_request_base_;
-  if (phase_ != Phase::kCheckPlans || k < 0 || k >= static_cast<int64_t>(plan_answered_.size()))
-    return TakeActions();  // not ours
+  if (phase_ != Phase::kCheckPlans) return TakeActions();  // not ours, or a late repeat
+  size_t k = 0;
+  while (k < plan_requests_.size() && plan_requests_[k].request_id != msg.request_id) ++k;
+  if (k == plan_requests_.size()) return TakeActions();  // not ours
   const std::string problem =
       CheckLength(msg.num_pairs, msg.pairs.size(), kMaxPairs, "PLAN_CHECK_REPLY.num_pairs");
   if (!problem.empty()) {
@@ -177,7 +186,9 @@ ConductorActions ViraalConductor::OnTrial(const orbed::alignment_trial_t& msg, c
       msg.trial_index < trial_index_) {
     return TakeActions();  // one it has (e.g. a kept trial it re-sent)
   }
-  if (phase_ != Phase::kAwaitTrial || mode_index_ >= options_.config.modes.size() ||
+  const bool requested = phase_ == Phase::kAwaitTrial && msg.request_id == trial_request_.request_id;
+  if (!requested && IssuedRequestId(msg.request_id)) return TakeActions();  // a repeat: ignored
+  if (!requested || mode_index_ >= options_.config.modes.size() ||
       msg.session_id != results_.sessions.back().session_id || msg.trial_index != trial_index_) {
     Refuse(options_.trial_channel + "/unexpected", "ALIGNMENT_TRIAL for session '" + msg.session_id +
                                                        "' trial " + std::to_string(msg.trial_index) +
@@ -219,9 +230,8 @@ ConductorActions ViraalConductor::OnTrial(const orbed::alignment_trial_t& msg, c
   const viraal::RobotPoints points = viraal::TrialPoints(*points_, msg);
   session_points_.push_back(points);
   pending_error_ = viraal::TrialError(robot_state_->X_WR, msg, points);
-  misalignment_.reset();
-  misalignment_request_id_ = SendMisalignment(pending_error_);
   Enter(Phase::kAwaitTrialResults);
+  SendMisalignment(pending_error_);
   Step();
   return TakeActions();
 }
@@ -240,9 +250,13 @@ ConductorActions ViraalConductor::OnRegistration(const orbed::registration_t& ms
     Refuse(options_.registration_channel + "/field", problem);
     return TakeActions();
   }
+  // Only the answer to the request the phase waits for counts; repeats and strays are ignored.
   if (msg.reason == orbed::registration_t::REASON_TRIAL) {
-    last_trial_registration_ = msg;
-  } else if (phase_ == Phase::kAwaitMean) {
+    if ((phase_ == Phase::kAwaitTrial || phase_ == Phase::kAwaitTrialResults) &&
+        msg.request_id == trial_request_.request_id) {
+      trial_registration_ = msg;
+    }
+  } else if (phase_ == Phase::kAwaitMean && msg.request_id == compute_request_.request_id) {
     mean_registration_ = msg;
   }
   Step();
@@ -251,8 +265,9 @@ ConductorActions ViraalConductor::OnRegistration(const orbed::registration_t& ms
 
 ConductorActions ViraalConductor::OnMisalignment(const orbed::misalignment_t& msg, const ConductorTime& now) {
   Begin(now);
-  if (msg.request_id != misalignment_request_id_ || misalignment_request_id_ == 0)
-    return TakeActions();  // not ours
+  if ((phase_ != Phase::kAwaitTrialResults && phase_ != Phase::kAwaitMeanMisalignment) ||
+      msg.request_id != misalignment_request_.request_id)
+    return TakeActions();  // not ours, or a late repeat
   std::string problem;
   if (msg.valid) {
     problem =
@@ -284,7 +299,54 @@ ConductorActions ViraalConductor::OnMisalignment(const orbed::misalignment_t& ms
 void ViraalConductor::Enter(Phase phase) {
   phase_ = phase;
   phase_start_s_ = now_.t_s;
+  attempts_ = 1;
+  retry_interval_s_ = options_.retry_initial_s;
+  next_retry_s_ = now_.t_s + retry_interval_s_;
 }
+
+void ViraalConductor::RetryIfDue() {
+  if (now_.t_s < next_retry_s_) return;
+  const size_t before = actions_.size();
+  switch (phase_) {
+    case Phase::kCheckPlans:
+      for (size_t k = 0; k < plan_requests_.size(); ++k) {
+        if (!plan_answered_[k]) Publish(options_.plan_check_request_channel, plan_requests_[k]);
+      }
+      break;
+    case Phase::kAwaitTrial:
+    case Phase::kAwaitTrialResults:
+      if (!TrialRegistered()) {
+        Publish(options_.session_control_channel, start_request_);
+        for (const orbed::alignment_trial_t& kept : kept_trials_) Publish(options_.trial_channel, kept);
+        Publish(options_.session_control_channel, trial_request_);
+      }
+      if (phase_ == Phase::kAwaitTrialResults && !misalignment_) {
+        Publish(options_.misalignment_request_channel, misalignment_request_);
+      }
+      break;
+    case Phase::kAwaitMean:
+      Publish(options_.session_control_channel, compute_request_);
+      break;
+    case Phase::kAwaitMeanMisalignment:
+      Publish(options_.misalignment_request_channel, misalignment_request_);
+      break;
+    default:
+      return;
+  }
+  retries_ += static_cast<int64_t>(actions_.size() - before);
+  ++attempts_;
+  Log(orbed::LogLevel::kDebug, "no answer yet: re-sent " + std::to_string(actions_.size() - before) +
+                                   " request(s), attempt " + std::to_string(attempts_));
+  retry_interval_s_ = std::min(2 * retry_interval_s_, options_.retry_max_s);
+  next_retry_s_ = now_.t_s + retry_interval_s_;
+}
+
+bool ViraalConductor::TrialRegistered() const {
+  return trial_ && trial_registration_ && trial_registration_->utime == trial_->utime &&
+         trial_registration_->num_trials == trial_index_ + 1;
+}
+
+std::string ViraalConductor::Attempts() const { return ", sent " + std::to_string(attempts_) + " times"; }
 
 void ViraalConductor::Step() {
   const double waited = PhaseSeconds();
@@ -310,7 +372,9 @@ void ViraalConductor::Step() {
       } else if (waited > options_.reply_timeout_s) {
         FailRun("orbed-iiwa-sim answered " + std::to_string(answered) + " of " +
                 std::to_string(plan_answered_.size()) + " PLAN_CHECK_REQUESTs within " +
-                Fixed(options_.reply_timeout_s, 1) + " s" + refusal);
+                Fixed(options_.reply_timeout_s, 1) + " s" + Attempts() + refusal);
+      } else {
+        RetryIfDue();
       }
       return;
     }
@@ -357,21 +421,25 @@ void ViraalConductor::Step() {
       if (waited > options_.trial_timeout_s) {
         FailRun("no ALIGNMENT_TRIAL for session '" + results_.sessions.back().session_id + "' trial " +
                 std::to_string(trial_index_) + " within " + Fixed(options_.trial_timeout_s, 1) +
-                " s of SESSION_CONTROL REQUEST_TRIAL: is orbed-hmd running (its emulated user answers "
-                "REQUEST_TRIAL on " +
+                " s of SESSION_CONTROL REQUEST_TRIAL" + Attempts() +
+                ": is orbed-hmd running (its emulated user answers REQUEST_TRIAL on " +
                 options_.trial_channel + ")?" + refusal);
+      } else {
+        RetryIfDue();
       }
       return;
     case Phase::kAwaitTrialResults: {
-      const bool registered = last_trial_registration_ && last_trial_registration_->utime == trial_->utime &&
-                              last_trial_registration_->num_trials == trial_index_ + 1;
+      const bool registered = TrialRegistered();
       if (registered && misalignment_) {
         FinishTrial();
       } else if (waited > options_.reply_timeout_s) {
         FailRun(std::string(registered ? "no MISALIGNMENT answer" : "no REGISTRATION (reason TRIAL)") +
                 " from orbed-registration for session '" + results_.sessions.back().session_id + "' trial " +
-                std::to_string(trial_index_) + " within " + Fixed(options_.reply_timeout_s, 1) +
-                " s (is it running? did it refuse the trial? see its PROCESS_STATUS rejections)" + refusal);
+                std::to_string(trial_index_) + " within " + Fixed(options_.reply_timeout_s, 1) + " s" +
+                Attempts() + " (is it running? did it refuse the trial? see its PROCESS_STATUS rejections)" +
+                refusal);
+      } else {
+        RetryIfDue();
       }
       return;
     }
@@ -385,13 +453,14 @@ void ViraalConductor::Step() {
           return;
         }
         pending_error_ = viraal::MeanError(robot_state_->X_WR, mean, session_points_);
-        misalignment_.reset();
-        misalignment_request_id_ = SendMisalignment(pending_error_);
         Enter(Phase::kAwaitMeanMisalignment);
+        SendMisalignment(pending_error_);
       } else if (waited > options_.reply_timeout_s) {
         FailRun("no REGISTRATION (reason COMPUTE) from orbed-registration for session '" +
                 results_.sessions.back().session_id + "' within " + Fixed(options_.reply_timeout_s, 1) +
-                " s" + refusal);
+                " s" + Attempts() + refusal);
+      } else {
+        RetryIfDue();
       }
       return;
     case Phase::kAwaitMeanMisalignment:
@@ -400,7 +469,9 @@ void ViraalConductor::Step() {
       } else if (waited > options_.reply_timeout_s) {
         FailRun("no MISALIGNMENT answer from orbed-registration for the mean of session '" +
                 results_.sessions.back().session_id + "' within " + Fixed(options_.reply_timeout_s, 1) +
-                " s" + refusal);
+                " s" + Attempts() + refusal);
+      } else {
+        RetryIfDue();
       }
       return;
     case Phase::kDone:
@@ -410,20 +481,21 @@ void ViraalConductor::Step() {
 
 void ViraalConductor::StartPlanChecks() {
   const auto& configurations = options_.config.configurations_deg;
-  plan_request_base_ = now_.utime;  // distinct from another client's ids in practice
+  plan_requests_.clear();
   plan_answered_.assign(configurations.size(), false);
   Enter(Phase::kCheckPlans);
-  for (size_t k = 0; k < configurations.size(); ++k) {
+  for (const std::vector<double>& q_deg : configurations) {
     orbed::plan_check_request_t request{};
     request.utime = now_.utime;
-    request.request_id = plan_request_base_ + static_cast<int64_t>(k);
-    request.num_joints = static_cast<int32_t>(configurations[k].size());
-    request.joint_position = FromVectorX(orbed::sim::DegToRad(ToVectorX(configurations[k])));
+    request.request_id = NewRequestId();
+    request.num_joints = static_cast<int32_t>(q_deg.size());
+    request.joint_position = FromVectorX(orbed::sim::DegToRad(ToVectorX(q_deg)));
     Publish(options_.plan_check_request_channel, request);
+    plan_requests_.push_back(request);
   }
 }
 
-void ViraalConductor::SendSessionControl(int8_t command) {
+orbed::session_control_t ViraalConductor::SendSessionControl(int8_t command) {
   const viraal::ModeSpec& mode = options_.config.modes[mode_index_];
   orbed::session_control_t msg{};
   msg.utime = now_.utime;
@@ -432,7 +504,9 @@ void ViraalConductor::SendSessionControl(int8_t command) {
   msg.display_mode = mode.display_mode;
   msg.num_mirrors = mode.num_mirrors;
   msg.method = options_.config.method;
+  msg.request_id = NewRequestId();
   Publish(options_.session_control_channel, msg);
+  return msg;
 }
 
 void ViraalConductor::StartSession() {
@@ -448,13 +522,14 @@ void ViraalConductor::StartSession() {
   const viraal::SessionResult& session = results_.sessions.back();
   trial_index_ = static_cast<int>(session.trials.size());
   session_points_.clear();
-  last_trial_registration_.reset();
   mean_registration_.reset();
-  SendSessionControl(+orbed::session_control_t::START);
+  start_request_ = SendSessionControl(+orbed::session_control_t::START);
+  kept_trials_.clear();
   for (const viraal::TrialResult& kept : session.trials) {
     const orbed::alignment_trial_t trial = viraal::TrialMessageFrom(kept, session, now_.utime);
     session_points_.push_back(viraal::TrialPoints(*points_, trial));
     Publish(options_.trial_channel, trial);
+    kept_trials_.push_back(trial);
   }
   Say("[" + mode.name + "] session " + session.session_id +
       " started: " + std::to_string(options_.config.trials) + " trials, " + std::to_string(mode.num_mirrors) +
@@ -485,15 +560,16 @@ void ViraalConductor::StartMove(bool first) {
 
 void ViraalConductor::RequestTrial() {
   trial_.reset();
-  SendSessionControl(+orbed::session_control_t::REQUEST_TRIAL);
+  trial_registration_.reset();
+  trial_request_ = SendSessionControl(+orbed::session_control_t::REQUEST_TRIAL);
   Enter(Phase::kAwaitTrial);
 }
 
-int64_t ViraalConductor::SendMisalignment(const viraal::AlignmentError& error) {
-  const orbed::misalignment_request_t request = viraal::MisalignmentRequest(
-      error, results_.sessions.back().session_id, now_.utime, now_.utime * 16 + (next_request_id_++ % 16));
-  Publish(options_.misalignment_request_channel, request);
-  return request.request_id;
+void ViraalConductor::SendMisalignment(const viraal::AlignmentError& error) {
+  misalignment_.reset();
+  misalignment_request_ =
+      viraal::MisalignmentRequest(error, results_.sessions.back().session_id, now_.utime, NewRequestId());
+  Publish(options_.misalignment_request_channel, misalignment_request_);
 }
 
 void ViraalConductor::FinishTrial() {
@@ -515,7 +591,7 @@ void ViraalConductor::FinishTrial() {
 
 void ViraalConductor::RequestMean() {
   mean_registration_.reset();
-  SendSessionControl(+orbed::session_control_t::COMPUTE);
+  compute_request_ = SendSessionControl(+orbed::session_control_t::COMPUTE);
   Enter(Phase::kAwaitMean);
 }
 

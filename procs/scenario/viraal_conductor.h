@@ -33,16 +33,32 @@
 /// (a Refusal action, key "<channel>/<class>"), and the last refusal is quoted if the phase then
 /// times out. Messages that belong to someone else (other request ids, other sessions, periodic
 /// REGISTRATION) are ignored, not refused. Handlers advance the phases at once where they can;
-/// Tick() enforces the timeouts and re-sends IIWA_COMMAND every command_resend_s while the arm is
-/// short of the target.
+/// Tick() enforces the timeouts and the retries below, and re-sends IIWA_COMMAND every
+/// command_resend_s while the arm is short of the target.
+///
+/// Requests and retries (datagrams may be lost, duplicated or reordered): every request carries a
+/// request id, distinct within the run (the Start() utime + 1, + 2, ...): PLAN_CHECK_REQUEST,
+/// SESSION_CONTROL (START, REQUEST_TRIAL, COMPUTE, STOP) and MISALIGNMENT_REQUEST. An answer counts
+/// only when it echoes the id of the request the phase waits for: PLAN_CHECK_REPLY and MISALIGNMENT
+/// their request's, ALIGNMENT_TRIAL its REQUEST_TRIAL's, REGISTRATION the COMPUTE's (reason
+/// COMPUTE) or the trial's (reason TRIAL, with the trial's utime and num_trials i + 1). An answer
+/// with an id this run used before (a repeat, a late duplicate) is ignored, not refused. While a
+/// phase waits, what is unanswered is re-sent, byte for byte, retry_initial_s after the phase began,
+/// then after intervals doubling up to retry_max_s, until the phase's timeout: the plan checks not
+/// yet answered; the REQUEST_TRIAL, preceded by the session's START (a receiver that missed the
+/// START opens the session; one that has it ignores the repeated id), until the trial is both
+/// received and registered (the headset answers a repeated REQUEST_TRIAL with the same trial, the
+/// server a repeat of that trial with the same REGISTRATION); the MISALIGNMENT_REQUEST; the
+/// COMPUTE. STOP is not retried: the next START replaces the session in every receiver.
 ///
 /// Outputs: every call returns the actions it produced, in order: messages to publish (with their
 /// channel), progress lines for the operator, log entries and refusals. The caller carries them out
 /// in that order. Nothing else leaves the machine.
 ///
-/// Time: ConductorTime::t_s is monotonic [s] and times the phases, timeouts, resends and the
-/// stopped grace; ConductorTime::utime [µs since the epoch] stamps the messages out and seeds the
-/// request ids. Neither is read from a clock here: identical calls give identical actions.
+/// Time: ConductorTime::t_s is monotonic [s] and times the phases, timeouts, retries, resends and
+/// the stopped grace; ConductorTime::utime [µs since the epoch] stamps the messages out and, at
+/// Start(), the request ids. Neither is read from a clock here: identical calls give identical
+/// actions.
 ///
 /// Threading: not thread-safe; one thread makes every call.
 
@@ -100,6 +116,10 @@ struct ConductorOptions {
   double stopped_grace_s{0.5};
   /// Period of the IIWA_COMMAND re-sends while the arm moves [s].
   double command_resend_s{0.25};
+  /// An unanswered request is first re-sent this long after it went out [s]; each later retry waits
+  /// twice as long as the one before, at most retry_max_s (>= retry_initial_s).
+  double retry_initial_s{0.2};
+  double retry_max_s{0.5};
   /// Sessions kept from an earlier run (resume.h): the finished ones first, then at most one in
   /// progress; empty = a new run.
   std::vector<viraal::SessionResult> kept_sessions;
@@ -118,7 +138,7 @@ struct ConductorOptions {
 };
 
 /// Throws std::invalid_argument naming the flag of the first duration or tolerance in `options`
-/// that is not a finite number > 0.
+/// that is not a finite number > 0, or when retry_max_s < retry_initial_s.
 void CheckConductorOptions(const ConductorOptions& options);
 
 /// A message to publish on `channel`.
@@ -187,6 +207,8 @@ class ViraalConductor {
   /// The results so far; final once done(). rejected_inputs counts this machine's refusals (the
   /// shell replaces it with its process's total, which also counts undecodable messages).
   const viraal::RunResults& results() const { return results_; }
+  /// Requests re-sent so far (each re-sent message counts once).
+  int64_t retries() const { return retries_; }
   const ConductorOptions& options() const { return options_; }
   const orbed::sim::RobotModel& model() const { return *model_; }
 
@@ -197,7 +219,7 @@ class ViraalConductor {
   // The timer's work; handlers call it too once they recorded an input.
   void Step();
 
-  // Phase entries: each emits what starts the phase.
+  // Phase entries: each emits what starts the phase. Enter() also starts the retry schedule.
   void Enter(Phase phase);
   void StartPlanChecks();
   void StartSession();
@@ -205,12 +227,24 @@ class ViraalConductor {
   void StartMove(bool first);
   void RequestTrial();
   void RequestMean();
-  int64_t SendMisalignment(const viraal::AlignmentError& error);
+  void SendMisalignment(const viraal::AlignmentError& error);
   void FinishTrial();
   void FinishSession();
   void FinishRun();
   void FailRun(const std::string& reason);
-  void SendSessionControl(int8_t command);
+  // A SESSION_CONTROL of the current session with a new request id, published and returned.
+  orbed::session_control_t SendSessionControl(int8_t command);
+  // Re-sends what the phase still waits for when the retry is due, and schedules the next one.
+  void RetryIfDue();
+  int64_t NewRequestId() { return request_id_base_ + next_request_id_++; }
+  // True for an id this run gave a request (so an answer carrying it is a repeat, not a stranger).
+  bool IssuedRequestId(int64_t id) const {
+    return id > request_id_base_ && id < request_id_base_ + next_request_id_;
+  }
+  // The trial is in and the server registered it (REGISTRATION reason TRIAL for it).
+  bool TrialRegistered() const;
+  // ", sent N times": how often the phase's request went out, for timeout reasons.
+  std::string Attempts() const;
 
   double PhaseSeconds() const { return now_.t_s - phase_start_s_; }
   const std::vector<double>& TargetDeg() const;
@@ -241,22 +275,34 @@ class ViraalConductor {
   std::optional<orbed::robot_state_t> robot_state_;
   double robot_state_received_s_{0};
 
-  // Plan checks: one request id per configuration.
-  int64_t plan_request_base_{0};
+  // Request ids: request_id_base_ + 1, + 2, ... (the base is Start()'s utime).
+  int64_t request_id_base_{0};
+  int64_t next_request_id_{1};
+  // The retry schedule of the phase's requests (set by Enter()).
+  double next_retry_s_{0};
+  double retry_interval_s_{0};
+  int attempts_{0};
+  int64_t retries_{0};
+
+  // Plan checks: one request per configuration, as sent.
+  std::vector<orbed::plan_check_request_t> plan_requests_;
   std::vector<bool> plan_answered_;
 
-  // Where the run is.
+  // Where the run is, and the requests of the current session and trial, as sent.
   size_t mode_index_{0};
   int trial_index_{0};
+  orbed::session_control_t start_request_;
+  std::vector<orbed::alignment_trial_t> kept_trials_;  // resuming: re-sent after START
+  orbed::session_control_t trial_request_;
+  orbed::session_control_t compute_request_;
+  orbed::misalignment_request_t misalignment_request_;
   std::optional<orbed::alignment_trial_t> trial_;
-  std::optional<orbed::registration_t> last_trial_registration_;
+  std::optional<orbed::registration_t> trial_registration_;
   double reach_s_{0};
-  int64_t misalignment_request_id_{0};
   std::optional<orbed::misalignment_t> misalignment_;
   std::optional<orbed::registration_t> mean_registration_;
   viraal::AlignmentError pending_error_;
   std::vector<viraal::RobotPoints> session_points_;
-  int64_t next_request_id_{1};
 
   viraal::RunResults results_;
 };

@@ -150,6 +150,7 @@ void ViraalScenario::Finish() {
   finished_ = true;
   results_ = conductor_->results();
   results_.rejected_inputs = process_->rejections().total();
+  ORBED_LOG(kInfo) << conductor_->retries() << " request(s) re-sent for lack of an answer";
   try {
     std::filesystem::create_directories(options_.results_dir);
     results_path_ = viraal::WriteResultsFile(options_.results_dir, viraal::ResultsJson(results_));

@@ -39,7 +39,9 @@ const std::map<std::string, Offset> kOffsets = {
 };
 
 // Answers REQUEST_TRIAL like orbed-hmd's emulated user would, instantly, and remembers the
-// ROBOT_STATE each trial was made at.
+// ROBOT_STATE each trial was made at. Like orbed-hmd, it answers a repeated request id (the
+// conductor's retry, should an answer be late) with the same trial, and a repeated START of its
+// session changes nothing.
 class FakeUser {
  public:
   explicit FakeUser(bool answers) : lcm_(""), answers_(answers) {
@@ -61,14 +63,20 @@ class FakeUser {
   void OnSession(const lcm::ReceiveBuffer*, const std::string&, const orbed::session_control_t* msg) {
     std::lock_guard<std::mutex> lock(mutex_);
     if (msg->command == orbed::session_control_t::START) {
-      session_ = msg->session_id;
-      mode_ = msg->display_mode;
-      mirrors_ = msg->num_mirrors;
-      next_index_ = 0;
+      if (msg->session_id != session_) {
+        session_ = msg->session_id;
+        mode_ = msg->display_mode;
+        mirrors_ = msg->num_mirrors;
+        next_index_ = 0;
+      }
       return;
     }
     if (msg->command != orbed::session_control_t::REQUEST_TRIAL || msg->session_id != session_ || !answers_ ||
         !has_state_) {
+      return;
+    }
+    if (const auto it = trials_.find(msg->request_id); it != trials_.end()) {
+      lcm_.publish("ALIGNMENT_TRIAL", &it->second);
       return;
     }
     const std::string mode = mode_ == orbed::alignment_trial_t::MODE_AR_REFLECTIVE ? "ar_reflective" : "ar";
@@ -90,7 +98,9 @@ class FakeUser {
     trial.X_WV = ToPose(X_WV);
     trial.duration_s = 20.0;
     trial.user_id = "fake-user";
+    trial.request_id = msg->request_id;
     states_[mode].push_back(state_);
+    trials_[msg->request_id] = trial;
     lcm_.publish("ALIGNMENT_TRIAL", &trial);
   }
   std::vector<orbed::robot_state_t> States(const std::string& mode) {
@@ -108,6 +118,7 @@ class FakeUser {
   int8_t mode_ = 0;
   int32_t mirrors_ = 0;
   int next_index_ = 0;
+  std::map<int64_t, orbed::alignment_trial_t> trials_;  // by request id
   std::map<std::string, std::vector<orbed::robot_state_t>> states_;
   std::atomic<bool> stop_{false};
   std::thread thread_;
