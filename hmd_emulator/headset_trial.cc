@@ -25,6 +25,10 @@ TrialSetup MakeHeadsetTrialSetup(const HmdConfigSet& config, const HeadsetTrialI
   setup.align_waypoint = config.hmd.align_waypoint;
   setup.settle_s = config.hmd.settle_s;
   setup.max_wait_s = config.hmd.max_wait_s;
+  setup.max_repeats = config.hmd.max_repeats;
+  for (const ScheduledFault& f : config.slam.faults) {
+    if (f.AppliesTo(inputs.session_id, inputs.trial_index)) setup.faults.push_back(f.timed);
+  }
   setup.intrinsics = geometry::Intrinsics::HoloLensPv();
   for (int i = 0; i < inputs.num_mirrors; ++i) {
     setup.capture_waypoints.push_back(config.hmd.displays[i].capture_waypoint);

@@ -9,7 +9,9 @@
 /// config.hmd.displays capture their frames at their waypoints, and the person aligns the virtual
 /// robot at config.hmd.align_waypoint (after config.hmd.settle_s, waiting up to
 /// config.hmd.max_wait_s for tracking), starting from X_WV_start, against the real robot at X_WR
-/// whose model points at the trial's q are p_RQ.
+/// whose model points at the trial's q are p_RQ. The forced faults of config.slam.faults for this
+/// session and trial index happen while the person aligns (viraal_trial.h), who re-does the
+/// alignment at most config.hmd.max_repeats times.
 ///
 /// Seeds: every trial draws from its own seeds, derived from (process seed, session id, trial
 /// index, purpose) by TrialSeed(): purpose kSlamSeedPurpose for the SLAM walk, kTrialSeedPurpose
@@ -57,7 +59,8 @@ struct HeadsetTrialInputs {
 };
 
 /// The TrialSetup (viraal_trial.h) of a headset trial: the walk, the capture and alignment
-/// waypoints and times of `config`, the HoloLens PV intrinsics, and X_WR and p_RQ of `inputs`.
+/// waypoints and times of `config`, the HoloLens PV intrinsics, X_WR and p_RQ of `inputs`, and
+/// the forced faults of config.slam.faults that apply to inputs' session and trial index.
 /// Throws std::invalid_argument when num_mirrors is negative or exceeds the displays placed.
 TrialSetup MakeHeadsetTrialSetup(const HmdConfigSet& config, const HeadsetTrialInputs& inputs);
 

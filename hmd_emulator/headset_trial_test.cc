@@ -101,6 +101,35 @@ TEST(HeadsetTrial, NumMirrorsChoosesTheDisplays) {
   EXPECT_THROW(RunHeadsetTrial(config, in), std::invalid_argument);
 }
 
+// slam.faults picks its trials: the session's (or every session's) trial of that index gets the
+// fault while aligning; the others are the trials they always were.
+TEST(HeadsetTrial, ForcedFaultsOfTheirTrialOnly) {
+  HmdConfigSet config = ShippedConfigs();
+  const HeadsetTrialInputs in = Inputs(config);  // session-a, trial 0
+  const TrialOutcome base = RunHeadsetTrial(config, in);
+  EXPECT_EQ(base.faults.losses, 0);
+  ScheduledFault fault;
+  fault.session_id = "session-a";
+  fault.trial_index = 0;
+  fault.timed.at_s = 1.0;
+  fault.timed.fault.state = TrackingState::kLost;
+  fault.timed.fault.duration_s = 2.0;
+  config.slam.faults = {fault};
+  EXPECT_EQ(MakeHeadsetTrialSetup(config, in).faults.size(), 1u);
+  EXPECT_EQ(MakeHeadsetTrialSetup(config, in).max_repeats, config.hmd.max_repeats);
+  const TrialOutcome o = RunHeadsetTrial(config, in);
+  EXPECT_EQ(o.faults.losses, 1);
+  EXPECT_NEAR(o.faults.wait_s, 2.0, 1e-9);
+  HeadsetTrialInputs other_index = in, other_session = in;
+  other_index.trial_index = 1;
+  other_session.session_id = "session-b";
+  EXPECT_TRUE(MakeHeadsetTrialSetup(config, other_index).faults.empty());
+  EXPECT_TRUE(MakeHeadsetTrialSetup(config, other_session).faults.empty());
+  ExpectSame(RunHeadsetTrial(config, other_session), RunHeadsetTrial(ShippedConfigs(), other_session));
+  config.slam.faults[0].session_id = "";  // every session's trial 0
+  EXPECT_EQ(MakeHeadsetTrialSetup(config, other_session).faults.size(), 1u);
+}
+
 TEST(HeadsetTrial, SeedsArePinned) {
   // Distinct per purpose, index and session; a pure function of its arguments.
   const std::uint64_t slam = TrialSeed(1, "s", 0, kSlamSeedPurpose);

@@ -30,9 +30,10 @@ std::vector<std::string> DefaultHmdConfigRelativePaths() {
 HmdConfig ParseHmdConfig(const YAML::Node& node, const std::string& source, const std::string& key,
                          const HmdConfig& base) {
   const YamlFields f(source);
-  f.CheckKeys(node, key,
-              {"name", "gaze_hz", "reflective_hz", "ar_view_hz", "align_waypoint", "settle_s", "max_wait_s",
-               "recapture_period_s", "gaze_fallback_distance_m", "max_gaze_distance_m", "displays"});
+  f.CheckKeys(
+      node, key,
+      {"name", "gaze_hz", "reflective_hz", "ar_view_hz", "align_waypoint", "settle_s", "max_wait_s",
+       "max_repeats", "recapture_period_s", "gaze_fallback_distance_m", "max_gaze_distance_m", "displays"});
   HmdConfig c = base;
   c.name = Text(f, node, "name", key, c.name);
   c.gaze_hz = f.NumberOr(node, "gaze_hz", key, c.gaze_hz, 0.1, 120, "Hz");
@@ -41,6 +42,7 @@ HmdConfig ParseHmdConfig(const YAML::Node& node, const std::string& source, cons
   c.align_waypoint = Text(f, node, "align_waypoint", key, c.align_waypoint);
   c.settle_s = f.NumberOr(node, "settle_s", key, c.settle_s, 0, 600, "s");
   c.max_wait_s = f.NumberOr(node, "max_wait_s", key, c.max_wait_s, 0, 3600, "s");
+  c.max_repeats = static_cast<int>(f.IntegerOr(node, "max_repeats", key, c.max_repeats, 0, 100));
   c.recapture_period_s = f.NumberOr(node, "recapture_period_s", key, c.recapture_period_s, 0, 3600, "s");
   c.gaze_fallback_distance_m =
       f.NumberOr(node, "gaze_fallback_distance_m", key, c.gaze_fallback_distance_m, 0.05, 100, "m");

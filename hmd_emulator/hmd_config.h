@@ -29,6 +29,7 @@
 ///   align_waypoint: ""           # where the emulated user aligns ("" = the walk's last waypoint)
 ///   settle_s: 0.5                # standing time at the alignment waypoint before aligning [s]
 ///   max_wait_s: 30               # longest wait for tracking to recover before aligning [s]
+///   max_repeats: 2               # alignments re-done at most per trial after a hologram jump
 ///   recapture_period_s: 0.5      # a display re-captures at most this often after the robot moved [s]
 ///   gaze_fallback_distance_m: 1.5  # D when the gaze ray misses the robot [m]
 ///   max_gaze_distance_m: 10      # ray-casting range [m]
@@ -63,6 +64,7 @@ struct HmdConfig {
   std::string align_waypoint;  ///< "" = the walk's last waypoint
   double settle_s{0.5};
   double max_wait_s{30.0};
+  int max_repeats{2};  ///< TrialSetup::max_repeats (viraal_trial.h)
   double recapture_period_s{0.5};
   double gaze_fallback_distance_m{1.5};
   double max_gaze_distance_m{10.0};

@@ -23,6 +23,7 @@ void ExpectSame(const HmdConfig& a, const HmdConfig& b, const std::string& what)
   EXPECT_EQ(a.align_waypoint, b.align_waypoint);
   EXPECT_EQ(a.settle_s, b.settle_s);
   EXPECT_EQ(a.max_wait_s, b.max_wait_s);
+  EXPECT_EQ(a.max_repeats, b.max_repeats);
   EXPECT_EQ(a.recapture_period_s, b.recapture_period_s);
   EXPECT_EQ(a.gaze_fallback_distance_m, b.gaze_fallback_distance_m);
   EXPECT_EQ(a.max_gaze_distance_m, b.max_gaze_distance_m);

@@ -1,5 +1,6 @@
 #include "hmd_emulator/slam_model.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -26,6 +27,50 @@ Eigen::Matrix3d ExpRotation(const Eigen::Vector3d& w) {
   return Eigen::AngleAxisd(angle, w / angle).toRotationMatrix();
 }
 
+// The `faults:` list (slam_model.h's file comment), checked.
+std::vector<ScheduledFault> ParseFaults(const YamlFields& f, const YAML::Node& list, const std::string& key,
+                                        double rate_hz) {
+  if (!list.IsSequence() || list.size() > 1000) f.Fail(list, key, "expected a list of at most 1000 faults");
+  std::vector<ScheduledFault> faults;
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const YAML::Node e = list[i];
+    const std::string k = key + "[" + std::to_string(i) + "]";
+    f.CheckKeys(e, k, {"session", "trial", "at_s", "state", "duration_s", "jump"});
+    ScheduledFault s;
+    s.session_id = f.StringOr(e, "session", k, "");
+    s.trial_index =
+        static_cast<int>(f.Integer(f.Required(e, "trial", k + ".trial"), k + ".trial", 0, 1000000));
+    s.timed.at_s = f.Number(f.Required(e, "at_s", k + ".at_s"), k + ".at_s", 0, 3600, "s");
+    const std::string state =
+        f.OneOf(f.Required(e, "state", k + ".state"), k + ".state", {"limited", "lost"});
+    s.timed.fault.state = state == "lost" ? TrackingState::kLost : TrackingState::kLimited;
+    s.timed.fault.duration_s =
+        f.Number(f.Required(e, "duration_s", k + ".duration_s"), k + ".duration_s", 1.0 / rate_hz, 60, "s");
+    if (e["jump"]) {
+      const std::string kj = k + ".jump";
+      f.CheckKeys(e["jump"], kj, {"position_m", "yaw_deg"});
+      if (e["jump"]["position_m"]) {
+        s.timed.fault.jump_W_m = f.Vector3(e["jump"]["position_m"], kj + ".position_m", "m");
+        if (!(s.timed.fault.jump_W_m.norm() <= 1.0))
+          f.Fail(e["jump"]["position_m"], kj + ".position_m", "at most 1 m");
+      }
+      s.timed.fault.jump_yaw_deg = f.NumberOr(e["jump"], "yaw_deg", kj, 0.0, -45, 45, "deg");
+    }
+    for (const ScheduledFault& earlier : faults) {
+      const bool same_trial =
+          earlier.trial_index == s.trial_index &&
+          (earlier.session_id.empty() || s.session_id.empty() || earlier.session_id == s.session_id);
+      if (same_trial && !(s.timed.at_s > earlier.timed.at_s + earlier.timed.fault.duration_s)) {
+        f.Fail(e["at_s"], k + ".at_s",
+               "after the end of the trial's earlier fault (at_s " + std::to_string(earlier.timed.at_s) +
+                   " + duration_s " + std::to_string(earlier.timed.fault.duration_s) + ")");
+      }
+    }
+    faults.push_back(s);
+  }
+  return faults;
+}
+
 }  // namespace
 
 const char* TrackingStateName(TrackingState state) {
@@ -45,7 +90,7 @@ const char* TrackingStateName(TrackingState state) {
 SlamConfig ParseSlamConfig(const YAML::Node& node, const std::string& source, const std::string& key,
                            const SlamConfig& base) {
   const YamlFields f(source);
-  f.CheckKeys(node, key, {"seed", "rate_hz", "head_to_camera", "jitter", "drift", "tracking_loss"});
+  f.CheckKeys(node, key, {"seed", "rate_hz", "head_to_camera", "jitter", "drift", "tracking_loss", "faults"});
   SlamConfig c = base;
   c.seed = static_cast<std::uint64_t>(
       f.IntegerOr(node, "seed", key, static_cast<long long>(c.seed), 0, (1LL << 62)));
@@ -95,6 +140,7 @@ SlamConfig ParseSlamConfig(const YAML::Node& node, const std::string& source, co
       f.NumberOr(t, "relocalization_correction", kt, c.relocalization_correction, 0, 1);
   c.jump_translation_std_m = f.NumberOr(t, "jump_translation_std_m", kt, c.jump_translation_std_m, 0, 1, "m");
   c.jump_yaw_std_deg = f.NumberOr(t, "jump_yaw_std_deg", kt, c.jump_yaw_std_deg, 0, 45, "deg");
+  if (node["faults"]) c.faults = ParseFaults(f, node["faults"], key + ".faults", c.rate_hz);
   return c;
 }
 
@@ -106,6 +152,14 @@ SlamConfig LoadSlamConfigFile(const std::string& path) {
 }
 
 SlamModel::SlamModel(const SlamConfig& config) : config_(config), rng_(config.seed) {}
+
+void SlamModel::Force(const ForcedFault& fault) {
+  if (fault.state != TrackingState::kLimited && fault.state != TrackingState::kLost) {
+    throw std::invalid_argument("SlamModel::Force: the state must be limited or lost");
+  }
+  if (!(fault.duration_s > 0)) throw std::invalid_argument("SlamModel::Force: duration_s must be positive");
+  pending_force_ = fault;
+}
 
 void SlamModel::Drift(const Eigen::Vector3d& p_WH, double ds_m, double multiplier) {
   if (!(ds_m > 0) || multiplier == 0) return;
@@ -125,7 +179,7 @@ void SlamModel::AdvanceState(double dt_s) {
       state_ = TrackingState::kTracking;
       [[fallthrough]];
     case TrackingState::kTracking: {
-      const double rate_per_s = config_.tracking_loss_rate_per_min / 60.0;
+      const double rate_per_s = random_losses_ ? config_.tracking_loss_rate_per_min / 60.0 : 0.0;
       if (rate_per_s > 0 && rng_.Uniform() < 1.0 - std::exp(-rate_per_s * dt_s)) {
         state_ = TrackingState::kLimited;
         state_left_s_ = rng_.Exponential(config_.limited_mean_s);
@@ -166,17 +220,36 @@ SlamSample SlamModel::Step(const Eigen::Isometry3d& X_WH_true, double t_s) {
   path_m_ += ds;
 
   const TrackingState before = state_;
-  if (seq_ > 0) AdvanceState(dt);
+  if (pending_force_) {
+    forced_ = pending_force_;
+    pending_force_.reset();
+    state_ = forced_->state;
+    forced_samples_left_ = std::max(1LL, std::llround(forced_->duration_s * config_.rate_hz)) - 1;
+  } else if (forced_) {
+    if (forced_samples_left_ > 0) {
+      --forced_samples_left_;
+    } else {
+      state_ = TrackingState::kRelocalized;
+    }
+  } else if (seq_ > 0) {
+    AdvanceState(dt);
+  }
   if (state_ == TrackingState::kRelocalized && before != TrackingState::kRelocalized) {
     // Re-matched to the stored map: shrink the accumulated error about the head, then jump.
     const double keep = 1.0 - config_.relocalization_correction;
     const Eigen::Vector3d e_head = E_ * p_WH - p_WH;  // the head's position error before
     const Eigen::Isometry3d shrunk = YawAboutPoint(p_WH, keep * YawOf(E_), keep * e_head);
-    // The translation drawn before the yaw, one per statement (as the pinned runs: the order of a
-    // call's arguments is unspecified, and GCC evaluates them last first).
-    const Eigen::Vector3d jump_t_W = config_.jump_translation_std_m * rng_.Normal3();
-    const double jump_yaw = config_.jump_yaw_std_deg * kDegToRad * rng_.Normal();
-    const Eigen::Isometry3d jump = YawAboutPoint(p_WH, jump_yaw, jump_t_W);
+    Eigen::Isometry3d jump;
+    if (forced_) {
+      jump = YawAboutPoint(p_WH, forced_->jump_yaw_deg * kDegToRad, forced_->jump_W_m);
+      forced_.reset();
+    } else {
+      // The translation drawn before the yaw, one per statement (as the pinned runs: the order of
+      // a call's arguments is unspecified, and GCC evaluates them last first).
+      const Eigen::Vector3d jump_t_W = config_.jump_translation_std_m * rng_.Normal3();
+      const double jump_yaw = config_.jump_yaw_std_deg * kDegToRad * rng_.Normal();
+      jump = YawAboutPoint(p_WH, jump_yaw, jump_t_W);
+    }
     E_ = jump * shrunk;
   } else if (state_ != TrackingState::kLost) {
     Drift(p_WH, ds, state_ == TrackingState::kLimited ? config_.limited_drift_multiplier : 1.0);

@@ -62,11 +62,30 @@
 ///     jump_yaw_std_deg: 0.5            # [deg]
 /// @endcode
 ///
+/// Forced faults (tests and demonstrations; none by default, so config/slam.yaml has none): the
+/// `slam.faults:` list schedules tracking faults in chosen trials of orbed-hmd, at times relative
+/// to the moment the person starts aligning (headset_trial.h, viraal_trial.h); a later file's list
+/// replaces an earlier one's as a whole. Each entry:
+///   {session: ID,           # the session id ("" or absent: every session)
+///    trial: N,              # the trial index within the session (from 0)
+///    at_s: T,               # onset, seconds after the alignment started, in [0, 3600]
+///    state: lost,           # limited | lost
+///    duration_s: D,         # time in that state, in [1 / rate_hz, 60] s; then one RELOCALIZED sample
+///    jump: {position_m: [x, y, z], yaw_deg: Y}}   # the relocalization jump (absent: none) [m, deg]
+/// Faults of one trial (same trial, same session or either ""), in the order written, must not
+/// overlap: each starts after the previous one's duration_s. A forced fault is a ForcedFault
+/// (SlamModel::Force): the state holds for round(duration_s · rate_hz) samples whatever the
+/// random process would do, then one RELOCALIZED sample shrinks the drift by
+/// relocalization_correction as a drawn one does and applies the given jump (about the head, as
+/// YawAboutPoint: yaw about the vertical through the head, then the translation) instead of a
+/// random one. It draws nothing from the random stream.
+///
 /// TrackingState values equal orbed::hmd_pose_t's TRACKING/LIMITED/LOST/RELOCALIZED constants.
 /// Units: m, s, rad inside (deg only in names that say so). Threading: a SlamModel is
 /// single-threaded (it owns its random stream); configs are plain data.
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -80,6 +99,31 @@ namespace orbed::hmd {
 
 enum class TrackingState : std::int8_t { kTracking = 0, kLimited = 1, kLost = 2, kRelocalized = 3 };
 const char* TrackingStateName(TrackingState state);
+
+/// A tracking fault forced at a chosen sample instead of drawn (see the file comment).
+struct ForcedFault {
+  TrackingState state{TrackingState::kLost};  ///< kLimited or kLost
+  double duration_s{1.0};
+  Eigen::Vector3d jump_W_m{Eigen::Vector3d::Zero()};  ///< relocalization jump, translation [m]
+  double jump_yaw_deg{0};                             ///< relocalization jump, yaw about the head [deg]
+};
+
+/// A forced fault at_s after the person started aligning [s].
+struct TimedFault {
+  double at_s{0};
+  ForcedFault fault;
+};
+
+/// One entry of `slam.faults`: a TimedFault in trial trial_index of session_id ("" = every session).
+struct ScheduledFault {
+  std::string session_id;
+  int trial_index{0};
+  TimedFault timed;
+
+  bool AppliesTo(const std::string& session, int index) const {
+    return index == trial_index && (session_id.empty() || session_id == session);
+  }
+};
 
 struct SlamConfig {
   std::uint64_t seed{1};
@@ -103,6 +147,8 @@ struct SlamConfig {
   double relocalization_correction{0.5};
   double jump_translation_std_m{0.01};
   double jump_yaw_std_deg{0.5};
+  /// Forced faults (`faults:`, see the file comment); none by default.
+  std::vector<ScheduledFault> faults;
 };
 
 /// Reads the `slam:` mapping (the node itself) over `base`, key by key: a key the mapping does not
@@ -144,6 +190,17 @@ class SlamModel {
   /// The first call initialises the map on W (E = I).
   SlamSample Step(const Eigen::Isometry3d& X_WH_true, double t_s);
 
+  /// Forces `fault` from the next Step() on, whatever the state: that sample and the next
+  /// round(duration_s · rate_hz) − 1 are in fault.state, the one after is RELOCALIZED with the
+  /// fault's jump (see the file comment). Throws std::invalid_argument unless the state is
+  /// kLimited or kLost and the duration is positive.
+  void Force(const ForcedFault& fault);
+  /// Whether a forced fault is under way: from Force() until the Step() that returns its
+  /// RELOCALIZED sample (false after that Step()).
+  bool forcing() const { return pending_force_.has_value() || forced_.has_value(); }
+  /// Turns the drawn (Poisson) tracking losses off or on (on by default); forced ones happen anyway.
+  void set_random_losses(bool on) { random_losses_ = on; }
+
   const SlamConfig& config() const { return config_; }
   /// The current drift part of the map error E = X_WW'.
   const Eigen::Isometry3d& X_WWmap() const { return E_; }
@@ -166,6 +223,10 @@ class SlamModel {
   double state_left_s_{0};
   bool lost_follows_{false};
   Eigen::Isometry3d frozen_X_WH_est_{Eigen::Isometry3d::Identity()};
+  bool random_losses_{true};
+  std::optional<ForcedFault> pending_force_;  // Force() called, not yet applied by Step()
+  std::optional<ForcedFault> forced_;         // under way: its jump is applied at RELOCALIZED
+  long long forced_samples_left_{0};          // samples still in forced_->state after this one
 };
 
 /// Samples a trajectory at config.rate_hz from t = 0 to t_end_s (inclusive of 0): one SlamModel

@@ -15,6 +15,7 @@
 
 #include "base/source_paths.h"
 #include "base/stats.h"
+#include "base/units.h"
 #include "base/yaml_fields.h"
 #include "geometry/camera_model.h"
 #include "orbed/hmd_pose_t.hpp"
@@ -223,6 +224,129 @@ TEST(SlamModel, TrackingLossFreezesAndRelocalizes) {
   EXPECT_GT(counts[1], 0);
   EXPECT_GT(counts[2], 0);
   EXPECT_GT(counts[3], 10);  // ~20/min over 2 min, most episodes end in a relocalization
+}
+
+// A forced fault, counted by hand: LOST for 0.5 s at 60 Hz is 30 LOST samples (the estimate
+// frozen), then one RELOCALIZED sample whose map error is exactly the given jump (no drift, so
+// nothing to shrink), then TRACKING. It draws nothing: the samples after it are those of a model
+// that was never forced, but for the jump.
+TEST(SlamModel, ForcedFaultHoldsItsSamplesThenJumps) {
+  SlamConfig c;
+  c.tracking_loss_rate_per_min = 0;
+  c.drift_fraction_of_distance = c.drift_yaw_deg_per_m = 0;
+  HeadTrajectoryConfig stand;
+  stand.speed_m_per_s = 1;
+  stand.p_W_look_at = Eigen::Vector3d(0, 0, 1.2);
+  stand.waypoints = {{"here", {1.5, -1, 1.7}, 30.0, {}}};
+  const HeadTrajectory walk(stand);
+  SlamModel forced(c), plain(c);
+  ForcedFault fault;
+  fault.state = TrackingState::kLost;
+  fault.duration_s = 0.5;
+  fault.jump_W_m = Eigen::Vector3d(0.02, -0.01, 0);
+  fault.jump_yaw_deg = 1.0;
+  const double dt = 1.0 / c.rate_hz;
+  std::vector<SlamSample> s;
+  for (int k = 0; k < 40; ++k) {
+    if (k == 5) {
+      forced.Force(fault);
+      EXPECT_TRUE(forced.forcing());
+    }
+    s.push_back(forced.Step(walk.X_WH(k * dt), k * dt));
+    const SlamSample p = plain.Step(walk.X_WH(k * dt), k * dt);
+    if (k < 5) EXPECT_TRUE(s.back().X_WH_est.isApprox(p.X_WH_est, 0));
+  }
+  for (int k = 0; k < 40; ++k) {
+    const TrackingState expected = k < 5     ? TrackingState::kTracking
+                                   : k < 35  ? TrackingState::kLost
+                                   : k == 35 ? TrackingState::kRelocalized
+                                             : TrackingState::kTracking;
+    EXPECT_EQ(s[k].state, expected) << "sample " << k;
+    if (expected == TrackingState::kLost) EXPECT_TRUE(s[k].X_WH_est.isApprox(s[4].X_WH_est, 0));
+  }
+  EXPECT_FALSE(forced.forcing());
+  // The jump about the head: yaw about the vertical through p_WH, then the translation.
+  const Eigen::Vector3d p_WH = s[35].X_WH_true.translation();
+  Eigen::Isometry3d jump = Eigen::Isometry3d::Identity();
+  jump.linear() = Eigen::AngleAxisd(1.0 * kDegToRad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  jump.translation() = p_WH - jump.linear() * p_WH + Eigen::Vector3d(0.02, -0.01, 0);
+  EXPECT_TRUE(s[35].X_WWmap.isApprox(jump, 1e-12));
+  EXPECT_TRUE(s[39].X_WWmap.isApprox(jump, 1e-12));
+  // A "fault" that keeps tracking, or lasts no time, is refused.
+  fault.state = TrackingState::kTracking;
+  EXPECT_THROW(forced.Force(fault), std::invalid_argument);
+  fault.state = TrackingState::kLimited;
+  fault.duration_s = 0;
+  EXPECT_THROW(forced.Force(fault), std::invalid_argument);
+}
+
+TEST(SlamModel, RandomLossesCanBeTurnedOff) {
+  SlamConfig c;
+  c.tracking_loss_rate_per_min = 60;
+  SlamModel model(c);
+  model.set_random_losses(false);
+  const HeadTrajectory walk(RectangleWalk());
+  for (int k = 0; k < 60 * 60; ++k) {
+    EXPECT_EQ(model.Step(walk.X_WH(k / 60.0), k / 60.0).state, TrackingState::kTracking) << k;
+  }
+}
+
+TEST(SlamConfig, FaultSchedule) {
+  auto parse = [](const std::string& text) {
+    return ParseSlamConfig(YamlFields::LoadString(text, "f.yaml")["slam"], "f.yaml");
+  };
+  const SlamConfig c = parse(
+      "slam:\n  faults:\n"
+      "    - {session: s1, trial: 2, at_s: 1.5, state: lost, duration_s: 2, jump: {position_m: [0.03, 0, 0], "
+      "yaw_deg: -1}}\n"
+      "    - {trial: 2, at_s: 3.6, state: limited, duration_s: 0.5}\n");
+  ASSERT_EQ(c.faults.size(), 2u);
+  EXPECT_EQ(c.faults[0].session_id, "s1");
+  EXPECT_EQ(c.faults[0].trial_index, 2);
+  EXPECT_EQ(c.faults[0].timed.at_s, 1.5);
+  EXPECT_EQ(c.faults[0].timed.fault.state, TrackingState::kLost);
+  EXPECT_EQ(c.faults[0].timed.fault.duration_s, 2.0);
+  EXPECT_EQ(c.faults[0].timed.fault.jump_W_m, Eigen::Vector3d(0.03, 0, 0));
+  EXPECT_EQ(c.faults[0].timed.fault.jump_yaw_deg, -1.0);
+  EXPECT_EQ(c.faults[1].timed.fault.state, TrackingState::kLimited);
+  EXPECT_EQ(c.faults[1].timed.fault.jump_W_m, Eigen::Vector3d::Zero());
+  EXPECT_TRUE(c.faults[0].AppliesTo("s1", 2));
+  EXPECT_FALSE(c.faults[0].AppliesTo("s2", 2));
+  EXPECT_FALSE(c.faults[0].AppliesTo("s1", 1));
+  EXPECT_TRUE(c.faults[1].AppliesTo("s2", 2));  // no session: every session
+  EXPECT_TRUE(SlamConfig{}.faults.empty());
+
+  auto error = [&](const std::string& text) {
+    try {
+      parse(text);
+    } catch (const std::runtime_error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  // Overlapping faults of one trial: the second starts before the first one's end (1.5 + 2).
+  EXPECT_NE(error("slam:\n  faults:\n"
+                  "    - {session: s1, trial: 2, at_s: 1.5, state: lost, duration_s: 2}\n"
+                  "    - {trial: 2, at_s: 3.5, state: lost, duration_s: 1}\n")
+                .find("f.yaml:4: slam.faults[1].at_s: after the end of the trial's earlier fault"),
+            std::string::npos);
+  // Another trial may overlap.
+  EXPECT_EQ(error("slam:\n  faults:\n"
+                  "    - {trial: 2, at_s: 1.5, state: lost, duration_s: 2}\n"
+                  "    - {trial: 3, at_s: 1.5, state: lost, duration_s: 2}\n"),
+            "no error");
+  EXPECT_NE(error("slam:\n  faults:\n    - {trial: 0, at_s: 1, state: tracking, duration_s: 1}\n")
+                .find("slam.faults[0].state: expected"),
+            std::string::npos);
+  EXPECT_NE(error("slam:\n  faults:\n    - {trial: 0, at_s: 1, state: lost, duration_s: 61}\n")
+                .find("slam.faults[0].duration_s"),
+            std::string::npos);
+  EXPECT_NE(
+      error("slam:\n  faults:\n    - {at_s: 1, state: lost, duration_s: 1}\n").find("slam.faults[0].trial"),
+      std::string::npos);
+  EXPECT_NE(error("slam:\n  faults:\n    - {trial: 0, at_s: 1, state: lost, duration_s: 1, when: 3}\n")
+                .find("unknown key"),
+            std::string::npos);
 }
 
 // The hologram relation X_WV_apparent = X_WH_true · X_WH_est⁻¹ · X_WV and its consequences.

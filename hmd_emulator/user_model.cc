@@ -247,6 +247,7 @@ AlignmentResult EmulatedUser::Align(const ViewingContext& ctx, const std::vector
   const int num_unknowns = 7 + static_cast<int>(displays.size());
   AlignmentResult result;
   Eigen::Isometry3d X_WV = X_WV_start;
+  result.poses.push_back({0.0, X_WV});
   while (true) {
     // Look.
     result.duration_s += c.look_time_s + c.display_look_time_s * static_cast<double>(displays.size());
@@ -383,9 +384,30 @@ AlignmentResult EmulatedUser::Align(const ViewingContext& ctx, const std::vector
     X_WV.linear() = Eigen::Quaterniond(X_WV.linear()).normalized().toRotationMatrix();
     ++result.nudges;
     result.duration_s += c.nudge_time_s;
+    result.poses.push_back({result.duration_s, X_WV});
   }
   result.X_WV = X_WV;
   return result;
+}
+
+Eigen::Isometry3d AlignmentResult::X_WV_at(double t_s) const {
+  Eigen::Isometry3d X = poses.empty() ? X_WV : poses.front().X_WV;
+  for (const TimedPose& p : poses) {
+    if (p.t_s > t_s) break;
+    X = p.X_WV;
+  }
+  return X;
+}
+
+bool EmulatedUser::SeesHologramMove(const Eigen::Isometry3d& X_WV_apparent_before,
+                                    const Eigen::Isometry3d& X_WV_apparent_after,
+                                    const std::vector<Eigen::Vector3d>& p_RQ,
+                                    const Eigen::Vector3d& p_W_eye) const {
+  if (p_RQ.empty()) return false;
+  const PoseError moved = EvaluatePose(X_WV_apparent_after, X_WV_apparent_before, p_RQ, p_W_eye);
+  const double rho_m = (X_WV_apparent_before * Centroid(p_RQ) - p_W_eye).norm();
+  return moved.lateral_m > rho_m * config_.stop_lateral_arcmin * kArcminToRad ||
+         moved.along_ray_m > rho_m * config_.stop_depth_fraction;
 }
 
 PoseError EvaluatePose(const Eigen::Isometry3d& X_WV_cmp, const Eigen::Isometry3d& X_WR,

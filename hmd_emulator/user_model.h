@@ -166,9 +166,20 @@ struct ViewingContext {
   std::vector<ReflectiveDisplayView> displays;                 ///< empty: AR only
 };
 
+/// The hologram's pose (map coordinates) from t_s on, t_s from the start of an alignment [s].
+struct TimedPose {
+  double t_s{0};
+  Eigen::Isometry3d X_WV{Eigen::Isometry3d::Identity()};
+};
+
 struct AlignmentResult {
   Eigen::Isometry3d X_WV{Eigen::Isometry3d::Identity()};  ///< chosen pose, map coordinates
   double duration_s{0};
+  /// The hologram through the alignment: X_WV_start at 0, then each nudge's result from the time
+  /// it was done (ascending t_s; the last one is X_WV).
+  std::vector<TimedPose> poses;
+  /// Where the hologram is t_s into the alignment (the last of `poses` at or before t_s).
+  Eigen::Isometry3d X_WV_at(double t_s) const;
   int nudges{0};
   /// "aligned" (thresholds met), "no_visible_improvement" (step below min_step), "max_nudges".
   std::string stop_reason;
@@ -189,6 +200,15 @@ class EmulatedUser {
   /// the real and the virtual robot. trial_seed: the trial's own randomness.
   AlignmentResult Align(const ViewingContext& context, const std::vector<Eigen::Vector3d>& p_RQ,
                         const Eigen::Isometry3d& X_WV_start, std::uint64_t trial_seed) const;
+
+  /// Whether the person sees the hologram move when it jumps from where it appeared
+  /// (X_WV_apparent_before) to X_WV_apparent_after (e.g. at a relocalization), looking from
+  /// p_W_eye: the model centroid moved across the line of sight by more than stop_lateral_arcmin
+  /// or along it by more than stop_depth_fraction of the viewing distance, the very discrepancies
+  /// at which the person would not have stopped aligning.
+  bool SeesHologramMove(const Eigen::Isometry3d& X_WV_apparent_before,
+                        const Eigen::Isometry3d& X_WV_apparent_after,
+                        const std::vector<Eigen::Vector3d>& p_RQ, const Eigen::Vector3d& p_W_eye) const;
 
   /// X_WV_start = X_WR_nominal · X_RV_start: the virtual robot shown at its known offset.
   Eigen::Isometry3d StartPose(const Eigen::Isometry3d& X_WR_nominal) const {

@@ -163,6 +163,26 @@ void ExpectSame(const UserConfig& a, const UserConfig& b, const std::string& wha
 
 // The defaults live in three places that must agree: user_model.h's @code{.yaml} block, UserConfig's
 // member initializers and config/user.yaml. Fails when one is edited without the others.
+// The person sees a jump beyond their own stopping thresholds (3 arcmin across the line of sight,
+// 1 % of the distance along it): at 2 m, 1 mm across is 1.7 arcmin (unseen), 5 mm is 8.6 (seen);
+// 15 mm along it is 0.75 % (unseen), 30 mm is 1.5 % (seen).
+TEST(EmulatedUser, SeesAJumpBeyondItsThresholds) {
+  const EmulatedUser user{UserConfig{}};
+  const std::vector<Eigen::Vector3d> p_RQ = {{0, 0, 0}};  // the centroid itself
+  const Eigen::Vector3d p_W_eye(-2, 0, 0);                // looking along +x from 2 m
+  auto shifted = [](const Eigen::Vector3d& t) {
+    Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+    X.translation() = t;
+    return X;
+  };
+  const Eigen::Isometry3d I = Eigen::Isometry3d::Identity();
+  EXPECT_FALSE(user.SeesHologramMove(I, I, p_RQ, p_W_eye));
+  EXPECT_FALSE(user.SeesHologramMove(I, shifted({0, 0.001, 0}), p_RQ, p_W_eye));
+  EXPECT_TRUE(user.SeesHologramMove(I, shifted({0, 0.005, 0}), p_RQ, p_W_eye));
+  EXPECT_FALSE(user.SeesHologramMove(I, shifted({0.015, 0, 0}), p_RQ, p_W_eye));
+  EXPECT_TRUE(user.SeesHologramMove(I, shifted({0.030, 0, 0}), p_RQ, p_W_eye));
+}
+
 TEST(UserConfig, HeaderStructAndShippedFileAgree) {
   const std::string header = orbed::SourceDir() + "/hmd_emulator/user_model.h";
   const std::string file = orbed::SourceDir() + "/" + kDefaultUserConfigRelativePath;

@@ -1,9 +1,62 @@
 #include "hmd_emulator/viraal_trial.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
 namespace orbed::hmd {
+namespace {
+
+// The alignment with setup.faults (viraal_trial.h's file comment). On entry out->alignment is the
+// first attempt, made with `ctx` from out->at_alignment, the last sample `model` produced; on
+// return out->alignment is the last attempt with duration_s the whole alignment's.
+void AlignThroughFaults(const TrialSetup& setup, const EmulatedUser& user, std::uint64_t trial_seed,
+                        ViewingContext ctx, SlamModel* model, TrialOutcome* out) {
+  model->set_random_losses(false);
+  const double dt = 1.0 / model->config().rate_hz;
+  const double t0 = out->at_alignment.t_s;
+  const Eigen::Isometry3d X_WH_stand = out->at_alignment.X_WH_true;
+  // The hologram appears at A · X_WV (ApparentPose); A_attempt is A when the current attempt began.
+  Eigen::Isometry3d A_attempt = ctx.X_WH_true * ctx.X_WH_est.inverse();
+  long long k = 0;             // samples since the alignment sample
+  double attempt_start_s = 0;  // when the current attempt began [s from t0]
+  double paused_s = 0;         // waits inside the current attempt [s]
+  TrackingFaultRecord& record = out->faults;
+  for (const TimedFault& f : setup.faults) {
+    const long long k_onset = std::max(k + 1, static_cast<long long>(std::ceil(f.at_s / dt - 1e-9)));
+    const double onset_s = static_cast<double>(k_onset) * dt;
+    if (onset_s >= attempt_start_s + paused_s + out->alignment.duration_s) break;  // submitted before
+    while (k + 1 < k_onset) model->Step(X_WH_stand, t0 + static_cast<double>(++k) * dt);
+    model->Force(f.fault);
+    SlamSample s;
+    do {
+      s = model->Step(X_WH_stand, t0 + static_cast<double>(++k) * dt);
+    } while (s.state != TrackingState::kRelocalized);
+    const double wait_s = static_cast<double>(k - k_onset) * dt;
+    ++record.losses;
+    ++record.relocalizations;
+    record.wait_s += wait_s;
+    record.met.push_back({onset_s, f.fault});
+    out->at_end = s;
+    const Eigen::Isometry3d X_WV_now = out->alignment.X_WV_at(onset_s - attempt_start_s - paused_s);
+    const Eigen::Isometry3d A_after = s.X_WH_true * s.X_WH_est.inverse();
+    if (record.repeats < setup.max_repeats && user.SeesHologramMove(A_attempt * X_WV_now, A_after * X_WV_now,
+                                                                    setup.p_RQ, s.X_WH_true.translation())) {
+      ++record.repeats;
+      ctx.X_WH_true = s.X_WH_true;
+      ctx.X_WH_est = s.X_WH_est;
+      out->alignment = user.Align(ctx, setup.p_RQ, X_WV_now, trial_seed);
+      attempt_start_s = static_cast<double>(k) * dt;
+      paused_s = 0;
+      A_attempt = A_after;
+    } else {
+      paused_s += wait_s;  // carries on where they were
+    }
+  }
+  out->alignment.duration_s += attempt_start_s + paused_s;
+}
+
+}  // namespace
 
 TrialOutcome RunTrial(const TrialSetup& setup, const SlamConfig& slam, const EmulatedUser& user,
                       const Eigen::Isometry3d& X_WV_start, std::uint64_t trial_seed) {
@@ -57,10 +110,12 @@ TrialOutcome RunTrial(const TrialSetup& setup, const SlamConfig& slam, const Emu
     ctx.displays.push_back(view);
   }
   out.alignment = user.Align(ctx, setup.p_RQ, X_WV_start, trial_seed);
-  const Eigen::Vector3d p_W_eye = ctx.X_WH_true.translation();
+  out.at_end = out.at_alignment;
+  if (!setup.faults.empty()) AlignThroughFaults(setup, user, trial_seed, ctx, &model, &out);
+  const Eigen::Vector3d p_W_eye = out.at_end.X_WH_true.translation();
   out.registration = EvaluatePose(out.alignment.X_WV, setup.X_WR, setup.p_RQ, p_W_eye);
-  out.augmentation = EvaluatePose(ApparentPose(ctx.X_WH_true, ctx.X_WH_est, out.alignment.X_WV), setup.X_WR,
-                                  setup.p_RQ, p_W_eye);
+  out.augmentation = EvaluatePose(ApparentPose(out.at_end.X_WH_true, out.at_end.X_WH_est, out.alignment.X_WV),
+                                  setup.X_WR, setup.p_RQ, p_W_eye);
   return out;
 }
 

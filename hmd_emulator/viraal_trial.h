@@ -11,6 +11,28 @@
 /// the end of the trial (ApparentPose) with the real robot, i.e. what the paper's landmark protocol
 /// measures inside the headset's own map.
 ///
+/// Tracking faults while aligning (setup.faults, forced; times from the start of the alignment,
+/// t = 0 at the alignment sample). Without faults the SLAM model is not stepped after the
+/// alignment sample and the trial is what it always was. With them the person stands still at the
+/// alignment waypoint (no drift; jitter only; drawn tracking losses off, so only the forced ones
+/// happen) and the model is stepped at rate_hz from the alignment sample on. A fault whose onset
+/// falls before the person submits interrupts them:
+///  - they stop and wait while the device is LIMITED or LOST, until its RELOCALIZED sample (the
+///    time between the fault's first sample and that one, round(duration_s · rate_hz) / rate_hz,
+///    is `wait_s`; it is part of duration_s, as it is part of the time the person took);
+///  - if the hologram then appears moved (EmulatedUser::SeesHologramMove, between where it appeared
+///    to them at the start of their current alignment and where it appears after the
+///    relocalization, at the pose they had reached at the onset), they re-do the alignment from that
+///    pose with what they see after the relocalization (same trial seed: the trial's biases are
+///    held), at most max_repeats times; the time of the interrupted attempt is spent;
+///  - otherwise (or with no repeats left) they carry on where they were: the attempt's result
+///    stands and finishes wait_s later.
+/// A fault after the person submitted does not happen to them. The augmentation error is taken
+/// with the last sample they aligned or waited with (after the last relocalization), so it shows a
+/// jump that the person did not re-align for. The record (TrackingFaultRecord) counts all this.
+/// Sources: the wait is the device's (the fault's duration); a repeat costs what the user model's
+/// looks and nudges cost (config/user.yaml); max_repeats is chosen (hmd.yaml).
+///
 /// Threading: pure function of its inputs (seeds included); reentrant.
 
 #include <cstdint>
@@ -36,15 +58,35 @@ struct TrialSetup {
   /// long for it to recover (then aligns anyway) [s].
   double max_wait_s{30.0};
   geometry::Intrinsics intrinsics;
+  /// Forced tracking faults while aligning (see the file comment): ascending at_s, each after the
+  /// previous one's end (the `slam.faults` parser checks it).
+  std::vector<TimedFault> faults;
+  /// The most alignments the person re-does in one trial after seeing the hologram jump.
+  int max_repeats{2};
+};
+
+/// What tracking faults did to the person while aligning (between the alignment sample and the
+/// submission; ALIGNMENT_TRIAL carries it).
+struct TrackingFaultRecord {
+  int losses{0};           ///< faults met (LIMITED or LOST episodes)
+  int relocalizations{0};  ///< RELOCALIZED samples
+  double wait_s{0};        ///< stood waiting for tracking, included in duration_s [s]
+  int repeats{0};          ///< alignments re-done after the hologram jumped
+  /// The faults met, at their onset (the sample they started on) from the alignment start.
+  std::vector<TimedFault> met;
 };
 
 struct TrialOutcome {
+  /// The person's (last) alignment; its duration_s is the whole alignment's, waits and interrupted
+  /// attempts included.
   AlignmentResult alignment;
-  PoseError registration;  ///< X_WV (map) against X_WR (truth)
-  PoseError augmentation;  ///< apparent hologram against X_WR, at the alignment sample
-  SlamSample at_alignment;
+  PoseError registration;   ///< X_WV (map) against X_WR (truth)
+  PoseError augmentation;   ///< apparent hologram against X_WR, at at_end
+  SlamSample at_alignment;  ///< the sample the person started aligning with
+  SlamSample at_end;        ///< the last one they aligned or waited with (= at_alignment without faults)
   std::vector<SlamSample> at_capture;
-  int relocalizations{0};  ///< RELOCALIZED samples during the walk
+  int relocalizations{0};      ///< RELOCALIZED samples during the walk (and the wait before aligning)
+  TrackingFaultRecord faults;  ///< while aligning
 };
 
 /// Runs one trial. slam.seed and trial_seed make it reproducible; X_WV_start is in map coordinates.

@@ -1,0 +1,227 @@
+// Tracking faults while the emulated person aligns (viraal_trial.h). The SLAM model is made exact
+// (no jitter, no drift, no drawn losses: the map is the world until a forced relocalization jump),
+// so the oracles are worked out from the pieces: the fault-free trial, the person's own alignment
+// (EmulatedUser::Align) from the pose they had reached, with what they see after the jump, and the
+// hologram relation (ApparentPose).
+#include "hmd_emulator/viraal_trial.h"
+
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "base/source_paths.h"
+#include "sim/scene.h"
+
+namespace orbed::hmd {
+namespace {
+
+struct Fixture {
+  TrialSetup setup;
+  SlamConfig slam;
+  EmulatedUser user{UserConfig{}};
+  Eigen::Isometry3d X_WV_start;
+  static constexpr std::uint64_t kTrialSeed = 11;
+
+  Fixture() {
+    const sim::Scene scene = sim::LoadSceneFile(orbed::SourceDir() + "/" + sim::kDefaultSceneRelativePath);
+    const sim::RobotModel robot =
+        sim::LoadRobotForScene(orbed::SourceDir() + "/" + sim::RobotModel::kDefaultUrdfRelativePath, scene);
+    setup.X_WR = scene.X_WR;
+    setup.p_RQ =
+        RobotModelPoints(robot, sim::DegToRad((Eigen::VectorXd(7) << 0, 30, 0, -60, 0, 45, 0).finished()));
+    setup.walk = LoadHeadTrajectoryFile(orbed::SourceDir() + "/hmd_emulator/config/viraal_walk.yaml");
+    setup.capture_waypoints = {"foot_end"};
+    setup.align_waypoint = "head_end";
+    setup.intrinsics = geometry::Intrinsics::HoloLensPv();
+    slam.jitter_translation_std_m = slam.jitter_rotation_std_deg = 0;
+    slam.drift_fraction_of_distance = slam.drift_yaw_deg_per_m = 0;
+    slam.tracking_loss_rate_per_min = 0;
+    X_WV_start = user.StartPose(scene.X_WR);
+  }
+  TrialOutcome Run(const std::vector<TimedFault>& faults, int max_repeats = 2) const {
+    TrialSetup s = setup;
+    s.faults = faults;
+    s.max_repeats = max_repeats;
+    return RunTrial(s, slam, user, X_WV_start, kTrialSeed);
+  }
+  // What the person sees with the head at `sample` (the displays as the trial captured them).
+  ViewingContext Context(const TrialOutcome& o, const SlamSample& sample) const {
+    ViewingContext ctx;
+    ctx.X_WR = setup.X_WR;
+    ctx.X_WH_true = sample.X_WH_true;
+    ctx.X_WH_est = sample.X_WH_est;
+    for (const auto& cap : o.at_capture) {
+      ReflectiveDisplayView view;
+      view.intrinsics = setup.intrinsics;
+      view.X_WC_true = cap.X_WC_true;
+      view.X_WC_est = cap.X_WC_est;
+      ctx.displays.push_back(view);
+    }
+    return ctx;
+  }
+};
+
+TimedFault Fault(double at_s, TrackingState state, double duration_s,
+                 const Eigen::Vector3d& jump_W_m = {0, 0, 0}) {
+  TimedFault f;
+  f.at_s = at_s;
+  f.fault.state = state;
+  f.fault.duration_s = duration_s;
+  f.fault.jump_W_m = jump_W_m;
+  return f;
+}
+
+// The jump as the model applies it at the head (yaw 0: a translation).
+Eigen::Isometry3d Translation(const Eigen::Vector3d& t) {
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  X.translation() = t;
+  return X;
+}
+
+TEST(TrackingFaults, NoneWithoutASchedule) {
+  const Fixture f;
+  const TrialOutcome o = f.Run({});
+  EXPECT_EQ(o.faults.losses, 0);
+  EXPECT_EQ(o.faults.relocalizations, 0);
+  EXPECT_EQ(o.faults.wait_s, 0);
+  EXPECT_EQ(o.faults.repeats, 0);
+  EXPECT_TRUE(o.at_end.X_WH_est.isApprox(o.at_alignment.X_WH_est, 0));
+  EXPECT_EQ(o.at_end.seq, o.at_alignment.seq);
+  // The exact model: the map is the world, the hologram appears where it is placed.
+  EXPECT_NEAR(o.augmentation.translation_error_m, o.registration.translation_error_m, 1e-12);
+}
+
+// LOST for 2 s, 1 s into the alignment, with no jump: the person waits and carries on; the trial is
+// the fault-free one, 2 s (120 samples at 60 Hz) longer.
+TEST(TrackingFaults, LostWithoutJumpAddsExactlyTheWait) {
+  const Fixture f;
+  const TrialOutcome base = f.Run({});
+  ASSERT_GT(base.alignment.duration_s, 1.0);
+  const TrialOutcome o = f.Run({Fault(1.0, TrackingState::kLost, 2.0)});
+  EXPECT_TRUE(o.alignment.X_WV.isApprox(base.alignment.X_WV, 0));
+  EXPECT_NEAR(o.alignment.duration_s, base.alignment.duration_s + 2.0, 1e-9);
+  EXPECT_EQ(o.faults.losses, 1);
+  EXPECT_EQ(o.faults.relocalizations, 1);
+  EXPECT_NEAR(o.faults.wait_s, 2.0, 1e-9);
+  EXPECT_EQ(o.faults.repeats, 0);
+  ASSERT_EQ(o.faults.met.size(), 1u);
+  EXPECT_NEAR(o.faults.met[0].at_s, 1.0, 1e-9);
+  EXPECT_EQ(o.at_end.state, TrackingState::kRelocalized);
+  EXPECT_NEAR(o.at_end.t_s - o.at_alignment.t_s, 3.0, 1e-9);
+  EXPECT_NEAR(o.registration.translation_error_m, base.registration.translation_error_m, 1e-12);
+  EXPECT_NEAR(o.augmentation.translation_error_m, base.augmentation.translation_error_m, 1e-12);
+  // LIMITED the same: the state does not matter to a person who waits.
+  const TrialOutcome limited = f.Run({Fault(1.0, TrackingState::kLimited, 2.0)});
+  EXPECT_TRUE(limited.alignment.X_WV.isApprox(base.alignment.X_WV, 0));
+  EXPECT_NEAR(limited.alignment.duration_s, base.alignment.duration_s + 2.0, 1e-9);
+}
+
+// A 5 cm jump 10 s into the alignment: the person sees the hologram move (86 arcmin at ~2 m),
+// re-does the alignment from where they were at 10 s with what they see after the jump, and ends
+// with a pose of the jumped map. (AR only here: a display captured before the jump still shows the
+// overlay drawn with the old map and pulls the other way; the next test has one.)
+TEST(TrackingFaults, JumpMakesThePersonRedoTheAlignmentInTheNewMap) {
+  Fixture f;
+  f.setup.capture_waypoints.clear();
+  const Eigen::Vector3d jump_W_m(0.05, 0, 0);
+  const TrialOutcome base = f.Run({});
+  ASSERT_GT(base.alignment.duration_s, 10.0);
+  const TrialOutcome o = f.Run({Fault(10.0, TrackingState::kLost, 2.0, jump_W_m)});
+  EXPECT_EQ(o.faults.losses, 1);
+  EXPECT_EQ(o.faults.repeats, 1);
+  EXPECT_NEAR(o.faults.wait_s, 2.0, 1e-9);
+  // After the jump the device believes the head is at J⁻¹ · X_WH_true.
+  const Eigen::Isometry3d J = Translation(jump_W_m);
+  EXPECT_TRUE(o.at_end.X_WH_est.isApprox(J.inverse() * o.at_alignment.X_WH_true, 1e-12));
+  // The oracle from the pieces: the second attempt.
+  ViewingContext after = f.Context(o, o.at_alignment);
+  after.X_WH_est = J.inverse() * o.at_alignment.X_WH_true;
+  const AlignmentResult redo =
+      f.user.Align(after, f.setup.p_RQ, base.alignment.X_WV_at(10.0), Fixture::kTrialSeed);
+  EXPECT_TRUE(o.alignment.X_WV.isApprox(redo.X_WV, 1e-12));
+  EXPECT_NEAR(o.alignment.duration_s, 10.0 + 2.0 + redo.duration_s, 1e-9);
+  const PoseError augmentation =
+      EvaluatePose(J * redo.X_WV, f.setup.X_WR, f.setup.p_RQ, o.at_alignment.X_WH_true.translation());
+  EXPECT_NEAR(o.augmentation.translation_error_m, augmentation.translation_error_m, 1e-9);
+  // Physically: the person aligned what they saw, so the hologram appears on the robot about as
+  // well as without the fault, and in map coordinates it is off by about the jump.
+  EXPECT_LT(o.augmentation.translation_error_m, base.augmentation.translation_error_m + 0.01);
+  EXPECT_GT(o.registration.translation_error_m, 0.03);
+}
+
+// With a display captured before the jump (stamped with the old map), the re-done alignment lands
+// between the two maps: the jump is partly re-aligned, partly left in the augmentation error.
+TEST(TrackingFaults, AStaleDisplayHoldsThePersonToTheOldMap) {
+  const Fixture f;
+  ASSERT_EQ(f.setup.capture_waypoints.size(), 1u);
+  const Eigen::Vector3d jump_W_m(0.05, 0, 0);
+  const TrialOutcome o = f.Run({Fault(10.0, TrackingState::kLost, 2.0, jump_W_m)});
+  EXPECT_EQ(o.faults.repeats, 1);
+  const PoseError old_map =
+      EvaluatePose(o.alignment.X_WV, f.setup.X_WR, f.setup.p_RQ, o.at_alignment.X_WH_true.translation());
+  EXPECT_GT(o.augmentation.translation_error_m, 0.01);
+  EXPECT_LT(o.augmentation.translation_error_m, 0.05);
+  EXPECT_LT(old_map.translation_error_m, 0.05);
+}
+
+// No repeats left: the person carries on, submits the pose of the old map, and the jump shows in
+// the augmentation error.
+TEST(TrackingFaults, WithoutRepeatsTheJumpStaysInTheAugmentationError) {
+  const Fixture f;
+  const Eigen::Vector3d jump_W_m(0.05, 0, 0);
+  const TrialOutcome base = f.Run({});
+  const TrialOutcome o = f.Run({Fault(10.0, TrackingState::kLost, 2.0, jump_W_m)}, /*max_repeats=*/0);
+  EXPECT_EQ(o.faults.repeats, 0);
+  EXPECT_TRUE(o.alignment.X_WV.isApprox(base.alignment.X_WV, 0));
+  EXPECT_NEAR(o.alignment.duration_s, base.alignment.duration_s + 2.0, 1e-9);
+  const PoseError augmentation = EvaluatePose(Translation(jump_W_m) * base.alignment.X_WV, f.setup.X_WR,
+                                              f.setup.p_RQ, o.at_alignment.X_WH_true.translation());
+  EXPECT_NEAR(o.augmentation.translation_error_m, augmentation.translation_error_m, 1e-9);
+  EXPECT_NEAR(o.registration.translation_error_m, base.registration.translation_error_m, 1e-12);
+}
+
+// Two jumps, one repeat allowed: the first is re-done (from 7 s on), the second, 1 s into the
+// re-done attempt, is waited out and the attempt carried on.
+TEST(TrackingFaults, RepeatsAreBounded) {
+  const Fixture f;
+  const TrialOutcome o = f.Run({Fault(5.0, TrackingState::kLost, 2.0, {0.05, 0, 0}),
+                                Fault(8.0, TrackingState::kLimited, 1.0, {0, 0.05, 0})},
+                               /*max_repeats=*/1);
+  EXPECT_EQ(o.faults.losses, 2);
+  EXPECT_EQ(o.faults.relocalizations, 2);
+  EXPECT_EQ(o.faults.repeats, 1);
+  EXPECT_NEAR(o.faults.wait_s, 3.0, 1e-9);
+  ViewingContext after = f.Context(o, o.at_alignment);
+  after.X_WH_est = Translation({0.05, 0, 0}).inverse() * o.at_alignment.X_WH_true;
+  const TrialOutcome base = f.Run({});
+  const AlignmentResult redo =
+      f.user.Align(after, f.setup.p_RQ, base.alignment.X_WV_at(5.0), Fixture::kTrialSeed);
+  ASSERT_GT(redo.duration_s, 1.0);  // the second fault falls inside the re-done attempt
+  EXPECT_TRUE(o.alignment.X_WV.isApprox(redo.X_WV, 1e-12));
+  EXPECT_NEAR(o.alignment.duration_s, 7.0 + redo.duration_s + 1.0, 1e-9);
+}
+
+// A fault scheduled after the person submitted does not happen to them.
+TEST(TrackingFaults, AfterTheSubmissionNothingHappens) {
+  const Fixture f;
+  const TrialOutcome base = f.Run({});
+  const TrialOutcome o =
+      f.Run({Fault(base.alignment.duration_s + 1.0, TrackingState::kLost, 2.0, {0.05, 0, 0})});
+  EXPECT_EQ(o.faults.losses, 0);
+  EXPECT_TRUE(o.faults.met.empty());
+  EXPECT_TRUE(o.alignment.X_WV.isApprox(base.alignment.X_WV, 0));
+  EXPECT_EQ(o.alignment.duration_s, base.alignment.duration_s);
+}
+
+TEST(AlignmentResult, PoseAtATime) {
+  AlignmentResult r;
+  r.poses = {{0.0, Translation({0, 0, 0})}, {7.5, Translation({1, 0, 0})}, {13.0, Translation({2, 0, 0})}};
+  EXPECT_EQ(r.X_WV_at(0).translation().x(), 0);
+  EXPECT_EQ(r.X_WV_at(7.4).translation().x(), 0);
+  EXPECT_EQ(r.X_WV_at(7.5).translation().x(), 1);
+  EXPECT_EQ(r.X_WV_at(100).translation().x(), 2);
+}
+
+}  // namespace
+}  // namespace orbed::hmd
