@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <stdexcept>
+#include <utility>
 
 #include <opencv2/highgui.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -163,6 +164,11 @@ void HmdProcess::PublishPose() {
       stream_->Step(std::chrono::duration<double>(now - t0_).count(), NowMicros());
   process_->Publish(options_.hmd_pose_channel, poses.estimate);
   process_->Publish(options_.hmd_pose_truth_channel, poses.truth);
+  if (pending_trial_ && !stream_->playing_faults()) {
+    const TrialOutcome outcome = std::move(*pending_trial_);
+    pending_trial_.reset();
+    PublishEmulatedTrial(outcome);
+  }
 }
 
 void HmdProcess::PublishGaze() {
@@ -204,7 +210,18 @@ void HmdProcess::OnRegistration(const orbed::registration_t& msg, const std::str
 }
 
 void HmdProcess::OnSessionControl(const orbed::session_control_t& msg, const std::string& channel) {
+  if (pending_trial_ && msg.command == orbed::session_control_t::REQUEST_TRIAL) {
+    const HmdSessionState& s = session_.state();
+    if (msg.session_id == s.id && msg.request_id != 0 && msg.request_id == s.requested_id) return;  // coming
+    return process_->Reject(channel + "/busy", "REQUEST_TRIAL for session '" + msg.session_id +
+                                                   "' while trial " + std::to_string(s.next_index) + " of '" +
+                                                   s.id + "' waits for its tracking faults to play");
+  }
   const SessionDecision decision = session_.Handle(msg, RobotKnown{robot_.have_q, robot_.have_X_WR});
+  if (decision.kind == SessionDecision::Kind::kStart || decision.kind == SessionDecision::Kind::kReset ||
+      decision.kind == SessionDecision::Kind::kStop) {
+    pending_trial_.reset();  // not the session's next trial any more
+  }
   switch (decision.kind) {
     case SessionDecision::Kind::kRefuse:
       return process_->Reject(channel + "/" + decision.refusal.key, decision.refusal.reason);
@@ -259,18 +276,34 @@ void HmdProcess::EmulateTrial(const std::string& channel) {
   } catch (const std::exception& e) {
     return process_->Reject(channel + "/trial_failed", std::string("the emulated trial failed: ") + e.what());
   }
+  if (outcome.faults.met.empty()) return PublishEmulatedTrial(outcome);
+  for (const TimedFault& f : outcome.faults.met) stream_->ScheduleFault(stream_->t_s() + f.at_s, f.fault);
+  ORBED_LOG(kInfo) << "trial " << inputs.trial_index << " of '" << s.id << "': " << outcome.faults.met.size()
+                   << " tracking fault(s) while aligning, played on " << options_.hmd_pose_channel
+                   << " before the answer";
+  pending_trial_ = outcome;
+}
+
+void HmdProcess::PublishEmulatedTrial(const TrialOutcome& outcome) {
+  const HmdSessionState& s = session_.state();
+  const std::int32_t index = s.next_index;
   X_WV_user_ = outcome.alignment.X_WV;
-  PublishTrial(outcome.alignment.X_WV, outcome.alignment.duration_s, user_id_);
-  ORBED_LOG(kInfo) << "trial " << inputs.trial_index << " of '" << s.id << "' ("
-                   << DisplayModeName(s.display_mode) << ", " << s.num_mirrors
-                   << " display(s)): " << outcome.alignment.stop_reason << " after "
+  PublishTrial(outcome.alignment.X_WV, outcome.alignment.duration_s, user_id_, outcome.faults);
+  const TrackingFaultRecord& f = outcome.faults;
+  ORBED_LOG(kInfo) << "trial " << index << " of '" << s.id << "' (" << DisplayModeName(s.display_mode) << ", "
+                   << s.num_mirrors << " display(s)): " << outcome.alignment.stop_reason << " after "
                    << outcome.alignment.nudges << " nudges, " << Fixed(outcome.alignment.duration_s, 1)
                    << " s emulated; error vs truth "
                    << Fixed(outcome.registration.translation_error_m * 1e3, 1) << " mm, "
-                   << Fixed(outcome.registration.rotation_error_deg, 2) << " deg";
+                   << Fixed(outcome.registration.rotation_error_deg, 2) << " deg"
+                   << (f.losses > 0
+                           ? "; tracking lost " + std::to_string(f.losses) + "x, waited " +
+                                 Fixed(f.wait_s, 1) + " s, re-aligned " + std::to_string(f.repeats) + "x"
+                           : "");
 }
 
-void HmdProcess::PublishTrial(const Eigen::Isometry3d& X_WV, double duration_s, const std::string& user_id) {
+void HmdProcess::PublishTrial(const Eigen::Isometry3d& X_WV, double duration_s, const std::string& user_id,
+                              const TrackingFaultRecord& faults) {
   orbed::alignment_trial_t msg{};
   msg.utime = NowMicros();
   msg.session_id = session_.state().id;
@@ -283,6 +316,10 @@ void HmdProcess::PublishTrial(const Eigen::Isometry3d& X_WV, double duration_s, 
   msg.duration_s = duration_s;
   msg.user_id = user_id;
   msg.request_id = session_.state().requested_id;
+  msg.tracking_losses = faults.losses;
+  msg.relocalizations = faults.relocalizations;
+  msg.tracking_wait_s = faults.wait_s;
+  msg.alignment_repeats = faults.repeats;
   process_->Publish(options_.trial_channel, msg);
   // Saved after it went out: a crash in between repeats this index (the same trial), never skips it.
   saved_.last_trial = msg;

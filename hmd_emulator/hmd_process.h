@@ -34,8 +34,17 @@
 /// once, in emulated time, at the latest q against the latest X_WR from the start offset, seeded
 /// from (--seed, session, index); then ALIGNMENT_TRIAL {session, index (per session from 0), mode,
 /// num_mirrors, q, X_WV, duration_s = the emulated alignment time, user_id "emulated-seed-<user
-/// seed>", request_id = the REQUEST_TRIAL's}. In interactive mode REQUEST_TRIAL only tells the
-/// person, and the trial submitted next answers it. A repeated request id (a retry, a duplicated
+/// seed>", request_id = the REQUEST_TRIAL's, the tracking faults the person met while aligning
+/// (tracking_losses, relocalizations, tracking_wait_s, alignment_repeats)}.
+/// Tracking faults (slam.faults, forced for chosen trials; viraal_trial.h): a trial that met any
+/// is not answered at once. Its faults are played on the live HMD_POSE stream at their times from
+/// the moment the request was accepted (the alignment's start; PoseStream::ScheduleFault), and the
+/// ALIGNMENT_TRIAL goes out right after the HMD_POSE of the last one's RELOCALIZED sample: on the
+/// bus, REQUEST_TRIAL, then HMD_POSE LIMITED / LOST ... RELOCALIZED, then the trial. Keep the
+/// faults' times within the conductor's trial timeout (60 s). Meanwhile a repeat of that request
+/// is not acted on (its answer is coming) and another REQUEST_TRIAL is refused
+/// (SESSION_CONTROL/busy); START, RESET or STOP drop the trial. In interactive mode REQUEST_TRIAL only tells
+/// the person, and the trial submitted next answers it. A repeated request id (a retry, a duplicated
 /// datagram) is answered by publishing the same ALIGNMENT_TRIAL again, byte for byte; a repeated
 /// START / RESET / STOP changes nothing (hmd_session.h).
 ///
@@ -47,7 +56,8 @@
 ///   IIWA_STATUS/num_joints, /non_finite, /limits (beyond a joint limit by > 0.01 rad);
 ///   ROBOT_STATE/pose (X_WR not finite or not a unit quaternion);
 ///   REGISTRATION/pose (a valid mean with a bad X_WV_mean);
-///   SESSION_CONTROL/<key> with the keys of hmd_session.h, and /trial_failed;
+///   SESSION_CONTROL/<key> with the keys of hmd_session.h, /trial_failed, and /busy (a request
+///   while a trial waits for its tracking faults to play);
 ///   ALIGNMENT_TRIAL/<key> (orbed::CheckAlignmentTrial's keys) for a bad trial of the active session;
 ///   and <channel>/decode for undecodable bytes (Process).
 ///
@@ -83,6 +93,7 @@
 #include "hmd_emulator/pose_stream.h"
 #include "hmd_emulator/robot_state.h"
 #include "hmd_emulator/session_file.h"
+#include "hmd_emulator/viraal_trial.h"
 #include "procs/common/channels.h"
 #include "procs/common/process.h"
 #include "sim/robot_model.h"
@@ -168,7 +179,9 @@ class HmdProcess {
   void SaveState();
   void EmulateTrial(const std::string& channel);
   void SubmitInteractiveTrial();
-  void PublishTrial(const Eigen::Isometry3d& X_WV, double duration_s, const std::string& user_id);
+  void PublishTrial(const Eigen::Isometry3d& X_WV, double duration_s, const std::string& user_id,
+                    const TrackingFaultRecord& faults = {});
+  void PublishEmulatedTrial(const TrialOutcome& outcome);
   void InteractiveTick();
   FrameInputs Inputs() const;
 
@@ -190,6 +203,8 @@ class HmdProcess {
   std::optional<Eigen::Isometry3d> X_WV_registration_, X_WV_user_;
   Eigen::Isometry3d X_WV_start_{Eigen::Isometry3d::Identity()};
   std::string user_id_;
+  // An emulated trial waiting for its tracking faults to play on HMD_POSE (see the file comment).
+  std::optional<TrialOutcome> pending_trial_;
 };
 
 }  // namespace orbed::hmd

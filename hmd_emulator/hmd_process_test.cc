@@ -13,6 +13,7 @@
 //   - a published trial equals RunHeadsetTrial() (headset_trial.h) of the same inputs.
 #include "hmd_emulator/hmd_process.h"
 
+#include <chrono>
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -240,6 +241,82 @@ TEST(HmdProcess, ARepeatedRequestIdGetsTheSameTrialAgain) {
   EXPECT_EQ(bytes(got.trials[3]), bytes(got.trials[0]));
   EXPECT_EQ(hmd.active_session(), "s2");
   EXPECT_EQ(hmd.process().rejections().total(), 0);
+}
+
+// A trial with a forced tracking fault (slam.faults) is answered after its fault has played on
+// HMD_POSE: LOST for 0.1 s (6 samples at 60 Hz), one RELOCALIZED sample, and in the same tick the
+// ALIGNMENT_TRIAL carrying the record. Meanwhile the request's retry is not acted on and another
+// request is refused (busy). The pose ticks are driven here, as fast as they go.
+TEST(HmdProcess, ATrialWithATrackingFaultIsAnsweredAfterItPlaysOnHmdPose) {
+  const std::string config = ::testing::TempDir() + "/hmd_fault.yaml";
+  std::ofstream(config) << "slam:\n  faults:\n    - {session: s1, trial: 0, at_s: 0.5, state: lost, "
+                           "duration_s: 0.1, jump: {position_m: [0.03, 0, 0]}}\n";
+  HmdOptions options = Inline();
+  options.config_paths = {config};
+  HmdProcess hmd(MemqFlags(0), options);
+  Collector got;
+  lcm::LCM& lcm = hmd.process().lcm();
+  got.Attach(lcm);
+  const orbed::iiwa_status_t status = Status(kQDeg);
+  const orbed::robot_state_t state = State(SceneX_WR());
+  auto start = Control("s1", +SC::START, +AT::MODE_AR_REFLECTIVE, 1);
+  auto request = Control("s1", +SC::REQUEST_TRIAL);
+  request.request_id = 7;
+  auto other = Control("s1", +SC::REQUEST_TRIAL);
+  other.request_id = 8;
+  lcm.publish("IIWA_STATUS", &status);
+  lcm.publish("ROBOT_STATE", &state);
+  lcm.publish("SESSION_CONTROL", &start);
+  lcm.publish("SESSION_CONTROL", &request);
+  lcm.publish("SESSION_CONTROL", &request);  // the conductor's retry: the answer is coming
+  lcm.publish("SESSION_CONTROL", &other);    // refused: busy
+  Drain(lcm);
+  EXPECT_TRUE(got.trials.empty());
+  EXPECT_EQ(hmd.process().rejections().total(), 1);
+
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  size_t poses_at_answer = 0;
+  while (got.trials.empty() && std::chrono::steady_clock::now() < deadline) {
+    hmd.PublishPose();
+    Drain(lcm);
+    poses_at_answer = got.est.size();
+  }
+  ASSERT_EQ(got.trials.size(), 1u);
+  std::vector<int> states;
+  for (const auto& p : got.est) states.push_back(p.tracking_state);
+  ASSERT_GE(states.size(), 7u);
+  EXPECT_EQ(poses_at_answer, states.size());
+  EXPECT_EQ(states.back(), +orbed::hmd_pose_t::RELOCALIZED);  // the trial right after it
+  for (size_t k = states.size() - 7; k + 1 < states.size(); ++k)
+    EXPECT_EQ(states[k], +orbed::hmd_pose_t::LOST) << k;
+  if (states.size() > 7) EXPECT_NE(states[states.size() - 8], +orbed::hmd_pose_t::LOST);
+
+  const AT& t = got.trials[0];
+  EXPECT_EQ(t.request_id, 7);
+  EXPECT_EQ(t.trial_index, 0);
+  EXPECT_EQ(t.tracking_losses, 1);
+  EXPECT_EQ(t.relocalizations, 1);
+  EXPECT_NEAR(t.tracking_wait_s, 0.1, 1e-9);
+  EXPECT_EQ(t.alignment_repeats, 1);  // 3 cm at ~2 m is ~50 arcmin: the person re-aligns
+  // The emulated trial itself, as the pure function makes it.
+  HeadsetTrialInputs in;
+  in.p_RQ = RobotModelPoints(
+      sim::LoadRobotForScene(HmdSourcePath(sim::RobotModel::kDefaultUrdfRelativePath),
+                             sim::LoadSceneFile(HmdSourcePath(sim::kDefaultSceneRelativePath))),
+      sim::DegToRad(Eigen::Map<const Eigen::VectorXd>(kQDeg.data(), 7)));
+  in.X_WR = SceneX_WR();
+  in.X_WV_start = EmulatedUser(hmd.config().user).StartPose(SceneX_WR());
+  in.process_seed = hmd.process().seed();
+  in.session_id = "s1";
+  in.num_mirrors = 1;
+  const TrialOutcome o = RunHeadsetTrial(hmd.config(), in);
+  EXPECT_EQ(t.duration_s, o.alignment.duration_s);
+  EXPECT_TRUE(FromPose(t.X_WV).isApprox(o.alignment.X_WV, 1e-12));
+  // Answered: the retry now gets the same trial.
+  lcm.publish("SESSION_CONTROL", &request);
+  Drain(lcm);
+  ASSERT_EQ(got.trials.size(), 2u);
+  EXPECT_EQ(got.trials[1].tracking_losses, 1);
 }
 
 TEST(HmdProcess, SameSeedSameSessionGivesTheSameTrial) {

@@ -20,8 +20,14 @@ PoseStream::PoseStream(const HmdConfigSet& config, const sim::Scene& scene, cons
   robot_geometry_.AddRobot(robot, BodyKind::kRealRobot);
 }
 
+void PoseStream::ScheduleFault(double t_s, const ForcedFault& fault) { scheduled_.push_back({t_s, fault}); }
+
 PoseStream::Poses PoseStream::Step(double t_s, int64_t utime) {
   t_s_ = t_s;
+  if (!scheduled_.empty() && scheduled_.front().at_s <= t_s && !slam_.forcing()) {
+    slam_.Force(scheduled_.front().fault);
+    scheduled_.pop_front();
+  }
   const SlamSample s = slam_.Step(trajectory_.X_WH(t_s), t_s);
   Poses poses;
   orbed::hmd_pose_t& est = poses.estimate;

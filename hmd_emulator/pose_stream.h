@@ -10,11 +10,17 @@
 /// max_gaze_distance_m; the nearer hit wins); the ray is reported from the ESTIMATED head, in map
 /// coordinates: origin_est, direction_est, hit = origin_est + t · direction_est.
 ///
+/// Forced faults (ScheduleFault): the live SLAM model plays a tracking fault from a chosen walk
+/// time (SlamModel::Force), so that HMD_POSE shows the LIMITED / LOST and RELOCALIZED samples of a
+/// fault that an emulated trial met (hmd_process.h); one at a time, in the order scheduled (a fault
+/// due while another is still playing starts after it).
+///
 /// Frames: W world (= the SLAM map for estimates), H head, C camera, R real robot base.
 /// Units: m, s; utime µs (the caller's stamp).
 /// Threading: not synchronised; one thread (the Process::Run() thread).
 
 #include <cstdint>
+#include <deque>
 #include <optional>
 #include <string>
 
@@ -41,6 +47,11 @@ class PoseStream {
   /// Steps head and SLAM to walk time t_s (non-decreasing) and stamps the sample `utime`.
   Poses Step(double t_s, int64_t utime);
 
+  /// Plays `fault` from the first Step() at walk time >= t_s on.
+  void ScheduleFault(double t_s, const ForcedFault& fault);
+  /// Whether a scheduled fault has not yet produced its RELOCALIZED sample.
+  bool playing_faults() const { return !scheduled_.empty() || slam_.forcing(); }
+
   /// GAZE_RAY of the latest sample (stamped with its utime); nothing before the first Step().
   /// Poses this stream's copy of the real robot at `robot` when known.
   std::optional<orbed::gaze_ray_t> Gaze(const RobotState& robot);
@@ -64,6 +75,7 @@ class PoseStream {
   SlamSample sample_;
   int64_t sample_utime_{0};
   double t_s_{0};
+  std::deque<TimedFault> scheduled_;  // at_s: walk time
 };
 
 }  // namespace orbed::hmd

@@ -55,6 +55,10 @@ TrialResult TrialResultFrom(const orbed::alignment_trial_t& trial, const orbed::
   result.errors = errors;
   result.user_duration_s = trial.duration_s;
   result.user_id = trial.user_id;
+  result.tracking_faults.losses = trial.tracking_losses;
+  result.tracking_faults.relocalizations = trial.relocalizations;
+  result.tracking_faults.wait_s = trial.tracking_wait_s;
+  result.tracking_faults.repeats = trial.alignment_repeats;
   result.X_WV = FromPose(trial.X_WV);
   result.X_WR = FromPose(X_WR);
   return result;
@@ -73,6 +77,10 @@ orbed::alignment_trial_t TrialMessageFrom(const TrialResult& trial, const Sessio
   msg.X_WV = ToPose(trial.X_WV);
   msg.duration_s = trial.user_duration_s;
   msg.user_id = trial.user_id;
+  msg.tracking_losses = trial.tracking_faults.losses;
+  msg.relocalizations = trial.tracking_faults.relocalizations;
+  msg.tracking_wait_s = trial.tracking_faults.wait_s;
+  msg.alignment_repeats = trial.tracking_faults.repeats;
   return msg;
 }
 

@@ -137,6 +137,14 @@ std::string ResultsJson(const RunResults& r) {
       WritePose(&json, t.X_WV);
       json.Key("X_WR");
       WritePose(&json, t.X_WR);
+      if (t.tracking_faults.any()) {
+        json.Key("tracking_faults").BeginObject();
+        json.Key("losses").Int(t.tracking_faults.losses);
+        json.Key("relocalizations").Int(t.tracking_faults.relocalizations);
+        json.Key("wait_s").Number(t.tracking_faults.wait_s);
+        json.Key("repeats").Int(t.tracking_faults.repeats);
+        json.EndObject();
+      }
       json.EndObject();
     }
     json.EndArray();
@@ -308,6 +316,13 @@ RunResults ParseResultsJson(const std::string& text, const std::string& source) 
       t.user_id = f.String(f.Member(t_at, "user_id"), kMaxName);
       t.X_WV = ReadPose(f, f.Member(t_at, "X_WV"));
       t.X_WR = ReadPose(f, f.Member(t_at, "X_WR"));
+      if (const auto faults = f.OptionalMember(t_at, "tracking_faults")) {
+        t.tracking_faults.losses = static_cast<int>(f.Integer(f.Member(*faults, "losses"), 0, 1000000));
+        t.tracking_faults.relocalizations =
+            static_cast<int>(f.Integer(f.Member(*faults, "relocalizations"), 0, 1000000));
+        t.tracking_faults.wait_s = f.Number(f.Member(*faults, "wait_s"), 0, t.user_duration_s);
+        t.tracking_faults.repeats = static_cast<int>(f.Integer(f.Member(*faults, "repeats"), 0, 1000000));
+      }
       s.trials.push_back(t);
     }
     if (const auto mean_at = f.OptionalMember(at, "mean")) {

@@ -20,7 +20,11 @@
 ///                               "misalignment_mm", "base_translation_error_mm",
 ///                               "flange_translation_error_mm", "misalignment_axes_mm" [t̄x,t̄y,t̄z],
 ///                               "misalignment_mean_pair_distance_mm", "user_duration_s",
-///                               "user_id", "X_WV", "X_WR"} ],
+///                               "user_id", "X_WV", "X_WR",
+///                               "tracking_faults": {"losses", "relocalizations", "wait_s",
+///                                                   "repeats"} (only on a trial whose user met
+///                                                   a tracking fault while aligning: see
+///                                                   TrackingFaults)} ],
 ///                  "trial_statistics": {"<measure>": {"mean", "std"}} over the trials (std with
 ///                                      N − 1; 0 for one trial),
 ///                  "mean": {"translation_error_mm", "rotation_error_deg", "misalignment_mm",
@@ -58,6 +62,16 @@ struct ErrorMeasures {
   double misalignment_mean_pair_distance_mm{0};                   ///< mean of the pair distances
 };
 
+/// The tracking faults the user met while aligning (ALIGNMENT_TRIAL's contract change 2 fields).
+struct TrackingFaults {
+  int losses{0};           ///< LIMITED or LOST episodes
+  int relocalizations{0};  ///< RELOCALIZED samples
+  double wait_s{0};        ///< stood waiting for tracking, part of user_duration_s [s]
+  int repeats{0};          ///< alignments re-done after the hologram jumped
+
+  bool any() const { return losses != 0 || relocalizations != 0 || wait_s != 0 || repeats != 0; }
+};
+
 struct TrialResult {
   int index{0};
   std::vector<double> q_deg;
@@ -66,6 +80,7 @@ struct TrialResult {
   std::string user_id;
   Eigen::Isometry3d X_WV{Eigen::Isometry3d::Identity()};
   Eigen::Isometry3d X_WR{Eigen::Isometry3d::Identity()};
+  TrackingFaults tracking_faults;  ///< written only when any()
 };
 
 struct MeanResult {

@@ -82,6 +82,23 @@ TEST(ViraalResultsReader, PartialRunsAndTheirOriginSurvive) {
   EXPECT_EQ(back.sessions[1].trials.size(), 1u);
 }
 
+// A trial's tracking faults are written only when there were any, and read back.
+TEST(ViraalResultsReader, TrackingFaultsOnlyWhereThereWereAny) {
+  RunResults r = ParseResultsJson(PinnedText(), "pinned.json");
+  EXPECT_FALSE(r.sessions[0].trials[1].tracking_faults.any());  // the pinned run met none
+  r.sessions[0].trials[1].tracking_faults = {2, 2, 3.5, 1};
+  const std::string text = ResultsJson(r);
+  const nlohmann::json doc = nlohmann::json::parse(text);
+  EXPECT_FALSE(doc["sessions"][0]["trials"][0].contains("tracking_faults"));
+  EXPECT_EQ(doc["sessions"][0]["trials"][1]["tracking_faults"],
+            nlohmann::json::parse(R"({"losses": 2, "relocalizations": 2, "wait_s": 3.5, "repeats": 1})"));
+  const TrackingFaults back = ParseResultsJson(text, "faults.json").sessions[0].trials[1].tracking_faults;
+  EXPECT_EQ(back.losses, 2);
+  EXPECT_EQ(back.relocalizations, 2);
+  EXPECT_EQ(back.wait_s, 3.5);
+  EXPECT_EQ(back.repeats, 1);
+}
+
 std::string RefusalOf(const std::function<void(nlohmann::json&)>& damage) {
   nlohmann::json doc = nlohmann::json::parse(PinnedText());
   damage(doc);
@@ -113,6 +130,11 @@ TEST(ViraalResultsReader, DamagedDocumentsAreRefusedNamingTheKey) {
             "r.json: sessions[0].display_mode: e");
   EXPECT_EQ(RefusalOf([](nlohmann::json& d) { d["sessions"] = nlohmann::json::array({1}); }),
             "r.json: sessions[0]: expected an object, got 1");
+  EXPECT_EQ(RefusalOf([](nlohmann::json& d) {
+              d["sessions"][0]["trials"][0]["tracking_faults"] = {
+                  {"losses", 1}, {"relocalizations", 1}, {"wait_s", 1e6}, {"repeats", 0}};
+            }).substr(0, 54),
+            "r.json: sessions[0].trials[0].tracking_faults.wait_s: ");
   EXPECT_THROW(ReadResultsFile("/nonexistent/results.json"), JsonReadError);
 }
 

@@ -38,6 +38,17 @@ std::variant<AlignmentTrial, Refusal> CheckAlignmentTrial(const orbed::alignment
   error = CheckFinite(&msg.duration_s, 1, "ALIGNMENT_TRIAL.duration_s");
   if (error.empty() && msg.duration_s < 0) error = "ALIGNMENT_TRIAL.duration_s is negative";
   if (!error.empty()) return Refusal{"duration_s", error};
+  error = CheckFinite(&msg.tracking_wait_s, 1, "ALIGNMENT_TRIAL.tracking_wait_s");
+  if (error.empty() && (msg.tracking_losses < 0 || msg.relocalizations < 0 || msg.alignment_repeats < 0)) {
+    error = "ALIGNMENT_TRIAL.tracking_losses, relocalizations and alignment_repeats must be >= 0, got " +
+            std::to_string(msg.tracking_losses) + ", " + std::to_string(msg.relocalizations) + ", " +
+            std::to_string(msg.alignment_repeats);
+  }
+  if (error.empty() && !(msg.tracking_wait_s >= 0 && msg.tracking_wait_s <= msg.duration_s)) {
+    error = "ALIGNMENT_TRIAL.tracking_wait_s " + std::to_string(msg.tracking_wait_s) +
+            " s is not in [0, duration_s " + std::to_string(msg.duration_s) + " s]";
+  }
+  if (!error.empty()) return Refusal{"tracking_faults", error};
   AlignmentTrial trial;
   trial.msg = msg;
   trial.X_WV = FromPose(msg.X_WV);

@@ -10,9 +10,12 @@
 ///   - display_mode MODE_AR with num_mirrors 0, or MODE_AR_REFLECTIVE with 1..kMaxMirrors;
 ///   - num_joints == joint_position's length, at most `max_joints`; every joint angle finite [rad];
 ///   - X_WV: finite position within kMaxAlignmentCoordinate_m of the origin, unit quaternion;
-///   - duration_s: finite and >= 0.
+///   - duration_s: finite and >= 0;
+///   - tracking faults (contract change 2): tracking_losses, relocalizations, alignment_repeats
+///     >= 0; tracking_wait_s finite, >= 0 and at most duration_s (the wait is part of it).
 /// Refusal keys are the field names (session_id, trial_index, display_mode, num_mirrors,
-/// num_joints, joint_position, X_WV, duration_s); processes count them as "<channel>/<key>".
+/// num_joints, joint_position, X_WV, duration_s), and tracking_faults for the four fault fields;
+/// processes count them as "<channel>/<key>".
 ///
 /// Threading: pure functions.
 

@@ -84,5 +84,29 @@ TEST(AlignmentTrial, EachRuleRefusesByFieldName) {
   EXPECT_EQ(Key(m), "duration_s");
 }
 
+// Contract change 2: the tracking faults the user met, the wait part of duration_s.
+TEST(AlignmentTrial, TrackingFaults) {
+  AT m = Good();
+  m.tracking_losses = 2;
+  m.relocalizations = 2;
+  m.tracking_wait_s = 3.5;
+  m.alignment_repeats = 1;
+  EXPECT_EQ(Key(m), "");
+  m.tracking_wait_s = m.duration_s;
+  EXPECT_EQ(Key(m), "");
+  m.tracking_wait_s = m.duration_s + 0.1;  // waited longer than the whole trial
+  EXPECT_EQ(Key(m), "tracking_faults");
+  m.tracking_wait_s = NAN;
+  EXPECT_EQ(Key(m), "tracking_faults");
+  m = Good();
+  m.tracking_wait_s = -1;
+  EXPECT_EQ(Key(m), "tracking_faults");
+  for (int32_t AT::*field : {&AT::tracking_losses, &AT::relocalizations, &AT::alignment_repeats}) {
+    m = Good();
+    m.*field = -1;
+    EXPECT_EQ(Key(m), "tracking_faults");
+  }
+}
+
 }  // namespace
 }  // namespace orbed

@@ -580,7 +580,12 @@ void ViraalConductor::FinishTrial() {
   Say(StepLabel() + ": robot at q=" + JointList(result.q_deg, 1) + " deg (reached in " + Fixed(reach_s_, 1) +
       " s); aligned in " + Fixed(trial.duration_s, 1) + " s of user time: " +
       Fixed(result.errors.translation_error_mm, 1) + " mm, " + Fixed(result.errors.rotation_error_deg, 2) +
-      " deg, misalignment " + Fixed(result.errors.misalignment_mm, 1) + " mm");
+      " deg, misalignment " + Fixed(result.errors.misalignment_mm, 1) + " mm" +
+      (result.tracking_faults.any()
+           ? "; tracking lost " + std::to_string(result.tracking_faults.losses) +
+                 "x while aligning, waited " + Fixed(result.tracking_faults.wait_s, 1) + " s, re-aligned " +
+                 std::to_string(result.tracking_faults.repeats) + "x"
+           : ""));
   ++trial_index_;
   if (trial_index_ < options_.config.trials) {
     StartMove(true);
