@@ -78,7 +78,8 @@
 /// random process would do, then one RELOCALIZED sample shrinks the drift by
 /// relocalization_correction as a drawn one does and applies the given jump (about the head, as
 /// YawAboutPoint: yaw about the vertical through the head, then the translation) instead of a
-/// random one. It draws nothing from the random stream.
+/// random one. The fault draws nothing itself (no state, duration or jump draws); its samples draw
+/// their jitter and drift as any sample does.
 ///
 /// TrackingState values equal orbed::hmd_pose_t's TRACKING/LIMITED/LOST/RELOCALIZED constants.
 /// Units: m, s, rad inside (deg only in names that say so). Threading: a SlamModel is
