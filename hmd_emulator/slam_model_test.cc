@@ -228,8 +228,7 @@ TEST(SlamModel, TrackingLossFreezesAndRelocalizes) {
 
 // A forced fault, counted by hand: LOST for 0.5 s at 60 Hz is 30 LOST samples (the estimate
 // frozen), then one RELOCALIZED sample whose map error is exactly the given jump (no drift, so
-// nothing to shrink), then TRACKING. It draws nothing: the samples after it are those of a model
-// that was never forced, but for the jump.
+// nothing to shrink), then TRACKING. Before the fault the model is the one never forced.
 TEST(SlamModel, ForcedFaultHoldsItsSamplesThenJumps) {
   SlamConfig c;
   c.tracking_loss_rate_per_min = 0;
