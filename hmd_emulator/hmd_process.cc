@@ -320,11 +320,13 @@ void HmdProcess::PublishTrial(const Eigen::Isometry3d& X_WV, double duration_s, 
   msg.relocalizations = faults.relocalizations;
   msg.tracking_wait_s = faults.wait_s;
   msg.alignment_repeats = faults.repeats;
-  process_->Publish(options_.trial_channel, msg);
-  // Saved after it went out: a crash in between repeats this index (the same trial), never skips it.
+  // Saved before it goes out: a headset killed in between restores this very message as the answer
+  // to its request id, so the conductor's retry gets these bytes (utime included), never a second,
+  // different trial with the same index.
   saved_.last_trial = msg;
   SaveState();
   session_.RecordTrial(msg);
+  process_->Publish(options_.trial_channel, msg);
 }
 
 void HmdProcess::OnTrial(const orbed::alignment_trial_t& msg, const std::string& channel) {

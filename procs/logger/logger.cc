@@ -191,27 +191,7 @@ void Logger::WriterLoop() {
       queue_bytes_ = 0;
       stop = writer_stop_;
     }
-    for (const Event& event : batch) {
-      const size_t written = file_->Write(event.utime, event.channel, event.data.data(), event.data.size());
-      std::lock_guard<std::mutex> lock(stats_mutex_);
-      if (written == 0) {
-        // Disk full or gone: every later event is lost too. Say so once, count the losses as
-        // drops, and stop the logger (its exit code and heartbeat say FAILED).
-        if (write_error_.empty()) {
-          write_error_ = file_->error();
-          process_.Fail("log write failed: " + write_error_);
-        }
-        ++lost_events_;
-        continue;
-      }
-      ++events_written_;
-      bytes_written_ += static_cast<int64_t>(written);
-      ChannelStats& stats = stats_[event.channel];
-      if (stats.events == 0) stats.first_utime = event.utime;
-      ++stats.events;
-      stats.bytes += static_cast<int64_t>(event.data.size());
-      stats.last_utime = event.utime;
-    }
+    WriteBatch(batch);
     batch.clear();
     if (stop || Clock::now() >= next_flush) {
       const bool flushed = file_->Flush();
@@ -226,6 +206,40 @@ void Logger::WriterLoop() {
     if (stop) break;
   }
   file_->Close();
+}
+
+void Logger::WriteBatch(const std::deque<Event>& batch) {
+  for (const Event& event : batch) {
+    const size_t written = file_->Write(event.utime, event.channel, event.data.data(), event.data.size());
+    std::lock_guard<std::mutex> lock(stats_mutex_);
+    if (written == 0) {
+      // Disk full or gone: every later event is lost too. Say so once, count the losses as
+      // drops, and stop the logger (its exit code and heartbeat say FAILED).
+      if (write_error_.empty()) {
+        write_error_ = file_->error();
+        process_.Fail("log write failed: " + write_error_);
+      }
+      ++lost_events_;
+      continue;
+    }
+    ++events_written_;
+    bytes_written_ += static_cast<int64_t>(written);
+    ChannelStats& stats = stats_[event.channel];
+    if (stats.events == 0) stats.first_utime = event.utime;
+    ++stats.events;
+    stats.bytes += static_cast<int64_t>(event.data.size());
+    stats.last_utime = event.utime;
+  }
+}
+
+void Logger::WriteQueued() {
+  std::deque<Event> batch;
+  {
+    std::lock_guard<std::mutex> lock(queue_mutex_);
+    batch.swap(queue_);
+    queue_bytes_ = 0;
+  }
+  WriteBatch(batch);
 }
 
 int Logger::Run() {

@@ -87,6 +87,9 @@ class Logger {
   /// This part's per-channel counts.
   std::map<std::string, ChannelStats> channel_stats() const;
   Process& process() { return process_; }
+  /// Writes what is queued, on the caller's thread, as Run()'s writer thread does (for fuzzing:
+  /// each input's event is written and freed before the next). Not while Run() is running.
+  void WriteQueued();
 
  private:
   struct Event {
@@ -96,6 +99,8 @@ class Logger {
   };
   void OnMessage(const lcm::ReceiveBuffer& rbuf, const std::string& channel);
   void WriterLoop();
+  // Writes `batch` to the file and counts it (the writer thread, or WriteQueued()).
+  void WriteBatch(const std::deque<Event>& batch);
   void WriteManifest(bool complete) const;
 
   LoggerOptions options_;

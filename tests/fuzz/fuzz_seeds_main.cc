@@ -5,7 +5,13 @@
 //                  message (fuzz_util.h), PER_CHANNEL messages of each channel (default 3);
 //   DIR/types/     for fuzz_decode: the type's index in ORBED_FOR_EACH_LCM_TYPE, then the message;
 //   DIR/event_log/ for fuzz_event_log: the log's first 100 events under kMaxSeedBytes, as a small
-//                  log of their own.
+//                  log of their own;
+//   DIR/state/     for fuzz_state_files (state_records.h): the first START, the first trial of its
+//                  session and the first IIWA_STATUS as a registration journal, a headset state
+//                  file, a sim state file and a raw journal;
+//   DIR/manifest/  for fuzz_manifest: the manifest.json beside LOG, if there is one, with the
+//                  folders taken out of its paths (a corpus in the repository names no machine's
+//                  folders).
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
@@ -13,15 +19,20 @@
 #include <fstream>
 #include <iterator>
 #include <map>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include <orbed/all_types.hpp>
+#include <orbed/alignment_trial_t.hpp>
+#include <orbed/session_control_t.hpp>
 
 #include "lcmtypes/bounded_decode.h"
 #include "procs/common/channels.h"
 #include "procs/logger/event_log_reader.h"
 #include "procs/logger/event_log_writer.h"
+#include "procs/logger/manifest.h"
+#include "tests/fuzz/state_records.h"
 
 namespace {
 
@@ -47,6 +58,40 @@ void WriteSeed(const fs::path& path, uint8_t first, const uint8_t* data, size_t 
   out.write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
 }
 
+void WriteBytes(const fs::path& path, const std::string& bytes) {
+  std::ofstream out(path, std::ios::binary);
+  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+}
+
+using Bytes = std::vector<uint8_t>;
+
+// The state-file seeds from the first START, the first trial of its session and an IIWA_STATUS.
+void WriteStateSeeds(const fs::path& dir, const Bytes& start, const Bytes& trial, const Bytes& status) {
+  namespace fz = orbed::fuzz;
+  const std::string session =
+      fz::StateRecord(0, start.data(), start.size()) + fz::StateRecord(1, trial.data(), trial.size());
+  WriteBytes(dir / "registration", std::string(1, char{fz::kRegistrationJournal}) + session);
+  WriteBytes(dir / "hmd", std::string(1, char{fz::kHmdStateFile}) + session);
+  WriteBytes(dir / "sim", std::string(1, char{fz::kSimStateFile}) + fz::StateRecord(2, status.data(), status.size()));
+  WriteBytes(dir / "raw", std::string(1, char{fz::kRawJournal}) +
+                              orbed::EncodeJournalRecord("SESSION_CONTROL", start.data(), start.size()) +
+                              orbed::EncodeJournalRecord("ALIGNMENT_TRIAL", trial.data(), trial.size()));
+}
+
+// `text` with every whitespace-separated word that names a path cut to its last component.
+std::string WithoutFolders(const std::string& text) {
+  std::string out;
+  size_t at = 0;
+  while (at < text.size()) {
+    const size_t end = std::min(text.find(' ', at), text.size());
+    const std::string word = text.substr(at, end - at);
+    out += word.find('/') == std::string::npos ? word : fs::path(word).filename().string();
+    if (end < text.size()) out += ' ';
+    at = end + 1;
+  }
+  return out;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -61,7 +106,9 @@ int main(int argc, char** argv) {
     return 1;
   }
   const fs::path dir(argv[2]);
-  for (const char* sub : {"bus", "types", "event_log"}) fs::create_directories(dir / sub);
+  for (const char* sub : {"bus", "types", "event_log", "state", "manifest"}) fs::create_directories(dir / sub);
+  Bytes start, trial, status;  // the state-file seeds' messages
+  std::string start_session;
   std::map<std::string, int> taken;  // seeds written per channel
   orbed::logger::EventLogScanner scanner = log.Scanner();
   orbed::logger::LogEvent event;
@@ -71,6 +118,21 @@ int main(int argc, char** argv) {
   int seeds = 0;
   while (scanner.Next(&event)) {
     ++events;
+    const Bytes bytes(event.data, event.data + event.size);
+    if (event.channel == "SESSION_CONTROL" && start.empty()) {
+      orbed::session_control_t control;
+      if (orbed::DecodeBounded(event.data, event.size, &control).ok() &&
+          control.command == orbed::session_control_t::START) {
+        start = bytes;
+        start_session = control.session_id;
+      }
+    } else if (event.channel == "ALIGNMENT_TRIAL" && trial.empty() && !start.empty()) {
+      orbed::alignment_trial_t message;
+      if (orbed::DecodeBounded(event.data, event.size, &message).ok() && message.session_id == start_session)
+        trial = bytes;
+    } else if (event.channel == "IIWA_STATUS" && status.empty()) {
+      status = bytes;
+    }
     if (head_events < 100 && event.size <= kMaxSeedBytes) {
       head.Write(event.timestamp_us, event.channel, event.data, event.size);
       ++head_events;
@@ -88,6 +150,22 @@ int main(int argc, char** argv) {
     ++seeds;
   }
   head.Close();
+  if (!start.empty() && !trial.empty() && !status.empty()) {
+    WriteStateSeeds(dir / "state", start, trial, status);
+  } else {
+    std::fprintf(stderr, "orbed-fuzz-seeds: no START, trial of its session and IIWA_STATUS: no state/ seeds\n");
+  }
+  const fs::path manifest_path = fs::path(argv[1]).parent_path() / "manifest.json";
+  if (fs::exists(manifest_path)) {
+    try {
+      orbed::logger::Manifest manifest = orbed::logger::ReadManifestFile(manifest_path.string());
+      manifest.command_line = WithoutFolders(manifest.command_line);
+      for (orbed::logger::HashedFile& file : manifest.files) file.path = fs::path(file.path).filename().string();
+      WriteBytes(dir / "manifest" / "manifest.json", orbed::logger::ManifestJson(manifest));
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "orbed-fuzz-seeds: no manifest/ seed: %s\n", e.what());
+    }
+  }
   std::printf("orbed-fuzz-seeds: %d seeds from %d events of %zu channels; %d events in event_log/\n", seeds,
               events, taken.size(), head_events);
   return 0;
