@@ -8,7 +8,8 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   orbed::fuzz::RefuseOrAccept([&] {
-    const orbed::logger::Manifest manifest = orbed::logger::ParseManifest(orbed::fuzz::AsText(data, size), "fuzz");
+    const orbed::logger::Manifest manifest =
+        orbed::logger::ParseManifest(orbed::fuzz::AsText(data, size), "fuzz");
     const std::string again = orbed::logger::ManifestJson(manifest);
     if (orbed::logger::ManifestJson(orbed::logger::ParseManifest(again, "rewritten")) != again) std::abort();
   });

@@ -23,8 +23,8 @@
 #include <string>
 #include <vector>
 
-#include <orbed/all_types.hpp>
 #include <orbed/alignment_trial_t.hpp>
+#include <orbed/all_types.hpp>
 #include <orbed/session_control_t.hpp>
 
 #include "lcmtypes/bounded_decode.h"
@@ -72,7 +72,8 @@ void WriteStateSeeds(const fs::path& dir, const Bytes& start, const Bytes& trial
       fz::StateRecord(0, start.data(), start.size()) + fz::StateRecord(1, trial.data(), trial.size());
   WriteBytes(dir / "registration", std::string(1, char{fz::kRegistrationJournal}) + session);
   WriteBytes(dir / "hmd", std::string(1, char{fz::kHmdStateFile}) + session);
-  WriteBytes(dir / "sim", std::string(1, char{fz::kSimStateFile}) + fz::StateRecord(2, status.data(), status.size()));
+  WriteBytes(dir / "sim",
+             std::string(1, char{fz::kSimStateFile}) + fz::StateRecord(2, status.data(), status.size()));
   WriteBytes(dir / "raw", std::string(1, char{fz::kRawJournal}) +
                               orbed::EncodeJournalRecord("SESSION_CONTROL", start.data(), start.size()) +
                               orbed::EncodeJournalRecord("ALIGNMENT_TRIAL", trial.data(), trial.size()));
@@ -106,7 +107,8 @@ int main(int argc, char** argv) {
     return 1;
   }
   const fs::path dir(argv[2]);
-  for (const char* sub : {"bus", "types", "event_log", "state", "manifest"}) fs::create_directories(dir / sub);
+  for (const char* sub : {"bus", "types", "event_log", "state", "manifest"})
+    fs::create_directories(dir / sub);
   Bytes start, trial, status;  // the state-file seeds' messages
   std::string start_session;
   std::map<std::string, int> taken;  // seeds written per channel
@@ -153,14 +155,16 @@ int main(int argc, char** argv) {
   if (!start.empty() && !trial.empty() && !status.empty()) {
     WriteStateSeeds(dir / "state", start, trial, status);
   } else {
-    std::fprintf(stderr, "orbed-fuzz-seeds: no START, trial of its session and IIWA_STATUS: no state/ seeds\n");
+    std::fprintf(stderr,
+                 "orbed-fuzz-seeds: no START, trial of its session and IIWA_STATUS: no state/ seeds\n");
   }
   const fs::path manifest_path = fs::path(argv[1]).parent_path() / "manifest.json";
   if (fs::exists(manifest_path)) {
     try {
       orbed::logger::Manifest manifest = orbed::logger::ReadManifestFile(manifest_path.string());
       manifest.command_line = WithoutFolders(manifest.command_line);
-      for (orbed::logger::HashedFile& file : manifest.files) file.path = fs::path(file.path).filename().string();
+      for (orbed::logger::HashedFile& file : manifest.files)
+        file.path = fs::path(file.path).filename().string();
       WriteBytes(dir / "manifest" / "manifest.json", orbed::logger::ManifestJson(manifest));
     } catch (const std::exception& e) {
       std::fprintf(stderr, "orbed-fuzz-seeds: no manifest/ seed: %s\n", e.what());

@@ -39,15 +39,16 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   orbed::fuzz::RefuseOrAccept([&] {
     if (mode == StateFileMode::kRegistrationJournal) {
       orbed::registration::RegistrationService service({}, [](const std::string&, const std::string&) {});
-      orbed::registration::SessionJournal replay(path, &service, [](const std::string&, const std::string&) {});
+      orbed::registration::SessionJournal replay(path, &service,
+                                                 [](const std::string&, const std::string&) {});
     } else if (mode == StateFileMode::kHmdStateFile) {
       orbed::hmd::HmdSessionOptions options;
       options.displays_placed = 2;  // as the shipped hmd.yaml places
       orbed::hmd::HmdSession session(options);
       orbed::hmd::RestoreSession(path, &session);
     } else {
-      static const auto* model =
-          new orbed::sim::RobotModel(orbed::sim::RobotModel::LoadFile(orbed::SourceTreePath("sim/models/iiwa7.urdf")));
+      static const auto* model = new orbed::sim::RobotModel(
+          orbed::sim::RobotModel::LoadFile(orbed::SourceTreePath("sim/models/iiwa7.urdf")));
       orbed::sim::ReadSimState(path, *model);
     }
   });

@@ -22,12 +22,18 @@ inline constexpr const char* kStateRecordChannels[] = {"SESSION_CONTROL", "ALIGN
                                                        "NOT_A_RECORD"};
 
 /// Modes (the input's first byte, modulo 4).
-enum StateFileMode : uint8_t { kRawJournal = 0, kRegistrationJournal = 1, kHmdStateFile = 2, kSimStateFile = 3 };
+enum StateFileMode : uint8_t {
+  kRawJournal = 0,
+  kRegistrationJournal = 1,
+  kHmdStateFile = 2,
+  kSimStateFile = 3
+};
 
 /// One record in the input form.
 inline std::string StateRecord(uint8_t channel_index, const uint8_t* data, size_t size) {
   const size_t n = size > 0xffff ? 0xffff : size;
-  std::string record{static_cast<char>(channel_index), static_cast<char>(n & 0xff), static_cast<char>(n >> 8)};
+  std::string record{static_cast<char>(channel_index), static_cast<char>(n & 0xff),
+                     static_cast<char>(n >> 8)};
   record.append(reinterpret_cast<const char*>(data), n);
   return record;
 }
