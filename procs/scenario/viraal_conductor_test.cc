@@ -745,10 +745,10 @@ class Emulation {
   std::vector<double> q_ = std::vector<double>(7, 0.0);
   std::set<std::string> lost_;
   int commands_ = 0;
-  std::string session_;                                  // opened by START (user and server)
-  std::map<int64_t, orbed::alignment_trial_t> trials_;   // the user's, by request id
-  std::set<int64_t> aligning_;                           // requests the user has started on
-  std::map<int, orbed::registration_t> registered_;       // the server's, by trial index
+  std::string session_;                                 // opened by START (user and server)
+  std::map<int64_t, orbed::alignment_trial_t> trials_;  // the user's, by request id
+  std::set<int64_t> aligning_;                          // requests the user has started on
+  std::map<int, orbed::registration_t> registered_;     // the server's, by trial index
 };
 
 TEST(ViraalConductor, AWholeRunInEmulatedTime) {
