@@ -16,7 +16,9 @@ std::string ReadAll(const std::string& path) {
   return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
 }
 
-std::string ProcPath(pid_t pid, const std::string& rest) { return "/proc/" + std::to_string(pid) + "/" + rest; }
+std::string ProcPath(pid_t pid, const std::string& rest) {
+  return "/proc/" + std::to_string(pid) + "/" + rest;
+}
 
 }  // namespace
 
@@ -61,7 +63,8 @@ std::map<uint64_t, int64_t> ParseUdpDropsByInode(const std::string& proc_net_udp
   std::string line;
   while (std::getline(lines, line)) {
     std::istringstream fields(line);
-    std::vector<std::string> f((std::istream_iterator<std::string>(fields)), std::istream_iterator<std::string>());
+    std::vector<std::string> f((std::istream_iterator<std::string>(fields)),
+                               std::istream_iterator<std::string>());
     if (f.size() <= kDrops || f[0].empty() || f[0].back() != ':') continue;
     try {
       size_t used_inode = 0, used_drops = 0;

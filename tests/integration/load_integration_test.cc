@@ -20,8 +20,8 @@
 
 #include <gtest/gtest.h>
 
-#include "tests/load/load_run.h"
 #include "tests/integration/testbed_util.h"
+#include "tests/load/load_run.h"
 
 namespace orbed::testing {
 namespace {

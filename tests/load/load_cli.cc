@@ -25,11 +25,13 @@ int RunLoadCli(int argc, const char* const* argv, std::ostream& out, std::ostrea
   app.add_option("--rss-early-s", options.rss_early_s, "When the early resident-memory sample is taken [s]")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  app.add_option("--warmup-s", options.warmup_s, "Rates are accounted from the first heartbeat after this [s]")
+  app.add_option("--warmup-s", options.warmup_s,
+                 "Rates are accounted from the first heartbeat after this [s]")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
-  app.add_option("--max-rss-growth-percent", max_growth_percent,
-                 "Fail when a process's resident memory grows more than this from the early sample to the end [%]")
+  app.add_option(
+         "--max-rss-growth-percent", max_growth_percent,
+         "Fail when a process's resident memory grows more than this from the early sample to the end [%]")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--ready-timeout-s", options.ready_timeout_s, "Longest wait for the testbed to come up [s]")

@@ -31,8 +31,8 @@ int64_t Delta(const std::map<std::string, int64_t>& first, const std::map<std::s
 
 LoadPlan MakeLoadPlan(double factor) {
   if (!(factor >= kMinFactor && factor <= kMaxFactor)) {
-    throw std::invalid_argument("the load factor must be in [" + Number(kMinFactor) + ", " + Number(kMaxFactor) +
-                                "], not " + Number(factor));
+    throw std::invalid_argument("the load factor must be in [" + Number(kMinFactor) + ", " +
+                                Number(kMaxFactor) + "], not " + Number(factor));
   }
   LoadPlan plan;
   plan.factor = factor;
@@ -57,8 +57,12 @@ LoadPlan MakeLoadPlan(double factor) {
   image(channels::kHmdCamera, kCameraHz, plan.camera_hz);
   image(channels::kReflectiveView, kReflectiveHz, plan.reflective_hz);
   image(channels::kArView, kArViewHz, plan.ar_view_hz);
-  plan.streams.push_back(
-      {channels::kGazeRay, "hmd", kGazeHz, plan.gaze_hz, {"timer/" + std::string(channels::kGazeRay)}, false});
+  plan.streams.push_back({channels::kGazeRay,
+                          "hmd",
+                          kGazeHz,
+                          plan.gaze_hz,
+                          {"timer/" + std::string(channels::kGazeRay)},
+                          false});
   return plan;
 }
 
@@ -74,8 +78,8 @@ std::string LoadPlan::HmdConfigYaml() const {
          " x nominal (orbed-hmd --config).\n"
          "hmd:\n"
          "  gaze_hz: " +
-         Number(gaze_hz) + "\n  reflective_hz: " + Number(reflective_hz) + "\n  ar_view_hz: " + Number(ar_view_hz) +
-         "\n";
+         Number(gaze_hz) + "\n  reflective_hz: " + Number(reflective_hz) +
+         "\n  ar_view_hz: " + Number(ar_view_hz) + "\n";
 }
 
 std::optional<int64_t> StreamRow::lost() const {
@@ -107,7 +111,8 @@ std::vector<std::string> Failures(const LoadReport& report, double max_rss_growt
   std::vector<std::string> failures;
   for (const ProcessRow& p : report.processes) {
     if (!p.alive_at_end) failures.push_back(p.name + " died");
-    if (p.respawns > 0) failures.push_back(p.name + " was respawned " + std::to_string(p.respawns) + " time(s)");
+    if (p.respawns > 0)
+      failures.push_back(p.name + " was respawned " + std::to_string(p.respawns) + " time(s)");
     const auto growth = p.rss_growth_percent();
     if (growth && *growth > max_rss_growth_percent) {
       failures.push_back(p.name + " resident memory grew " + Fixed(*growth, 1) + " % (" +
@@ -124,13 +129,14 @@ void PrintReport(const LoadReport& report, std::ostream& out) {
   char line[256];
   out << "load: " << Fixed(report.factor, 1) << " x nominal rates for " << Fixed(report.duration_s, 0)
       << " s; RSS sampled at " << Fixed(report.rss_early_s, 0) << " s and at the end\n";
-  std::snprintf(line, sizeof(line), "%-13s %12s %12s %8s %9s %13s %9s  %s\n", "process", "RSS@early kB", "RSS@end kB",
-                "growth", "respawns", "socket drops", "dropped", "drops by reason (heartbeat)");
+  std::snprintf(line, sizeof(line), "%-13s %12s %12s %8s %9s %13s %9s  %s\n", "process", "RSS@early kB",
+                "RSS@end kB", "growth", "respawns", "socket drops", "dropped", "drops by reason (heartbeat)");
   out << line;
   for (const ProcessRow& p : report.processes) {
     const auto growth = p.rss_growth_percent();
     std::string reasons;
-    for (const auto& [key, count] : p.drop_counts) reasons += (reasons.empty() ? "" : ", ") + key + " " + std::to_string(count);
+    for (const auto& [key, count] : p.drop_counts)
+      reasons += (reasons.empty() ? "" : ", ") + key + " " + std::to_string(count);
     std::snprintf(line, sizeof(line), "%-13s %12lld %12lld %7s%% %9d %13lld %9lld  %s\n", p.name.c_str(),
                   static_cast<long long>(p.rss_early_kb), static_cast<long long>(p.rss_end_kb),
                   growth ? Fixed(*growth, 1).c_str() : "-", p.respawns,
@@ -139,8 +145,8 @@ void PrintReport(const LoadReport& report, std::ostream& out) {
     out << line;
   }
   out << "\n";
-  std::snprintf(line, sizeof(line), "%-17s %8s %8s %10s %7s %9s %9s %9s %9s %7s\n", "channel", "nom Hz", "want Hz",
-                "achieved", "window", "wanted", "received", "sent", "lost", "drops");
+  std::snprintf(line, sizeof(line), "%-17s %8s %8s %10s %7s %9s %9s %9s %9s %7s\n", "channel", "nom Hz",
+                "want Hz", "achieved", "window", "wanted", "received", "sent", "lost", "drops");
   out << line;
   for (const StreamRow& s : report.streams) {
     const auto lost = s.lost();
@@ -154,10 +160,14 @@ void PrintReport(const LoadReport& report, std::ostream& out) {
   if (report.logger.known) {
     out << "\nlogger: " << report.logger.messages_in << " messages in = " << report.logger.events_written
         << " written + " << report.logger.drops << " dropped (queue full) + " << report.logger.self_tests
-        << " LCM start-up probes" << (report.logger.unaccounted() == 0 ? "" : " + " + std::to_string(report.logger.unaccounted()) + " unaccounted")
+        << " LCM start-up probes"
+        << (report.logger.unaccounted() == 0
+                ? ""
+                : " + " + std::to_string(report.logger.unaccounted()) + " unaccounted")
         << "\n";
   }
-  out << "watcher (orbed-load's own socket): " << report.watcher_socket_drops << " datagrams dropped by the kernel\n";
+  out << "watcher (orbed-load's own socket): " << report.watcher_socket_drops
+      << " datagrams dropped by the kernel\n";
 }
 
 }  // namespace orbed::load

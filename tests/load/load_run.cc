@@ -90,10 +90,12 @@ class BusWatcher {
       if (DecodeBounded(rbuf->data, rbuf->data_size, &pose).ok()) count.last_seq = pose.seq;
     } else if (channel == channels::kProcessStatus) {
       orbed::process_status_t status;
-      if (!DecodeBounded(rbuf->data, rbuf->data_size, &status).ok() || watched_.count(status.name) == 0) return;
+      if (!DecodeBounded(rbuf->data, rbuf->data_size, &status).ok() || watched_.count(status.name) == 0)
+        return;
       Snapshot snapshot;
       snapshot.utime_us = status.utime;
-      for (int i = 0; i < status.num_drop_reasons; ++i) snapshot.drops[status.drop_reason[i]] = status.drop_count[i];
+      for (int i = 0; i < status.num_drop_reasons; ++i)
+        snapshot.drops[status.drop_reason[i]] = status.drop_count[i];
       snapshot.counts = counts_;
       beats_[status.name].push_back({status, std::move(snapshot)});
     }
@@ -104,9 +106,9 @@ class BusWatcher {
   std::atomic<bool> stop_{false};
   std::thread thread_;
   mutable std::mutex mutex_;
-  std::map<std::string, ChannelCount> counts_;        // guarded by mutex_
-  std::map<std::string, std::vector<Beat>> beats_;    // guarded by mutex_
-  int64_t self_tests_{0};                             // guarded by mutex_
+  std::map<std::string, ChannelCount> counts_;      // guarded by mutex_
+  std::map<std::string, std::vector<Beat>> beats_;  // guarded by mutex_
+  int64_t self_tests_{0};                           // guarded by mutex_
 };
 
 Clock::time_point After(Clock::time_point t, double seconds) {
@@ -114,7 +116,8 @@ Clock::time_point After(Clock::time_point t, double seconds) {
 }
 
 // Polls `condition` every 20 ms (draining the launcher's output) until true or `deadline`.
-bool PollUntil(launcher::Child& launcher, const std::function<bool()>& condition, Clock::time_point deadline) {
+bool PollUntil(launcher::Child& launcher, const std::function<bool()>& condition,
+               Clock::time_point deadline) {
   for (;;) {
     launcher.Drain("");
     if (condition()) return true;
@@ -167,8 +170,8 @@ LoadReport RunLoad(const LoadOptions& options, std::ostream& log) {
   if (!launcher.Start({bin_dir + "/orbed-launch", launch_file}, env, bin_dir, &error)) {
     throw std::runtime_error("cannot start orbed-launch: " + error);
   }
-  log << "load: " << spec.name << " (" << launch_file << ") at " << plan.factor << " x nominal rates; logs in "
-      << options.log_dir << "\n";
+  log << "load: " << spec.name << " (" << launch_file << ") at " << plan.factor
+      << " x nominal rates; logs in " << options.log_dir << "\n";
 
   // Ready: every process heartbeats RUNNING from the pid the launcher started it with.
   std::map<std::string, pid_t> children;
@@ -191,11 +194,12 @@ LoadReport RunLoad(const LoadOptions& options, std::ostream& log) {
       After(Clock::now(), options.ready_timeout_s));
   if (!ready || !launcher.running()) {
     launcher.Signal(SIGINT);
-    PollUntil(launcher, [&] { return launcher.Poll(); }, After(Clock::now(), 30));
+    PollUntil(
+        launcher, [&] { return launcher.Poll(); }, After(Clock::now(), 30));
     if (launcher.running()) launcher.Signal(SIGKILL);
-    throw std::runtime_error(ready ? "orbed-launch ended before the testbed was ready: " + launcher.DescribeExit()
-                                   : "the testbed was not ready within " + std::to_string(options.ready_timeout_s) +
-                                         " s");
+    throw std::runtime_error(
+        ready ? "orbed-launch ended before the testbed was ready: " + launcher.DescribeExit()
+              : "the testbed was not ready within " + std::to_string(options.ready_timeout_s) + " s");
   }
   const Clock::time_point start = Clock::now();
   // Heartbeat utimes are wall-clock: the window's bounds on that clock.
@@ -209,10 +213,12 @@ LoadReport RunLoad(const LoadOptions& options, std::ostream& log) {
   std::map<std::string, ProcessRow> rows;
   for (const auto& name : names) rows[name].name = name;
   // The run: deadlines only; the early sample, then the end (or orbed-launch ending by itself).
-  PollUntil(launcher, [&] { return !launcher.running() || launcher.Poll(); }, After(start, options.rss_early_s));
+  PollUntil(
+      launcher, [&] { return !launcher.running() || launcher.Poll(); }, After(start, options.rss_early_s));
   for (auto& [name, row] : rows) row.rss_early_kb = ProcStatusKb(children[name], "VmRSS");
   log << "load: resident memory sampled at " << options.rss_early_s << " s\n";
-  PollUntil(launcher, [&] { return !launcher.running() || launcher.Poll(); }, After(start, options.duration_s));
+  PollUntil(
+      launcher, [&] { return !launcher.running() || launcher.Poll(); }, After(start, options.duration_s));
   const Clock::time_point end = Clock::now();
   const int64_t end_utime = NowMicros();
   const std::map<std::string, pid_t> children_at_end =
@@ -228,9 +234,11 @@ LoadReport RunLoad(const LoadOptions& options, std::ostream& log) {
   log << "load: " << std::chrono::duration<double>(end - start).count() << " s done; stopping the testbed\n";
 
   launcher.Signal(SIGINT);
-  if (!PollUntil(launcher, [&] { return launcher.Poll(); }, After(Clock::now(), 90))) {
+  if (!PollUntil(
+          launcher, [&] { return launcher.Poll(); }, After(Clock::now(), 90))) {
     launcher.Signal(SIGKILL);
-    PollUntil(launcher, [&] { return launcher.Poll(); }, After(Clock::now(), 10));
+    PollUntil(
+        launcher, [&] { return launcher.Poll(); }, After(Clock::now(), 10));
   }
   launcher.Drain("", true);
   report.launcher_exit_code = launcher.exit_code() != 0 ? launcher.exit_code() : launcher.term_signal();
@@ -247,7 +255,8 @@ LoadReport RunLoad(const LoadOptions& options, std::ostream& log) {
     return std::nullopt;
   };
   if (rows.count(kLoggerName) > 0) {
-    PollUntil(launcher, [&] { return final_beat(kLoggerName).has_value(); }, After(Clock::now(), 5));
+    PollUntil(
+        launcher, [&] { return final_beat(kLoggerName).has_value(); }, After(Clock::now(), 5));
     const auto beat = final_beat(kLoggerName);
     const fs::path manifest_path = fs::path(options.log_dir) / "manifest.json";
     if (beat && fs::exists(manifest_path)) {
@@ -286,7 +295,8 @@ LoadReport RunLoad(const LoadOptions& options, std::ostream& log) {
       if (!first && beat.status.utime >= warm_utime) first = &beat.snapshot;
       if (first) last = &beat.snapshot;
     }
-    if (first && last && last->utime_us > first->utime_us) report.streams.push_back(AccountStream(stream, *first, *last));
+    if (first && last && last->utime_us > first->utime_us)
+      report.streams.push_back(AccountStream(stream, *first, *last));
   }
   for (const auto& name : names) report.processes.push_back(rows[name]);
   return report;

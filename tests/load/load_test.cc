@@ -30,7 +30,8 @@ TEST(LoadPlan, TenTimesTheNominalRates) {
   EXPECT_DOUBLE_EQ(Stream(plan, "IIWA_STATUS").wanted_hz, 2000);
   EXPECT_EQ(Stream(plan, "IIWA_STATUS").drop_keys, std::vector<std::string>{"timer/tick"});
   EXPECT_TRUE(Stream(plan, "HMD_POSE_TRUTH").has_seq);
-  EXPECT_EQ(Stream(plan, "HMD_CAMERA").drop_keys, (std::vector<std::string>{"timer/HMD_CAMERA", "HMD_CAMERA/busy"}));
+  EXPECT_EQ(Stream(plan, "HMD_CAMERA").drop_keys,
+            (std::vector<std::string>{"timer/HMD_CAMERA", "HMD_CAMERA/busy"}));
   EXPECT_EQ(plan.streams.size(), 9u);
 
   const auto env = plan.LaunchEnvironment("/x/load_hmd.yaml");
