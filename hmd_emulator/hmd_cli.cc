@@ -26,8 +26,12 @@ int RunHmd(int argc, const char* const* argv, std::ostream& out, std::ostream& e
   app.add_option_function<std::uint64_t>(
       "--user-seed", [&o](const std::uint64_t& seed) { o.user_seed = seed; },
       "The emulated person (overrides user.seed): a different seed is a different person");
-  app.add_option("--camera-hz", o.camera_hz, "HMD_CAMERA rate [Hz]")->capture_default_str();
-  app.add_option("--pose-hz", o.pose_hz, "HMD_POSE / HMD_POSE_TRUTH rate [Hz]")->capture_default_str();
+  app.add_option("--camera-hz", o.camera_hz,
+                 "HMD_CAMERA rate [Hz], (0, 1000]; faster than the renderer keeps up with, a request that "
+                 "finds the previous one still waiting replaces it, counted as the drop HMD_CAMERA/busy")
+      ->capture_default_str();
+  app.add_option("--pose-hz", o.pose_hz, "HMD_POSE / HMD_POSE_TRUTH rate [Hz], (0, 1000]")
+      ->capture_default_str();
   app.add_option("--jpeg-quality", o.jpeg_quality, "JPEG quality of every image, 1..100")
       ->capture_default_str();
   app.add_option("--displays", o.displays,

@@ -36,9 +36,9 @@ HmdConfig ParseHmdConfig(const YAML::Node& node, const std::string& source, cons
        "max_repeats", "recapture_period_s", "gaze_fallback_distance_m", "max_gaze_distance_m", "displays"});
   HmdConfig c = base;
   c.name = Text(f, node, "name", key, c.name);
-  c.gaze_hz = f.NumberOr(node, "gaze_hz", key, c.gaze_hz, 0.1, 120, "Hz");
-  c.reflective_hz = f.NumberOr(node, "reflective_hz", key, c.reflective_hz, 0.1, 120, "Hz");
-  c.ar_view_hz = f.NumberOr(node, "ar_view_hz", key, c.ar_view_hz, 0.1, 120, "Hz");
+  c.gaze_hz = f.NumberOr(node, "gaze_hz", key, c.gaze_hz, 0.1, 1000, "Hz");
+  c.reflective_hz = f.NumberOr(node, "reflective_hz", key, c.reflective_hz, 0.1, 1000, "Hz");
+  c.ar_view_hz = f.NumberOr(node, "ar_view_hz", key, c.ar_view_hz, 0.1, 1000, "Hz");
   c.align_waypoint = Text(f, node, "align_waypoint", key, c.align_waypoint);
   c.settle_s = f.NumberOr(node, "settle_s", key, c.settle_s, 0, 600, "s");
   c.max_wait_s = f.NumberOr(node, "max_wait_s", key, c.max_wait_s, 0, 3600, "s");

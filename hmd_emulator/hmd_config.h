@@ -23,9 +23,10 @@
 /// @code{.yaml}
 /// hmd:
 ///   name: hololens1              # hmd_name on HMD_POSE and GAZE_RAY
-///   gaze_hz: 10                  # GAZE_RAY rate [Hz]
-///   reflective_hz: 30            # REFLECTIVE_VIEW rate per display [Hz]
-///   ar_view_hz: 5                # AR_VIEW rate [Hz]
+///   gaze_hz: 10                  # GAZE_RAY rate [Hz], 0.1 .. 1000
+///   reflective_hz: 30            # REFLECTIVE_VIEW rate per display [Hz], 0.1 .. 1000 (above what
+///                                #   the renderer keeps up with, requests are dropped and counted)
+///   ar_view_hz: 5                # AR_VIEW rate [Hz], 0.1 .. 1000 (likewise)
 ///   align_waypoint: ""           # where the emulated user aligns ("" = the walk's last waypoint)
 ///   settle_s: 0.5                # standing time at the alignment waypoint before aligning [s]
 ///   max_wait_s: 30               # longest wait for tracking to recover before aligning [s]

@@ -31,8 +31,8 @@ HmdProcess::HmdProcess(const orbed::CommonFlags& flags, const HmdOptions& option
   if (options_.urdf_path.empty())
     options_.urdf_path = HmdSourcePath(sim::RobotModel::kDefaultUrdfRelativePath);
   if (options_.scene_path.empty()) options_.scene_path = HmdSourcePath(sim::kDefaultSceneRelativePath);
-  if (!(options_.camera_hz > 0 && options_.camera_hz <= 120)) {
-    throw std::invalid_argument("--camera-hz must be in (0, 120] Hz");
+  if (!(options_.camera_hz > 0 && options_.camera_hz <= 1000)) {
+    throw std::invalid_argument("--camera-hz must be in (0, 1000] Hz");
   }
   if (!(options_.pose_hz > 0 && options_.pose_hz <= 1000))
     throw std::invalid_argument("--pose-hz must be in (0, 1000] Hz");
@@ -114,13 +114,22 @@ HmdProcess::HmdProcess(const orbed::CommonFlags& flags, const HmdOptions& option
   };
   pipeline_ = std::make_unique<ImagePipeline>(*robot_model_, stream_->scene_objects(), images, out);
 
-  process_->AddTimer(1.0 / options_.pose_hz, [this] { PublishPose(); });
-  process_->AddTimer(1.0 / config_.hmd.gaze_hz, [this] { PublishGaze(); });
-  process_->AddTimer(1.0 / options_.camera_hz, [this] { RequestCamera(); });
+  // Named by what they publish: a timer that falls behind counts its skipped deadlines as
+  // "timer/<channel>" drops on the heartbeat.
+  process_->AddTimer(
+      1.0 / options_.pose_hz, [this] { PublishPose(); }, options_.hmd_pose_channel);
+  process_->AddTimer(
+      1.0 / config_.hmd.gaze_hz, [this] { PublishGaze(); }, options_.gaze_channel);
+  process_->AddTimer(
+      1.0 / options_.camera_hz, [this] { RequestCamera(); }, options_.camera_channel);
   if (options_.displays > 0)
-    process_->AddTimer(1.0 / config_.hmd.reflective_hz, [this] { RequestReflective(); });
-  process_->AddTimer(1.0 / config_.hmd.ar_view_hz, [this] { RequestArView(); });
-  if (options_.interactive) process_->AddTimer(1.0 / kInteractiveHz, [this] { InteractiveTick(); });
+    process_->AddTimer(
+        1.0 / config_.hmd.reflective_hz, [this] { RequestReflective(); }, options_.reflective_channel);
+  process_->AddTimer(
+      1.0 / config_.hmd.ar_view_hz, [this] { RequestArView(); }, options_.ar_view_channel);
+  if (options_.interactive)
+    process_->AddTimer(
+        1.0 / kInteractiveHz, [this] { InteractiveTick(); }, "interactive");
 
   ORBED_LOG(kInfo) << "robot " << options_.urdf_path << ", scene " << options_.scene_path << "; walk of "
                    << config_.walk.waypoints.size() << " waypoints (" << Fixed(walk.length_m(), 2)
@@ -175,9 +184,20 @@ void HmdProcess::PublishGaze() {
   if (const auto gaze = stream_->Gaze(robot_)) process_->Publish(options_.gaze_channel, *gaze);
 }
 
-void HmdProcess::RequestCamera() { pipeline_->Post(ImagePipeline::Job::kCamera, Inputs()); }
-void HmdProcess::RequestReflective() { pipeline_->Post(ImagePipeline::Job::kReflective, Inputs()); }
-void HmdProcess::RequestArView() { pipeline_->Post(ImagePipeline::Job::kArView, Inputs(), true); }
+// A request that replaces one the renderer has not started is a frame never made: a drop
+// "<channel>/busy" on the heartbeat.
+void HmdProcess::RequestCamera() {
+  if (pipeline_->Post(ImagePipeline::Job::kCamera, Inputs()))
+    process_->CountDrop(options_.camera_channel + "/busy");
+}
+void HmdProcess::RequestReflective() {
+  if (pipeline_->Post(ImagePipeline::Job::kReflective, Inputs()))
+    process_->CountDrop(options_.reflective_channel + "/busy");
+}
+void HmdProcess::RequestArView() {
+  if (pipeline_->Post(ImagePipeline::Job::kArView, Inputs(), true))
+    process_->CountDrop(options_.ar_view_channel + "/busy");
+}
 
 void HmdProcess::OnIiwaStatus(const orbed::iiwa_status_t& msg, const std::string& channel) {
   std::string error = CheckSize(msg.num_joints, robot_model_->num_joints(), "num_joints");

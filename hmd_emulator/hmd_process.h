@@ -23,6 +23,9 @@
 ///               ALIGNMENT_TRIAL (alignment_trial_t): one per accepted REQUEST_TRIAL (emulated user)
 ///               or Enter (interactive); SESSION_CONTROL START once, for a local session, when a
 ///               person submits in interactive mode with no session active; PROCESS_STATUS at 1 Hz.
+/// Drops under load, counted on the heartbeat (Process::CountDrop): "timer/<channel>" for a stream's
+/// skipped deadlines (e.g. timer/HMD_POSE), "<channel>/busy" for an image request that replaced one
+/// the renderer had not started (HMD_CAMERA/busy, REFLECTIVE_VIEW/busy, AR_VIEW/busy).
 ///
 /// The robot: one RobotState (robot_state.h), the latest valid q and X_WR.
 /// The current X_WV (map coordinates): in interactive mode the person's; otherwise the latest valid

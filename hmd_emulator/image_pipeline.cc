@@ -75,20 +75,23 @@ ImagePipeline::~ImagePipeline() {
   if (worker_.joinable()) worker_.join();
 }
 
-void ImagePipeline::Post(Job job, const FrameInputs& inputs, bool publish) {
+bool ImagePipeline::Post(Job job, const FrameInputs& inputs, bool publish) {
   if (!options_.threaded) {
     Run(job, inputs, publish);
-    return;
+    return false;
   }
   const int j = static_cast<int>(job);
+  bool replaced = false;
   {
     std::lock_guard<std::mutex> lock(jobs_mutex_);
-    if (pending_[j]) ++skipped_;
+    replaced = pending_[j];
+    if (replaced) ++skipped_;
     pending_[j] = true;
     inputs_[j] = inputs;
     if (job == Job::kArView) publish_ar_ = publish_ar_ || publish;
   }
   jobs_cv_.notify_all();
+  return replaced;
 }
 
 void ImagePipeline::Flush() {

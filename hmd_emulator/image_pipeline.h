@@ -111,8 +111,10 @@ class ImagePipeline {
   ImagePipeline& operator=(const ImagePipeline&) = delete;
 
   /// Makes (inline) or requests (threaded) one job from `inputs`. kArView with publish = false only
-  /// refreshes LatestArView() (the interactive window) without an AR_VIEW message.
-  void Post(Job job, const FrameInputs& inputs, bool publish = true);
+  /// refreshes LatestArView() (the interactive window) without an AR_VIEW message. Returns true when
+  /// the request replaced one of its kind still pending (counted in skipped(): that frame is never
+  /// made), false otherwise (always false inline).
+  bool Post(Job job, const FrameInputs& inputs, bool publish = true);
   /// Waits until the worker has done every pending job (no-op inline).
   void Flush();
   /// Display `display` captures again at the next camera frame (out-of-range indices are ignored).

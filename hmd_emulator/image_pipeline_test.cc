@@ -270,11 +270,13 @@ TEST(ImagePipeline, WorkerIsLatestWinsAndCountsSkipped) {
   };
   ImagePipelineOptions options;
   ImagePipeline pipeline(world.robot, world.stream.scene_objects(), options, outputs(&threaded_out));
-  for (const FrameInputs& in : inputs) pipeline.Post(ImagePipeline::Job::kCamera, in);
+  int64_t replaced = 0;  // what Post() said: the caller's drop count
+  for (const FrameInputs& in : inputs) replaced += pipeline.Post(ImagePipeline::Job::kCamera, in) ? 1 : 0;
   pipeline.Flush();
   const int64_t published = static_cast<int64_t>(threaded_out.camera.size());
   EXPECT_GE(published, 1);
   EXPECT_EQ(published + pipeline.skipped(), static_cast<int64_t>(inputs.size()));
+  EXPECT_EQ(replaced, pipeline.skipped());
   // The last request always wins, and its frame is the frame of those inputs.
   ASSERT_FALSE(threaded_out.camera.empty());
   EXPECT_EQ(threaded_out.camera.back().utime, inputs.back().sample_utime);

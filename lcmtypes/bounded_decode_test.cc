@@ -145,6 +145,10 @@ process_status_t StatusWithReasons() {
   status.reject_count = {3, 1};
   status.num_reasons = 2;
   status.last_error = "bad session id";
+  status.dropped = 7;
+  status.drop_reason = {"timer/tick", "HMD_CAMERA/busy"};
+  status.drop_count = {2, 5};
+  status.num_drop_reasons = 2;
   return status;
 }
 
@@ -182,10 +186,11 @@ TEST(BoundedDecodeTest, AHugeCountIsRefusedBeforeAnyAllocation) {
   process_status_t status{};
   status.name = "x";
   Bytes bytes = Encode(status);
-  // num_reasons sits just before last_error ("" = int32 length 1 + the NUL byte): 4 + 1 + 4 bytes
-  // from the end.
-  const size_t count_at = bytes.size() - 9;
-  for (const uint32_t count : {0x7fffffffu, 0x80000000u, 0xffffffffu, 6u}) {
+  // num_reasons sits just before last_error ("" = int32 length 1 + the NUL byte), dropped (int64)
+  // and num_drop_reasons (int32): 4 + 1 + 8 + 4 + 4 bytes from the end.
+  const size_t count_at = bytes.size() - 21;
+  // 18: one more than the 17 bytes left after the count.
+  for (const uint32_t count : {0x7fffffffu, 0x80000000u, 0xffffffffu, 18u}) {
     SCOPED_TRACE(count);
     for (int i = 0; i < 4; ++i)
       bytes[count_at + static_cast<size_t>(i)] = static_cast<uint8_t>(count >> (24 - 8 * i));

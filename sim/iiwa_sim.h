@@ -18,7 +18,8 @@
 ///               an invalid request gets request_valid = false and a reason, never silence; the
 ///               answer is a pure function of the request's q and the static scene, so a repeated
 ///               request (a client's retry) gets the same answer (only its utime differs);
-///               PROCESS_STATUS at 1 Hz (Process), with rejections counted per class.
+///               PROCESS_STATUS at 1 Hz (Process), with rejections counted per class and the
+///               tick deadlines the loop skipped under load counted as the drop "timer/tick".
 ///
 /// IIWA_STATUS fields: joint_position_measured = q after this tick's step; joint_velocity_estimated
 /// = that step / P (the period, below); joint_position_commanded = the last accepted command as sent

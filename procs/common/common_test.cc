@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <limits>
+#include <map>
 #include <optional>
 #include <sstream>
 #include <thread>
@@ -249,6 +250,54 @@ TEST(Process, TimerCatchesUpAfterAShortStall) {
   process.Run();
   EXPECT_GE(ticks, 9);
   EXPECT_LE(ticks, 10);
+}
+
+// A 0.75 s stall in a 0.1 s timer is beyond the catch-up: the deadlines it skipped are counted as
+// drops under the timer's name, on the heartbeat too, and every deadline was run or counted.
+TEST(Process, TimerSkippedDeadlinesAreCountedDrops) {
+  CommonFlags flags("orbed-test");
+  flags.lcm_url = "memq://";
+  flags.duration_s = 1.55;
+  Process process(flags);
+  int ticks = 0;
+  process.AddTimer(
+      0.1,
+      [&] {
+        if (++ticks == 2) std::this_thread::sleep_for(std::chrono::milliseconds(750));
+      },
+      "STREAM");
+  process.Run();
+  const auto drops = process.drop_counts();
+  ASSERT_EQ(drops.count("timer/STREAM"), 1u);
+  const int64_t skipped = drops.at("timer/STREAM");
+  EXPECT_GE(skipped, 1);
+  EXPECT_EQ(process.dropped(), skipped);
+  // 15 deadlines in 1.55 s (0.1 ... 1.5 s), each run or skipped; the last may be pending at the stop.
+  EXPECT_GE(ticks + skipped, 14);
+  EXPECT_LE(ticks + skipped, 15);
+  const orbed::process_status_t status = process.MakeStatus();
+  EXPECT_EQ(status.dropped, skipped);
+  ASSERT_EQ(status.num_drop_reasons, 1);
+  EXPECT_EQ(status.drop_reason[0], "timer/STREAM");
+  EXPECT_EQ(status.drop_count[0], skipped);
+  EXPECT_EQ(status.rejected_inputs, 0);  // a drop is not a rejection
+}
+
+TEST(Process, CountDropSumsPerKeyAndBoundsTheKeys) {
+  CommonFlags flags("orbed-test");
+  flags.lcm_url = "memq://";
+  Process process(flags);
+  EXPECT_EQ(process.MakeStatus().num_drop_reasons, 0);
+  process.CountDrop("HMD_CAMERA/busy");
+  process.CountDrop("HMD_CAMERA/busy", 4);
+  process.CountDrop("ignored", 0);
+  EXPECT_EQ(process.drop_counts(), (std::map<std::string, int64_t>{{"HMD_CAMERA/busy", 5}}));
+  for (int i = 0; i < 100; ++i) process.CountDrop("made-up/" + std::to_string(i));
+  const auto drops = process.drop_counts();
+  EXPECT_EQ(drops.size(), kMaxRejectionClasses);
+  EXPECT_EQ(drops.at("HMD_CAMERA/busy"), 5);
+  EXPECT_EQ(drops.at(kOtherRejectionClass), 100 - static_cast<int64_t>(kMaxRejectionClasses - 2));
+  EXPECT_EQ(process.dropped(), 105);
 }
 
 TEST(Process, ExceptionsInTimersAndHandlersAreCountedNotFatal) {

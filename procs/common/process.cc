@@ -78,9 +78,10 @@ Process::Process(const CommonFlags& flags)
 
 Process::~Process() = default;
 
-void Process::AddTimer(double period_s, std::function<void()> callback) {
+void Process::AddTimer(double period_s, std::function<void()> callback, const std::string& name) {
   if (!(period_s > 0)) throw std::invalid_argument("timer period must be > 0 s");
   Timer timer;
+  timer.drop_key = "timer/" + (name.empty() ? std::to_string(timers_.size()) : name);
   timer.period = Seconds(period_s);
   timer.next = std::chrono::steady_clock::now() + timer.period;
   timer.callback = std::move(callback);
@@ -146,6 +147,32 @@ void Process::Fail(const std::string& error) {
   stop_requested_ = true;
 }
 
+void Process::CountDrop(const std::string& key, int64_t count) {
+  if (count <= 0) return;
+  int64_t before = 0, after = 0;
+  {
+    std::lock_guard<std::mutex> lock(drop_mutex_);
+    const bool known = drops_.count(key) > 0 || drops_.size() < kMaxRejectionClasses - 1;
+    int64_t& counter = drops_[known ? key : kOtherRejectionClass];
+    before = counter;
+    after = counter += count;
+    dropped_ += count;
+  }
+  if (before == 0 || before / 1000 != after / 1000) {
+    ORBED_LOG(kWarn) << "dropped under load: " << key << " " << after << " so far";
+  }
+}
+
+std::map<std::string, int64_t> Process::drop_counts() const {
+  std::lock_guard<std::mutex> lock(drop_mutex_);
+  return drops_;
+}
+
+int64_t Process::dropped() const {
+  std::lock_guard<std::mutex> lock(drop_mutex_);
+  return dropped_;
+}
+
 double Process::UptimeSeconds() const {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
 }
@@ -173,6 +200,15 @@ orbed::process_status_t Process::MakeStatus() const {
     status.reject_count.push_back(count);
   }
   status.num_reasons = static_cast<int32_t>(status.reject_reason.size());
+  {
+    std::lock_guard<std::mutex> lock(drop_mutex_);
+    status.dropped = dropped_;
+    for (const auto& [reason, count] : drops_) {
+      status.drop_reason.push_back(reason);
+      status.drop_count.push_back(count);
+    }
+    status.num_drop_reasons = static_cast<int32_t>(status.drop_reason.size());
+  }
   std::lock_guard<std::mutex> lock(error_mutex_);
   status.last_error = last_error_.empty() ? rejections_.last_reason() : last_error_;
   return status;
@@ -214,6 +250,7 @@ int Process::Run() {
         if (now - timer.next > kMaxCatchUpPeriods * timer.period) {
           const auto behind = (now - timer.next) / timer.period + 1;
           timer.next += behind * timer.period;
+          CountDrop(timer.drop_key, static_cast<int64_t>(behind));
         }
       }
     }

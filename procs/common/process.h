@@ -19,11 +19,18 @@
 /// reordered. Delayed and held datagrams are delivered later from the Run() loop, on the same
 /// thread, with their original receive utime. What was done is logged at start and at exit
 /// ("chaos: N datagrams: ... dropped, ..."); it is not a rejection and not counted as one.
+///
+/// Drops under load: work a process could not do in time is counted, never silent, on its
+/// heartbeat (process_status_t dropped / drop_reason / drop_count, contract change 3): a timer more
+/// than a few periods behind skips deadlines, counted as "timer/<name>" per skipped deadline; a
+/// process counts its own kinds with CountDrop (the headset's renderer: "<channel>/busy").
 
 #include <atomic>
 #include <chrono>
 #include <functional>
+#include <map>
 #include <memory>
+#include <mutex>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -82,9 +89,14 @@ class Process {
 
   /// Calls `callback` every `period_s` seconds on the Run() thread, first at start + period.
   /// Up to 5 missed ticks run back to back (the average rate holds through a busy moment); beyond
-  /// that they are skipped. An exception from a callback is a counted rejection ("timer/<i>").
+  /// that they are skipped, each skipped deadline a counted drop "timer/<name>" (`name` defaults
+  /// to the timer's index). An exception from a callback is a counted rejection ("timer/<i>").
   /// Exceptions from message handlers likewise ("<channel>/handler"): the process keeps running.
-  void AddTimer(double period_s, std::function<void()> callback);
+  void AddTimer(double period_s, std::function<void()> callback, const std::string& name = "");
+
+  /// Counts `count` units of work dropped under load under `key` (thread-safe; logged: the first of
+  /// a key, then every 1000th). At most kMaxRejectionClasses keys, further ones under "other".
+  void CountDrop(const std::string& key, int64_t count = 1);
 
   /// Records a rejected input with its class `key` and a reason; logs it (rate-limited).
   void Reject(const std::string& key, const std::string& reason) { rejections_.Reject(key, reason); }
@@ -103,6 +115,9 @@ class Process {
   int64_t messages_in() const { return messages_in_; }
   int64_t messages_out() const { return messages_out_; }
   const RejectionCounter& rejections() const { return rejections_; }
+  /// Drops so far per key (CountDrop, skipped timer deadlines), and their sum.
+  std::map<std::string, int64_t> drop_counts() const;
+  int64_t dropped() const;
   double UptimeSeconds() const;
   /// The fault injection's queue, or nullptr when the process runs without one.
   const ChaosQueue* chaos() const { return chaos_.get(); }
@@ -115,6 +130,7 @@ class Process {
     std::chrono::steady_clock::duration period;
     std::chrono::steady_clock::time_point next;
     std::function<void()> callback;
+    std::string drop_key;  // "timer/<name>"
   };
   // One subscription: LCM calls OnRaw(), which hands the datagram to the process (Receive: the
   // fault injection, if any); Deliver() decodes into the typed handler, or passes the bytes on.
@@ -150,7 +166,10 @@ class Process {
   std::atomic<int64_t> messages_in_{0};
   std::atomic<int64_t> messages_out_{0};
   RejectionCounter rejections_;
-  std::unique_ptr<ChaosQueue> chaos_;  // null without a chaos spec
+  mutable std::mutex drop_mutex_;
+  std::map<std::string, int64_t> drops_;  // guarded by drop_mutex_
+  int64_t dropped_ = 0;                   // guarded by drop_mutex_
+  std::unique_ptr<ChaosQueue> chaos_;     // null without a chaos spec
   mutable std::mutex error_mutex_;
   std::string last_error_;  // guarded by error_mutex_
 };

@@ -7,8 +7,6 @@
 //     allocator quarantine alone is larger);
 //   - the refusals show in PROCESS_STATUS, counted under "<channel>/decode/<why>";
 //   - a ViRAAl run (orbed-scenario) started afterwards against the same testbed completes.
-#include <dirent.h>
-
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -24,6 +22,7 @@
 #include <yaml-cpp/yaml.h>
 #include <lcm/lcm-cpp.hpp>
 
+#include "base/proc_stats.h"
 #include "procs/common/channels.h"
 #include "procs/common/conversions.h"
 #include "tests/integration/testbed_util.h"
@@ -83,40 +82,6 @@ std::vector<uint8_t> Mutate(const std::vector<uint8_t>& original, std::mt19937& 
   return bytes;
 }
 
-// Peak resident set of a live process [kB] (VmHWM), or -1.
-long PeakResidentKb(int pid) {
-  std::ifstream status("/proc/" + std::to_string(pid) + "/status");
-  std::string key;
-  while (status >> key) {
-    if (key == "VmHWM:") {
-      long kb = -1;
-      status >> kb;
-      return kb;
-    }
-    status.ignore(1 << 12, '\n');
-  }
-  return -1;
-}
-
-// The launcher's children by their --name, from /proc (the truth the bus cannot forge).
-std::map<std::string, int> ChildrenByName(int launcher_pid) {
-  std::map<std::string, int> children;
-  for (const auto& task : fs::directory_iterator("/proc/" + std::to_string(launcher_pid) + "/task")) {
-    std::ifstream list(task.path() / "children");
-    int pid = 0;
-    while (list >> pid) {
-      std::ifstream cmdline("/proc/" + std::to_string(pid) + "/cmdline");
-      std::vector<std::string> args;
-      std::string arg;
-      while (std::getline(cmdline, arg, '\0')) args.push_back(arg);
-      for (size_t i = 0; i + 1 < args.size(); ++i) {
-        if (args[i] == "--name") children[args[i + 1]] = pid;
-      }
-    }
-  }
-  return children;
-}
-
 const char* const kTestbed[] = {"logger", "sim", "registration", "hmd", "monitor"};
 
 TEST(Storm, MutatedTrafficIsRefusedAndTheTestbedKeepsWorking) {
@@ -133,7 +98,7 @@ TEST(Storm, MutatedTrafficIsRefusedAndTheTestbedKeepsWorking) {
       {{"ORBED_LOG_DIR", log_dir}});
   // The testbed's own heartbeats are those from the launcher's children (the storm replays
   // heartbeats of the recorded run, mutated, under the same names).
-  std::map<std::string, int> children;
+  std::map<std::string, pid_t> children;
   auto heartbeat_of = [&](const std::string& name) -> std::unique_ptr<orbed::process_status_t> {
     const auto beats = watcher.Heartbeats(name);
     for (auto it = beats.rbegin(); it != beats.rend(); ++it) {
@@ -194,7 +159,7 @@ TEST(Storm, MutatedTrafficIsRefusedAndTheTestbedKeepsWorking) {
   for (const char* name : kTestbed) {
     const int pid = children[name];
     ASSERT_EQ(::kill(pid, 0), 0) << name << " (pid " << pid << ") is gone";
-    const long peak_kb = PeakResidentKb(pid);
+    const long peak_kb = static_cast<long>(ProcStatusKb(pid, "VmHWM"));
     std::printf("storm: %-12s pid %d peak resident %ld MB, %lld decode refusals\n", name, pid, peak_kb / 1024,
                 static_cast<long long>(decode_refusals(name)));
     EXPECT_TRUE(sanitized || peak_kb < 256 * 1024) << name << " peaked at " << peak_kb << " kB";

@@ -1,0 +1,63 @@
+#include "tests/load/load_cli.h"
+
+#include <exception>
+
+#include <CLI/CLI.hpp>
+
+#include "tests/load/load_run.h"
+
+namespace orbed::load {
+
+int RunLoadCli(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
+  CLI::App app{
+      "orbed-load: runs the testbed (scripts/launch/load.yaml) at --factor times its nominal rates and\n"
+      "measures it: resident memory of each process early and at the end, respawns, the drops each\n"
+      "process counts on its heartbeat and the kernel's socket drops, and per stream the wanted and\n"
+      "achieved rates. Run it in a private network namespace (scripts/orbed load does)."};
+  LoadOptions options;
+  double max_growth_percent = 10;
+  app.add_option("--factor", options.factor, "Times the nominal rates, in [0.1, 16]")
+      ->check(CLI::Range(kMinFactor, kMaxFactor))
+      ->capture_default_str();
+  app.add_option("--duration-s", options.duration_s, "Length of the run from when every process is ready [s]")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app.add_option("--rss-early-s", options.rss_early_s, "When the early resident-memory sample is taken [s]")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app.add_option("--warmup-s", options.warmup_s,
+                 "Rates are accounted from the first heartbeat after this [s]")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option(
+         "--max-rss-growth-percent", max_growth_percent,
+         "Fail when a process's resident memory grows more than this from the early sample to the end [%]")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--ready-timeout-s", options.ready_timeout_s, "Longest wait for the testbed to come up [s]")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app.add_option("--launch-file", options.launch_file, "Launch file (default: scripts/launch/load.yaml)")
+      ->check(CLI::ExistingFile);
+  app.add_option("--log-dir", options.log_dir, "The testbed's log folder (ORBED_LOG_DIR)")->required();
+  app.add_option("--bin-dir", options.bin_dir, "Where orbed-launch is (default: beside orbed-load)");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e, out, err);
+  }
+  try {
+    const LoadReport report = RunLoad(options, err);
+    out << "\n";
+    PrintReport(report, out);
+    const auto failures = Failures(report, max_growth_percent);
+    for (const auto& failure : failures) err << "orbed-load: FAILED: " << failure << "\n";
+    if (failures.empty()) err << "orbed-load: passed\n";
+    return failures.empty() ? 0 : 1;
+  } catch (const std::exception& e) {
+    err << "orbed-load: " << e.what() << "\n";
+    return 1;
+  }
+}
+
+}  // namespace orbed::load
