@@ -289,7 +289,9 @@ TEST(HmdProcess, ATrialWithATrackingFaultIsAnsweredAfterItPlaysOnHmdPose) {
   EXPECT_EQ(states.back(), +orbed::hmd_pose_t::RELOCALIZED);  // the trial right after it
   for (size_t k = states.size() - 7; k + 1 < states.size(); ++k)
     EXPECT_EQ(states[k], +orbed::hmd_pose_t::LOST) << k;
-  if (states.size() > 7) EXPECT_NE(states[states.size() - 8], +orbed::hmd_pose_t::LOST);
+  if (states.size() > 7) {
+    EXPECT_NE(states[states.size() - 8], +orbed::hmd_pose_t::LOST);
+  }
 
   const AT& t = got.trials[0];
   EXPECT_EQ(t.request_id, 7);

@@ -253,7 +253,9 @@ TEST(SlamModel, ForcedFaultHoldsItsSamplesThenJumps) {
     }
     s.push_back(forced.Step(walk.X_WH(k * dt), k * dt));
     const SlamSample p = plain.Step(walk.X_WH(k * dt), k * dt);
-    if (k < 5) EXPECT_TRUE(s.back().X_WH_est.isApprox(p.X_WH_est, 0));
+    if (k < 5) {
+      EXPECT_TRUE(s.back().X_WH_est.isApprox(p.X_WH_est, 0));
+    }
   }
   for (int k = 0; k < 40; ++k) {
     const TrackingState expected = k < 5     ? TrackingState::kTracking
@@ -261,7 +263,9 @@ TEST(SlamModel, ForcedFaultHoldsItsSamplesThenJumps) {
                                    : k == 35 ? TrackingState::kRelocalized
                                              : TrackingState::kTracking;
     EXPECT_EQ(s[k].state, expected) << "sample " << k;
-    if (expected == TrackingState::kLost) EXPECT_TRUE(s[k].X_WH_est.isApprox(s[4].X_WH_est, 0));
+    if (expected == TrackingState::kLost) {
+      EXPECT_TRUE(s[k].X_WH_est.isApprox(s[4].X_WH_est, 0));
+    }
   }
   EXPECT_FALSE(forced.forcing());
   // The jump about the head: yaw about the vertical through p_WH, then the translation.
