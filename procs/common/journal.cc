@@ -1,5 +1,7 @@
 #include "procs/common/journal.h"
 
+#include <algorithm>
+
 #include <fcntl.h>
 #include <unistd.h>
 
@@ -103,7 +105,12 @@ JournalContents ReadJournal(const std::string& path, const JournalLimits& limits
     if (errno == ENOENT) return {};
     throw std::runtime_error("cannot read the journal " + path + ": " + std::strerror(errno));
   }
-  std::vector<uint8_t> bytes(limits.max_file_bytes + 1);
+  // Sized by the file, not by the limit: a small journal costs what it holds (fuzz_state_files
+  // found the old buffer of max_file_bytes + 1 for every read).
+  in.seekg(0, std::ios::end);
+  const uint64_t file_bytes = in ? static_cast<uint64_t>(in.tellg()) : 0;
+  in.seekg(0, std::ios::beg);
+  std::vector<uint8_t> bytes(std::min<uint64_t>(file_bytes, limits.max_file_bytes + 1));
   in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
   if (in.bad()) throw std::runtime_error("cannot read the journal " + path);
   bytes.resize(static_cast<size_t>(in.gcount()));
