@@ -27,6 +27,9 @@ endif()
 
 find_package(OpenCV REQUIRED COMPONENTS core imgproc imgcodecs highgui)
 find_package(urdfdom REQUIRED)
+# TinyXML, the parser urdfdom 3 uses: the robot model reads a URDF's joints with it before urdfdom.
+find_path(TINYXML_INCLUDE_DIR tinyxml.h REQUIRED)
+find_library(TINYXML_LIBRARY tinyxml REQUIRED)
 # Bullet in double precision only; never link the single-precision libraries beside it.
 pkg_check_modules(BULLET REQUIRED IMPORTED_TARGET bullet-float64)
 find_package(fcl QUIET)

@@ -1,5 +1,6 @@
 #include "sim/robot_model.h"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <functional>
@@ -7,6 +8,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include <tinyxml.h>
 #include <urdf_parser/urdf_parser.h>
 
 #include "base/units.h"
@@ -32,6 +34,56 @@ Eigen::Isometry3d ToIsometry(const urdf::Pose& pose) {
 }
 
 bool FinitePositive(double v) { return std::isfinite(v) && v > 0; }
+
+// urdfdom 3.0.1 links every joint's parent and child with owning pointers before it looks for the
+// root, so a joint whose child is its own parent, or a loop of joints, leaves a reference cycle that
+// is never freed, whether the parse then fails or not (found by fuzz_urdf). This reads the joints'
+// <parent link> and <child link> with the same XML parser (TinyXML) first and returns the loop as
+// "a -> b -> a", or "" when the joints form no directed cycle (or the XML does not parse: urdfdom
+// refuses that before it links anything).
+std::string FindJointLoop(const std::string& urdf_xml) {
+  TiXmlDocument doc;
+  doc.Parse(urdf_xml.c_str());
+  if (doc.Error()) return "";
+  const TiXmlElement* robot = doc.FirstChildElement("robot");
+  if (robot == nullptr) return "";
+  std::map<std::string, std::vector<std::string>> children_of;
+  for (const TiXmlElement* joint = robot->FirstChildElement("joint"); joint != nullptr;
+       joint = joint->NextSiblingElement("joint")) {
+    const TiXmlElement* parent = joint->FirstChildElement("parent");
+    const TiXmlElement* child = joint->FirstChildElement("child");
+    const char* parent_name = parent != nullptr ? parent->Attribute("link") : nullptr;
+    const char* child_name = child != nullptr ? child->Attribute("link") : nullptr;
+    if (parent_name == nullptr || child_name == nullptr) continue;
+    children_of[parent_name].push_back(child_name);
+  }
+  // Depth-first search; a link met again while still on the path closes a loop.
+  enum class Mark { kNew, kOnPath, kDone };
+  std::map<std::string, Mark> mark;
+  std::vector<std::string> path;
+  std::string loop;
+  std::function<bool(const std::string&)> visit = [&](const std::string& link) {
+    mark[link] = Mark::kOnPath;
+    path.push_back(link);
+    for (const std::string& child : children_of[link]) {
+      const Mark m = mark.count(child) != 0 ? mark[child] : Mark::kNew;
+      if (m == Mark::kOnPath) {
+        auto it = std::find(path.begin(), path.end(), child);
+        for (; it != path.end(); ++it) loop += "'" + *it + "' -> ";
+        loop += "'" + child + "'";
+        return true;
+      }
+      if (m == Mark::kNew && visit(child)) return true;
+    }
+    path.pop_back();
+    mark[link] = Mark::kDone;
+    return false;
+  };
+  for (const auto& entry : children_of) {
+    if (mark.count(entry.first) == 0 && visit(entry.first)) return loop;
+  }
+  return "";
+}
 
 }  // namespace
 
@@ -87,6 +139,8 @@ RobotModel RobotModel::LoadString(const std::string& urdf_xml, const std::string
                                   const std::string& flange_link, const std::string& tool_tip_link) {
   const std::string src = source_name;
   auto fail = [&src](const std::string& what) -> void { throw std::runtime_error(src + ": " + what); };
+  const std::string loop = FindJointLoop(urdf_xml);
+  if (!loop.empty()) fail("the joints form a loop (a URDF must be a tree): " + loop);
   urdf::ModelInterfaceSharedPtr urdf_model = urdf::parseURDF(urdf_xml);
   if (!urdf_model) {
     fail(

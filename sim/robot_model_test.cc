@@ -222,6 +222,24 @@ std::string Expect(const std::string& xml) {
   return "(no error)";
 }
 
+// urdfdom 3.0.1 would leak a reference cycle on these (the sanitizer build's LeakSanitizer checks that
+// none is made); the loader refuses them first and names the loop.
+TEST(RobotModelTest, JointLoopsAreRefusedBeforeUrdfdomLinksThem) {
+  const std::string links = "<robot name='r'><link name='a'/><link name='b'/><link name='c'/>";
+  auto joint = [](const char* name, const char* parent, const char* child) {
+    return std::string("<joint name='") + name + "' type='fixed'><parent link='" + parent +
+           "'/><child link='" + child + "'/></joint>";
+  };
+  std::string e = Expect(links + joint("j1", "a", "b") + joint("j2", "b", "b") + "</robot>");
+  EXPECT_NE(e.find("bad.urdf: the joints form a loop (a URDF must be a tree): 'b' -> 'b'"), std::string::npos)
+      << e;
+  e = Expect(links + joint("j1", "a", "b") + joint("j2", "b", "c") + joint("j3", "c", "a") + "</robot>");
+  EXPECT_NE(e.find("'a' -> 'b' -> 'c' -> 'a'"), std::string::npos) << e;
+  // A chain is not a loop: it gets past the check to the flange check.
+  e = Expect(links + joint("j1", "a", "b") + joint("j2", "b", "c") + "</robot>");
+  EXPECT_EQ(e.find("loop"), std::string::npos) << e;
+}
+
 TEST(RobotModelTest, BadUrdfsAreRejectedWithTheElement) {
   const std::string head = "<robot name='r'><link name='a'/><link name='iiwa_link_ee'/>";
   EXPECT_NE(Expect("<robot").find("bad.urdf"), std::string::npos);
