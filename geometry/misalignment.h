@@ -10,7 +10,8 @@
 /// Over pairs (Table 1 columns): the mean absolute per-axis error t̄ = (t̄_x, t̄_y, t̄_z) and its
 /// sample standard deviation σ_t (N − 1 in the denominator; 0 for one pair) [m]; the table's last
 /// column, ‖t̄‖₂ and ‖σ_t‖₂ [m]; and the mean of the per-pair norms [m] (a distance, which ‖t̄‖₂ is
-/// not: ‖t̄‖₂ ≥ mean‖·‖ in general).
+/// not: the norm of a mean is at most the mean of the norms, so ‖t̄‖₂ ≤ mean_k ‖p_virtual_k − p_real_k‖,
+/// equal only when every pair's error points the same way).
 ///
 /// Validation: at least one pair, equal counts, finite coordinates; otherwise valid = false with
 /// the reason. Threading: pure function, reentrant.

@@ -145,8 +145,8 @@ Se3MeanResult ComputeSe3Mean(const std::vector<Eigen::Quaterniond>& quat_WV,
   d.translation_rms_m = std::sqrt(sum_sq_translation * inv_n);
   d.translation_covariance_m2 *= inv_n;
   if (options.method == AveragingMethod::kChordal) {
-    constexpr double kMargin = 1e-9;  // as KarcherOptions::certificate_margin_rad
-    result.unique = max_angle < kHalfPi - kMargin;
+    // The chordal mean is the top eigenvector of M: unique exactly when that eigenvalue is simple.
+    result.unique = result.chordal_eigen_gap > kChordalGapMargin;
   } else {
     result.unique = max_angle < kHalfPi - options.karcher.certificate_margin_rad;
   }

@@ -32,6 +32,10 @@
 
 namespace orbed::geometry {
 
+/// The chordal mean counts as unique when its eigen-gap exceeds this (rounding of the 4x4
+/// eigensolver lies far below it).
+inline constexpr double kChordalGapMargin = 1e-9;
+
 /// Values match orbed::registration_t::METHOD_*.
 enum class AveragingMethod : int { kChordal = 0, kKarcher = 1, kRobust = 2 };
 
@@ -69,7 +73,12 @@ struct Se3MeanResult {
   std::vector<int> used;
   std::vector<RejectedTrial> rejected;
   /// Rotation solver: Karcher iterations (0 for chordal), converged (true for chordal, a closed
-  /// form), the certificate and ambiguity flags of rotation_mean.h, the chordal eigen-gap.
+  /// form), the ambiguity flag of rotation_mean.h, the chordal eigen-gap. `unique` certifies the
+  /// mean that was computed: for Karcher and robust, rotation_mean.h's certificate (every used
+  /// residual below π/2, so the L2 mean is the unique minimizer); for chordal, that the largest
+  /// eigenvalue of the quaternion matrix M is simple (eigen-gap > kChordalGapMargin), which is when
+  /// the chordal mean is unique (a residual test would say nothing about it: the chordal mean is not
+  /// the minimizer of the geodesic cost).
   int iterations = 0;
   bool converged = false;
   bool unique = false;

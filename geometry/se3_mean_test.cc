@@ -56,6 +56,28 @@ TEST(Se3MeanTest, ChordalMethodReportsNoIterations) {
   EXPECT_NEAR(AngleBetween(r.q_WV_mean, Rot(std::atan(0.5), z)), 0.0, 1e-13);
 }
 
+// Rotations θ_i about one axis: M's two non-zero eigenvalues are (1 ± R)/2 with R = |mean e^{iθ_i}|,
+// so the eigen-gap is R; the chordal mean is unique exactly when R > 0, whatever the residuals.
+TEST(Se3MeanTest, ChordalUniquenessIsTheEigenGapNotAResidualTest) {
+  const Eigen::Vector3d z = Eigen::Vector3d::UnitZ();
+  Se3MeanOptions options;
+  options.method = AveragingMethod::kChordal;
+  const std::vector<Eigen::Vector3d> origins(3, Eigen::Vector3d::Zero());
+  // 0, 0, 170 deg: a residual of about 160 deg, yet one chordal mean.
+  const double far = 170 * kDegToRad;
+  Se3MeanResult r = ComputeSe3Mean({Rot(0, z), Rot(0, z), Rot(far, z)}, origins, options);
+  ASSERT_TRUE(r.valid);
+  const double R = std::hypot(2 + std::cos(far), std::sin(far)) / 3;
+  EXPECT_NEAR(r.chordal_eigen_gap, R, 1e-12);
+  EXPECT_GT(r.dispersion.rotation_max_deg, 150.0);
+  EXPECT_TRUE(r.unique);
+  // 0, 120, 240 deg: R = 0, every rotation about z is as close; no unique chordal mean.
+  r = ComputeSe3Mean({Rot(0, z), Rot(120 * kDegToRad, z), Rot(240 * kDegToRad, z)}, origins, options);
+  ASSERT_TRUE(r.valid);
+  EXPECT_NEAR(r.chordal_eigen_gap, 0.0, 1e-12);
+  EXPECT_FALSE(r.unique);
+}
+
 TEST(Se3MeanTest, AveragingAboutTheModelCentroidRemovesTheLeverArm) {
   // Every trial places the model centroid C at the same world point c, with rotations ±20° about
   // z: the mean rotation is I, and about C the mean base is c − p_VC with zero translation spread.

@@ -153,6 +153,7 @@ TEST(UserStudyCli, ManyTrialsPrintASummaryWithTheRankTest) {
       test::RunCommand(RunUserStudy, "orbed-user-study", {"--trials", "12", "--run-id", "summary"});
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("ar_reflective (12 trials)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("Table 1 [mm]"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("Mann-Whitney U"), std::string::npos) << r.out;
   EXPECT_NE(r.err.find("24/24 trials"), std::string::npos) << r.err;  // progress
 }

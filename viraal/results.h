@@ -27,6 +27,8 @@
 ///                                                   TrackingFaults)} ],
 ///                  "trial_statistics": {"<measure>": {"mean", "std"}} over the trials (std with
 ///                                      N − 1; 0 for one trial),
+///                  "table1": {"num_trials", "axes_mean_mm", "axes_std_mm", "mean_mm", "std_mm"}
+///                            (the paper's statistic over the trials: Table1Row),
 ///                  "mean": {"translation_error_mm", "rotation_error_deg", "misalignment_mm",
 ///                           "base_translation_error_mm", "flange_translation_error_mm",
 ///                           "misalignment_axes_mm", "misalignment_mean_pair_distance_mm",
@@ -37,8 +39,8 @@
 ///
 /// ReadResultsFile reads the document back (the conductor resuming a run), checked like any input
 /// from outside (base/json_fields.h): every field with its type and range, bounded counts, unit
-/// quaternions; "trial_statistics" are derived, not read; "started_utime" and "duration_s" may be
-/// absent (a pinned file leaves them out).
+/// quaternions; "trial_statistics" and "table1" are derived, not read; "started_utime" and "duration_s" may
+/// be absent (a pinned file leaves them out).
 ///
 /// Threading: plain data and pure functions.
 
@@ -126,6 +128,24 @@ struct MeanStd {
   double std{0};
 };
 MeanStd ComputeMeanStd(const std::vector<double>& values);
+
+/// The paper's Table 1 statistic over the trials of one mode. Each trial contributes its per-axis
+/// error t̄_i = (t̄x, t̄y, t̄z) [mm]: the mean |virtual − real| over its landmark pairs, per axis of W
+/// (misalignment_axes_mm). Per axis, the mean and the sample standard deviation (N − 1; 0 for one
+/// trial) over the trials; the row's two figures are the L2 norms of those two vectors (the paper's
+/// means (17.4, 11.9, 21.6) give its 30.2 mm). This is not the mean of the per-trial norms ‖t̄_i‖₂
+/// (trial_statistics' misalignment_mm), which is never smaller: ‖mean_i t̄_i‖₂ ≤ mean_i ‖t̄_i‖₂ by
+/// the triangle inequality.
+struct Table1Row {
+  int num_trials{0};
+  Eigen::Vector3d axes_mean_mm{Eigen::Vector3d::Zero()};
+  Eigen::Vector3d axes_std_mm{Eigen::Vector3d::Zero()};
+  double mean_mm{0};  ///< ‖axes_mean_mm‖₂
+  double std_mm{0};   ///< ‖axes_std_mm‖₂
+};
+Table1Row ComputeTable1Row(const std::vector<Eigen::Vector3d>& trial_axes_mm);
+/// The row of a session's trials (their misalignment_axes_mm).
+Table1Row SessionTable1Row(const SessionResult& session);
 
 /// results.json text (pretty-printed, 2 spaces).
 std::string ResultsJson(const RunResults& results);

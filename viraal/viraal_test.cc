@@ -190,6 +190,47 @@ int Count(const std::string& text, const std::string& pattern) {
       std::distance(std::sregex_iterator(text.begin(), text.end(), re), std::sregex_iterator()));
 }
 
+// Two trials m ∓ s/√2 per axis have mean m and sample standard deviation s, so the row of the
+// paper's own per-axis figures must give the paper's norms (Table 1, rounded as printed there).
+TEST(ViraalResults, Table1RowGivesThePapersNormsFromItsPerAxisFigures) {
+  struct PaperRow {
+    Eigen::Vector3d mean, std;
+    double mean_norm, std_norm;
+  };
+  const PaperRow rows[] = {{{17.4, 11.9, 21.6}, {16.1, 6.24, 16.5}, 30.2, 23.9},   // AR only
+                           {{9.00, 10.3, 9.18}, {5.64, 7.45, 5.77}, 16.5, 11.0}};  // with the display
+  for (const PaperRow& p : rows) {
+    const Eigen::Vector3d half_spread = p.std / std::sqrt(2.0);
+    const Table1Row row = ComputeTable1Row({p.mean - half_spread, p.mean + half_spread});
+    EXPECT_EQ(row.num_trials, 2);
+    EXPECT_NEAR((row.axes_mean_mm - p.mean).norm(), 0.0, 1e-12);
+    EXPECT_NEAR((row.axes_std_mm - p.std).norm(), 0.0, 1e-12);
+    EXPECT_NEAR(row.mean_mm, p.mean_norm, 0.05);
+    EXPECT_NEAR(row.std_mm, p.std_norm, 0.05);
+  }
+}
+
+// By hand: trials (3, 0, 4), (1, 2, 2), (2, 1, 0): means (2, 1, 2) → 3; sample stds (1, 1, 2) → √6.
+// The mean of the trials' norms is (5 + 3 + √5)/3 ≈ 3.41, larger than 3 (triangle inequality).
+TEST(ViraalResults, Table1RowIsTheNormOfPerAxisMeansNotTheMeanOfNorms) {
+  SessionResult s;
+  for (const Eigen::Vector3d& axes :
+       {Eigen::Vector3d(3, 0, 4), Eigen::Vector3d(1, 2, 2), Eigen::Vector3d(2, 1, 0)}) {
+    TrialResult t;
+    t.errors.misalignment_axes_mm = axes;
+    t.errors.misalignment_mm = axes.norm();
+    s.trials.push_back(t);
+  }
+  const Table1Row row = SessionTable1Row(s);
+  EXPECT_EQ(row.num_trials, 3);
+  EXPECT_NEAR((row.axes_mean_mm - Eigen::Vector3d(2, 1, 2)).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((row.axes_std_mm - Eigen::Vector3d(1, 1, 2)).norm(), 0.0, 1e-12);
+  EXPECT_NEAR(row.mean_mm, 3.0, 1e-12);
+  EXPECT_NEAR(row.std_mm, std::sqrt(6.0), 1e-12);
+  EXPECT_EQ(ComputeTable1Row({}).num_trials, 0);
+  EXPECT_EQ(ComputeTable1Row({{1, 2, 2}}).std_mm, 0.0);  // one trial: no spread
+}
+
 TEST(ViraalResults, JsonHasTheDocumentedShape) {
   RunResults r;
   r.run_id = "t";
@@ -222,8 +263,11 @@ TEST(ViraalResults, JsonHasTheDocumentedShape) {
   EXPECT_NE(json.find("\"translation_error_mm\": {\n          \"mean\": 11,\n          \"std\": 1"),
             std::string::npos)
       << json;
+  EXPECT_EQ(Count(json, "\"table1\": \\{"), 2);
+  EXPECT_EQ(Count(json, "\"num_trials\": 3"), 2);
   const std::string table = ResultsTable(r);
   EXPECT_NE(table.find("paper: 16.5 +/- 11.0 mm"), std::string::npos) << table;
+  EXPECT_EQ(Count(table, "Table 1 \\(3 trials\\): 0.0 \\+/- 0.0 mm"), 2) << table;
 }
 
 }  // namespace

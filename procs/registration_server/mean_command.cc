@@ -86,7 +86,10 @@ int RunMeanCommand(const MeanCommandOptions& options, std::ostream& out, std::os
     err << name << ": warning: the Karcher iteration hit its cap without converging\n";
   }
   if (!result.unique) {
-    err << name << ": warning: a trial lies >= 90 deg from the mean; the mean may not be unique\n";
+    err << name
+        << (result.method == geometry::AveragingMethod::kChordal
+                ? ": warning: the chordal eigen-gap is 0; the chordal mean is not unique\n"
+                : ": warning: a trial lies >= 90 deg from the mean; the mean may not be unique\n");
   }
 
   if (options.json) {
