@@ -14,6 +14,7 @@
 #include "base/format.h"
 #include "base/source_paths.h"
 #include "base/stats.h"
+#include "study/landmark_validation.h"
 #include "study/viraal_study.h"
 #include "viraal/paper_reference.h"
 
@@ -77,12 +78,19 @@ std::string Summary(const StudyOptions& options, const viraal::RunResults& resul
       rot.push_back(t.errors.rotation_error_deg);
     }
     misalignment.push_back(mis);
+    const viraal::Table1Row table1 = viraal::SessionTable1Row(s);
+    const auto axes = [](const Eigen::Vector3d& v) {
+      return "(" + Fixed(v.x(), 1) + ", " + Fixed(v.y(), 1) + ", " + Fixed(v.z(), 1) + ")";
+    };
     text += s.mode + " (" + std::to_string(s.trials.size()) + " trials)\n";
-    text += "  misalignment [mm]  " + MeanStdText(mis, 1);
+    text += "  Table 1 [mm]       " + Fixed(table1.mean_mm, 1) + " +/- " + Fixed(table1.std_mm, 1);
     if (const viraal::PaperFigure* paper = PaperFor(s.mode)) {
-      text += "   (paper: " + Fixed(paper->misalignment_mm, 1) + " +/- " + Fixed(paper->std_mm, 1) + ")";
+      text += "   (paper: " + Fixed(paper->misalignment_mm, 1) + " +/- " + Fixed(paper->std_mm, 1) + " mm)";
     }
-    text += "\n  translation [mm]   " + MeanStdText(trans, 1) + "\n";
+    text += "\n    per axis x, y, z: means " + axes(table1.axes_mean_mm) + ", standard deviations " +
+            axes(table1.axes_std_mm) + "\n";
+    text += "  misalignment [mm]  " + MeanStdText(mis, 1) + "   (mean of the trials' ||t_bar||)\n";
+    text += "  translation [mm]   " + MeanStdText(trans, 1) + "\n";
     text += "  rotation [deg]     " + MeanStdText(rot, 2) + "\n";
     const std::vector<double> triples = GroupMeanMisalignment_mm(options, s, 3);
     text += "  SE(3) means of N = 3 consecutive trials (" + std::to_string(triples.size()) +
@@ -99,6 +107,26 @@ std::string Summary(const StudyOptions& options, const viraal::RunResults& resul
   text += "paper, SE(3) mean of N = 3 trials with the display: " +
           Fixed(viraal::kPaperArReflectiveMean.misalignment_mm, 1) + " +/- " +
           Fixed(viraal::kPaperArReflectiveMean.std_mm, 2) + " mm\n";
+  return text;
+}
+
+// The optical-table experiment: mean error per separation and over all, beside the paper's.
+std::string LandmarkValidationSummary(const LandmarkValidationOptions& options, const LandmarkValidation& v) {
+  std::string text =
+      "Landmark measurement error (optical table; each target triangulated from 2 gaze rays; " +
+      std::to_string(options.repeats) + " measurements per separation; pointing sigma " +
+      Fixed(options.pointing_std_deg, 2) + " deg per axis)\n";
+  for (double separation : options.separations_mm) {
+    std::vector<double> errors;
+    for (const LandmarkMeasurement& m : v.measurements) {
+      if (m.separation_mm == separation) errors.push_back(m.error_mm);
+    }
+    char label[32];
+    std::snprintf(label, sizeof(label), "  %6.0f mm apart: ", separation);
+    text += label + std::string("error ") + MeanStdText(errors, 1) + " mm\n";
+  }
+  text += "  all " + std::to_string(v.measurements.size()) + ": average error " + Fixed(v.mean_error_mm, 1) +
+          " mm   (paper: " + Fixed(kPaperLandmarkValidationMm, 1) + " mm over 12 measurements)\n";
   return text;
 }
 
@@ -130,11 +158,46 @@ int RunUserStudy(int argc, const char* const* argv, std::ostream& out, std::ostr
   app.add_option("--scene", o.scene_path, "Scene YAML (default: sim/models/scenes/trocar_or.yaml)");
   app.add_option("--json", json_path, "Write the results.json the conductor would write to this file");
   app.add_flag("--quiet", quiet, "No progress lines on stderr");
+  bool landmark_validation = false;
+  LandmarkValidationOptions validation;
+  std::string csv_path;
+  auto* validation_flag = app.add_flag(
+      "--landmark-validation", landmark_validation,
+      "Instead of alignment trials: the paper's check of the landmark measurement itself (distances of "
+      "targets 5-20 cm apart on an optical table, each target triangulated from two gaze rays)");
+  app.add_option("--repeats", validation.repeats, "--landmark-validation: measurements per separation")
+      ->transform(PositiveDecimalInt())
+      ->capture_default_str()
+      ->needs(validation_flag);
+  app.add_option("--pointing-std-deg", validation.pointing_std_deg,
+                 "--landmark-validation: head-gaze pointing error per axis [deg]")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str()
+      ->needs(validation_flag);
+  app.add_option("--csv", csv_path, "--landmark-validation: write landmark_validation.csv to this file")
+      ->needs(validation_flag);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     const int code = app.exit(e, out, err);
     return code == 0 ? 0 : 2;  // this tool's bad-argument code, not CLI11's
+  }
+  if (landmark_validation) {
+    try {
+      validation.seed = o.seed;
+      validation.slam = LoadShippedSlamConfig(o.headset_config_paths);
+      const LandmarkValidation v = RunLandmarkValidation(validation);
+      out << LandmarkValidationSummary(validation, v);
+      if (!csv_path.empty()) {
+        std::ofstream file(csv_path);
+        file << LandmarkValidationCsv(v);
+        if (!file) throw std::runtime_error("cannot write " + csv_path);
+      }
+    } catch (const std::exception& e) {
+      err << "orbed-user-study: " << e.what() << "\n";
+      return 1;
+    }
+    return 0;
   }
   try {
     o.scenario = viraal::LoadScenarioFile(scenario_path);

@@ -6,12 +6,18 @@
 ///
 ///   orbed-user-study [--trials N] [--modes LIST] [--seed N] [--run-id ID] [--scenario FILE]
 ///                    [--config FILE]... [--urdf FILE] [--scene FILE] [--json FILE] [--quiet]
+///   orbed-user-study --landmark-validation [--repeats N] [--pointing-std-deg X] [--csv FILE]
+///                    [--seed N] [--config FILE]...
 ///
 /// Prints the run's table (viraal/results.h) for up to 10 trials per mode, else a summary per mode
 /// (the trials' misalignment, translation and rotation errors, mean ± std, and the SE(3) mean of all
 /// the mode's trials) beside the paper's Table 1, and the one-sided Mann–Whitney test that the first
 /// mode's trial misalignment is smaller than the second's. Progress goes to `err` unless --quiet.
-/// --json writes the results.json the conductor would write.
+/// --json writes the results.json the conductor would write. Each mode's first line is the paper's
+/// Table 1 statistic (viraal::Table1Row: the norms of the per-axis means and standard deviations).
+/// --landmark-validation runs the paper's check of the measurement itself instead
+/// (landmark_validation.h): the error per separation and on average beside the paper's 3.6 mm;
+/// --csv writes landmark_validation.csv.
 ///
 /// Exit codes: 0 done (or --help, on `out`); 2 bad arguments (the message on `err` names the flag);
 /// 1 the study failed (unreadable file, a configuration outside the limits; message on `err`).

@@ -1,0 +1,176 @@
+#include "study/landmark_validation.h"
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include <Eigen/Geometry>
+
+#include "base/format.h"
+#include "base/units.h"
+#include "geometry/triangulation.h"
+#include "hmd_emulator/hmd_config.h"
+#include "hmd_emulator/random.h"
+
+namespace orbed::study {
+namespace {
+
+// The head at p_WH looking at p_WQ: z along the line of sight, x to the right and horizontal, y
+// down (world z is up), as H is defined in head_trajectory.h.
+Eigen::Isometry3d HeadLookingAt(const Eigen::Vector3d& p_WH, const Eigen::Vector3d& p_WQ) {
+  const Eigen::Vector3d z = (p_WQ - p_WH).normalized();
+  const Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitZ()).normalized();
+  const Eigen::Vector3d y = z.cross(x);
+  Eigen::Isometry3d X_WH = Eigen::Isometry3d::Identity();
+  X_WH.linear().col(0) = x;
+  X_WH.linear().col(1) = y;
+  X_WH.linear().col(2) = z;
+  X_WH.translation() = p_WH;
+  return X_WH;
+}
+
+// One measurement's walk through the SLAM model: the clock and the samples it takes.
+class AnnotatingPerson {
+ public:
+  AnnotatingPerson(const LandmarkValidationOptions& options, std::uint64_t seed)
+      : options_(options), slam_(SlamWithSeed(options.slam, seed)), rng_(seed ^ 0x9e3779b97f4a7c15ULL) {
+    slam_.set_random_losses(false);
+  }
+
+  // Holds the cursor on p_WQ from p_WH (with this annotation's pointing error) for the dwell time
+  // and taps: the ray the device records, in map coordinates.
+  void Annotate(const Eigen::Vector3d& p_WH, const Eigen::Vector3d& p_WQ, std::vector<Eigen::Vector3d>* origins,
+                std::vector<Eigen::Vector3d>* directions) {
+    const double sigma_rad = options_.pointing_std_deg * kDegToRad;
+    const double about_x = rng_.Normal(0.0, sigma_rad);
+    const double about_y = rng_.Normal(0.0, sigma_rad);
+    Eigen::Isometry3d X_WH_true = HeadLookingAt(p_WH, p_WQ);
+    X_WH_true.linear() = X_WH_true.linear() * Eigen::AngleAxisd(about_x, Eigen::Vector3d::UnitX()).toRotationMatrix() *
+                         Eigen::AngleAxisd(about_y, Eigen::Vector3d::UnitY()).toRotationMatrix();
+    const int samples = std::max(1, static_cast<int>(std::lround(options_.dwell_s * options_.slam.rate_hz)));
+    hmd::SlamSample last;
+    for (int k = 0; k < samples; ++k) last = Step(X_WH_true);
+    origins->push_back(last.X_WH_est.translation());
+    directions->push_back(last.X_WH_est.linear().col(2));
+  }
+
+  // Steps sideways from `from` to `to`, looking at `look_at`.
+  void Walk(const Eigen::Vector3d& from, const Eigen::Vector3d& to, const Eigen::Vector3d& look_at) {
+    const double distance = (to - from).norm();
+    const int samples = std::max(
+        1, static_cast<int>(std::ceil(distance / options_.walk_speed_m_per_s * options_.slam.rate_hz)));
+    for (int k = 1; k <= samples; ++k) {
+      const Eigen::Vector3d p = from + (to - from) * (static_cast<double>(k) / samples);
+      Step(HeadLookingAt(p, look_at));
+    }
+  }
+
+ private:
+  static hmd::SlamConfig SlamWithSeed(hmd::SlamConfig config, std::uint64_t seed) {
+    config.seed = seed;
+    config.faults.clear();
+    return config;
+  }
+
+  hmd::SlamSample Step(const Eigen::Isometry3d& X_WH_true) {
+    const hmd::SlamSample s = slam_.Step(X_WH_true, t_s_);
+    t_s_ += 1.0 / options_.slam.rate_hz;
+    return s;
+  }
+
+  const LandmarkValidationOptions& options_;
+  hmd::SlamModel slam_;
+  hmd::Random rng_;
+  double t_s_{0};
+};
+
+Eigen::Vector3d Triangulate(const std::vector<Eigen::Vector3d>& origins, const std::vector<Eigen::Vector3d>& directions,
+                            const char* target) {
+  const geometry::TriangulationResult r = geometry::TriangulateRays(origins, directions);
+  if (!r.valid) throw std::runtime_error(std::string("landmark validation: target ") + target + ": " + r.reason);
+  return r.p_W;
+}
+
+void CheckOptions(const LandmarkValidationOptions& o) {
+  auto positive = [](double v) { return std::isfinite(v) && v > 0; };
+  if (o.separations_mm.empty()) throw std::invalid_argument("landmark validation: no target separation given");
+  for (double s : o.separations_mm) {
+    if (!positive(s) || s > 2000) {
+      throw std::invalid_argument("landmark validation: separation " + Fixed(s, 1) + " mm is not in (0, 2000]");
+    }
+  }
+  if (o.repeats < 1) throw std::invalid_argument("landmark validation: repeats must be >= 1");
+  if (!std::isfinite(o.pointing_std_deg) || o.pointing_std_deg < 0) {
+    throw std::invalid_argument("landmark validation: pointing_std_deg must be >= 0");
+  }
+  for (double v : {o.eye_height_m, o.standoff_m, o.baseline_m, o.dwell_s, o.walk_speed_m_per_s, o.slam.rate_hz}) {
+    if (!positive(v)) throw std::invalid_argument("landmark validation: geometry and times must be > 0");
+  }
+  if (!std::isfinite(o.table_height_m) || o.table_height_m >= o.eye_height_m) {
+    throw std::invalid_argument("landmark validation: the table top must be below the eyes");
+  }
+  if (!std::isfinite(o.centre_jitter_m) || o.centre_jitter_m < 0) {
+    throw std::invalid_argument("landmark validation: centre_jitter_m must be >= 0");
+  }
+}
+
+}  // namespace
+
+LandmarkValidation RunLandmarkValidation(const LandmarkValidationOptions& options) {
+  CheckOptions(options);
+  LandmarkValidation out;
+  hmd::Random rng(options.seed);
+  const Eigen::Vector3d p_WH1(0.0, 0.0, options.eye_height_m);
+  const Eigen::Vector3d p_WH2 = p_WH1 + Eigen::Vector3d(0.0, options.baseline_m, 0.0);
+  double sum_error_mm = 0;
+  for (double separation_mm : options.separations_mm) {
+    for (int repeat = 0; repeat < options.repeats; ++repeat) {
+      const double cx = rng.Uniform(-options.centre_jitter_m, options.centre_jitter_m);
+      const double cy = rng.Uniform(-options.centre_jitter_m, options.centre_jitter_m);
+      const double heading = rng.Uniform(0.0, 2.0 * M_PI);
+      const std::uint64_t person_seed = rng.NextSeed();
+      const Eigen::Vector3d centre(options.standoff_m + cx, cy, options.table_height_m);
+      const Eigen::Vector3d half = 0.5e-3 * separation_mm * Eigen::Vector3d(std::cos(heading), std::sin(heading), 0);
+      const Eigen::Vector3d p_WA = centre - half, p_WB = centre + half;
+
+      AnnotatingPerson person(options, person_seed);
+      std::vector<Eigen::Vector3d> origins_A, directions_A, origins_B, directions_B;
+      person.Annotate(p_WH1, p_WA, &origins_A, &directions_A);
+      person.Annotate(p_WH1, p_WB, &origins_B, &directions_B);
+      person.Walk(p_WH1, p_WH2, centre);
+      person.Annotate(p_WH2, p_WA, &origins_A, &directions_A);
+      person.Annotate(p_WH2, p_WB, &origins_B, &directions_B);
+      const Eigen::Vector3d x_A = Triangulate(origins_A, directions_A, "A");
+      const Eigen::Vector3d x_B = Triangulate(origins_B, directions_B, "B");
+
+      LandmarkMeasurement m;
+      m.repeat = repeat;
+      m.separation_mm = separation_mm;
+      m.measured_mm = 1e3 * (x_A - x_B).norm();
+      m.error_mm = std::abs(m.measured_mm - separation_mm);
+      sum_error_mm += m.error_mm;
+      out.measurements.push_back(m);
+    }
+  }
+  out.mean_error_mm = sum_error_mm / static_cast<double>(out.measurements.size());
+  return out;
+}
+
+std::string LandmarkValidationCsv(const LandmarkValidation& validation) {
+  std::ostringstream csv;
+  csv.precision(17);
+  csv << "repeat,separation_mm,measured_mm,error_mm\n";
+  for (const LandmarkMeasurement& m : validation.measurements) {
+    csv << (m.repeat + 1) << "," << m.separation_mm << "," << m.measured_mm << "," << m.error_mm << "\n";
+  }
+  return csv.str();
+}
+
+hmd::SlamConfig LoadShippedSlamConfig(const std::vector<std::string>& headset_config_paths) {
+  std::vector<std::string> paths;
+  for (const auto& relative : hmd::DefaultHmdConfigRelativePaths()) paths.push_back(hmd::HmdSourcePath(relative));
+  paths.insert(paths.end(), headset_config_paths.begin(), headset_config_paths.end());
+  return hmd::LoadHmdConfigs(paths).slam;
+}
+
+}  // namespace orbed::study
