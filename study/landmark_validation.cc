@@ -39,13 +39,14 @@ class AnnotatingPerson {
 
   // Holds the cursor on p_WQ from p_WH (with this annotation's pointing error) for the dwell time
   // and taps: the ray the device records, in map coordinates.
-  void Annotate(const Eigen::Vector3d& p_WH, const Eigen::Vector3d& p_WQ, std::vector<Eigen::Vector3d>* origins,
-                std::vector<Eigen::Vector3d>* directions) {
+  void Annotate(const Eigen::Vector3d& p_WH, const Eigen::Vector3d& p_WQ,
+                std::vector<Eigen::Vector3d>* origins, std::vector<Eigen::Vector3d>* directions) {
     const double sigma_rad = options_.pointing_std_deg * kDegToRad;
     const double about_x = rng_.Normal(0.0, sigma_rad);
     const double about_y = rng_.Normal(0.0, sigma_rad);
     Eigen::Isometry3d X_WH_true = HeadLookingAt(p_WH, p_WQ);
-    X_WH_true.linear() = X_WH_true.linear() * Eigen::AngleAxisd(about_x, Eigen::Vector3d::UnitX()).toRotationMatrix() *
+    X_WH_true.linear() = X_WH_true.linear() *
+                         Eigen::AngleAxisd(about_x, Eigen::Vector3d::UnitX()).toRotationMatrix() *
                          Eigen::AngleAxisd(about_y, Eigen::Vector3d::UnitY()).toRotationMatrix();
     const int samples = std::max(1, static_cast<int>(std::lround(options_.dwell_s * options_.slam.rate_hz)));
     hmd::SlamSample last;
@@ -84,26 +85,30 @@ class AnnotatingPerson {
   double t_s_{0};
 };
 
-Eigen::Vector3d Triangulate(const std::vector<Eigen::Vector3d>& origins, const std::vector<Eigen::Vector3d>& directions,
-                            const char* target) {
+Eigen::Vector3d Triangulate(const std::vector<Eigen::Vector3d>& origins,
+                            const std::vector<Eigen::Vector3d>& directions, const char* target) {
   const geometry::TriangulationResult r = geometry::TriangulateRays(origins, directions);
-  if (!r.valid) throw std::runtime_error(std::string("landmark validation: target ") + target + ": " + r.reason);
+  if (!r.valid)
+    throw std::runtime_error(std::string("landmark validation: target ") + target + ": " + r.reason);
   return r.p_W;
 }
 
 void CheckOptions(const LandmarkValidationOptions& o) {
   auto positive = [](double v) { return std::isfinite(v) && v > 0; };
-  if (o.separations_mm.empty()) throw std::invalid_argument("landmark validation: no target separation given");
+  if (o.separations_mm.empty())
+    throw std::invalid_argument("landmark validation: no target separation given");
   for (double s : o.separations_mm) {
     if (!positive(s) || s > 2000) {
-      throw std::invalid_argument("landmark validation: separation " + Fixed(s, 1) + " mm is not in (0, 2000]");
+      throw std::invalid_argument("landmark validation: separation " + Fixed(s, 1) +
+                                  " mm is not in (0, 2000]");
     }
   }
   if (o.repeats < 1) throw std::invalid_argument("landmark validation: repeats must be >= 1");
   if (!std::isfinite(o.pointing_std_deg) || o.pointing_std_deg < 0) {
     throw std::invalid_argument("landmark validation: pointing_std_deg must be >= 0");
   }
-  for (double v : {o.eye_height_m, o.standoff_m, o.baseline_m, o.dwell_s, o.walk_speed_m_per_s, o.slam.rate_hz}) {
+  for (double v :
+       {o.eye_height_m, o.standoff_m, o.baseline_m, o.dwell_s, o.walk_speed_m_per_s, o.slam.rate_hz}) {
     if (!positive(v)) throw std::invalid_argument("landmark validation: geometry and times must be > 0");
   }
   if (!std::isfinite(o.table_height_m) || o.table_height_m >= o.eye_height_m) {
@@ -130,7 +135,8 @@ LandmarkValidation RunLandmarkValidation(const LandmarkValidationOptions& option
       const double heading = rng.Uniform(0.0, 2.0 * M_PI);
       const std::uint64_t person_seed = rng.NextSeed();
       const Eigen::Vector3d centre(options.standoff_m + cx, cy, options.table_height_m);
-      const Eigen::Vector3d half = 0.5e-3 * separation_mm * Eigen::Vector3d(std::cos(heading), std::sin(heading), 0);
+      const Eigen::Vector3d half =
+          0.5e-3 * separation_mm * Eigen::Vector3d(std::cos(heading), std::sin(heading), 0);
       const Eigen::Vector3d p_WA = centre - half, p_WB = centre + half;
 
       AnnotatingPerson person(options, person_seed);
@@ -168,7 +174,8 @@ std::string LandmarkValidationCsv(const LandmarkValidation& validation) {
 
 hmd::SlamConfig LoadShippedSlamConfig(const std::vector<std::string>& headset_config_paths) {
   std::vector<std::string> paths;
-  for (const auto& relative : hmd::DefaultHmdConfigRelativePaths()) paths.push_back(hmd::HmdSourcePath(relative));
+  for (const auto& relative : hmd::DefaultHmdConfigRelativePaths())
+    paths.push_back(hmd::HmdSourcePath(relative));
   paths.insert(paths.end(), headset_config_paths.begin(), headset_config_paths.end());
   return hmd::LoadHmdConfigs(paths).slam;
 }

@@ -87,7 +87,8 @@ TEST(LandmarkValidation, CsvHasTheDocumentedColumns) {
   while (std::getline(csv, line)) {
     int repeat = 0;
     double separation = 0, measured = 0, error = 0;
-    ASSERT_EQ(std::sscanf(line.c_str(), "%d,%lf,%lf,%lf", &repeat, &separation, &measured, &error), 4) << line;
+    ASSERT_EQ(std::sscanf(line.c_str(), "%d,%lf,%lf,%lf", &repeat, &separation, &measured, &error), 4)
+        << line;
     EXPECT_EQ(repeat, rows % 2 + 1);
     EXPECT_EQ(separation, rows < 2 ? 50.0 : 200.0);
     EXPECT_DOUBLE_EQ(error, std::abs(measured - separation));

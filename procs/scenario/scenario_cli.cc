@@ -27,8 +27,10 @@ int RunScenario(int argc, const char* const* argv, std::ostream& out, std::ostre
   app.add_option("--scenario", scenario_path,
                  "Scenario YAML (default: viraal/viraal.yaml under $ORBED_SOURCE_DIR, else under "
                  "the source tree it was built from)");
-  app.add_option("--trials", trials, "Trials per mode (overrides the file's trials)")
-      ->check(CLI::Range(1, 1000));
+  app.add_option("--trials", trials,
+                 "Trials per mode (overrides the file's trials; default $ORBED_TRIALS if set)")
+      ->check(CLI::Range(1, 1000))
+      ->envname("ORBED_TRIALS");
   app.add_option("--modes", modes, "Comma-separated run order of ar_reflective, ar (overrides the file)");
   app.add_option("--q-deg", q_deg,
                  "A trial configuration q1,...,q7 [deg]; repeat for each (replaces the file's list)");
