@@ -30,14 +30,15 @@ std::string Row(const std::string& user, const std::string& mode, const std::str
                 const viraal::ErrorMeasures& e, const std::string& duration_s) {
   const Eigen::Vector3d& t = e.misalignment_axes_mm;
   return user + "," + mode + "," + trial + "," + Csv(t.x()) + "," + Csv(t.y()) + "," + Csv(t.z()) + "," +
-         Csv(t.norm()) + "," + Csv(e.translation_error_mm) + "," + Csv(e.rotation_error_deg) + "," + duration_s +
-         "\n";
+         Csv(t.norm()) + "," + Csv(e.translation_error_mm) + "," + Csv(e.rotation_error_deg) + "," +
+         duration_s + "\n";
 }
 
 void WriteRow(JsonWriter* json, const viraal::Table1Row& row) {
   json->BeginObject();
   const char* axes[3] = {"t_x", "t_y", "t_z"};
-  for (int k = 0; k < 3; ++k) json->Key(axes[k]).Array(std::vector<double>{row.axes_mean_mm[k], row.axes_std_mm[k]});
+  for (int k = 0; k < 3; ++k)
+    json->Key(axes[k]).Array(std::vector<double>{row.axes_mean_mm[k], row.axes_std_mm[k]});
   json->Key("norm").Array(std::vector<double>{row.mean_mm, row.std_mm});
   json->Key("num_trials").Int(row.num_trials);
   json->EndObject();
@@ -193,7 +194,8 @@ int RunStudyTables(int argc, const char* const* argv, std::ostream& out, std::os
   std::vector<std::string> config_paths;
   app.add_option("--out", out_dir, "Folder to write the files into (created if missing)")->required();
   app.add_option("--seed", validation.seed, "Seed of the landmark check")->capture_default_str();
-  app.add_option("--config", config_paths, "Headset config applied over the shipped ones (the runs' --config)");
+  app.add_option("--config", config_paths,
+                 "Headset config applied over the shipped ones (the runs' --config)");
   app.add_option("runs", run_paths, "Each user's results.json or its run folder")->required();
   try {
     app.parse(argc, argv);
@@ -216,8 +218,8 @@ int RunStudyTables(int argc, const char* const* argv, std::ostream& out, std::os
       for (const UserRun& earlier : runs) {
         const std::string a = FirstUserId(earlier.results), b = FirstUserId(run.results);
         if (!a.empty() && a == b) {
-          throw std::runtime_error(run_paths[i] + ": user " + run.user + " is the same person as " + earlier.user +
-                                   " ('" + EscapeText(a) + "')");
+          throw std::runtime_error(run_paths[i] + ": user " + run.user + " is the same person as " +
+                                   earlier.user + " ('" + EscapeText(a) + "')");
         }
       }
       runs.push_back(std::move(run));

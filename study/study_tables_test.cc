@@ -33,7 +33,8 @@ nlohmann::json PinnedJson() {
 
 std::vector<UserRun> Users(int n) {
   std::vector<UserRun> runs;
-  for (int i = 0; i < n; ++i) runs.push_back({"u" + std::to_string(i + 1), viraal::ReadResultsFile(SourceTreePath(kPinned))});
+  for (int i = 0; i < n; ++i)
+    runs.push_back({"u" + std::to_string(i + 1), viraal::ReadResultsFile(SourceTreePath(kPinned))});
   return runs;
 }
 
@@ -87,8 +88,8 @@ TEST(StudyTables, CsvsHaveTheStudyColumnsAndTheFilesValues) {
   char user[8], mode[32];
   int trial = 0;
   double t[3], mis, translation, rotation, duration;
-  ASSERT_EQ(std::sscanf(trials[11].c_str(), "%7[^,],%31[^,],%d,%lf,%lf,%lf,%lf,%lf,%lf,%lf", user, mode, &trial,
-                        &t[0], &t[1], &t[2], &mis, &translation, &rotation, &duration),
+  ASSERT_EQ(std::sscanf(trials[11].c_str(), "%7[^,],%31[^,],%d,%lf,%lf,%lf,%lf,%lf,%lf,%lf", user, mode,
+                        &trial, &t[0], &t[1], &t[2], &mis, &translation, &rotation, &duration),
             10)
       << trials[11];
   const nlohmann::json& expected = pinned["sessions"][1]["trials"][1];
@@ -151,7 +152,8 @@ TEST(StudyTables, TheCommandWritesTheFilesAndRefusesAnUnfinishedRun) {
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("ViRAAl study: 2 users"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("paper 30.2 +/- 23.9 mm"), std::string::npos) << r.out;
-  for (const char* name : {"alignment_trials.csv", "alignment_means.csv", "landmark_validation.csv", "tables.json"}) {
+  for (const char* name :
+       {"alignment_trials.csv", "alignment_means.csv", "landmark_validation.csv", "tables.json"}) {
     EXPECT_TRUE(std::filesystem::exists(dir + "/" + name)) << name;
   }
 
