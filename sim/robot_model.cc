@@ -12,6 +12,7 @@
 #include <urdf_parser/urdf_parser.h>
 
 #include "base/units.h"
+#include "base/utf8.h"
 
 namespace orbed::sim {
 namespace {
@@ -139,6 +140,11 @@ RobotModel RobotModel::LoadString(const std::string& urdf_xml, const std::string
                                   const std::string& flange_link, const std::string& tool_tip_link) {
   const std::string src = source_name;
   auto fail = [&src](const std::string& what) -> void { throw std::runtime_error(src + ": " + what); };
+  // TinyXML, under urdfdom and FindJointLoop, reads past the end of text that is not UTF-8.
+  const size_t bad_byte = FindInvalidUtf8(urdf_xml);
+  if (bad_byte != std::string_view::npos) {
+    fail("byte " + std::to_string(bad_byte) + " is not valid UTF-8 text (a URDF is an XML text file)");
+  }
   const std::string loop = FindJointLoop(urdf_xml);
   if (!loop.empty()) fail("the joints form a loop (a URDF must be a tree): " + loop);
   urdf::ModelInterfaceSharedPtr urdf_model = urdf::parseURDF(urdf_xml);

@@ -222,6 +222,15 @@ std::string Expect(const std::string& xml) {
   return "(no error)";
 }
 
+// TinyXML 2.6 skips a UTF-8 character by its lead byte's length: a lead byte at the end made it read
+// past the text (fuzz_urdf); the sanitizer build catches a regression here.
+TEST(RobotModelTest, TextThatIsNotUtf8IsRefusedBeforeAnyXmlParser) {
+  std::string e = Expect("<robot name='r'><link name='a'><visual><origin xyz=\"0 0 \xDC");
+  EXPECT_NE(e.find("bad.urdf: byte 56 is not valid UTF-8 text"), std::string::npos) << e;
+  e = Expect(std::string("<robot name='r'>\0</robot>", 25));
+  EXPECT_NE(e.find("byte 16 is not valid UTF-8"), std::string::npos) << e;
+}
+
 // urdfdom 3.0.1 would leak a reference cycle on these (the sanitizer build's LeakSanitizer checks that
 // none is made); the loader refuses them first and names the loop.
 TEST(RobotModelTest, JointLoopsAreRefusedBeforeUrdfdomLinksThem) {
