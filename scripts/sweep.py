@@ -1,0 +1,183 @@
+#!/usr/bin/python3
+"""orbed sweep: the ViRAAl alignment error as one model input varies (issue 10 item 7).
+
+Each point runs orbed-user-study (the live run's protocol without the bus) for USERS emulated
+persons (user.seed 1..USERS) with TRIALS trials per display mode, and reports the paper's Table 1
+statistic over all their trials (results.json's table1, pooled: per axis of W the mean and sample
+std of the trials' mean absolute landmark errors, then the norms of the two vectors). Sweeps:
+
+  drift          slam.drift.fraction_of_distance (per metre walked); the shipped walk and display.
+  capture_angle  the angle, about the robot's middle (the walk's look-at point), between where the
+                 display's frame is captured and where the person aligns (head_end); the walk starts
+                 at the capture point (the map starts there) and goes straight to head_end, so the
+                 path, and the drift the alignment sees, grows with the angle (path_m says how much).
+  displays       1, 2, 3 displays (reflective_mirrors) captured at 104.5 deg (foot_end, shipped),
+                 60 deg and 150 deg; the walk visits them from the farthest to head_end.
+
+Writes sweep.csv and one PNG per sweep into OUT and prints the table. Model inputs not swept keep
+the shipped values (docs/parameters.md). Run by `scripts/orbed sweep`; needs python3-matplotlib.
+"""
+import argparse
+import csv
+import json
+import math
+import os
+import subprocess
+import sys
+import tempfile
+
+LOOK_AT = (0.25, -0.45, 1.25)       # head_trajectory.look_at_m of viraal_walk.yaml
+HEAD_END = (-0.75, -1.40, 1.70)     # the alignment waypoint of viraal_walk.yaml
+FOOT_END = (1.45, -1.20, 1.70)      # the shipped display's capture waypoint
+SPEED = 0.8                         # head_trajectory.speed_m_per_s of viraal_walk.yaml
+MODES = ("ar_reflective", "ar")
+
+
+def on_circle(angle_deg):
+    """The point at head_end's distance and height from the look-at point, turned by angle_deg
+    (counter-clockwise seen from above, towards foot_end) from head_end."""
+    dx, dy = HEAD_END[0] - LOOK_AT[0], HEAD_END[1] - LOOK_AT[1]
+    a = math.radians(angle_deg)
+    return (round(LOOK_AT[0] + dx * math.cos(a) - dy * math.sin(a), 4),
+            round(LOOK_AT[1] + dx * math.sin(a) + dy * math.cos(a), 4), HEAD_END[2])
+
+
+def angle_from_head_end(p):
+    a = math.atan2(p[1] - LOOK_AT[1], p[0] - LOOK_AT[0]) - math.atan2(HEAD_END[1] - LOOK_AT[1], HEAD_END[0] - LOOK_AT[0])
+    return math.degrees(math.atan2(math.sin(a), math.cos(a)))
+
+
+def walk_yaml(captures):
+    """A head_trajectory + hmd overlay: the walk from the first capture point through the others to
+    head_end, one display per capture point, in the order given."""
+    lines = ["head_trajectory:", f"  speed_m_per_s: {SPEED}", f"  look_at_m: [{LOOK_AT[0]}, {LOOK_AT[1]}, {LOOK_AT[2]}]",
+             "  waypoints:"]
+    names = []
+    for i, p in enumerate(captures):
+        names.append(f"capture_{i}")
+        lines.append(f"    - {{name: capture_{i}, position_m: [{p[0]}, {p[1]}, {p[2]}], dwell_s: 2.0}}")
+    lines.append(f"    - {{name: head_end, position_m: [{HEAD_END[0]}, {HEAD_END[1]}, {HEAD_END[2]}], dwell_s: 60.0}}")
+    lines += ["hmd:", "  align_waypoint: head_end", "  displays:"]
+    lines += [f"    - {{capture_waypoint: {n}}}" for n in names]
+    path = sum(math.dist(a, b) for a, b in zip(captures + [HEAD_END], captures[1:] + [HEAD_END]))
+    return "\n".join(lines) + "\n", path
+
+
+def run_point(study, tmp, trials, users, overlay_text, scenario_text):
+    """Table 1 per mode over USERS persons for one model setting."""
+    axes = {m: [] for m in MODES}
+    for user in range(1, users + 1):
+        overlay = os.path.join(tmp, "overlay.yaml")
+        with open(overlay, "w") as f:
+            f.write(overlay_text + f"user:\n  seed: {user}\n")
+        scenario = os.path.join(tmp, "scenario.yaml")
+        with open(scenario, "w") as f:
+            f.write(scenario_text)
+        out = os.path.join(tmp, "results.json")
+        cmd = [study, "--trials", str(trials), "--run-id", f"sweep-u{user}", "--config", overlay,
+               "--scenario", scenario, "--json", out, "--quiet"]
+        done = subprocess.run(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+        if done.returncode != 0:
+            sys.exit(f"sweep: {' '.join(cmd)} failed: {done.stderr.strip()}")
+        with open(out) as f:
+            results = json.load(f)
+        for s in results["sessions"]:
+            axes[s["mode"]] += [t["misalignment_axes_mm"] for t in s["trials"]]
+    row = {}
+    for mode, values in axes.items():
+        n = len(values)
+        means = [sum(v[k] for v in values) / n for k in range(3)]
+        stds = [math.sqrt(sum((v[k] - means[k]) ** 2 for v in values) / (n - 1)) if n > 1 else 0.0 for k in range(3)]
+        row[mode] = (math.hypot(*means), math.hypot(*stds), n)
+    return row
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--study", required=True, help="orbed-user-study")
+    parser.add_argument("--source", required=True, help="the repository (for the shipped files)")
+    parser.add_argument("--out", required=True, help="folder for sweep.csv and the PNGs")
+    parser.add_argument("--trials", type=int, default=50, help="trials per person and mode (default 50)")
+    parser.add_argument("--users", type=int, default=4, help="emulated persons per point (default 4)")
+    parser.add_argument("--only", choices=["drift", "capture_angle", "displays"], help="one sweep only")
+    args = parser.parse_args()
+    if args.trials < 2 or args.users < 1:
+        sys.exit("sweep: --trials must be >= 2 and --users >= 1")
+    os.makedirs(args.out, exist_ok=True)
+    with open(os.path.join(args.source, "viraal", "viraal.yaml")) as f:
+        scenario = f.read()
+
+    def with_mirrors(n):
+        return scenario.replace("reflective_mirrors: 1", f"reflective_mirrors: {n}")
+
+    shipped_walk, shipped_path = walk_yaml([FOOT_END])
+    sweeps = {
+        "drift": [(f, f"slam:\n  drift:\n    fraction_of_distance: {f}\n", scenario, shipped_path)
+                  for f in (0.0, 0.003, 0.006, 0.01, 0.014, 0.02)],
+        "capture_angle": [],
+        "displays": [],
+    }
+    for angle in (0, 15, 30, 60, 90, 120, 150, 170):
+        text, path = walk_yaml([on_circle(angle)])
+        sweeps["capture_angle"].append((angle, text, scenario, path))
+    foot_angle = angle_from_head_end(FOOT_END)
+    for n, captures in ((1, [FOOT_END]), (2, [FOOT_END, on_circle(60)]), (3, [on_circle(150), FOOT_END, on_circle(60)])):
+        text, path = walk_yaml(captures)
+        sweeps["displays"].append((n, text, with_mirrors(n), path))
+
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for name, points in sweeps.items():
+            if args.only and name != args.only:
+                continue
+            for value, overlay, scenario_text, path in points:
+                result = run_point(args.study, tmp, args.trials, args.users, overlay, scenario_text)
+                for mode in MODES:
+                    mean, std, n = result[mode]
+                    rows.append({"sweep": name, "value": value, "mode": mode, "trials": n,
+                                 "table1_mean_mm": round(mean, 3), "table1_std_mm": round(std, 3),
+                                 "path_m": round(path, 3)})
+                print(f"{name:14s} {value:>6}  with display {result['ar_reflective'][0]:5.1f} +/- "
+                      f"{result['ar_reflective'][1]:4.1f} mm   AR only {result['ar'][0]:5.1f} +/- {result['ar'][1]:4.1f} mm"
+                      f"   (walk {path:.2f} m)", flush=True)
+    with open(os.path.join(args.out, "sweep.csv"), "w", newline="") as f:
+        writer = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
+        writer.writeheader()
+        writer.writerows(rows)
+
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    labels = {"drift": "SLAM drift [fraction of the distance walked]",
+              "capture_angle": "angle between capture and alignment viewpoints [deg]",
+              "displays": "number of reflective displays"}
+    for name in labels:
+        mine = [r for r in rows if r["sweep"] == name]
+        if not mine:
+            continue
+        fig, ax = plt.subplots(figsize=(6.4, 4.0), dpi=100)
+        span = max(r["value"] for r in mine) - min(r["value"] for r in mine)
+        for mode, colour, paper, shift in (("ar_reflective", "tab:blue", 16.5, -0.006), ("ar", "tab:orange", 30.2, 0.006)):
+            pts = [r for r in mine if r["mode"] == mode]
+            ax.errorbar([r["value"] + shift * span for r in pts], [r["table1_mean_mm"] for r in pts],
+                        yerr=[r["table1_std_mm"] for r in pts], color=colour, marker="o", capsize=3,
+                        label=("with the display" if mode == "ar_reflective" else "AR only"))
+            ax.axhline(paper, color=colour, linestyle=":", linewidth=1)
+        if name == "capture_angle":
+            ax.axvline(foot_angle, color="grey", linestyle="--", linewidth=1)
+            ax.text(foot_angle, ax.get_ylim()[1] * 0.95, " shipped", color="grey", fontsize=8, va="top")
+        if name == "displays":
+            ax.set_xticks(sorted({r["value"] for r in mine}))
+        ax.set_xlabel(labels[name])
+        ax.set_ylabel("misalignment, Table 1 statistic [mm]")
+        ax.set_title(f"{args.users} persons x {args.trials} trials per mode; bars: norm of the per-axis stds; "
+                     "dotted: paper", fontsize=8)
+        ax.legend(fontsize=8)
+        fig.tight_layout()
+        fig.savefig(os.path.join(args.out, f"{name}.png"))
+        plt.close(fig)
+    print(f"sweep: {os.path.join(args.out, 'sweep.csv')} and the PNGs beside it")
+
+
+if __name__ == "__main__":
+    main()
