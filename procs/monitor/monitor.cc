@@ -62,17 +62,17 @@ Monitor::Monitor(const CommonFlags& flags, MonitorOptions options) : options_(op
 }
 
 std::string Monitor::Table(int64_t now_utime) const {
-  std::string out = "process               state     uptime_s      in       out  rejected  last error\n";
+  std::string out = "process               state     uptime_s      in       out  rejected   dropped  last error\n";
   char line[512];
   for (const auto& [name, seen] : processes_) {
     const orbed::process_status_t& s = seen.status;
     const double age_s = (now_utime - seen.recv_utime) * 1e-6;
     const std::string state = age_s > options_.silent_after_s ? "SILENT" : StateName(s.state);
     // Names and errors come from the bus: escaped before they reach a terminal.
-    std::snprintf(line, sizeof(line), "%-20s  %-8s  %8.1f  %7lld  %8lld  %8lld  %s\n",
+    std::snprintf(line, sizeof(line), "%-20s  %-8s  %8.1f  %7lld  %8lld  %8lld  %8lld  %s\n",
                   EscapeText(name).c_str(), state.c_str(), s.uptime_s, static_cast<long long>(s.messages_in),
                   static_cast<long long>(s.messages_out), static_cast<long long>(s.rejected_inputs),
-                  EscapeText(s.last_error.substr(0, 60)).c_str());
+                  static_cast<long long>(s.dropped), EscapeText(s.last_error.substr(0, 60)).c_str());
     out += line;
   }
   if (have_logger_) {

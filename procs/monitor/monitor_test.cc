@@ -25,6 +25,10 @@ TEST(Monitor, TabulatesHeartbeatsAndFlagsSilentProcesses) {
   status.messages_in = 12;
   status.messages_out = 345;
   status.rejected_inputs = 2;
+  status.dropped = 7;  // work skipped under load (contract change 3), by reason
+  status.num_drop_reasons = 1;
+  status.drop_reason = {"timer/tick"};
+  status.drop_count = {7};
   status.last_error = "IIWA_COMMAND/num_joints: num_joints is 6, expected 7";
   monitor.process().lcm().publish(channels::kProcessStatus, &status);
   orbed::process_status_t bad = status;
@@ -41,9 +45,9 @@ TEST(Monitor, TabulatesHeartbeatsAndFlagsSilentProcesses) {
   const int64_t now = NowMicros();
   const std::string table = monitor.Table(now);
   // The sim's row, field by field: name, state, uptime [s] to 0.1, messages in and out, rejected
-  // inputs, the last error (cut at 60 characters).
+  // inputs, dropped work, the last error (cut at 60 characters).
   const std::string sim_row =
-      "sim                   running       42.2       12       345         2  "
+      "sim                   running       42.2       12       345         2         7  "
       "IIWA_COMMAND/num_joints: num_joints is 6, expected 7\n";
   EXPECT_NE(table.find(sim_row), std::string::npos) << table;
   EXPECT_EQ(table.find("liar"), std::string::npos);  // rejected: state out of range
