@@ -1,7 +1,7 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Checks that docs/parameters.md documents every leaf key of the shipped model configs.
 
-Usage: python3 tests/check_parameters.py REPO_ROOT
+Usage: /usr/bin/python3 tests/check_parameters.py REPO_ROOT
 
 For each YAML file in FILES, docs/parameters.md has a section whose `## ` heading names the file in
 backticks. In that section every leaf key path of the file must appear exactly once, either in the
@@ -14,19 +14,14 @@ Leaf paths: mapping keys joined by '.'; a list of mappings contributes `key[].su
 `sub` of its items (its value: the list of the items' values); any other value (a scalar, a list
 of scalars or lists) is a leaf.
 
-Reads YAML with PyYAML when it is installed, and always also with the small parser below (the
-subset these files use); with PyYAML both must agree, so the check behaves the same on a machine
-without PyYAML. Exit 0: documented; 1: a discrepancy (each printed); 2: usage or unreadable input.
+Reads YAML with PyYAML (Debian's python3-yaml, for /usr/bin/python3). Exit 0: documented; 1: a discrepancy (each printed); 2: usage or unreadable input.
 """
 
 import os
 import re
 import sys
 
-try:
-    import yaml  # PyYAML, optional
-except ImportError:  # pragma: no cover - depends on the machine
-    yaml = None
+import yaml  # PyYAML: Debian's python3-yaml, which `scripts/orbed setup` installs
 
 FILES = [
     "hmd_emulator/config/user.yaml",
@@ -39,188 +34,6 @@ FILES = [
 DOC = "docs/parameters.md"
 SOURCE_CLASSES = ("paper", "literature", "literature (as stated, not checked)", "fitted", "choice")
 NOT_MODEL_PREFIX = "Not model parameters:"
-
-
-class ParseError(Exception):
-    pass
-
-
-# ---- A parser for the YAML subset of the config files -------------------------------------------
-# Block mappings and block sequences by indentation, flow collections ({...}, [...]) on one line,
-# plain and quoted scalars, '#' comments. Anything else is a ParseError, never a silent guess.
-
-_INT = re.compile(r"^[-+]?[0-9]+$")
-_FLOAT = re.compile(r"^[-+]?([0-9]+\.[0-9]*|\.[0-9]+|[0-9]+)([eE][-+]?[0-9]+)?$")
-
-
-def _scalar(text, where):
-    t = text.strip()
-    if t == "":
-        return None
-    if t[0] in "\"'":
-        if len(t) < 2 or t[-1] != t[0]:
-            raise ParseError(f"{where}: unterminated quoted scalar {t!r}")
-        return t[1:-1]
-    if t in ("~", "null", "Null", "NULL"):
-        return None
-    if t in ("true", "True", "TRUE"):
-        return True
-    if t in ("false", "False", "FALSE"):
-        return False
-    if _INT.match(t):
-        return int(t)
-    if _FLOAT.match(t):
-        return float(t)
-    if t[0] in "&*!|>%@`{}[]":
-        raise ParseError(f"{where}: unsupported YAML {t!r}")
-    return t
-
-
-def _strip_comment(line):
-    """The line without a trailing '# comment' (a '#' at the start or after a blank, outside quotes)."""
-    quote = None
-    for i, ch in enumerate(line):
-        if quote:
-            if ch == quote:
-                quote = None
-        elif ch in "\"'" and (i == 0 or line[i - 1] in " \t[{,:"):
-            quote = ch
-        elif ch == "#" and (i == 0 or line[i - 1] in " \t"):
-            return line[:i].rstrip()
-    return line.rstrip()
-
-
-def parse_flow(text, where):
-    """A flow value on one line: {k: v, ...}, [a, b, ...] (nested) or a scalar."""
-    pos = 0
-
-    def skip():
-        nonlocal pos
-        while pos < len(text) and text[pos] in " \t":
-            pos += 1
-
-    def value(stop):
-        nonlocal pos
-        skip()
-        if pos < len(text) and text[pos] == "[":
-            pos += 1
-            items = []
-            skip()
-            if pos < len(text) and text[pos] == "]":
-                pos += 1
-                return items
-            while True:
-                items.append(value(",]"))
-                skip()
-                if pos >= len(text):
-                    raise ParseError(f"{where}: unterminated [ in {text!r}")
-                if text[pos] == "]":
-                    pos += 1
-                    return items
-                pos += 1  # ','
-        if pos < len(text) and text[pos] == "{":
-            pos += 1
-            mapping = {}
-            skip()
-            if pos < len(text) and text[pos] == "}":
-                pos += 1
-                return mapping
-            while True:
-                skip()
-                colon = text.find(":", pos)
-                if colon < 0:
-                    raise ParseError(f"{where}: expected 'key: value' in {text!r}")
-                key = _scalar(text[pos:colon], where)
-                if not isinstance(key, str) or key in mapping:
-                    raise ParseError(f"{where}: bad or repeated key {key!r} in {text!r}")
-                pos = colon + 1
-                mapping[key] = value(",}")
-                skip()
-                if pos >= len(text):
-                    raise ParseError(f"{where}: unterminated {{ in {text!r}")
-                if text[pos] == "}":
-                    pos += 1
-                    return mapping
-                pos += 1  # ','
-        start = pos
-        quote = None
-        while pos < len(text):
-            ch = text[pos]
-            if quote:
-                if ch == quote:
-                    quote = None
-            elif ch in "\"'" and pos == start:
-                quote = ch
-            elif ch in stop or ch in "[]{}":
-                break
-            pos += 1
-        return _scalar(text[start:pos], where)
-
-    result = value("")
-    skip()
-    if pos != len(text):
-        raise ParseError(f"{where}: unexpected {text[pos:]!r} after a value in {text!r}")
-    return result
-
-
-def parse_yaml_subset(source_text, name):
-    lines = []  # (line number, indent, content)
-    for number, raw in enumerate(source_text.splitlines(), 1):
-        if "\t" in raw[: len(raw) - len(raw.lstrip())]:
-            raise ParseError(f"{name}:{number}: tab in indentation")
-        content = _strip_comment(raw)
-        if content.strip() in ("", "---"):
-            continue
-        lines.append((number, len(content) - len(content.lstrip(" ")), content.strip()))
-
-    def block(i, indent):
-        number, ind, content = lines[i]
-        if content == "-" or content.startswith("- "):
-            items = []
-            while i < len(lines) and lines[i][1] == indent and (lines[i][2] == "-" or lines[i][2].startswith("- ")):
-                number, _, content = lines[i]
-                rest = content[1:].strip()
-                if rest == "":
-                    if i + 1 < len(lines) and lines[i + 1][1] > indent:
-                        item, i = block(i + 1, lines[i + 1][1])
-                    else:
-                        item, i = None, i + 1
-                elif re.match(r"^[^\[{\"'][^:]*:(\s|$)", rest):
-                    raise ParseError(f"{name}:{number}: a block mapping inside a '- ' item is not supported")
-                else:
-                    item, i = parse_flow(rest, f"{name}:{number}"), i + 1
-                items.append(item)
-            return items, i
-        mapping = {}
-        while i < len(lines) and lines[i][1] == indent:
-            number, _, content = lines[i]
-            if content.startswith("- "):
-                raise ParseError(f"{name}:{number}: a '- ' item where a key was expected")
-            m = re.match(r"^([^\s:\[\]{}#][^:]*?):(\s+(.*))?$", content)
-            if not m:
-                raise ParseError(f"{name}:{number}: expected 'key: value', got {content!r}")
-            key = m.group(1).strip()
-            if key in mapping:
-                raise ParseError(f"{name}:{number}: repeated key {key!r}")
-            rest = (m.group(3) or "").strip()
-            if rest:
-                mapping[key], i = parse_flow(rest, f"{name}:{number}"), i + 1
-            elif i + 1 < len(lines) and (
-                lines[i + 1][1] > indent
-                or (lines[i + 1][1] == indent and (lines[i + 1][2] == "-" or lines[i + 1][2].startswith("- ")))
-            ):
-                mapping[key], i = block(i + 1, lines[i + 1][1])
-            else:
-                mapping[key], i = None, i + 1
-        return mapping, i
-
-    if not lines:
-        return None
-    node, i = block(0, lines[0][1])
-    if i != len(lines):
-        number, _, content = lines[i]
-        raise ParseError(f"{name}:{number}: unexpected indentation at {content!r}")
-    return node
 
 
 # ---- Leaf paths ---------------------------------------------------------------------------------
@@ -255,23 +68,11 @@ def leaf_paths(node, prefix=""):
 
 def load_config(path, name):
     with open(path, encoding="utf-8") as f:
-        text = f.read()
-    try:
-        own = parse_yaml_subset(text, name)
-    except ParseError as e:
-        raise ParseError(f"{e} (tests/check_parameters.py's YAML subset; extend it or simplify the file)")
-    if yaml is not None:
-        reference = yaml.safe_load(text)
-        if reference != own:
-            raise ParseError(f"{name}: PyYAML and the subset parser of tests/check_parameters.py read it "
-                             f"differently; extend the subset parser so the check does not depend on PyYAML")
-    return leaf_paths(own)
+        return leaf_paths(yaml.safe_load(f))
 
 
 def parse_value(text):
-    if yaml is not None:
-        return yaml.safe_load(text)
-    return parse_flow(text, "value")
+    return yaml.safe_load(text)
 
 
 # ---- docs/parameters.md -------------------------------------------------------------------------
@@ -355,7 +156,7 @@ def main(argv):
     for name in FILES:
         try:
             leaves = load_config(os.path.join(root, name), name)
-        except (OSError, ParseError) as e:
+        except (OSError, yaml.YAMLError) as e:
             print(f"check_parameters: {e}", file=sys.stderr)
             return 2
         total += len(leaves)
@@ -399,7 +200,7 @@ def main(argv):
         print(f"check_parameters: {len(problems)} problem(s)")
         return 1
     print(f"check_parameters: {total} leaf keys in {len(FILES)} files documented in {DOC} "
-          f"(YAML read by {'PyYAML and ' if yaml else ''}the subset parser)")
+          "(YAML read by PyYAML)")
     return 0
 
 
