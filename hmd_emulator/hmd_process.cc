@@ -14,6 +14,7 @@
 #include "procs/common/conversions.h"
 #include "procs/common/log.h"
 #include "procs/common/validation.h"
+#include "sim/iiwa_status_check.h"
 
 namespace orbed::hmd {
 namespace {
@@ -200,16 +201,10 @@ void HmdProcess::RequestArView() {
 }
 
 void HmdProcess::OnIiwaStatus(const orbed::iiwa_status_t& msg, const std::string& channel) {
-  std::string error = CheckSize(msg.num_joints, robot_model_->num_joints(), "num_joints");
-  if (error.empty() && msg.joint_position_measured.size() != static_cast<size_t>(msg.num_joints)) {
-    error = "joint_position_measured has " + std::to_string(msg.joint_position_measured.size()) + " entries";
-  }
-  if (!error.empty()) return process_->Reject(channel + "/num_joints", error);
-  error = CheckFinite(msg.joint_position_measured, "joint_position_measured");
-  if (!error.empty()) return process_->Reject(channel + "/non_finite", error);
-  const Eigen::VectorXd q = ToVectorX(msg.joint_position_measured);
-  error = robot_model_->ValidateJointVector(q, kJointLimitSlackRad);
-  if (!error.empty()) return process_->Reject(channel + "/limits", "joint_position_measured: " + error);
+  Eigen::VectorXd q;
+  const sim::IiwaStatusProblem problem = sim::CheckIiwaStatus(msg, *robot_model_, kJointLimitSlackRad, &q);
+  if (!problem.rejection_class.empty())
+    return process_->Reject(channel + "/" + problem.rejection_class, problem.reason);
   robot_.q_rad = q;
   robot_.have_q = true;
 }

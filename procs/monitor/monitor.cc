@@ -62,7 +62,8 @@ Monitor::Monitor(const CommonFlags& flags, MonitorOptions options) : options_(op
 }
 
 std::string Monitor::Table(int64_t now_utime) const {
-  std::string out = "process               state     uptime_s      in       out  rejected   dropped  last error\n";
+  std::string out =
+      "process               state     uptime_s      in       out  rejected   dropped  last error\n";
   char line[512];
   for (const auto& [name, seen] : processes_) {
     const orbed::process_status_t& s = seen.status;

@@ -1,0 +1,91 @@
+#include "procs/guidance/guidance.h"
+
+#include <cmath>
+#include <stdexcept>
+#include <utility>
+
+#include "base/format.h"
+#include "base/units.h"
+
+namespace orbed::guidance {
+namespace {
+
+// Copies of lcm-gen's in-class constants (it emits no out-of-line definitions to bind a reference to).
+constexpr int8_t kTwist = orbed::guidance_t::JOINT_TWIST;
+constexpr int8_t kRevolve = orbed::guidance_t::JOINT_REVOLVE;
+
+}  // namespace
+
+std::vector<int8_t> JointKinds(const sim::RobotModel& model) {
+  const std::vector<Eigen::Isometry3d> X_RL = model.CalcLinkPoses(Eigen::VectorXd::Zero(model.num_joints()));
+  const double cos_twist = std::cos(kTwistAngleDeg * kDegToRad);
+  std::vector<int8_t> kinds;
+  for (int j = 0; j < model.num_joints(); ++j) {
+    const int link = model.joints()[j].link;
+    const Eigen::Vector3d p_RJ = X_RL[link].translation();
+    const Eigen::Vector3d axis_R = X_RL[link].linear() * model.links()[link].axis_J;
+    // The next point down the arm that is not at this joint's origin: a later joint's origin, else
+    // the tool tip.
+    Eigen::Vector3d along = Eigen::Vector3d::Zero();
+    for (int k = j + 1; k < model.num_joints() && along.norm() < 1e-6; ++k) {
+      along = X_RL[model.joints()[k].link].translation() - p_RJ;
+    }
+    if (along.norm() < 1e-6) along = X_RL[model.tool_tip_link()].translation() - p_RJ;
+    const bool twist = along.norm() >= 1e-6 && std::abs(axis_R.dot(along.normalized())) >= cos_twist;
+    kinds.push_back(twist ? kTwist : kRevolve);
+  }
+  return kinds;
+}
+
+int8_t GuidanceModeFromName(const std::string& name) {
+  if (name == "ar") return orbed::guidance_t::MODE_AR;
+  if (name == "ar_reflective") return orbed::guidance_t::MODE_AR_REFLECTIVE;
+  if (name == "fixed") return orbed::guidance_t::MODE_FIXED_DISPLAY;
+  throw std::invalid_argument("guidance mode '" + EscapeText(name) +
+                              "': expected ar, ar_reflective or fixed");
+}
+
+const char* GuidanceModeName(int8_t mode) {
+  switch (mode) {
+    case orbed::guidance_t::MODE_AR:
+      return "ar";
+    case orbed::guidance_t::MODE_AR_REFLECTIVE:
+      return "ar_reflective";
+    case orbed::guidance_t::MODE_FIXED_DISPLAY:
+      return "fixed";
+  }
+  return "?";
+}
+
+GuidanceCore::GuidanceCore(const sim::RobotModel& model, GuidanceTarget target)
+    : target_(std::move(target)), kinds_(JointKinds(model)) {
+  if (GuidanceModeName(target_.mode)[0] == '?') {
+    throw std::invalid_argument("guidance mode " + std::to_string(target_.mode) + " is not one of 0, 1, 2");
+  }
+  const std::string limits = model.ValidateJointVector(target_.q_target_rad);
+  if (!limits.empty()) throw std::invalid_argument("guidance target: " + limits);
+  if (!(target_.tolerance_deg > 0 && target_.tolerance_deg <= 90)) {
+    throw std::invalid_argument("guidance tolerance " + Fixed(target_.tolerance_deg, 3) +
+                                " deg is not in (0, 90]");
+  }
+}
+
+orbed::guidance_t GuidanceCore::Compute(const Eigen::VectorXd& q_rad, int64_t utime) const {
+  orbed::guidance_t g{};
+  g.utime = utime;
+  g.mode = target_.mode;
+  g.num_joints = static_cast<int32_t>(target_.q_target_rad.size());
+  g.next_joint = -1;
+  for (int i = 0; i < g.num_joints; ++i) {
+    const double error_deg = (q_rad[i] - target_.q_target_rad[i]) * kRadToDeg;
+    g.target_position.push_back(target_.q_target_rad[i]);
+    g.current_position.push_back(q_rad[i]);
+    g.error_deg.push_back(error_deg);
+    g.joint_kind.push_back(kinds_[i]);
+    if (g.next_joint < 0 && std::abs(error_deg) > target_.tolerance_deg) g.next_joint = i;
+  }
+  g.done = g.next_joint < 0;
+  return g;
+}
+
+}  // namespace orbed::guidance

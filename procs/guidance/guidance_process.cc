@@ -1,0 +1,113 @@
+#include "procs/guidance/guidance_process.h"
+
+#include <cmath>
+#include <exception>
+
+#include <CLI/CLI.hpp>
+#include <orbed/guidance_t.hpp>
+#include <orbed/iiwa_status_t.hpp>
+
+#include "base/number_list.h"
+#include "base/source_paths.h"
+#include "base/units.h"
+#include "procs/common/channels.h"
+#include "procs/common/conversions.h"
+#include "procs/common/flags.h"
+#include "procs/common/log.h"
+#include "sim/iiwa_status_check.h"
+
+namespace orbed::guidance {
+namespace {
+
+// The sim clamps to the limits; this absorbs rounding (as orbed-hmd).
+constexpr double kJointLimitSlackRad = 0.01;
+
+sim::RobotModel LoadModel(const std::string& urdf_path) {
+  return sim::RobotModel::LoadFile(
+      urdf_path.empty() ? SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath) : urdf_path);
+}
+
+}  // namespace
+
+GuidanceProcess::GuidanceProcess(const CommonFlags& flags, const GuidanceOptions& options)
+    : process_(flags),
+      model_(LoadModel(options.urdf_path)),
+      core_(model_, options.target),
+      options_(options) {
+  process_.Subscribe<orbed::iiwa_status_t>(
+      options_.iiwa_status_channel,
+      [this](const orbed::iiwa_status_t& msg, const std::string& channel, int64_t) {
+        Eigen::VectorXd q;
+        const sim::IiwaStatusProblem problem = sim::CheckIiwaStatus(msg, model_, kJointLimitSlackRad, &q);
+        if (!problem.rejection_class.empty()) {
+          process_.Reject(channel + "/" + problem.rejection_class, problem.reason);
+          return;
+        }
+        q_rad_ = q;
+        have_q_ = true;
+      });
+  process_.AddTimer(
+      1.0 / options_.rate_hz,
+      [this] {
+        if (const auto guidance = GuidanceNow(NowMicros()))
+          process_.Publish(options_.guidance_channel, *guidance);
+      },
+      options_.guidance_channel);
+  std::string target;
+  for (int i = 0; i < options_.target.q_target_rad.size(); ++i) {
+    target += (i ? ", " : "") +
+              std::to_string(static_cast<int>(std::lround(options_.target.q_target_rad[i] * kRadToDeg)));
+  }
+  ORBED_LOG(kInfo) << "guidance: mode " << GuidanceModeName(options_.target.mode) << ", target (" << target
+                   << ") deg, tolerance " << options_.target.tolerance_deg << " deg, " << options_.rate_hz
+                   << " Hz on " << options_.guidance_channel;
+}
+
+std::optional<orbed::guidance_t> GuidanceProcess::GuidanceNow(int64_t utime) const {
+  if (!have_q_) return std::nullopt;
+  return core_.Compute(q_rad_, utime);
+}
+
+int RunGuidance(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
+  CLI::App app{
+      "orbed-guidance: joint-by-joint set-up guidance toward a target configuration. Subscribes\n"
+      "IIWA_STATUS; publishes GUIDANCE (target and current joints, per-joint error [deg], the next\n"
+      "joint to move from the base outwards, twisting or revolving per joint, done) at --rate-hz."};
+  CommonFlags common("orbed-guidance");
+  AddCommonFlags(&app, &common);
+  GuidanceOptions options;
+  std::string target_deg, mode = "ar";
+  app.add_option("--target-deg", target_deg, "Target configuration q1,...,q7 [deg] (within the joint limits)")
+      ->required();
+  app.add_option("--mode", mode, "Guidance mode on GUIDANCE: ar, ar_reflective or fixed")
+      ->capture_default_str();
+  app.add_option("--tolerance-deg", options.target.tolerance_deg,
+                 "A joint within this of its target is done [deg]")
+      ->check(CLI::Range(0.001, 90.0))
+      ->capture_default_str();
+  app.add_option("--rate-hz", options.rate_hz, "GUIDANCE rate [Hz]")
+      ->check(CLI::Range(0.1, 1000.0))
+      ->capture_default_str();
+  app.add_option("--urdf", options.urdf_path,
+                 "Robot URDF (default: sim/models/iiwa7.urdf under $ORBED_SOURCE_DIR, else the source tree)");
+  app.add_option("--iiwa-status-channel", options.iiwa_status_channel)->capture_default_str();
+  app.add_option("--guidance-channel", options.guidance_channel)->capture_default_str();
+  if (const auto code = ParseCommandLine(&app, common, argc, argv, out, err)) return *code;
+  try {
+    options.target.mode = GuidanceModeFromName(mode);
+    const std::vector<double> q_deg = ParseNumberList(target_deg, "--target-deg");
+    options.target.q_target_rad = Eigen::Map<const Eigen::VectorXd>(q_deg.data(), q_deg.size()) * kDegToRad;
+  } catch (const std::invalid_argument& e) {
+    err << "orbed-guidance: " << e.what() << "\n";
+    return 2;
+  }
+  try {
+    GuidanceProcess guidance(common, options);
+    return guidance.Run();
+  } catch (const std::exception& e) {
+    err << "orbed-guidance: " << e.what() << "\n";
+    return 1;
+  }
+}
+
+}  // namespace orbed::guidance

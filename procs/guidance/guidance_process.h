@@ -1,0 +1,49 @@
+#pragma once
+/// @file
+/// orbed-guidance's shell: subscribes IIWA_STATUS (checked like every subscriber with a robot model:
+/// sim/iiwa_status_check.h; refused ones counted), and every 1/rate_hz publishes GUIDANCE for the
+/// latest measured configuration (guidance.h), nothing before the first good IIWA_STATUS.
+///
+/// Threading: everything on the Process::Run thread.
+
+#include <optional>
+#include <string>
+
+#include <Eigen/Core>
+
+#include "procs/common/process.h"
+#include "procs/guidance/guidance.h"
+#include "sim/robot_model.h"
+
+namespace orbed::guidance {
+
+struct GuidanceOptions {
+  std::string urdf_path;  ///< "" = the shipped model
+  GuidanceTarget target;  ///< q_target_rad filled from target_deg by the command line
+  double rate_hz{30.0};
+  std::string iiwa_status_channel{"IIWA_STATUS"};
+  std::string guidance_channel{"GUIDANCE"};
+};
+
+class GuidanceProcess {
+ public:
+  /// Throws std::runtime_error / std::invalid_argument for an unreadable model or a bad target.
+  GuidanceProcess(const CommonFlags& flags, const GuidanceOptions& options);
+  int Run() { return process_.Run(); }
+  Process& process() { return process_; }
+  /// The GUIDANCE the timer would publish now: none before the first good IIWA_STATUS.
+  std::optional<orbed::guidance_t> GuidanceNow(int64_t utime) const;
+
+ private:
+  Process process_;
+  sim::RobotModel model_;
+  GuidanceCore core_;
+  GuidanceOptions options_;
+  Eigen::VectorXd q_rad_;
+  bool have_q_{false};
+};
+
+/// orbed-guidance's command line (flags: --help): exit 0, 2 on bad arguments, 1 when it cannot start.
+int RunGuidance(int argc, const char* const* argv, std::ostream& out, std::ostream& err);
+
+}  // namespace orbed::guidance

@@ -1,0 +1,156 @@
+// orbed-guidance against hand computations:
+//   - joint kinds from the iiwa's geometry: 1, 3, 5, 7 twist, 2, 4, 6 revolve (the paper's split);
+//   - errors current − target in degrees, the next joint the first one outside the tolerance from the
+//     base, done when none is;
+//   - targets outside the limits, of the wrong size, a bad mode or tolerance are refused by name;
+//   - the process on memq://: GUIDANCE for the last good IIWA_STATUS, bad ones counted by class.
+#include "procs/guidance/guidance.h"
+
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "base/source_paths.h"
+#include "base/test_command.h"
+#include "base/units.h"
+#include "procs/guidance/guidance_process.h"
+
+namespace orbed::guidance {
+namespace {
+
+sim::RobotModel Iiwa() {
+  return sim::RobotModel::LoadFile(SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath));
+}
+
+Eigen::VectorXd Deg(std::vector<double> q_deg) {
+  return Eigen::Map<Eigen::VectorXd>(q_deg.data(), q_deg.size()) * kDegToRad;
+}
+
+constexpr int8_t T = orbed::guidance_t::JOINT_TWIST, R = orbed::guidance_t::JOINT_REVOLVE;
+
+TEST(Guidance, TheIiwasOddJointsTwistAndItsEvenJointsRevolve) {
+  EXPECT_EQ(JointKinds(Iiwa()), (std::vector<int8_t>{T, R, T, R, T, R, T}));
+}
+
+TEST(Guidance, ErrorsNextJointAndDoneByHand) {
+  const sim::RobotModel model = Iiwa();
+  GuidanceTarget target;
+  target.mode = orbed::guidance_t::MODE_AR_REFLECTIVE;
+  target.q_target_rad = Deg({0, 30, 0, -60, 0, 45, 0});
+  target.tolerance_deg = 1.0;
+  const GuidanceCore core(model, target);
+
+  // Joint 1 is 10 deg past its target: it is next, whatever the others.
+  orbed::guidance_t g = core.Compute(Deg({10, 30.5, 0, -60, 0, 45, -20}), 77);
+  EXPECT_EQ(g.utime, 77);
+  EXPECT_EQ(g.mode, int{orbed::guidance_t::MODE_AR_REFLECTIVE});
+  ASSERT_EQ(g.num_joints, 7);
+  const double expected[7] = {10, 0.5, 0, 0, 0, 0, -20};
+  for (int i = 0; i < 7; ++i) {
+    EXPECT_NEAR(g.error_deg[i], expected[i], 1e-9) << "joint " << i + 1;
+    EXPECT_DOUBLE_EQ(g.target_position[i], target.q_target_rad[i]);
+  }
+  EXPECT_EQ(g.joint_kind, (std::vector<int8_t>{T, R, T, R, T, R, T}));
+  EXPECT_EQ(g.next_joint, 0);
+  EXPECT_FALSE(g.done);
+  // Joint 1 done, joint 2 within the tolerance (0.5 deg): joint 7 is next (−20 deg: turn it back +20).
+  g = core.Compute(Deg({0.9, 30.5, 0, -60, 0, 45, -20}), 78);
+  EXPECT_EQ(g.next_joint, 6);
+  EXPECT_NEAR(g.error_deg[6], -20, 1e-9);
+  // All within 1 deg: done.
+  g = core.Compute(Deg({-0.99, 30.99, 0.5, -60.5, 0, 44.01, 0.3}), 79);
+  EXPECT_EQ(g.next_joint, -1);
+  EXPECT_TRUE(g.done);
+}
+
+TEST(Guidance, BadTargetsAreRefusedByName) {
+  const sim::RobotModel model = Iiwa();
+  auto refused = [&model](GuidanceTarget t) -> std::string {
+    try {
+      GuidanceCore core(model, t);
+    } catch (const std::invalid_argument& e) {
+      return e.what();
+    }
+    return "(accepted)";
+  };
+  GuidanceTarget t;
+  t.q_target_rad = Deg({0, 121, 0, 0, 0, 0, 0});  // joint 2's limit is 120 deg
+  EXPECT_NE(refused(t).find("iiwa_joint_2"), std::string::npos) << refused(t);
+  t.q_target_rad = Deg({0, 0, 0});
+  EXPECT_NE(refused(t).find("expected 7"), std::string::npos) << refused(t);
+  t.q_target_rad = Deg({0, 0, 0, 0, 0, 0, 0});
+  t.tolerance_deg = 0;
+  EXPECT_NE(refused(t).find("tolerance"), std::string::npos);
+  t.tolerance_deg = 1;
+  t.mode = 5;
+  EXPECT_NE(refused(t).find("mode 5"), std::string::npos);
+  EXPECT_THROW(GuidanceModeFromName("hologram"), std::invalid_argument);
+  EXPECT_EQ(GuidanceModeFromName("fixed"), int{orbed::guidance_t::MODE_FIXED_DISPLAY});
+}
+
+orbed::iiwa_status_t Status(const Eigen::VectorXd& q) {
+  orbed::iiwa_status_t s{};
+  s.num_joints = static_cast<int32_t>(q.size());
+  s.joint_position_measured.assign(q.data(), q.data() + q.size());
+  for (auto* v : {&s.joint_velocity_estimated, &s.joint_position_commanded, &s.joint_position_ipo,
+                  &s.joint_torque_measured, &s.joint_torque_commanded, &s.joint_torque_external}) {
+    v->assign(q.size(), 0.0);
+  }
+  return s;
+}
+
+TEST(GuidanceProcess, PublishesForTheLastGoodStatusAndCountsBadOnes) {
+  CommonFlags flags("orbed-guidance-test");
+  flags.lcm_url = "memq://";
+  flags.duration_s = 0.3;
+  GuidanceOptions options;
+  options.target.q_target_rad = Deg({0, 30, 0, -60, 0, 45, 0});
+  options.rate_hz = 50;
+  GuidanceProcess guidance(flags, options);
+
+  struct Collector {
+    std::vector<orbed::guidance_t> seen;
+    void On(const lcm::ReceiveBuffer*, const std::string&, const orbed::guidance_t* msg) {
+      seen.push_back(*msg);
+    }
+  } collector;
+  guidance.process().lcm().subscribe("GUIDANCE", &Collector::On, &collector);
+
+  auto good = Status(Deg({0, 30, 5, -60, 0, 45, 0}));
+  guidance.process().lcm().publish("IIWA_STATUS", &good);
+  auto short_status = Status(Deg({0, 30, 0, -60, 0, 45}));
+  guidance.process().lcm().publish("IIWA_STATUS", &short_status);
+  auto nan = good;
+  nan.joint_position_measured[3] = std::nan("");
+  guidance.process().lcm().publish("IIWA_STATUS", &nan);
+  auto beyond = Status(Deg({0, 125, 0, -60, 0, 45, 0}));
+  guidance.process().lcm().publish("IIWA_STATUS", &beyond);
+  EXPECT_EQ(guidance.Run(), 0);
+
+  ASSERT_FALSE(collector.seen.empty());
+  const orbed::guidance_t& last = collector.seen.back();
+  EXPECT_EQ(last.next_joint, 2);  // joint 3, 5 deg off
+  EXPECT_NEAR(last.error_deg[2], 5.0, 1e-9);
+  EXPECT_FALSE(last.done);
+  const auto counts = guidance.process().rejections().counts();
+  EXPECT_EQ(counts.at("IIWA_STATUS/num_joints"), 1);
+  EXPECT_EQ(counts.at("IIWA_STATUS/non_finite"), 1);
+  EXPECT_EQ(counts.at("IIWA_STATUS/limits"), 1);
+}
+
+TEST(GuidanceCli, BadArgumentsExitTwoAndNameTheFlag) {
+  test::CommandRun r = test::RunCommand(RunGuidance, "orbed-guidance", {"--target-deg", "0,30,x"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--target-deg"), std::string::npos) << r.err;
+  r = test::RunCommand(RunGuidance, "orbed-guidance", {"--target-deg", "0,0,0,0,0,0,0", "--mode", "holo"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("ar, ar_reflective or fixed"), std::string::npos) << r.err;
+  r = test::RunCommand(RunGuidance, "orbed-guidance",
+                       {"--target-deg", "0,130,0,0,0,0,0", "--lcm-url", "memq://", "--duration-s", "0.05"});
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("iiwa_joint_2"), std::string::npos) << r.err;
+}
+
+}  // namespace
+}  // namespace orbed::guidance
