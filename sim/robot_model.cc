@@ -39,16 +39,20 @@ bool FinitePositive(double v) { return std::isfinite(v) && v > 0; }
 // urdfdom 3.0.1 links every joint's parent and child with owning pointers before it looks for the
 // root, so a joint whose child is its own parent, or a loop of joints, leaves a reference cycle that
 // is never freed, whether the parse then fails or not (found by fuzz_urdf). This reads the joints'
-// <parent link> and <child link> with the same XML parser (TinyXML) first and returns the loop as
-// "a -> b -> a", or "" when the joints form no directed cycle (or the XML does not parse: urdfdom
-// refuses that before it links anything).
-std::string FindJointLoop(const std::string& urdf_xml) {
+// <parent link> and <child link> with the same XML parser (TinyXML) first and returns what is wrong:
+// more than kMaxUrdfJoints joints (the model is walked recursively later) or the loop as
+// "the joints form a loop ...: 'a' -> 'b' -> 'a'"; "" when neither (or the XML does not parse:
+// urdfdom refuses that before it links anything).
+constexpr int kMaxUrdfJoints = 1000;
+
+std::string CheckJointGraph(const std::string& urdf_xml) {
   TiXmlDocument doc;
   doc.Parse(urdf_xml.c_str());
   if (doc.Error()) return "";
   const TiXmlElement* robot = doc.FirstChildElement("robot");
   if (robot == nullptr) return "";
   std::map<std::string, std::vector<std::string>> children_of;
+  int num_joints = 0;
   for (const TiXmlElement* joint = robot->FirstChildElement("joint"); joint != nullptr;
        joint = joint->NextSiblingElement("joint")) {
     const TiXmlElement* parent = joint->FirstChildElement("parent");
@@ -57,31 +61,42 @@ std::string FindJointLoop(const std::string& urdf_xml) {
     const char* child_name = child != nullptr ? child->Attribute("link") : nullptr;
     if (parent_name == nullptr || child_name == nullptr) continue;
     children_of[parent_name].push_back(child_name);
-  }
-  // Depth-first search; a link met again while still on the path closes a loop.
-  enum class Mark { kNew, kOnPath, kDone };
-  std::map<std::string, Mark> mark;
-  std::vector<std::string> path;
-  std::string loop;
-  std::function<bool(const std::string&)> visit = [&](const std::string& link) {
-    mark[link] = Mark::kOnPath;
-    path.push_back(link);
-    for (const std::string& child : children_of[link]) {
-      const Mark m = mark.count(child) != 0 ? mark[child] : Mark::kNew;
-      if (m == Mark::kOnPath) {
-        auto it = std::find(path.begin(), path.end(), child);
-        for (; it != path.end(); ++it) loop += "'" + *it + "' -> ";
-        loop += "'" + child + "'";
-        return true;
-      }
-      if (m == Mark::kNew && visit(child)) return true;
+    if (++num_joints > kMaxUrdfJoints) {
+      return "more than " + std::to_string(kMaxUrdfJoints) + " joints (a robot has tens)";
     }
-    path.pop_back();
-    mark[link] = Mark::kDone;
-    return false;
-  };
-  for (const auto& entry : children_of) {
-    if (mark.count(entry.first) == 0 && visit(entry.first)) return loop;
+  }
+  // Depth-first search with an explicit stack (a file may hold a very long chain); a link met
+  // again while it is still on the path closes a loop.
+  enum class Mark { kOnPath, kDone };
+  std::map<std::string, Mark> mark;
+  const std::vector<std::string> no_children;
+  for (const auto& root : children_of) {
+    if (mark.count(root.first) != 0) continue;
+    // Each frame: a link on the path and the index of its next child to visit.
+    std::vector<std::pair<std::string, size_t>> path{{root.first, 0}};
+    mark[root.first] = Mark::kOnPath;
+    while (!path.empty()) {
+      auto& [link, next] = path.back();
+      const auto found = children_of.find(link);
+      const std::vector<std::string>& children = found != children_of.end() ? found->second : no_children;
+      if (next == children.size()) {
+        mark[link] = Mark::kDone;
+        path.pop_back();
+        continue;
+      }
+      const std::string child = children[next++];
+      const auto seen = mark.find(child);
+      if (seen == mark.end()) {
+        mark[child] = Mark::kOnPath;
+        path.emplace_back(child, 0);
+      } else if (seen->second == Mark::kOnPath) {
+        std::string loop;
+        size_t k = 0;
+        while (path[k].first != child) ++k;
+        for (; k < path.size(); ++k) loop += "'" + path[k].first + "' -> ";
+        return "the joints form a loop (a URDF must be a tree): " + loop + "'" + child + "'";
+      }
+    }
   }
   return "";
 }
@@ -140,13 +155,13 @@ RobotModel RobotModel::LoadString(const std::string& urdf_xml, const std::string
                                   const std::string& flange_link, const std::string& tool_tip_link) {
   const std::string src = source_name;
   auto fail = [&src](const std::string& what) -> void { throw std::runtime_error(src + ": " + what); };
-  // TinyXML, under urdfdom and FindJointLoop, reads past the end of text that is not UTF-8.
+  // TinyXML, under urdfdom and CheckJointGraph, reads past the end of text that is not UTF-8.
   const size_t bad_byte = FindInvalidUtf8(urdf_xml);
   if (bad_byte != std::string_view::npos) {
     fail("byte " + std::to_string(bad_byte) + " is not valid UTF-8 text (a URDF is an XML text file)");
   }
-  const std::string loop = FindJointLoop(urdf_xml);
-  if (!loop.empty()) fail("the joints form a loop (a URDF must be a tree): " + loop);
+  const std::string graph_error = CheckJointGraph(urdf_xml);
+  if (!graph_error.empty()) fail(graph_error);
   urdf::ModelInterfaceSharedPtr urdf_model = urdf::parseURDF(urdf_xml);
   if (!urdf_model) {
     fail(

@@ -244,6 +244,20 @@ TEST(RobotModelTest, JointLoopsAreRefusedBeforeUrdfdomLinksThem) {
       << e;
   e = Expect(links + joint("j1", "a", "b") + joint("j2", "b", "c") + joint("j3", "c", "a") + "</robot>");
   EXPECT_NE(e.find("'a' -> 'b' -> 'c' -> 'a'"), std::string::npos) << e;
+  // A long chain closed into a loop at its end; beyond 1000 joints the file is refused for its size.
+  auto chain = [&joint](int joints) {
+    std::string xml = "<robot name='r'>";
+    for (int i = 0; i <= joints; ++i) xml += "<link name='l" + std::to_string(i) + "'/>";
+    for (int i = 0; i < joints; ++i) {
+      xml += joint(("j" + std::to_string(i)).c_str(), ("l" + std::to_string(i)).c_str(),
+                   ("l" + std::to_string(i + 1)).c_str());
+    }
+    return xml;
+  };
+  e = Expect(chain(998) + joint("back", "l998", "l997") + "</robot>");
+  EXPECT_NE(e.find("'l997' -> 'l998' -> 'l997'"), std::string::npos) << e.substr(0, 200);
+  e = Expect(chain(1001) + "</robot>");
+  EXPECT_NE(e.find("more than 1000 joints"), std::string::npos) << e.substr(0, 200);
   // A chain is not a loop: it gets past the check to the flange check.
   e = Expect(links + joint("j1", "a", "b") + joint("j2", "b", "c") + "</robot>");
   EXPECT_EQ(e.find("loop"), std::string::npos) << e;

@@ -1,5 +1,6 @@
 #include "study/landmark_validation.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -116,6 +117,15 @@ void CheckOptions(const LandmarkValidationOptions& o) {
   }
   if (!std::isfinite(o.centre_jitter_m) || o.centre_jitter_m < 0) {
     throw std::invalid_argument("landmark validation: centre_jitter_m must be >= 0");
+  }
+  // Every target in front of the head, never below it (where the line of sight is vertical and the
+  // head's heading undefined).
+  const double largest_separation_m =
+      1e-3 * *std::max_element(o.separations_mm.begin(), o.separations_mm.end());
+  if (o.standoff_m <= o.centre_jitter_m * std::sqrt(2.0) + 0.5 * largest_separation_m + 0.05) {
+    throw std::invalid_argument(
+        "landmark validation: standoff_m must exceed centre_jitter_m * sqrt(2) + half the largest "
+        "separation + 0.05 m (a target would lie under the head)");
   }
 }
 

@@ -121,6 +121,9 @@ TEST(LandmarkValidation, BadOptionsAreRefusedByName) {
   o.pointing_std_deg = -1;
   EXPECT_NE(refused(o).find("pointing_std_deg"), std::string::npos);
   o = {};
+  o.standoff_m = 0.1;  // the 200 mm pair could reach under the head
+  EXPECT_NE(refused(o).find("standoff_m"), std::string::npos);
+  o = {};
   o.table_height_m = 2.0;
   EXPECT_NE(refused(o).find("below the eyes"), std::string::npos);
 }

@@ -222,6 +222,13 @@ int RunStudyTables(int argc, const char* const* argv, std::ostream& out, std::os
                                    earlier.user + " ('" + EscapeText(a) + "')");
         }
       }
+      // Only the protocol's modes: their names become CSV fields, JSON keys and terminal text.
+      for (const viraal::SessionResult& s : run.results.sessions) {
+        if (s.mode != "ar_reflective" && s.mode != "ar") {
+          throw std::runtime_error(run_paths[i] + ": mode '" + EscapeText(s.mode) +
+                                   "' is not one of the study's (ar_reflective, ar)");
+        }
+      }
       runs.push_back(std::move(run));
     }
     validation.slam = LoadShippedSlamConfig(config_paths);

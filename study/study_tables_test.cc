@@ -164,6 +164,13 @@ TEST(StudyTables, TheCommandWritesTheFilesAndRefusesAnUnfinishedRun) {
   r = test::RunCommand(RunStudyTables, "orbed-study-tables", {"--out", dir, pinned, partial_path});
   EXPECT_EQ(r.code, 1);
   EXPECT_NE(r.err.find("did not finish"), std::string::npos) << r.err;
+  nlohmann::json odd_mode = other_person;
+  odd_mode["sessions"][0]["mode"] = "se3_mean";
+  const std::string odd_path = ::testing::TempDir() + "odd_mode_results.json";
+  std::ofstream(odd_path) << odd_mode.dump();
+  r = test::RunCommand(RunStudyTables, "orbed-study-tables", {"--out", dir, pinned, odd_path});
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("mode 'se3_mean' is not one of the study's"), std::string::npos) << r.err;
   EXPECT_EQ(test::RunCommand(RunStudyTables, "orbed-study-tables", {pinned}).code, 2);  // no --out
 }
 

@@ -10,7 +10,8 @@
 ///   joint_kind[i] = JOINT_TWIST when the joint's axis runs along its link (it turns the arm about
 ///                   itself: iiwa joints 1, 3, 5, 7), else JOINT_REVOLVE (it swings the arm: 2, 4, 6);
 ///                   from the model's geometry at q = 0: the axis against the direction from the
-///                   joint to the next joint's origin (for the last joint, to the tool tip), twisting
+///                   joint to the next joint origin down the arm that is not at the same place (the
+///                   iiwa's joints 2/3, 4/5 and 6/7 share origins), else to the tool tip; twisting
 ///                   when the angle between the two lines is below kTwistAngleDeg.
 ///
 /// Frames: joint angles are the URDF's [rad]; the axis and link directions are compared in the base

@@ -36,7 +36,7 @@ GuidanceProcess::GuidanceProcess(const CommonFlags& flags, const GuidanceOptions
       options_(options) {
   process_.Subscribe<orbed::iiwa_status_t>(
       options_.iiwa_status_channel,
-      [this](const orbed::iiwa_status_t& msg, const std::string& channel, int64_t) {
+      [this](const orbed::iiwa_status_t& msg, const std::string& channel, int64_t received_utime) {
         Eigen::VectorXd q;
         const sim::IiwaStatusProblem problem = sim::CheckIiwaStatus(msg, model_, kJointLimitSlackRad, &q);
         if (!problem.rejection_class.empty()) {
@@ -45,12 +45,21 @@ GuidanceProcess::GuidanceProcess(const CommonFlags& flags, const GuidanceOptions
         }
         q_rad_ = q;
         have_q_ = true;
+        q_received_utime_ = received_utime;
       });
   process_.AddTimer(
       1.0 / options_.rate_hz,
       [this] {
-        if (const auto guidance = GuidanceNow(NowMicros()))
-          process_.Publish(options_.guidance_channel, *guidance);
+        const auto guidance = GuidanceNow(NowMicros());
+        if (guidance) process_.Publish(options_.guidance_channel, *guidance);
+        if (have_q_ && !guidance != stale_logged_) {
+          stale_logged_ = !guidance;
+          if (stale_logged_) {
+            ORBED_LOG(kWarn) << "no IIWA_STATUS for " << options_.stale_after_s << " s: GUIDANCE paused";
+          } else {
+            ORBED_LOG(kInfo) << "IIWA_STATUS again: GUIDANCE resumed";
+          }
+        }
       },
       options_.guidance_channel);
   std::string target;
@@ -64,7 +73,8 @@ GuidanceProcess::GuidanceProcess(const CommonFlags& flags, const GuidanceOptions
 }
 
 std::optional<orbed::guidance_t> GuidanceProcess::GuidanceNow(int64_t utime) const {
-  if (!have_q_) return std::nullopt;
+  const int64_t stale_after_us = static_cast<int64_t>(options_.stale_after_s * 1e6);
+  if (!have_q_ || utime - q_received_utime_ > stale_after_us) return std::nullopt;
   return core_.Compute(q_rad_, utime);
 }
 
@@ -87,6 +97,10 @@ int RunGuidance(int argc, const char* const* argv, std::ostream& out, std::ostre
       ->capture_default_str();
   app.add_option("--rate-hz", options.rate_hz, "GUIDANCE rate [Hz]")
       ->check(CLI::Range(0.1, 1000.0))
+      ->capture_default_str();
+  app.add_option("--stale-after-s", options.stale_after_s,
+                 "No GUIDANCE while the latest IIWA_STATUS is older than this [s]")
+      ->check(CLI::Range(0.01, 60.0))
       ->capture_default_str();
   app.add_option("--urdf", options.urdf_path,
                  "Robot URDF (default: sim/models/iiwa7.urdf under $ORBED_SOURCE_DIR, else the source tree)");

@@ -2,7 +2,9 @@
 /// @file
 /// orbed-guidance's shell: subscribes IIWA_STATUS (checked like every subscriber with a robot model:
 /// sim/iiwa_status_check.h; refused ones counted), and every 1/rate_hz publishes GUIDANCE for the
-/// latest measured configuration (guidance.h), nothing before the first good IIWA_STATUS.
+/// latest measured configuration (guidance.h): nothing before the first good IIWA_STATUS, and nothing
+/// while the latest is older than stale_after_s (a stopped arm's last pose is not guidance; logged
+/// when it goes stale and when it is fresh again).
 ///
 /// Threading: everything on the Process::Run thread.
 
@@ -21,6 +23,8 @@ struct GuidanceOptions {
   std::string urdf_path;  ///< "" = the shipped model
   GuidanceTarget target;  ///< q_target_rad filled from target_deg by the command line
   double rate_hz{30.0};
+  /// No GUIDANCE from an IIWA_STATUS received longer ago than this [s] (the sim sends 200 Hz).
+  double stale_after_s{0.5};
   std::string iiwa_status_channel{"IIWA_STATUS"};
   std::string guidance_channel{"GUIDANCE"};
 };
@@ -31,7 +35,8 @@ class GuidanceProcess {
   GuidanceProcess(const CommonFlags& flags, const GuidanceOptions& options);
   int Run() { return process_.Run(); }
   Process& process() { return process_; }
-  /// The GUIDANCE the timer would publish now: none before the first good IIWA_STATUS.
+  /// The GUIDANCE the timer would publish at `utime` (wall clock [µs]): none before the first good
+  /// IIWA_STATUS or when the latest was received more than stale_after_s before.
   std::optional<orbed::guidance_t> GuidanceNow(int64_t utime) const;
 
  private:
@@ -41,6 +46,8 @@ class GuidanceProcess {
   GuidanceOptions options_;
   Eigen::VectorXd q_rad_;
   bool have_q_{false};
+  int64_t q_received_utime_{0};
+  bool stale_logged_{false};
 };
 
 /// orbed-guidance's command line (flags: --help): exit 0, 2 on bad arguments, 1 when it cannot start.

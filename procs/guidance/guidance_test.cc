@@ -133,6 +133,9 @@ TEST(GuidanceProcess, PublishesForTheLastGoodStatusAndCountsBadOnes) {
   EXPECT_EQ(last.next_joint, 2);  // joint 3, 5 deg off
   EXPECT_NEAR(last.error_deg[2], 5.0, 1e-9);
   EXPECT_FALSE(last.done);
+  // A second after the last status (the run ended 0.3 s after it), the arm's pose is stale: none.
+  EXPECT_TRUE(guidance.GuidanceNow(last.utime).has_value());
+  EXPECT_FALSE(guidance.GuidanceNow(last.utime + 1'000'000).has_value());
   const auto counts = guidance.process().rejections().counts();
   EXPECT_EQ(counts.at("IIWA_STATUS/num_joints"), 1);
   EXPECT_EQ(counts.at("IIWA_STATUS/non_finite"), 1);
