@@ -17,6 +17,7 @@
 #include "sim/scene.h"
 #include "sim/trocar_clearance.h"
 #include "sim/trocar_ik.h"
+#include "sim/trocar_plan.h"
 
 namespace orbed::sim {
 namespace {
@@ -209,6 +210,42 @@ int RunIk(const std::string& scene_path, const std::string& urdf, uint64_t seed,
   return ik.success ? 0 : 1;
 }
 
+// plan: every target's q and what it was checked for; exit 1 (one line on stderr) when the plan
+// cannot be made.
+int RunPlan(const std::string& scene_path, const std::string& urdf, const TrocarPlanOptions& options,
+            std::ostream& out, std::ostream& err) {
+  const Scene scene = LoadScene(scene_path);
+  const RobotModel model = LoadModel(urdf, &scene);
+  std::vector<PlannedTarget> plan;
+  try {
+    plan = PlanTrocarTargets(model, scene, options);
+  } catch (const std::runtime_error& e) {
+    err << "orbed-robot: " << e.what() << "\n";
+    return 1;
+  }
+  JsonWriter j;
+  j.BeginObject();
+  j.Key("scene").String(scene_path);
+  j.Key("min_separation_deg").Number(options.min_separation_deg);
+  j.Key("min_clearance_m").Number(options.min_clearance_m);
+  j.Key("seed").Int(static_cast<int64_t>(options.seed));
+  j.Key("targets").BeginArray();
+  for (const PlannedTarget& t : plan) {
+    const Eigen::VectorXd q_deg = RadToDeg(t.q_rad);
+    j.BeginObject();
+    j.Key("q_deg").Array(std::vector<double>(q_deg.data(), q_deg.data() + q_deg.size()));
+    j.Key("clearance_m").Number(t.clearance_m);
+    j.Key("separation_deg").Number(t.separation_deg);
+    j.Key("position_error_m").Number(t.position_error_m);
+    j.Key("angle_error_deg").Number(t.angle_error_deg);
+    j.EndObject();
+  }
+  j.EndArray();
+  j.EndObject();
+  out << j.str() << "\n";
+  return 0;
+}
+
 }  // namespace
 
 int RunRobotTool(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
@@ -230,6 +267,26 @@ int RunRobotTool(int argc, const char* const* argv, std::ostream& out, std::ostr
   ik->add_option("--urdf", urdf, "robot URDF");
   ik->add_option("--seed", seed, "random seed of the IK starts");
   ik->add_option("--starts", starts, "number of random IK starts")->check(CLI::Range(1, 100000));
+  TrocarPlanOptions plan_options;
+  auto* plan = app.add_subcommand(
+      "plan",
+      "distinct collision-free configurations docking the tool at the scene's trocar (the set-up targets)");
+  plan->add_option("--scene", scene_path, "scene YAML")->required();
+  plan->add_option("--urdf", urdf, "robot URDF");
+  plan->add_option("--targets", plan_options.num_targets, "number of targets")
+      ->check(CLI::Range(1, 20))
+      ->capture_default_str();
+  plan->add_option("--min-separation-deg", plan_options.min_separation_deg,
+                   "every two targets differ by at least this in some joint [deg]")
+      ->check(CLI::Range(0.0, 180.0))
+      ->capture_default_str();
+  plan->add_option("--min-clearance-m", plan_options.min_clearance_m, "arm clearance of every target [m]")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  plan->add_option("--seed", plan_options.seed, "random seed of the IK starts")->capture_default_str();
+  plan->add_option("--starts", plan_options.starts, "IK starts per target")
+      ->check(CLI::Range(1, 1000))
+      ->capture_default_str();
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp&) {
@@ -250,6 +307,7 @@ int RunRobotTool(int argc, const char* const* argv, std::ostream& out, std::ostr
     if (*fk) return RunFk(q_text, urdf, out);
     if (*check) return RunCheck(q_text, scene_path, urdf, out);
     if (*ik) return RunIk(scene_path, urdf, seed, starts, out);
+    if (*plan) return RunPlan(scene_path, urdf, plan_options, out, err);
   } catch (const UsageError& e) {
     err << "orbed-robot: " << e.what() << "\n";
     return 2;

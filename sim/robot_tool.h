@@ -13,7 +13,13 @@
 ///         {"success":b,"q_deg":[...],"clearance_m":c,"position_error_m":e,"angle_error_deg":a,...}
 ///         the arm's clearance (links 0-7; the tool necessarily ends at the patient) maximised over
 ///         the redundancy; the full check (tool included) must be collision-free.
-/// Exit codes: 0 ok; 1 ik found no collision-free solution (JSON still printed, success false);
+///   plan  --scene FILE [--urdf FILE] [--targets N] [--min-separation-deg D] [--min-clearance-m C]
+///         [--seed N] [--starts N]
+///         {"scene","min_separation_deg","min_clearance_m","seed","targets":[{"q_deg":[...],
+///          "clearance_m","separation_deg","position_error_m","angle_error_deg"},...]}
+///         distinct set-up targets for the scene's trocar (trocar_plan.h); orbed-guidance --plan.
+/// Exit codes: 0 ok; 1 ik found no collision-free solution (JSON still printed, success false), or
+/// plan could not find a target (the reason on stderr, no JSON);
 /// 2 bad arguments or unreadable files (one line on stderr).
 /// Files: --urdf defaults to $ORBED_SOURCE_DIR/sim/models/iiwa7.urdf, else the source tree the
 /// tool was built from.

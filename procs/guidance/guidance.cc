@@ -5,6 +5,7 @@
 #include <utility>
 
 #include "base/format.h"
+#include "base/json_fields.h"
 #include "base/units.h"
 
 namespace orbed::guidance {
@@ -55,6 +56,20 @@ const char* GuidanceModeName(int8_t mode) {
       return "fixed";
   }
   return "?";
+}
+
+Eigen::VectorXd ReadPlanTarget(const std::string& path, int number, int num_joints) {
+  const JsonFields f(path);
+  const nlohmann::json doc = f.ReadFile(path, 1 << 20, 8);
+  const JsonAt targets = f.Member({doc, ""}, "targets");
+  const size_t count = f.ArraySize(targets, 20);
+  if (number < 1 || static_cast<size_t>(number) > count) {
+    throw std::runtime_error(path + ": has " + std::to_string(count) + " target(s); there is no target " +
+                             std::to_string(number));
+  }
+  const JsonAt target = f.Element(targets, static_cast<size_t>(number - 1));
+  const std::vector<double> q_deg = f.Numbers(f.Member(target, "q_deg"), num_joints, -360.0, 360.0);
+  return Eigen::Map<const Eigen::VectorXd>(q_deg.data(), num_joints) * kDegToRad;
 }
 
 GuidanceCore::GuidanceCore(const sim::RobotModel& model, GuidanceTarget target)

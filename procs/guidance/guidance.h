@@ -46,6 +46,13 @@ struct GuidanceTarget {
   double tolerance_deg{1.0};
 };
 
+/// Target `number` (1-based) of a plan written by `orbed-robot plan` (JSON: {"targets": [{"q_deg":
+/// [...]}, ...]}) [rad]. Read as outside input (base/json_fields.h: at most 1 MB, 20 targets,
+/// num_joints finite angles in [−360, 360] deg); throws std::runtime_error naming the file, the key
+/// and what was expected, or the number when the plan has fewer targets. Joint limits are the
+/// GuidanceCore's check.
+Eigen::VectorXd ReadPlanTarget(const std::string& path, int number, int num_joints);
+
 class GuidanceCore {
  public:
   /// Throws std::invalid_argument when the target has the wrong size, lies outside the joint limits,

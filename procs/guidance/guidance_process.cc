@@ -86,9 +86,17 @@ int RunGuidance(int argc, const char* const* argv, std::ostream& out, std::ostre
   CommonFlags common("orbed-guidance");
   AddCommonFlags(&app, &common);
   GuidanceOptions options;
-  std::string target_deg, mode = "ar";
-  app.add_option("--target-deg", target_deg, "Target configuration q1,...,q7 [deg] (within the joint limits)")
-      ->required();
+  std::string target_deg, mode = "ar", plan_path;
+  int plan_target = 1;
+  auto* target_flag = app.add_option("--target-deg", target_deg,
+                                     "Target configuration q1,...,q7 [deg] (within the joint limits)");
+  auto* plan_flag =
+      app.add_option("--plan", plan_path, "A plan from `orbed-robot plan`: its --target is the target")
+          ->excludes(target_flag);
+  app.add_option("--target", plan_target, "Which target of --plan (1-based)")
+      ->check(CLI::Range(1, 20))
+      ->capture_default_str()
+      ->needs(plan_flag);
   app.add_option("--mode", mode, "Guidance mode on GUIDANCE: ar, ar_reflective or fixed")
       ->capture_default_str();
   app.add_option("--tolerance-deg", options.target.tolerance_deg,
@@ -107,15 +115,27 @@ int RunGuidance(int argc, const char* const* argv, std::ostream& out, std::ostre
   app.add_option("--iiwa-status-channel", options.iiwa_status_channel)->capture_default_str();
   app.add_option("--guidance-channel", options.guidance_channel)->capture_default_str();
   if (const auto code = ParseCommandLine(&app, common, argc, argv, out, err)) return *code;
+  if (target_deg.empty() && plan_path.empty()) {
+    err << "orbed-guidance: a target is needed: --target-deg q1,...,q7 or --plan FILE [--target N]\n";
+    return 2;
+  }
   try {
     options.target.mode = GuidanceModeFromName(mode);
-    const std::vector<double> q_deg = ParseNumberList(target_deg, "--target-deg");
-    options.target.q_target_rad = Eigen::Map<const Eigen::VectorXd>(q_deg.data(), q_deg.size()) * kDegToRad;
+    if (!target_deg.empty()) {
+      const std::vector<double> q_deg = ParseNumberList(target_deg, "--target-deg");
+      options.target.q_target_rad = Eigen::Map<const Eigen::VectorXd>(q_deg.data(), q_deg.size()) * kDegToRad;
+    }
   } catch (const std::invalid_argument& e) {
     err << "orbed-guidance: " << e.what() << "\n";
     return 2;
   }
   try {
+    if (!plan_path.empty()) {
+      const sim::RobotModel model = sim::RobotModel::LoadFile(
+          options.urdf_path.empty() ? SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath)
+                                    : options.urdf_path);
+      options.target.q_target_rad = ReadPlanTarget(plan_path, plan_target, model.num_joints());
+    }
     GuidanceProcess guidance(common, options);
     return guidance.Run();
   } catch (const std::exception& e) {

@@ -50,7 +50,9 @@ class GuidanceProcess {
   bool stale_logged_{false};
 };
 
-/// orbed-guidance's command line (flags: --help): exit 0, 2 on bad arguments, 1 when it cannot start.
+/// orbed-guidance's command line (flags: --help): the target from --target-deg, or from --plan FILE
+/// [--target N] (orbed-robot plan). Exit 0; on bad arguments 2 or CLI11's usage code (106-109); 1
+/// when it cannot start (an unreadable plan or model, a target outside the limits).
 int RunGuidance(int argc, const char* const* argv, std::ostream& out, std::ostream& err);
 
 }  // namespace orbed::guidance

@@ -6,6 +6,7 @@
 //   - the process on memq://: GUIDANCE for the last good IIWA_STATUS, bad ones counted by class.
 #include "procs/guidance/guidance.h"
 
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -140,6 +141,50 @@ TEST(GuidanceProcess, PublishesForTheLastGoodStatusAndCountsBadOnes) {
   EXPECT_EQ(counts.at("IIWA_STATUS/num_joints"), 1);
   EXPECT_EQ(counts.at("IIWA_STATUS/non_finite"), 1);
   EXPECT_EQ(counts.at("IIWA_STATUS/limits"), 1);
+}
+
+std::string WritePlan(const std::string& name, const std::string& text) {
+  const std::string path = ::testing::TempDir() + name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+TEST(GuidancePlan, TargetsAreReadFromAnOrbedRobotPlanAndCheckedAsInput) {
+  const std::string plan = WritePlan("plan.json",
+                                     R"({"scene": "x", "targets": [{"q_deg": [0, 30, 0, -60, 0, 45, 0]},
+                                         {"q_deg": [10, 20, 30, -40, 50, 60, -70], "clearance_m": 0.1}]})");
+  const Eigen::VectorXd q = ReadPlanTarget(plan, 2, 7);
+  EXPECT_NEAR((q - Deg({10, 20, 30, -40, 50, 60, -70})).norm(), 0.0, 1e-12);
+  auto error = [](const std::string& path, int number) -> std::string {
+    try {
+      ReadPlanTarget(path, number, 7);
+    } catch (const std::runtime_error& e) {
+      return e.what();
+    }
+    return "(accepted)";
+  };
+  EXPECT_NE(error(plan, 3).find("has 2 target(s); there is no target 3"), std::string::npos)
+      << error(plan, 3);
+  const std::string short_q = WritePlan("short.json", R"({"targets": [{"q_deg": [0, 30, 0]}]})");
+  EXPECT_NE(error(short_q, 1).find("targets[0].q_deg"), std::string::npos) << error(short_q, 1);
+  const std::string huge = WritePlan("huge.json", R"({"targets": [{"q_deg": [0, 30, 0, 1e400, 0, 0, 0]}]})");
+  EXPECT_NE(error(huge, 1).find("not valid JSON"), std::string::npos) << error(huge, 1);  // beyond a double
+  const std::string wild = WritePlan("wild.json", R"({"targets": [{"q_deg": [0, 30, 0, 400, 0, 0, 0]}]})");
+  EXPECT_NE(error(wild, 1).find("targets[0].q_deg"), std::string::npos) << error(wild, 1);
+  EXPECT_NE(error(WritePlan("garbage.json", "{not json"), 1), "(accepted)");
+  // The command with a plan runs; with neither or both targets it refuses.
+  EXPECT_EQ(
+      test::RunCommand(RunGuidance, "orbed-guidance",
+                       {"--plan", plan, "--target", "2", "--lcm-url", "memq://", "--duration-s", "0.05"})
+          .code,
+      0);
+  EXPECT_EQ(test::RunCommand(RunGuidance, "orbed-guidance", {"--lcm-url", "memq://"}).code, 2);
+  const test::CommandRun both =
+      test::RunCommand(RunGuidance, "orbed-guidance",
+                       {"--plan", plan, "--target-deg", "0,0,0,0,0,0,0", "--lcm-url", "memq://"});
+  EXPECT_NE(both.code, 0);
+  EXPECT_NE(both.code, 1);  // a usage error, not a failure to run
+  EXPECT_NE(both.err.find("excludes"), std::string::npos) << both.err;
 }
 
 TEST(GuidanceCli, BadArgumentsExitTwoAndNameTheFlag) {
