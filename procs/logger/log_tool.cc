@@ -1,0 +1,177 @@
+#include "procs/logger/log_tool.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <exception>
+#include <map>
+#include <regex>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "base/format.h"
+#include "procs/logger/event_log_reader.h"
+#include "procs/logger/event_log_writer.h"
+
+namespace orbed::logger {
+namespace {
+
+struct ChannelSummary {
+  int64_t events = 0;
+  uint64_t bytes = 0;
+  int64_t first_us = 0, last_us = 0;
+  double largest_gap_s = 0;
+};
+
+struct LogSummary {
+  std::map<std::string, ChannelSummary> channels;
+  int64_t events = 0;
+  int64_t first_us = 0, last_us = 0;
+  std::vector<LogDamage> damage;
+};
+
+LogSummary Summarize(const MappedLog& log) {
+  LogSummary s;
+  EventLogScanner scanner = log.Scanner();
+  LogEvent e;
+  while (scanner.Next(&e)) {
+    ChannelSummary& c = s.channels[e.channel];
+    if (c.events > 0) c.largest_gap_s = std::max(c.largest_gap_s, (e.timestamp_us - c.last_us) * 1e-6);
+    if (c.events == 0) c.first_us = e.timestamp_us;
+    c.last_us = e.timestamp_us;
+    ++c.events;
+    c.bytes += e.size;
+    if (s.events == 0) s.first_us = e.timestamp_us;
+    s.first_us = std::min(s.first_us, e.timestamp_us);
+    s.last_us = std::max(s.last_us, e.timestamp_us);
+    ++s.events;
+  }
+  s.damage = scanner.damage();
+  return s;
+}
+
+std::string Damage(const LogDamage& d) {
+  return "bytes " + std::to_string(d.offset) + ".." + std::to_string(d.offset + d.bytes) + " (" +
+         std::to_string(d.bytes) + " bytes): " + EscapeText(d.reason);
+}
+
+int Info(const MappedLog& log, const std::string& path, std::ostream& out) {
+  const LogSummary s = Summarize(log);
+  const double duration_s = s.events > 1 ? (s.last_us - s.first_us) * 1e-6 : 0.0;
+  out << EscapeText(path) << ": " << s.events << " events, " << log.size() << " bytes, "
+      << Fixed(duration_s, 3) << " s, " << s.channels.size() << " channels, " << s.damage.size()
+      << " damaged range(s)\n";
+  char line[512];
+  std::snprintf(line, sizeof(line), "%-28s %10s %12s %9s %11s\n", "channel", "events", "bytes", "rate_hz",
+                "max_gap_s");
+  out << line;
+  for (const auto& [name, c] : s.channels) {
+    const double span_s = (c.last_us - c.first_us) * 1e-6;
+    const double rate_hz = c.events > 1 && span_s > 0 ? (c.events - 1) / span_s : 0.0;
+    std::snprintf(line, sizeof(line), "%-28s %10lld %12llu %9.1f %11.3f\n", EscapeText(name).c_str(),
+                  static_cast<long long>(c.events), static_cast<unsigned long long>(c.bytes), rate_hz,
+                  c.largest_gap_s);
+    out << line;
+  }
+  for (const LogDamage& d : s.damage) out << "damaged: " << Damage(d) << "\n";
+  return 0;
+}
+
+int Check(const MappedLog& log, const std::string& path, std::ostream& out) {
+  const LogSummary s = Summarize(log);
+  for (const LogDamage& d : s.damage) out << EscapeText(path) << ": damaged " << Damage(d) << "\n";
+  uint64_t damaged = 0;
+  for (const LogDamage& d : s.damage) damaged += d.bytes;
+  out << EscapeText(path) << ": " << s.events << " events read, " << damaged << " of " << log.size()
+      << " bytes damaged in " << s.damage.size() << " range(s)\n";
+  return s.damage.empty() ? 0 : 1;
+}
+
+int Cut(const MappedLog& log, const std::string& out_path, double from_s, double to_s,
+        const std::regex& channels, std::ostream& out, std::ostream& err) {
+  EventLogWriter writer(out_path);
+  if (!writer.ok()) {
+    err << "orbed-log: " << writer.error() << "\n";
+    return 1;
+  }
+  EventLogScanner scanner = log.Scanner();
+  LogEvent e;
+  bool have_start = false;
+  int64_t start_us = 0, kept = 0;
+  while (scanner.Next(&e)) {
+    if (!have_start) {
+      start_us = e.timestamp_us;
+      have_start = true;
+    }
+    const double t_s = (e.timestamp_us - start_us) * 1e-6;
+    if (t_s < from_s || t_s > to_s || !std::regex_match(e.channel, channels)) continue;
+    if (writer.Write(e.timestamp_us, e.channel, e.data, e.size) == 0) {
+      err << "orbed-log: " << writer.error() << "\n";
+      return 1;
+    }
+    ++kept;
+  }
+  writer.Close();
+  if (!writer.error().empty()) {
+    err << "orbed-log: " << writer.error() << "\n";
+    return 1;
+  }
+  out << "orbed-log: " << kept << " events written to " << EscapeText(out_path) << "\n";
+  return 0;
+}
+
+}  // namespace
+
+int RunLogTool(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
+  CLI::App app{
+      "orbed-log: what is in an LCM event log (orbed-logger's or lcm-logger's), whether it is damaged,\n"
+      "and a cut of it by time and channel."};
+  app.require_subcommand(1);
+  std::string log_path, out_path, channels = ".*";
+  double from_s = 0, to_s = 1e18;
+  auto* info = app.add_subcommand("info", "channels, counts, bytes, rates, largest gaps, duration, damage");
+  info->add_option("log", log_path, "the log")->required();
+  auto* check = app.add_subcommand("check", "damaged byte ranges (exit 1 if any); the rest is still read");
+  check->add_option("log", log_path, "the log")->required();
+  auto* cut = app.add_subcommand("cut", "events in a time range and on matching channels, as a new log");
+  cut->add_option("log", log_path, "the log")->required();
+  cut->add_option("out", out_path, "the new log (overwritten)")->required();
+  cut->add_option("--from-s", from_s, "from this many seconds after the first event")
+      ->check(CLI::NonNegativeNumber);
+  cut->add_option("--to-s", to_s, "to this many seconds after the first event")
+      ->check(CLI::NonNegativeNumber);
+  cut->add_option("--channels", channels, "keep channels whose whole name matches this regex")
+      ->capture_default_str();
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e, out, err);
+    return code == 0 ? 0 : 2;
+  }
+  std::regex channel_regex;
+  try {
+    channel_regex = std::regex(channels, std::regex::extended);
+  } catch (const std::regex_error& e) {
+    err << "orbed-log: --channels '" << EscapeText(channels) << "' is not a regular expression\n";
+    return 2;
+  }
+  if (*cut && to_s < from_s) {
+    err << "orbed-log: --to-s is before --from-s\n";
+    return 2;
+  }
+  const MappedLog log(log_path);
+  if (!log.ok()) {
+    err << "orbed-log: " << log.error() << "\n";
+    return 1;
+  }
+  try {
+    if (*info) return Info(log, log_path, out);
+    if (*check) return Check(log, log_path, out);
+    return Cut(log, out_path, from_s, to_s, channel_regex, out, err);
+  } catch (const std::exception& e) {
+    err << "orbed-log: " << e.what() << "\n";
+    return 1;
+  }
+}
+
+}  // namespace orbed::logger
