@@ -3,8 +3,11 @@
 /// one run: orbed's Bullet CollisionWorld with its closed-form fast path (the default), the same
 /// with GJK/EPA for every primitive pair (fast_path = false), both without bound pruning, and FCL
 /// answering the same query — the same pairs, the same primitives (capsules, cylinders, spheres,
-/// boxes), the minimum signed distance, the closest pair and per-link clearance. The joint vectors
-/// are a fixed pool of 1024 seeded random vectors within the limits.
+/// boxes), the minimum signed distance, the closest pair and per-link clearance — every checked pair
+/// one after the other (FclChecker), and through FCL's own broadphase (a dynamic AABB tree over every
+/// primitive, its distance query pruning by the best distance so far, the same pairs filtered in the
+/// callback: FclBroadphaseChecker, the minimum distance only). The joint vectors are a fixed pool of
+/// 1024 seeded random vectors within the limits.
 ///
 /// Counters: `pairs` = exact pair distances computed per query; `gjk_prims` = primitive pairs of
 /// those that went to GJK/EPA; `max_diff_vs_bullet_m` = the largest |min distance (FCL) - min
@@ -12,6 +15,7 @@
 /// Run: build-*/bench/collision_bench (needs $ORBED_SOURCE_DIR or runs from the source root).
 #include <cmath>
 #include <cstdlib>
+#include <deque>
 #include <limits>
 #include <memory>
 #include <random>
@@ -19,6 +23,7 @@
 #include <vector>
 
 #include <benchmark/benchmark.h>
+#include <fcl/broadphase/broadphase_dynamic_AABB_tree.h>
 #include <fcl/narrowphase/collision_object.h>
 #include <fcl/narrowphase/distance.h>
 
@@ -158,6 +163,93 @@ class FclChecker {
   std::vector<Eigen::Isometry3d> X_RL_;
 };
 
+// The same minimum distance through FCL's broadphase manager: every primitive of every link and
+// object in one dynamic AABB tree; the distance callback skips primitive pairs whose links are not
+// a checked pair (adjacent links, links of one body, scene objects among themselves) and hands the
+// best distance back (at least 0: overlapping boxes are always visited, for the deepest penetration)
+// so the tree prunes every pair of boxes farther apart.
+class FclBroadphaseChecker {
+ public:
+  explicit FclBroadphaseChecker(const CollisionWorld& world, const Scene& scene)
+      : model_(world.model()), X_WR_(scene.X_WR) {
+    const int num_links = model_.num_links();
+    const int num_objects = static_cast<int>(scene.objects.size());
+    // Owner ids: links 0..num_links-1, scene objects num_links + k.
+    owners_ = num_links + num_objects;
+    checked_.assign(static_cast<size_t>(owners_ * owners_), false);
+    for (const auto& pair : world.CheckedPairs()) {
+      const int a = pair.link_a, b = pair.link_b >= 0 ? pair.link_b : num_links + pair.object_b;
+      checked_[Index(a, b)] = checked_[Index(b, a)] = true;
+    }
+    for (int l = 0; l < num_links; ++l) {
+      for (const auto& g : world.LinkPrimitives(l)) Add(ToFcl(g), l, g.X_LG, Eigen::Isometry3d::Identity());
+    }
+    for (int k = 0; k < num_objects; ++k) {
+      const SceneObject& o = scene.objects[k];
+      Add(ToFcl(ObjectPrimitive(o)), num_links + k, Eigen::Isometry3d::Identity(), o.X_WO);
+    }
+    for (auto& c : children_) manager_.registerObject(c.object.get());
+    manager_.setup();
+    request_.enable_signed_distance = true;
+    request_.gjk_solver_type = fcl::GST_LIBCCD;
+  }
+
+  double MinDistance(const Eigen::VectorXd& q) {
+    model_.CalcLinkPoses(q, &X_RL_);
+    for (auto& c : children_) {
+      if (c.owner < model_.num_links()) {
+        c.object->setTransform(X_WR_ * X_RL_[c.owner] * c.X_LG);
+        c.object->computeAABB();
+      }
+    }
+    manager_.update();
+    Query query{this, std::numeric_limits<double>::infinity()};
+    manager_.distance(&query, &Callback);
+    return query.best;
+  }
+
+ private:
+  struct Child {
+    std::unique_ptr<fcl::CollisionObjectd> object;
+    int owner;
+    Eigen::Isometry3d X_LG;
+  };
+  struct Query {
+    FclBroadphaseChecker* self;
+    double best;
+  };
+  size_t Index(int a, int b) const { return static_cast<size_t>(a * owners_ + b); }
+  void Add(std::shared_ptr<fcl::CollisionGeometryd> shape, int owner, const Eigen::Isometry3d& X_LG,
+           const Eigen::Isometry3d& X_WO) {
+    auto object = std::make_unique<fcl::CollisionObjectd>(shape);
+    object->setTransform(X_WO);
+    object->computeAABB();
+    children_.push_back({std::move(object), owner, X_LG});
+    children_.back().object->setUserData(&children_.back().owner);
+  }
+  static bool Callback(fcl::CollisionObjectd* o1, fcl::CollisionObjectd* o2, void* data, double& dist) {
+    auto* query = static_cast<Query*>(data);
+    const int a = *static_cast<int*>(o1->getUserData()), b = *static_cast<int*>(o2->getUserData());
+    if (!query->self->checked_[query->self->Index(a, b)]) return false;
+    fcl::DistanceResultd result;
+    fcl::distance(o1, o2, query->self->request_, result);
+    query->best = std::min(query->best, result.min_distance);
+    // Prune by the best distance, but never below zero: boxes that overlap may hold a deeper
+    // penetration than the best one found so far.
+    dist = std::max(query->best, 1e-9);
+    return false;
+  }
+
+  const RobotModel& model_;
+  Eigen::Isometry3d X_WR_;
+  int owners_ = 0;
+  std::vector<bool> checked_;
+  std::deque<Child> children_;  // stable addresses: each object's user data points at its owner
+  fcl::DynamicAABBTreeCollisionManagerd manager_;
+  fcl::DistanceRequestd request_;
+  std::vector<Eigen::Isometry3d> X_RL_;
+};
+
 void BM_Fk(benchmark::State& state) {
   const auto& f = F();
   std::vector<Eigen::Isometry3d> X;
@@ -217,6 +309,20 @@ void BM_FclFkAndCheck(benchmark::State& state) {
   state.counters["max_diff_vs_bullet_m"] = max_diff;
 }
 BENCHMARK(BM_FclFkAndCheck);
+
+void BM_FclBroadphaseFkAndCheck(benchmark::State& state) {
+  auto& f = F();
+  CollisionWorld world(f.model, &f.scene);
+  FclBroadphaseChecker checker(world, f.scene);
+  double max_diff = 0;
+  for (const auto& q : f.pool) {
+    max_diff = std::max(max_diff, std::abs(checker.MinDistance(q) - world.Check(q).min_distance_m));
+  }
+  size_t i = 0;
+  for (auto _ : state) benchmark::DoNotOptimize(checker.MinDistance(f.pool[i++ & 1023]));
+  state.counters["max_diff_vs_bullet_m"] = max_diff;
+}
+BENCHMARK(BM_FclBroadphaseFkAndCheck);
 
 }  // namespace
 }  // namespace orbed::sim
