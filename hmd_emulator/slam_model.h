@@ -93,8 +93,8 @@
 #include <yaml-cpp/yaml.h>
 #include <Eigen/Geometry>
 
+#include "base/random.h"
 #include "hmd_emulator/head_trajectory.h"
-#include "hmd_emulator/random.h"
 
 namespace orbed::hmd {
 

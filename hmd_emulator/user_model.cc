@@ -3,9 +3,9 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "base/random.h"
 #include "base/units.h"
 #include "base/yaml_fields.h"
-#include "hmd_emulator/random.h"
 #include "sim/scene.h"
 
 namespace orbed::hmd {

@@ -8,10 +8,10 @@
 #include <Eigen/Geometry>
 
 #include "base/format.h"
+#include "base/random.h"
 #include "base/units.h"
 #include "geometry/triangulation.h"
 #include "hmd_emulator/hmd_config.h"
-#include "hmd_emulator/random.h"
 
 namespace orbed::study {
 namespace {
@@ -82,7 +82,7 @@ class AnnotatingPerson {
 
   const LandmarkValidationOptions& options_;
   hmd::SlamModel slam_;
-  hmd::Random rng_;
+  Random rng_;
   double t_s_{0};
 };
 
@@ -134,7 +134,7 @@ void CheckOptions(const LandmarkValidationOptions& o) {
 LandmarkValidation RunLandmarkValidation(const LandmarkValidationOptions& options) {
   CheckOptions(options);
   LandmarkValidation out;
-  hmd::Random rng(options.seed);
+  Random rng(options.seed);
   const Eigen::Vector3d p_WH1(0.0, 0.0, options.eye_height_m);
   const Eigen::Vector3d p_WH2 = p_WH1 + Eigen::Vector3d(0.0, options.baseline_m, 0.0);
   double sum_error_mm = 0;

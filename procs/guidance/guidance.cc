@@ -7,6 +7,7 @@
 #include "base/format.h"
 #include "base/json_fields.h"
 #include "base/units.h"
+#include "procs/common/validation.h"
 
 namespace orbed::guidance {
 namespace {
@@ -70,6 +71,26 @@ Eigen::VectorXd ReadPlanTarget(const std::string& path, int number, int num_join
   const JsonAt target = f.Element(targets, static_cast<size_t>(number - 1));
   const std::vector<double> q_deg = f.Numbers(f.Member(target, "q_deg"), num_joints, -360.0, 360.0);
   return Eigen::Map<const Eigen::VectorXd>(q_deg.data(), num_joints) * kDegToRad;
+}
+
+std::string CheckGuidance(const orbed::guidance_t& msg, const sim::RobotModel& model, double slack_rad) {
+  const int n = model.num_joints();
+  std::string problem = FirstError({CheckSize(msg.num_joints, n, "GUIDANCE.num_joints"),
+                                    CheckEnum(msg.mode, 0, 2, "GUIDANCE.mode"),
+                                    CheckEnum(msg.next_joint, -1, n - 1, "GUIDANCE.next_joint")});
+  if (!problem.empty()) return problem;
+  for (int8_t kind : msg.joint_kind) {
+    problem = CheckEnum(kind, orbed::guidance_t::JOINT_TWIST, orbed::guidance_t::JOINT_REVOLVE,
+                        "GUIDANCE.joint_kind");
+    if (!problem.empty()) return problem;
+  }
+  const std::string target =
+      model.ValidateJointVector(Eigen::Map<const Eigen::VectorXd>(msg.target_position.data(), n), slack_rad);
+  if (!target.empty()) return "GUIDANCE.target_position: " + target;
+  const std::string current =
+      model.ValidateJointVector(Eigen::Map<const Eigen::VectorXd>(msg.current_position.data(), n), slack_rad);
+  if (!current.empty()) return "GUIDANCE.current_position: " + current;
+  return "";
 }
 
 GuidanceCore::GuidanceCore(const sim::RobotModel& model, GuidanceTarget target)

@@ -53,6 +53,12 @@ struct GuidanceTarget {
 /// GuidanceCore's check.
 Eigen::VectorXd ReadPlanTarget(const std::string& path, int number, int num_joints);
 
+/// The check of a GUIDANCE message its readers make (the one definition): num_joints equal to the
+/// model's, mode and joint kinds in range, next_joint in [-1, num_joints), target and current joint
+/// vectors finite and within the joint limits (+ slack_rad). Returns "" or a one-line reason naming
+/// the field.
+std::string CheckGuidance(const orbed::guidance_t& msg, const sim::RobotModel& model, double slack_rad);
+
 class GuidanceCore {
  public:
   /// Throws std::invalid_argument when the target has the wrong size, lies outside the joint limits,

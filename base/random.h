@@ -14,7 +14,7 @@
 
 #include <Eigen/Core>
 
-namespace orbed::hmd {
+namespace orbed {
 
 class Random {
  public:
@@ -61,4 +61,4 @@ class Random {
   double spare_ = 0.0;
 };
 
-}  // namespace orbed::hmd
+}  // namespace orbed

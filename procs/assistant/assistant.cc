@@ -1,0 +1,268 @@
+#include "procs/assistant/assistant.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include <orbed/guidance_t.hpp>
+
+#include "base/units.h"
+#include "base/yaml_fields.h"
+
+namespace orbed::assistant {
+namespace {
+
+constexpr double kArcminToRad = kDegToRad / 60.0;
+
+// Two unit vectors across the unit ray n.
+void Across(const Eigen::Vector3d& n, Eigen::Vector3d* e1, Eigen::Vector3d* e2) {
+  const Eigen::Vector3d helper = std::abs(n.z()) < 0.9 ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d::UnitX();
+  *e1 = n.cross(helper).normalized();
+  *e2 = n.cross(*e1);
+}
+
+void AddUnique(int link, const Eigen::Vector3d& p_L, std::vector<Feature>* features) {
+  for (const Feature& f : *features) {
+    if (f.link == link && (f.p_L - p_L).norm() < 1e-3) return;
+  }
+  features->push_back({link, p_L});
+}
+
+// The skeleton of the links of `body` (file comment of assistant.h).
+void AddBody(const sim::RobotModel& model, int body, double marker_m, std::vector<Feature>* features) {
+  for (int i = 0; i < model.num_links(); ++i) {
+    const sim::RobotLink& link = model.links()[i];
+    if (link.body != body) continue;
+    AddUnique(i, Eigen::Vector3d::Zero(), features);
+    for (const sim::CollisionPrimitive& g : link.collision) {
+      AddUnique(i, g.X_LG.translation(), features);
+      if (g.kind == sim::CollisionPrimitive::Kind::kCylinder ||
+          g.kind == sim::CollisionPrimitive::Kind::kCapsule) {
+        const Eigen::Vector3d half = 0.5 * g.length_m * g.X_LG.linear().col(2);
+        AddUnique(i, g.X_LG.translation() + half, features);
+        AddUnique(i, g.X_LG.translation() - half, features);
+      } else if (g.kind == sim::CollisionPrimitive::Kind::kBox) {
+        for (int c = 0; c < 8; ++c) {
+          const Eigen::Vector3d corner(((c & 1) ? 0.5 : -0.5) * g.size_m.x(),
+                                       ((c & 2) ? 0.5 : -0.5) * g.size_m.y(),
+                                       ((c & 4) ? 0.5 : -0.5) * g.size_m.z());
+          AddUnique(i, g.X_LG * corner, features);
+        }
+      }
+    }
+    if (i == model.flange_link() && marker_m > 0) AddUnique(i, Eigen::Vector3d(marker_m, 0, 0), features);
+  }
+}
+
+void CheckConfig(const AssistantConfig& c) {
+  auto require = [](bool ok, const char* what) {
+    if (!ok) throw std::invalid_argument(std::string("assistant config: ") + what);
+  };
+  require(c.eye_position_m.allFinite() && c.monitor_camera_m.allFinite(), "positions must be finite");
+  require(c.lateral_noise_arcmin > 0 && c.depth_noise_fraction_std > 0 && c.picture_noise_arcmin > 0 &&
+              c.picture_depth_fraction_std > 0,
+          "perception noises must be > 0");
+  require(c.user_scale_log_sigma >= 0 && c.mental_rotation_std_deg >= 0 && c.picture_scale_log_sigma >= 0 &&
+              c.placement_noise_deg >= 0 && c.flange_marker_offset_m >= 0,
+          "spreads must be >= 0");
+  require(
+      c.match_margin > 0 && c.looks_per_joint >= 1 && c.looks_per_joint <= 10 && c.correction_window_deg > 0,
+      "match_margin > 0, looks_per_joint 1..10, correction_window_deg > 0");
+  require(c.joint_overhead_s >= 0 && c.look_s >= 0 && c.mental_rotation_deg_per_s > 0 &&
+              c.hand_speed_deg_per_s > 0,
+          "times >= 0 and speeds > 0");
+}
+
+}  // namespace
+
+AssistantConfig LoadAssistantConfig(const std::string& path) {
+  const YAML::Node root = YamlFields::LoadFile(path);
+  const YamlFields f(path);
+  f.CheckKeys(root, "", {"assistant"});
+  const YAML::Node a = f.Required(root, "assistant", "assistant");
+  f.CheckKeys(a, "assistant",
+              {"seed", "eye_position_m", "user_scale_log_sigma", "headset", "monitor", "acting", "time"});
+  AssistantConfig c;
+  c.seed = static_cast<uint64_t>(f.IntegerOr(a, "seed", "assistant", 1, 0, 1'000'000'000));
+  if (a["eye_position_m"]) c.eye_position_m = f.Vector3(a["eye_position_m"], "assistant.eye_position_m", "m");
+  c.user_scale_log_sigma = f.NumberOr(a, "user_scale_log_sigma", "assistant", c.user_scale_log_sigma, 0, 2);
+
+  const YAML::Node h = f.Section(a, "headset", "assistant.headset");
+  f.CheckKeys(h, "assistant.headset", {"lateral_noise_arcmin", "depth_noise_fraction_std"});
+  c.lateral_noise_arcmin =
+      f.NumberOr(h, "lateral_noise_arcmin", "assistant.headset", c.lateral_noise_arcmin, 1e-3, 600, "arcmin");
+  c.depth_noise_fraction_std =
+      f.NumberOr(h, "depth_noise_fraction_std", "assistant.headset", c.depth_noise_fraction_std, 1e-5, 1);
+
+  const YAML::Node m = f.Section(a, "monitor", "assistant.monitor");
+  f.CheckKeys(m, "assistant.monitor",
+              {"camera_m", "mental_rotation_std_deg", "picture_scale_log_sigma", "picture_noise_arcmin",
+               "picture_depth_fraction_std"});
+  if (m["camera_m"]) c.monitor_camera_m = f.Vector3(m["camera_m"], "assistant.monitor.camera_m", "m");
+  c.mental_rotation_std_deg =
+      f.NumberOr(m, "mental_rotation_std_deg", "assistant.monitor", c.mental_rotation_std_deg, 0, 90, "deg");
+  c.picture_scale_log_sigma =
+      f.NumberOr(m, "picture_scale_log_sigma", "assistant.monitor", c.picture_scale_log_sigma, 0, 1);
+  c.picture_noise_arcmin =
+      f.NumberOr(m, "picture_noise_arcmin", "assistant.monitor", c.picture_noise_arcmin, 1e-3, 600, "arcmin");
+  c.picture_depth_fraction_std =
+      f.NumberOr(m, "picture_depth_fraction_std", "assistant.monitor", c.picture_depth_fraction_std, 1e-5, 1);
+
+  const YAML::Node act = f.Section(a, "acting", "assistant.acting");
+  f.CheckKeys(act, "assistant.acting",
+              {"match_margin", "looks_per_joint", "correction_window_deg", "placement_noise_deg",
+               "flange_marker_offset_m"});
+  c.match_margin = f.NumberOr(act, "match_margin", "assistant.acting", c.match_margin, 1e-3, 1e6);
+  c.looks_per_joint =
+      static_cast<int>(f.IntegerOr(act, "looks_per_joint", "assistant.acting", c.looks_per_joint, 1, 10));
+  c.correction_window_deg =
+      f.NumberOr(act, "correction_window_deg", "assistant.acting", c.correction_window_deg, 0.5, 360, "deg");
+  c.placement_noise_deg =
+      f.NumberOr(act, "placement_noise_deg", "assistant.acting", c.placement_noise_deg, 0, 45, "deg");
+  c.flange_marker_offset_m =
+      f.NumberOr(act, "flange_marker_offset_m", "assistant.acting", c.flange_marker_offset_m, 0, 0.5, "m");
+
+  const YAML::Node t = f.Section(a, "time", "assistant.time");
+  f.CheckKeys(t, "assistant.time",
+              {"joint_overhead_s", "look_s", "mental_rotation_deg_per_s", "hand_speed_deg_per_s"});
+  c.joint_overhead_s = f.NumberOr(t, "joint_overhead_s", "assistant.time", c.joint_overhead_s, 0, 600, "s");
+  c.look_s = f.NumberOr(t, "look_s", "assistant.time", c.look_s, 0, 600, "s");
+  c.mental_rotation_deg_per_s = f.NumberOr(t, "mental_rotation_deg_per_s", "assistant.time",
+                                           c.mental_rotation_deg_per_s, 1e-3, 1e4, "deg/s");
+  c.hand_speed_deg_per_s =
+      f.NumberOr(t, "hand_speed_deg_per_s", "assistant.time", c.hand_speed_deg_per_s, 1e-3, 1e4, "deg/s");
+  return c;
+}
+
+Assistant::Assistant(const sim::RobotModel& model, const AssistantConfig& config)
+    : model_(&model), config_(config), rng_(config.seed) {
+  CheckConfig(config_);
+  scale_ = rng_.LogNormalUnitMedian(config_.user_scale_log_sigma);
+  const int n = model.num_joints();
+  features_.resize(n);
+  for (int j = 0; j < n; ++j) {
+    AddBody(model, model.links()[model.joints()[j].link].body, config_.flange_marker_offset_m, &features_[j]);
+    if (j + 1 < n) {
+      AddBody(model, model.links()[model.joints()[j + 1].link].body, config_.flange_marker_offset_m,
+              &features_[j]);
+    }
+  }
+}
+
+std::vector<Eigen::Vector3d> Assistant::PerceiveTarget(int joint, const Eigen::VectorXd& q_target,
+                                                       const Viewing& view) {
+  const std::vector<Eigen::Isometry3d> X_RL = model_->CalcLinkPoses(q_target);
+  std::vector<Eigen::Vector3d> seen;
+  const bool monitor = view.mode == orbed::guidance_t::MODE_FIXED_DISPLAY;
+  if (!monitor) {
+    const double lateral = scale_ * config_.lateral_noise_arcmin * kArcminToRad;
+    const double depth = scale_ * config_.depth_noise_fraction_std;
+    for (const Feature& f : features_[joint]) {
+      const Eigen::Vector3d h = view.X_WV_seen * (X_RL[f.link] * f.p_L);
+      const double rho = (h - view.p_WE).norm();
+      Eigen::Vector3d e1, e2;
+      const Eigen::Vector3d n = (h - view.p_WE) / rho;
+      Across(n, &e1, &e2);
+      const double a = rng_.Normal(), b = rng_.Normal(), c = rng_.Normal();
+      seen.push_back(h + rho * lateral * (a * e1 + b * e2) + rho * depth * c * n);
+    }
+    return seen;
+  }
+  // The monitor's picture turned into the person's view: a rotation about the vertical through the
+  // base and a scale about the base, per look.
+  const double psi = scale_ * config_.mental_rotation_std_deg * kDegToRad * rng_.Normal();
+  const double k = std::exp(scale_ * config_.picture_scale_log_sigma * rng_.Normal());
+  const Eigen::Matrix3d R_turn = Eigen::AngleAxisd(psi, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const double lateral = scale_ * config_.picture_noise_arcmin * kArcminToRad;
+  const double depth = scale_ * config_.picture_depth_fraction_std;
+  const Eigen::Vector3d p_WR = view.X_WR.translation();
+  for (const Feature& f : features_[joint]) {
+    const Eigen::Vector3d p = view.X_WR * (X_RL[f.link] * f.p_L);
+    const Eigen::Vector3d h = p_WR + k * (R_turn * (p - p_WR));
+    const double rho = (h - config_.monitor_camera_m).norm();
+    const Eigen::Vector3d n = (h - config_.monitor_camera_m) / rho;
+    Eigen::Vector3d e1, e2;
+    Across(n, &e1, &e2);
+    const double a = rng_.Normal(), b = rng_.Normal(), c = rng_.Normal();
+    seen.push_back(h + rho * lateral * (a * e1 + b * e2) + rho * depth * c * n);
+  }
+  return seen;
+}
+
+double Assistant::Discrepancy(int joint, double x_rad, const Eigen::VectorXd& q_now,
+                              const std::vector<Eigen::Vector3d>& p_W_target_seen,
+                              const Viewing& view) const {
+  Eigen::VectorXd q = q_now;
+  q[joint] = x_rad;
+  const std::vector<Eigen::Isometry3d> X_RL = model_->CalcLinkPoses(q);
+  const double lateral = config_.lateral_noise_arcmin * kArcminToRad;
+  const double depth = config_.depth_noise_fraction_std;
+  double sum = 0;
+  const std::vector<Feature>& features = features_[joint];
+  for (size_t i = 0; i < features.size(); ++i) {
+    const Eigen::Vector3d r = view.X_WR * (X_RL[features[i].link] * features[i].p_L);
+    const double rho = std::max((r - view.p_WE).norm(), 0.05);
+    const Eigen::Vector3d n = (r - view.p_WE) / rho;
+    const Eigen::Vector3d d = r - p_W_target_seen[i];
+    const double along = n.dot(d);
+    const double across2 = (d - along * n).squaredNorm();
+    sum += across2 / std::pow(rho * lateral, 2) + along * along / std::pow(rho * depth, 2);
+  }
+  return sum;
+}
+
+JointLook Assistant::Look(int joint, const Eigen::VectorXd& q_now, const Eigen::VectorXd& q_target,
+                          const Viewing& view, double window_rad) {
+  if (joint < 0 || joint >= model_->num_joints() || q_now.size() != model_->num_joints() ||
+      q_target.size() != model_->num_joints()) {
+    throw std::invalid_argument("Assistant::Look: joint or vector size does not match the model");
+  }
+  const sim::JointInfo& info = model_->joints()[joint];
+  const std::vector<Eigen::Vector3d> seen = PerceiveTarget(joint, q_target, view);
+  const double lo = std::max(info.lower_rad, q_now[joint] - window_rad);
+  const double hi = std::min(info.upper_rad, q_now[joint] + window_rad);
+  const double step = kGridStepDeg * kDegToRad;
+  const int count = std::max(1, static_cast<int>(std::floor((hi - lo) / step)) + 1);
+  std::vector<double> x(count), d(count);
+  double d_min = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < count; ++i) {
+    x[i] = std::min(hi, lo + i * step);
+    d[i] = Discrepancy(joint, x[i], q_now, seen, view);
+    d_min = std::min(d_min, d[i]);
+  }
+  // The angles that look right, and the one of them nearest to where the joint is.
+  JointLook look;
+  double best_distance = std::numeric_limits<double>::infinity();
+  bool inside = false;
+  for (int i = 0; i < count; ++i) {
+    const bool right = d[i] <= d_min + config_.match_margin;
+    if (right && !inside) ++look.ranges;
+    inside = right;
+    if (right && std::abs(x[i] - q_now[joint]) < best_distance) {
+      best_distance = std::abs(x[i] - q_now[joint]);
+      look.aim_rad = x[i];
+    }
+  }
+  const double placed = look.aim_rad + scale_ * config_.placement_noise_deg * kDegToRad * rng_.Normal();
+  look.q_rad = std::clamp(placed, info.lower_rad, info.upper_rad);
+  look.time_s = config_.look_s;
+  if (view.mode == orbed::guidance_t::MODE_FIXED_DISPLAY)
+    look.time_s += MonitorDisparityDeg(view) / config_.mental_rotation_deg_per_s;
+  return look;
+}
+
+double Assistant::TravelTime_s(double delta_rad) const {
+  return std::abs(delta_rad) * kRadToDeg / config_.hand_speed_deg_per_s;
+}
+
+double Assistant::MonitorDisparityDeg(const Viewing& view) const {
+  const Eigen::Vector3d p_WR = view.X_WR.translation();
+  Eigen::Vector2d a = (config_.monitor_camera_m - p_WR).head<2>();
+  Eigen::Vector2d b = (view.p_WE - p_WR).head<2>();
+  if (a.norm() < 1e-9 || b.norm() < 1e-9) return 0;
+  const double cos_angle = std::clamp(a.normalized().dot(b.normalized()), -1.0, 1.0);
+  return std::acos(cos_angle) * kRadToDeg;
+}
+
+}  // namespace orbed::assistant

@@ -1,0 +1,126 @@
+#pragma once
+/// @file
+/// orbed-assistant: the emulated set-up assistant (assistant.h) on the bus. It moves the real arm
+/// joint by joint, from joint 1 to the flange, to where the target looks right to it, through
+/// IIWA_COMMAND, so the sim's speeds, limits and collision stops hold.
+///
+///   Subscribes: GUIDANCE (the target and the guidance mode: checked by guidance::CheckGuidance; the
+///               errors and the next joint it carries are NOT read: the person does not see numbers,
+///               only the virtual robot or the monitor's picture), IIWA_STATUS (the measured q,
+///               sim/iiwa_status_check.h), ROBOT_STATE (the true X_WR and the motion state),
+///               REGISTRATION (headset modes: the latest valid X_WV_mean is where the hologram is
+///               drawn), HMD_POSE and HMD_POSE_TRUTH (optional: the pair of one seq gives the eye,
+///               and the SLAM error A = X_WH_true · X_WH_est⁻¹ that moves the hologram in the world).
+///   Publishes:  IIWA_COMMAND (the measured q with the joint being moved set to where the person
+///               puts it; re-sent every command_resend_s until the arm is there and at rest, or
+///               stopped by a limit or a collision: then the joint stays where the sim stopped it).
+///
+/// The run: wait for GUIDANCE, IIWA_STATUS, ROBOT_STATE with the arm at rest and, in the headset
+/// modes, a REGISTRATION; then for each joint, looks_per_joint looks (the first over the whole
+/// range, the others within correction_window_deg), each followed by the move; then write the
+/// result file (--result) and, with --exit-when-done, stop. Execution time is the time model's
+/// (assistant.h), not the wall clock's: the sim moves at the iiwa's own speeds, a person's hand
+/// more slowly. A move that does not finish within move_timeout_s fails the run (exit 1).
+///
+/// Result file (JSON): mode, seed, person_scale, q_start_deg, q_target_deg, q_reached_deg (the
+/// measured joints at the end), error_deg (|reached − target| per joint), twisting (1/0 per joint,
+/// from GUIDANCE), ranges (per joint, at its first look: how many separate ranges looked right),
+/// execution_s, headset_pose (whether HMD poses were used).
+///
+/// Threading: everything on the Process::Run thread.
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <orbed/guidance_t.hpp>
+
+#include "procs/assistant/assistant.h"
+#include "procs/common/process.h"
+#include "sim/robot_model.h"
+
+namespace orbed::assistant {
+
+struct AssistantOptions {
+  std::string urdf_path;         ///< "" = the shipped model
+  std::string config_path;       ///< "" = procs/assistant/assistant.yaml
+  std::optional<uint64_t> seed;  ///< overrides the config's seed
+  std::string result_path;       ///< "" = no file
+  bool exit_when_done{false};
+  double step_period_s{0.02};
+  double command_resend_s{0.25};
+  double move_timeout_s{30.0};
+  /// A joint within this of where the person put it, with the arm at rest, has arrived [deg].
+  double arrived_deg{0.05};
+  std::string guidance_channel{"GUIDANCE"};
+  std::string iiwa_status_channel{"IIWA_STATUS"};
+  std::string robot_state_channel{"ROBOT_STATE"};
+  std::string registration_channel{"REGISTRATION"};
+  std::string hmd_pose_channel{"HMD_POSE"};
+  std::string hmd_pose_truth_channel{"HMD_POSE_TRUTH"};
+  std::string iiwa_command_channel{"IIWA_COMMAND"};
+};
+
+/// What a finished set-up reports (also the result file's content).
+struct SetupResult {
+  int8_t mode{0};
+  uint64_t seed{0};
+  double person_scale{1};
+  Eigen::VectorXd q_start_rad, q_target_rad, q_reached_rad;
+  std::vector<int> twisting;
+  std::vector<int> ranges;
+  double execution_s{0};
+  bool headset_pose{false};
+};
+std::string SetupResultJson(const SetupResult& result);
+
+class AssistantProcess {
+ public:
+  /// Throws std::runtime_error / std::invalid_argument for an unreadable model or config.
+  AssistantProcess(const CommonFlags& flags, const AssistantOptions& options);
+  int Run() { return process_.Run(); }
+  Process& process() { return process_; }
+  const std::optional<SetupResult>& result() const { return result_; }
+
+ private:
+  enum class Phase { kWait, kLook, kMove, kDone };
+  void Step();
+  void StartMove(double t_s);
+  void Finish();
+  Viewing CurrentView() const;
+
+  Process process_;
+  sim::RobotModel model_;
+  AssistantOptions options_;
+  Assistant assistant_;
+
+  // Latest inputs.
+  std::optional<orbed::guidance_t> guidance_;
+  Eigen::VectorXd q_rad_;
+  bool have_q_{false};
+  std::optional<Eigen::Isometry3d> X_WR_;
+  int8_t motion_state_{0};
+  std::optional<Eigen::Isometry3d> X_WV_;
+  std::optional<std::pair<int64_t, Eigen::Isometry3d>> X_WH_est_, X_WH_true_;  // (seq, pose)
+  std::optional<Eigen::Isometry3d> A_;   // X_WH_true · X_WH_est⁻¹ of the latest matching pair
+  std::optional<Eigen::Vector3d> p_WE_;  // the true head position of that pair
+
+  // The run.
+  Phase phase_{Phase::kWait};
+  int joint_{0};
+  int look_{0};
+  Eigen::VectorXd q_goal_;
+  double move_started_s_{0};
+  double last_command_s_{-1e9};
+  SetupResult partial_;
+  std::optional<SetupResult> result_;
+  bool waiting_logged_{false};
+};
+
+/// orbed-assistant's command line (flags: --help). Exit 0; 2 or CLI11's usage code (106-109) on bad
+/// arguments; 1 when it cannot start or a move times out.
+int RunAssistant(int argc, const char* const* argv, std::ostream& out, std::ostream& err);
+
+}  // namespace orbed::assistant
