@@ -12,6 +12,7 @@
 #include <orbed/registration_t.hpp>
 #include <orbed/robot_state_t.hpp>
 
+#include "base/format.h"
 #include "base/json.h"
 #include "base/replace_file.h"
 #include "base/source_paths.h"
@@ -132,6 +133,24 @@ AssistantProcess::AssistantProcess(const CommonFlags& flags, const AssistantOpti
   };
   process_.Subscribe<orbed::hmd_pose_t>(options_.hmd_pose_channel, on_pose(false));
   process_.Subscribe<orbed::hmd_pose_t>(options_.hmd_pose_truth_channel, on_pose(true));
+  process_.Subscribe<orbed::setup_task_t>(
+      options_.setup_task_channel,
+      [this](const orbed::setup_task_t& msg, const std::string& channel, int64_t) {
+        if (options_.once) return;
+        if (task_ && msg.request_id == task_->request_id) {
+          if (task_result_) process_.Publish(options_.setup_result_channel, *task_result_);  // a repeat
+          return;
+        }
+        const std::string problem = guidance::CheckSetupTask(msg, model_, 0.0);
+        if (!problem.empty()) return process_.Reject(channel + "/field", problem);
+        task_ = msg;
+        task_result_.reset();
+        phase_ = Phase::kWait;
+        waiting_logged_ = false;
+        ORBED_LOG(kInfo) << "assistant: task " << EscapeText(msg.task_id) << " (mode "
+                         << guidance::GuidanceModeName(msg.mode) << ")";
+      });
+  if (options_.once) phase_ = Phase::kWait;
   process_.AddTimer(
       options_.step_period_s, [this] { Step(); }, "step");
   ORBED_LOG(kInfo) << "assistant: person seed " << assistant_.config().seed << " (noise scale "
@@ -152,9 +171,18 @@ void AssistantProcess::Step() {
   const double t_s = SteadySeconds();
   const int n = model_.num_joints();
   switch (phase_) {
+    case Phase::kIdle:
+      return;
     case Phase::kWait: {
       const bool headset = guidance_ && guidance_->mode != orbed::guidance_t::MODE_FIXED_DISPLAY;
-      const bool ready = guidance_ && have_q_ && X_WR_ &&
+      bool shows_task = true;  // the GUIDANCE is this task's
+      if (task_ && guidance_) {
+        shows_task = guidance_->mode == task_->mode;
+        for (int i = 0; i < n && shows_task; ++i) {
+          shows_task = std::abs(guidance_->target_position[i] - task_->target_position[i]) < 1e-9;
+        }
+      }
+      const bool ready = guidance_ && shows_task && have_q_ && X_WR_ &&
                          motion_state_ == orbed::robot_state_t::MOTION_IDLE && (!headset || X_WV_);
       if (!ready) {
         if (guidance_ && headset && !X_WV_ && !waiting_logged_) {
@@ -255,29 +283,62 @@ void AssistantProcess::Finish() {
     worst = std::max(worst, std::abs(q_rad_[i] - partial_.q_target_rad[i]));
   ORBED_LOG(kInfo) << "assistant: done in " << partial_.execution_s << " s (time model); largest joint error "
                    << worst * kRadToDeg << " deg";
+  if (task_) {
+    orbed::setup_result_t r{};
+    r.utime = NowMicros();
+    r.request_id = task_->request_id;
+    r.task_id = task_->task_id;
+    r.mode = partial_.mode;
+    r.num_joints = static_cast<int32_t>(q_rad_.size());
+    for (int i = 0; i < q_rad_.size(); ++i) r.reached_position.push_back(q_rad_[i]);
+    r.ranges = partial_.ranges;
+    r.execution_s = partial_.execution_s;
+    r.person_scale = partial_.person_scale;
+    task_result_ = r;
+    process_.Publish(options_.setup_result_channel, r);
+  }
+  if (task_) {
+    orbed::setup_result_t r{};
+    r.utime = NowMicros();
+    r.request_id = task_->request_id;
+    r.task_id = task_->task_id;
+    r.mode = partial_.mode;
+    r.num_joints = static_cast<int32_t>(q_rad_.size());
+    for (int i = 0; i < q_rad_.size(); ++i) r.reached_position.push_back(q_rad_[i]);
+    r.ranges = partial_.ranges;
+    r.execution_s = partial_.execution_s;
+    r.person_scale = partial_.person_scale;
+    task_result_ = r;
+    process_.Publish(options_.setup_result_channel, r);
+  }
   if (!options_.result_path.empty()) {
     std::string error;
     if (!ReplaceFile(options_.result_path, SetupResultJson(*result_), &error)) {
       process_.Fail("cannot write " + options_.result_path + ": " + error);
     }
   }
-  if (options_.exit_when_done) process_.RequestStop();
+  if (options_.once) process_.RequestStop();
 }
 
 int RunAssistant(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
   CLI::App app{
       "orbed-assistant: the emulated set-up assistant. Follows GUIDANCE's target (the virtual robot\n"
       "or the fixed monitor's picture, never its numbers) and moves the real arm joint by joint with\n"
-      "IIWA_COMMAND to where the target looks right to it (procs/assistant/assistant.h)."};
+      "IIWA_COMMAND to where the target looks right to it (procs/assistant/assistant.h). Serves\n"
+      "SETUP_TASK (orbed-setup) with SETUP_RESULT, or with --once one set-up on its own."};
   CommonFlags common("orbed-assistant");
   AddCommonFlags(&app, &common);
   AssistantOptions options;
   uint64_t seed = 0;
   app.add_option("--config", options.config_path,
                  "Assistant parameters (default: procs/assistant/assistant.yaml in the source tree)");
-  auto* seed_flag = app.add_option("--person-seed", seed, "The person (overrides the config's seed)");
+  auto* seed_flag =
+      app.add_option("--person-seed", seed,
+                     "The person (overrides the config's seed; default $ORBED_USER_SEED if set)")
+          ->envname("ORBED_USER_SEED");
   app.add_option("--result", options.result_path, "Write the set-up's result (JSON) to this file when done");
-  app.add_flag("--exit-when-done", options.exit_when_done, "Stop after the set-up (exit 0)");
+  app.add_flag("--once", options.once,
+               "Carry out the first GUIDANCE's target without a SETUP_TASK, then stop (exit 0)");
   app.add_option("--move-timeout-s", options.move_timeout_s,
                  "A move not finished after this fails the run [s]")
       ->check(CLI::Range(0.1, 3600.0))
@@ -291,6 +352,8 @@ int RunAssistant(int argc, const char* const* argv, std::ostream& out, std::ostr
   app.add_option("--hmd-pose-channel", options.hmd_pose_channel)->capture_default_str();
   app.add_option("--hmd-pose-truth-channel", options.hmd_pose_truth_channel)->capture_default_str();
   app.add_option("--iiwa-command-channel", options.iiwa_command_channel)->capture_default_str();
+  app.add_option("--setup-task-channel", options.setup_task_channel)->capture_default_str();
+  app.add_option("--setup-result-channel", options.setup_result_channel)->capture_default_str();
   if (const auto code = ParseCommandLine(&app, common, argc, argv, out, err)) return *code;
   if (seed_flag->count() > 0) options.seed = seed;
   try {

@@ -15,12 +15,19 @@
 ///               puts it; re-sent every command_resend_s until the arm is there and at rest, or
 ///               stopped by a limit or a collision: then the joint stays where the sim stopped it).
 ///
-/// The run: wait for GUIDANCE, IIWA_STATUS, ROBOT_STATE with the arm at rest and, in the headset
+/// Tasks: by default the assistant serves SETUP_TASK (setup_task_t from orbed-setup, checked by
+/// guidance::CheckSetupTask): a task with a new request id starts a set-up (a repeat of the
+/// current one changes nothing; a repeat of a finished one gets its SETUP_RESULT again), and the
+/// set-up waits for a GUIDANCE showing that task's target and mode. With --once it carries out the
+/// first GUIDANCE's target without a task and stops.
+///
+/// A set-up: wait for GUIDANCE, IIWA_STATUS, ROBOT_STATE with the arm at rest and, in the headset
 /// modes, a REGISTRATION; then for each joint, looks_per_joint looks (the first over the whole
-/// range, the others within correction_window_deg), each followed by the move; then write the
-/// result file (--result) and, with --exit-when-done, stop. Execution time is the time model's
-/// (assistant.h), not the wall clock's: the sim moves at the iiwa's own speeds, a person's hand
-/// more slowly. A move that does not finish within move_timeout_s fails the run (exit 1).
+/// range, the others within correction_window_deg), each followed by the move; then publish
+/// SETUP_RESULT (setup_result_t) for a task, write the result file (--result) and, with --once, stop.
+/// Execution time is the time model's (assistant.h), not the wall clock's: the sim moves at the iiwa's own
+/// speeds, a person's hand more slowly. A move that does not finish within move_timeout_s fails the run (exit
+/// 1).
 ///
 /// Result file (JSON): mode, seed, person_scale, q_start_deg, q_target_deg, q_reached_deg (the
 /// measured joints at the end), error_deg (|reached − target| per joint), twisting (1/0 per joint,
@@ -36,6 +43,8 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <orbed/guidance_t.hpp>
+#include <orbed/setup_result_t.hpp>
+#include <orbed/setup_task_t.hpp>
 
 #include "procs/assistant/assistant.h"
 #include "procs/common/process.h"
@@ -48,7 +57,7 @@ struct AssistantOptions {
   std::string config_path;       ///< "" = procs/assistant/assistant.yaml
   std::optional<uint64_t> seed;  ///< overrides the config's seed
   std::string result_path;       ///< "" = no file
-  bool exit_when_done{false};
+  bool once{false};              ///< carry out GUIDANCE's target without a SETUP_TASK, then stop
   double step_period_s{0.02};
   double command_resend_s{0.25};
   double move_timeout_s{30.0};
@@ -61,6 +70,8 @@ struct AssistantOptions {
   std::string hmd_pose_channel{"HMD_POSE"};
   std::string hmd_pose_truth_channel{"HMD_POSE_TRUTH"};
   std::string iiwa_command_channel{"IIWA_COMMAND"};
+  std::string setup_task_channel{"SETUP_TASK"};
+  std::string setup_result_channel{"SETUP_RESULT"};
 };
 
 /// What a finished set-up reports (also the result file's content).
@@ -85,7 +96,7 @@ class AssistantProcess {
   const std::optional<SetupResult>& result() const { return result_; }
 
  private:
-  enum class Phase { kWait, kLook, kMove, kDone };
+  enum class Phase { kIdle, kWait, kLook, kMove, kDone };
   void Step();
   void StartMove(double t_s);
   void Finish();
@@ -108,7 +119,9 @@ class AssistantProcess {
   std::optional<Eigen::Vector3d> p_WE_;  // the true head position of that pair
 
   // The run.
-  Phase phase_{Phase::kWait};
+  Phase phase_{Phase::kIdle};
+  std::optional<orbed::setup_task_t> task_;           // the task being carried out or last finished
+  std::optional<orbed::setup_result_t> task_result_;  // its answer, once finished
   int joint_{0};
   int look_{0};
   Eigen::VectorXd q_goal_;

@@ -25,15 +25,18 @@ inline constexpr char kLandmark[] = "LANDMARK";                         // landm
 inline constexpr char kMisalignmentRequest[] = "MISALIGNMENT_REQUEST";  // misalignment_request_t
 inline constexpr char kMisalignment[] = "MISALIGNMENT";                 // misalignment_t
 inline constexpr char kGuidance[] = "GUIDANCE";                         // guidance_t, 30 Hz
+inline constexpr char kSetupTask[] = "SETUP_TASK";                      // setup_task_t, orbed-setup
+inline constexpr char kSetupResult[] = "SETUP_RESULT";                  // setup_result_t, orbed-assistant
 inline constexpr char kProcessStatus[] = "PROCESS_STATUS";              // process_status_t, 1 Hz each
 inline constexpr char kLoggerStatus[] = "LOGGER_STATUS";                // logger_status_t, 1 Hz
 
-/// Every channel above, in this order (tools that address channels by index: the fuzz targets).
+/// Every channel above (tools that address channels by index: the fuzz targets and their corpora;
+/// new channels are appended so that the indices of the old ones stay).
 inline constexpr const char* kAllChannels[] = {
     kIiwaStatus,      kIiwaCommand,    kRobotState,          kCollisionStatus, kPlanCheckRequest,
     kPlanCheckReply,  kHmdPose,        kHmdPoseTruth,        kHmdCamera,       kArView,
     kGazeRay,         kReflectiveView, kAlignmentTrial,      kRegistration,    kSessionControl,
     kLandmarkRequest, kLandmark,       kMisalignmentRequest, kMisalignment,    kGuidance,
-    kProcessStatus,   kLoggerStatus};
+    kProcessStatus,   kLoggerStatus,   kSetupTask,           kSetupResult};
 
 }  // namespace orbed::channels

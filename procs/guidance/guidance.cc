@@ -93,6 +93,47 @@ std::string CheckGuidance(const orbed::guidance_t& msg, const sim::RobotModel& m
   return "";
 }
 
+namespace {
+std::string CheckTaskHeader(int64_t request_id, const std::string& task_id, int8_t mode, int32_t num_joints,
+                            const sim::RobotModel& model, const std::string& what) {
+  if (request_id == 0) return what + ".request_id: 0 (a task needs an id)";
+  if (task_id.empty() || task_id.size() > 256) {
+    return what + ".task_id: " + std::to_string(task_id.size()) + " bytes, expected 1 ... 256";
+  }
+  return FirstError({CheckEnum(mode, 0, 2, what + ".mode"),
+                     CheckSize(num_joints, model.num_joints(), what + ".num_joints")});
+}
+}  // namespace
+
+std::string CheckSetupTask(const orbed::setup_task_t& msg, const sim::RobotModel& model, double slack_rad) {
+  const std::string header =
+      CheckTaskHeader(msg.request_id, msg.task_id, msg.mode, msg.num_joints, model, "SETUP_TASK");
+  if (!header.empty()) return header;
+  const std::string target = model.ValidateJointVector(
+      Eigen::Map<const Eigen::VectorXd>(msg.target_position.data(), msg.num_joints), slack_rad);
+  return target.empty() ? "" : "SETUP_TASK.target_position: " + target;
+}
+
+std::string CheckSetupResult(const orbed::setup_result_t& msg, const sim::RobotModel& model,
+                             double slack_rad) {
+  const std::string header =
+      CheckTaskHeader(msg.request_id, msg.task_id, msg.mode, msg.num_joints, model, "SETUP_RESULT");
+  if (!header.empty()) return header;
+  const std::string reached = model.ValidateJointVector(
+      Eigen::Map<const Eigen::VectorXd>(msg.reached_position.data(), msg.num_joints), slack_rad);
+  if (!reached.empty()) return "SETUP_RESULT.reached_position: " + reached;
+  for (int32_t r : msg.ranges) {
+    if (r < 0) return "SETUP_RESULT.ranges: " + std::to_string(r) + " < 0";
+  }
+  if (!(std::isfinite(msg.execution_s) && msg.execution_s >= 0 && msg.execution_s < 1e6)) {
+    return "SETUP_RESULT.execution_s: not a finite time in [0, 1e6) s";
+  }
+  if (!(std::isfinite(msg.person_scale) && msg.person_scale >= 0 && msg.person_scale < 1e3)) {
+    return "SETUP_RESULT.person_scale: not finite in [0, 1000)";
+  }
+  return "";
+}
+
 GuidanceCore::GuidanceCore(const sim::RobotModel& model, GuidanceTarget target)
     : target_(std::move(target)), kinds_(JointKinds(model)) {
   if (GuidanceModeName(target_.mode)[0] == '?') {

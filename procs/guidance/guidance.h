@@ -23,6 +23,8 @@
 
 #include <Eigen/Core>
 #include <orbed/guidance_t.hpp>
+#include <orbed/setup_result_t.hpp>
+#include <orbed/setup_task_t.hpp>
 
 #include "sim/robot_model.h"
 
@@ -58,6 +60,14 @@ Eigen::VectorXd ReadPlanTarget(const std::string& path, int number, int num_join
 /// vectors finite and within the joint limits (+ slack_rad). Returns "" or a one-line reason naming
 /// the field.
 std::string CheckGuidance(const orbed::guidance_t& msg, const sim::RobotModel& model, double slack_rad);
+
+/// The checks of the set-up study's messages (setup_task_t, setup_result_t), one definition each:
+/// request_id != 0, task_id of 1 ... 256 bytes, mode in range, num_joints equal to the model's, joint
+/// vectors within the joint limits (+ slack_rad); the result also ranges >= 0 and finite
+/// execution_s and person_scale >= 0. Returns "" or a one-line reason naming the field.
+std::string CheckSetupTask(const orbed::setup_task_t& msg, const sim::RobotModel& model, double slack_rad);
+std::string CheckSetupResult(const orbed::setup_result_t& msg, const sim::RobotModel& model,
+                             double slack_rad);
 
 class GuidanceCore {
  public:

@@ -6,7 +6,9 @@
 #include <CLI/CLI.hpp>
 #include <orbed/guidance_t.hpp>
 #include <orbed/iiwa_status_t.hpp>
+#include <orbed/setup_task_t.hpp>
 
+#include "base/format.h"
 #include "base/number_list.h"
 #include "base/source_paths.h"
 #include "base/units.h"
@@ -32,7 +34,9 @@ sim::RobotModel LoadModel(const std::string& urdf_path) {
 GuidanceProcess::GuidanceProcess(const CommonFlags& flags, const GuidanceOptions& options)
     : process_(flags),
       model_(LoadModel(options.urdf_path)),
-      core_(model_, options.target),
+      core_(options.target.q_target_rad.size() > 0
+                ? std::optional<GuidanceCore>(GuidanceCore(model_, options.target))
+                : std::nullopt),
       options_(options) {
   process_.Subscribe<orbed::iiwa_status_t>(
       options_.iiwa_status_channel,
@@ -47,12 +51,26 @@ GuidanceProcess::GuidanceProcess(const CommonFlags& flags, const GuidanceOptions
         have_q_ = true;
         q_received_utime_ = received_utime;
       });
+  process_.Subscribe<orbed::setup_task_t>(
+      options_.setup_task_channel,
+      [this](const orbed::setup_task_t& msg, const std::string& channel, int64_t) {
+        if (msg.request_id != 0 && msg.request_id == task_request_id_) return;  // a repeat
+        const std::string problem = CheckSetupTask(msg, model_, 0.0);
+        if (!problem.empty()) return process_.Reject(channel + "/field", problem);
+        GuidanceTarget target = options_.target;
+        target.mode = msg.mode;
+        target.q_target_rad = Eigen::Map<const Eigen::VectorXd>(msg.target_position.data(), msg.num_joints);
+        core_.emplace(model_, target);
+        task_request_id_ = msg.request_id;
+        ORBED_LOG(kInfo) << "guidance: task " << EscapeText(msg.task_id) << ", mode "
+                         << GuidanceModeName(msg.mode);
+      });
   process_.AddTimer(
       1.0 / options_.rate_hz,
       [this] {
         const auto guidance = GuidanceNow(NowMicros());
         if (guidance) process_.Publish(options_.guidance_channel, *guidance);
-        if (have_q_ && !guidance != stale_logged_) {
+        if (core_ && have_q_ && !guidance != stale_logged_) {
           stale_logged_ = !guidance;
           if (stale_logged_) {
             ORBED_LOG(kWarn) << "no IIWA_STATUS for " << options_.stale_after_s << " s: GUIDANCE paused";
@@ -62,6 +80,10 @@ GuidanceProcess::GuidanceProcess(const CommonFlags& flags, const GuidanceOptions
         }
       },
       options_.guidance_channel);
+  if (!core_) {
+    ORBED_LOG(kInfo) << "guidance: no target yet; waiting for SETUP_TASK on " << options_.setup_task_channel;
+    return;
+  }
   std::string target;
   for (int i = 0; i < options_.target.q_target_rad.size(); ++i) {
     target += (i ? ", " : "") +
@@ -74,15 +96,16 @@ GuidanceProcess::GuidanceProcess(const CommonFlags& flags, const GuidanceOptions
 
 std::optional<orbed::guidance_t> GuidanceProcess::GuidanceNow(int64_t utime) const {
   const int64_t stale_after_us = static_cast<int64_t>(options_.stale_after_s * 1e6);
-  if (!have_q_ || utime - q_received_utime_ > stale_after_us) return std::nullopt;
-  return core_.Compute(q_rad_, utime);
+  if (!core_ || !have_q_ || utime - q_received_utime_ > stale_after_us) return std::nullopt;
+  return core_->Compute(q_rad_, utime);
 }
 
 int RunGuidance(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
   CLI::App app{
       "orbed-guidance: joint-by-joint set-up guidance toward a target configuration. Subscribes\n"
       "IIWA_STATUS; publishes GUIDANCE (target and current joints, per-joint error [deg], the next\n"
-      "joint to move from the base outwards, twisting or revolving per joint, done) at --rate-hz."};
+      "joint to move from the base outwards, twisting or revolving per joint, done) at --rate-hz.\n"
+      "Without --target-deg or --plan it waits for a target on SETUP_TASK (orbed-setup)."};
   CommonFlags common("orbed-guidance");
   AddCommonFlags(&app, &common);
   GuidanceOptions options;
@@ -114,11 +137,8 @@ int RunGuidance(int argc, const char* const* argv, std::ostream& out, std::ostre
                  "Robot URDF (default: sim/models/iiwa7.urdf under $ORBED_SOURCE_DIR, else the source tree)");
   app.add_option("--iiwa-status-channel", options.iiwa_status_channel)->capture_default_str();
   app.add_option("--guidance-channel", options.guidance_channel)->capture_default_str();
+  app.add_option("--setup-task-channel", options.setup_task_channel)->capture_default_str();
   if (const auto code = ParseCommandLine(&app, common, argc, argv, out, err)) return *code;
-  if (target_deg.empty() && plan_path.empty()) {
-    err << "orbed-guidance: a target is needed: --target-deg q1,...,q7 or --plan FILE [--target N]\n";
-    return 2;
-  }
   try {
     options.target.mode = GuidanceModeFromName(mode);
     if (!target_deg.empty()) {

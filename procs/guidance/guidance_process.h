@@ -6,6 +6,9 @@
 /// while the latest is older than stale_after_s (a stopped arm's last pose is not guidance; logged
 /// when it goes stale and when it is fresh again).
 ///
+/// SETUP_TASK (setup_task_t, from orbed-setup; checked by CheckSetupTask) replaces the target and
+/// the mode, keeping the tolerance; a repeated request id changes nothing.
+///
 /// Threading: everything on the Process::Run thread.
 
 #include <optional>
@@ -21,12 +24,14 @@ namespace orbed::guidance {
 
 struct GuidanceOptions {
   std::string urdf_path;  ///< "" = the shipped model
-  GuidanceTarget target;  ///< q_target_rad filled from target_deg by the command line
+  /// q_target_rad filled by the command line; empty: no GUIDANCE until a SETUP_TASK gives one.
+  GuidanceTarget target;
   double rate_hz{30.0};
   /// No GUIDANCE from an IIWA_STATUS received longer ago than this [s] (the sim sends 200 Hz).
   double stale_after_s{0.5};
   std::string iiwa_status_channel{"IIWA_STATUS"};
   std::string guidance_channel{"GUIDANCE"};
+  std::string setup_task_channel{"SETUP_TASK"};
 };
 
 class GuidanceProcess {
@@ -42,17 +47,18 @@ class GuidanceProcess {
  private:
   Process process_;
   sim::RobotModel model_;
-  GuidanceCore core_;
+  std::optional<GuidanceCore> core_;  ///< none until a target (command line or SETUP_TASK)
   GuidanceOptions options_;
   Eigen::VectorXd q_rad_;
   bool have_q_{false};
   int64_t q_received_utime_{0};
   bool stale_logged_{false};
+  int64_t task_request_id_{0};
 };
 
 /// orbed-guidance's command line (flags: --help): the target from --target-deg, or from --plan FILE
-/// [--target N] (orbed-robot plan). Exit 0; on bad arguments 2 or CLI11's usage code (106-109); 1
-/// when it cannot start (an unreadable plan or model, a target outside the limits).
+/// [--target N] (orbed-robot plan), or none (then from SETUP_TASK). Exit 0; on bad arguments 2 or CLI11's
+/// usage code (106-109); 1 when it cannot start (an unreadable plan or model, a target outside the limits).
 int RunGuidance(int argc, const char* const* argv, std::ostream& out, std::ostream& err);
 
 }  // namespace orbed::guidance

@@ -6,7 +6,9 @@
 //   - the process on memq://: GUIDANCE for the last good IIWA_STATUS, bad ones counted by class.
 #include "procs/guidance/guidance.h"
 
+#include <cmath>
 #include <fstream>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -172,13 +174,16 @@ TEST(GuidancePlan, TargetsAreReadFromAnOrbedRobotPlanAndCheckedAsInput) {
   const std::string wild = WritePlan("wild.json", R"({"targets": [{"q_deg": [0, 30, 0, 400, 0, 0, 0]}]})");
   EXPECT_NE(error(wild, 1).find("targets[0].q_deg"), std::string::npos) << error(wild, 1);
   EXPECT_NE(error(WritePlan("garbage.json", "{not json"), 1), "(accepted)");
-  // The command with a plan runs; with neither or both targets it refuses.
+  // The command with a plan runs, and with neither (then it waits for SETUP_TASK); with both it
+  // refuses.
   EXPECT_EQ(
       test::RunCommand(RunGuidance, "orbed-guidance",
                        {"--plan", plan, "--target", "2", "--lcm-url", "memq://", "--duration-s", "0.05"})
           .code,
       0);
-  EXPECT_EQ(test::RunCommand(RunGuidance, "orbed-guidance", {"--lcm-url", "memq://"}).code, 2);
+  EXPECT_EQ(
+      test::RunCommand(RunGuidance, "orbed-guidance", {"--lcm-url", "memq://", "--duration-s", "0.05"}).code,
+      0);
   const test::CommandRun both =
       test::RunCommand(RunGuidance, "orbed-guidance",
                        {"--plan", plan, "--target-deg", "0,0,0,0,0,0,0", "--lcm-url", "memq://"});
@@ -198,6 +203,52 @@ TEST(GuidanceCli, BadArgumentsExitTwoAndNameTheFlag) {
                        {"--target-deg", "0,130,0,0,0,0,0", "--lcm-url", "memq://", "--duration-s", "0.05"});
   EXPECT_EQ(r.code, 1);
   EXPECT_NE(r.err.find("iiwa_joint_2"), std::string::npos) << r.err;
+}
+
+}  // namespace
+}  // namespace orbed::guidance
+
+namespace orbed::guidance {
+namespace {
+
+// The set-up study's two messages: each field out of its range is named.
+TEST(SetupMessages, ChecksNameTheField) {
+  const sim::RobotModel model =
+      sim::RobotModel::LoadFile(SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath));
+  orbed::setup_task_t task{};
+  task.request_id = 7;
+  task.task_id = "u1-ar-1";
+  task.mode = orbed::guidance_t::MODE_AR;
+  task.num_joints = 7;
+  task.target_position.assign(7, 0.1);
+  EXPECT_EQ(CheckSetupTask(task, model, 0.0), "");
+  auto bad = [&](auto mutate, const std::string& field) {
+    orbed::setup_task_t t = task;
+    mutate(t);
+    const std::string reason = CheckSetupTask(t, model, 0.0);
+    EXPECT_NE(reason.find(field), std::string::npos) << reason;
+  };
+  bad([](orbed::setup_task_t& t) { t.request_id = 0; }, "request_id");
+  bad([](orbed::setup_task_t& t) { t.task_id = ""; }, "task_id");
+  bad([](orbed::setup_task_t& t) { t.task_id = std::string(257, 'x'); }, "task_id");
+  bad([](orbed::setup_task_t& t) { t.mode = 3; }, "mode");
+  bad([](orbed::setup_task_t& t) { t.target_position[1] = 2.2; }, "iiwa_joint_2");  // 126 deg > 120
+  bad([](orbed::setup_task_t& t) { t.target_position[3] = std::nan(""); }, "target_position");
+
+  orbed::setup_result_t result{};
+  result.request_id = 7;
+  result.task_id = "u1-ar-1";
+  result.num_joints = 7;
+  result.reached_position.assign(7, 0.0);
+  result.ranges.assign(7, 1);
+  result.execution_s = 80;
+  result.person_scale = 1.2;
+  EXPECT_EQ(CheckSetupResult(result, model, 0.0), "");
+  result.ranges[2] = -1;
+  EXPECT_NE(CheckSetupResult(result, model, 0.0).find("ranges"), std::string::npos);
+  result.ranges[2] = 1;
+  result.execution_s = std::numeric_limits<double>::infinity();
+  EXPECT_NE(CheckSetupResult(result, model, 0.0).find("execution_s"), std::string::npos);
 }
 
 }  // namespace

@@ -1,0 +1,349 @@
+#include "procs/setup/setup_conductor.h"
+
+#include <cmath>
+#include <stdexcept>
+#include <utility>
+
+#include <orbed/guidance_t.hpp>
+
+#include "base/format.h"
+#include "base/json.h"
+#include "base/units.h"
+#include "procs/common/validation.h"
+#include "procs/guidance/guidance.h"
+
+namespace orbed::setup {
+namespace {
+
+constexpr int kMaxLinks = 64;
+
+std::string ModeName(int8_t mode) { return mode >= 0 && mode <= 2 ? kModeNames[mode] : "?"; }
+
+}  // namespace
+
+std::string SetupRunJson(const SetupRun& run, bool partial) {
+  JsonWriter json(2);
+  json.BeginObject();
+  json.Key("user").String(run.user);
+  json.Key("run_id").String(run.run_id);
+  json.Key("status").String(partial ? "partial" : (run.ok ? "ok" : "failed"));
+  json.Key("error").String(run.error);
+  json.Key("order").BeginArray();
+  for (const std::string& m : run.order) json.String(m);
+  json.EndArray();
+  json.Key("setups").BeginArray();
+  for (const SetupRecord& r : run.setups) {
+    json.BeginObject();
+    json.Key("task_id").String(r.task_id);
+    json.Key("mode").String(ModeName(r.mode));
+    json.Key("order").Int(r.order);
+    json.Key("target").Int(r.target);
+    json.Key("target_deg").Array(r.target_deg);
+    json.Key("reached_deg").Array(r.reached_deg);
+    json.Key("assistant_reached_deg").Array(r.assistant_reached_deg);
+    std::vector<double> error;
+    for (size_t i = 0; i < r.reached_deg.size(); ++i)
+      error.push_back(std::abs(r.reached_deg[i] - r.target_deg[i]));
+    json.Key("error_deg").Array(error);
+    json.Key("twisting").Array(r.twisting);
+    json.Key("ranges").Array(r.ranges);
+    json.Key("execution_s").Number(r.execution_s);
+    json.Key("alignment_s");
+    if (r.alignment_s) {
+      json.Number(*r.alignment_s);
+    } else {
+      json.Null();
+    }
+    json.Key("person_scale").Number(r.person_scale);
+    json.Key("alignment");
+    if (r.alignment && r.alignment->mean) {
+      json.BeginObject();
+      json.Key("session_id").String(r.alignment->session_id);
+      json.Key("trials").Int(static_cast<int64_t>(r.alignment->trials.size()));
+      json.Key("translation_error_mm").Number(r.alignment->mean->errors.translation_error_mm);
+      json.Key("rotation_error_deg").Number(r.alignment->mean->errors.rotation_error_deg);
+      json.Key("misalignment_mm").Number(r.alignment->mean->errors.misalignment_mm);
+      json.EndObject();
+    } else {
+      json.Null();
+    }
+    json.EndObject();
+  }
+  json.EndArray();
+  json.EndObject();
+  return json.str() + "\n";
+}
+
+SetupConductor::SetupConductor(SetupOptions options, sim::RobotModel model)
+    : options_(std::move(options)), model_(std::make_unique<const sim::RobotModel>(std::move(model))) {
+  if (options_.modes.empty()) throw std::invalid_argument("set-up study: no modes");
+  for (size_t i = 0; i < options_.modes.size(); ++i) {
+    if (options_.modes[i] < 0 || options_.modes[i] > 2)
+      throw std::invalid_argument("set-up study: mode out of range");
+    for (size_t j = 0; j < i; ++j) {
+      if (options_.modes[j] == options_.modes[i]) {
+        throw std::invalid_argument("set-up study: mode " + ModeName(options_.modes[i]) + " twice");
+      }
+    }
+  }
+  if (options_.targets_deg.empty()) throw std::invalid_argument("set-up study: no targets");
+  auto check = [&](const std::vector<double>& q_deg, const std::string& what) {
+    if (static_cast<int>(q_deg.size()) != model_->num_joints()) {
+      throw std::invalid_argument("set-up study: " + what + " has " + std::to_string(q_deg.size()) +
+                                  " joints, the robot " + std::to_string(model_->num_joints()));
+    }
+    Eigen::VectorXd q(q_deg.size());
+    for (size_t i = 0; i < q_deg.size(); ++i) q[i] = q_deg[i] * kDegToRad;
+    const std::string limits = model_->ValidateJointVector(q);
+    if (!limits.empty()) throw std::invalid_argument("set-up study: " + what + ": " + limits);
+  };
+  for (size_t k = 0; k < options_.targets_deg.size(); ++k)
+    check(options_.targets_deg[k], "target " + std::to_string(k + 1));
+  check(options_.start_deg, "the start");
+  for (int8_t kind : guidance::JointKinds(*model_))
+    twisting_.push_back(kind == orbed::guidance_t::JOINT_TWIST);
+  run_.user = options_.user;
+  run_.run_id = options_.run_id;
+  for (int8_t m : options_.modes) run_.order.push_back(ModeName(m));
+}
+
+SetupConductor::~SetupConductor() = default;
+
+void SetupConductor::Begin(const ConductorTime& now) {
+  if (phase_ == Phase::kNotStarted) throw std::logic_error("SetupConductor: Start() first");
+  now_ = now;
+}
+
+SetupConductor::Actions SetupConductor::Take() {
+  Actions out = std::move(actions_);
+  actions_ = Actions{};
+  return out;
+}
+
+std::string SetupConductor::TaskId() const {
+  return options_.user + "-" + ModeName(Mode()) + "-" + std::to_string(target_index_ + 1);
+}
+
+SetupConductor::Actions SetupConductor::Start(const ConductorTime& now) {
+  if (phase_ != Phase::kNotStarted) throw std::logic_error("SetupConductor: Start() twice");
+  now_ = now;
+  request_id_base_ = now.utime;
+  phase_ = Phase::kWaitRobot;
+  phase_start_s_ = now.t_s;
+  std::string order;
+  for (const std::string& m : run_.order) order += (order.empty() ? "" : ", ") + m;
+  actions_.progress.push_back("set-up study, user " + options_.user + ": modes " + order + ", " +
+                              std::to_string(options_.targets_deg.size()) + " target(s) each");
+  return Take();
+}
+
+void SetupConductor::StartTask() {
+  alignment_result_.reset();
+  if (Mode() == orbed::guidance_t::MODE_FIXED_DISPLAY) return EnterPark();
+  scenario::ConductorOptions o;
+  o.config = options_.alignment;
+  const bool reflective = Mode() == orbed::guidance_t::MODE_AR_REFLECTIVE;
+  o.config.modes = {viraal::ModeFromName(reflective ? "ar_reflective" : "ar", options_.reflective_mirrors)};
+  o.run_id = options_.run_id + "-" + TaskId();
+  o.startup_timeout_s = options_.startup_timeout_s;
+  o.move_timeout_s = options_.move_timeout_s;
+  alignment_ = std::make_unique<scenario::ViraalConductor>(o, *model_);
+  phase_ = Phase::kAlign;
+  phase_start_s_ = now_.t_s;
+  actions_.progress.push_back(TaskId() + ": aligning " + std::to_string(o.config.trials) + " times (" +
+                              ModeName(Mode()) + ")");
+  ConductorActions started = alignment_->Start(now_);
+  actions_.viraal.insert(actions_.viraal.end(), started.begin(), started.end());
+  // The conductor waits for a ROBOT_STATE: give it the latest at once.
+  if (robot_state_) {
+    ConductorActions more = alignment_->OnRobotState(*robot_state_, now_);
+    actions_.viraal.insert(actions_.viraal.end(), more.begin(), more.end());
+  }
+}
+
+void SetupConductor::EnterPark() {
+  phase_ = Phase::kPark;
+  phase_start_s_ = now_.t_s;
+  last_send_s_ = -1e9;
+  Step();
+}
+
+void SetupConductor::SendTask() {
+  actions_.publish.push_back({options_.setup_task_channel, task_});
+  last_send_s_ = now_.t_s;
+}
+
+void SetupConductor::Fail(const std::string& reason) {
+  run_.ok = false;
+  run_.error = reason;
+  phase_ = Phase::kDone;
+  actions_.progress.push_back("FAILED: " + reason);
+}
+
+void SetupConductor::Step() {
+  switch (phase_) {
+    case Phase::kNotStarted:
+    case Phase::kDone:
+      return;
+    case Phase::kWaitRobot:
+      if (robot_state_) return StartTask();
+      if (now_.t_s - phase_start_s_ > options_.startup_timeout_s) {
+        Fail("no ROBOT_STATE within " + Fixed(options_.startup_timeout_s, 1) +
+             " s: is orbed-iiwa-sim running?");
+      }
+      return;
+    case Phase::kAlign: {
+      if (!alignment_->done()) return;
+      if (alignment_->status() != scenario::ViraalConductor::Status::kSucceeded) {
+        return Fail(TaskId() + ": the alignment failed: " + alignment_->results().error);
+      }
+      alignment_result_ = alignment_->results().sessions.back();
+      alignment_.reset();
+      return EnterPark();
+    }
+    case Phase::kPark: {
+      bool there = robot_state_ && robot_state_->motion_state == orbed::robot_state_t::MOTION_IDLE;
+      for (size_t i = 0; there && i < options_.start_deg.size(); ++i) {
+        there = std::abs(robot_state_->joint_position[i] * kRadToDeg - options_.start_deg[i]) <
+                options_.tolerance_deg;
+      }
+      if (there) {
+        task_ = orbed::setup_task_t{};
+        task_.utime = now_.utime;
+        task_.request_id = request_id_base_ + next_request_id_++;
+        task_.task_id = TaskId();
+        task_.mode = Mode();
+        task_.num_joints = model_->num_joints();
+        for (double q : options_.targets_deg[target_index_]) task_.target_position.push_back(q * kDegToRad);
+        phase_ = Phase::kTask;
+        phase_start_s_ = now_.t_s;
+        actions_.progress.push_back(TaskId() + ": set-up (SETUP_TASK to orbed-assistant)");
+        return SendTask();
+      }
+      if (now_.t_s - phase_start_s_ > options_.move_timeout_s) {
+        return Fail(TaskId() + ": the arm did not reach the start within " +
+                    Fixed(options_.move_timeout_s, 1) + " s (orbed-iiwa-sim)");
+      }
+      if (now_.t_s - last_send_s_ >= options_.command_resend_s) {
+        orbed::iiwa_command_t command{};
+        command.utime = now_.utime;
+        command.num_joints = model_->num_joints();
+        for (double q : options_.start_deg) command.joint_position.push_back(q * kDegToRad);
+        command.num_torques = 0;
+        actions_.publish.push_back({options_.iiwa_command_channel, command});
+        last_send_s_ = now_.t_s;
+      }
+      return;
+    }
+    case Phase::kTask:
+      if (now_.t_s - phase_start_s_ > options_.task_timeout_s) {
+        return Fail(TaskId() + ": no SETUP_RESULT within " + Fixed(options_.task_timeout_s, 1) +
+                    " s: is orbed-assistant running (and orbed-guidance)?");
+      }
+      if (now_.t_s - last_send_s_ >= options_.task_resend_s) SendTask();
+      return;
+  }
+}
+
+SetupConductor::Actions SetupConductor::OnRobotState(const orbed::robot_state_t& msg,
+                                                     const ConductorTime& now) {
+  Begin(now);
+  const std::string problem =
+      FirstError({CheckPose(msg.X_WR, "ROBOT_STATE.X_WR"),
+                  CheckSize(msg.num_joints, model_->num_joints(), "ROBOT_STATE.num_joints"),
+                  CheckFinite(msg.joint_position, "ROBOT_STATE.joint_position"),
+                  CheckLength(msg.num_links, msg.X_RL.size(), kMaxLinks, "ROBOT_STATE.num_links"),
+                  CheckEnum(msg.motion_state, orbed::robot_state_t::MOTION_IDLE,
+                            orbed::robot_state_t::MOTION_IN_COLLISION, "ROBOT_STATE.motion_state")});
+  if (!problem.empty()) {
+    actions_.refusals.push_back({options_.robot_state_channel + "/field", problem});
+    return Take();
+  }
+  robot_state_ = msg;
+  if (phase_ == Phase::kAlign) {
+    ConductorActions more = alignment_->OnRobotState(msg, now);
+    actions_.viraal.insert(actions_.viraal.end(), more.begin(), more.end());
+  }
+  Step();
+  return Take();
+}
+
+#define ORBED_FORWARD(Method, Type)                                                           \
+  SetupConductor::Actions SetupConductor::Method(const Type& msg, const ConductorTime& now) { \
+    Begin(now);                                                                               \
+    if (phase_ == Phase::kAlign) {                                                            \
+      ConductorActions more = alignment_->Method(msg, now);                                   \
+      actions_.viraal.insert(actions_.viraal.end(), more.begin(), more.end());                \
+      Step();                                                                                 \
+    }                                                                                         \
+    return Take();                                                                            \
+  }
+ORBED_FORWARD(OnPlanCheckReply, orbed::plan_check_reply_t)
+ORBED_FORWARD(OnTrial, orbed::alignment_trial_t)
+ORBED_FORWARD(OnRegistration, orbed::registration_t)
+ORBED_FORWARD(OnMisalignment, orbed::misalignment_t)
+#undef ORBED_FORWARD
+
+SetupConductor::Actions SetupConductor::OnSetupResult(const orbed::setup_result_t& msg,
+                                                      const ConductorTime& now) {
+  Begin(now);
+  if (phase_ != Phase::kTask || msg.request_id != task_.request_id) return Take();  // not ours, or a repeat
+  const std::string problem = guidance::CheckSetupResult(msg, *model_, 0.01);
+  if (!problem.empty()) {
+    actions_.refusals.push_back({options_.setup_result_channel + "/field", problem});
+    return Take();
+  }
+  SetupRecord r;
+  r.task_id = task_.task_id;
+  r.mode = Mode();
+  r.order = static_cast<int>(mode_index_) + 1;
+  r.target = static_cast<int>(target_index_) + 1;
+  r.target_deg = options_.targets_deg[target_index_];
+  for (double q : robot_state_->joint_position) r.reached_deg.push_back(q * kRadToDeg);
+  for (double q : msg.reached_position) r.assistant_reached_deg.push_back(q * kRadToDeg);
+  r.twisting = twisting_;
+  r.ranges.assign(msg.ranges.begin(), msg.ranges.end());
+  r.execution_s = msg.execution_s;
+  r.person_scale = msg.person_scale;
+  if (alignment_result_) {
+    double total = 0;
+    for (const viraal::TrialResult& t : alignment_result_->trials) total += t.user_duration_s;
+    r.alignment_s = total;
+    r.alignment = alignment_result_;
+  }
+  double worst = 0;
+  for (size_t i = 0; i < r.reached_deg.size(); ++i)
+    worst = std::max(worst, std::abs(r.reached_deg[i] - r.target_deg[i]));
+  actions_.progress.push_back(r.task_id + ": done, largest joint error " + Fixed(worst, 1) +
+                              " deg, execution " + Fixed(r.execution_s, 0) + " s");
+  run_.setups.push_back(std::move(r));
+  if (++target_index_ >= options_.targets_deg.size()) {
+    target_index_ = 0;
+    ++mode_index_;
+  }
+  if (mode_index_ >= options_.modes.size()) {
+    run_.ok = true;
+    phase_ = Phase::kDone;
+    return Take();
+  }
+  StartTask();
+  return Take();
+}
+
+SetupConductor::Actions SetupConductor::Tick(const ConductorTime& now) {
+  Begin(now);
+  if (phase_ == Phase::kAlign) {
+    ConductorActions more = alignment_->Tick(now);
+    actions_.viraal.insert(actions_.viraal.end(), more.begin(), more.end());
+  }
+  Step();
+  return Take();
+}
+
+SetupConductor::Actions SetupConductor::Abort(const std::string& reason, const ConductorTime& now) {
+  Begin(now);
+  if (phase_ != Phase::kDone) Fail(reason);
+  return Take();
+}
+
+}  // namespace orbed::setup

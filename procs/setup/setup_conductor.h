@@ -1,0 +1,176 @@
+#pragma once
+/// @file
+/// The conductor of one user's part of the paper's robot set-up study (Sec. IV-B, Tables 2-4) as a
+/// phase machine without a bus or a clock. SetupProcess (setup_process.h) feeds it the decoded
+/// messages and the time and publishes what it asks for.
+///
+/// The run, for each mode of the user's order (ar_reflective, ar, fixed in some order) and each
+/// target k = 1 .. K of the plan:
+///   kAlign (ar, ar_reflective only): the user aligns N times in that mode and the registration
+///     server's SE(3) mean is applied (the paper: "before each AR target the user aligns three
+///     times"): a ViraalConductor (procs/scenario/viraal_conductor.h) with the alignment protocol,
+///     that mode only and session "<run_id>-<task_id>" runs to its end; its every input and tick
+///     are forwarded to it, its actions passed on. Its failure fails the run.
+///   kPark: IIWA_COMMAND the start configuration (re-sent every command_resend_s) until every joint
+///     is within tolerance_deg and the motion is IDLE: the experimenter parks the arm.
+///   kTask: SETUP_TASK (task "<user>-<mode>-<k>", the target, the mode; a new request id) re-sent
+///     every task_resend_s until the SETUP_RESULT with its id comes back (from orbed-assistant);
+///     orbed-guidance shows the target. The record: the target, the joints the sim measured when
+///     the answer came (ROBOT_STATE: the truth, not the assistant's word), the assistant's execution
+///     time and ranges, the alignment's time (the sum of the N trials' duration_s) and its mean's
+///     errors against the truth.
+/// A phase that waits longer than its timeout fails the run with a one-line reason naming the
+/// process that did not answer.
+///
+/// Inputs are checked (guidance::CheckSetupResult; ROBOT_STATE's pose, joint count and motion
+/// enum); a bad one is refused (a Refusal, key "<channel>/field") and changes nothing. Results of
+/// other request ids are ignored.
+///
+/// Time: ConductorTime (viraal_conductor.h): t_s monotonic [s], utime wall clock [µs]. Threading:
+/// one thread makes every call.
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include <orbed/iiwa_command_t.hpp>
+#include <orbed/robot_state_t.hpp>
+#include <orbed/setup_result_t.hpp>
+#include <orbed/setup_task_t.hpp>
+
+#include "procs/scenario/viraal_conductor.h"
+#include "sim/robot_model.h"
+#include "viraal/protocol.h"
+#include "viraal/results.h"
+
+namespace orbed::setup {
+
+using scenario::ConductorActions;
+using scenario::ConductorTime;
+
+/// The set-up study's mode names, as in STUDY.md (guidance_t::MODE_* order).
+inline constexpr const char* kModeNames[] = {"ar", "ar_reflective", "fixed"};
+
+struct SetupOptions {
+  std::string user{"u1"};
+  std::string run_id{"setup"};
+  /// guidance_t::MODE_* in the user's order (each at most once).
+  std::vector<int8_t> modes;
+  /// The targets [deg] (the plan), in order; the start configuration [deg].
+  std::vector<std::vector<double>> targets_deg;
+  std::vector<double> start_deg;
+  /// The alignment protocol of the headset modes (its modes are replaced per task; its trials are N).
+  viraal::ScenarioConfig alignment;
+  int reflective_mirrors{1};
+  double tolerance_deg{0.1};
+  double startup_timeout_s{10.0};
+  double move_timeout_s{30.0};
+  double task_timeout_s{600.0};
+  double command_resend_s{0.25};
+  double task_resend_s{1.0};
+  std::string robot_state_channel{"ROBOT_STATE"};
+  std::string iiwa_command_channel{"IIWA_COMMAND"};
+  std::string setup_task_channel{"SETUP_TASK"};
+  std::string setup_result_channel{"SETUP_RESULT"};
+};
+
+/// One finished set-up.
+struct SetupRecord {
+  std::string task_id;
+  int8_t mode{0};
+  int order{0};   ///< the mode's place in the user's order, 1-based
+  int target{0};  ///< 1-based
+  std::vector<double> target_deg, reached_deg, assistant_reached_deg;
+  std::vector<int> twisting;  ///< 1 for a twisting joint (guidance::JointKinds)
+  std::vector<int> ranges;
+  double execution_s{0};
+  std::optional<double> alignment_s;  ///< headset modes: the N trials' time
+  std::optional<viraal::SessionResult> alignment;
+  double person_scale{1};
+};
+
+struct SetupRun {
+  std::string user, run_id;
+  bool ok{false};
+  std::string error;
+  std::vector<std::string> order;  ///< mode names
+  std::vector<SetupRecord> setups;
+};
+/// setup_results.json's text: {"user", "run_id", "status": "ok" | "failed" | "partial", "error",
+/// "order", "setups": [{task_id, mode, order, target, target_deg, reached_deg,
+/// assistant_reached_deg, error_deg, twisting, ranges, execution_s, alignment_s (null for fixed),
+/// person_scale, alignment: null | {trials, translation_error_mm, rotation_error_deg,
+/// misalignment_mm} of the mean}]}.
+std::string SetupRunJson(const SetupRun& run, bool partial);
+
+/// A message of this conductor's own to publish.
+struct SetupPublication {
+  std::string channel;
+  std::variant<orbed::iiwa_command_t, orbed::setup_task_t> message;
+};
+
+class SetupConductor {
+ public:
+  enum class Phase { kNotStarted, kWaitRobot, kAlign, kPark, kTask, kDone };
+
+  /// Throws std::invalid_argument for empty modes or targets, a mode twice or out of range,
+  /// targets or start outside the joint limits or of the wrong size.
+  SetupConductor(SetupOptions options, sim::RobotModel model);
+  ~SetupConductor();
+
+  /// Every call returns the nested ViRAAl conductor's actions (alignment) and appends this
+  /// conductor's own publications, progress lines and refusals to `own`.
+  struct Actions {
+    ConductorActions viraal;  ///< publications, progress, logs, refusals of the alignment
+    std::vector<SetupPublication> publish;
+    std::vector<std::string> progress;
+    std::vector<scenario::Refusal> refusals;
+  };
+  Actions Start(const ConductorTime& now);
+  Actions OnRobotState(const orbed::robot_state_t& msg, const ConductorTime& now);
+  Actions OnPlanCheckReply(const orbed::plan_check_reply_t& msg, const ConductorTime& now);
+  Actions OnTrial(const orbed::alignment_trial_t& msg, const ConductorTime& now);
+  Actions OnRegistration(const orbed::registration_t& msg, const ConductorTime& now);
+  Actions OnMisalignment(const orbed::misalignment_t& msg, const ConductorTime& now);
+  Actions OnSetupResult(const orbed::setup_result_t& msg, const ConductorTime& now);
+  Actions Tick(const ConductorTime& now);
+  Actions Abort(const std::string& reason, const ConductorTime& now);
+
+  Phase phase() const { return phase_; }
+  bool done() const { return phase_ == Phase::kDone; }
+  const SetupRun& run() const { return run_; }
+
+ private:
+  void Begin(const ConductorTime& now);
+  Actions Take();
+  void Step();
+  void StartTask();  // enters kAlign or kPark for task_index_
+  void EnterPark();
+  void SendTask();
+  void Fail(const std::string& reason);
+  std::string TaskId() const;
+  int8_t Mode() const { return options_.modes[mode_index_]; }
+
+  SetupOptions options_;
+  std::unique_ptr<const sim::RobotModel> model_;
+  std::vector<int> twisting_;
+  ConductorTime now_;
+  Actions actions_;
+  Phase phase_{Phase::kNotStarted};
+  double phase_start_s_{0};
+  double last_send_s_{-1e9};
+  std::optional<orbed::robot_state_t> robot_state_;
+  size_t mode_index_{0};
+  size_t target_index_{0};
+  std::unique_ptr<scenario::ViraalConductor> alignment_;
+  std::optional<viraal::SessionResult> alignment_result_;
+  orbed::setup_task_t task_{};
+  int64_t request_id_base_{0};
+  int64_t next_request_id_{1};
+  SetupRun run_;
+};
+
+}  // namespace orbed::setup

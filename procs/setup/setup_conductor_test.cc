@@ -1,0 +1,171 @@
+// SetupConductor driven by hand in emulated time: a fake arm (ROBOT_STATE at the commanded joints)
+// and a fake assistant (SETUP_RESULT). Fixed-display tasks only: the headset modes' alignment is the
+// ViRAAl conductor's, tested in procs/scenario and end to end in setup_integration_test.
+#include "procs/setup/setup_conductor.h"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+#include <gtest/gtest.h>
+#include <orbed/guidance_t.hpp>
+
+#include "base/source_paths.h"
+#include "base/units.h"
+#include "procs/setup/setup_process.h"
+
+namespace orbed::setup {
+namespace {
+
+constexpr int8_t kFixed = orbed::guidance_t::MODE_FIXED_DISPLAY;
+
+sim::RobotModel Model() {
+  return sim::RobotModel::LoadFile(SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath));
+}
+
+SetupOptions FixedOnly() {
+  SetupOptions o;
+  o.user = "u3";
+  o.modes = {kFixed};
+  o.targets_deg = {{10, 20, 0, -60, 0, 40, 0}, {-10, 30, 5, -70, 0, 30, 20}};
+  o.start_deg = {0, 20, 0, -60, 0, 40, 0};
+  return o;
+}
+
+orbed::robot_state_t State(const std::vector<double>& q_deg, int8_t motion) {
+  orbed::robot_state_t s{};
+  s.X_WR.quaternion_wxyz[0] = 1;
+  s.num_joints = static_cast<int32_t>(q_deg.size());
+  for (double q : q_deg) {
+    s.joint_position.push_back(q * kDegToRad);
+    s.joint_limit_hit.push_back(0);
+  }
+  s.motion_state = motion;
+  return s;
+}
+
+ConductorTime At(double t_s) { return ConductorTime{t_s, 1'000'000'000 + static_cast<int64_t>(t_s * 1e6)}; }
+
+const orbed::setup_task_t* FindTask(const SetupConductor::Actions& a) {
+  for (const SetupPublication& p : a.publish) {
+    if (const auto* task = std::get_if<orbed::setup_task_t>(&p.message)) return task;
+  }
+  return nullptr;
+}
+
+TEST(SetupConductor, ParksThenAsksForEachTargetAndRecordsTheSimsJoints) {
+  SetupConductor c(FixedOnly(), Model());
+  c.Start(At(0));
+  // The arm somewhere else: the conductor parks it (IIWA_COMMAND to the start), no task yet.
+  SetupConductor::Actions a = c.OnRobotState(State({5, 5, 5, -50, 5, 5, 5}, 0), At(0.1));
+  ASSERT_EQ(a.publish.size(), 1u);
+  const auto* command = std::get_if<orbed::iiwa_command_t>(&a.publish[0].message);
+  ASSERT_NE(command, nullptr);
+  EXPECT_NEAR(command->joint_position[3], -60 * kDegToRad, 1e-12);
+  EXPECT_EQ(FindTask(a), nullptr);
+  // At the start and at rest: the first task.
+  a = c.OnRobotState(State({0, 20, 0, -60, 0, 40, 0}, 0), At(0.5));
+  const orbed::setup_task_t* task = FindTask(a);
+  ASSERT_NE(task, nullptr);
+  EXPECT_EQ(task->task_id, "u3-fixed-1");
+  EXPECT_EQ(task->mode, kFixed);
+  EXPECT_NEAR(task->target_position[0], 10 * kDegToRad, 1e-12);
+  const orbed::setup_task_t first = *task;
+  // Unanswered, it is re-sent unchanged after task_resend_s.
+  EXPECT_EQ(FindTask(c.Tick(At(0.9))), nullptr);
+  a = c.Tick(At(1.6));
+  ASSERT_NE(FindTask(a), nullptr);
+  EXPECT_EQ(FindTask(a)->request_id, first.request_id);
+
+  // The assistant's answer; the sim says the arm is at (12, 20, ...): the record takes the sim's.
+  c.OnRobotState(State({12, 20, 0, -60, 0, 40, 0}, 0), At(2.0));
+  orbed::setup_result_t r{};
+  r.request_id = first.request_id;
+  r.task_id = first.task_id;
+  r.mode = kFixed;
+  r.num_joints = 7;
+  r.reached_position.assign(7, 0.0);
+  r.ranges.assign(7, 1);
+  r.execution_s = 95;
+  r.person_scale = 1.1;
+  orbed::setup_result_t other = r;
+  other.request_id = first.request_id + 100;  // someone else's: ignored
+  EXPECT_TRUE(c.OnSetupResult(other, At(2.1)).publish.empty());
+  EXPECT_TRUE(c.run().setups.empty());
+  orbed::setup_result_t bad = r;
+  bad.execution_s = -1;
+  EXPECT_EQ(c.OnSetupResult(bad, At(2.15)).refusals.size(), 1u);
+  c.OnSetupResult(r, At(2.2));
+  ASSERT_EQ(c.run().setups.size(), 1u);
+  const SetupRecord& rec = c.run().setups[0];
+  EXPECT_EQ(rec.target, 1);
+  EXPECT_EQ(rec.order, 1);
+  EXPECT_NEAR(rec.reached_deg[0], 12.0, 1e-9);
+  EXPECT_NEAR(rec.assistant_reached_deg[0], 0.0, 1e-9);
+  EXPECT_EQ(rec.execution_s, 95);
+  EXPECT_FALSE(rec.alignment_s.has_value());
+  EXPECT_EQ(rec.twisting, (std::vector<int>{1, 0, 1, 0, 1, 0, 1}));
+  // A repeat of the answer changes nothing; the second target is next (after parking again).
+  c.OnSetupResult(r, At(2.3));
+  EXPECT_EQ(c.run().setups.size(), 1u);
+  a = c.OnRobotState(State({0, 20, 0, -60, 0, 40, 0}, 0), At(2.4));
+  ASSERT_NE(FindTask(a), nullptr);
+  EXPECT_EQ(FindTask(a)->task_id, "u3-fixed-2");
+  r.request_id = FindTask(a)->request_id;
+  c.OnSetupResult(r, At(3.0));
+  EXPECT_TRUE(c.done());
+  EXPECT_TRUE(c.run().ok);
+  const std::string json = SetupRunJson(c.run(), false);
+  EXPECT_NE(json.find("\"status\": \"ok\""), std::string::npos) << json;
+  EXPECT_NE(json.find("\"alignment_s\": null"), std::string::npos) << json;
+}
+
+TEST(SetupConductor, TimeoutsNameWhoDidNotAnswer) {
+  {
+    SetupConductor c(FixedOnly(), Model());
+    c.Start(At(0));
+    c.Tick(At(11));
+    EXPECT_TRUE(c.done());
+    EXPECT_NE(c.run().error.find("orbed-iiwa-sim"), std::string::npos) << c.run().error;
+  }
+  {
+    SetupOptions o = FixedOnly();
+    o.task_timeout_s = 5;
+    SetupConductor c(o, Model());
+    c.Start(At(0));
+    c.OnRobotState(State({0, 20, 0, -60, 0, 40, 0}, 0), At(0.1));
+    c.Tick(At(6));
+    EXPECT_TRUE(c.done());
+    EXPECT_FALSE(c.run().ok);
+    EXPECT_NE(c.run().error.find("orbed-assistant"), std::string::npos) << c.run().error;
+  }
+}
+
+TEST(SetupConductor, RefusesBadOptions) {
+  SetupOptions o = FixedOnly();
+  o.modes = {kFixed, kFixed};
+  EXPECT_THROW(SetupConductor(o, Model()), std::invalid_argument);
+  o = FixedOnly();
+  o.targets_deg[0][1] = 130;  // joint 2's limit is 120
+  EXPECT_THROW(SetupConductor(o, Model()), std::invalid_argument);
+  o = FixedOnly();
+  o.start_deg.pop_back();
+  EXPECT_THROW(SetupConductor(o, Model()), std::invalid_argument);
+}
+
+// Every order of the three modes comes from some seed, and a seed always gives the same one.
+TEST(SetupConductor, UserSeedsGiveEveryOrder) {
+  std::set<std::vector<int8_t>> seen;
+  for (uint64_t seed = 1; seed <= 60; ++seed) {
+    const std::vector<int8_t> order = ModeOrderForSeed(seed);
+    EXPECT_EQ(order, ModeOrderForSeed(seed));
+    std::vector<int8_t> sorted = order;
+    std::sort(sorted.begin(), sorted.end());
+    EXPECT_EQ(sorted, (std::vector<int8_t>{0, 1, 2}));
+    seen.insert(order);
+  }
+  EXPECT_EQ(seen.size(), 6u);
+}
+
+}  // namespace
+}  // namespace orbed::setup

@@ -1,0 +1,223 @@
+#include "procs/setup/setup_process.h"
+
+#include <cstdlib>
+#include <exception>
+#include <filesystem>
+#include <ostream>
+#include <utility>
+
+#include <CLI/CLI.hpp>
+#include <orbed/alignment_trial_t.hpp>
+#include <orbed/misalignment_t.hpp>
+#include <orbed/plan_check_reply_t.hpp>
+#include <orbed/registration_t.hpp>
+
+#include "base/json_fields.h"
+#include "base/number_list.h"
+#include "base/random.h"
+#include "base/replace_file.h"
+#include "base/source_paths.h"
+#include "base/units.h"
+#include "procs/common/conversions.h"
+#include "procs/common/flags.h"
+#include "procs/common/log.h"
+#include "procs/guidance/guidance.h"
+
+namespace orbed::setup {
+
+std::vector<int8_t> ModeOrderForSeed(uint64_t user_seed) {
+  std::vector<int8_t> order = {0, 1, 2};
+  Random rng(user_seed ^ 0x5e7a9ULL);
+  for (int i = 2; i > 0; --i) {
+    const int j = static_cast<int>(rng.Uniform() * (i + 1));
+    std::swap(order[i], order[j]);
+  }
+  return order;
+}
+
+SetupProcess::SetupProcess(const CommonFlags& flags, const SetupOptions& options,
+                           const std::string& urdf_path, const std::string& results_dir, std::ostream* out)
+    : process_(flags), results_dir_(results_dir), out_(out), origin_(std::chrono::steady_clock::now()) {
+  conductor_ = std::make_unique<SetupConductor>(options, sim::RobotModel::LoadFile(urdf_path));
+  process_.Subscribe<orbed::robot_state_t>(
+      options.robot_state_channel, [this](const orbed::robot_state_t& m, const std::string&, int64_t) {
+        Apply(conductor_->OnRobotState(m, Now()));
+      });
+  const scenario::ConductorOptions channels;  // the alignment's channels: the defaults
+  process_.Subscribe<orbed::plan_check_reply_t>(
+      channels.plan_check_reply_channel, [this](const orbed::plan_check_reply_t& m, const std::string&,
+                                                int64_t) { Apply(conductor_->OnPlanCheckReply(m, Now())); });
+  process_.Subscribe<orbed::alignment_trial_t>(
+      channels.trial_channel, [this](const orbed::alignment_trial_t& m, const std::string&, int64_t) {
+        Apply(conductor_->OnTrial(m, Now()));
+      });
+  process_.Subscribe<orbed::registration_t>(
+      channels.registration_channel, [this](const orbed::registration_t& m, const std::string&, int64_t) {
+        Apply(conductor_->OnRegistration(m, Now()));
+      });
+  process_.Subscribe<orbed::misalignment_t>(
+      channels.misalignment_channel, [this](const orbed::misalignment_t& m, const std::string&, int64_t) {
+        Apply(conductor_->OnMisalignment(m, Now()));
+      });
+  process_.Subscribe<orbed::setup_result_t>(
+      options.setup_result_channel, [this](const orbed::setup_result_t& m, const std::string&, int64_t) {
+        Apply(conductor_->OnSetupResult(m, Now()));
+      });
+  process_.AddTimer(
+      0.01, [this] { Apply(conductor_->Tick(Now())); }, "tick");
+}
+
+ConductorTime SetupProcess::Now() const {
+  const std::chrono::duration<double> t = std::chrono::steady_clock::now() - origin_;
+  return ConductorTime{t.count(), NowMicros()};
+}
+
+int SetupProcess::Run() {
+  Apply(conductor_->Start(Now()));
+  Write(true);
+  const int code = process_.Run();
+  if (!finished_) {
+    Apply(conductor_->Abort("interrupted before the study's set-ups were done", Now()));
+    return 1;
+  }
+  return conductor_->run().ok ? code : 1;
+}
+
+void SetupProcess::Apply(SetupConductor::Actions actions) {
+  for (const scenario::ConductorAction& action : actions.viraal) {
+    if (const auto* publication = std::get_if<scenario::Publication>(&action)) {
+      std::visit([&](const auto& msg) { process_.Publish(publication->channel, msg); }, publication->message);
+    } else if (const auto* line = std::get_if<scenario::ProgressLine>(&action)) {
+      if (out_) *out_ << "  " << line->text << "\n" << std::flush;
+    } else if (const auto* entry = std::get_if<scenario::LogEntry>(&action)) {
+      orbed::Log(entry->level, entry->text);
+    } else if (const auto* refusal = std::get_if<scenario::Refusal>(&action)) {
+      process_.Reject(refusal->key, refusal->reason);
+    }
+  }
+  for (const SetupPublication& p : actions.publish) {
+    std::visit([&](const auto& msg) { process_.Publish(p.channel, msg); }, p.message);
+  }
+  for (const std::string& line : actions.progress) {
+    if (out_) *out_ << line << "\n" << std::flush;
+    ORBED_LOG(kInfo) << line;
+  }
+  for (const scenario::Refusal& r : actions.refusals) process_.Reject(r.key, r.reason);
+  if (finished_) return;
+  if (conductor_->done()) {
+    finished_ = true;
+    Write(false);
+    if (conductor_->run().ok) {
+      process_.RequestStop();
+    } else {
+      process_.Fail(conductor_->run().error);
+    }
+  } else if (conductor_->run().setups.size() != written_setups_) {
+    Write(true);
+  }
+}
+
+void SetupProcess::Write(bool partial) {
+  written_setups_ = conductor_->run().setups.size();
+  std::error_code ec;
+  std::filesystem::create_directories(results_dir_, ec);
+  const std::string path = results_dir_ + "/setup_results.json";
+  std::string error;
+  if (!ReplaceFile(path, SetupRunJson(conductor_->run(), partial), &error)) {
+    ORBED_LOG(kWarn) << "cannot write " << path << ": " << error;
+  } else if (!partial && out_) {
+    *out_ << "set-up results: " << path << "\n" << std::flush;
+  }
+}
+
+int RunSetup(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
+  CLI::App app{
+      "orbed-setup: one user's part of the paper's robot set-up study (Sec. IV-B, Tables 2-4). For\n"
+      "each mode of the user's order and each target: in the headset modes the user aligns N times\n"
+      "and the mean is applied, the arm is parked at the start, and SETUP_TASK asks orbed-assistant\n"
+      "to set the arm up to the target (orbed-guidance shows it). Writes setup_results.json."};
+  CommonFlags common("orbed-setup");
+  AddCommonFlags(&app, &common);
+  SetupOptions options;
+  std::string plan_path, scenario_path, urdf_path, results_dir, modes, start_deg = "0,20,0,-60,0,40,0";
+  uint64_t user_seed = 1;
+  int targets = 3, trials = 3;
+  app.add_option("--user", options.user,
+                 "The user's name in task ids and results (u1, u2, ...; default $ORBED_USER if set)")
+      ->envname("ORBED_USER")
+      ->capture_default_str();
+  app.add_option("--user-seed", user_seed,
+                 "The user's seed: the order of the modes (unless --modes; default $ORBED_USER_SEED if set)")
+      ->envname("ORBED_USER_SEED")
+      ->capture_default_str();
+  app.add_option(
+         "--modes", modes,
+         "The order of the modes, e.g. fixed,ar,ar_reflective (default $ORBED_SETUP_MODES if set, else from "
+         "--user-seed)")
+      ->envname("ORBED_SETUP_MODES");
+  app.add_option("--plan", plan_path, "Targets from `orbed-robot plan` (default: procs/setup/targets.json)");
+  app.add_option("--targets", targets,
+                 "How many of the plan's targets per mode (default $ORBED_SETUP_TARGETS if set)")
+      ->envname("ORBED_SETUP_TARGETS")
+      ->check(CLI::Range(1, 20))
+      ->capture_default_str();
+  app.add_option("--start-deg", start_deg, "Where the arm is parked before each set-up [deg]")
+      ->capture_default_str();
+  app.add_option("--scenario", scenario_path, "The alignment protocol (default: viraal/viraal.yaml)");
+  app.add_option("--trials", trials, "Alignments before each headset set-up (the paper: N = 3)")
+      ->check(CLI::Range(1, 100))
+      ->capture_default_str();
+  app.add_option("--run-id", options.run_id,
+                 "Run id (session ids are <run-id>-<task id>; default $ORBED_RUN_ID if set)")
+      ->envname("ORBED_RUN_ID")
+      ->capture_default_str();
+  app.add_option("--results-dir", results_dir,
+                 "Folder of setup_results.json (default: $ORBED_LOG_DIR, else .)");
+  app.add_option("--urdf", urdf_path, "Robot URDF (default: the shipped iiwa 7)");
+  app.add_option("--task-timeout-s", options.task_timeout_s, "Wait for a SETUP_RESULT [s]")
+      ->check(CLI::Range(1.0, 36000.0))
+      ->capture_default_str();
+  app.add_option("--move-timeout-s", options.move_timeout_s, "Wait for the arm to reach a configuration [s]")
+      ->check(CLI::Range(1.0, 3600.0))
+      ->capture_default_str();
+  if (const auto code = ParseCommandLine(&app, common, argc, argv, out, err)) return *code;
+  try {
+    if (modes.empty()) {
+      options.modes = ModeOrderForSeed(user_seed);
+    } else {
+      size_t begin = 0;
+      while (begin <= modes.size()) {
+        const size_t comma = std::min(modes.find(',', begin), modes.size());
+        options.modes.push_back(guidance::GuidanceModeFromName(modes.substr(begin, comma - begin)));
+        begin = comma + 1;
+      }
+    }
+    options.start_deg = ParseNumberList(start_deg, "--start-deg");
+  } catch (const std::invalid_argument& e) {
+    err << "orbed-setup: " << e.what() << "\n";
+    return 2;
+  }
+  try {
+    if (urdf_path.empty()) urdf_path = SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath);
+    if (plan_path.empty()) plan_path = SourceTreePath("procs/setup/targets.json");
+    if (scenario_path.empty()) scenario_path = SourceTreePath(viraal::kDefaultScenarioRelativePath);
+    if (results_dir.empty()) {
+      const char* env = std::getenv("ORBED_LOG_DIR");
+      results_dir = env && *env ? env : ".";
+    }
+    const sim::RobotModel model = sim::RobotModel::LoadFile(urdf_path);
+    for (int k = 1; k <= targets; ++k) {
+      const Eigen::VectorXd q = guidance::ReadPlanTarget(plan_path, k, model.num_joints()) * kRadToDeg;
+      options.targets_deg.emplace_back(q.data(), q.data() + q.size());
+    }
+    options.alignment = viraal::LoadScenarioFile(scenario_path);
+    options.alignment.trials = trials;
+    SetupProcess setup(common, options, urdf_path, results_dir, &out);
+    return setup.Run();
+  } catch (const std::exception& e) {
+    err << "orbed-setup: " << e.what() << "\n";
+    return 1;
+  }
+}
+
+}  // namespace orbed::setup

@@ -1,0 +1,61 @@
+#pragma once
+/// @file
+/// orbed-setup: one user's part of the robot set-up study (SetupConductor, setup_conductor.h) on
+/// the bus.
+///
+///   Subscribes: ROBOT_STATE, PLAN_CHECK_REPLY, ALIGNMENT_TRIAL, REGISTRATION, MISALIGNMENT (for
+///               the alignments before the headset modes' set-ups, as orbed-scenario), SETUP_RESULT.
+///   Publishes:  what the conductor asks for: SESSION_CONTROL, PLAN_CHECK_REQUEST,
+///               MISALIGNMENT_REQUEST and IIWA_COMMAND of the alignments; IIWA_COMMAND parking the
+///               arm; SETUP_TASK.
+///
+/// setup_results.json (SetupRunJson) in results_dir is rewritten with status "partial" after each
+/// set-up and once at the end ("ok" or "failed"); then the process stops: exit 0 on success, 1 on a
+/// failure (the reason on stdout and the heartbeat) or when stopped from outside before the end.
+///
+/// The user's order of the three modes: given, or drawn from the user seed (a uniform permutation,
+/// Fisher-Yates with base/random.h), so a study's users meet the modes in randomized orders as the
+/// paper's did, reproducibly.
+///
+/// Clocks: steady_clock for the conductor's t_s, the wall clock for utimes. Threading: everything on
+/// the Process::Run thread.
+
+#include <chrono>
+#include <iosfwd>
+#include <memory>
+#include <string>
+
+#include "procs/common/process.h"
+#include "procs/setup/setup_conductor.h"
+
+namespace orbed::setup {
+
+/// A uniform random order of guidance modes 0, 1, 2 for a user seed.
+std::vector<int8_t> ModeOrderForSeed(uint64_t user_seed);
+
+class SetupProcess {
+ public:
+  /// Throws std::invalid_argument / std::runtime_error for bad options or an unreadable model.
+  SetupProcess(const CommonFlags& flags, const SetupOptions& options, const std::string& urdf_path,
+               const std::string& results_dir, std::ostream* out);
+  int Run();
+
+ private:
+  void Apply(SetupConductor::Actions actions);
+  ConductorTime Now() const;
+  void Write(bool partial);
+
+  Process process_;
+  std::unique_ptr<SetupConductor> conductor_;
+  std::string results_dir_;
+  std::ostream* out_;
+  std::chrono::steady_clock::time_point origin_;
+  size_t written_setups_{0};
+  bool finished_{false};
+};
+
+/// orbed-setup's command line (flags: --help). Exit 0 when every set-up finished; 1 on a failure; 2
+/// or CLI11's usage code (106-109) on bad arguments.
+int RunSetup(int argc, const char* const* argv, std::ostream& out, std::ostream& err);
+
+}  // namespace orbed::setup
