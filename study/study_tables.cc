@@ -129,7 +129,8 @@ std::string AlignmentMeansCsv(const std::vector<UserRun>& runs) {
   return csv;
 }
 
-std::string TablesJson(const std::vector<UserRun>& runs, const LandmarkValidation& validation) {
+std::string TablesJson(const std::vector<UserRun>& runs, const LandmarkValidation& validation,
+                       const std::vector<SetupUserRun>& setup_runs) {
   JsonWriter json(2);
   json.BeginObject();
   json.Key("users").Int(static_cast<int64_t>(runs.size()));
@@ -146,6 +147,7 @@ std::string TablesJson(const std::vector<UserRun>& runs, const LandmarkValidatio
   json.EndObject();
   json.EndObject();
   json.Key("landmark_validation_mm").Number(validation.mean_error_mm);
+  if (!setup_runs.empty()) WriteSetupTables(&json, setup_runs);
   json.Key("paper").BeginObject();
   json.Key("source").String(viraal::kPaperSource);
   json.Key("table1").BeginObject();
@@ -161,6 +163,7 @@ std::string TablesJson(const std::vector<UserRun>& runs, const LandmarkValidatio
   json.EndObject();
   json.EndObject();
   json.Key("landmark_validation_mm").Number(kPaperLandmarkValidationMm);
+  if (!setup_runs.empty()) WriteSetupPaper(&json);
   json.EndObject();
   json.EndObject();
   return json.str() + "\n";
@@ -196,14 +199,30 @@ int RunStudyTables(int argc, const char* const* argv, std::ostream& out, std::os
   app.add_option("--seed", validation.seed, "Seed of the landmark check")->capture_default_str();
   app.add_option("--config", config_paths,
                  "Headset config applied over the shipped ones (the runs' --config)");
-  app.add_option("runs", run_paths, "Each user's results.json or its run folder")->required();
+  std::vector<std::string> setup_paths;
+  app.add_option("--setup", setup_paths,
+                 "Each set-up user's setup_results.json or its run folder (orbed-setup)");
+  app.add_option("runs", run_paths, "Each ViRAAl user's results.json or its run folder");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     const int code = app.exit(e, out, err);
     return code == 0 ? 0 : 2;
   }
+  if (run_paths.empty() && setup_paths.empty()) {
+    err << "orbed-study-tables: no runs: give ViRAAl runs and/or --setup runs\n";
+    return 2;
+  }
   try {
+    std::vector<SetupUserRun> setup_runs;
+    for (const std::string& path : setup_paths) {
+      setup_runs.push_back(ReadSetupResults(path));
+      for (size_t k = 0; k + 1 < setup_runs.size(); ++k) {
+        if (setup_runs[k].user == setup_runs.back().user) {
+          throw std::runtime_error(path + ": user " + EscapeText(setup_runs.back().user) + " is there twice");
+        }
+      }
+    }
     std::vector<UserRun> runs;
     for (size_t i = 0; i < run_paths.size(); ++i) {
       UserRun run;
@@ -238,14 +257,20 @@ int RunStudyTables(int argc, const char* const* argv, std::ostream& out, std::os
         {"alignment_trials.csv", AlignmentTrialsCsv(runs)},
         {"alignment_means.csv", AlignmentMeansCsv(runs)},
         {"landmark_validation.csv", LandmarkValidationCsv(v)},
-        {"tables.json", TablesJson(runs, v)}};
-    for (const auto& [name, text] : files) {
+        {"tables.json", TablesJson(runs, v, setup_runs)}};
+    std::vector<std::pair<std::string, std::string>> all(std::begin(files), std::end(files));
+    if (!setup_runs.empty()) {
+      all.emplace_back("setup_joints.csv", SetupJointsCsv(setup_runs));
+      all.emplace_back("setup_times.csv", SetupTimesCsv(setup_runs));
+    }
+    for (const auto& [name, text] : all) {
       const std::string path = (std::filesystem::path(out_dir) / name).string();
       std::ofstream file(path);
       file << text;
       if (!file) throw std::runtime_error("cannot write " + path);
     }
-    out << StudySummary(runs, v);
+    if (!runs.empty()) out << StudySummary(runs, v);
+    if (!setup_runs.empty()) out << SetupSummary(setup_runs);
   } catch (const std::exception& e) {
     err << "orbed-study-tables: " << e.what() << "\n";
     return 1;

@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "study/landmark_validation.h"
+#include "study/setup_tables.h"
 #include "viraal/results.h"
 
 namespace orbed::study {
@@ -42,14 +43,17 @@ viraal::Table1Row ModeMeansRow(const std::vector<UserRun>& runs, const std::stri
 
 std::string AlignmentTrialsCsv(const std::vector<UserRun>& runs);
 std::string AlignmentMeansCsv(const std::vector<UserRun>& runs);
-std::string TablesJson(const std::vector<UserRun>& runs, const LandmarkValidation& validation);
+/// With set-up runs, tables.json also has Tables 2-4 (setup_tables.h) and the paper's.
+std::string TablesJson(const std::vector<UserRun>& runs, const LandmarkValidation& validation,
+                       const std::vector<SetupUserRun>& setup_runs = {});
 /// Table 1 as the study measured it, beside the paper's, for the terminal.
 std::string StudySummary(const std::vector<UserRun>& runs, const LandmarkValidation& validation);
 
-/// orbed-study-tables --out DIR [--seed S] RUN...: reads each RUN's results.json (a file or its
-/// folder), runs the landmark check (--seed), writes the three files above and
-/// landmark_validation.csv into DIR, prints StudySummary. Exit 0, 2 on bad arguments, 1 when a run
-/// cannot be read or did not finish (the message names it).
+/// orbed-study-tables --out DIR [--seed S] [--setup SETUP_RUN]... [RUN...]: reads each RUN's
+/// results.json (a file or its folder) and each SETUP_RUN's setup_results.json, runs the landmark
+/// check (--seed), writes the three files above, landmark_validation.csv and, with set-up runs,
+/// setup_joints.csv and setup_times.csv into DIR, prints StudySummary and SetupSummary. Exit 0, 2 on bad
+/// arguments, 1 when a run cannot be read or did not finish (the message names it).
 int RunStudyTables(int argc, const char* const* argv, std::ostream& out, std::ostream& err);
 
 }  // namespace orbed::study

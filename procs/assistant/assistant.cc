@@ -158,7 +158,7 @@ std::vector<Eigen::Vector3d> Assistant::PerceiveTarget(int joint, const Eigen::V
   if (!monitor) {
     const double lateral = scale_ * config_.lateral_noise_arcmin * kArcminToRad;
     const double depth = scale_ * config_.depth_noise_fraction_std;
-    for (const Feature& f : features_[joint]) {
+    for (const Feature& f : FeaturesWithPivot(joint)) {
       const Eigen::Vector3d h = view.X_WV_seen * (X_RL[f.link] * f.p_L);
       const double rho = (h - view.p_WE).norm();
       Eigen::Vector3d e1, e2;
@@ -177,7 +177,7 @@ std::vector<Eigen::Vector3d> Assistant::PerceiveTarget(int joint, const Eigen::V
   const double lateral = scale_ * config_.picture_noise_arcmin * kArcminToRad;
   const double depth = scale_ * config_.picture_depth_fraction_std;
   const Eigen::Vector3d p_WR = view.X_WR.translation();
-  for (const Feature& f : features_[joint]) {
+  for (const Feature& f : FeaturesWithPivot(joint)) {
     const Eigen::Vector3d p = view.X_WR * (X_RL[f.link] * f.p_L);
     const Eigen::Vector3d h = p_WR + k * (R_turn * (p - p_WR));
     const double rho = (h - config_.monitor_camera_m).norm();
@@ -190,6 +190,12 @@ std::vector<Eigen::Vector3d> Assistant::PerceiveTarget(int joint, const Eigen::V
   return seen;
 }
 
+std::vector<Feature> Assistant::FeaturesWithPivot(int joint) const {
+  std::vector<Feature> out = features_[joint];
+  out.push_back({model_->joints()[joint].link, Eigen::Vector3d::Zero()});  // the joint, on its axis
+  return out;
+}
+
 double Assistant::Discrepancy(int joint, double x_rad, const Eigen::VectorXd& q_now,
                               const std::vector<Eigen::Vector3d>& p_W_target_seen,
                               const Viewing& view) const {
@@ -199,12 +205,15 @@ double Assistant::Discrepancy(int joint, double x_rad, const Eigen::VectorXd& q_
   const double lateral = config_.lateral_noise_arcmin * kArcminToRad;
   const double depth = config_.depth_noise_fraction_std;
   double sum = 0;
-  const std::vector<Feature>& features = features_[joint];
-  for (size_t i = 0; i < features.size(); ++i) {
+  const std::vector<Feature> features = FeaturesWithPivot(joint);
+  const Eigen::Vector3d r_pivot = view.X_WR * (X_RL[features.back().link] * features.back().p_L);
+  const Eigen::Vector3d& h_pivot = p_W_target_seen.back();
+  for (size_t i = 0; i + 1 < features.size(); ++i) {
     const Eigen::Vector3d r = view.X_WR * (X_RL[features[i].link] * features[i].p_L);
     const double rho = std::max((r - view.p_WE).norm(), 0.05);
     const Eigen::Vector3d n = (r - view.p_WE) / rho;
-    const Eigen::Vector3d d = r - p_W_target_seen[i];
+    // The link's shape about its joint: a shift of the whole hologram is not a reason to turn.
+    const Eigen::Vector3d d = (r - r_pivot) - (p_W_target_seen[i] - h_pivot);
     const double along = n.dot(d);
     const double across2 = (d - along * n).squaredNorm();
     sum += across2 / std::pow(rho * lateral, 2) + along * along / std::pow(rho * depth, 2);

@@ -32,9 +32,12 @@
 ///
 /// Where they stop. For a look at joint j with the arm at q_now, the person scores every angle
 /// x of joint j on a grid (kGridStepDeg, within the joint's limits and `window_rad` of q_now) by
-///   D(x) = Σ_p |lateral(r_p(x) − h'_p)|² / (ρ_p σ_lat)² + (n_p · (r_p(x) − h'_p))² / (ρ_p σ_depth)²
-/// (r_p(x): the real point with joint j at x and the others at q_now; n_p the unit ray from the eye
-/// to r_p; σ the configured, unscaled noises: what the person believes of their own eyes). Every x
+///   D(x) = Σ_p |lateral(d_p)|² / (ρ_p σ_lat)² + (n_p · d_p)² / (ρ_p σ_depth)²,
+///   d_p = (r_p(x) − r_0) − (h'_p − h'_0)
+/// (r_p(x): the real point with joint j at x and the others at q_now; r_0, h'_0 the joint itself on
+/// the real arm and as perceived on the target: people judge which way a link points from its joint,
+/// so a shift of the whole hologram is no reason to turn a joint, a tilt is; n_p the unit ray from
+/// the eye to r_p; σ the configured, unscaled noises: what the person believes of their own eyes). Every x
 /// with D(x) ≤ min D + `match_margin` looks right; the person turns the joint from where it is to
 /// the nearest such x, and the hand puts it there with noise N(0, s·placement_noise_deg). The
 /// angles that look right form `ranges` separate ranges: two for a half-turn ambiguity, one wide
@@ -137,7 +140,10 @@ class Assistant {
 
   /// The skeleton joint `joint` is judged by (B_j and B_j+1).
   const std::vector<Feature>& features(int joint) const { return features_[joint]; }
-  /// The target's skeleton points in W as this look perceives them (draws the look's noise).
+  /// features(joint) and last the joint itself (the child link's origin, on the axis): the pivot.
+  std::vector<Feature> FeaturesWithPivot(int joint) const;
+  /// The target's points of FeaturesWithPivot in W as this look perceives them (draws the look's
+  /// noise).
   std::vector<Eigen::Vector3d> PerceiveTarget(int joint, const Eigen::VectorXd& q_target,
                                               const Viewing& view);
   /// The time of the hand's travel |delta_rad| [s].

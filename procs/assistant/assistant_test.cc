@@ -174,17 +174,25 @@ TEST(Assistant, ACorrectingLookStaysInItsWindow) {
   EXPECT_NEAR(look.q_rad * kRadToDeg, 10.0, 1e-6);  // the window's edge nearest the target
 }
 
-// The hologram where the registration puts it: a registration 3 cm off (up) moves the revolving
-// joint's match by a few degrees (3 cm at the 0.4-0.8 m lever of links 3-7: 2-4 deg), not by zero.
-TEST(Assistant, ARegistrationErrorMovesTheMatch) {
+// The hologram where the registration puts it. People judge which way a link points from its joint:
+// a hologram shifted 3 cm moves no joint's match (to within the grid and the near-perfect eye); one
+// turned 3 deg about the vertical turns joint 1's match by 3 deg.
+TEST(Assistant, ARegistrationTiltMovesTheMatchAShiftDoesNot) {
   const sim::RobotModel model = Model();
-  Assistant a(model, Perfect());
-  Viewing view = Overlay(Eigen::Isometry3d::Identity());
-  view.X_WV_seen.translation() = Eigen::Vector3d(0, 0, 0.03);    // 3 cm up
-  const Eigen::VectorXd q_target = Deg({0, 90, 0, 0, 0, 0, 0});  // the arm horizontal from joint 2 on
-  const JointLook look = a.Look(1, Deg({0, 80, 0, 0, 0, 0, 0}), q_target, view, kInf);
-  EXPECT_GT(std::abs(look.q_rad * kRadToDeg - 90.0), 0.5);
-  EXPECT_LT(std::abs(look.q_rad * kRadToDeg - 90.0), 6.0);
+  const Eigen::VectorXd q_target = Deg({20, 45, 0, -30, 0, 30, 0});
+  const Eigen::VectorXd q_now = Deg({0, 45, 0, -30, 0, 30, 0});
+  {
+    Assistant a(model, Perfect());
+    Viewing view = Overlay(Eigen::Isometry3d::Identity());
+    view.X_WV_seen.translation() = Eigen::Vector3d(0.02, -0.01, 0.03);
+    EXPECT_NEAR(a.Look(0, q_now, q_target, view, kInf).q_rad * kRadToDeg, 20.0, 0.3);
+  }
+  {
+    Assistant a(model, Perfect());
+    Viewing view = Overlay(Eigen::Isometry3d::Identity());
+    view.X_WV_seen.linear() = Eigen::AngleAxisd(3 * kDegToRad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    EXPECT_NEAR(a.Look(0, q_now, q_target, view, kInf).q_rad * kRadToDeg, 23.0, 0.3);
+  }
 }
 
 TEST(Assistant, TimesInClosedForm) {

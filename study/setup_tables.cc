@@ -1,0 +1,291 @@
+#include "study/setup_tables.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <stdexcept>
+
+#include "base/format.h"
+#include "base/json_fields.h"
+#include "base/stats.h"
+#include "study/paper_setup.h"
+
+namespace orbed::study {
+namespace {
+
+constexpr size_t kMaxSetups = 100;
+constexpr size_t kMaxJoints = 20;
+
+bool IsSetupMode(const std::string& mode) {
+  return mode == "ar_reflective" || mode == "ar" || mode == "fixed";
+}
+
+void WriteStats(JsonWriter* json, const Stats5& s) {
+  json->BeginObject();
+  json->Key("mean").Number(s.mean);
+  json->Key("median").Number(s.median);
+  json->Key("min").Number(s.min);
+  json->Key("max").Number(s.max);
+  json->Key("std").Number(s.std);
+  json->Key("n").Int(s.n);
+  json->EndObject();
+}
+
+void WritePaperStats(JsonWriter* json, const PaperStats& s) {
+  json->BeginObject();
+  json->Key("mean").Number(s.mean);
+  json->Key("median").Number(s.median);
+  json->Key("min").Number(s.min);
+  json->Key("max").Number(s.max);
+  json->Key("std").Number(s.std);
+  json->EndObject();
+}
+
+bool HasMode(const std::vector<SetupUserRun>& runs, const std::string& mode) {
+  for (const SetupUserRun& run : runs) {
+    for (const SetupRow& row : run.setups) {
+      if (row.mode == mode) return true;
+    }
+  }
+  return false;
+}
+
+int NumJoints(const std::vector<SetupUserRun>& runs) {
+  for (const SetupUserRun& run : runs) {
+    for (const SetupRow& row : run.setups) return static_cast<int>(row.target_deg.size());
+  }
+  return 0;
+}
+
+std::vector<double> Times(const std::vector<SetupUserRun>& runs, const std::string& mode, bool alignment) {
+  std::vector<double> out;
+  for (const SetupUserRun& run : runs) {
+    for (const SetupRow& row : run.setups) {
+      if (row.mode != mode) continue;
+      if (!alignment) out.push_back(row.execution_s);
+      if (alignment && row.alignment_s) out.push_back(*row.alignment_s);
+    }
+  }
+  return out;
+}
+
+std::string Clock(double s) {
+  const int total = static_cast<int>(std::lround(s));
+  char text[16];
+  std::snprintf(text, sizeof(text), "%d:%02d", total / 60, total % 60);
+  return text;
+}
+
+std::string StatsText(const Stats5& s, int decimals, bool clock) {
+  auto f = [&](double v) { return clock ? Clock(v) : Fixed(v, decimals); };
+  return f(s.mean) + " / " + f(s.median) + " / " + f(s.min) + " / " + f(s.max) + " / " + f(s.std);
+}
+
+}  // namespace
+
+SetupUserRun ReadSetupResults(const std::string& path) {
+  std::string file = path;
+  if (std::filesystem::is_directory(path))
+    file = (std::filesystem::path(path) / "setup_results.json").string();
+  const JsonFields f(file);
+  const nlohmann::json doc = f.ReadFile(file, 4 << 20, 8);
+  const JsonAt root{doc, ""};
+  const std::string status = f.String(f.Member(root, "status"), 16);
+  if (status != "ok") {
+    const std::string error = f.String(f.Member(root, "error"), 4096);
+    throw std::runtime_error(file + ": the set-up run did not finish (status " + EscapeText(status) +
+                             (error.empty() ? "" : ": " + EscapeText(error)) + ")");
+  }
+  SetupUserRun run;
+  run.user = f.String(f.Member(root, "user"), 64);
+  const JsonAt order = f.Member(root, "order");
+  for (size_t i = 0, n = f.ArraySize(order, 3); i < n; ++i)
+    run.order.push_back(f.String(f.Element(order, i), 32));
+  const JsonAt setups = f.Member(root, "setups");
+  size_t num_joints = 0;
+  for (size_t i = 0, n = f.ArraySize(setups, kMaxSetups); i < n; ++i) {
+    const JsonAt s = f.Element(setups, i);
+    SetupRow row;
+    row.mode = f.String(f.Member(s, "mode"), 32);
+    if (!IsSetupMode(row.mode)) {
+      throw std::runtime_error(file + ": " + s.key + ".mode: '" + EscapeText(row.mode) +
+                               "' is not one of ar_reflective, ar, fixed");
+    }
+    row.order = static_cast<int>(f.Integer(f.Member(s, "order"), 1, 3));
+    row.target = static_cast<int>(f.Integer(f.Member(s, "target"), 1, 100));
+    const JsonAt target = f.Member(s, "target_deg");
+    const size_t joints = f.ArraySize(target, kMaxJoints);
+    if (joints == 0 || (num_joints != 0 && joints != num_joints)) {
+      throw std::runtime_error(file + ": " + target.key + ": " + std::to_string(joints) +
+                               " joints, expected " + std::to_string(num_joints ? num_joints : 1) +
+                               (num_joints ? "" : " or more"));
+    }
+    num_joints = joints;
+    row.target_deg = f.Numbers(target, joints, -360, 360);
+    row.reached_deg = f.Numbers(f.Member(s, "reached_deg"), joints, -360, 360);
+    for (double t : f.Numbers(f.Member(s, "twisting"), joints, 0, 1)) row.twisting.push_back(t != 0);
+    row.execution_s = f.Number(f.Member(s, "execution_s"), 0, 1e6);
+    // null (fixed display: no alignment) reads as absent.
+    if (const std::optional<JsonAt> alignment = f.OptionalMember(s, "alignment_s")) {
+      row.alignment_s = f.Number(*alignment, 0, 1e6);
+    }
+    run.setups.push_back(std::move(row));
+  }
+  return run;
+}
+
+Stats5 Summarize(const std::vector<double>& values) {
+  Stats5 s;
+  s.n = static_cast<int>(values.size());
+  if (values.empty()) return s;
+  s.mean = stats::Mean(values);
+  s.median = stats::Median(values);
+  s.min = *std::min_element(values.begin(), values.end());
+  s.max = *std::max_element(values.begin(), values.end());
+  s.std = stats::StdDev(values);
+  return s;
+}
+
+std::vector<double> JointErrors(const std::vector<SetupUserRun>& runs, const std::string& mode, int joint) {
+  std::vector<double> out;
+  for (const SetupUserRun& run : runs) {
+    for (const SetupRow& row : run.setups) {
+      if (row.mode != mode) continue;
+      for (size_t j = 0; j < row.target_deg.size(); ++j) {
+        if (joint < 0 || static_cast<int>(j) == joint)
+          out.push_back(std::abs(row.reached_deg[j] - row.target_deg[j]));
+      }
+    }
+  }
+  return out;
+}
+
+std::string SetupJointsCsv(const std::vector<SetupUserRun>& runs) {
+  std::string csv = "user,mode,order,target,joint,twisting,target_deg,reached_deg,error_deg\n";
+  for (const SetupUserRun& run : runs) {
+    for (const SetupRow& row : run.setups) {
+      for (size_t j = 0; j < row.target_deg.size(); ++j) {
+        csv += run.user + "," + row.mode + "," + std::to_string(row.order) + "," +
+               std::to_string(row.target) + "," + std::to_string(j + 1) + "," +
+               std::to_string(row.twisting[j]) + "," + JsonNumber(row.target_deg[j]) + "," +
+               JsonNumber(row.reached_deg[j]) + "," +
+               JsonNumber(std::abs(row.reached_deg[j] - row.target_deg[j])) + "\n";
+      }
+    }
+  }
+  return csv;
+}
+
+std::string SetupTimesCsv(const std::vector<SetupUserRun>& runs) {
+  std::string csv = "user,mode,order,target,execution_s,alignment_s\n";
+  for (const SetupUserRun& run : runs) {
+    for (const SetupRow& row : run.setups) {
+      csv += run.user + "," + row.mode + "," + std::to_string(row.order) + "," + std::to_string(row.target) +
+             "," + JsonNumber(row.execution_s) + "," + (row.alignment_s ? JsonNumber(*row.alignment_s) : "") +
+             "\n";
+    }
+  }
+  return csv;
+}
+
+void WriteSetupTables(JsonWriter* json, const std::vector<SetupUserRun>& runs) {
+  json->Key("setup_users").Int(static_cast<int64_t>(runs.size()));
+  json->Key("table2").BeginObject();
+  for (const char* mode : kSetupModes) {
+    if (!HasMode(runs, mode)) continue;
+    json->Key(mode);
+    WriteStats(json, Summarize(JointErrors(runs, mode, -1)));
+  }
+  json->EndObject();
+  json->Key("table3").BeginObject();
+  const int joints = NumJoints(runs);
+  for (const char* pair : kSetupPairs) {
+    const std::string p = pair;
+    const std::string a = p.substr(0, p.find('/')), b = p.substr(p.find('/') + 1);
+    if (!HasMode(runs, a) || !HasMode(runs, b)) continue;
+    json->Key(p).BeginObject();
+    for (int j = -1; j < joints; ++j) {
+      const stats::MannWhitneyResult r =
+          stats::MannWhitneyU(JointErrors(runs, a, j), JointErrors(runs, b, j));
+      json->Key(j < 0 ? "total" : "joint" + std::to_string(j + 1));
+      if (r.valid) {
+        json->Number(r.p_two_sided);
+      } else {
+        json->Null();  // all tied (or empty): no test
+      }
+    }
+    json->EndObject();
+  }
+  json->EndObject();
+  json->Key("table3_test").String("mann_whitney_u");
+  json->Key("table4").BeginObject();
+  for (const char* mode : kSetupModes) {
+    if (!HasMode(runs, mode)) continue;
+    json->Key(mode).BeginObject();
+    json->Key("execution_s");
+    WriteStats(json, Summarize(Times(runs, mode, false)));
+    const std::vector<double> alignment = Times(runs, mode, true);
+    if (!alignment.empty()) {
+      json->Key("alignment_s");
+      WriteStats(json, Summarize(alignment));
+    }
+    json->EndObject();
+  }
+  json->EndObject();
+}
+
+void WriteSetupPaper(JsonWriter* json) {
+  json->Key("setup_source").String(kPaperSetupSource);
+  json->Key("table2").BeginObject();
+  for (int m = 0; m < 3; ++m) {
+    json->Key(kSetupModes[m]);
+    WritePaperStats(json, kPaperTable2[m]);
+  }
+  json->EndObject();
+  json->Key("table3").BeginObject();
+  for (int p = 0; p < 3; ++p) {
+    json->Key(kSetupPairs[p]).BeginObject();
+    for (int j = 0; j < 6; ++j) json->Key("joint" + std::to_string(j + 1)).Number(kPaperTable3[p][j]);
+    json->Key("total").Number(kPaperTable3[p][6]);
+    json->EndObject();
+  }
+  json->EndObject();
+  json->Key("table4").BeginObject();
+  for (int m = 0; m < 3; ++m) {
+    json->Key(kSetupModes[m]).BeginObject();
+    json->Key("execution_s");
+    WritePaperStats(json, kPaperExecution[m]);
+    if (m < 2) {
+      json->Key("alignment_s");
+      WritePaperStats(json, kPaperAlignment[m]);
+    }
+    json->EndObject();
+  }
+  json->EndObject();
+}
+
+std::string SetupSummary(const std::vector<SetupUserRun>& runs) {
+  size_t setups = 0;
+  for (const SetupUserRun& run : runs) setups += run.setups.size();
+  std::string text = "Robot set-up study: " + std::to_string(runs.size()) + " users, " +
+                     std::to_string(setups) +
+                     " set-ups\n  Table 2, joint error [deg]   mean / median / min / max / std\n";
+  for (int m = 0; m < 3; ++m) {
+    if (!HasMode(runs, kSetupModes[m])) continue;
+    const PaperStats& p = kPaperTable2[m];
+    text += "    " + std::string(kSetupModes[m]) + std::string(15 - std::string(kSetupModes[m]).size(), ' ') +
+            StatsText(Summarize(JointErrors(runs, kSetupModes[m], -1)), 1, false) + "   paper " +
+            StatsText(Stats5{0, p.mean, p.median, p.min, p.max, p.std}, 2, false) + "\n";
+  }
+  text += "  Table 4, execution time [min:s]\n";
+  for (int m = 0; m < 3; ++m) {
+    if (!HasMode(runs, kSetupModes[m])) continue;
+    const PaperStats& p = kPaperExecution[m];
+    text += "    " + std::string(kSetupModes[m]) + std::string(15 - std::string(kSetupModes[m]).size(), ' ') +
+            StatsText(Summarize(Times(runs, kSetupModes[m], false)), 0, true) + "   paper " +
+            StatsText(Stats5{0, p.mean, p.median, p.min, p.max, p.std}, 0, true) + "\n";
+  }
+  return text;
+}
+
+}  // namespace orbed::study
