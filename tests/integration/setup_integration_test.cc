@@ -1,0 +1,168 @@
+// The robot set-up study's processes over real LCM, in a private network namespace.
+//  1. orbed-assistant --once beside the real sim and orbed-guidance, with a near-perfect person
+//     (tests' own config): the arm ends on the target (each joint within 0.5 deg: the grid is
+//     0.25 deg), the result file's joints are the sim's IIWA_STATUS, and the twisting joints the
+//     straight arm hides (1 and 3: nothing downstream is bent) were left where they were.
+//  2. The same person, the target the iiwa reaches with joint 2 bent the other way than the arm's
+//     start: joint 1 ends half a turn from its target (the q1 + 180 deg, -q2 ambiguity), seen over
+//     the bus, not in the core.
+//  3. scripts/launch/setup.yaml for one user and one target per mode through orbed-launch: the run
+//     ends with exit 0; setup_results.json has the three set-ups in the order the user seed draws,
+//     each reached_deg equal to the assistant's (the sim's measured joints, twice read), an
+//     alignment of 3 trials before each headset set-up and none before the fixed one.
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+#include <lcm/lcm-cpp.hpp>
+#include <orbed/iiwa_status_t.hpp>
+
+#include "base/units.h"
+#include "procs/setup/setup_process.h"
+#include "tests/integration/testbed_util.h"
+
+namespace orbed::testing {
+namespace {
+
+constexpr char kPerfectConfig[] = R"(assistant:
+  user_scale_log_sigma: 0
+  headset: {lateral_noise_arcmin: 0.001, depth_noise_fraction_std: 0.00001}
+  monitor: {mental_rotation_std_deg: 0, picture_scale_log_sigma: 0, picture_noise_arcmin: 0.001,
+            picture_depth_fraction_std: 0.00001}
+  acting: {placement_noise_deg: 0}
+)";
+
+class StatusWatcher {
+ public:
+  explicit StatusWatcher(BusWatcher* bus) { bus->lcm().subscribe("IIWA_STATUS", &StatusWatcher::On, this); }
+  bool Latest(orbed::iiwa_status_t* out) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!have_) return false;
+    *out = status_;
+    return true;
+  }
+
+ private:
+  void On(const lcm::ReceiveBuffer*, const std::string&, const orbed::iiwa_status_t* msg) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    status_ = *msg;
+    have_ = true;
+  }
+  mutable std::mutex mutex_;
+  orbed::iiwa_status_t status_{};
+  bool have_{false};
+};
+
+std::string WriteFile(const std::string& dir, const std::string& name, const std::string& text) {
+  const std::string path = dir + "/" + name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+std::string Join(const std::vector<double>& q) {
+  std::string out;
+  for (double x : q) out += (out.empty() ? "" : ",") + std::to_string(x);
+  return out;
+}
+
+// Runs sim + guidance (fixed display, `target_deg`) + assistant --once; returns the result file.
+YAML::Node RunOnce(const std::vector<double>& target_deg, const std::vector<double>& start_deg,
+                   orbed::iiwa_status_t* final_status) {
+  const std::string dir = MakeTempDir("setup_once");
+  const std::string config = WriteFile(dir, "perfect.yaml", kPerfectConfig);
+  BusWatcher bus;
+  StatusWatcher status(&bus);
+  bus.Start();
+  RunningProcess sim({BinPath("orbed-iiwa-sim"), "--initial-q-deg", Join(start_deg)});
+  RunningProcess guidance({BinPath("orbed-guidance"), "--target-deg", Join(target_deg), "--mode", "fixed"});
+  RunningProcess assistant(
+      {BinPath("orbed-assistant"), "--once", "--config", config, "--result", dir + "/result.json"});
+  EXPECT_TRUE(assistant.Wait(240)) << "the assistant did not finish";
+  EXPECT_EQ(assistant.exit_code(), 0);
+  EXPECT_TRUE(status.Latest(final_status));
+  return YAML::LoadFile(dir + "/result.json");
+}
+
+TEST(Assistant, APerfectPersonSetsTheArmUpOverTheBus) {
+  const std::vector<double> target = {0, 35, 0, -50, 0, 40, 20};
+  orbed::iiwa_status_t status{};
+  const YAML::Node result = RunOnce(target, {0, 0, 0, 0, 0, 0, 0}, &status);
+  ASSERT_EQ(result["q_reached_deg"].size(), 7u);
+  ASSERT_EQ(status.joint_position_measured.size(), 7u);
+  for (int i = 0; i < 7; ++i) {
+    EXPECT_NEAR(result["q_reached_deg"][i].as<double>(), target[i], 0.5) << "joint " << i + 1;
+    EXPECT_NEAR(result["q_reached_deg"][i].as<double>(), status.joint_position_measured[i] * kRadToDeg, 0.05)
+        << "joint " << i + 1;
+    EXPECT_NEAR(result["error_deg"][i].as<double>(),
+                std::abs(result["q_reached_deg"][i].as<double>() - target[i]), 1e-9);
+  }
+  EXPECT_EQ(result["mode"].as<std::string>(), "fixed");
+  EXPECT_EQ(result["twisting"][0].as<int>(), 1);
+  EXPECT_EQ(result["twisting"][1].as<int>(), 0);
+  // Joint 1 at its first look: the arm straight up, nothing off its axis: one range, everything.
+  EXPECT_EQ(result["ranges"][0].as<int>(), 1);
+  EXPECT_GT(result["execution_s"].as<double>(), 0);
+}
+
+TEST(Assistant, TheOtherElbowSendsJointOneHalfATurnAway) {
+  const std::vector<double> target = {60, -30, 0, -50, 0, 40, 0};
+  orbed::iiwa_status_t status{};
+  const YAML::Node result = RunOnce(target, {0, 30, 0, -50, 0, 40, 0}, &status);
+  ASSERT_EQ(result["q_reached_deg"].size(), 7u);
+  EXPECT_NEAR(result["q_reached_deg"][0].as<double>(), 60.0 - 180.0, 1.0);
+  // Then joint 2 matches the elbow from the other side: +30, not the target's -30.
+  EXPECT_NEAR(result["q_reached_deg"][1].as<double>(), 30.0, 1.0);
+}
+
+TEST(SetupStudy, OneUserThroughTheLaunchFile) {
+  const std::string log_dir = MakeTempDir("setup_e2e");
+  constexpr uint64_t kSeed = 4;
+  RunningProcess launcher(
+      {BinPath("orbed-launch"), SourcePath("scripts/launch/setup.yaml"), "--duration-s", "400"},
+      {{"ORBED_LOG_DIR", log_dir},
+       {"ORBED_RUN_ID", "setup-e2e"},
+       {"ORBED_USER", "u7"},
+       {"ORBED_USER_SEED", std::to_string(kSeed)},
+       {"ORBED_SETUP_TARGETS", "1"}});
+  ASSERT_TRUE(launcher.Wait(400)) << "the run did not finish";
+  ASSERT_EQ(launcher.exit_code(), 0);
+  const YAML::Node results = YAML::LoadFile(log_dir + "/setup_results.json");
+  EXPECT_EQ(results["status"].as<std::string>(), "ok");
+  EXPECT_EQ(results["user"].as<std::string>(), "u7");
+  const std::vector<int8_t> order = setup::ModeOrderForSeed(kSeed);
+  const YAML::Node setups = results["setups"];
+  ASSERT_EQ(setups.size(), 3u);
+  for (size_t k = 0; k < 3; ++k) {
+    const YAML::Node s = setups[k];
+    const std::string mode = setup::kModeNames[order[k]];
+    EXPECT_EQ(s["mode"].as<std::string>(), mode);
+    EXPECT_EQ(s["order"].as<int>(), static_cast<int>(k) + 1);
+    EXPECT_EQ(s["task_id"].as<std::string>(), "u7-" + mode + "-1");
+    ASSERT_EQ(s["reached_deg"].size(), 7u);
+    for (int i = 0; i < 7; ++i) {
+      EXPECT_NEAR(s["reached_deg"][i].as<double>(), s["assistant_reached_deg"][i].as<double>(), 0.05) << mode;
+    }
+    if (mode == "fixed") {
+      EXPECT_TRUE(s["alignment"].IsNull());
+      EXPECT_TRUE(s["alignment_s"].IsNull());
+    } else {
+      ASSERT_TRUE(s["alignment"].IsMap()) << mode;
+      EXPECT_EQ(s["alignment"]["trials"].as<int>(), 3);
+      EXPECT_GT(s["alignment_s"].as<double>(), 0);
+      EXPECT_LT(s["alignment"]["translation_error_mm"].as<double>(), 200.0);
+    }
+  }
+  const YAML::Node manifest = YAML::LoadFile(log_dir + "/manifest.json");
+  EXPECT_TRUE(manifest["complete"].as<bool>());
+  for (const char* channel : {"SETUP_TASK", "SETUP_RESULT", "GUIDANCE", "IIWA_COMMAND", "ALIGNMENT_TRIAL"}) {
+    EXPECT_TRUE(manifest["channels"][channel]) << channel << " missing from the log";
+  }
+}
+
+}  // namespace
+}  // namespace orbed::testing
