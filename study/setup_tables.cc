@@ -20,26 +20,21 @@ bool IsSetupMode(const std::string& mode) {
   return mode == "ar_reflective" || mode == "ar" || mode == "fixed";
 }
 
-void WriteStats(JsonWriter* json, const Stats5& s) {
+// {mean, median, min, max, std[, n]}.
+void WriteStats(JsonWriter* json, const Stats5& s, bool with_n = true) {
   json->BeginObject();
   json->Key("mean").Number(s.mean);
   json->Key("median").Number(s.median);
   json->Key("min").Number(s.min);
   json->Key("max").Number(s.max);
   json->Key("std").Number(s.std);
-  json->Key("n").Int(s.n);
+  if (with_n) json->Key("n").Int(s.n);
   json->EndObject();
 }
 
-void WritePaperStats(JsonWriter* json, const PaperStats& s) {
-  json->BeginObject();
-  json->Key("mean").Number(s.mean);
-  json->Key("median").Number(s.median);
-  json->Key("min").Number(s.min);
-  json->Key("max").Number(s.max);
-  json->Key("std").Number(s.std);
-  json->EndObject();
-}
+Stats5 FromPaper(const PaperStats& p) { return Stats5{0, p.mean, p.median, p.min, p.max, p.std}; }
+
+void WritePaperStats(JsonWriter* json, const PaperStats& p) { WriteStats(json, FromPaper(p), false); }
 
 bool HasMode(const std::vector<SetupUserRun>& runs, const std::string& mode) {
   for (const SetupUserRun& run : runs) {
@@ -275,7 +270,7 @@ std::string SetupSummary(const std::vector<SetupUserRun>& runs) {
     const PaperStats& p = kPaperTable2[m];
     text += "    " + std::string(kSetupModes[m]) + std::string(15 - std::string(kSetupModes[m]).size(), ' ') +
             StatsText(Summarize(JointErrors(runs, kSetupModes[m], -1)), 1, false) + "   paper " +
-            StatsText(Stats5{0, p.mean, p.median, p.min, p.max, p.std}, 2, false) + "\n";
+            StatsText(FromPaper(p), 2, false) + "\n";
   }
   text += "  Table 4, execution time [min:s]\n";
   for (int m = 0; m < 3; ++m) {
@@ -283,7 +278,7 @@ std::string SetupSummary(const std::vector<SetupUserRun>& runs) {
     const PaperStats& p = kPaperExecution[m];
     text += "    " + std::string(kSetupModes[m]) + std::string(15 - std::string(kSetupModes[m]).size(), ' ') +
             StatsText(Summarize(Times(runs, kSetupModes[m], false)), 0, true) + "   paper " +
-            StatsText(Stats5{0, p.mean, p.median, p.min, p.max, p.std}, 0, true) + "\n";
+            StatsText(FromPaper(p), 0, true) + "\n";
   }
   return text;
 }

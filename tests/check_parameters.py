@@ -30,6 +30,7 @@ FILES = [
     "hmd_emulator/config/viraal_walk.yaml",
     "hmd_emulator/config/walk_loop.yaml",
     "viraal/viraal.yaml",
+    "procs/assistant/assistant.yaml",
 ]
 DOC = "docs/parameters.md"
 SOURCE_CLASSES = ("paper", "literature", "literature (as stated, not checked)", "fitted", "choice")

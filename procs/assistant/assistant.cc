@@ -22,6 +22,18 @@ void Across(const Eigen::Vector3d& n, Eigen::Vector3d* e1, Eigen::Vector3d* e2) 
   *e2 = n.cross(*e1);
 }
 
+// A point seen from `origin` with noise: `lateral_rad` across the ray (two axes), `depth_fraction`
+// of the distance along it.
+Eigen::Vector3d Perturb(const Eigen::Vector3d& p, const Eigen::Vector3d& origin, double lateral_rad,
+                        double depth_fraction, Random* rng) {
+  const double rho = (p - origin).norm();
+  const Eigen::Vector3d n = (p - origin) / rho;
+  Eigen::Vector3d e1, e2;
+  Across(n, &e1, &e2);
+  const double a = rng->Normal(), b = rng->Normal(), c = rng->Normal();
+  return p + rho * lateral_rad * (a * e1 + b * e2) + rho * depth_fraction * c * n;
+}
+
 void AddUnique(int link, const Eigen::Vector3d& p_L, std::vector<Feature>* features) {
   for (const Feature& f : *features) {
     if (f.link == link && (f.p_L - p_L).norm() < 1e-3) return;
@@ -154,38 +166,27 @@ std::vector<Eigen::Vector3d> Assistant::PerceiveTarget(int joint, const Eigen::V
                                                        const Viewing& view) {
   const std::vector<Eigen::Isometry3d> X_RL = model_->CalcLinkPoses(q_target);
   std::vector<Eigen::Vector3d> seen;
-  const bool monitor = view.mode == orbed::guidance_t::MODE_FIXED_DISPLAY;
-  if (!monitor) {
-    const double lateral = scale_ * config_.lateral_noise_arcmin * kArcminToRad;
-    const double depth = scale_ * config_.depth_noise_fraction_std;
+  if (view.mode != orbed::guidance_t::MODE_FIXED_DISPLAY) {
+    // The hologram, seen from the eye.
     for (const Feature& f : FeaturesWithPivot(joint)) {
-      const Eigen::Vector3d h = view.X_WV_seen * (X_RL[f.link] * f.p_L);
-      const double rho = (h - view.p_WE).norm();
-      Eigen::Vector3d e1, e2;
-      const Eigen::Vector3d n = (h - view.p_WE) / rho;
-      Across(n, &e1, &e2);
-      const double a = rng_.Normal(), b = rng_.Normal(), c = rng_.Normal();
-      seen.push_back(h + rho * lateral * (a * e1 + b * e2) + rho * depth * c * n);
+      seen.push_back(Perturb(view.X_WV_seen * (X_RL[f.link] * f.p_L), view.p_WE,
+                             scale_ * config_.lateral_noise_arcmin * kArcminToRad,
+                             scale_ * config_.depth_noise_fraction_std, &rng_));
     }
     return seen;
   }
   // The monitor's picture turned into the person's view: a rotation about the vertical through the
-  // base and a scale about the base, per look.
+  // base and a scale about the base, per look; read with the picture's noise along the monitor
+  // camera's rays.
   const double psi = scale_ * config_.mental_rotation_std_deg * kDegToRad * rng_.Normal();
   const double k = std::exp(scale_ * config_.picture_scale_log_sigma * rng_.Normal());
   const Eigen::Matrix3d R_turn = Eigen::AngleAxisd(psi, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  const double lateral = scale_ * config_.picture_noise_arcmin * kArcminToRad;
-  const double depth = scale_ * config_.picture_depth_fraction_std;
   const Eigen::Vector3d p_WR = view.X_WR.translation();
   for (const Feature& f : FeaturesWithPivot(joint)) {
     const Eigen::Vector3d p = view.X_WR * (X_RL[f.link] * f.p_L);
-    const Eigen::Vector3d h = p_WR + k * (R_turn * (p - p_WR));
-    const double rho = (h - config_.monitor_camera_m).norm();
-    const Eigen::Vector3d n = (h - config_.monitor_camera_m) / rho;
-    Eigen::Vector3d e1, e2;
-    Across(n, &e1, &e2);
-    const double a = rng_.Normal(), b = rng_.Normal(), c = rng_.Normal();
-    seen.push_back(h + rho * lateral * (a * e1 + b * e2) + rho * depth * c * n);
+    seen.push_back(Perturb(p_WR + k * (R_turn * (p - p_WR)), config_.monitor_camera_m,
+                           scale_ * config_.picture_noise_arcmin * kArcminToRad,
+                           scale_ * config_.picture_depth_fraction_std, &rng_));
   }
   return seen;
 }

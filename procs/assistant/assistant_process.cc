@@ -297,20 +297,6 @@ void AssistantProcess::Finish() {
     task_result_ = r;
     process_.Publish(options_.setup_result_channel, r);
   }
-  if (task_) {
-    orbed::setup_result_t r{};
-    r.utime = NowMicros();
-    r.request_id = task_->request_id;
-    r.task_id = task_->task_id;
-    r.mode = partial_.mode;
-    r.num_joints = static_cast<int32_t>(q_rad_.size());
-    for (int i = 0; i < q_rad_.size(); ++i) r.reached_position.push_back(q_rad_[i]);
-    r.ranges = partial_.ranges;
-    r.execution_s = partial_.execution_s;
-    r.person_scale = partial_.person_scale;
-    task_result_ = r;
-    process_.Publish(options_.setup_result_channel, r);
-  }
   if (!options_.result_path.empty()) {
     std::string error;
     if (!ReplaceFile(options_.result_path, SetupResultJson(*result_), &error)) {

@@ -94,10 +94,11 @@ class AssistantProcess {
   int Run() { return process_.Run(); }
   Process& process() { return process_; }
   const std::optional<SetupResult>& result() const { return result_; }
+  /// The timer's work (public for the fuzz target, which has no timer running).
+  void Step();
 
  private:
   enum class Phase { kIdle, kWait, kLook, kMove, kDone };
-  void Step();
   void StartMove(double t_s);
   void Finish();
   Viewing CurrentView() const;

@@ -72,9 +72,15 @@ ConductorTime SetupProcess::Now() const {
   return ConductorTime{t.count(), NowMicros()};
 }
 
-int SetupProcess::Run() {
+void SetupProcess::Start() {
+  if (started_) return;
+  started_ = true;
   Apply(conductor_->Start(Now()));
   Write(true);
+}
+
+int SetupProcess::Run() {
+  Start();
   const int code = process_.Run();
   if (!finished_) {
     Apply(conductor_->Abort("interrupted before the study's set-ups were done", Now()));

@@ -38,7 +38,11 @@ class SetupProcess {
   /// Throws std::invalid_argument / std::runtime_error for bad options or an unreadable model.
   SetupProcess(const CommonFlags& flags, const SetupOptions& options, const std::string& urdf_path,
                const std::string& results_dir, std::ostream* out);
+  /// Starts the conductor (Run() does; public for the fuzz target, which feeds the handlers
+  /// without running). Once only.
+  void Start();
   int Run();
+  Process& process() { return process_; }
 
  private:
   void Apply(SetupConductor::Actions actions);
@@ -52,6 +56,7 @@ class SetupProcess {
   std::chrono::steady_clock::time_point origin_;
   size_t written_setups_{0};
   bool finished_{false};
+  bool started_{false};
 };
 
 /// orbed-setup's command line (flags: --help). Exit 0 when every set-up finished; 1 on a failure; 2

@@ -1,0 +1,132 @@
+// The set-up study's tables from setup_results.json files (study/setup_tables.h). Oracles: hand
+// computations (means, medians of small samples; the Mann-Whitney U normal approximation for a
+// fully separated 3 vs 4 sample: U = 0, sigma^2 = 3*4*8/12 = 8, z = (6 - 0.5)/sqrt(8) = 1.94454,
+// p = erfc(z/sqrt 2) = 0.0518299), and the paper's own numbers carried through unchanged.
+#include "study/setup_tables.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "study/paper_setup.h"
+
+namespace orbed::study {
+namespace {
+
+// One set-up: joint 1 reached at `error1` from a target of 10 deg, the other joints exactly.
+std::string SetupJson(const std::string& mode, int order, int target, double error1, double execution_s,
+                      const std::string& alignment_s) {
+  return R"({"task_id": "x", "mode": ")" + mode + R"(", "order": )" + std::to_string(order) +
+         R"(, "target": )" + std::to_string(target) +
+         R"(, "target_deg": [10, 20, 0, -60, 0, 40, 0], "reached_deg": [)" + std::to_string(10 + error1) +
+         R"(, 20, 0, -60, 0, 40, 0], "assistant_reached_deg": [0, 0, 0, 0, 0, 0, 0],
+          "twisting": [1, 0, 1, 0, 1, 0, 1], "ranges": [1, 1, 1, 1, 1, 1, 1], "execution_s": )" +
+         std::to_string(execution_s) + R"(, "alignment_s": )" + alignment_s + R"(, "person_scale": 1,
+          "alignment": null})";
+}
+
+std::string Write(const std::string& name, const std::string& text) {
+  const std::string path = ::testing::TempDir() + "/" + name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+std::vector<SetupUserRun> TwoUsers() {
+  const std::string u1 =
+      R"({"user": "u1", "run_id": "r", "status": "ok", "error": "", "order": ["ar", "fixed"],
+    "setups": [)" +
+      SetupJson("ar", 1, 1, 1, 60, "100") + "," + SetupJson("ar", 1, 2, 2, 90, "140") + "," +
+      SetupJson("fixed", 2, 1, 4, 100, "null") + "," + SetupJson("fixed", 2, 2, -5, 120, "null") + "]}";
+  const std::string u2 =
+      R"({"user": "u2", "run_id": "r", "status": "ok", "error": "", "order": ["fixed", "ar"],
+    "setups": [)" +
+      SetupJson("fixed", 1, 1, 6, 80, "null") + "," + SetupJson("fixed", 1, 2, 7, 140, "null") + "," +
+      SetupJson("ar", 2, 1, -3, 75, "120") + "]}";
+  return {ReadSetupResults(Write("u1.json", u1)), ReadSetupResults(Write("u2.json", u2))};
+}
+
+TEST(SetupTables, ReadsTheRunsAndWritesTheCsvFiles) {
+  const std::vector<SetupUserRun> runs = TwoUsers();
+  ASSERT_EQ(runs[0].setups.size(), 4u);
+  EXPECT_EQ(runs[1].user, "u2");
+  EXPECT_FALSE(runs[0].setups[2].alignment_s.has_value());
+  EXPECT_EQ(*runs[0].setups[1].alignment_s, 140);
+  const std::string joints = SetupJointsCsv(runs);
+  EXPECT_EQ(joints.substr(0, joints.find('\n')),
+            "user,mode,order,target,joint,twisting,target_deg,reached_deg,error_deg");
+  EXPECT_NE(joints.find("\nu1,ar,1,1,1,1,10,11,1\n"), std::string::npos) << joints;
+  EXPECT_NE(joints.find("\nu1,fixed,2,2,1,1,10,5,5\n"), std::string::npos) << joints;
+  EXPECT_EQ(std::count(joints.begin(), joints.end(), '\n'), 1 + 7 * 7);
+  const std::string times = SetupTimesCsv(runs);
+  EXPECT_EQ(times.substr(0, times.find('\n')), "user,mode,order,target,execution_s,alignment_s");
+  EXPECT_NE(times.find("\nu1,fixed,2,1,100,\n"), std::string::npos) << times;
+  EXPECT_NE(times.find("\nu2,ar,2,1,75,120\n"), std::string::npos) << times;
+}
+
+TEST(SetupTables, TablesTwoThreeAndFourByHand) {
+  const std::vector<SetupUserRun> runs = TwoUsers();
+  JsonWriter writer;
+  writer.BeginObject();
+  WriteSetupTables(&writer, runs);
+  writer.EndObject();
+  const nlohmann::json t = nlohmann::json::parse(writer.str());
+  // Table 2, ar: joint 1 errors {1, 2, 3} and 18 zeros.
+  EXPECT_NEAR(t["table2"]["ar"]["mean"].get<double>(), 6.0 / 21.0, 1e-12);
+  EXPECT_EQ(t["table2"]["ar"]["median"].get<double>(), 0.0);
+  EXPECT_EQ(t["table2"]["ar"]["max"].get<double>(), 3.0);
+  EXPECT_EQ(t["table2"]["ar"]["n"].get<int>(), 21);
+  EXPECT_FALSE(t["table2"].contains("ar_reflective"));
+  // Table 3, ar/fixed, joint 1: {1, 2, 3} against {4, 5, 6, 7}.
+  EXPECT_NEAR(t["table3"]["ar/fixed"]["joint1"].get<double>(), 0.0518299272, 1e-9);
+  EXPECT_TRUE(t["table3"]["ar/fixed"]["joint2"].is_null());  // all zero: no test
+  EXPECT_FALSE(t["table3"].contains("ar_reflective/ar"));
+  EXPECT_EQ(t["table3_test"].get<std::string>(), "mann_whitney_u");
+  // Table 4: execution {60, 90, 75}, alignment {100, 140, 120}; fixed has no alignment.
+  EXPECT_EQ(t["table4"]["ar"]["execution_s"]["median"].get<double>(), 75.0);
+  EXPECT_NEAR(t["table4"]["ar"]["execution_s"]["std"].get<double>(), 15.0, 1e-12);
+  EXPECT_EQ(t["table4"]["ar"]["alignment_s"]["mean"].get<double>(), 120.0);
+  EXPECT_FALSE(t["table4"]["fixed"].contains("alignment_s"));
+  EXPECT_EQ(t["table4"]["fixed"]["execution_s"]["max"].get<double>(), 140.0);
+
+  JsonWriter paper;
+  paper.BeginObject();
+  WriteSetupPaper(&paper);
+  paper.EndObject();
+  const nlohmann::json p = nlohmann::json::parse(paper.str());
+  EXPECT_EQ(p["table2"]["fixed"]["median"].get<double>(), 50.6);
+  EXPECT_EQ(p["table3"]["ar/fixed"]["total"].get<double>(), 2.0e-18);
+  EXPECT_EQ(p["table4"]["ar"]["execution_s"]["mean"].get<double>(), 91.0);              // 1:31
+  EXPECT_EQ(p["table4"]["ar_reflective"]["alignment_s"]["mean"].get<double>(), 272.0);  // 4:32
+}
+
+TEST(SetupTables, RefusesUnfinishedOrMalformedRuns) {
+  auto error = [](const std::string& text) {
+    try {
+      ReadSetupResults(Write("bad.json", text));
+      return std::string("(accepted)");
+    } catch (const std::runtime_error& e) {
+      return std::string(e.what());
+    }
+  };
+  EXPECT_NE(
+      error(R"({"user": "u1", "status": "failed", "error": "no SETUP_RESULT", "order": [], "setups": []})")
+          .find("no SETUP_RESULT"),
+      std::string::npos);
+  EXPECT_NE(error(R"({"user": "u1", "status": "ok", "error": "", "order": [], "setups": [)" +
+                  SetupJson("holo", 1, 1, 1, 1, "1") + "]}")
+                .find("holo"),
+            std::string::npos);
+  std::string short_target = SetupJson("ar", 1, 1, 1, 1, "1");
+  short_target.replace(short_target.find("[10, 20, 0, -60, 0, 40, 0]"), 26, "[10, 20]");
+  EXPECT_NE(
+      error(R"({"user": "u1", "status": "ok", "error": "", "order": [], "setups": [)" + short_target + "]}"),
+      "(accepted)");
+  EXPECT_NE(error("{not json"), "(accepted)");
+}
+
+}  // namespace
+}  // namespace orbed::study
