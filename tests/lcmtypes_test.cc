@@ -80,7 +80,8 @@ TEST(LcmTypes, EveryTypeRoundTripsAndHasAUniqueFingerprint) {
 // another fingerprint ("<channel>/decode/fingerprint"): any change of a type is a breaking change
 // on the wire. docs/design.md §3 "Changing the contract" says how one is made: fields appended at the
 // end, the change listed there with the old and new fingerprints, and this table updated in the same
-// commit. Last change: contract change 3 (dropped, drop_reason and drop_count appended to
+// commit. Last change: contract change 4 (setup_task_t and setup_result_t added for the robot set-up
+// study); before it, contract change 3 (dropped, drop_reason and drop_count appended to
 // process_status_t); before it, contract change 2 (the tracking fault record appended to
 // alignment_trial_t) and contract change 1 (request_id appended to session_control_t,
 // alignment_trial_t and registration_t).
@@ -106,7 +107,9 @@ TEST(LcmTypes, FingerprintsArePinned) {
                                                   {"reflective_view_t", 0xba9d743e2da58034ULL},
                                                   {"registration_t", 0xa59c0b3d053d0d83ULL},
                                                   {"robot_state_t", 0x3af0ecdeab2a6837ULL},
-                                                  {"session_control_t", 0xcdbe036ad16d76feULL}};
+                                                  {"session_control_t", 0xcdbe036ad16d76feULL},
+                                                  {"setup_result_t", 0x7b1a0cab822c59c1ULL},
+                                                  {"setup_task_t", 0x45ebcc451fbad1b9ULL}};
   std::map<std::string, uint64_t> actual;
 #define ORBED_HASH(type) actual[#type] = static_cast<uint64_t>(orbed::type::getHash());
   ORBED_FOR_EACH_LCM_TYPE(ORBED_HASH)
