@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <drake/lcmt_iiwa_command.hpp>
 #include <drake/lcmt_iiwa_status.hpp>
+#include <drake/lcmt_viewer_draw.hpp>
+#include <drake/lcmt_viewer_load_robot.hpp>
 #include <map>
 #include <orbed/all_types.hpp>
 #include <string>
@@ -48,6 +50,37 @@ TEST(LcmTypes, IiwaCommandFingerprintEqualsDrakes) {
   EXPECT_EQ(ours.num_torques, 0);
 }
 
+// Drake's viewer types (Meldis, drake-visualizer): the same fingerprints, and a draw message
+// written by one decodes as the other with the same values.
+TEST(LcmTypes, ViewerTypesAreDrakes) {
+  EXPECT_EQ(orbed::viewer_geometry_data_t::getHash(), drake::lcmt_viewer_geometry_data::getHash());
+  EXPECT_EQ(orbed::viewer_link_data_t::getHash(), drake::lcmt_viewer_link_data::getHash());
+  EXPECT_EQ(orbed::viewer_load_robot_t::getHash(), drake::lcmt_viewer_load_robot::getHash());
+  EXPECT_EQ(orbed::viewer_draw_t::getHash(), drake::lcmt_viewer_draw::getHash());
+  orbed::viewer_load_robot_t load{};
+  orbed::viewer_link_data_t link{};
+  link.name = "iiwa_link_2";
+  link.robot_num = 1;
+  orbed::viewer_geometry_data_t g{};
+  g.type = orbed::viewer_geometry_data_t::CYLINDER;
+  g.quaternion[0] = 1;
+  g.color[3] = 0.5f;
+  g.num_float_data = 2;
+  g.float_data = {0.07f, 0.11f};
+  link.num_geom = 1;
+  link.geom.push_back(g);
+  load.num_links = 1;
+  load.link.push_back(link);
+  std::vector<uint8_t> bytes(load.getEncodedSize());
+  ASSERT_EQ(load.encode(bytes.data(), 0, static_cast<int>(bytes.size())), static_cast<int>(bytes.size()));
+  drake::lcmt_viewer_load_robot theirs;
+  ASSERT_EQ(theirs.decode(bytes.data(), 0, static_cast<int>(bytes.size())), static_cast<int>(bytes.size()));
+  ASSERT_EQ(theirs.link.size(), 1u);
+  EXPECT_EQ(theirs.link[0].name, "iiwa_link_2");
+  EXPECT_EQ(theirs.link[0].geom[0].type, int{drake::lcmt_viewer_geometry_data::CYLINDER});
+  EXPECT_EQ(theirs.link[0].geom[0].float_data[1], 0.11f);
+}
+
 // A different field order or name must change the fingerprint (the test above could not pass
 // by accident): Drake's status vs our command.
 TEST(LcmTypes, FingerprintsDifferAcrossTypes) {
@@ -80,11 +113,11 @@ TEST(LcmTypes, EveryTypeRoundTripsAndHasAUniqueFingerprint) {
 // another fingerprint ("<channel>/decode/fingerprint"): any change of a type is a breaking change
 // on the wire. docs/design.md §3 "Changing the contract" says how one is made: fields appended at the
 // end, the change listed there with the old and new fingerprints, and this table updated in the same
-// commit. Last change: contract change 4 (setup_task_t and setup_result_t added for the robot set-up
-// study); before it, contract change 3 (dropped, drop_reason and drop_count appended to
-// process_status_t); before it, contract change 2 (the tracking fault record appended to
-// alignment_trial_t) and contract change 1 (request_id appended to session_control_t,
-// alignment_trial_t and registration_t).
+// commit. Last change: contract change 4 (types added: setup_task_t and setup_result_t for the robot
+// set-up study, the four viewer_*_t types that are Drake's lcmt_viewer_*); before it, contract change 3
+// (dropped, drop_reason and drop_count appended to process_status_t); before it, contract change 2 (the
+// tracking fault record appended to alignment_trial_t) and contract change 1 (request_id appended to
+// session_control_t, alignment_trial_t and registration_t).
 TEST(LcmTypes, FingerprintsArePinned) {
   const std::map<std::string, uint64_t> pinned = {{"alignment_trial_t", 0x92399efaae13478cULL},
                                                   {"collision_status_t", 0x9f78934234cce93fULL},
@@ -109,7 +142,11 @@ TEST(LcmTypes, FingerprintsArePinned) {
                                                   {"robot_state_t", 0x3af0ecdeab2a6837ULL},
                                                   {"session_control_t", 0xcdbe036ad16d76feULL},
                                                   {"setup_result_t", 0x7b1a0cab822c59c1ULL},
-                                                  {"setup_task_t", 0x45ebcc451fbad1b9ULL}};
+                                                  {"setup_task_t", 0x45ebcc451fbad1b9ULL},
+                                                  {"viewer_draw_t", 0x414f0bfe5b2f4244ULL},
+                                                  {"viewer_geometry_data_t", 0x5d2e34cb3257db07ULL},
+                                                  {"viewer_link_data_t", 0x51252725af982a63ULL},
+                                                  {"viewer_load_robot_t", 0x8987209b10aa2d39ULL}};
   std::map<std::string, uint64_t> actual;
 #define ORBED_HASH(type) actual[#type] = static_cast<uint64_t>(orbed::type::getHash());
   ORBED_FOR_EACH_LCM_TYPE(ORBED_HASH)

@@ -1,0 +1,118 @@
+#include "procs/drake_viewer/viewer_bridge.h"
+
+#include <exception>
+
+#include <CLI/CLI.hpp>
+#include <orbed/guidance_t.hpp>
+#include <orbed/registration_t.hpp>
+#include <orbed/robot_state_t.hpp>
+
+#include "base/source_paths.h"
+#include "procs/common/conversions.h"
+#include "procs/common/flags.h"
+#include "procs/common/log.h"
+#include "procs/common/validation.h"
+#include "procs/drake_viewer/viewer_messages.h"
+#include "procs/guidance/guidance.h"
+
+namespace orbed::viewer {
+namespace {
+
+std::optional<sim::Scene> LoadScene(const std::string& path) {
+  if (path == "none") return std::nullopt;
+  return sim::LoadSceneFile(path.empty() ? SourceTreePath(sim::kDefaultSceneRelativePath) : path);
+}
+
+}  // namespace
+
+ViewerBridge::ViewerBridge(const CommonFlags& flags, const ViewerOptions& options)
+    : process_(flags),
+      options_(options),
+      scene_(LoadScene(options.scene_path)),
+      model_(sim::RobotModel::LoadFile(options.urdf_path.empty()
+                                           ? SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath)
+                                           : options.urdf_path)) {
+  const int n = model_.num_joints();
+  process_.Subscribe<orbed::robot_state_t>(
+      options_.robot_state_channel,
+      [this, n](const orbed::robot_state_t& msg, const std::string& channel, int64_t) {
+        const std::string problem = FirstError(
+            {CheckPose(msg.X_WR, "ROBOT_STATE.X_WR"), CheckSize(msg.num_joints, n, "ROBOT_STATE.num_joints"),
+             CheckBounded(msg.joint_position.data(), static_cast<int>(msg.joint_position.size()), 100.0,
+                          "ROBOT_STATE.joint_position")});
+        if (!problem.empty()) return process_.Reject(channel + "/field", problem);
+        X_WR_ = FromPose(msg.X_WR);
+        q_real_ = Eigen::Map<const Eigen::VectorXd>(msg.joint_position.data(), n);
+      });
+  process_.Subscribe<orbed::registration_t>(
+      options_.registration_channel,
+      [this](const orbed::registration_t& msg, const std::string& channel, int64_t) {
+        if (!msg.valid) return;  // no mean yet
+        const std::string problem = CheckPose(msg.X_WV_mean, "REGISTRATION.X_WV_mean");
+        if (!problem.empty()) return process_.Reject(channel + "/pose", problem);
+        X_WV_ = FromPose(msg.X_WV_mean);
+      });
+  process_.Subscribe<orbed::guidance_t>(
+      options_.guidance_channel,
+      [this, n](const orbed::guidance_t& msg, const std::string& channel, int64_t) {
+        const std::string problem = guidance::CheckGuidance(msg, model_, 0.01);
+        if (!problem.empty()) return process_.Reject(channel + "/field", problem);
+        q_target_ = Eigen::Map<const Eigen::VectorXd>(msg.target_position.data(), n);
+        have_target_ = true;
+      });
+  const orbed::viewer_load_robot_t load = MakeLoadRobot(model_, scene_ ? &*scene_ : nullptr);
+  process_.AddTimer(
+      options_.load_period_s, [this, load] { process_.Publish(options_.load_channel, load); },
+      options_.load_channel);
+  process_.AddTimer(
+      1.0 / options_.rate_hz,
+      [this] {
+        if (const auto draw = DrawNow(NowMicros())) process_.Publish(options_.draw_channel, *draw);
+      },
+      options_.draw_channel);
+  process_.Publish(options_.load_channel, load);
+  ORBED_LOG(kInfo) << "drake viewer: " << load.num_links << " links (real robot, virtual robot"
+                   << (scene_ ? ", " + std::to_string(scene_->objects.size()) + " scene objects" : "")
+                   << ") on " << options_.load_channel << ", poses at " << options_.rate_hz << " Hz on "
+                   << options_.draw_channel;
+}
+
+std::optional<orbed::viewer_draw_t> ViewerBridge::DrawNow(int64_t utime) const {
+  if (!X_WR_) return std::nullopt;
+  return MakeDraw(model_, scene_ ? &*scene_ : nullptr, *X_WR_, q_real_, X_WV_,
+                  have_target_ ? q_target_ : q_real_, utime);
+}
+
+int RunViewerBridge(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
+  CLI::App app{
+      "orbed-drake-viewer: the testbed in Drake's viewer. Publishes DRAKE_VIEWER_LOAD_ROBOT (the real\n"
+      "and the virtual iiwa and the scene's objects) and DRAKE_VIEWER_DRAW (their poses) with Drake's\n"
+      "lcmt_viewer_* types, from ROBOT_STATE, REGISTRATION and GUIDANCE. Start Meldis on the same LCM\n"
+      "URL: python3 -m pydrake.visualization.meldis"};
+  CommonFlags common("orbed-drake-viewer");
+  AddCommonFlags(&app, &common);
+  ViewerOptions options;
+  app.add_option("--urdf", options.urdf_path, "Robot URDF (default: the shipped iiwa 7)");
+  app.add_option("--scene", options.scene_path, "Scene YAML (default: the shipped OR; none: no scene)");
+  app.add_option("--rate-hz", options.rate_hz, "DRAKE_VIEWER_DRAW rate [Hz]")
+      ->check(CLI::Range(0.1, 1000.0))
+      ->capture_default_str();
+  app.add_option("--load-period-s", options.load_period_s, "Period of DRAKE_VIEWER_LOAD_ROBOT [s]")
+      ->check(CLI::Range(0.1, 3600.0))
+      ->capture_default_str();
+  app.add_option("--robot-state-channel", options.robot_state_channel)->capture_default_str();
+  app.add_option("--registration-channel", options.registration_channel)->capture_default_str();
+  app.add_option("--guidance-channel", options.guidance_channel)->capture_default_str();
+  app.add_option("--load-channel", options.load_channel)->capture_default_str();
+  app.add_option("--draw-channel", options.draw_channel)->capture_default_str();
+  if (const auto code = ParseCommandLine(&app, common, argc, argv, out, err)) return *code;
+  try {
+    ViewerBridge bridge(common, options);
+    return bridge.Run();
+  } catch (const std::exception& e) {
+    err << "orbed-drake-viewer: " << e.what() << "\n";
+    return 1;
+  }
+}
+
+}  // namespace orbed::viewer
