@@ -200,8 +200,10 @@ int RunStudyTables(int argc, const char* const* argv, std::ostream& out, std::os
   app.add_option("--config", config_paths,
                  "Headset config applied over the shipped ones (the runs' --config)");
   std::vector<std::string> setup_paths;
+  // One value per --setup, so that ViRAAl runs may follow.
   app.add_option("--setup", setup_paths,
-                 "Each set-up user's setup_results.json or its run folder (orbed-setup)");
+                 "A set-up user's setup_results.json or its run folder (orbed-setup); one per --setup")
+      ->allow_extra_args(false);
   app.add_option("runs", run_paths, "Each ViRAAl user's results.json or its run folder");
   try {
     app.parse(argc, argv);
