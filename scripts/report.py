@@ -183,8 +183,8 @@ def report(study_dir):
                                                  "red-edged (Fig. 8)")):
             parts.append("<figure><img src='figures/%s'><figcaption>%s</figcaption></figure>" % (name, caption))
     trials_path = os.path.join(study_dir, "alignment_trials.csv")
-    if os.path.exists(trials_path):
-        rows = read_csv(trials_path)
+    rows = read_csv(trials_path) if os.path.exists(trials_path) else []
+    if rows:
         parts.append("<h2>Ground truth the paper could not measure</h2><table><tr><th></th>"
                      "<th>registration error at the robot's centroid [mm]</th><th>rotation error [deg]</th></tr>")
         for mode in ("ar_reflective", "ar"):

@@ -9,7 +9,8 @@
 ///                     |reached − target|, reached = the sim's measured joints when the assistant
 ///                     said it was done)
 ///   setup_times.csv   user,mode,order,target,execution_s,alignment_s (alignment_s empty for fixed)
-///   tables.json keys  "table2": {mode: {mean, median, min, max, std, n}} over every joint's error;
+///   tables.json keys  "setup_users" (how many), "table2": {mode: {mean, median, min, max, std, n}} over
+///   every joint's error;
 ///                     "table3": {"ar_reflective/ar" | "ar_reflective/fixed" | "ar/fixed":
 ///                     {"joint1" .. "joint7", "total"}}: two-sided p-values of the Mann-Whitney U
 ///                     test (unpaired: every set-up of every user pooled per mode; normal

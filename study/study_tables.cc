@@ -260,7 +260,11 @@ int RunStudyTables(int argc, const char* const* argv, std::ostream& out, std::os
         {"alignment_means.csv", AlignmentMeansCsv(runs)},
         {"landmark_validation.csv", LandmarkValidationCsv(v)},
         {"tables.json", TablesJson(runs, v, setup_runs)}};
-    std::vector<std::pair<std::string, std::string>> all(std::begin(files), std::end(files));
+    std::vector<std::pair<std::string, std::string>> all;
+    for (const auto& [name, text] : files) {
+      const bool alignment = std::string(name).rfind("alignment_", 0) == 0;
+      if (!alignment || !runs.empty()) all.emplace_back(name, text);  // no ViRAAl runs: no alignment files
+    }
     if (!setup_runs.empty()) {
       all.emplace_back("setup_joints.csv", SetupJointsCsv(setup_runs));
       all.emplace_back("setup_times.csv", SetupTimesCsv(setup_runs));

@@ -9,7 +9,8 @@
 ///   kAlign (ar, ar_reflective only): the user aligns N times in that mode and the registration
 ///     server's SE(3) mean is applied (the paper: "before each AR target the user aligns three
 ///     times"): a ViraalConductor (procs/scenario/viraal_conductor.h) with the alignment protocol,
-///     that mode only and session "<run_id>-<task_id>" runs to its end; its every input and tick
+///     that mode only and run id "<run_id>-<task_id>" (so session "<run_id>-<task_id>-<mode>") runs to
+///     its end; its every input and tick
 ///     are forwarded to it, its actions passed on. Its failure fails the run.
 ///   kPark: IIWA_COMMAND the start configuration (re-sent every command_resend_s) until every joint
 ///     is within tolerance_deg and the motion is IDLE: the experimenter parks the arm.
@@ -51,7 +52,7 @@ namespace orbed::setup {
 using scenario::ConductorActions;
 using scenario::ConductorTime;
 
-/// The set-up study's mode names, as in STUDY.md (guidance_t::MODE_* order).
+/// The set-up study's mode names, as its files and tables name them (guidance_t::MODE_* order).
 inline constexpr const char* kModeNames[] = {"ar", "ar_reflective", "fixed"};
 
 struct SetupOptions {
@@ -102,7 +103,7 @@ struct SetupRun {
 /// setup_results.json's text: {"user", "run_id", "status": "ok" | "failed" | "partial", "error",
 /// "order", "setups": [{task_id, mode, order, target, target_deg, reached_deg,
 /// assistant_reached_deg, error_deg, twisting, ranges, execution_s, alignment_s (null for fixed),
-/// person_scale, alignment: null | {trials, translation_error_mm, rotation_error_deg,
+/// person_scale, alignment: null | {session_id, trials, translation_error_mm, rotation_error_deg,
 /// misalignment_mm} of the mean}]}.
 std::string SetupRunJson(const SetupRun& run, bool partial);
 

@@ -174,7 +174,7 @@ int RunSetup(int argc, const char* const* argv, std::ostream& out, std::ostream&
       ->check(CLI::Range(1, 100))
       ->capture_default_str();
   app.add_option("--run-id", options.run_id,
-                 "Run id (session ids are <run-id>-<task id>; default $ORBED_RUN_ID if set)")
+                 "Run id (sessions are <run-id>-<task id>-<mode>; default $ORBED_RUN_ID if set)")
       ->envname("ORBED_RUN_ID")
       ->capture_default_str();
   app.add_option("--results-dir", results_dir,
