@@ -21,7 +21,7 @@
 #include "procs/common/flags.h"
 #include "procs/common/log.h"
 #include "procs/common/validation.h"
-#include "procs/guidance/guidance.h"
+#include "sim/guidance_messages.h"
 #include "sim/iiwa_status_check.h"
 
 namespace orbed::assistant {

@@ -13,7 +13,7 @@
 #include "procs/common/log.h"
 #include "procs/common/validation.h"
 #include "procs/drake_viewer/viewer_messages.h"
-#include "procs/guidance/guidance.h"
+#include "sim/guidance_messages.h"
 
 namespace orbed::viewer {
 namespace {

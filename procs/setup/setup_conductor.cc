@@ -10,7 +10,7 @@
 #include "base/json.h"
 #include "base/units.h"
 #include "procs/common/validation.h"
-#include "procs/guidance/guidance.h"
+#include "sim/guidance_messages.h"
 
 namespace orbed::setup {
 namespace {

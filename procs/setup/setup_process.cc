@@ -21,7 +21,7 @@
 #include "procs/common/conversions.h"
 #include "procs/common/flags.h"
 #include "procs/common/log.h"
-#include "procs/guidance/guidance.h"
+#include "sim/guidance_messages.h"
 
 namespace orbed::setup {
 

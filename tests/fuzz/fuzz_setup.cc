@@ -3,8 +3,8 @@
 #include <filesystem>
 
 #include "base/source_paths.h"
-#include "procs/guidance/guidance.h"
 #include "procs/setup/setup_process.h"
+#include "sim/guidance_messages.h"
 #include "tests/fuzz/fuzz_util.h"
 #include "viraal/protocol.h"
 
