@@ -53,6 +53,7 @@ int RunHmd(int argc, const char* const* argv, std::ostream& out, std::ostream& e
   app.add_option("--robot-state-channel", o.robot_state_channel)->capture_default_str();
   app.add_option("--session-control-channel", o.session_control_channel)->capture_default_str();
   app.add_option("--registration-channel", o.registration_channel)->capture_default_str();
+  app.add_option("--guidance-channel", o.guidance_channel)->capture_default_str();
   app.add_option("--hmd-pose-channel", o.hmd_pose_channel)->capture_default_str();
   app.add_option("--hmd-pose-truth-channel", o.hmd_pose_truth_channel)->capture_default_str();
   app.add_option("--camera-channel", o.camera_channel)->capture_default_str();

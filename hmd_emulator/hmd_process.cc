@@ -14,6 +14,7 @@
 #include "procs/common/conversions.h"
 #include "procs/common/log.h"
 #include "procs/common/validation.h"
+#include "sim/guidance_messages.h"
 #include "sim/iiwa_status_check.h"
 
 namespace orbed::hmd {
@@ -84,6 +85,9 @@ HmdProcess::HmdProcess(const orbed::CommonFlags& flags, const HmdOptions& option
   process_->Subscribe<orbed::registration_t>(
       options_.registration_channel,
       [this](const orbed::registration_t& m, const std::string& ch, int64_t) { OnRegistration(m, ch); });
+  process_->Subscribe<orbed::guidance_t>(
+      options_.guidance_channel,
+      [this](const orbed::guidance_t& m, const std::string& ch, int64_t) { OnGuidance(m, ch); });
   process_->Subscribe<orbed::alignment_trial_t>(
       options_.trial_channel,
       [this](const orbed::alignment_trial_t& m, const std::string& ch, int64_t) { OnTrial(m, ch); });
@@ -160,6 +164,9 @@ FrameInputs HmdProcess::Inputs() const {
   in.sample_utime = stream_->sample_utime();
   in.robot = robot_;
   in.X_WV = CurrentX_WV();
+  const HologramShown hologram = Hologram();
+  in.hide_hologram = hologram.hidden;
+  in.q_hologram_rad = hologram.q_rad;
   in.t_s = stream_->t_s();
   return in;
 }
@@ -214,6 +221,30 @@ void HmdProcess::OnRobotState(const orbed::robot_state_t& msg, const std::string
   if (!error.empty()) return process_->Reject(channel + "/pose", error);
   robot_.X_WR = FromPose(msg.X_WR);
   robot_.have_X_WR = true;
+}
+
+void HmdProcess::OnGuidance(const orbed::guidance_t& msg, const std::string& channel) {
+  const std::string problem = guidance::CheckGuidance(msg, *robot_model_, kJointLimitSlackRad);
+  if (!problem.empty()) return process_->Reject(channel + "/field", problem);
+  guidance_ = msg;
+  guidance_received_ = std::chrono::steady_clock::now();
+}
+
+HmdProcess::HologramShown HmdProcess::Hologram() const {
+  HologramShown shown;
+  // An alignment session in progress aligns the hologram at the real arm's joints.
+  if (session_.state().active()) return shown;
+  if (!guidance_ ||
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - guidance_received_).count() >
+          kGuidanceFreshS) {
+    return shown;
+  }
+  if (guidance_->mode == orbed::guidance_t::MODE_FIXED_DISPLAY) {
+    shown.hidden = true;
+    return shown;
+  }
+  shown.q_rad = Eigen::Map<const Eigen::VectorXd>(guidance_->target_position.data(), guidance_->num_joints);
+  return shown;
 }
 
 void HmdProcess::OnRegistration(const orbed::registration_t& msg, const std::string& channel) {

@@ -84,6 +84,7 @@
 #include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 #include <orbed/alignment_trial_t.hpp>
+#include <orbed/guidance_t.hpp>
 #include <orbed/iiwa_status_t.hpp>
 #include <orbed/registration_t.hpp>
 #include <orbed/robot_state_t.hpp>
@@ -126,6 +127,9 @@ struct HmdOptions {
   std::string robot_state_channel{channels::kRobotState};
   std::string session_control_channel{channels::kSessionControl};
   std::string registration_channel{channels::kRegistration};
+  /// The set-up guidance (orbed-guidance): while a GUIDANCE is fresh, the hologram shows its target
+  /// configuration (modes ar, ar_reflective), or nothing (fixed: the guidance is on a monitor).
+  std::string guidance_channel{channels::kGuidance};
   std::string hmd_pose_channel{channels::kHmdPose};
   std::string hmd_pose_truth_channel{channels::kHmdPoseTruth};
   std::string camera_channel{channels::kHmdCamera};
@@ -168,6 +172,16 @@ class HmdProcess {
   /// Waits until the worker has finished every pending request (no-op inline).
   void Flush();
 
+  /// What the hologram shows: the real arm's joints (q_rad empty) during an alignment session or
+  /// when no GUIDANCE came in the last kGuidanceFreshS, else GUIDANCE's target (ar, ar_reflective)
+  /// or nothing (hidden: fixed display).
+  struct HologramShown {
+    bool hidden{false};
+    Eigen::VectorXd q_rad;
+  };
+  static constexpr double kGuidanceFreshS = 1.0;
+  HologramShown Hologram() const;
+
   /// The current X_WV (see the file comment) and the active session ("" when none).
   Eigen::Isometry3d CurrentX_WV() const;
   const std::string& active_session() const { return session_.state().id; }
@@ -179,6 +193,7 @@ class HmdProcess {
   void OnSessionControl(const orbed::session_control_t& msg, const std::string& channel);
   void OnRegistration(const orbed::registration_t& msg, const std::string& channel);
   void OnTrial(const orbed::alignment_trial_t& msg, const std::string& channel);
+  void OnGuidance(const orbed::guidance_t& msg, const std::string& channel);
   void SaveState();
   void EmulateTrial(const std::string& channel);
   void SubmitInteractiveTrial();
@@ -190,6 +205,8 @@ class HmdProcess {
 
   HmdOptions options_;
   HmdConfigSet config_;
+  std::optional<orbed::guidance_t> guidance_;                // the latest valid GUIDANCE
+  std::chrono::steady_clock::time_point guidance_received_;  // when it came
   std::unique_ptr<sim::RobotModel> robot_model_;
   std::unique_ptr<orbed::Process> process_;
   std::unique_ptr<PoseStream> stream_;

@@ -734,3 +734,56 @@ TEST(HmdConfig, OverlaysMergeKeyByKey) {
 
 }  // namespace
 }  // namespace orbed::hmd
+
+namespace orbed::hmd {
+namespace {
+
+orbed::guidance_t Guidance(int8_t mode, const std::vector<double>& target_deg) {
+  orbed::guidance_t g{};
+  g.utime = NowMicros();
+  g.mode = mode;
+  g.num_joints = static_cast<int32_t>(target_deg.size());
+  for (double q : target_deg) {
+    g.target_position.push_back(q * kDegToRad);
+    g.current_position.push_back(0);
+    g.error_deg.push_back(-q);
+    g.joint_kind.push_back(0);
+  }
+  g.next_joint = 0;
+  return g;
+}
+
+// During a set-up the hologram shows GUIDANCE's target (ar, ar_reflective) or nothing (fixed), and
+// the real arm's joints again once GUIDANCE is no longer fresh; a bad GUIDANCE is refused, counted
+// and changes nothing.
+TEST(HmdProcess, TheHologramShowsTheGuidancesTarget) {
+  HmdProcess hmd(MemqFlags(0.05), Inline());
+  lcm::LCM& lcm = hmd.process().lcm();
+  EXPECT_EQ(hmd.Hologram().q_rad.size(), 0);
+  EXPECT_FALSE(hmd.Hologram().hidden);
+  const std::vector<double> target = {20, 35, 0, -50, 0, 40, 10};
+  const auto ar = Guidance(+orbed::guidance_t::MODE_AR, target);
+  lcm.publish("GUIDANCE", &ar);
+  Drain(lcm);
+  ASSERT_EQ(hmd.Hologram().q_rad.size(), 7);
+  EXPECT_NEAR(hmd.Hologram().q_rad[1], 35 * kDegToRad, 1e-12);
+  auto bad = Guidance(+orbed::guidance_t::MODE_AR, {1, 2, 3});
+  lcm.publish("GUIDANCE", &bad);
+  Drain(lcm);
+  EXPECT_EQ(hmd.process().rejections().counts()["GUIDANCE/field"], 1);
+  EXPECT_NEAR(hmd.Hologram().q_rad[6], 10 * kDegToRad, 1e-12);
+  const auto fixed = Guidance(+orbed::guidance_t::MODE_FIXED_DISPLAY, target);
+  lcm.publish("GUIDANCE", &fixed);
+  Drain(lcm);
+  EXPECT_TRUE(hmd.Hologram().hidden);
+  // An alignment session: the hologram is aligned at the real joints whatever the guidance says.
+  const auto start = Control("align", +SC::START);
+  lcm.publish("SESSION_CONTROL", &start);
+  lcm.publish("GUIDANCE", &ar);
+  Drain(lcm);
+  EXPECT_FALSE(hmd.Hologram().hidden);
+  EXPECT_EQ(hmd.Hologram().q_rad.size(), 0);
+}
+
+}  // namespace
+}  // namespace orbed::hmd

@@ -280,8 +280,10 @@ void ImagePipeline::Reflective(const FrameInputs& in) {
 void ImagePipeline::ArView(const FrameInputs& in, bool publish) {
   if (!have_frame_) return;
   cv::Mat ar;
-  if (robot_.known()) {
-    compositor_.ComposeArView(bgr_, renderer_.intrinsics(), frame_X_WC_est_, robot_.q_rad, in.X_WV, &ar);
+  if (robot_.known() && !in.hide_hologram) {
+    const Eigen::VectorXd& q =
+        in.q_hologram_rad.size() == robot_.q_rad.size() ? in.q_hologram_rad : robot_.q_rad;
+    compositor_.ComposeArView(bgr_, renderer_.intrinsics(), frame_X_WC_est_, q, in.X_WV, &ar);
   } else {
     ar = bgr_.clone();
   }

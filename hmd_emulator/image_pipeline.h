@@ -65,7 +65,11 @@ struct FrameInputs {
   int64_t sample_utime{0};  ///< its utime [µs]
   RobotState robot;
   Eigen::Isometry3d X_WV{Eigen::Isometry3d::Identity()};  ///< the hologram (map coordinates)
-  double t_s{0};                                          ///< walk time of the sample [s]
+  /// The hologram's joints in AR_VIEW during a set-up (GUIDANCE's target); empty = the real arm's.
+  Eigen::VectorXd q_hologram_rad;
+  /// No hologram in AR_VIEW (the fixed-display mode: the guidance is on a monitor).
+  bool hide_hologram{false};
+  double t_s{0};  ///< walk time of the sample [s]
 };
 
 struct ImagePipelineOptions {
