@@ -6,11 +6,16 @@
 //  2. The same person, the target the iiwa reaches with joint 2 bent the other way than the arm's
 //     start: joint 1 ends half a turn from its target (the q1 + 180 deg, -q2 ambiguity), seen over
 //     the bus, not in the core.
+//  4. A set-up whose assistant and guidance are SIGKILLed while the assistant moves the arm: the
+//     launcher brings both back, the conductor's re-sent SETUP_TASK reaches them, the set-up is done
+//     from where the arm was, and the run ends with exit 0 and a consistent record.
 //  3. scripts/launch/setup.yaml for one user and one target per mode through orbed-launch: the run
 //     ends with exit 0; setup_results.json has the three set-ups in the order the user seed draws,
 //     each reached_deg equal to the assistant's (the sim's measured joints, twice read), an
 //     alignment of 3 trials before each headset set-up and none before the fixed one.
+#include <atomic>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <fstream>
 #include <mutex>
@@ -21,6 +26,7 @@
 #include <yaml-cpp/yaml.h>
 #include <lcm/lcm-cpp.hpp>
 #include <orbed/iiwa_status_t.hpp>
+#include <orbed/setup_task_t.hpp>
 
 #include "base/units.h"
 #include "procs/setup/setup_process.h"
@@ -161,6 +167,66 @@ TEST(SetupStudy, OneUserThroughTheLaunchFile) {
   EXPECT_TRUE(manifest["complete"].as<bool>());
   for (const char* channel : {"SETUP_TASK", "SETUP_RESULT", "GUIDANCE", "IIWA_COMMAND", "ALIGNMENT_TRIAL"}) {
     EXPECT_TRUE(manifest["channels"][channel]) << channel << " missing from the log";
+  }
+}
+
+int LatestPid(const BusWatcher& bus, const std::string& name) {
+  const auto beats = bus.Heartbeats(name);
+  return beats.empty() ? 0 : beats.back().status.pid;
+}
+
+class CommandCounter {
+ public:
+  explicit CommandCounter(BusWatcher* bus) {
+    bus->lcm().subscribe("SETUP_TASK", &CommandCounter::OnTask, this);
+  }
+  int tasks() const { return tasks_.load(); }
+
+ private:
+  void OnTask(const lcm::ReceiveBuffer*, const std::string&, const orbed::setup_task_t*) { ++tasks_; }
+  std::atomic<int> tasks_{0};
+};
+
+TEST(SetupStudy, AKilledAssistantAndGuidanceComeBackAndTheSetUpFinishes) {
+  const std::string log_dir = MakeTempDir("setup_crash");
+  BusWatcher bus;
+  CommandCounter tasks(&bus);
+  bus.Start();
+  RunningProcess launcher(
+      {BinPath("orbed-launch"), SourcePath("scripts/launch/setup.yaml"), "--duration-s", "400"},
+      {{"ORBED_LOG_DIR", log_dir},
+       {"ORBED_RUN_ID", "setup-crash"},
+       {"ORBED_USER", "u2"},
+       {"ORBED_USER_SEED", "2"},
+       {"ORBED_SETUP_MODES", "fixed"},
+       {"ORBED_SETUP_TARGETS", "1"}});
+  // The task is out and the assistant has started moving (its IIWA_COMMANDs on its heartbeat).
+  ASSERT_TRUE(WaitFor(
+      [&] {
+        const auto beats = bus.Heartbeats("assistant");
+        return tasks.tasks() > 0 && !beats.empty() && beats.back().status.messages_out > beats.size() + 2;
+      },
+      120))
+      << "the set-up did not start";
+  const int assistant = LatestPid(bus, "assistant"), guidance = LatestPid(bus, "guidance");
+  ASSERT_GT(assistant, 0);
+  ASSERT_GT(guidance, 0);
+  ASSERT_EQ(kill(assistant, SIGKILL), 0);
+  ASSERT_EQ(kill(guidance, SIGKILL), 0);
+  const int tasks_at_kill = tasks.tasks();
+  ASSERT_TRUE(launcher.Wait(400)) << "the run did not finish";
+  ASSERT_EQ(launcher.exit_code(), 0);
+  EXPECT_NE(LatestPid(bus, "assistant"), assistant) << "the assistant was not respawned";
+  EXPECT_NE(LatestPid(bus, "guidance"), guidance) << "the guidance was not respawned";
+  // The set-up was still waiting for its answer when they died: the task went out again.
+  EXPECT_GT(tasks.tasks(), tasks_at_kill);
+  const YAML::Node results = YAML::LoadFile(log_dir + "/setup_results.json");
+  EXPECT_EQ(results["status"].as<std::string>(), "ok");
+  ASSERT_EQ(results["setups"].size(), 1u);
+  const YAML::Node s = results["setups"][0];
+  EXPECT_EQ(s["mode"].as<std::string>(), "fixed");
+  for (int i = 0; i < 7; ++i) {
+    EXPECT_NEAR(s["reached_deg"][i].as<double>(), s["assistant_reached_deg"][i].as<double>(), 0.05);
   }
 }
 
