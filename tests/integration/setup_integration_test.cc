@@ -204,7 +204,8 @@ TEST(SetupStudy, AKilledAssistantAndGuidanceComeBackAndTheSetUpFinishes) {
   ASSERT_TRUE(WaitFor(
       [&] {
         const auto beats = bus.Heartbeats("assistant");
-        return tasks.tasks() > 0 && !beats.empty() && beats.back().status.messages_out > beats.size() + 2;
+        return tasks.tasks() > 0 && !beats.empty() &&
+               beats.back().status.messages_out > static_cast<int64_t>(beats.size()) + 2;
       },
       120))
       << "the set-up did not start";
