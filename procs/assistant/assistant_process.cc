@@ -20,6 +20,7 @@
 #include "procs/common/conversions.h"
 #include "procs/common/flags.h"
 #include "procs/common/log.h"
+#include "procs/common/requests.h"
 #include "procs/common/validation.h"
 #include "sim/guidance_messages.h"
 #include "sim/iiwa_status_check.h"
@@ -102,10 +103,7 @@ AssistantProcess::AssistantProcess(const CommonFlags& flags, const AssistantOpti
   process_.Subscribe<orbed::robot_state_t>(
       options_.robot_state_channel,
       [this](const orbed::robot_state_t& msg, const std::string& channel, int64_t) {
-        const std::string problem =
-            FirstError({CheckPose(msg.X_WR, "ROBOT_STATE.X_WR"),
-                        CheckEnum(msg.motion_state, orbed::robot_state_t::MOTION_IDLE,
-                                  orbed::robot_state_t::MOTION_IN_COLLISION, "ROBOT_STATE.motion_state")});
+        const std::string problem = CheckRobotState(msg, model_.num_joints());
         if (!problem.empty()) return process_.Reject(channel + "/field", problem);
         X_WR_ = FromPose(msg.X_WR);
         motion_state_ = msg.motion_state;

@@ -81,4 +81,17 @@ std::variant<MisalignmentRequest, Refusal> CheckMisalignmentRequest(const orbed:
   return request;
 }
 
+std::string CheckRobotState(const orbed::robot_state_t& msg, int num_joints) {
+  return FirstError(
+      {CheckPose(msg.X_WR, "ROBOT_STATE.X_WR"),
+       CheckSize(msg.num_joints, num_joints, "ROBOT_STATE.num_joints"),
+       CheckLength(msg.num_joints, msg.joint_position.size(), num_joints, "ROBOT_STATE.num_joints"),
+       CheckLength(msg.num_joints, msg.joint_limit_hit.size(), num_joints, "ROBOT_STATE.joint_limit_hit"),
+       CheckFinite(msg.joint_position, "ROBOT_STATE.joint_position"),
+       CheckLength(msg.num_links, msg.X_RL.size(), kMaxRobotStateLinks, "ROBOT_STATE.num_links"),
+       CheckLength(msg.num_links, msg.link_names.size(), kMaxRobotStateLinks, "ROBOT_STATE.link_names"),
+       CheckEnum(msg.motion_state, orbed::robot_state_t::MOTION_IDLE,
+                 orbed::robot_state_t::MOTION_IN_COLLISION, "ROBOT_STATE.motion_state")});
+}
+
 }  // namespace orbed

@@ -15,6 +15,11 @@
 ///                                          of 0 (origins [m], directions). Key: invalid.
 ///   MISALIGNMENT_REQUEST (misalignment_request_t)  num_pairs in [0, max_pairs], equal to both
 ///                                          arrays' lengths; rows as above [m]. Key: invalid.
+///   ROBOT_STATE (robot_state_t), read by the conductors, the assistant and the viewer bridge:
+///                                          X_WR a valid pose; num_joints == the arm's and equal to
+///                                          the joint arrays' lengths; finite angles [rad]; num_links
+///                                          equal to the link arrays' lengths and at most kMaxLinks;
+///                                          motion_state in range. The reason names the field.
 /// Whether a landmark's rays can be triangulated, or pairs evaluated, is the server's computation,
 /// not the contract.
 ///
@@ -30,6 +35,7 @@
 #include <orbed/landmark_request_t.hpp>
 #include <orbed/misalignment_request_t.hpp>
 #include <orbed/plan_check_request_t.hpp>
+#include <orbed/robot_state_t.hpp>
 
 #include "procs/common/session_control.h"
 
@@ -38,6 +44,12 @@ namespace orbed {
 /// Coordinates and direction components beyond this are not an operating room [m]; bounding them
 /// keeps sums of squares finite.
 inline constexpr double kMaxRequestCoordinate = 1e4;
+/// The most links a ROBOT_STATE may carry.
+inline constexpr int kMaxRobotStateLinks = 1000;
+
+/// "" or the reason ROBOT_STATE is refused (see the file comment); keys are the reader's
+/// ("<channel>/field").
+std::string CheckRobotState(const orbed::robot_state_t& msg, int num_joints);
 
 struct IiwaCommand {
   int64_t utime{0};

@@ -3,6 +3,7 @@
 #include "procs/common/requests.h"
 
 #include <cmath>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -13,6 +14,35 @@ template <class T, class V>
 std::string Key(const V& checked) {
   if (std::holds_alternative<T>(checked)) return "";
   return std::get<Refusal>(checked).key;
+}
+
+// ROBOT_STATE: every field out of its contract is named (a count that disagrees with its array, the
+// arm's joint count, NaN, a bad quaternion, an unknown motion state, too many links).
+TEST(Requests, RobotState) {
+  orbed::robot_state_t good{};
+  good.X_WR.quaternion_wxyz[0] = 1;
+  good.num_joints = 7;
+  good.joint_position.assign(7, 0.1);
+  good.joint_limit_hit.assign(7, 0);
+  EXPECT_EQ(CheckRobotState(good, 7), "");
+  auto reason = [&](auto mutate) {
+    orbed::robot_state_t m = good;
+    mutate(m);
+    return CheckRobotState(m, 7);
+  };
+  EXPECT_NE(reason([](auto& m) { m.num_joints = 6; }).find("num_joints"), std::string::npos);
+  EXPECT_NE(reason([](auto& m) { m.joint_limit_hit.pop_back(); }).find("joint_limit_hit"), std::string::npos);
+  EXPECT_NE(reason([](auto& m) { m.joint_position[2] = std::nan(""); }).find("joint_position"),
+            std::string::npos);
+  EXPECT_NE(reason([](auto& m) { m.X_WR.quaternion_wxyz[0] = 0.5; }).find("X_WR"), std::string::npos);
+  EXPECT_NE(reason([](auto& m) { m.motion_state = 9; }).find("motion_state"), std::string::npos);
+  EXPECT_NE(reason([](auto& m) { m.num_links = 1; }).find("num_links"), std::string::npos);
+  EXPECT_NE(reason([](auto& m) {
+              m.num_links = kMaxRobotStateLinks + 1;
+              m.X_RL.resize(m.num_links);
+              m.link_names.assign(m.num_links, "l");
+            }).find("num_links"),
+            std::string::npos);
 }
 
 TEST(Requests, IiwaCommand) {

@@ -11,6 +11,7 @@
 #include "procs/common/conversions.h"
 #include "procs/common/flags.h"
 #include "procs/common/log.h"
+#include "procs/common/requests.h"
 #include "procs/common/validation.h"
 #include "procs/drake_viewer/viewer_messages.h"
 #include "sim/guidance_messages.h"
@@ -36,10 +37,7 @@ ViewerBridge::ViewerBridge(const CommonFlags& flags, const ViewerOptions& option
   process_.Subscribe<orbed::robot_state_t>(
       options_.robot_state_channel,
       [this, n](const orbed::robot_state_t& msg, const std::string& channel, int64_t) {
-        const std::string problem = FirstError(
-            {CheckPose(msg.X_WR, "ROBOT_STATE.X_WR"), CheckSize(msg.num_joints, n, "ROBOT_STATE.num_joints"),
-             CheckBounded(msg.joint_position.data(), static_cast<int>(msg.joint_position.size()), 100.0,
-                          "ROBOT_STATE.joint_position")});
+        const std::string problem = CheckRobotState(msg, n);
         if (!problem.empty()) return process_.Reject(channel + "/field", problem);
         X_WR_ = FromPose(msg.X_WR);
         q_real_ = Eigen::Map<const Eigen::VectorXd>(msg.joint_position.data(), n);

@@ -11,6 +11,7 @@
 #include "base/units.h"
 #include "procs/common/alignment_trial.h"
 #include "procs/common/conversions.h"
+#include "procs/common/requests.h"
 #include "procs/common/validation.h"
 #include "viraal/exchange.h"
 
@@ -18,7 +19,6 @@ namespace orbed::scenario {
 namespace {
 
 constexpr int kMaxJoints = 64;
-constexpr int kMaxLinks = 1000;
 constexpr int kMaxPairs = 10000;
 // Only a ROBOT_STATE received this long after the last IIWA_COMMAND counts as a stop [s].
 constexpr double kFreshStateAfterCommand_s = 0.050;
@@ -123,15 +123,7 @@ ConductorActions ViraalConductor::Abort(const std::string& reason, const Conduct
 
 ConductorActions ViraalConductor::OnRobotState(const orbed::robot_state_t& msg, const ConductorTime& now) {
   Begin(now);
-  const std::string problem = FirstError(
-      {CheckPose(msg.X_WR, "ROBOT_STATE.X_WR"),
-       CheckLength(msg.num_joints, msg.joint_position.size(), kMaxJoints, "ROBOT_STATE.num_joints"),
-       CheckSize(msg.num_joints, model_->num_joints(), "ROBOT_STATE.num_joints"),
-       CheckLength(msg.num_joints, msg.joint_limit_hit.size(), kMaxJoints, "ROBOT_STATE.joint_limit_hit"),
-       CheckFinite(msg.joint_position, "ROBOT_STATE.joint_position"),
-       CheckLength(msg.num_links, msg.X_RL.size(), kMaxLinks, "ROBOT_STATE.num_links"),
-       CheckEnum(msg.motion_state, orbed::robot_state_t::MOTION_IDLE,
-                 orbed::robot_state_t::MOTION_IN_COLLISION, "ROBOT_STATE.motion_state")});
+  const std::string problem = CheckRobotState(msg, model_->num_joints());
   if (!problem.empty()) {
     Refuse(options_.robot_state_channel + "/field", problem);
     return TakeActions();

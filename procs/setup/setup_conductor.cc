@@ -9,15 +9,14 @@
 #include "base/format.h"
 #include "base/json.h"
 #include "base/units.h"
+#include "procs/common/requests.h"
 #include "procs/common/validation.h"
 #include "sim/guidance_messages.h"
 
 namespace orbed::setup {
 namespace {
 
-constexpr int kMaxLinks = 64;
-
-std::string ModeName(int8_t mode) { return mode >= 0 && mode <= 2 ? kModeNames[mode] : "?"; }
+std::string ModeName(int8_t mode) { return guidance::GuidanceModeName(mode); }
 
 }  // namespace
 
@@ -248,13 +247,7 @@ void SetupConductor::Step() {
 SetupConductor::Actions SetupConductor::OnRobotState(const orbed::robot_state_t& msg,
                                                      const ConductorTime& now) {
   Begin(now);
-  const std::string problem =
-      FirstError({CheckPose(msg.X_WR, "ROBOT_STATE.X_WR"),
-                  CheckSize(msg.num_joints, model_->num_joints(), "ROBOT_STATE.num_joints"),
-                  CheckFinite(msg.joint_position, "ROBOT_STATE.joint_position"),
-                  CheckLength(msg.num_links, msg.X_RL.size(), kMaxLinks, "ROBOT_STATE.num_links"),
-                  CheckEnum(msg.motion_state, orbed::robot_state_t::MOTION_IDLE,
-                            orbed::robot_state_t::MOTION_IN_COLLISION, "ROBOT_STATE.motion_state")});
+  const std::string problem = CheckRobotState(msg, model_->num_joints());
   if (!problem.empty()) {
     actions_.refusals.push_back({options_.robot_state_channel + "/field", problem});
     return Take();

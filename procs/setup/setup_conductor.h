@@ -52,9 +52,6 @@ namespace orbed::setup {
 using scenario::ConductorActions;
 using scenario::ConductorTime;
 
-/// The set-up study's mode names, as its files and tables name them (guidance_t::MODE_* order).
-inline constexpr const char* kModeNames[] = {"ar", "ar_reflective", "fixed"};
-
 struct SetupOptions {
   std::string user{"u1"};
   std::string run_id{"setup"};

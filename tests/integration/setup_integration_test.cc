@@ -30,6 +30,7 @@
 
 #include "base/units.h"
 #include "procs/setup/setup_process.h"
+#include "sim/guidance_messages.h"
 #include "tests/integration/testbed_util.h"
 
 namespace orbed::testing {
@@ -145,7 +146,7 @@ TEST(SetupStudy, OneUserThroughTheLaunchFile) {
   ASSERT_EQ(setups.size(), 3u);
   for (size_t k = 0; k < 3; ++k) {
     const YAML::Node s = setups[k];
-    const std::string mode = setup::kModeNames[order[k]];
+    const std::string mode = guidance::GuidanceModeName(order[k]);
     EXPECT_EQ(s["mode"].as<std::string>(), mode);
     EXPECT_EQ(s["order"].as<int>(), static_cast<int>(k) + 1);
     EXPECT_EQ(s["task_id"].as<std::string>(), "u7-" + mode + "-1");
