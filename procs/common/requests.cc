@@ -1,5 +1,8 @@
 #include "procs/common/requests.h"
 
+#include <cmath>
+#include <limits>
+
 #include "procs/common/conversions.h"
 #include "procs/common/validation.h"
 
@@ -92,6 +95,17 @@ std::string CheckRobotState(const orbed::robot_state_t& msg, int num_joints) {
        CheckLength(msg.num_links, msg.link_names.size(), kMaxRobotStateLinks, "ROBOT_STATE.link_names"),
        CheckEnum(msg.motion_state, orbed::robot_state_t::MOTION_IDLE,
                  orbed::robot_state_t::MOTION_IN_COLLISION, "ROBOT_STATE.motion_state")});
+}
+
+std::string CheckCollisionStatus(const orbed::collision_status_t& msg) {
+  if (std::isnan(msg.min_distance_m) || msg.min_distance_m == -std::numeric_limits<double>::infinity())
+    return "COLLISION_STATUS.min_distance_m: expected a number or +inf";
+  return FirstError(
+      {CheckLength(msg.num_contacts, msg.contacts.size(), kMaxRobotStateLinks,
+                   "COLLISION_STATUS.num_contacts"),
+       CheckLength(msg.num_links, msg.link_names.size(), kMaxRobotStateLinks, "COLLISION_STATUS.link_names"),
+       CheckLength(msg.num_links, msg.link_clearance_m.size(), kMaxRobotStateLinks,
+                   "COLLISION_STATUS.link_clearance_m")});
 }
 
 }  // namespace orbed

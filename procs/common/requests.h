@@ -20,6 +20,10 @@
 ///                                          the joint arrays' lengths; finite angles [rad]; num_links
 ///                                          equal to the link arrays' lengths and at most kMaxLinks;
 ///                                          motion_state in range. The reason names the field.
+///   COLLISION_STATUS (collision_status_t), read by orbed-setup: min_distance_m a number or +inf
+///                                          (no pair checked), never NaN or −inf; num_contacts and
+///                                          num_links equal to their arrays' lengths, at most
+///                                          kMaxRobotStateLinks. The reason names the field.
 /// Whether a landmark's rays can be triangulated, or pairs evaluated, is the server's computation,
 /// not the contract.
 ///
@@ -31,6 +35,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <orbed/collision_status_t.hpp>
 #include <orbed/iiwa_command_t.hpp>
 #include <orbed/landmark_request_t.hpp>
 #include <orbed/misalignment_request_t.hpp>
@@ -50,6 +55,9 @@ inline constexpr int kMaxRobotStateLinks = 1000;
 /// "" or the reason ROBOT_STATE is refused (see the file comment); keys are the reader's
 /// ("<channel>/field").
 std::string CheckRobotState(const orbed::robot_state_t& msg, int num_joints);
+
+/// "" or the reason COLLISION_STATUS is refused (see the file comment).
+std::string CheckCollisionStatus(const orbed::collision_status_t& msg);
 
 struct IiwaCommand {
   int64_t utime{0};

@@ -3,6 +3,7 @@
 #include "procs/common/requests.h"
 
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -43,6 +44,29 @@ TEST(Requests, RobotState) {
               m.link_names.assign(m.num_links, "l");
             }).find("num_links"),
             std::string::npos);
+}
+
+// COLLISION_STATUS: +inf (nothing checked) passes; NaN, −inf and counts that disagree are named.
+TEST(Requests, CollisionStatus) {
+  orbed::collision_status_t good{};
+  good.min_distance_m = 0.12;
+  good.num_links = 2;
+  good.link_names = {"a", "b"};
+  good.link_clearance_m = {0.12, 0.3};
+  EXPECT_EQ(CheckCollisionStatus(good), "");
+  orbed::collision_status_t m = good;
+  m.min_distance_m = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(CheckCollisionStatus(m), "");
+  m.min_distance_m = -std::numeric_limits<double>::infinity();
+  EXPECT_NE(CheckCollisionStatus(m).find("min_distance_m"), std::string::npos);
+  m.min_distance_m = std::nan("");
+  EXPECT_NE(CheckCollisionStatus(m).find("min_distance_m"), std::string::npos);
+  m = good;
+  m.num_contacts = 1;
+  EXPECT_NE(CheckCollisionStatus(m).find("num_contacts"), std::string::npos);
+  m = good;
+  m.link_clearance_m.pop_back();
+  EXPECT_NE(CheckCollisionStatus(m).find("link_clearance_m"), std::string::npos);
 }
 
 TEST(Requests, IiwaCommand) {

@@ -1,5 +1,6 @@
 #include "procs/setup/setup_conductor.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <utility>
@@ -18,7 +19,33 @@ namespace {
 
 std::string ModeName(int8_t mode) { return guidance::GuidanceModeName(mode); }
 
+bool Stopped(int8_t motion_state) {
+  return motion_state == orbed::robot_state_t::MOTION_STOPPED_BEFORE_COLLISION ||
+         motion_state == orbed::robot_state_t::MOTION_IN_COLLISION;
+}
+
 }  // namespace
+
+Docking DockingError(const sim::RobotModel& model, const std::vector<double>& target_deg,
+                     const std::vector<double>& reached_deg) {
+  const size_t n = static_cast<size_t>(model.num_joints());
+  if (target_deg.size() != n || reached_deg.size() != n)
+    throw std::invalid_argument("DockingError: joint vectors must have " + std::to_string(n) + " values");
+  Eigen::VectorXd q_target(n), q_reached(n);
+  for (size_t i = 0; i < n; ++i) {
+    q_target[i] = target_deg[i] * kDegToRad;
+    q_reached[i] = reached_deg[i] * kDegToRad;
+  }
+  const Eigen::Isometry3d X_RT_target = model.CalcToolTipPose(q_target);
+  const Eigen::Isometry3d X_RT_reached = model.CalcToolTipPose(q_reached);
+  const Eigen::Vector3d z_target = X_RT_target.linear().col(2);
+  const Eigen::Vector3d z_reached = X_RT_reached.linear().col(2);
+  Docking d;
+  d.tip_mm = (X_RT_reached.translation() - X_RT_target.translation()).norm() * 1e3;
+  // atan2 of |a × b| and a · b: accurate at small and large angles alike.
+  d.axis_deg = std::atan2(z_target.cross(z_reached).norm(), z_target.dot(z_reached)) * kRadToDeg;
+  return d;
+}
 
 std::string SetupRunJson(const SetupRun& run, bool partial) {
   JsonWriter json(2);
@@ -54,6 +81,16 @@ std::string SetupRunJson(const SetupRun& run, bool partial) {
       json.Null();
     }
     json.Key("person_scale").Number(r.person_scale);
+    json.Key("docking_tip_mm").Number(r.docking_tip_mm);
+    json.Key("docking_axis_deg").Number(r.docking_axis_deg);
+    json.Key("min_clearance_m");
+    if (r.min_clearance_m) {
+      json.Number(*r.min_clearance_m);
+    } else {
+      json.Null();
+    }
+    json.Key("contact").Bool(r.contact);
+    json.Key("collision_stops").Int(r.collision_stops);
     json.Key("alignment");
     if (r.alignment && r.alignment->mean) {
       json.BeginObject();
@@ -216,6 +253,9 @@ void SetupConductor::Step() {
         for (double q : options_.targets_deg[target_index_]) task_.target_position.push_back(q * kDegToRad);
         phase_ = Phase::kTask;
         phase_start_s_ = now_.t_s;
+        task_min_clearance_m_.reset();
+        task_contact_ = false;
+        task_collision_stops_ = 0;
         actions_.progress.push_back(TaskId() + ": set-up (SETUP_TASK to orbed-assistant)");
         return SendTask();
       }
@@ -251,6 +291,12 @@ SetupConductor::Actions SetupConductor::OnRobotState(const orbed::robot_state_t&
   if (!problem.empty()) {
     actions_.refusals.push_back({options_.robot_state_channel + "/field", problem});
     return Take();
+  }
+  if (phase_ == Phase::kTask) {
+    const bool was_stopped =
+        robot_state_ && Stopped(robot_state_->motion_state) && robot_state_->motion_state == msg.motion_state;
+    if (Stopped(msg.motion_state) && !was_stopped) ++task_collision_stops_;
+    if (msg.motion_state == orbed::robot_state_t::MOTION_IN_COLLISION) task_contact_ = true;
   }
   robot_state_ = msg;
   if (phase_ == Phase::kAlign) {
@@ -298,6 +344,12 @@ SetupConductor::Actions SetupConductor::OnSetupResult(const orbed::setup_result_
   r.ranges.assign(msg.ranges.begin(), msg.ranges.end());
   r.execution_s = msg.execution_s;
   r.person_scale = msg.person_scale;
+  const Docking docking = DockingError(*model_, r.target_deg, r.reached_deg);
+  r.docking_tip_mm = docking.tip_mm;
+  r.docking_axis_deg = docking.axis_deg;
+  r.min_clearance_m = task_min_clearance_m_;
+  r.contact = task_contact_;
+  r.collision_stops = task_collision_stops_;
   if (alignment_result_) {
     double total = 0;
     for (const viraal::TrialResult& t : alignment_result_->trials) total += t.user_duration_s;
@@ -308,7 +360,9 @@ SetupConductor::Actions SetupConductor::OnSetupResult(const orbed::setup_result_
   for (size_t i = 0; i < r.reached_deg.size(); ++i)
     worst = std::max(worst, std::abs(r.reached_deg[i] - r.target_deg[i]));
   actions_.progress.push_back(r.task_id + ": done, largest joint error " + Fixed(worst, 1) +
-                              " deg, execution " + Fixed(r.execution_s, 0) + " s");
+                              " deg, docking " + Fixed(r.docking_tip_mm, 0) + " mm / " +
+                              Fixed(r.docking_axis_deg, 1) + " deg, execution " + Fixed(r.execution_s, 0) +
+                              " s");
   run_.setups.push_back(std::move(r));
   if (++target_index_ >= options_.targets_deg.size()) {
     target_index_ = 0;
@@ -320,6 +374,21 @@ SetupConductor::Actions SetupConductor::OnSetupResult(const orbed::setup_result_
     return Take();
   }
   StartTask();
+  return Take();
+}
+
+SetupConductor::Actions SetupConductor::OnCollisionStatus(const orbed::collision_status_t& msg,
+                                                          const ConductorTime& now) {
+  Begin(now);
+  const std::string problem = CheckCollisionStatus(msg);
+  if (!problem.empty()) {
+    actions_.refusals.push_back({options_.collision_status_channel + "/field", problem});
+    return Take();
+  }
+  if (phase_ == Phase::kTask) {
+    task_min_clearance_m_ = std::min(task_min_clearance_m_.value_or(msg.min_distance_m), msg.min_distance_m);
+    if (msg.in_collision) task_contact_ = true;
+  }
   return Take();
 }
 

@@ -19,13 +19,15 @@
 ///     orbed-guidance shows the target. The record: the target, the joints the sim measured when
 ///     the answer came (ROBOT_STATE: the truth, not the assistant's word), the assistant's execution
 ///     time and ranges, the alignment's time (the sum of the N trials' duration_s) and its mean's
-///     errors against the truth.
+///     errors against the truth; the docking error those joints cause (DockingError); and, from
+///     COLLISION_STATUS and ROBOT_STATE while the assistant moved the arm, the smallest clearance
+///     to anything (self or scene) [m], whether any pair touched, and how often the sim stopped the
+///     arm before a collision (the paper's Sec. IV-B "beyond": collisions and near misses).
 /// A phase that waits longer than its timeout fails the run with a one-line reason naming the
 /// process that did not answer.
 ///
-/// Inputs are checked (guidance::CheckSetupResult; ROBOT_STATE's pose, joint count and motion
-/// enum); a bad one is refused (a Refusal, key "<channel>/field") and changes nothing. Results of
-/// other request ids are ignored.
+/// Inputs are checked (guidance::CheckSetupResult; CheckRobotState; CheckCollisionStatus); a bad one is
+/// refused (a Refusal, key "<channel>/field") and changes nothing. Results of other request ids are ignored.
 ///
 /// Time: ConductorTime (viraal_conductor.h): t_s monotonic [s], utime wall clock [µs]. Threading:
 /// one thread makes every call.
@@ -37,6 +39,7 @@
 #include <variant>
 #include <vector>
 
+#include <orbed/collision_status_t.hpp>
 #include <orbed/iiwa_command_t.hpp>
 #include <orbed/robot_state_t.hpp>
 #include <orbed/setup_result_t.hpp>
@@ -70,6 +73,7 @@ struct SetupOptions {
   double command_resend_s{0.25};
   double task_resend_s{1.0};
   std::string robot_state_channel{"ROBOT_STATE"};
+  std::string collision_status_channel{"COLLISION_STATUS"};
   std::string iiwa_command_channel{"IIWA_COMMAND"};
   std::string setup_task_channel{"SETUP_TASK"};
   std::string setup_result_channel{"SETUP_RESULT"};
@@ -88,7 +92,25 @@ struct SetupRecord {
   std::optional<double> alignment_s;  ///< headset modes: the N trials' time
   std::optional<viraal::SessionResult> alignment;
   double person_scale{1};
+  /// The docking error the joint errors cause (DockingError of target_deg and reached_deg).
+  double docking_tip_mm{0}, docking_axis_deg{0};
+  /// While the assistant moved the arm: the smallest COLLISION_STATUS.min_distance_m (none when no
+  /// COLLISION_STATUS came), whether any pair penetrated, and how many times the motion state became
+  /// STOPPED_BEFORE_COLLISION or IN_COLLISION.
+  std::optional<double> min_clearance_m;
+  bool contact{false};
+  int collision_stops{0};
 };
+
+/// How far the tool tip T and its axis (+z of T) end up from where the target configuration puts
+/// them: |p_RT(reached) − p_RT(target)| [mm] and the angle between the two tool axes [deg], by the
+/// model's forward kinematics (its tool: the URDF's tool tip). At the trocar this is the docking
+/// error of the paper's Fig. 4e. Throws std::invalid_argument for vectors of the wrong size.
+struct Docking {
+  double tip_mm{0}, axis_deg{0};
+};
+Docking DockingError(const sim::RobotModel& model, const std::vector<double>& target_deg,
+                     const std::vector<double>& reached_deg);
 
 struct SetupRun {
   std::string user, run_id;
@@ -100,7 +122,8 @@ struct SetupRun {
 /// setup_results.json's text: {"user", "run_id", "status": "ok" | "failed" | "partial", "error",
 /// "order", "setups": [{task_id, mode, order, target, target_deg, reached_deg,
 /// assistant_reached_deg, error_deg, twisting, ranges, execution_s, alignment_s (null for fixed),
-/// person_scale, alignment: null | {session_id, trials, translation_error_mm, rotation_error_deg,
+/// person_scale, docking_tip_mm, docking_axis_deg, min_clearance_m (null when unknown), contact,
+/// collision_stops, alignment: null | {session_id, trials, translation_error_mm, rotation_error_deg,
 /// misalignment_mm} of the mean}]}.
 std::string SetupRunJson(const SetupRun& run, bool partial);
 
@@ -134,6 +157,7 @@ class SetupConductor {
   Actions OnRegistration(const orbed::registration_t& msg, const ConductorTime& now);
   Actions OnMisalignment(const orbed::misalignment_t& msg, const ConductorTime& now);
   Actions OnSetupResult(const orbed::setup_result_t& msg, const ConductorTime& now);
+  Actions OnCollisionStatus(const orbed::collision_status_t& msg, const ConductorTime& now);
   Actions Tick(const ConductorTime& now);
   Actions Abort(const std::string& reason, const ConductorTime& now);
 
@@ -161,6 +185,10 @@ class SetupConductor {
   double phase_start_s_{0};
   double last_send_s_{-1e9};
   std::optional<orbed::robot_state_t> robot_state_;
+  // What the arm met during the current kTask (reset when it starts).
+  std::optional<double> task_min_clearance_m_;
+  bool task_contact_{false};
+  int task_collision_stops_{0};
   size_t mode_index_{0};
   size_t target_index_{0};
   std::unique_ptr<scenario::ViraalConductor> alignment_;

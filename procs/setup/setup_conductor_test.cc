@@ -120,6 +120,98 @@ TEST(SetupConductor, ParksThenAsksForEachTargetAndRecordsTheSimsJoints) {
   EXPECT_NE(json.find("\"alignment_s\": null"), std::string::npos) << json;
 }
 
+orbed::collision_status_t Clearance(double min_distance_m, bool in_collision) {
+  orbed::collision_status_t m{};
+  m.min_distance_m = min_distance_m;
+  m.in_collision = in_collision;
+  return m;
+}
+
+// Clearance and collision stops are what happened while the assistant had the arm: what came
+// before the task (parking) does not count, a stop that lasts several messages counts once, a
+// bad COLLISION_STATUS is refused and changes nothing.
+TEST(SetupConductor, RecordsClearanceAndStopsDuringTheSetUpOnly) {
+  SetupConductor c(FixedOnly(), Model());
+  c.Start(At(0));
+  c.OnCollisionStatus(Clearance(-0.01, true), At(0.05));  // before the task: not the assistant's
+  SetupConductor::Actions a = c.OnRobotState(State({0, 20, 0, -60, 0, 40, 0}, 0), At(0.1));
+  const orbed::setup_task_t* task = FindTask(a);
+  ASSERT_NE(task, nullptr);
+  const orbed::setup_task_t first = *task;
+  constexpr int8_t kStopped = orbed::robot_state_t::MOTION_STOPPED_BEFORE_COLLISION;
+  constexpr int8_t kMoving = orbed::robot_state_t::MOTION_MOVING;
+  c.OnCollisionStatus(Clearance(0.20, false), At(0.2));
+  c.OnRobotState(State({2, 20, 0, -60, 0, 40, 0}, kMoving), At(0.3));
+  c.OnCollisionStatus(Clearance(0.004, false), At(0.4));
+  c.OnRobotState(State({3, 20, 0, -60, 0, 40, 0}, kStopped), At(0.5));
+  c.OnRobotState(State({3, 20, 0, -60, 0, 40, 0}, kStopped), At(0.6));
+  c.OnRobotState(State({3, 20, 0, -60, 0, 40, 0}, kMoving), At(0.7));
+  c.OnRobotState(State({4, 20, 0, -60, 0, 40, 0}, kStopped), At(0.8));
+  EXPECT_EQ(c.OnCollisionStatus(Clearance(std::nan(""), true), At(0.85)).refusals.size(), 1u);
+  c.OnCollisionStatus(Clearance(0.05, false), At(0.9));
+  c.OnRobotState(State({10, 20, 0, -60, 0, 40, 0}, 0), At(1.0));
+  orbed::setup_result_t r{};
+  r.request_id = first.request_id;
+  r.task_id = first.task_id;
+  r.mode = kFixed;
+  r.num_joints = 7;
+  r.reached_position.assign(7, 0.0);
+  r.ranges.assign(7, 1);
+  r.execution_s = 60;
+  r.person_scale = 1;
+  c.OnSetupResult(r, At(1.1));
+  ASSERT_EQ(c.run().setups.size(), 1u);
+  const SetupRecord& rec = c.run().setups[0];
+  ASSERT_TRUE(rec.min_clearance_m.has_value());
+  EXPECT_EQ(*rec.min_clearance_m, 0.004);
+  EXPECT_FALSE(rec.contact);
+  EXPECT_EQ(rec.collision_stops, 2);
+  // Reached the target exactly: no docking error.
+  EXPECT_NEAR(rec.docking_tip_mm, 0, 1e-9);
+  EXPECT_NEAR(rec.docking_axis_deg, 0, 1e-6);
+  const std::string json = SetupRunJson(c.run(), true);
+  EXPECT_NE(json.find("\"collision_stops\": 2"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"contact\": false"), std::string::npos) << json;
+}
+
+// The docking error against closed forms. The iiwa 7's joint 7 turns the flange about the tool
+// axis: no error at all. Joint 6 swings the tool about an axis through the wrist point, which lies
+// on the tool axis 0.126 m behind the flange (KUKA data sheet, DH d7): the axis turns by the joint
+// error θ and the tip moves on a circle of radius 0.126 m + the tool length, a chord 2 r sin(θ/2).
+// Joint 1 turns everything about the base's vertical z: the tip moves on a circle of its horizontal
+// distance ρ from z, and a tool axis at α from z turns by acos(cos²α + sin²α cos θ).
+TEST(DockingError, ClosedForms) {
+  const sim::RobotModel model = Model();
+  const std::vector<double> target = {10, 40, -20, -70, 30, 50, 15};
+  std::vector<double> reached = target;
+  reached[6] += 37;
+  Docking d = DockingError(model, target, reached);
+  EXPECT_NEAR(d.tip_mm, 0, 1e-9);
+  EXPECT_NEAR(d.axis_deg, 0, 1e-9);
+
+  const double theta_deg = 12;
+  reached = target;
+  reached[5] += theta_deg;
+  d = DockingError(model, target, reached);
+  EXPECT_NEAR(d.axis_deg, theta_deg, 1e-9);
+  const double r_m = 0.126 + model.tool_length_m();
+  EXPECT_NEAR(d.tip_mm, 2 * r_m * std::sin(theta_deg * kDegToRad / 2) * 1e3, 1e-6);
+
+  reached = target;
+  reached[0] += theta_deg;
+  d = DockingError(model, target, reached);
+  Eigen::VectorXd q(7);
+  for (int i = 0; i < 7; ++i) q[i] = target[i] * kDegToRad;
+  const Eigen::Isometry3d X_RT = model.CalcToolTipPose(q);
+  const double rho_m = X_RT.translation().head<2>().norm();
+  const double cos_alpha = X_RT.linear()(2, 2);
+  const double c = std::cos(theta_deg * kDegToRad);
+  EXPECT_NEAR(d.tip_mm, 2 * rho_m * std::sin(theta_deg * kDegToRad / 2) * 1e3, 1e-6);
+  EXPECT_NEAR(d.axis_deg, std::acos(cos_alpha * cos_alpha + (1 - cos_alpha * cos_alpha) * c) * kRadToDeg,
+              1e-6);
+  EXPECT_THROW(DockingError(model, target, {1, 2}), std::invalid_argument);
+}
+
 TEST(SetupConductor, TimeoutsNameWhoDidNotAnswer) {
   {
     SetupConductor c(FixedOnly(), Model());

@@ -43,6 +43,9 @@ SetupProcess::SetupProcess(const CommonFlags& flags, const SetupOptions& options
       options.robot_state_channel, [this](const orbed::robot_state_t& m, const std::string&, int64_t) {
         Apply(conductor_->OnRobotState(m, Now()));
       });
+  process_.Subscribe<orbed::collision_status_t>(
+      options.collision_status_channel, [this](const orbed::collision_status_t& m, const std::string&,
+                                               int64_t) { Apply(conductor_->OnCollisionStatus(m, Now())); });
   const scenario::ConductorOptions channels;  // the alignment's channels: the defaults
   process_.Subscribe<orbed::plan_check_reply_t>(
       channels.plan_check_reply_channel, [this](const orbed::plan_check_reply_t& m, const std::string&,

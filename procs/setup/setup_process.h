@@ -3,7 +3,8 @@
 /// orbed-setup: one user's part of the robot set-up study (SetupConductor, setup_conductor.h) on
 /// the bus.
 ///
-///   Subscribes: ROBOT_STATE, PLAN_CHECK_REPLY, ALIGNMENT_TRIAL, REGISTRATION, MISALIGNMENT (for
+///   Subscribes: ROBOT_STATE, COLLISION_STATUS (clearance during each set-up), PLAN_CHECK_REPLY,
+///   ALIGNMENT_TRIAL, REGISTRATION, MISALIGNMENT (for
 ///               the alignments before the headset modes' set-ups, as orbed-scenario), SETUP_RESULT.
 ///   Publishes:  what the conductor asks for: SESSION_CONTROL, PLAN_CHECK_REQUEST,
 ///               MISALIGNMENT_REQUEST and IIWA_COMMAND of the alignments; IIWA_COMMAND parking the
