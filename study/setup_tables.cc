@@ -7,6 +7,7 @@
 
 #include "base/format.h"
 #include "base/json_fields.h"
+#include "base/random.h"
 #include "base/stats.h"
 #include "study/paper_setup.h"
 
@@ -124,6 +125,16 @@ SetupUserRun ReadSetupResults(const std::string& path) {
     if (const std::optional<JsonAt> alignment = f.OptionalMember(s, "alignment_s")) {
       row.alignment_s = f.Number(*alignment, 0, 1e6);
     }
+    // Beyond the paper: absent or null in results written before orbed-setup recorded them.
+    if (const std::optional<JsonAt> v = f.OptionalMember(s, "docking_tip_mm"))
+      row.docking_tip_mm = f.Number(*v, 0, 1e5);
+    if (const std::optional<JsonAt> v = f.OptionalMember(s, "docking_axis_deg"))
+      row.docking_axis_deg = f.Number(*v, 0, 180);
+    if (const std::optional<JsonAt> v = f.OptionalMember(s, "min_clearance_m"))
+      row.min_clearance_m = f.Number(*v, -10, 1e3);
+    if (const std::optional<JsonAt> v = f.OptionalMember(s, "contact")) row.contact = f.Bool(*v);
+    if (const std::optional<JsonAt> v = f.OptionalMember(s, "collision_stops"))
+      row.collision_stops = static_cast<int>(f.Integer(*v, 0, 1000000));
     run.setups.push_back(std::move(row));
   }
   return run;
@@ -183,6 +194,139 @@ std::string SetupTimesCsv(const std::vector<SetupUserRun>& runs) {
   return csv;
 }
 
+std::string SetupDockingCsv(const std::vector<SetupUserRun>& runs) {
+  auto cell = [](const std::optional<double>& v) { return v ? JsonNumber(*v) : std::string(); };
+  std::string csv =
+      "user,mode,order,target,docking_tip_mm,docking_axis_deg,min_clearance_m,contact,collision_stops\n";
+  for (const SetupUserRun& run : runs) {
+    for (const SetupRow& row : run.setups) {
+      csv += run.user + "," + row.mode + "," + std::to_string(row.order) + "," + std::to_string(row.target) +
+             "," + cell(row.docking_tip_mm) + "," + cell(row.docking_axis_deg) + "," +
+             cell(row.min_clearance_m) + "," + (row.contact ? "1" : "0") + "," +
+             std::to_string(row.collision_stops) + "\n";
+    }
+  }
+  return csv;
+}
+
+std::vector<PowerPoint> SetupPower(const std::vector<SetupUserRun>& runs, const std::string& a,
+                                   const std::string& b, const std::vector<int>& users, int resamples,
+                                   double alpha, uint64_t seed) {
+  // Each user's pooled errors in a and in b; only users who did both.
+  std::vector<std::vector<double>> errors_a, errors_b;
+  for (const SetupUserRun& run : runs) {
+    std::vector<double> ea = JointErrors({run}, a, -1), eb = JointErrors({run}, b, -1);
+    if (ea.empty() || eb.empty()) continue;
+    errors_a.push_back(std::move(ea));
+    errors_b.push_back(std::move(eb));
+  }
+  std::vector<PowerPoint> out;
+  if (errors_a.empty() || resamples <= 0) return out;
+  Random rng(seed);
+  const size_t pool = errors_a.size();
+  for (int n : users) {
+    int rejected = 0;
+    for (int k = 0; k < resamples; ++k) {
+      std::vector<double> x, y;
+      for (int u = 0; u < n; ++u) {
+        const size_t pick =
+            std::min(pool - 1, static_cast<size_t>(rng.Uniform() * static_cast<double>(pool)));
+        x.insert(x.end(), errors_a[pick].begin(), errors_a[pick].end());
+        y.insert(y.end(), errors_b[pick].begin(), errors_b[pick].end());
+      }
+      const stats::MannWhitneyResult r = stats::MannWhitneyU(x, y);
+      if (r.valid && r.p_two_sided < alpha) ++rejected;
+    }
+    out.push_back({n, static_cast<double>(rejected) / resamples});
+  }
+  return out;
+}
+
+namespace {
+
+void WriteBeyond(JsonWriter* json, const std::vector<SetupUserRun>& runs) {
+  auto values = [&](const std::string& mode, std::optional<double> SetupRow::*field) {
+    std::vector<double> out;
+    for (const SetupUserRun& run : runs) {
+      for (const SetupRow& row : run.setups) {
+        if (row.mode == mode && row.*field) out.push_back(*(row.*field));
+      }
+    }
+    return out;
+  };
+  json->Key("beyond").BeginObject();
+  json->Key("docking").BeginObject();
+  for (const char* mode : kSetupModes) {
+    const std::vector<double> tip = values(mode, &SetupRow::docking_tip_mm);
+    if (tip.empty()) continue;
+    json->Key(mode).BeginObject();
+    json->Key("tip_mm");
+    WriteStats(json, Summarize(tip));
+    json->Key("axis_deg");
+    WriteStats(json, Summarize(values(mode, &SetupRow::docking_axis_deg)));
+    json->EndObject();
+  }
+  json->EndObject();
+  json->Key("near_miss_m").Number(kNearMissM);
+  json->Key("collisions").BeginObject();
+  for (const char* mode : kSetupModes) {
+    if (!HasMode(runs, mode)) continue;
+    int setups = 0, contact = 0, stops = 0, near = 0;
+    for (const SetupUserRun& run : runs) {
+      for (const SetupRow& row : run.setups) {
+        if (row.mode != mode) continue;
+        ++setups;
+        contact += row.contact;
+        stops += row.collision_stops;
+        near += !row.contact && row.min_clearance_m && *row.min_clearance_m < kNearMissM;
+      }
+    }
+    json->Key(mode).BeginObject();
+    json->Key("setups").Int(setups);
+    json->Key("contact").Int(contact);
+    json->Key("collision_stops").Int(stops);
+    json->Key("near_miss").Int(near);
+    const std::vector<double> clearance = values(mode, &SetupRow::min_clearance_m);
+    if (!clearance.empty()) {
+      json->Key("min_clearance_m");
+      WriteStats(json, Summarize(clearance));
+    }
+    json->EndObject();
+  }
+  json->EndObject();
+  json->Key("power_method")
+      .String(
+          "bootstrap over users: 500 studies of N users drawn with replacement per N, Table 3's pooled "
+          "two-sided Mann-Whitney U on all joints, power = fraction with p < 0.05");
+  json->Key("power").BeginObject();
+  for (const char* pair : kSetupPairs) {
+    const std::string p = pair;
+    const std::vector<PowerPoint> curve =
+        SetupPower(runs, p.substr(0, p.find('/')), p.substr(p.find('/') + 1), kPowerUsers, 500, 0.05, 1);
+    if (curve.empty()) continue;
+    json->Key(p).BeginObject();
+    json->Key("users").BeginArray();
+    for (const PowerPoint& point : curve) json->Int(point.users);
+    json->EndArray();
+    json->Key("power").BeginArray();
+    for (const PowerPoint& point : curve) json->Number(point.power);
+    json->EndArray();
+    json->Key("users_for_80");
+    const auto enough =
+        std::find_if(curve.begin(), curve.end(), [](const PowerPoint& q) { return q.power >= 0.8; });
+    if (enough != curve.end()) {
+      json->Int(enough->users);
+    } else {
+      json->Null();
+    }
+    json->EndObject();
+  }
+  json->EndObject();
+  json->EndObject();
+}
+
+}  // namespace
+
 void WriteSetupTables(JsonWriter* json, const std::vector<SetupUserRun>& runs) {
   json->Key("setup_users").Int(static_cast<int64_t>(runs.size()));
   json->Key("table2").BeginObject();
@@ -227,6 +371,7 @@ void WriteSetupTables(JsonWriter* json, const std::vector<SetupUserRun>& runs) {
     json->EndObject();
   }
   json->EndObject();
+  WriteBeyond(json, runs);
 }
 
 void WriteSetupPaper(JsonWriter* json) {
@@ -279,6 +424,37 @@ std::string SetupSummary(const std::vector<SetupUserRun>& runs) {
     text += "    " + std::string(kSetupModes[m]) + std::string(15 - std::string(kSetupModes[m]).size(), ' ') +
             StatsText(Summarize(Times(runs, kSetupModes[m], false)), 0, true) + "   paper " +
             StatsText(FromPaper(p), 0, true) + "\n";
+  }
+  text +=
+      "  Beyond the paper: docking error at the trocar (tip [mm] / tool axis [deg], median), contacts, "
+      "collision stops, near misses (< " +
+      Fixed(kNearMissM * 100, 0) + " cm)\n";
+  for (int m = 0; m < 3; ++m) {
+    const std::string mode = kSetupModes[m];
+    if (!HasMode(runs, mode)) continue;
+    std::vector<double> tip, axis;
+    int contact = 0, stops = 0, near = 0;
+    for (const SetupUserRun& run : runs) {
+      for (const SetupRow& row : run.setups) {
+        if (row.mode != mode) continue;
+        if (row.docking_tip_mm) tip.push_back(*row.docking_tip_mm);
+        if (row.docking_axis_deg) axis.push_back(*row.docking_axis_deg);
+        contact += row.contact;
+        stops += row.collision_stops;
+        near += !row.contact && row.min_clearance_m && *row.min_clearance_m < kNearMissM;
+      }
+    }
+    text += "    " + mode + std::string(15 - mode.size(), ' ') +
+            (tip.empty() ? std::string("(not recorded)")
+                         : Fixed(stats::Median(tip), 0) + " mm / " + Fixed(stats::Median(axis), 1) + " deg") +
+            ", " + std::to_string(contact) + " contact(s), " + std::to_string(stops) + " stop(s), " +
+            std::to_string(near) + " near miss(es)\n";
+  }
+  const std::vector<PowerPoint> power = SetupPower(runs, "ar_reflective", "ar", kPowerUsers, 500, 0.05, 1);
+  if (!power.empty()) {
+    text += "  Power of ar_reflective vs ar (Table 3 total, alpha 0.05), users: power\n   ";
+    for (const PowerPoint& q : power) text += " " + std::to_string(q.users) + ": " + Fixed(q.power, 2);
+    text += "\n";
   }
   return text;
 }

@@ -17,10 +17,26 @@
 ///                     approximation with tie and continuity corrections, base/stats.h);
 ///                     "table3_test": "mann_whitney_u"; "table4": {mode: {"execution_s": {...},
 ///                     "alignment_s": {...} (headset modes)}}; the paper's in "paper".
+///   setup_docking.csv user,mode,order,target,docking_tip_mm,docking_axis_deg,min_clearance_m,
+///                     contact,collision_stops (beyond the paper: what the joint errors do at the
+///                     trocar, and what the arm came close to while the assistant moved it; empty
+///                     cells for runs that did not record them)
+///   tables.json "beyond": {"docking": {mode: {"tip_mm": {...}, "axis_deg": {...}}},
+///                     "collisions": {mode: {"setups", "contact", "collision_stops", "near_miss",
+///                     "min_clearance_m": {...}}} with "near_miss_m" (a set-up is a near miss when
+///                     its smallest clearance is below it and nothing touched), "power": {pair:
+///                     {"users": [...], "power": [...], "users_for_80": n | null}} with "power_method".
+///
+/// Power analysis (SetupPower): how many users a study would need for Table 3's total test to
+/// reject at alpha = 0.05 with probability 0.8, if people were like the emulated ones. A bootstrap
+/// over users: for each study size N, `resamples` studies of N users drawn with replacement from
+/// the runs (each drawn user brings all their set-ups), the pooled test of Table 3 on each; the
+/// power is the fraction with p < alpha. Deterministic for a seed (base/random.h).
 ///
 /// Statistics: sample standard deviations (n − 1); medians of even counts average the middle two.
 /// Threading: pure functions.
 
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -37,6 +53,10 @@ struct SetupRow {
   std::vector<int> twisting;
   double execution_s{0};
   std::optional<double> alignment_s;
+  /// Beyond the paper (orbed-setup records them; absent in older results).
+  std::optional<double> docking_tip_mm, docking_axis_deg, min_clearance_m;
+  bool contact{false};
+  int collision_stops{0};
 };
 
 struct SetupUserRun {
@@ -62,7 +82,25 @@ std::vector<double> JointErrors(const std::vector<SetupUserRun>& runs, const std
 
 std::string SetupJointsCsv(const std::vector<SetupUserRun>& runs);
 std::string SetupTimesCsv(const std::vector<SetupUserRun>& runs);
-/// Writes the "table2", "table3", "table3_test" and "table4" members into an open JSON object.
+std::string SetupDockingCsv(const std::vector<SetupUserRun>& runs);
+
+/// A set-up is a near miss when nothing touched but the arm came closer than this [m] to itself or
+/// the scene: the plan's own clearance for its targets (sim/trocar_plan.h min_clearance_m).
+inline constexpr double kNearMissM = 0.05;
+
+struct PowerPoint {
+  int users{0};
+  double power{0};  ///< fraction of the resampled studies with p < alpha
+};
+/// Study sizes the power analysis tries.
+inline const std::vector<int> kPowerUsers = {4, 8, 12, 16, 24, 32, 48, 64};
+/// The power of Table 3's total test between modes a and b (see the file comment) at each size of
+/// `users`. Empty when a mode is missing or no run has both.
+std::vector<PowerPoint> SetupPower(const std::vector<SetupUserRun>& runs, const std::string& a,
+                                   const std::string& b, const std::vector<int>& users, int resamples,
+                                   double alpha, uint64_t seed);
+/// Writes the "table2", "table3", "table3_test", "table4" and "beyond" members into an open JSON
+/// object (the power analysis: 500 resamples per size, seed 1).
 void WriteSetupTables(JsonWriter* json, const std::vector<SetupUserRun>& runs);
 /// Writes the paper's "table2", "table3", "table4" (and "setup_source") into an open JSON object.
 void WriteSetupPaper(JsonWriter* json);

@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "base/stats.h"
 #include "study/paper_setup.h"
 
 namespace orbed::study {
@@ -101,6 +102,104 @@ TEST(SetupTables, TablesTwoThreeAndFourByHand) {
   EXPECT_EQ(p["table3"]["ar/fixed"]["total"].get<double>(), 2.0e-18);
   EXPECT_EQ(p["table4"]["ar"]["execution_s"]["mean"].get<double>(), 91.0);              // 1:31
   EXPECT_EQ(p["table4"]["ar_reflective"]["alignment_s"]["mean"].get<double>(), 272.0);  // 4:32
+}
+
+// One set-up with every joint `error` deg off, and what orbed-setup records beyond the paper.
+std::string SetupJsonBeyond(const std::string& mode, int target, double error, double tip_mm, double axis_deg,
+                            const std::string& clearance_m, bool contact, int stops) {
+  std::string reached;
+  const double target_deg[7] = {10, 20, 0, -60, 0, 40, 0};
+  for (int j = 0; j < 7; ++j) reached += (j ? ", " : "") + std::to_string(target_deg[j] + error);
+  return R"({"task_id": "x", "mode": ")" + mode + R"(", "order": 1, "target": )" + std::to_string(target) +
+         R"(, "target_deg": [10, 20, 0, -60, 0, 40, 0], "reached_deg": [)" + reached +
+         R"(], "twisting": [1, 0, 1, 0, 1, 0, 1], "execution_s": 60, "alignment_s": null, "docking_tip_mm": )" +
+         std::to_string(tip_mm) + R"(, "docking_axis_deg": )" + std::to_string(axis_deg) +
+         R"(, "min_clearance_m": )" + clearance_m + R"(, "contact": )" + (contact ? "true" : "false") +
+         R"(, "collision_stops": )" + std::to_string(stops) + "}";
+}
+
+SetupUserRun User(const std::string& name, const std::vector<std::string>& setups) {
+  std::string text = R"({"user": ")" + name + R"(", "status": "ok", "error": "", "order": [], "setups": [)";
+  for (size_t i = 0; i < setups.size(); ++i) text += (i ? "," : "") + setups[i];
+  return ReadSetupResults(Write(name + ".json", text + "]}"));
+}
+
+// Docking, contacts, stops and near misses counted by hand: a contact is never also a near miss,
+// a clearance of exactly 5 cm is not one, an unknown clearance (null) is not one.
+TEST(SetupTables, BeyondThePaperByHand) {
+  const std::vector<SetupUserRun> runs = {
+      User("u1", {SetupJsonBeyond("ar", 1, 1, 4, 0.5, "0.01", false, 0),
+                  SetupJsonBeyond("ar", 2, 1, 10, 1.5, "-0.002", true, 2),
+                  SetupJsonBeyond("fixed", 1, 3, 80, 12, "0.05", false, 1)}),
+      User("u2", {SetupJsonBeyond("ar", 1, 1, 6, 1.0, "null", false, 0),
+                  SetupJsonBeyond("fixed", 1, 3, 40, 6, "0.049", false, 0)})};
+  const std::string csv = SetupDockingCsv(runs);
+  EXPECT_EQ(csv.substr(0, csv.find('\n')),
+            "user,mode,order,target,docking_tip_mm,docking_axis_deg,min_clearance_m,contact,collision_stops");
+  EXPECT_NE(csv.find("\nu1,ar,1,2,10,1.5,-0.002,1,2\n"), std::string::npos) << csv;
+  EXPECT_NE(csv.find("\nu2,ar,1,1,6,1,,0,0\n"), std::string::npos) << csv;
+  JsonWriter writer;
+  writer.BeginObject();
+  WriteSetupTables(&writer, runs);
+  writer.EndObject();
+  const nlohmann::json b = nlohmann::json::parse(writer.str())["beyond"];
+  EXPECT_EQ(b["docking"]["ar"]["tip_mm"]["median"].get<double>(), 6.0);
+  EXPECT_EQ(b["docking"]["ar"]["axis_deg"]["mean"].get<double>(), 1.0);
+  EXPECT_EQ(b["docking"]["fixed"]["tip_mm"]["mean"].get<double>(), 60.0);
+  EXPECT_EQ(b["collisions"]["ar"]["setups"].get<int>(), 3);
+  EXPECT_EQ(b["collisions"]["ar"]["contact"].get<int>(), 1);
+  EXPECT_EQ(b["collisions"]["ar"]["collision_stops"].get<int>(), 2);
+  EXPECT_EQ(b["collisions"]["ar"]["near_miss"].get<int>(), 1);  // 0.01; not the contact, not null
+  EXPECT_EQ(b["collisions"]["ar"]["min_clearance_m"]["n"].get<int>(), 2);
+  EXPECT_EQ(b["collisions"]["fixed"]["near_miss"].get<int>(), 1);  // 0.049, not 0.05
+  EXPECT_EQ(b["collisions"]["fixed"]["collision_stops"].get<int>(), 1);
+  EXPECT_EQ(b["near_miss_m"].get<double>(), kNearMissM);
+  // u2 did no fixed set-up: the ar/fixed power analysis draws u1 only.
+  ASSERT_TRUE(b["power"].contains("ar/fixed"));
+  EXPECT_EQ(b["power"]["ar/fixed"]["users"].size(), kPowerUsers.size());
+}
+
+// The power analysis: modes that give each user the same errors are never told apart (power 0);
+// modes whose errors never overlap always are (power 1 from the smallest study); and a pool of
+// one separating user (S) and one indifferent user (I) has the power the binomial count of S among
+// N draws gives: sum over k of C(N, k) / 2^N for the k whose pooled test rejects.
+TEST(SetupTables, PowerByBootstrapOverUsers) {
+  auto user = [](const std::string& name, double error_a, double error_b) {
+    return User(name, {SetupJsonBeyond("ar_reflective", 1, error_a, 0, 0, "null", false, 0),
+                       SetupJsonBeyond("ar", 1, error_b, 0, 0, "null", false, 0),
+                       SetupJsonBeyond("ar_reflective", 2, error_a + 0.5, 0, 0, "null", false, 0),
+                       SetupJsonBeyond("ar", 2, error_b + 0.5, 0, 0, "null", false, 0)});
+  };
+  const std::vector<int> sizes = {4, 8};
+  for (const PowerPoint& q :
+       SetupPower({user("a", 2, 2), user("b", 7, 7)}, "ar_reflective", "ar", sizes, 200, 0.05, 3))
+    EXPECT_EQ(q.power, 0.0) << q.users;
+  for (const PowerPoint& q :
+       SetupPower({user("a", 1, 20), user("b", 2, 30)}, "ar_reflective", "ar", sizes, 200, 0.05, 3))
+    EXPECT_EQ(q.power, 1.0) << q.users;
+  EXPECT_TRUE(SetupPower({user("a", 1, 2)}, "ar_reflective", "fixed", sizes, 10, 0.05, 1).empty());
+
+  const SetupUserRun separating = user("s", 1, 20), indifferent = user("i", 5, 5);
+  const int n = 4;
+  double expected = 0;
+  for (int k = 0; k <= n; ++k) {
+    std::vector<SetupUserRun> drawn;
+    for (int u = 0; u < n; ++u) drawn.push_back(u < k ? separating : indifferent);
+    const stats::MannWhitneyResult r =
+        stats::MannWhitneyU(JointErrors(drawn, "ar_reflective", -1), JointErrors(drawn, "ar", -1));
+    const double binomial =
+        std::tgamma(n + 1) / (std::tgamma(k + 1) * std::tgamma(n - k + 1)) / std::pow(2, n);
+    if (r.valid && r.p_two_sided < 0.05) expected += binomial;
+  }
+  EXPECT_GT(expected, 0.0);
+  EXPECT_LT(expected, 1.0);
+  const std::vector<PowerPoint> mixed =
+      SetupPower({separating, indifferent}, "ar_reflective", "ar", {n}, 4000, 0.05, 7);
+  ASSERT_EQ(mixed.size(), 1u);
+  // 4000 resamples: the estimate's standard error is at most 0.008.
+  EXPECT_NEAR(mixed[0].power, expected, 0.04);
+  EXPECT_EQ(mixed[0].power,
+            SetupPower({separating, indifferent}, "ar_reflective", "ar", {n}, 4000, 0.05, 7)[0].power);
 }
 
 TEST(SetupTables, RefusesUnfinishedOrMalformedRuns) {

@@ -268,6 +268,7 @@ int RunStudyTables(int argc, const char* const* argv, std::ostream& out, std::os
     if (!setup_runs.empty()) {
       all.emplace_back("setup_joints.csv", SetupJointsCsv(setup_runs));
       all.emplace_back("setup_times.csv", SetupTimesCsv(setup_runs));
+      all.emplace_back("setup_docking.csv", SetupDockingCsv(setup_runs));
     }
     for (const auto& [name, text] : all) {
       const std::string path = (std::filesystem::path(out_dir) / name).string();
