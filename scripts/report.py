@@ -96,6 +96,66 @@ def figures(study_dir, joints_rows):
     plt.close(fig)
 
 
+def power_figure(study_dir, beyond):
+    """The power analysis's curves (tables.json beyond.power): one line per pair of modes."""
+    curves = beyond.get("power", {})
+    if not curves:
+        return False
+    fig, ax = plt.subplots(figsize=(6, 4))
+    for pair, curve in curves.items():
+        ax.plot(curve["users"], curve["power"], marker="o", label=pair)
+    ax.axhline(0.8, color="grey", linestyle="--", linewidth=1)
+    ax.set_ylim(-0.02, 1.02)
+    ax.set_xlabel("users in the study")
+    ax.set_ylabel("power of the total test (alpha 0.05)")
+    ax.legend()
+    fig.tight_layout()
+    os.makedirs(os.path.join(study_dir, "figures"), exist_ok=True)
+    fig.savefig(os.path.join(study_dir, "figures", "power.png"), dpi=100)
+    plt.close(fig)
+    return True
+
+
+def beyond_section(study_dir, beyond):
+    """Docking error, collisions and the power analysis: numbers the paper did not report."""
+    parts = ["<h2>Beyond the paper</h2>"]
+    docking = beyond.get("docking", {})
+    collisions = beyond.get("collisions", {})
+    if docking or collisions:
+        parts.append("<table><tr><th></th><th>docking: tool tip [mm] median / max</th>"
+                     "<th>tool axis [deg] median / max</th><th>set-ups</th><th>contacts</th>"
+                     "<th>collision stops</th><th>near misses (&lt; %s cm)</th>"
+                     "<th>smallest clearance [mm]</th></tr>" % fmt(beyond.get("near_miss_m", 0) * 100, 0))
+        for mode in MODES:
+            d = docking.get(mode)
+            c = collisions.get(mode)
+            if not d and not c:
+                continue
+            tip = "%s / %s" % (fmt(d["tip_mm"]["median"], 0), fmt(d["tip_mm"]["max"], 0)) if d else "-"
+            axis = "%s / %s" % (fmt(d["axis_deg"]["median"]), fmt(d["axis_deg"]["max"])) if d else "-"
+            clearance = c.get("min_clearance_m") if c else None
+            parts.append("<tr><th>%s</th><td>%s</td><td>%s</td><td>%s</td><td>%s</td><td>%s</td><td>%s</td>"
+                         "<td>%s</td></tr>" % (
+                             LABELS[mode], tip, axis, c["setups"] if c else "-", c["contact"] if c else "-",
+                             c["collision_stops"] if c else "-", c["near_miss"] if c else "-",
+                             fmt(clearance["min"] * 1e3, 0) if clearance else "-"))
+        parts.append("</table><p>The docking error is where the tool tip and its axis end up against where "
+                     "the target configuration puts them at the trocar (forward kinematics of the sim's "
+                     "joints); contacts, stops and clearances are the sim's collision checks while the "
+                     "assistant moved the arm.</p>")
+    power = beyond.get("power", {})
+    if power:
+        parts.append("<p>Power analysis (%s). Users needed for 80 %% power: %s.</p>" % (
+            html.escape(beyond.get("power_method", "")),
+            ", ".join("%s %s" % (html.escape(pair), curve["users_for_80"] if curve["users_for_80"] is not None
+                                 else "more than %d" % curve["users"][-1])
+                      for pair, curve in power.items())))
+        if power_figure(study_dir, beyond):
+            parts.append("<figure><img src='figures/power.png'><figcaption>Power of Table 3's total test "
+                         "against the number of users, from the emulated people</figcaption></figure>")
+    return parts
+
+
 def fmt(value, digits=1):
     if value is None:
         return "-"
@@ -182,6 +242,8 @@ def report(study_dir):
                               ("joint_rank.png", "Mean error per joint, log scale; twisting joints "
                                                  "red-edged (Fig. 8)")):
             parts.append("<figure><img src='figures/%s'><figcaption>%s</figcaption></figure>" % (name, caption))
+    if tables.get("beyond"):
+        parts.extend(beyond_section(study_dir, tables["beyond"]))
     trials_path = os.path.join(study_dir, "alignment_trials.csv")
     rows = read_csv(trials_path) if os.path.exists(trials_path) else []
     if rows:

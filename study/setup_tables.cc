@@ -125,6 +125,11 @@ SetupUserRun ReadSetupResults(const std::string& path) {
     if (const std::optional<JsonAt> alignment = f.OptionalMember(s, "alignment_s")) {
       row.alignment_s = f.Number(*alignment, 0, 1e6);
     }
+    if (const std::optional<JsonAt> v = f.OptionalMember(s, "registration")) {
+      row.registration = f.String(*v, 16);
+      if (row.registration != "measured" && row.registration != "truth")
+        throw std::runtime_error(file + ": " + v->key + ": expected measured, truth or null");
+    }
     // Beyond the paper: absent or null in results written before orbed-setup recorded them.
     if (const std::optional<JsonAt> v = f.OptionalMember(s, "docking_tip_mm"))
       row.docking_tip_mm = f.Number(*v, 0, 1e5);
@@ -244,7 +249,8 @@ std::vector<PowerPoint> SetupPower(const std::vector<SetupUserRun>& runs, const 
 
 namespace {
 
-void WriteBeyond(JsonWriter* json, const std::vector<SetupUserRun>& runs) {
+void WriteBeyond(JsonWriter* json, const std::vector<SetupUserRun>& runs,
+                 const std::vector<SetupUserRun>& truth_runs) {
   auto values = [&](const std::string& mode, std::optional<double> SetupRow::*field) {
     std::vector<double> out;
     for (const SetupUserRun& run : runs) {
@@ -294,6 +300,23 @@ void WriteBeyond(JsonWriter* json, const std::vector<SetupUserRun>& runs) {
     json->EndObject();
   }
   json->EndObject();
+  if (!truth_runs.empty()) {
+    json->Key("registration_share").BeginObject();
+    for (const char* mode : kSetupModes) {
+      const std::vector<double> measured = JointErrors(runs, mode, -1),
+                                truth = JointErrors(truth_runs, mode, -1);
+      if (measured.empty() || truth.empty()) continue;
+      const Stats5 m = Summarize(measured), t = Summarize(truth);
+      json->Key(mode).BeginObject();
+      json->Key("measured_deg");
+      WriteStats(json, m);
+      json->Key("truth_deg");
+      WriteStats(json, t);
+      json->Key("share").Number(m.mean > 0 ? 1 - t.mean / m.mean : 0.0);
+      json->EndObject();
+    }
+    json->EndObject();
+  }
   json->Key("power_method")
       .String(
           "bootstrap over users: 500 studies of N users drawn with replacement per N, Table 3's pooled "
@@ -327,7 +350,8 @@ void WriteBeyond(JsonWriter* json, const std::vector<SetupUserRun>& runs) {
 
 }  // namespace
 
-void WriteSetupTables(JsonWriter* json, const std::vector<SetupUserRun>& runs) {
+void WriteSetupTables(JsonWriter* json, const std::vector<SetupUserRun>& runs,
+                      const std::vector<SetupUserRun>& truth_runs) {
   json->Key("setup_users").Int(static_cast<int64_t>(runs.size()));
   json->Key("table2").BeginObject();
   for (const char* mode : kSetupModes) {
@@ -371,7 +395,7 @@ void WriteSetupTables(JsonWriter* json, const std::vector<SetupUserRun>& runs) {
     json->EndObject();
   }
   json->EndObject();
-  WriteBeyond(json, runs);
+  WriteBeyond(json, runs, truth_runs);
 }
 
 void WriteSetupPaper(JsonWriter* json) {
@@ -404,7 +428,7 @@ void WriteSetupPaper(JsonWriter* json) {
   json->EndObject();
 }
 
-std::string SetupSummary(const std::vector<SetupUserRun>& runs) {
+std::string SetupSummary(const std::vector<SetupUserRun>& runs, const std::vector<SetupUserRun>& truth_runs) {
   size_t setups = 0;
   for (const SetupUserRun& run : runs) setups += run.setups.size();
   std::string text = "Robot set-up study: " + std::to_string(runs.size()) + " users, " +
@@ -449,6 +473,15 @@ std::string SetupSummary(const std::vector<SetupUserRun>& runs) {
                          : Fixed(stats::Median(tip), 0) + " mm / " + Fixed(stats::Median(axis), 1) + " deg") +
             ", " + std::to_string(contact) + " contact(s), " + std::to_string(stops) + " stop(s), " +
             std::to_string(near) + " near miss(es)\n";
+  }
+  for (const char* mode : kSetupModes) {
+    const std::vector<double> measured = JointErrors(runs, mode, -1),
+                              truth = JointErrors(truth_runs, mode, -1);
+    if (measured.empty() || truth.empty()) continue;
+    const double m = stats::Mean(measured), t = stats::Mean(truth);
+    text += "  Registration's share, " + std::string(mode) + ": mean joint error " + Fixed(m, 1) +
+            " deg measured, " + Fixed(t, 1) + " deg with the true registration (" +
+            Fixed(m > 0 ? 100 * (1 - t / m) : 0.0, 0) + " %)\n";
   }
   const std::vector<PowerPoint> power = SetupPower(runs, "ar_reflective", "ar", kPowerUsers, 500, 0.05, 1);
   if (!power.empty()) {

@@ -53,6 +53,9 @@ struct SetupRow {
   std::vector<int> twisting;
   double execution_s{0};
   std::optional<double> alignment_s;
+  /// "measured" or "truth" (orbed-setup --registration) in the headset modes; "" for fixed or
+  /// older results.
+  std::string registration;
   /// Beyond the paper (orbed-setup records them; absent in older results).
   std::optional<double> docking_tip_mm, docking_axis_deg, min_clearance_m;
   bool contact{false};
@@ -100,11 +103,16 @@ std::vector<PowerPoint> SetupPower(const std::vector<SetupUserRun>& runs, const 
                                    const std::string& b, const std::vector<int>& users, int resamples,
                                    double alpha, uint64_t seed);
 /// Writes the "table2", "table3", "table3_test", "table4" and "beyond" members into an open JSON
-/// object (the power analysis: 500 resamples per size, seed 1).
-void WriteSetupTables(JsonWriter* json, const std::vector<SetupUserRun>& runs);
+/// object (the power analysis: 500 resamples per size, seed 1). With `truth_runs` (the same users
+/// with --registration truth) also beyond.registration_share: {mode: {"measured_deg": {...},
+/// "truth_deg": {...}, "share": 1 − truth mean / measured mean}} over every joint's error: the
+/// part of a headset mode's error that a perfect registration removes.
+void WriteSetupTables(JsonWriter* json, const std::vector<SetupUserRun>& runs,
+                      const std::vector<SetupUserRun>& truth_runs = {});
 /// Writes the paper's "table2", "table3", "table4" (and "setup_source") into an open JSON object.
 void WriteSetupPaper(JsonWriter* json);
 /// Tables 2-4 beside the paper's, for the terminal.
-std::string SetupSummary(const std::vector<SetupUserRun>& runs);
+std::string SetupSummary(const std::vector<SetupUserRun>& runs,
+                         const std::vector<SetupUserRun>& truth_runs = {});
 
 }  // namespace orbed::study

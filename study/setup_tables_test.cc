@@ -202,6 +202,34 @@ TEST(SetupTables, PowerByBootstrapOverUsers) {
             SetupPower({separating, indifferent}, "ar_reflective", "ar", {n}, 4000, 0.05, 7)[0].power);
 }
 
+// The registration's share: 1 − (mean error with the true registration) / (mean error measured).
+TEST(SetupTables, RegistrationShareByHand) {
+  auto with = [](const std::string& registration, double error) {
+    std::string setup = SetupJsonBeyond("ar", 1, error, 0, 0, "null", false, 0);
+    setup.insert(setup.size() - 1, R"(, "registration": ")" + registration + "\"");
+    return setup;
+  };
+  const std::vector<SetupUserRun> measured = {User("m1", {with("measured", 4)}),
+                                              User("m2", {with("measured", 6)})};
+  const std::vector<SetupUserRun> truth = {User("t1", {with("truth", 1)}), User("t2", {with("truth", 2)})};
+  EXPECT_EQ(truth[0].setups[0].registration, "truth");
+  JsonWriter writer;
+  writer.BeginObject();
+  WriteSetupTables(&writer, measured, truth);
+  writer.EndObject();
+  const nlohmann::json share = nlohmann::json::parse(writer.str())["beyond"]["registration_share"];
+  EXPECT_EQ(share["ar"]["measured_deg"]["mean"].get<double>(), 5.0);
+  EXPECT_EQ(share["ar"]["truth_deg"]["mean"].get<double>(), 1.5);
+  EXPECT_NEAR(share["ar"]["share"].get<double>(), 0.7, 1e-12);
+  EXPECT_FALSE(share.contains("fixed"));
+  EXPECT_THROW(User("bad", {[&] {
+                      std::string setup = with("truth", 1);
+                      setup.replace(setup.find("\"truth\""), 7, "\"guess\"");
+                      return setup;
+                    }()}),
+               std::runtime_error);
+}
+
 TEST(SetupTables, RefusesUnfinishedOrMalformedRuns) {
   auto error = [](const std::string& text) {
     try {

@@ -130,7 +130,8 @@ std::string AlignmentMeansCsv(const std::vector<UserRun>& runs) {
 }
 
 std::string TablesJson(const std::vector<UserRun>& runs, const LandmarkValidation& validation,
-                       const std::vector<SetupUserRun>& setup_runs) {
+                       const std::vector<SetupUserRun>& setup_runs,
+                       const std::vector<SetupUserRun>& setup_truth_runs) {
   JsonWriter json(2);
   json.BeginObject();
   json.Key("users").Int(static_cast<int64_t>(runs.size()));
@@ -147,7 +148,7 @@ std::string TablesJson(const std::vector<UserRun>& runs, const LandmarkValidatio
   json.EndObject();
   json.EndObject();
   json.Key("landmark_validation_mm").Number(validation.mean_error_mm);
-  if (!setup_runs.empty()) WriteSetupTables(&json, setup_runs);
+  if (!setup_runs.empty()) WriteSetupTables(&json, setup_runs, setup_truth_runs);
   json.Key("paper").BeginObject();
   json.Key("source").String(viraal::kPaperSource);
   json.Key("table1").BeginObject();
@@ -204,6 +205,11 @@ int RunStudyTables(int argc, const char* const* argv, std::ostream& out, std::os
   app.add_option("--setup", setup_paths,
                  "A set-up user's setup_results.json or its run folder (orbed-setup); one per --setup")
       ->allow_extra_args(false);
+  std::vector<std::string> setup_truth_paths;
+  app.add_option("--setup-truth", setup_truth_paths,
+                 "The same set-up users run with orbed-setup --registration truth (the registration's share "
+                 "of the error); one per --setup-truth")
+      ->allow_extra_args(false);
   app.add_option("runs", run_paths, "Each ViRAAl user's results.json or its run folder");
   try {
     app.parse(argc, argv);
@@ -216,9 +222,22 @@ int RunStudyTables(int argc, const char* const* argv, std::ostream& out, std::os
     return 2;
   }
   try {
-    std::vector<SetupUserRun> setup_runs;
+    std::vector<SetupUserRun> setup_runs, setup_truth_runs;
+    for (const std::string& path : setup_truth_paths) {
+      setup_truth_runs.push_back(ReadSetupResults(path));
+      for (const SetupRow& row : setup_truth_runs.back().setups) {
+        if (row.registration == "measured")
+          throw std::runtime_error(path + ": a measured-registration run given as --setup-truth");
+      }
+    }
+    if (!setup_truth_paths.empty() && setup_paths.empty())
+      throw std::runtime_error("--setup-truth needs the measured runs (--setup) to compare with");
     for (const std::string& path : setup_paths) {
       setup_runs.push_back(ReadSetupResults(path));
+      for (const SetupRow& row : setup_runs.back().setups) {
+        if (row.registration == "truth")
+          throw std::runtime_error(path + ": a --registration truth run: give it as --setup-truth");
+      }
       for (size_t k = 0; k + 1 < setup_runs.size(); ++k) {
         if (setup_runs[k].user == setup_runs.back().user) {
           throw std::runtime_error(path + ": user " + EscapeText(setup_runs.back().user) + " is there twice");
@@ -259,7 +278,7 @@ int RunStudyTables(int argc, const char* const* argv, std::ostream& out, std::os
         {"alignment_trials.csv", AlignmentTrialsCsv(runs)},
         {"alignment_means.csv", AlignmentMeansCsv(runs)},
         {"landmark_validation.csv", LandmarkValidationCsv(v)},
-        {"tables.json", TablesJson(runs, v, setup_runs)}};
+        {"tables.json", TablesJson(runs, v, setup_runs, setup_truth_runs)}};
     std::vector<std::pair<std::string, std::string>> all;
     for (const auto& [name, text] : files) {
       const bool alignment = std::string(name).rfind("alignment_", 0) == 0;
@@ -277,7 +296,7 @@ int RunStudyTables(int argc, const char* const* argv, std::ostream& out, std::os
       if (!file) throw std::runtime_error("cannot write " + path);
     }
     if (!runs.empty()) out << StudySummary(runs, v);
-    if (!setup_runs.empty()) out << SetupSummary(setup_runs);
+    if (!setup_runs.empty()) out << SetupSummary(setup_runs, setup_truth_runs);
   } catch (const std::exception& e) {
     err << "orbed-study-tables: " << e.what() << "\n";
     return 1;

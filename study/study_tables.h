@@ -45,7 +45,8 @@ std::string AlignmentTrialsCsv(const std::vector<UserRun>& runs);
 std::string AlignmentMeansCsv(const std::vector<UserRun>& runs);
 /// With set-up runs, tables.json also has Tables 2-4 (setup_tables.h) and the paper's.
 std::string TablesJson(const std::vector<UserRun>& runs, const LandmarkValidation& validation,
-                       const std::vector<SetupUserRun>& setup_runs = {});
+                       const std::vector<SetupUserRun>& setup_runs = {},
+                       const std::vector<SetupUserRun>& setup_truth_runs = {});
 /// Table 1 as the study measured it, beside the paper's, for the terminal.
 std::string StudySummary(const std::vector<UserRun>& runs, const LandmarkValidation& validation);
 

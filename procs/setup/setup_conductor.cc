@@ -81,6 +81,12 @@ std::string SetupRunJson(const SetupRun& run, bool partial) {
       json.Null();
     }
     json.Key("person_scale").Number(r.person_scale);
+    json.Key("registration");
+    if (r.mode == orbed::guidance_t::MODE_FIXED_DISPLAY) {
+      json.Null();
+    } else {
+      json.String(r.perfect_registration ? "truth" : "measured");
+    }
     json.Key("docking_tip_mm").Number(r.docking_tip_mm);
     json.Key("docking_axis_deg").Number(r.docking_axis_deg);
     json.Key("min_clearance_m");
@@ -175,7 +181,7 @@ SetupConductor::Actions SetupConductor::Start(const ConductorTime& now) {
 
 void SetupConductor::StartTask() {
   alignment_result_.reset();
-  if (Mode() == orbed::guidance_t::MODE_FIXED_DISPLAY) return EnterPark();
+  if (Mode() == orbed::guidance_t::MODE_FIXED_DISPLAY || options_.perfect_registration) return EnterPark();
   scenario::ConductorOptions o;
   o.config = options_.alignment;
   const bool reflective = Mode() == orbed::guidance_t::MODE_AR_REFLECTIVE;
@@ -205,6 +211,17 @@ void SetupConductor::EnterPark() {
 }
 
 void SetupConductor::SendTask() {
+  if (options_.perfect_registration && Mode() != orbed::guidance_t::MODE_FIXED_DISPLAY) {
+    orbed::registration_t truth{};
+    truth.utime = now_.utime;
+    truth.session_id = options_.run_id + "-" + task_.task_id + "-truth";
+    truth.reason = orbed::registration_t::REASON_COMPUTE;
+    truth.valid = true;
+    truth.X_WV_mean = robot_state_->X_WR;  // kPark waited for a ROBOT_STATE
+    truth.converged = true;
+    truth.unique = true;
+    actions_.publish.push_back({options_.registration_channel, truth});
+  }
   actions_.publish.push_back({options_.setup_task_channel, task_});
   last_send_s_ = now_.t_s;
 }
@@ -344,6 +361,7 @@ SetupConductor::Actions SetupConductor::OnSetupResult(const orbed::setup_result_
   r.ranges.assign(msg.ranges.begin(), msg.ranges.end());
   r.execution_s = msg.execution_s;
   r.person_scale = msg.person_scale;
+  r.perfect_registration = options_.perfect_registration && r.mode != orbed::guidance_t::MODE_FIXED_DISPLAY;
   const Docking docking = DockingError(*model_, r.target_deg, r.reached_deg);
   r.docking_tip_mm = docking.tip_mm;
   r.docking_axis_deg = docking.axis_deg;

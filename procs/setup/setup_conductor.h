@@ -23,6 +23,11 @@
 ///     COLLISION_STATUS and ROBOT_STATE while the assistant moved the arm, the smallest clearance
 ///     to anything (self or scene) [m], whether any pair touched, and how often the sim stopped the
 ///     arm before a collision (the paper's Sec. IV-B "beyond": collisions and near misses).
+/// With perfect_registration (the "registration's share" experiment beyond the paper) the
+/// headset modes skip kAlign: the conductor publishes a REGISTRATION (session
+/// "<run_id>-<task_id>-truth", valid, num_trials 0) whose X_WV_mean is the true base pose X_WR of
+/// the latest ROBOT_STATE, with every SETUP_TASK (so a restarted reader gets it again), and the
+/// hologram stands where the real robot is; only the SLAM error and the person remain.
 /// A phase that waits longer than its timeout fails the run with a one-line reason naming the
 /// process that did not answer.
 ///
@@ -41,6 +46,7 @@
 
 #include <orbed/collision_status_t.hpp>
 #include <orbed/iiwa_command_t.hpp>
+#include <orbed/registration_t.hpp>
 #include <orbed/robot_state_t.hpp>
 #include <orbed/setup_result_t.hpp>
 #include <orbed/setup_task_t.hpp>
@@ -66,6 +72,8 @@ struct SetupOptions {
   /// The alignment protocol of the headset modes (its modes are replaced per task; its trials are N).
   viraal::ScenarioConfig alignment;
   int reflective_mirrors{1};
+  /// Headset modes: the true registration instead of N alignments (see the file comment).
+  bool perfect_registration{false};
   double tolerance_deg{0.1};
   double startup_timeout_s{10.0};
   double move_timeout_s{30.0};
@@ -77,6 +85,7 @@ struct SetupOptions {
   std::string iiwa_command_channel{"IIWA_COMMAND"};
   std::string setup_task_channel{"SETUP_TASK"};
   std::string setup_result_channel{"SETUP_RESULT"};
+  std::string registration_channel{"REGISTRATION"};
 };
 
 /// One finished set-up.
@@ -92,6 +101,7 @@ struct SetupRecord {
   std::optional<double> alignment_s;  ///< headset modes: the N trials' time
   std::optional<viraal::SessionResult> alignment;
   double person_scale{1};
+  bool perfect_registration{false};  ///< headset mode with the true registration
   /// The docking error the joint errors cause (DockingError of target_deg and reached_deg).
   double docking_tip_mm{0}, docking_axis_deg{0};
   /// While the assistant moved the arm: the smallest COLLISION_STATUS.min_distance_m (none when no
@@ -122,15 +132,15 @@ struct SetupRun {
 /// setup_results.json's text: {"user", "run_id", "status": "ok" | "failed" | "partial", "error",
 /// "order", "setups": [{task_id, mode, order, target, target_deg, reached_deg,
 /// assistant_reached_deg, error_deg, twisting, ranges, execution_s, alignment_s (null for fixed),
-/// person_scale, docking_tip_mm, docking_axis_deg, min_clearance_m (null when unknown), contact,
-/// collision_stops, alignment: null | {session_id, trials, translation_error_mm, rotation_error_deg,
-/// misalignment_mm} of the mean}]}.
+/// person_scale, registration ("measured" | "truth" | null for fixed), docking_tip_mm, docking_axis_deg,
+/// min_clearance_m (null when unknown), contact, collision_stops, alignment: null | {session_id, trials,
+/// translation_error_mm, rotation_error_deg, misalignment_mm} of the mean}]}.
 std::string SetupRunJson(const SetupRun& run, bool partial);
 
 /// A message of this conductor's own to publish.
 struct SetupPublication {
   std::string channel;
-  std::variant<orbed::iiwa_command_t, orbed::setup_task_t> message;
+  std::variant<orbed::iiwa_command_t, orbed::setup_task_t, orbed::registration_t> message;
 };
 
 class SetupConductor {

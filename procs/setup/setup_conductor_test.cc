@@ -212,6 +212,54 @@ TEST(DockingError, ClosedForms) {
   EXPECT_THROW(DockingError(model, target, {1, 2}), std::invalid_argument);
 }
 
+// The registration's share: a headset mode with perfect_registration aligns nobody; every
+// SETUP_TASK goes with a REGISTRATION whose mean is the true base pose of the latest ROBOT_STATE.
+TEST(SetupConductor, PerfectRegistrationPublishesTheTrueBasePose) {
+  SetupOptions o = FixedOnly();
+  o.modes = {orbed::guidance_t::MODE_AR};
+  o.targets_deg.resize(1);
+  o.perfect_registration = true;
+  SetupConductor c(o, Model());
+  c.Start(At(0));
+  orbed::robot_state_t state = State({0, 20, 0, -60, 0, 40, 0}, 0);
+  state.X_WR.position_m[0] = 1.5;
+  state.X_WR.position_m[1] = -0.25;
+  state.X_WR.quaternion_wxyz[0] = std::sqrt(0.5);
+  state.X_WR.quaternion_wxyz[3] = std::sqrt(0.5);
+  SetupConductor::Actions a = c.OnRobotState(state, At(0.1));
+  EXPECT_TRUE(a.viraal.empty());  // no alignment session
+  ASSERT_EQ(a.publish.size(), 2u);
+  const auto* truth = std::get_if<orbed::registration_t>(&a.publish[0].message);
+  ASSERT_NE(truth, nullptr);
+  EXPECT_EQ(a.publish[0].channel, "REGISTRATION");
+  EXPECT_TRUE(truth->valid);
+  EXPECT_EQ(truth->num_trials, 0);
+  EXPECT_EQ(truth->session_id, "setup-u3-ar-1-truth");
+  for (int i = 0; i < 3; ++i) EXPECT_EQ(truth->X_WV_mean.position_m[i], state.X_WR.position_m[i]);
+  for (int i = 0; i < 4; ++i) EXPECT_EQ(truth->X_WV_mean.quaternion_wxyz[i], state.X_WR.quaternion_wxyz[i]);
+  const orbed::setup_task_t* task = FindTask(a);
+  ASSERT_NE(task, nullptr);
+  // Re-sent with the task.
+  a = c.Tick(At(1.2));
+  ASSERT_EQ(a.publish.size(), 2u);
+  EXPECT_NE(std::get_if<orbed::registration_t>(&a.publish[0].message), nullptr);
+  orbed::setup_result_t r{};
+  r.request_id = task->request_id;
+  r.task_id = task->task_id;
+  r.mode = orbed::guidance_t::MODE_AR;
+  r.num_joints = 7;
+  r.reached_position.assign(7, 0.0);
+  r.ranges.assign(7, 1);
+  r.execution_s = 60;
+  r.person_scale = 1;
+  c.OnSetupResult(r, At(1.5));
+  ASSERT_TRUE(c.done());
+  ASSERT_EQ(c.run().setups.size(), 1u);
+  EXPECT_TRUE(c.run().setups[0].perfect_registration);
+  EXPECT_FALSE(c.run().setups[0].alignment_s.has_value());
+  EXPECT_NE(SetupRunJson(c.run(), false).find("\"registration\": \"truth\""), std::string::npos);
+}
+
 TEST(SetupConductor, TimeoutsNameWhoDidNotAnswer) {
   {
     SetupConductor c(FixedOnly(), Model());

@@ -176,6 +176,14 @@ int RunSetup(int argc, const char* const* argv, std::ostream& out, std::ostream&
   app.add_option("--trials", trials, "Alignments before each headset set-up (the paper: N = 3)")
       ->check(CLI::Range(1, 100))
       ->capture_default_str();
+  std::string registration = "measured";
+  app.add_option("--registration", registration,
+                 "Headset modes: 'measured' (N alignments, their mean; the paper) or 'truth' (the true base "
+                 "pose published as the registration: the registration's share of the error; default "
+                 "$ORBED_SETUP_REGISTRATION if set)")
+      ->envname("ORBED_SETUP_REGISTRATION")
+      ->check(CLI::IsMember({"measured", "truth"}))
+      ->capture_default_str();
   app.add_option("--run-id", options.run_id,
                  "Run id (sessions are <run-id>-<task id>-<mode>; default $ORBED_RUN_ID if set)")
       ->envname("ORBED_RUN_ID")
@@ -202,6 +210,7 @@ int RunSetup(int argc, const char* const* argv, std::ostream& out, std::ostream&
       }
     }
     options.start_deg = ParseNumberList(start_deg, "--start-deg");
+    options.perfect_registration = registration == "truth";
   } catch (const std::invalid_argument& e) {
     err << "orbed-setup: " << e.what() << "\n";
     return 2;
