@@ -77,6 +77,19 @@ TEST(Sha256, KnownVectors) {
             "cdc76e5c9914fb9281a1c7e284d73e67f1809a48a497200e046d39ccc7112cd0");
 }
 
+// A file is read in 64 KiB blocks: the million-'a' vector spans 16 of them and a partial one.
+TEST(Sha256, FilesInBlocks) {
+  const std::string path = ::testing::TempDir() + "/sha256_million_a";
+  std::ofstream(path, std::ios::binary) << std::string(1000000, 'a');
+  std::string error;
+  EXPECT_EQ(Sha256FileHex(path, &error), "cdc76e5c9914fb9281a1c7e284d73e67f1809a48a497200e046d39ccc7112cd0");
+  EXPECT_EQ(error, "");
+  std::ofstream(path, std::ios::binary | std::ios::trunc);  // empty
+  EXPECT_EQ(Sha256FileHex(path), "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855");
+  EXPECT_EQ(Sha256FileHex(path + ".missing", &error), "");
+  EXPECT_NE(error.find("cannot read"), std::string::npos);
+}
+
 TEST(NumberList, ParsesAndRejectsWithTheItem) {
   EXPECT_EQ(ParseNumberList("0, 30.5,-60 ", "--q-deg"), (std::vector<double>{0, 30.5, -60}));
   EXPECT_EQ(ParseNumberList("", "x"), std::vector<double>{});

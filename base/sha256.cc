@@ -1,83 +1,50 @@
 #include "base/sha256.h"
 
-#include <array>
 #include <fstream>
-#include <iterator>
-#include <sstream>
+#include <memory>
+#include <stdexcept>
+#include <vector>
+
+#include <openssl/evp.h>
 
 namespace orbed {
 namespace {
 
-// Round constants: the first 32 bits of the fractional parts of the cube roots of the first 64
-// primes (FIPS 180-4, 4.2.2).
-constexpr std::array<uint32_t, 64> kRound = {
-    0x428a2f98, 0x71374491, 0xb5c0fbcf, 0xe9b5dba5, 0x3956c25b, 0x59f111f1, 0x923f82a4, 0xab1c5ed5,
-    0xd807aa98, 0x12835b01, 0x243185be, 0x550c7dc3, 0x72be5d74, 0x80deb1fe, 0x9bdc06a7, 0xc19bf174,
-    0xe49b69c1, 0xefbe4786, 0x0fc19dc6, 0x240ca1cc, 0x2de92c6f, 0x4a7484aa, 0x5cb0a9dc, 0x76f988da,
-    0x983e5152, 0xa831c66d, 0xb00327c8, 0xbf597fc7, 0xc6e00bf3, 0xd5a79147, 0x06ca6351, 0x14292967,
-    0x27b70a85, 0x2e1b2138, 0x4d2c6dfc, 0x53380d13, 0x650a7354, 0x766a0abb, 0x81c2c92e, 0x92722c85,
-    0xa2bfe8a1, 0xa81a664b, 0xc24b8b70, 0xc76c51a3, 0xd192e819, 0xd6990624, 0xf40e3585, 0x106aa070,
-    0x19a4c116, 0x1e376c08, 0x2748774c, 0x34b0bcb5, 0x391c0cb3, 0x4ed8aa4a, 0x5b9cca4f, 0x682e6ff3,
-    0x748f82ee, 0x78a5636f, 0x84c87814, 0x8cc70208, 0x90befffa, 0xa4506ceb, 0xbef9a3f7, 0xc67178f2};
+// One digest in progress; throws only when libcrypto itself fails (out of memory).
+class Digest {
+ public:
+  Digest() : context_(EVP_MD_CTX_new(), &EVP_MD_CTX_free) {
+    if (!context_ || EVP_DigestInit_ex(context_.get(), EVP_sha256(), nullptr) != 1)
+      throw std::runtime_error("libcrypto: cannot start a SHA-256 digest");
+  }
+  void Update(const char* data, size_t size) {
+    if (size > 0 && EVP_DigestUpdate(context_.get(), data, size) != 1)
+      throw std::runtime_error("libcrypto: SHA-256 update failed");
+  }
+  std::string FinalHex() {
+    unsigned char digest[EVP_MAX_MD_SIZE];
+    unsigned int length = 0;
+    if (EVP_DigestFinal_ex(context_.get(), digest, &length) != 1)
+      throw std::runtime_error("libcrypto: SHA-256 final failed");
+    static const char kHex[] = "0123456789abcdef";
+    std::string hex;
+    for (unsigned int i = 0; i < length; ++i) {
+      hex.push_back(kHex[digest[i] >> 4]);
+      hex.push_back(kHex[digest[i] & 0xf]);
+    }
+    return hex;
+  }
 
-uint32_t Rotr(uint32_t x, int n) { return (x >> n) | (x << (32 - n)); }
-
-void Compress(std::array<uint32_t, 8>* state, const uint8_t* block) {
-  uint32_t w[64];
-  for (int i = 0; i < 16; ++i) {
-    w[i] = (uint32_t{block[4 * i]} << 24) | (uint32_t{block[4 * i + 1]} << 16) |
-           (uint32_t{block[4 * i + 2]} << 8) | uint32_t{block[4 * i + 3]};
-  }
-  for (int i = 16; i < 64; ++i) {
-    const uint32_t s0 = Rotr(w[i - 15], 7) ^ Rotr(w[i - 15], 18) ^ (w[i - 15] >> 3);
-    const uint32_t s1 = Rotr(w[i - 2], 17) ^ Rotr(w[i - 2], 19) ^ (w[i - 2] >> 10);
-    w[i] = w[i - 16] + s0 + w[i - 7] + s1;
-  }
-  uint32_t a = (*state)[0], b = (*state)[1], c = (*state)[2], d = (*state)[3];
-  uint32_t e = (*state)[4], f = (*state)[5], g = (*state)[6], h = (*state)[7];
-  for (int i = 0; i < 64; ++i) {
-    const uint32_t t1 =
-        h + (Rotr(e, 6) ^ Rotr(e, 11) ^ Rotr(e, 25)) + ((e & f) ^ (~e & g)) + kRound[i] + w[i];
-    const uint32_t t2 = (Rotr(a, 2) ^ Rotr(a, 13) ^ Rotr(a, 22)) + ((a & b) ^ (a & c) ^ (b & c));
-    h = g;
-    g = f;
-    f = e;
-    e = d + t1;
-    d = c;
-    c = b;
-    b = a;
-    a = t1 + t2;
-  }
-  (*state)[0] += a;
-  (*state)[1] += b;
-  (*state)[2] += c;
-  (*state)[3] += d;
-  (*state)[4] += e;
-  (*state)[5] += f;
-  (*state)[6] += g;
-  (*state)[7] += h;
-}
+ private:
+  std::unique_ptr<EVP_MD_CTX, decltype(&EVP_MD_CTX_free)> context_;
+};
 
 }  // namespace
 
 std::string Sha256Hex(const std::string& bytes) {
-  // Initial hash: first 32 bits of the fractional parts of the square roots of the first 8 primes.
-  std::array<uint32_t, 8> state = {0x6a09e667, 0xbb67ae85, 0x3c6ef372, 0xa54ff53a,
-                                   0x510e527f, 0x9b05688c, 0x1f83d9ab, 0x5be0cd19};
-  std::string padded = bytes;
-  const uint64_t bit_length = static_cast<uint64_t>(bytes.size()) * 8;
-  padded.push_back(static_cast<char>(0x80));
-  while (padded.size() % 64 != 56) padded.push_back('\0');
-  for (int i = 7; i >= 0; --i) padded.push_back(static_cast<char>((bit_length >> (8 * i)) & 0xff));
-  for (size_t offset = 0; offset < padded.size(); offset += 64) {
-    Compress(&state, reinterpret_cast<const uint8_t*>(padded.data() + offset));
-  }
-  static const char kHex[] = "0123456789abcdef";
-  std::string hex;
-  for (uint32_t word : state) {
-    for (int shift = 28; shift >= 0; shift -= 4) hex.push_back(kHex[(word >> shift) & 0xf]);
-  }
-  return hex;
+  Digest digest;
+  digest.Update(bytes.data(), bytes.size());
+  return digest.FinalHex();
 }
 
 std::string Sha256FileHex(const std::string& path, std::string* error) {
@@ -86,8 +53,17 @@ std::string Sha256FileHex(const std::string& path, std::string* error) {
     if (error) *error = "cannot read " + path;
     return "";
   }
-  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  return Sha256Hex(bytes);
+  Digest digest;
+  std::vector<char> block(64 * 1024);
+  while (in) {
+    in.read(block.data(), static_cast<std::streamsize>(block.size()));
+    digest.Update(block.data(), static_cast<size_t>(in.gcount()));
+  }
+  if (in.bad()) {
+    if (error) *error = "read error in " + path;
+    return "";
+  }
+  return digest.FinalHex();
 }
 
 }  // namespace orbed

@@ -1,5 +1,6 @@
-// libFuzzer: orbed-setup's handlers (ROBOT_STATE, COLLISION_STATUS, PLAN_CHECK_REPLY, ALIGNMENT_TRIAL, REGISTRATION,
-// MISALIGNMENT, SETUP_RESULT) into its conductor, started once with the shipped plan and protocol.
+// libFuzzer: orbed-setup's handlers (ROBOT_STATE, COLLISION_STATUS, PLAN_CHECK_REPLY, ALIGNMENT_TRIAL,
+// REGISTRATION, MISALIGNMENT, SETUP_RESULT) into its conductor, started once with the shipped plan and
+// protocol.
 #include <filesystem>
 
 #include "base/source_paths.h"
