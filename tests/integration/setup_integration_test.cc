@@ -9,6 +9,9 @@
 //  4. A set-up whose assistant and guidance are SIGKILLed while the assistant moves the arm: the
 //     launcher brings both back, the conductor's re-sent SETUP_TASK reaches them, the set-up is done
 //     from where the arm was, and the run ends with exit 0 and a consistent record.
+//  5. The registration's share over the bus: setup.yaml with ORBED_SETUP_REGISTRATION=truth, one AR
+//     set-up: no alignment, REGISTRATION carries exactly ROBOT_STATE's true base pose, the assistant
+//     finishes with it, and the record has the clearance the sim's COLLISION_STATUS gave.
 //  3. scripts/launch/setup.yaml for one user and one target per mode through orbed-launch: the run
 //     ends with exit 0; setup_results.json has the three set-ups in the order the user seed draws,
 //     each reached_deg equal to the assistant's (the sim's measured joints, twice read), an
@@ -26,6 +29,8 @@
 #include <yaml-cpp/yaml.h>
 #include <lcm/lcm-cpp.hpp>
 #include <orbed/iiwa_status_t.hpp>
+#include <orbed/registration_t.hpp>
+#include <orbed/robot_state_t.hpp>
 #include <orbed/setup_task_t.hpp>
 
 #include "base/units.h"
@@ -230,6 +235,83 @@ TEST(SetupStudy, AKilledAssistantAndGuidanceComeBackAndTheSetUpFinishes) {
   for (int i = 0; i < 7; ++i) {
     EXPECT_NEAR(s["reached_deg"][i].as<double>(), s["assistant_reached_deg"][i].as<double>(), 0.05);
   }
+}
+
+// The latest REGISTRATION and ROBOT_STATE on the bus.
+class PoseWatcher {
+ public:
+  explicit PoseWatcher(BusWatcher* bus) {
+    bus->lcm().subscribe("REGISTRATION", &PoseWatcher::OnRegistration, this);
+    bus->lcm().subscribe("ROBOT_STATE", &PoseWatcher::OnState, this);
+  }
+  int registrations() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return registrations_;
+  }
+  orbed::registration_t registration() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return registration_;
+  }
+  orbed::pose_t X_WR() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return X_WR_;
+  }
+
+ private:
+  void OnRegistration(const lcm::ReceiveBuffer*, const std::string&, const orbed::registration_t* msg) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++registrations_;
+    registration_ = *msg;
+  }
+  void OnState(const lcm::ReceiveBuffer*, const std::string&, const orbed::robot_state_t* msg) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    X_WR_ = msg->X_WR;
+  }
+  mutable std::mutex mutex_;
+  int registrations_{0};
+  orbed::registration_t registration_{};
+  orbed::pose_t X_WR_{};
+};
+
+TEST(SetupStudy, TheTrueRegistrationGoesOverTheBusInsteadOfAlignments) {
+  const std::string log_dir = MakeTempDir("setup_truth");
+  BusWatcher bus;
+  PoseWatcher poses(&bus);
+  bus.Start();
+  RunningProcess launcher(
+      {BinPath("orbed-launch"), SourcePath("scripts/launch/setup.yaml"), "--duration-s", "400"},
+      {{"ORBED_LOG_DIR", log_dir},
+       {"ORBED_RUN_ID", "setup-truth"},
+       {"ORBED_USER", "u3"},
+       {"ORBED_USER_SEED", "3"},
+       {"ORBED_SETUP_MODES", "ar"},
+       {"ORBED_SETUP_REGISTRATION", "truth"},
+       {"ORBED_SETUP_TARGETS", "1"}});
+  ASSERT_TRUE(launcher.Wait(400)) << "the run did not finish";
+  ASSERT_EQ(launcher.exit_code(), 0);
+  const YAML::Node results = YAML::LoadFile(log_dir + "/setup_results.json");
+  EXPECT_EQ(results["status"].as<std::string>(), "ok");
+  ASSERT_EQ(results["setups"].size(), 1u);
+  const YAML::Node s = results["setups"][0];
+  EXPECT_EQ(s["registration"].as<std::string>(), "truth");
+  EXPECT_TRUE(s["alignment"].IsNull());
+  // The sim's COLLISION_STATUS reached the conductor: a clearance, and the arm touched nothing.
+  ASSERT_FALSE(s["min_clearance_m"].IsNull());
+  EXPECT_GT(s["min_clearance_m"].as<double>(), 0.0);
+  EXPECT_FALSE(s["contact"].as<bool>());
+  EXPECT_GE(s["docking_tip_mm"].as<double>(), 0.0);
+  // The latest REGISTRATION (the conductor's: the server, with no session, sends none): the true
+  // base pose, bit for bit.
+  ASSERT_GT(poses.registrations(), 0);
+  const orbed::registration_t truth = poses.registration();
+  EXPECT_EQ(truth.session_id, "setup-truth-u3-ar-1-truth");
+  EXPECT_TRUE(truth.valid);
+  const orbed::pose_t X_WR = poses.X_WR();
+  for (int i = 0; i < 3; ++i) EXPECT_EQ(truth.X_WV_mean.position_m[i], X_WR.position_m[i]);
+  for (int i = 0; i < 4; ++i) EXPECT_EQ(truth.X_WV_mean.quaternion_wxyz[i], X_WR.quaternion_wxyz[i]);
+  const YAML::Node manifest = YAML::LoadFile(log_dir + "/manifest.json");
+  EXPECT_FALSE(manifest["channels"]["ALIGNMENT_TRIAL"]) << "an alignment ran";
+  EXPECT_TRUE(manifest["channels"]["REGISTRATION"]);
 }
 
 }  // namespace
