@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <fstream>
 #include <iterator>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -111,8 +112,11 @@ TEST(Json, WritesEscapedCompactJson) {
   json.Key("ok").Bool(true);
   json.Key("n").Int(-3);
   json.Key("empty").BeginArray().EndArray();
+  json.Key("some").Number(std::optional<double>(1.5));
+  json.Key("none").Number(std::optional<double>());
   json.EndObject();
-  EXPECT_EQ(json.str(), R"({"name":"a\"b\n","v":[0.1,2,null],"ok":true,"n":-3,"empty":[]})");
+  EXPECT_EQ(json.str(),
+            R"({"name":"a\"b\n","v":[0.1,2,null],"ok":true,"n":-3,"empty":[],"some":1.5,"none":null})");
 }
 
 // The message of what `read` throws, or "(no error)".

@@ -12,6 +12,7 @@
 ///   std::cout << json.str() << "\n";
 
 #include <cstdint>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -37,6 +38,8 @@ class JsonWriter {
   JsonWriter& Int(int64_t value);
   JsonWriter& Bool(bool value);
   JsonWriter& Null();
+  /// The number, or null when there is none.
+  JsonWriter& Number(const std::optional<double>& value) { return value ? Number(*value) : Null(); }
   JsonWriter& Array(const std::vector<double>& values);
   JsonWriter& Array(const std::vector<int>& values);
   const std::string str() const { return out_.str(); }

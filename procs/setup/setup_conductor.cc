@@ -74,12 +74,7 @@ std::string SetupRunJson(const SetupRun& run, bool partial) {
     json.Key("twisting").Array(r.twisting);
     json.Key("ranges").Array(r.ranges);
     json.Key("execution_s").Number(r.execution_s);
-    json.Key("alignment_s");
-    if (r.alignment_s) {
-      json.Number(*r.alignment_s);
-    } else {
-      json.Null();
-    }
+    json.Key("alignment_s").Number(r.alignment_s);
     json.Key("person_scale").Number(r.person_scale);
     json.Key("registration");
     if (r.mode == orbed::guidance_t::MODE_FIXED_DISPLAY) {
@@ -89,12 +84,7 @@ std::string SetupRunJson(const SetupRun& run, bool partial) {
     }
     json.Key("docking_tip_mm").Number(r.docking_tip_mm);
     json.Key("docking_axis_deg").Number(r.docking_axis_deg);
-    json.Key("min_clearance_m");
-    if (r.min_clearance_m) {
-      json.Number(*r.min_clearance_m);
-    } else {
-      json.Null();
-    }
+    json.Key("min_clearance_m").Number(r.min_clearance_m);
     json.Key("contact").Bool(r.contact);
     json.Key("collision_stops").Int(r.collision_stops);
     json.Key("alignment");

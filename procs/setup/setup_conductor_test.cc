@@ -53,6 +53,20 @@ const orbed::setup_task_t* FindTask(const SetupConductor::Actions& a) {
   return nullptr;
 }
 
+// The assistant's answer to `task`: all joints at 0, one range each.
+orbed::setup_result_t Answer(const orbed::setup_task_t& task, double execution_s, double person_scale) {
+  orbed::setup_result_t r{};
+  r.request_id = task.request_id;
+  r.task_id = task.task_id;
+  r.mode = task.mode;
+  r.num_joints = 7;
+  r.reached_position.assign(7, 0.0);
+  r.ranges.assign(7, 1);
+  r.execution_s = execution_s;
+  r.person_scale = person_scale;
+  return r;
+}
+
 TEST(SetupConductor, ParksThenAsksForEachTargetAndRecordsTheSimsJoints) {
   SetupConductor c(FixedOnly(), Model());
   c.Start(At(0));
@@ -79,15 +93,7 @@ TEST(SetupConductor, ParksThenAsksForEachTargetAndRecordsTheSimsJoints) {
 
   // The assistant's answer; the sim says the arm is at (12, 20, ...): the record takes the sim's.
   c.OnRobotState(State({12, 20, 0, -60, 0, 40, 0}, 0), At(2.0));
-  orbed::setup_result_t r{};
-  r.request_id = first.request_id;
-  r.task_id = first.task_id;
-  r.mode = kFixed;
-  r.num_joints = 7;
-  r.reached_position.assign(7, 0.0);
-  r.ranges.assign(7, 1);
-  r.execution_s = 95;
-  r.person_scale = 1.1;
+  orbed::setup_result_t r = Answer(first, 95, 1.1);
   orbed::setup_result_t other = r;
   other.request_id = first.request_id + 100;  // someone else's: ignored
   EXPECT_TRUE(c.OnSetupResult(other, At(2.1)).publish.empty());
@@ -150,16 +156,7 @@ TEST(SetupConductor, RecordsClearanceAndStopsDuringTheSetUpOnly) {
   EXPECT_EQ(c.OnCollisionStatus(Clearance(std::nan(""), true), At(0.85)).refusals.size(), 1u);
   c.OnCollisionStatus(Clearance(0.05, false), At(0.9));
   c.OnRobotState(State({10, 20, 0, -60, 0, 40, 0}, 0), At(1.0));
-  orbed::setup_result_t r{};
-  r.request_id = first.request_id;
-  r.task_id = first.task_id;
-  r.mode = kFixed;
-  r.num_joints = 7;
-  r.reached_position.assign(7, 0.0);
-  r.ranges.assign(7, 1);
-  r.execution_s = 60;
-  r.person_scale = 1;
-  c.OnSetupResult(r, At(1.1));
+  c.OnSetupResult(Answer(first, 60, 1), At(1.1));
   ASSERT_EQ(c.run().setups.size(), 1u);
   const SetupRecord& rec = c.run().setups[0];
   ASSERT_TRUE(rec.min_clearance_m.has_value());
@@ -237,22 +234,13 @@ TEST(SetupConductor, PerfectRegistrationPublishesTheTrueBasePose) {
   EXPECT_EQ(truth->session_id, "setup-u3-ar-1-truth");
   for (int i = 0; i < 3; ++i) EXPECT_EQ(truth->X_WV_mean.position_m[i], state.X_WR.position_m[i]);
   for (int i = 0; i < 4; ++i) EXPECT_EQ(truth->X_WV_mean.quaternion_wxyz[i], state.X_WR.quaternion_wxyz[i]);
-  const orbed::setup_task_t* task = FindTask(a);
-  ASSERT_NE(task, nullptr);
+  ASSERT_NE(FindTask(a), nullptr);
+  const orbed::setup_task_t task = *FindTask(a);
   // Re-sent with the task.
   a = c.Tick(At(1.2));
   ASSERT_EQ(a.publish.size(), 2u);
   EXPECT_NE(std::get_if<orbed::registration_t>(&a.publish[0].message), nullptr);
-  orbed::setup_result_t r{};
-  r.request_id = task->request_id;
-  r.task_id = task->task_id;
-  r.mode = orbed::guidance_t::MODE_AR;
-  r.num_joints = 7;
-  r.reached_position.assign(7, 0.0);
-  r.ranges.assign(7, 1);
-  r.execution_s = 60;
-  r.person_scale = 1;
-  c.OnSetupResult(r, At(1.5));
+  c.OnSetupResult(Answer(task, 60, 1), At(1.5));
   ASSERT_TRUE(c.done());
   ASSERT_EQ(c.run().setups.size(), 1u);
   EXPECT_TRUE(c.run().setups[0].perfect_registration);
