@@ -249,27 +249,61 @@ std::vector<PowerPoint> SetupPower(const std::vector<SetupUserRun>& runs, const 
 
 namespace {
 
+// The recorded values of an optional per-set-up field over `mode`'s set-ups.
+std::vector<double> RowValues(const std::vector<SetupUserRun>& runs, const std::string& mode,
+                              std::optional<double> SetupRow::*field) {
+  std::vector<double> out;
+  for (const SetupUserRun& run : runs) {
+    for (const SetupRow& row : run.setups) {
+      if (row.mode == mode && row.*field) out.push_back(*(row.*field));
+    }
+  }
+  return out;
+}
+
+struct CollisionCounts {
+  int setups{0}, contact{0}, stops{0}, near_miss{0};
+};
+CollisionCounts CountCollisions(const std::vector<SetupUserRun>& runs, const std::string& mode) {
+  CollisionCounts c;
+  for (const SetupUserRun& run : runs) {
+    for (const SetupRow& row : run.setups) {
+      if (row.mode != mode) continue;
+      ++c.setups;
+      c.contact += row.contact;
+      c.stops += row.collision_stops;
+      c.near_miss += !row.contact && row.min_clearance_m && *row.min_clearance_m < kNearMissM;
+    }
+  }
+  return c;
+}
+
+// 1 − truth mean / measured mean, or nothing when either side has no set-up of `mode`.
+struct Share {
+  Stats5 measured, truth;
+  double share{0};
+};
+std::optional<Share> RegistrationShare(const std::vector<SetupUserRun>& runs,
+                                       const std::vector<SetupUserRun>& truth_runs, const std::string& mode) {
+  const std::vector<double> measured = JointErrors(runs, mode, -1), truth = JointErrors(truth_runs, mode, -1);
+  if (measured.empty() || truth.empty()) return std::nullopt;
+  Share s{Summarize(measured), Summarize(truth), 0};
+  s.share = s.measured.mean > 0 ? 1 - s.truth.mean / s.measured.mean : 0.0;
+  return s;
+}
+
 void WriteBeyond(JsonWriter* json, const std::vector<SetupUserRun>& runs,
                  const std::vector<SetupUserRun>& truth_runs) {
-  auto values = [&](const std::string& mode, std::optional<double> SetupRow::*field) {
-    std::vector<double> out;
-    for (const SetupUserRun& run : runs) {
-      for (const SetupRow& row : run.setups) {
-        if (row.mode == mode && row.*field) out.push_back(*(row.*field));
-      }
-    }
-    return out;
-  };
   json->Key("beyond").BeginObject();
   json->Key("docking").BeginObject();
   for (const char* mode : kSetupModes) {
-    const std::vector<double> tip = values(mode, &SetupRow::docking_tip_mm);
+    const std::vector<double> tip = RowValues(runs, mode, &SetupRow::docking_tip_mm);
     if (tip.empty()) continue;
     json->Key(mode).BeginObject();
     json->Key("tip_mm");
     WriteStats(json, Summarize(tip));
     json->Key("axis_deg");
-    WriteStats(json, Summarize(values(mode, &SetupRow::docking_axis_deg)));
+    WriteStats(json, Summarize(RowValues(runs, mode, &SetupRow::docking_axis_deg)));
     json->EndObject();
   }
   json->EndObject();
@@ -277,22 +311,13 @@ void WriteBeyond(JsonWriter* json, const std::vector<SetupUserRun>& runs,
   json->Key("collisions").BeginObject();
   for (const char* mode : kSetupModes) {
     if (!HasMode(runs, mode)) continue;
-    int setups = 0, contact = 0, stops = 0, near = 0;
-    for (const SetupUserRun& run : runs) {
-      for (const SetupRow& row : run.setups) {
-        if (row.mode != mode) continue;
-        ++setups;
-        contact += row.contact;
-        stops += row.collision_stops;
-        near += !row.contact && row.min_clearance_m && *row.min_clearance_m < kNearMissM;
-      }
-    }
+    const CollisionCounts c = CountCollisions(runs, mode);
     json->Key(mode).BeginObject();
-    json->Key("setups").Int(setups);
-    json->Key("contact").Int(contact);
-    json->Key("collision_stops").Int(stops);
-    json->Key("near_miss").Int(near);
-    const std::vector<double> clearance = values(mode, &SetupRow::min_clearance_m);
+    json->Key("setups").Int(c.setups);
+    json->Key("contact").Int(c.contact);
+    json->Key("collision_stops").Int(c.stops);
+    json->Key("near_miss").Int(c.near_miss);
+    const std::vector<double> clearance = RowValues(runs, mode, &SetupRow::min_clearance_m);
     if (!clearance.empty()) {
       json->Key("min_clearance_m");
       WriteStats(json, Summarize(clearance));
@@ -303,16 +328,14 @@ void WriteBeyond(JsonWriter* json, const std::vector<SetupUserRun>& runs,
   if (!truth_runs.empty()) {
     json->Key("registration_share").BeginObject();
     for (const char* mode : kSetupModes) {
-      const std::vector<double> measured = JointErrors(runs, mode, -1),
-                                truth = JointErrors(truth_runs, mode, -1);
-      if (measured.empty() || truth.empty()) continue;
-      const Stats5 m = Summarize(measured), t = Summarize(truth);
+      const std::optional<Share> share = RegistrationShare(runs, truth_runs, mode);
+      if (!share) continue;
       json->Key(mode).BeginObject();
       json->Key("measured_deg");
-      WriteStats(json, m);
+      WriteStats(json, share->measured);
       json->Key("truth_deg");
-      WriteStats(json, t);
-      json->Key("share").Number(m.mean > 0 ? 1 - t.mean / m.mean : 0.0);
+      WriteStats(json, share->truth);
+      json->Key("share").Number(share->share);
       json->EndObject();
     }
     json->EndObject();
@@ -456,32 +479,21 @@ std::string SetupSummary(const std::vector<SetupUserRun>& runs, const std::vecto
   for (int m = 0; m < 3; ++m) {
     const std::string mode = kSetupModes[m];
     if (!HasMode(runs, mode)) continue;
-    std::vector<double> tip, axis;
-    int contact = 0, stops = 0, near = 0;
-    for (const SetupUserRun& run : runs) {
-      for (const SetupRow& row : run.setups) {
-        if (row.mode != mode) continue;
-        if (row.docking_tip_mm) tip.push_back(*row.docking_tip_mm);
-        if (row.docking_axis_deg) axis.push_back(*row.docking_axis_deg);
-        contact += row.contact;
-        stops += row.collision_stops;
-        near += !row.contact && row.min_clearance_m && *row.min_clearance_m < kNearMissM;
-      }
-    }
+    const std::vector<double> tip = RowValues(runs, mode, &SetupRow::docking_tip_mm),
+                              axis = RowValues(runs, mode, &SetupRow::docking_axis_deg);
+    const CollisionCounts c = CountCollisions(runs, mode);
     text += "    " + mode + std::string(15 - mode.size(), ' ') +
             (tip.empty() ? std::string("(not recorded)")
                          : Fixed(stats::Median(tip), 0) + " mm / " + Fixed(stats::Median(axis), 1) + " deg") +
-            ", " + std::to_string(contact) + " contact(s), " + std::to_string(stops) + " stop(s), " +
-            std::to_string(near) + " near miss(es)\n";
+            ", " + std::to_string(c.contact) + " contact(s), " + std::to_string(c.stops) + " stop(s), " +
+            std::to_string(c.near_miss) + " near miss(es)\n";
   }
   for (const char* mode : kSetupModes) {
-    const std::vector<double> measured = JointErrors(runs, mode, -1),
-                              truth = JointErrors(truth_runs, mode, -1);
-    if (measured.empty() || truth.empty()) continue;
-    const double m = stats::Mean(measured), t = stats::Mean(truth);
-    text += "  Registration's share, " + std::string(mode) + ": mean joint error " + Fixed(m, 1) +
-            " deg measured, " + Fixed(t, 1) + " deg with the true registration (" +
-            Fixed(m > 0 ? 100 * (1 - t / m) : 0.0, 0) + " %)\n";
+    const std::optional<Share> share = RegistrationShare(runs, truth_runs, mode);
+    if (!share) continue;
+    text += "  Registration's share, " + std::string(mode) + ": mean joint error " +
+            Fixed(share->measured.mean, 1) + " deg measured, " + Fixed(share->truth.mean, 1) +
+            " deg with the true registration (" + Fixed(100 * share->share, 0) + " %)\n";
   }
   const std::vector<PowerPoint> power = SetupPower(runs, "ar_reflective", "ar", kPowerUsers, 500, 0.05, 1);
   if (!power.empty()) {
