@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -104,6 +105,17 @@ TEST(NumberList, ParsesAndRejectsWithTheItem) {
   }
 }
 
+TEST(Format, ShortestDecimalReadsBack) {
+  EXPECT_EQ(ShortestDecimal(0.1), "0.1");
+  EXPECT_EQ(ShortestDecimal(2.0), "2");
+  EXPECT_EQ(ShortestDecimal(1e-300), "1e-300");
+  EXPECT_EQ(ShortestDecimal(1.0 / 3.0), "0.3333333333333333");  // 16 digits read back exactly
+  EXPECT_EQ(std::stod(ShortestDecimal(1.0 / 3.0)), 1.0 / 3.0);
+  EXPECT_EQ(ShortestDecimal(0.1f), "0.1");  // the float's own shortest, not 0.10000000149011612
+  EXPECT_EQ(ShortestDecimal(std::nan("")), "nan");
+  EXPECT_EQ(ShortestDecimal(-std::numeric_limits<double>::infinity()), "-inf");
+}
+
 TEST(Json, WritesEscapedCompactJson) {
   JsonWriter json;
   json.BeginObject();
@@ -116,7 +128,26 @@ TEST(Json, WritesEscapedCompactJson) {
   json.Key("none").Number(std::optional<double>());
   json.EndObject();
   EXPECT_EQ(json.str(),
-            R"({"name":"a\"b\n","v":[0.1,2,null],"ok":true,"n":-3,"empty":[],"some":1.5,"none":null})");
+            R"({"name":"a\"b\n","v":[0.1,2.0,null],"ok":true,"n":-3,"empty":[],"some":1.5,"none":null})");
+}
+
+TEST(Json, EscapesControlBytesAndReplacesBadUtf8) {
+  JsonWriter json;
+  json.BeginArray().String(std::string("tab\t bell\x07 nul") + '\0').String("caf\xc3\xa9 \xff!").EndArray();
+  // Control bytes as JSON escapes (RFC 8259 section 7); valid UTF-8 as is; a byte that is not UTF-8
+  // becomes U+FFFD (EF BF BD), so the document stays valid JSON.
+  EXPECT_EQ(json.str(), "[\"tab\\t bell\\u0007 nul\\u0000\",\"caf\xc3\xa9 \xef\xbf\xbd!\"]");
+}
+
+TEST(Json, PrettyPrintsNestedContainersInOrder) {
+  JsonWriter json(2);
+  json.BeginObject();
+  json.Key("z").Int(1);
+  json.Key("a").BeginArray().BeginObject().Key("k").Number(std::nan("")).EndObject().EndArray();
+  json.EndObject();
+  EXPECT_EQ(json.str(), "{\n  \"z\": 1,\n  \"a\": [\n    {\n      \"k\": null\n    }\n  ]\n}");
+  EXPECT_EQ(JsonNumber(0.1), "0.1");
+  EXPECT_EQ(JsonNumber(-std::numeric_limits<double>::infinity()), "null");
 }
 
 // The message of what `read` throws, or "(no error)".

@@ -1,5 +1,7 @@
 #include "base/format.h"
 
+#include <charconv>
+#include <cmath>
 #include <cstdio>
 #include <ctime>
 
@@ -10,6 +12,20 @@ std::string Fixed(double value, int digits) {
   std::snprintf(text, sizeof(text), "%.*f", digits, value);
   return text;
 }
+
+namespace {
+template <class Float>
+std::string Shortest(Float value) {
+  if (std::isnan(value)) return "nan";
+  if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
+  char buffer[64];
+  const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);
+  return std::string(buffer, result.ptr);
+}
+}  // namespace
+
+std::string ShortestDecimal(double value) { return Shortest(value); }
+std::string ShortestDecimal(float value) { return Shortest(value); }
 
 std::string EscapeText(const std::string& text) {
   std::string out;

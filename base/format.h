@@ -12,6 +12,11 @@ namespace orbed {
 /// `value` with exactly `digits` decimals ("%.*f"): Fixed(2.345, 1) == "2.3".
 std::string Fixed(double value, int digits);
 
+/// The shortest decimal that reads back to exactly `value` (std::to_chars): 0.1 → "0.1", 2 → "2",
+/// 1e-300 → "1e-300"; "nan", "inf", "-inf" for the rest. For CSV cells and text that must round-trip.
+std::string ShortestDecimal(double value);
+std::string ShortestDecimal(float value);
+
 /// `text` safe to print on a terminal: printable ASCII as is, a backslash as "\\", every other byte
 /// as "\xNN" (so a corrupted id from the bus cannot move the cursor or fake a log line). For text
 /// that came from the bus or a file.

@@ -1,148 +1,92 @@
 #include "base/json.h"
 
-#include <charconv>
 #include <cmath>
-#include <cstdio>
+
+#include "base/format.h"
 
 namespace orbed {
 
-std::string JsonQuote(const std::string& text) {
-  std::string out = "\"";
-  for (unsigned char c : text) {
-    switch (c) {
-      case '"':
-        out += "\\\"";
-        break;
-      case '\\':
-        out += "\\\\";
-        break;
-      case '\n':
-        out += "\\n";
-        break;
-      case '\r':
-        out += "\\r";
-        break;
-      case '\t':
-        out += "\\t";
-        break;
-      default:
-        if (c < 0x20) {
-          char buffer[8];
-          std::snprintf(buffer, sizeof(buffer), "\\u%04x", c);
-          out += buffer;
-        } else {
-          out += static_cast<char>(c);
-        }
-    }
+std::string JsonNumber(double value) { return std::isfinite(value) ? ShortestDecimal(value) : "null"; }
+
+nlohmann::ordered_json& JsonWriter::Add(nlohmann::ordered_json value) {
+  if (open_.empty()) {
+    root_ = std::move(value);
+    return root_;
   }
-  return out + "\"";
-}
-
-std::string JsonNumber(double value) {
-  if (!std::isfinite(value)) return "null";
-  char buffer[32];
-  const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);
-  return std::string(buffer, result.ptr);
-}
-
-void JsonWriter::NewLine() {
-  if (indent_ <= 0) return;
-  out_ << "\n" << std::string(first_in_level_.size() * indent_, ' ');
-}
-
-void JsonWriter::BeforeValue() {
-  if (after_key_) {
-    after_key_ = false;
-    return;
+  nlohmann::ordered_json& parent = *open_.back();
+  if (parent.is_array()) {
+    parent.push_back(std::move(value));
+    return parent.back();
   }
-  if (first_in_level_.empty()) return;
-  if (!first_in_level_.back()) out_ << ",";
-  first_in_level_.back() = false;
-  NewLine();
+  nlohmann::ordered_json& slot = parent[key_];
+  slot = std::move(value);
+  return slot;
 }
 
 JsonWriter& JsonWriter::BeginObject() {
-  BeforeValue();
-  out_ << "{";
-  first_in_level_.push_back(true);
+  open_.push_back(&Add(nlohmann::ordered_json::object()));
   return *this;
 }
 
 JsonWriter& JsonWriter::EndObject() {
-  const bool empty = first_in_level_.back();
-  first_in_level_.pop_back();
-  if (!empty) NewLine();
-  out_ << "}";
+  open_.pop_back();
   return *this;
 }
 
 JsonWriter& JsonWriter::BeginArray() {
-  BeforeValue();
-  out_ << "[";
-  first_in_level_.push_back(true);
+  open_.push_back(&Add(nlohmann::ordered_json::array()));
   return *this;
 }
 
 JsonWriter& JsonWriter::EndArray() {
-  const bool empty = first_in_level_.back();
-  first_in_level_.pop_back();
-  if (!empty) NewLine();
-  out_ << "]";
+  open_.pop_back();
   return *this;
 }
 
 JsonWriter& JsonWriter::Key(const std::string& key) {
-  BeforeValue();
-  out_ << JsonQuote(key) << (indent_ > 0 ? ": " : ":");
-  after_key_ = true;
+  key_ = key;
   return *this;
 }
 
 JsonWriter& JsonWriter::String(const std::string& value) {
-  BeforeValue();
-  out_ << JsonQuote(value);
+  Add(value);
   return *this;
 }
 
 JsonWriter& JsonWriter::Number(double value) {
-  BeforeValue();
-  out_ << JsonNumber(value);
+  Add(std::isfinite(value) ? nlohmann::ordered_json(value) : nlohmann::ordered_json(nullptr));
   return *this;
 }
 
 JsonWriter& JsonWriter::Int(int64_t value) {
-  BeforeValue();
-  out_ << value;
+  Add(value);
   return *this;
 }
 
 JsonWriter& JsonWriter::Bool(bool value) {
-  BeforeValue();
-  out_ << (value ? "true" : "false");
+  Add(value);
   return *this;
 }
 
 JsonWriter& JsonWriter::Null() {
-  BeforeValue();
-  out_ << "null";
+  Add(nullptr);
   return *this;
 }
 
 JsonWriter& JsonWriter::Array(const std::vector<double>& values) {
-  // Numeric arrays stay on one line even when pretty-printing.
-  BeforeValue();
-  out_ << "[";
-  for (size_t i = 0; i < values.size(); ++i) out_ << (i ? "," : "") << JsonNumber(values[i]);
-  out_ << "]";
+  nlohmann::ordered_json array = nlohmann::ordered_json::array();
+  for (double v : values) array.push_back(std::isfinite(v) ? nlohmann::ordered_json(v) : nullptr);
+  Add(std::move(array));
   return *this;
 }
 
 JsonWriter& JsonWriter::Array(const std::vector<int>& values) {
-  BeforeValue();
-  out_ << "[";
-  for (size_t i = 0; i < values.size(); ++i) out_ << (i ? "," : "") << values[i];
-  out_ << "]";
+  Add(values);
   return *this;
+}
+
+std::string JsonWriter::str() const {
+  return root_.dump(indent_ > 0 ? indent_ : -1, ' ', false, nlohmann::ordered_json::error_handler_t::replace);
 }
 
 }  // namespace orbed

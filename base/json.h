@@ -1,27 +1,32 @@
 #pragma once
 /// @file
-/// Just enough JSON output for the command-line tools, manifests and results files: a streaming
-/// writer that handles commas, escaping and non-finite numbers (written as null, since JSON has no
-/// NaN). Not a parser. Not thread-safe (one writer per document).
+/// The JSON writer of the command-line tools, manifests and results files: a streaming interface
+/// over nlohmann::ordered_json (Debian's nlohmann-json3-dev), which does the escaping, the number
+/// format and the layout. Keys keep the order they were written in. Non-finite numbers are written
+/// as null (JSON has no NaN); text that is not valid UTF-8 has each bad byte replaced by U+FFFD, so
+/// the output is always valid JSON. Reading is json_fields.h. Not thread-safe (one writer per
+/// document).
 ///
 ///   JsonWriter json;
 ///   json.BeginObject();
 ///   json.Key("n_used").Int(3);
 ///   json.Key("translation_m").Array(std::vector<double>{0.1, 0.2, 0.3});
 ///   json.EndObject();
-///   std::cout << json.str() << "\n";
+///   std::cout << json.str() << "\n";   // {"n_used":3,"translation_m":[0.1,0.2,0.3]}
+///
+/// Numbers are the shortest decimal that reads back to the same double, with nlohmann's ".0" on
+/// whole numbers (2.0); integers written with Int() have none.
 
 #include <cstdint>
 #include <optional>
-#include <sstream>
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 namespace orbed {
 
-/// Escapes a string for JSON (quotes included in the result).
-std::string JsonQuote(const std::string& text);
-/// Shortest round-trip decimal for finite values, "null" for NaN and infinities.
+/// A finite value as the shortest decimal that reads back to it, "null" for NaN and infinities.
 std::string JsonNumber(double value);
 
 class JsonWriter {
@@ -42,15 +47,17 @@ class JsonWriter {
   JsonWriter& Number(const std::optional<double>& value) { return value ? Number(*value) : Null(); }
   JsonWriter& Array(const std::vector<double>& values);
   JsonWriter& Array(const std::vector<int>& values);
-  const std::string str() const { return out_.str(); }
+  /// The document so far (complete once every Begin has its End).
+  std::string str() const;
 
  private:
-  void BeforeValue();
-  void NewLine();
-  std::ostringstream out_;
+  // Puts `value` where the writer stands (the root, after a Key, or at the end of an array) and
+  // returns it there.
+  nlohmann::ordered_json& Add(nlohmann::ordered_json value);
   int indent_;
-  std::vector<bool> first_in_level_;  // one entry per open object/array
-  bool after_key_ = false;
+  nlohmann::ordered_json root_;
+  std::vector<nlohmann::ordered_json*> open_;  // the open objects and arrays, innermost last
+  std::string key_;                            // the key of the next value in an object
 };
 
 }  // namespace orbed

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 namespace orbed::sim {
 namespace {
@@ -31,9 +32,10 @@ TEST(RobotToolTest, FkPrintsTheFlangeAtTheZeroPose) {
   const ToolRun r = Tool({"fk", "--q-deg", "0,0,0,0,0,0,0"});
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(r.out.rfind("{\"frame\":\"R\"", 0), 0u) << r.out;
-  EXPECT_NE(r.out.find("\"flange\":{\"position_m\":[0,0,1.266],\"rotation\":[[1,0,0],[0,1,0],[0,0,1]]}"),
-            std::string::npos)
-      << r.out;
+  // Read back by nlohmann's parser: the flange at the data sheet's 0.34 + 0.4 + 0.4 + 0.126 m.
+  const nlohmann::json fk = nlohmann::json::parse(r.out);
+  EXPECT_EQ(fk["flange"]["position_m"], nlohmann::json::parse("[0, 0, 1.266]")) << r.out;
+  EXPECT_EQ(fk["flange"]["rotation"], nlohmann::json::parse("[[1, 0, 0], [0, 1, 0], [0, 0, 1]]")) << r.out;
   EXPECT_NE(r.out.find("\"links\":{\"iiwa_link_0\""), std::string::npos);
 }
 

@@ -39,7 +39,11 @@ TEST(ViraalResultsReader, ThePinnedRunReadsAndWritesBackTheSameDocument) {
   const nlohmann::json again = nlohmann::json::parse(ResultsJson(r));
   std::function<void(const nlohmann::json&, const nlohmann::json&, const std::string&)> same =
       [&](const nlohmann::json& a, const nlohmann::json& b, const std::string& where) {
-        ASSERT_EQ(a.type(), b.type()) << where;
+        // A number keeps its value, not its spelling: the pinned file's "0" (written by the
+        // hand-written writer before nlohmann's) reads as an integer, the writer's 0.0 as a float.
+        if (!(a.is_number() && b.is_number())) {
+          ASSERT_EQ(a.type(), b.type()) << where;
+        }
         if (a.is_object()) {
           // The pinned file leaves out the run's times, which the writer always writes.
           const size_t times = where == "results" ? 2 : 0;
@@ -49,7 +53,7 @@ TEST(ViraalResultsReader, ThePinnedRunReadsAndWritesBackTheSameDocument) {
         } else if (a.is_array()) {
           ASSERT_EQ(a.size(), b.size()) << where;
           for (size_t i = 0; i < a.size(); ++i) same(a[i], b[i], where + "[" + std::to_string(i) + "]");
-        } else if (a.is_number_float()) {
+        } else if (a.is_number() && (a.is_number_float() || b.is_number_float())) {
           // Derived numbers are recomputed: the trial statistics and the Table 1 rows to their
           // round-off (the file's Table 1 rows were computed with Python's statistics module).
           const bool pose = where.find("quaternion") != std::string::npos;

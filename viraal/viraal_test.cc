@@ -260,7 +260,7 @@ TEST(ViraalResults, JsonHasTheDocumentedShape) {
   EXPECT_EQ(Count(json, "\"misalignment_mm\": "), 6 + 2 + 2 + 3);  // + paper_reference
   EXPECT_NE(json.find("\"status\": \"ok\""), std::string::npos);
   // translation_error_mm 10, 11, 12: mean 11, std 1.
-  EXPECT_NE(json.find("\"translation_error_mm\": {\n          \"mean\": 11,\n          \"std\": 1"),
+  EXPECT_NE(json.find("\"translation_error_mm\": {\n          \"mean\": 11.0,\n          \"std\": 1.0"),
             std::string::npos)
       << json;
   EXPECT_EQ(Count(json, "\"table1\": \\{"), 2);

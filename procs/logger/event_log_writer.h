@@ -1,7 +1,8 @@
 #pragma once
 /// @file
 /// Writes the standard LCM event-log format (what lcm-logger writes and lcm-logplayer, lcm-spy
-/// and LCM's LogFile API read). Per event, big-endian:
+/// and LCM's LogFile API read) through LCM's own C writer (lcm/eventlog.h), adding errors that name
+/// the file and errno, byte counts and a chosen buffer size. Per event, big-endian:
 ///   uint32 sync 0xEDA1DA01 | int64 event number | int64 timestamp [us] |
 ///   int32 channel length | int32 data length | channel bytes | data bytes
 /// Buffered; Flush() pushes the buffer to the kernel, so after a SIGKILL the file holds every
@@ -13,6 +14,8 @@
 #include <cstdio>
 #include <string>
 
+struct _lcm_eventlog_t;
+
 namespace orbed::logger {
 
 class EventLogWriter {
@@ -23,7 +26,7 @@ class EventLogWriter {
   EventLogWriter(const EventLogWriter&) = delete;
   EventLogWriter& operator=(const EventLogWriter&) = delete;
 
-  bool ok() const { return file_ != nullptr && error_.empty(); }
+  bool ok() const { return log_ != nullptr && error_.empty(); }
   const std::string& error() const { return error_; }
 
   /// Appends one event; the event number is assigned in order from 0. Returns bytes written
@@ -39,10 +42,9 @@ class EventLogWriter {
   static constexpr uint32_t kSyncWord = 0xEDA1DA01;
 
  private:
-  FILE* file_ = nullptr;
+  _lcm_eventlog_t* log_ = nullptr;  // LCM's writer (it numbers the events from 0)
   std::string path_;
   std::string error_;
-  int64_t next_event_number_ = 0;
 };
 
 }  // namespace orbed::logger

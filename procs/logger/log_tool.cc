@@ -10,6 +10,7 @@
 #include <CLI/CLI.hpp>
 
 #include "base/format.h"
+#include "procs/logger/csv_export.h"
 #include "procs/logger/event_log_reader.h"
 #include "procs/logger/event_log_writer.h"
 
@@ -120,12 +121,43 @@ int Cut(const MappedLog& log, const std::string& out_path, double from_s, double
   return 0;
 }
 
+int Export(const MappedLog& log, const CsvExportOptions& options, std::ostream& out, std::ostream& err) {
+  const CsvExportResult result = ExportCsv(log, options);
+  if (!result.ok()) {
+    err << "orbed-log: " << EscapeText(result.error) << "\n";
+    return 1;
+  }
+  char line[512];
+  std::snprintf(line, sizeof(line), "%-28s %-24s %10s %8s %9s  %s\n", "channel", "type", "rows", "columns",
+                "refused", "file");
+  out << line;
+  int files = 0;
+  for (const CsvChannelResult& c : result.channels) {
+    int64_t refused = 0;
+    for (const auto& [reason, n] : c.refused) refused += n;
+    if (c.file.empty()) {
+      out << EscapeText(c.channel) << ": not exported, no orbed or Drake fingerprint (" << c.unknown
+          << " events)\n";
+      continue;
+    }
+    ++files;
+    std::snprintf(line, sizeof(line), "%-28s %-24s %10lld %8zu %9lld  %s\n", EscapeText(c.channel).c_str(),
+                  c.type.c_str(), static_cast<long long>(c.rows), c.columns + 1,
+                  static_cast<long long>(refused + c.unknown), EscapeText(c.file).c_str());
+    out << line;
+    for (const auto& [reason, n] : c.refused) out << "  refused " << n << ": " << reason << "\n";
+    if (c.unknown > 0) out << "  refused " << c.unknown << ": unknown fingerprint\n";
+  }
+  out << "orbed-log: " << files << " CSV file(s) in " << EscapeText(options.out_dir) << "\n";
+  return 0;
+}
+
 }  // namespace
 
 int RunLogTool(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
   CLI::App app{
       "orbed-log: what is in an LCM event log (orbed-logger's or lcm-logger's), whether it is damaged,\n"
-      "and a cut of it by time and channel."};
+      "a cut of it by time and channel, and its messages as CSV tables."};
   app.require_subcommand(1);
   std::string log_path, out_path, channels = ".*";
   double from_s = 0, to_s = 1e18;
@@ -142,6 +174,18 @@ int RunLogTool(int argc, const char* const* argv, std::ostream& out, std::ostrea
       ->check(CLI::NonNegativeNumber);
   cut->add_option("--channels", channels, "keep channels whose whole name matches this regex")
       ->capture_default_str();
+  auto* export_cmd = app.add_subcommand(
+      "export", "one CSV file per channel: every field a column, named by its path, with its unit");
+  export_cmd->add_option("log", log_path, "the log")->required();
+  export_cmd->add_option("dir", out_path, "the folder for the CSV files (created; files overwritten)")
+      ->required();
+  export_cmd->add_flag("--csv", "CSV (the only format, and the default)");
+  export_cmd->add_option("--from-s", from_s, "from this many seconds after the first event")
+      ->check(CLI::NonNegativeNumber);
+  export_cmd->add_option("--to-s", to_s, "to this many seconds after the first event")
+      ->check(CLI::NonNegativeNumber);
+  export_cmd->add_option("--channels", channels, "export channels whose whole name matches this regex")
+      ->capture_default_str();
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -155,7 +199,7 @@ int RunLogTool(int argc, const char* const* argv, std::ostream& out, std::ostrea
     err << "orbed-log: --channels '" << EscapeText(channels) << "' is not a regular expression\n";
     return 2;
   }
-  if (*cut && to_s < from_s) {
+  if ((*cut || *export_cmd) && to_s < from_s) {
     err << "orbed-log: --to-s is before --from-s\n";
     return 2;
   }
@@ -167,6 +211,14 @@ int RunLogTool(int argc, const char* const* argv, std::ostream& out, std::ostrea
   try {
     if (*info) return Info(log, log_path, out);
     if (*check) return Check(log, log_path, out);
+    if (*export_cmd) {
+      CsvExportOptions options;
+      options.out_dir = out_path;
+      options.from_s = from_s;
+      options.to_s = to_s;
+      options.channels = channel_regex;
+      return Export(log, options, out, err);
+    }
     return Cut(log, out_path, from_s, to_s, channel_regex, out, err);
   } catch (const std::exception& e) {
     err << "orbed-log: " << e.what() << "\n";

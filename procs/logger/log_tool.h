@@ -12,10 +12,12 @@
 ///                          the events from A to B seconds after the first event whose channel
 ///                          matches REGEX (whole name), written as a new log (numbered from 0,
 ///                          timestamps kept); damage is left behind
+///   orbed-log export LOG DIR [--csv] [--from-s A] [--to-s B] [--channels REGEX]
+///                          one CSV file per channel of a known type (csv_export.h): a column per
+///                          field, named by its path with its unit; refusals counted per reason
 ///
-/// Exit codes: 0 ok; 1 check found damage, or a log cannot be read or written (one line on stderr);
-/// 2 bad arguments.
-/// Threading: single-threaded.
+/// Exit codes: 0 ok; 1 check found damage, or a log or a CSV file cannot be read or written (one line on
+/// stderr); 2 bad arguments. Threading: single-threaded.
 
 #include <ostream>
 

@@ -1,24 +1,15 @@
 #include "procs/registration_server/mean_command.h"
 
-#include <charconv>
-#include <cmath>
 #include <fstream>
 #include <iostream>
 #include <sstream>
+#include <vector>
 
+#include "base/json.h"
 #include "procs/registration_server/trial_file.h"
 
 namespace orbed::registration {
 namespace {
-
-// Shortest decimal that reads back to the same double; JSON has no NaN/Inf, so those become null.
-std::string Number(double x) {
-  if (!std::isfinite(x)) return "null";
-  char buf[64];
-  const auto [ptr, ec] = std::to_chars(buf, buf + sizeof(buf), x);
-  if (ec != std::errc()) return "null";
-  return std::string(buf, ptr);
-}
 
 const char* Bool(bool b) { return b ? "true" : "false"; }
 
@@ -27,19 +18,21 @@ const char* Bool(bool b) { return b ? "true" : "false"; }
 std::string FormatMeanJson(const geometry::Se3MeanResult& result) {
   const Eigen::Quaterniond& q = result.q_WV_mean;
   const Eigen::Vector3d& p = result.p_WV_mean;
-  std::string s = "{\"rotation_wxyz\":[" + Number(q.w()) + "," + Number(q.x()) + "," + Number(q.y()) + "," +
-                  Number(q.z()) + "],\"translation_m\":[" + Number(p.x()) + "," + Number(p.y()) + "," +
-                  Number(p.z()) + "],\"converged\":" + Bool(result.converged) +
-                  ",\"unique\":" + Bool(result.unique) +
-                  ",\"iterations\":" + std::to_string(result.iterations) +
-                  ",\"n_used\":" + std::to_string(result.dispersion.num_used) + ",\"rejected\":[";
-  for (size_t k = 0; k < result.rejected.size(); ++k) {
-    if (k > 0) s += ",";
-    s += std::to_string(result.rejected[k].index);
-  }
-  s += "],\"rotation_rms_deg\":" + Number(result.dispersion.rotation_rms_deg) +
-       ",\"translation_rms_m\":" + Number(result.dispersion.translation_rms_m) + "}";
-  return s;
+  std::vector<int> rejected;
+  for (const auto& r : result.rejected) rejected.push_back(static_cast<int>(r.index));
+  JsonWriter json;
+  json.BeginObject();
+  json.Key("rotation_wxyz").Array(std::vector<double>{q.w(), q.x(), q.y(), q.z()});
+  json.Key("translation_m").Array(std::vector<double>{p.x(), p.y(), p.z()});
+  json.Key("converged").Bool(result.converged);
+  json.Key("unique").Bool(result.unique);
+  json.Key("iterations").Int(result.iterations);
+  json.Key("n_used").Int(result.dispersion.num_used);
+  json.Key("rejected").Array(rejected);
+  json.Key("rotation_rms_deg").Number(result.dispersion.rotation_rms_deg);
+  json.Key("translation_rms_m").Number(result.dispersion.translation_rms_m);
+  json.EndObject();
+  return json.str();
 }
 
 int RunMeanCommand(const MeanCommandOptions& options, std::ostream& out, std::ostream& err) {

@@ -111,7 +111,7 @@ TEST(MeanCommandTest, JsonNumbersRoundTrip) {
   r.dispersion.rotation_rms_deg = 0.5;
   r.dispersion.translation_rms_m = 0.004;
   EXPECT_EQ(FormatMeanJson(r),
-            "{\"rotation_wxyz\":[0.1,0.2,0.3,0.3333333333333333],\"translation_m\":[1e-20,-2.5,3],"
+            "{\"rotation_wxyz\":[0.1,0.2,0.3,0.3333333333333333],\"translation_m\":[1e-20,-2.5,3.0],"
             "\"converged\":true,\"unique\":false,\"iterations\":4,\"n_used\":2,\"rejected\":[7,9],"
             "\"rotation_rms_deg\":0.5,\"translation_rms_m\":0.004}");
 }

@@ -1,10 +1,12 @@
 // libFuzzer: DecodeBounded on every message type (the first byte picks the type). A message that
-// passes must be exactly one message for LCM: decoded in full and re-encoded byte for byte.
+// passes must be exactly one message for LCM: decoded in full and re-encoded byte for byte; and it
+// flattens (orbed-log export's cells) into as many cells as names.
 #include <cstdlib>
 #include <cstring>
 #include <vector>
 
 #include <orbed/all_types.hpp>
+#include <orbed/flatten.hpp>
 
 #include "lcmtypes/bounded_decode.h"
 
@@ -20,6 +22,9 @@ void CheckOne(const uint8_t* data, size_t size) {
       std::memcmp(again.data(), data, size) != 0) {
     std::abort();  // the wire check let through bytes that are not one message
   }
+  orbed::flat::FlatRow row;
+  orbed::flat::Flatten(msg, "", row);
+  if (row.names.size() != row.cells.size() || row.names.empty()) std::abort();
 }
 
 using Checker = void (*)(const uint8_t*, size_t);

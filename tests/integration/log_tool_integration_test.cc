@@ -2,14 +2,19 @@
 // lcm-logger records 50 messages on LOG_TOOL_A and 5 on LOG_TOOL_B published here; the
 // recording is cut short of a clean end by appending half an event (a logger killed mid-write).
 // `orbed-log info` counts both channels exactly and reports the torn tail as damage; `check` exits 1
-// naming its offset; `cut --channels LOG_TOOL_B` keeps the 5.
+// naming its offset; `cut --channels LOG_TOOL_B` keeps the 5. Five encoded iiwa_status_t messages on
+// LOG_TOOL_STATUS come back from `export --csv` with the values published; the zero payloads of A and
+// B have no known fingerprint and are listed as not exported.
 #include <csignal>
 #include <cstdio>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
+
+#include <orbed/iiwa_status_t.hpp>
 
 #include "base/test_command.h"
 #include "procs/logger/event_log_reader.h"
@@ -49,10 +54,20 @@ TEST(LogTool, ReadsWhatLcmLoggerWrites) {
   for (int burst = 1; burst <= 5; ++burst) {
     for (int i = 0; i < 10; ++i) lcm.publish("LOG_TOOL_A", payload, sizeof(payload));
     lcm.publish("LOG_TOOL_B", payload, 3);
+    orbed::iiwa_status_t status{};
+    status.utime = burst;
+    status.num_joints = 2;
+    for (std::vector<double>* v :
+         {&status.joint_position_measured, &status.joint_velocity_estimated, &status.joint_position_commanded,
+          &status.joint_position_ipo, &status.joint_torque_measured, &status.joint_torque_commanded,
+          &status.joint_torque_external})
+      *v = {0.25 * burst, -1.0 / burst};
+    lcm.publish("LOG_TOOL_STATUS", &status);
     ASSERT_TRUE(WaitFor(
         [&] {
           lcm.publish("LOG_TOOL_END", payload, 1);
-          return on_disk("LOG_TOOL_A") == 10 * burst && on_disk("LOG_TOOL_B") == burst;
+          return on_disk("LOG_TOOL_A") == 10 * burst && on_disk("LOG_TOOL_B") == burst &&
+                 on_disk("LOG_TOOL_STATUS") == burst;
         },
         20))
         << "burst " << burst << ", on disk: " << on_disk("LOG_TOOL_A") << " A, " << on_disk("LOG_TOOL_B")
@@ -87,6 +102,37 @@ TEST(LogTool, ReadsWhatLcmLoggerWrites) {
   r = test::RunCommand(logger::RunLogTool, "orbed-log", {"cut", log, cut, "--channels", "LOG_TOOL_B"});
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("5 events written"), std::string::npos) << r.out;
+
+  const std::string csv_dir = dir + "/csv";
+  r = test::RunCommand(logger::RunLogTool, "orbed-log", {"export", log, csv_dir, "--csv"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("LOG_TOOL_A: not exported, no orbed or Drake fingerprint (50 events)"),
+            std::string::npos)
+      << r.out;
+  std::ifstream csv(csv_dir + "/LOG_TOOL_STATUS.csv");
+  std::string line;
+  ASSERT_TRUE(std::getline(csv, line));
+  const std::string header_start =
+      "log_utime (us),utime (us),num_joints,joint_position_measured[0] (rad),joint_position_measured[1] "
+      "(rad),"
+      "joint_velocity_estimated[0] (rad/s),";
+  EXPECT_EQ(line.substr(0, header_start.size()), header_start);
+  for (int burst = 1; burst <= 5; ++burst) {
+    ASSERT_TRUE(std::getline(csv, line)) << "row " << burst;
+    std::vector<std::string> cells;
+    for (size_t start = 0, end = 0; end != std::string::npos; start = end + 1) {
+      end = line.find(',', start);
+      cells.push_back(line.substr(start, end == std::string::npos ? end : end - start));
+    }
+    ASSERT_EQ(cells.size(), 17u) << line;  // log time, utime, count, 7 arrays of 2
+    EXPECT_EQ(cells[1], std::to_string(burst));
+    EXPECT_EQ(cells[2], "2");
+    // Read back exactly (shortest round-trip decimals): the first and the last array.
+    EXPECT_EQ(std::stod(cells[3]), 0.25 * burst) << line;
+    EXPECT_EQ(std::stod(cells[4]), -1.0 / burst) << line;
+    EXPECT_EQ(std::stod(cells[16]), -1.0 / burst) << line;
+  }
+  EXPECT_FALSE(std::getline(csv, line));
 }
 
 }  // namespace
