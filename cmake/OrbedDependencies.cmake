@@ -34,3 +34,14 @@ find_library(TINYXML_LIBRARY tinyxml REQUIRED)
 # Bullet in double precision only; never link the single-precision libraries beside it.
 pkg_check_modules(BULLET REQUIRED IMPORTED_TARGET bullet-float64)
 find_package(fcl QUIET)
+
+# OpenIGTLink 1.11 (protocol v2) for orbed-igtl-bridge. Debian's config file is pre-target CMake
+# (variables only), so the library is found by hand; the example sources the integration test
+# builds its receiver from come with openigtlink-examples.
+find_library(OPENIGTLINK_LIBRARY OpenIGTLink REQUIRED)
+find_path(OPENIGTLINK_INCLUDE_DIR igtlTransformMessage.h PATH_SUFFIXES openigtlink REQUIRED)
+add_library(orbed_openigtlink INTERFACE)
+target_include_directories(orbed_openigtlink SYSTEM INTERFACE ${OPENIGTLINK_INCLUDE_DIR})
+target_link_libraries(orbed_openigtlink INTERFACE ${OPENIGTLINK_LIBRARY} Threads::Threads)
+find_path(OPENIGTLINK_EXAMPLES_DIR Receiver/ReceiveClient.cxx
+          PATHS /usr/share/doc/openigtlink-examples/examples NO_DEFAULT_PATH REQUIRED)

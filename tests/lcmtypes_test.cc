@@ -143,6 +143,7 @@ TEST(LcmTypes, FingerprintsArePinned) {
                                                   {"session_control_t", 0xcdbe036ad16d76feULL},
                                                   {"setup_result_t", 0x7b1a0cab822c59c1ULL},
                                                   {"setup_task_t", 0x45ebcc451fbad1b9ULL},
+                                                  {"target_pose_t", 0x861ba235288a4402ULL},
                                                   {"viewer_draw_t", 0x414f0bfe5b2f4244ULL},
                                                   {"viewer_geometry_data_t", 0x5d2e34cb3257db07ULL},
                                                   {"viewer_link_data_t", 0x51252725af982a63ULL},

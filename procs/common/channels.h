@@ -29,6 +29,7 @@ inline constexpr char kSetupTask[] = "SETUP_TASK";                      // setup
 inline constexpr char kSetupResult[] = "SETUP_RESULT";                  // setup_result_t, orbed-assistant
 inline constexpr char kProcessStatus[] = "PROCESS_STATUS";              // process_status_t, 1 Hz each
 inline constexpr char kLoggerStatus[] = "LOGGER_STATUS";                // logger_status_t, 1 Hz
+inline constexpr char kIgtlTarget[] = "IGTL_TARGET";                    // target_pose_t, orbed-igtl-bridge
 
 /// Every channel above (tools that address channels by index: the fuzz targets and their corpora;
 /// new channels are appended so that the indices of the old ones stay).
@@ -37,6 +38,6 @@ inline constexpr const char* kAllChannels[] = {
     kPlanCheckReply,  kHmdPose,        kHmdPoseTruth,        kHmdCamera,       kArView,
     kGazeRay,         kReflectiveView, kAlignmentTrial,      kRegistration,    kSessionControl,
     kLandmarkRequest, kLandmark,       kMisalignmentRequest, kMisalignment,    kGuidance,
-    kProcessStatus,   kLoggerStatus,   kSetupTask,           kSetupResult};
+    kProcessStatus,   kLoggerStatus,   kSetupTask,           kSetupResult,     kIgtlTarget};
 
 }  // namespace orbed::channels
