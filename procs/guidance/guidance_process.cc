@@ -7,6 +7,7 @@
 #include <orbed/guidance_t.hpp>
 #include <orbed/iiwa_status_t.hpp>
 #include <orbed/setup_task_t.hpp>
+#include <orbed/target_pose_t.hpp>
 
 #include "base/format.h"
 #include "base/number_list.h"
@@ -16,7 +17,9 @@
 #include "procs/common/conversions.h"
 #include "procs/common/flags.h"
 #include "procs/common/log.h"
+#include "procs/common/validation.h"
 #include "sim/iiwa_status_check.h"
+#include "sim/trocar_clearance.h"
 
 namespace orbed::guidance {
 namespace {
@@ -65,6 +68,16 @@ GuidanceProcess::GuidanceProcess(const CommonFlags& flags, const GuidanceOptions
         ORBED_LOG(kInfo) << "guidance: task " << EscapeText(msg.task_id) << ", mode "
                          << GuidanceModeName(msg.mode);
       });
+  if (!options_.igtl_target_name.empty()) {
+    process_.Subscribe<orbed::target_pose_t>(
+        options_.igtl_target_channel,
+        [this](const orbed::target_pose_t& msg, const std::string& channel, int64_t) {
+          if (msg.name != options_.igtl_target_name) return;  // another frame from the planner
+          const std::string problem = CheckPose(msg.X_WT, "X_WT");
+          if (!problem.empty()) return process_.Reject(channel + "/pose", problem);
+          OnIgtlTarget(FromPose(msg.X_WT));
+        });
+  }
   process_.AddTimer(
       1.0 / options_.rate_hz,
       [this] {
@@ -81,7 +94,10 @@ GuidanceProcess::GuidanceProcess(const CommonFlags& flags, const GuidanceOptions
       },
       options_.guidance_channel);
   if (!core_) {
-    ORBED_LOG(kInfo) << "guidance: no target yet; waiting for SETUP_TASK on " << options_.setup_task_channel;
+    ORBED_LOG(kInfo) << "guidance: no target yet; waiting for SETUP_TASK on " << options_.setup_task_channel
+                     << (options_.igtl_target_name.empty() ? std::string()
+                                                           : " or a '" + options_.igtl_target_name + "' on " +
+                                                                 options_.igtl_target_channel);
     return;
   }
   std::string target;
@@ -92,6 +108,40 @@ GuidanceProcess::GuidanceProcess(const CommonFlags& flags, const GuidanceOptions
   ORBED_LOG(kInfo) << "guidance: mode " << GuidanceModeName(options_.target.mode) << ", target (" << target
                    << ") deg, tolerance " << options_.target.tolerance_deg << " deg, " << options_.rate_hz
                    << " Hz on " << options_.guidance_channel;
+}
+
+void GuidanceProcess::OnIgtlTarget(const Eigen::Isometry3d& X_WT) {
+  if (last_X_WT_ && last_X_WT_->isApprox(X_WT, 1e-12)) return;  // solved already
+  last_X_WT_ = X_WT;
+  const std::string key = options_.igtl_target_channel + "/ik";
+  try {
+    if (!scene_) {
+      scene_ = sim::LoadSceneFile(options_.scene_path.empty() ? SourceTreePath(sim::kDefaultSceneRelativePath)
+                                                              : options_.scene_path);
+      ik_model_ = sim::LoadRobotForScene(options_.urdf_path.empty()
+                                             ? SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath)
+                                             : options_.urdf_path,
+                                         *scene_);
+      clearance_ = sim::MakeTrocarClearanceFunction(*ik_model_, *scene_);
+    }
+  } catch (const std::exception& e) {
+    scene_.reset();
+    return process_.Reject(key, std::string("cannot load the scene: ") + e.what());
+  }
+  const Eigen::Isometry3d X_RT = scene_->X_WR.inverse() * X_WT;
+  sim::TrocarIkTarget trocar;
+  trocar.p_RT = X_RT.translation();
+  trocar.axis_R = X_RT.linear().col(2);
+  const sim::TrocarIkResult ik = sim::SolveTrocarIk(*ik_model_, trocar, sim::TrocarIkOptions{}, clearance_);
+  if (!ik.success) return process_.Reject(key, "no collision-free docking: " + ik.message);
+  GuidanceTarget target = core_ ? core_->target() : options_.target;
+  target.q_target_rad = ik.q_rad;
+  core_.emplace(model_, target);
+  std::string q_deg;
+  for (int i = 0; i < ik.q_rad.size(); ++i)
+    q_deg += (i ? ", " : "") + std::to_string(static_cast<int>(std::lround(ik.q_rad[i] * kRadToDeg)));
+  ORBED_LOG(kInfo) << "guidance: target from " << options_.igtl_target_channel << " '"
+                   << options_.igtl_target_name << "': (" << q_deg << ") deg";
 }
 
 std::optional<orbed::guidance_t> GuidanceProcess::GuidanceNow(int64_t utime) const {
@@ -105,7 +155,9 @@ int RunGuidance(int argc, const char* const* argv, std::ostream& out, std::ostre
       "orbed-guidance: joint-by-joint set-up guidance toward a target configuration. Subscribes\n"
       "IIWA_STATUS; publishes GUIDANCE (target and current joints, per-joint error [deg], the next\n"
       "joint to move from the base outwards, twisting or revolving per joint, done) at --rate-hz.\n"
-      "Without --target-deg or --plan it waits for a target on SETUP_TASK (orbed-setup)."};
+      "Without --target-deg or --plan it waits for a target on SETUP_TASK (orbed-setup). A trocar pose\n"
+      "named --igtl-target-name on IGTL_TARGET (3D Slicer through orbed-igtl-bridge) replaces the target\n"
+      "with the trocar IK's docking configuration."};
   CommonFlags common("orbed-guidance");
   AddCommonFlags(&app, &common);
   GuidanceOptions options;
@@ -138,6 +190,12 @@ int RunGuidance(int argc, const char* const* argv, std::ostream& out, std::ostre
   app.add_option("--iiwa-status-channel", options.iiwa_status_channel)->capture_default_str();
   app.add_option("--guidance-channel", options.guidance_channel)->capture_default_str();
   app.add_option("--setup-task-channel", options.setup_task_channel)->capture_default_str();
+  app.add_option("--igtl-target-channel", options.igtl_target_channel)->capture_default_str();
+  app.add_option(
+         "--igtl-target-name", options.igtl_target_name,
+         "IGTL_TARGET pose read as the trocar (tool tip, axis +z) and docked by trocar IK; \"\": none")
+      ->capture_default_str();
+  app.add_option("--scene", options.scene_path, "Scene YAML for IGTL_TARGET's IK (default: the shipped OR)");
   if (const auto code = ParseCommandLine(&app, common, argc, argv, out, err)) return *code;
   try {
     options.target.mode = GuidanceModeFromName(mode);

@@ -9,6 +9,14 @@
 /// SETUP_TASK (setup_task_t, from orbed-setup; checked by CheckSetupTask) replaces the target and
 /// the mode, keeping the tolerance; a repeated request id changes nothing.
 ///
+/// IGTL_TARGET (target_pose_t, from orbed-igtl-bridge: a pose planned in 3D Slicer) named
+/// igtl_target_name ("Trocar") is read as the trocar in W: the tool tip T at its origin, the tool
+/// axis along its +z. The trocar IK (sim/trocar_ik.h, with the scene's base pose, tool length and
+/// clearance objective, as `orbed-robot ik`) turns it into the joint target, which replaces the
+/// current one (mode and tolerance kept). Other names are ignored; a pose that is not one, or that
+/// the IK cannot dock collision-free, is refused (IGTL_TARGET/pose, IGTL_TARGET/ik) and the target
+/// stays; the same pose again is not solved again. The IK (about 0.1 s) runs on the process thread.
+///
 /// Threading: everything on the Process::Run thread.
 
 #include <optional>
@@ -19,6 +27,8 @@
 #include "procs/common/process.h"
 #include "procs/guidance/guidance.h"
 #include "sim/robot_model.h"
+#include "sim/scene.h"
+#include "sim/trocar_ik.h"
 
 namespace orbed::guidance {
 
@@ -32,6 +42,9 @@ struct GuidanceOptions {
   std::string iiwa_status_channel{"IIWA_STATUS"};
   std::string guidance_channel{"GUIDANCE"};
   std::string setup_task_channel{"SETUP_TASK"};
+  std::string igtl_target_channel{"IGTL_TARGET"};
+  std::string igtl_target_name{"Trocar"};  ///< "" = IGTL_TARGET ignored
+  std::string scene_path;                  ///< for IGTL_TARGET's IK; "" = the shipped scene
 };
 
 class GuidanceProcess {
@@ -54,6 +67,13 @@ class GuidanceProcess {
   int64_t q_received_utime_{0};
   bool stale_logged_{false};
   int64_t task_request_id_{0};
+  // IGTL_TARGET: the scene, the model with its tool and the clearance objective (loaded at the
+  // first target), and the last pose solved.
+  void OnIgtlTarget(const Eigen::Isometry3d& X_WT);
+  std::optional<sim::Scene> scene_;
+  std::optional<sim::RobotModel> ik_model_;
+  sim::ClearanceFunction clearance_;
+  std::optional<Eigen::Isometry3d> last_X_WT_;
 };
 
 /// orbed-guidance's command line (flags: --help): the target from --target-deg, or from --plan FILE

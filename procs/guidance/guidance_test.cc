@@ -13,10 +13,12 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <orbed/target_pose_t.hpp>
 
 #include "base/source_paths.h"
 #include "base/test_command.h"
 #include "base/units.h"
+#include "procs/common/conversions.h"
 #include "procs/guidance/guidance_process.h"
 
 namespace orbed::guidance {
@@ -143,6 +145,40 @@ TEST(GuidanceProcess, PublishesForTheLastGoodStatusAndCountsBadOnes) {
   EXPECT_EQ(counts.at("IIWA_STATUS/num_joints"), 1);
   EXPECT_EQ(counts.at("IIWA_STATUS/non_finite"), 1);
   EXPECT_EQ(counts.at("IIWA_STATUS/limits"), 1);
+}
+
+// IGTL_TARGET: an unreachable trocar (5 m away) and a non-unit quaternion are refused and the
+// command-line target stays; other names are ignored.
+TEST(GuidanceProcess, IgtlTargetsTheIkCannotDockAreRefused) {
+  CommonFlags flags("orbed-guidance-test");
+  flags.lcm_url = "memq://";
+  flags.duration_s = 0.2;
+  GuidanceOptions options;
+  options.target.q_target_rad = Deg({0, 30, 0, -60, 0, 45, 0});
+  options.stale_after_s = 3600;  // the status below stays fresh however slowly this machine runs
+  GuidanceProcess guidance(flags, options);
+  orbed::target_pose_t far{};
+  far.source = "igtl";
+  far.name = "Trocar";
+  far.X_WT.position_m[0] = 5.0;
+  far.X_WT.quaternion_wxyz[0] = 1;
+  guidance.process().lcm().publish("IGTL_TARGET", &far);
+  orbed::target_pose_t bad = far;
+  bad.X_WT.quaternion_wxyz[0] = 2;
+  guidance.process().lcm().publish("IGTL_TARGET", &bad);
+  orbed::target_pose_t other = bad;
+  other.name = "Needle";
+  guidance.process().lcm().publish("IGTL_TARGET", &other);
+  auto status = Status(Deg({0, 0, 0, 0, 0, 0, 0}));
+  guidance.process().lcm().publish("IIWA_STATUS", &status);
+  EXPECT_EQ(guidance.Run(), 0);
+  const auto counts = guidance.process().rejections().counts();
+  EXPECT_EQ(counts.at("IGTL_TARGET/ik"), 1);
+  EXPECT_EQ(counts.at("IGTL_TARGET/pose"), 1);
+  EXPECT_EQ(counts.size(), 2u);
+  const auto g = guidance.GuidanceNow(NowMicros());
+  ASSERT_TRUE(g.has_value());
+  EXPECT_NEAR(g->target_position[1], 30 * kDegToRad, 1e-12);  // the command line's target
 }
 
 std::string WritePlan(const std::string& name, const std::string& text) {

@@ -8,7 +8,9 @@
 //   - the library's example ReceiveClient (built from Debian's openigtlink-examples sources) reads
 //     TRANSFORM and STATUS messages from the bridge;
 //   - the library's example TrackerClient's TRANSFORMs (a circle of 50 mm radius with x = z) come
-//     out on IGTL_TARGET as such, and the bridge refuses none of them.
+//     out on IGTL_TARGET as such, and the bridge refuses none of them;
+//   - a "Trocar" TRANSFORM planned in Slicer becomes orbed-guidance's target: the GUIDANCE target's
+//     forward kinematics puts the tool tip at the sent point and the tool axis along its z.
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -25,12 +27,14 @@
 #include <igtlTransformMessage.h>
 #include <lcm/lcm-cpp.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <orbed/guidance_t.hpp>
 #include <orbed/image_t.hpp>
 #include <orbed/robot_state_t.hpp>
 #include <orbed/target_pose_t.hpp>
 
 #include "procs/common/conversions.h"
 #include "sim/robot_model.h"
+#include "sim/scene.h"
 #include "tests/integration/testbed_util.h"
 
 namespace orbed::testing {
@@ -43,6 +47,13 @@ class Watcher {
   explicit Watcher(BusWatcher* bus) {
     bus->lcm().subscribe("ROBOT_STATE", &Watcher::OnState, this);
     bus->lcm().subscribe("IGTL_TARGET", &Watcher::OnTarget, this);
+    bus->lcm().subscribe("GUIDANCE", &Watcher::OnGuidance, this);
+  }
+  bool Guidance(orbed::guidance_t* out) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!have_guidance_) return false;
+    *out = guidance_;
+    return true;
   }
   bool State(orbed::robot_state_t* out) const {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -68,7 +79,14 @@ class Watcher {
     std::lock_guard<std::mutex> lock(mutex_);
     targets_.push_back(*msg);
   }
+  void OnGuidance(const lcm::ReceiveBuffer*, const std::string&, const orbed::guidance_t* msg) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    guidance_ = *msg;
+    have_guidance_ = true;
+  }
   mutable std::mutex mutex_;
+  orbed::guidance_t guidance_{};
+  bool have_guidance_{false};
   orbed::robot_state_t state_{};
   bool have_state_{false};
   std::vector<orbed::target_pose_t> targets_;
@@ -249,6 +267,50 @@ TEST(IgtlBridge, SlicersViewOfTheTestbedAndTargetsBack) {
   const auto beats = bus.Heartbeats("orbed-igtl-bridge");
   ASSERT_FALSE(beats.empty());
   EXPECT_EQ(beats.back().status.rejected_inputs, 0);
+}
+
+TEST(IgtlBridge, ATrocarPlannedInSlicerBecomesTheGuidanceTarget) {
+  BusWatcher bus;
+  Watcher watcher(&bus);
+  bus.Start();
+  RunningProcess sim({BinPath("orbed-iiwa-sim")});
+  RunningProcess bridge({BinPath("orbed-igtl-bridge"), "--port", std::to_string(kPort)});
+  RunningProcess guidance({BinPath("orbed-guidance")});  // no target until one comes
+  igtl::ClientSocket::Pointer client;
+  ASSERT_TRUE(WaitFor(
+      [&] {
+        client = igtl::ClientSocket::New();
+        return client->ConnectToServer("127.0.0.1", kPort) == 0;
+      },
+      30));
+
+  // A trocar 3 cm beside the scene's, tilted 10 degrees about x: tip at its origin, axis along z.
+  const sim::Scene scene = sim::LoadSceneFile(SourcePath("sim/models/scenes/trocar_or.yaml"));
+  const Eigen::Vector3d p_WT = scene.trocar.p_WT + Eigen::Vector3d(0.03, 0, 0);
+  const Eigen::Vector3d axis_W =
+      Eigen::AngleAxisd(10 * M_PI / 180, Eigen::Vector3d::UnitX()) * scene.trocar.insertion_direction_W;
+  const Eigen::Matrix3d R_WT =
+      Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), axis_W).toRotationMatrix();
+  igtl::TransformMessage::Pointer trocar = igtl::TransformMessage::New();
+  trocar->SetDeviceName("Trocar");
+  igtl::Matrix4x4 m;
+  igtl::IdentityMatrix(m);
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) m[r][c] = static_cast<float>(R_WT(r, c));
+    m[r][3] = static_cast<float>(p_WT(r) * 1000.0);
+  }
+  trocar->SetMatrix(m);
+  trocar->Pack();
+  ASSERT_EQ(client->Send(trocar->GetPackPointer(), trocar->GetPackSize()), 1);
+
+  orbed::guidance_t g{};
+  ASSERT_TRUE(WaitFor([&] { return watcher.Guidance(&g); }, 60)) << "no GUIDANCE from the Slicer target";
+  const sim::RobotModel model =
+      sim::LoadRobotForScene(SourcePath("sim/models/iiwa7.urdf"), scene);  // with the scene's tool
+  const Eigen::Isometry3d X_WT = scene.X_WR * model.CalcToolTipPose(ToVectorX(g.target_position));
+  // The sent pose went through 32-bit floats (in mm): about 1e-4 mm and 1e-7 rad.
+  EXPECT_LT((X_WT.translation() - p_WT).norm(), 1e-4) << X_WT.translation().transpose();
+  EXPECT_LT(std::acos(std::min(1.0, X_WT.linear().col(2).dot(axis_W.normalized()))), 1e-3);
 }
 
 }  // namespace
