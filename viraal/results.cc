@@ -220,7 +220,11 @@ std::string ResultsTable(const RunResults& r) {
         << PadLeft(Fixed(e.misalignment_mm, 1), 10) << PadLeft(Fixed(e.base_translation_error_mm, 1), 9)
         << "\n";
   };
-  out << "ViRAAl run " << r.run_id << " (" << (r.ok ? "ok" : "FAILED: " + r.error) << ")\n";
+  out << "ViRAAl run " << r.run_id << ": "
+      << (r.ok        ? "ok"
+          : r.partial ? "partial"
+                      : "FAILED: " + r.error)
+      << "  (" << Fixed(r.duration_s, 1) << " s)\n";
   out << PadRight("mode", 15) << PadRight("trial", 8) << PadRight("q [deg]", 44) << PadLeft("t [mm]", 9)
       << PadLeft("R [deg]", 9) << PadLeft("mis [mm]", 10) << PadLeft("base[mm]", 9) << "\n";
   for (const SessionResult& s : r.sessions) {

@@ -1,5 +1,6 @@
 #include "procs/scenario/scenario_cli.h"
 
+#include <exception>
 #include <string>
 #include <vector>
 
@@ -8,8 +9,26 @@
 #include "procs/common/flags.h"
 #include "procs/scenario/viraal_scenario.h"
 #include "viraal/protocol.h"
+#include "viraal/results.h"
 
 namespace orbed::scenario {
+
+int PrintResults(const std::string& path, std::ostream& out, std::ostream& err) {
+  viraal::RunResults results;
+  try {
+    results = viraal::ReadResultsFile(path);
+  } catch (const std::exception& e) {
+    err << "orbed-scenario: " << e.what() << "\n";
+    return 1;
+  }
+  out << viraal::ResultsTable(results);
+  if (results.ok) return 0;
+  if (!results.partial) return 1;
+  size_t done = 0;
+  for (const viraal::SessionResult& s : results.sessions) done += s.trials.size();
+  out << "the run stopped before it finished (" << done << " trial(s) done)\n";
+  return 3;
+}
 
 int RunScenario(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
   CLI::App app{
@@ -78,7 +97,12 @@ int RunScenario(int argc, const char* const* argv, std::ostream& out, std::ostre
   app.add_option("--registration-channel", run.registration_channel)->capture_default_str();
   app.add_option("--misalignment-request-channel", run.misalignment_request_channel)->capture_default_str();
   app.add_option("--misalignment-channel", run.misalignment_channel)->capture_default_str();
+  std::string print_path;
+  app.add_option("--print", print_path,
+                 "Print the results table of a finished run (its results.json or its folder) and exit: 0 ok, "
+                 "1 failed, 3 stopped before the end (it can be resumed)");
   if (const auto code = ParseCommandLine(&app, common, argc, argv, out, err)) return *code;
+  if (!print_path.empty()) return PrintResults(print_path, out, err);
   try {
     if (scenario_path.empty()) scenario_path = ScenarioSourcePath(viraal::kDefaultScenarioRelativePath);
     run.config = viraal::LoadScenarioFile(scenario_path);

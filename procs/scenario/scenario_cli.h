@@ -14,6 +14,8 @@
 ///   --tolerance-deg, --startup-timeout-s, --reply-timeout-s, --move-timeout-s,
 ///   --trial-timeout-s        see ConductorOptions (viraal_conductor.h)
 ///   --<name>-channel           the nine channels, defaults from channels.h
+///   --print RESULTS            no run: print the table of a run's results.json (or its folder)
+///                              and exit 0 ok, 1 failed or unreadable, 3 stopped before the end
 ///
 /// Streams: --help's usage and the run's progress lines and table go to `out`; flag errors and a
 /// failure to start ("orbed-scenario: <reason>") to `err`. Log lines go to stderr (log.h).
@@ -21,9 +23,12 @@
 /// parse error code (non-zero).
 
 #include <ostream>
+#include <string>
 
 namespace orbed::scenario {
 
 int RunScenario(int argc, const char* const* argv, std::ostream& out, std::ostream& err);
+/// --print: the results table of `path` (results.json or its folder) on `out`; exit code as above.
+int PrintResults(const std::string& path, std::ostream& out, std::ostream& err);
 
 }  // namespace orbed::scenario

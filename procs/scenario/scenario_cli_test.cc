@@ -12,6 +12,8 @@
 
 #include <gtest/gtest.h>
 
+#include "base/source_paths.h"
+
 namespace orbed::scenario {
 namespace {
 
@@ -128,6 +130,32 @@ TEST(ScenarioCli, TheRunIdComesFromTheFlagThenOrbedRunIdThenTheClock) {
   const std::string id = RunIdOfAFailedRun({}, &run);
   EXPECT_EQ(id.rfind("viraal-", 0), 0u) << id;
   EXPECT_EQ(id.size(), std::string("viraal-20250101T000000Z").size()) << id;
+}
+
+// --print: the pinned run's table (its Table 1 rows as the README's pinned block shows them), exit
+// 0; the same run marked partial, exit 3 with the trials done; a missing file, exit 1 naming it.
+TEST(ScenarioCli, PrintsAFinishedRunsTable) {
+  const std::string pinned = SourceTreePath("tests/integration/testdata/viraal_pinned_results.json");
+  CliRun r = Cli({"--print", pinned});
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(Contains(r.out, "ViRAAl run pinned: ok")) << r.out;
+  EXPECT_TRUE(Contains(r.out, "Table 1 (3 trials): ")) << r.out;
+  EXPECT_TRUE(Contains(r.out, "(paper: 30.2 +/- 23.9 mm)")) << r.out;
+
+  std::string text = ReadFile(pinned);
+  const std::string ok = "\"status\": \"ok\"";
+  ASSERT_NE(text.find(ok), std::string::npos);
+  text.replace(text.find(ok), ok.size(), "\"status\": \"partial\"");
+  const std::string partial = ::testing::TempDir() + "partial_results.json";
+  std::ofstream(partial) << text;
+  r = Cli({"--print", partial});
+  EXPECT_EQ(r.code, 3) << r.err;
+  EXPECT_TRUE(Contains(r.out, "ViRAAl run pinned: partial")) << r.out;
+  EXPECT_TRUE(Contains(r.out, "the run stopped before it finished (6 trial(s) done)")) << r.out;
+
+  r = Cli({"--print", "/nonexistent/results.json"});
+  EXPECT_EQ(r.code, 1);
+  EXPECT_TRUE(Contains(r.err, "/nonexistent/results.json")) << r.err;
 }
 
 }  // namespace
