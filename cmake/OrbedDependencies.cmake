@@ -45,3 +45,11 @@ target_include_directories(orbed_openigtlink SYSTEM INTERFACE ${OPENIGTLINK_INCL
 target_link_libraries(orbed_openigtlink INTERFACE ${OPENIGTLINK_LIBRARY} Threads::Threads)
 find_path(OPENIGTLINK_EXAMPLES_DIR Receiver/ReceiveClient.cxx
           PATHS /usr/share/doc/openigtlink-examples/examples NO_DEFAULT_PATH REQUIRED)
+
+# websocketpp 0.8 (header-only) on standalone asio, for orbed-foxglove-bridge.
+find_path(WEBSOCKETPP_INCLUDE_DIR websocketpp/server.hpp REQUIRED)
+find_path(ASIO_INCLUDE_DIR asio.hpp REQUIRED)
+add_library(orbed_websocketpp INTERFACE)
+target_include_directories(orbed_websocketpp SYSTEM INTERFACE ${WEBSOCKETPP_INCLUDE_DIR} ${ASIO_INCLUDE_DIR})
+target_compile_definitions(orbed_websocketpp INTERFACE ASIO_STANDALONE)
+target_link_libraries(orbed_websocketpp INTERFACE Threads::Threads)

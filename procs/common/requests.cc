@@ -97,6 +97,24 @@ std::string CheckRobotState(const orbed::robot_state_t& msg, int num_joints) {
                  orbed::robot_state_t::MOTION_IN_COLLISION, "ROBOT_STATE.motion_state")});
 }
 
+std::string CheckImage(const orbed::image_t& msg) {
+  if (msg.width <= 0 || msg.height <= 0 || msg.width > kMaxImageSide || msg.height > kMaxImageSide)
+    return "image: size " + std::to_string(msg.width) + " x " + std::to_string(msg.height) + " px";
+  if (msg.num_bytes != static_cast<int64_t>(msg.data.size())) return "image: num_bytes differs from the data";
+  if (!(msg.fx_px > 0) || !(msg.fy_px > 0) || !std::isfinite(msg.fx_px) || !std::isfinite(msg.fy_px))
+    return "image: fx_px, fy_px must be finite and > 0";
+  const std::string pose = CheckPose(msg.X_WC, "image.X_WC");
+  if (!pose.empty()) return pose;
+  if (msg.pixel_format == orbed::image_t::FORMAT_JPEG) return "";
+  const int channels = msg.pixel_format == orbed::image_t::FORMAT_GRAY8 ? 1 : 3;
+  if (msg.pixel_format < orbed::image_t::FORMAT_GRAY8 || msg.pixel_format > orbed::image_t::FORMAT_BGR8)
+    return "image: pixel_format " + std::to_string(msg.pixel_format);
+  if (msg.row_stride < channels * msg.width ||
+      static_cast<int64_t>(msg.row_stride) * msg.height != static_cast<int64_t>(msg.num_bytes))
+    return "image: row_stride and height do not give num_bytes";
+  return "";
+}
+
 std::string CheckCollisionStatus(const orbed::collision_status_t& msg) {
   if (std::isnan(msg.min_distance_m) || msg.min_distance_m == -std::numeric_limits<double>::infinity())
     return "COLLISION_STATUS.min_distance_m: expected a number or +inf";

@@ -24,6 +24,11 @@
 ///                                          (no pair checked), never NaN or −inf; num_contacts and
 ///                                          num_links equal to their arrays' lengths, at most
 ///                                          kMaxRobotStateLinks. The reason names the field.
+///   HMD_CAMERA, AR_VIEW, REFLECTIVE_VIEW.image (image_t), read by the bridges: width and height in
+///                                          1..kMaxImageSide [px]; num_bytes equal to the data's length;
+///                                          fx_px, fy_px finite and > 0; X_WC a valid pose; a known
+///                                          pixel_format; raw formats: row_stride * height == num_bytes
+///                                          and rows at least width pixels. The reason names the field.
 /// Whether a landmark's rays can be triangulated, or pairs evaluated, is the server's computation,
 /// not the contract.
 ///
@@ -37,6 +42,7 @@
 #include <Eigen/Core>
 #include <orbed/collision_status_t.hpp>
 #include <orbed/iiwa_command_t.hpp>
+#include <orbed/image_t.hpp>
 #include <orbed/landmark_request_t.hpp>
 #include <orbed/misalignment_request_t.hpp>
 #include <orbed/plan_check_request_t.hpp>
@@ -58,6 +64,11 @@ std::string CheckRobotState(const orbed::robot_state_t& msg, int num_joints);
 
 /// "" or the reason COLLISION_STATUS is refused (see the file comment).
 std::string CheckCollisionStatus(const orbed::collision_status_t& msg);
+
+/// Images larger than this on a side are refused (the HoloLens PV camera is 1280 x 720) [px].
+inline constexpr int kMaxImageSide = 8192;
+/// "" or the reason an image_t is refused (see the file comment).
+std::string CheckImage(const orbed::image_t& msg);
 
 struct IiwaCommand {
   int64_t utime{0};

@@ -32,21 +32,13 @@
 namespace orbed::igtl_bridge {
 namespace {
 
-/// Images larger than this on a side are refused (the HoloLens PV camera is 1280 x 720).
-constexpr int kMaxImageSide = 8192;
-
-// "" or why an image_t cannot be shown; on success *bgr holds the decoded picture.
+// "" or why an image_t cannot be shown (CheckImage, then the decoding); on success *bgr holds it.
 std::string DecodeImage(const orbed::image_t& img, cv::Mat* bgr) {
-  if (img.width <= 0 || img.height <= 0 || img.width > kMaxImageSide || img.height > kMaxImageSide)
-    return "size " + std::to_string(img.width) + " x " + std::to_string(img.height) + " px";
-  if (img.num_bytes != static_cast<int64_t>(img.data.size())) return "num_bytes differs from the data";
-  if (!(img.fx_px > 0) || !std::isfinite(img.fx_px)) return "fx_px not > 0";
-  const std::string pose = CheckPose(img.X_WC, "X_WC");
-  if (!pose.empty()) return pose;
+  const std::string problem = CheckImage(img);
+  if (!problem.empty()) return problem;
   if (img.pixel_format == orbed::image_t::FORMAT_JPEG) {
     *bgr = cv::imdecode(img.data, cv::IMREAD_COLOR);
-  } else if (img.pixel_format == orbed::image_t::FORMAT_BGR8 && img.row_stride >= 3 * img.width &&
-             static_cast<int64_t>(img.row_stride) * img.height == img.num_bytes) {
+  } else if (img.pixel_format == orbed::image_t::FORMAT_BGR8) {
     *bgr = cv::Mat(img.height, img.width, CV_8UC3, const_cast<uint8_t*>(img.data.data()), img.row_stride)
                .clone();
   } else {

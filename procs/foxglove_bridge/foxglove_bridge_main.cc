@@ -1,0 +1,10 @@
+/// @file
+/// orbed-foxglove-bridge: the testbed live in Foxglove (what, flags and exit codes:
+/// procs/foxglove_bridge/foxglove_bridge.h and --help).
+#include <iostream>
+
+#include "procs/foxglove_bridge/foxglove_bridge.h"
+
+int main(int argc, char** argv) {
+  return orbed::foxglove::RunFoxgloveBridge(argc, argv, std::cout, std::cerr);
+}

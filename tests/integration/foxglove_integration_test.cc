@@ -1,0 +1,110 @@
+// orbed-foxglove-bridge beside the real orbed-iiwa-sim over real LCM, in a private network namespace,
+// read by a client built on Foxglove's own @foxglove/ws-protocol (tests/foxglove/client.test.mjs in
+// node's test runner). This side writes what the bus says into the file the client checks against:
+// ROBOT_STATE's X_WR, the model's forward kinematics of its joints to iiwa_link_ee, the JPEG it
+// publishes on HMD_CAMERA (the client compares the image bytes exactly) and a scene object's name.
+// The client must see them on /tf, /hmd/camera and /scene and exit 0.
+#include <fstream>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <lcm/lcm-cpp.hpp>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <orbed/image_t.hpp>
+#include <orbed/robot_state_t.hpp>
+
+#include "procs/common/conversions.h"
+#include "sim/robot_model.h"
+#include "sim/scene.h"
+#include "tests/integration/testbed_util.h"
+
+namespace orbed::testing {
+namespace {
+
+class StateWatcher {
+ public:
+  explicit StateWatcher(BusWatcher* bus) { bus->lcm().subscribe("ROBOT_STATE", &StateWatcher::On, this); }
+  bool Latest(orbed::robot_state_t* out) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!have_) return false;
+    *out = state_;
+    return true;
+  }
+
+ private:
+  void On(const lcm::ReceiveBuffer*, const std::string&, const orbed::robot_state_t* msg) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    state_ = *msg;
+    have_ = true;
+  }
+  mutable std::mutex mutex_;
+  orbed::robot_state_t state_{};
+  bool have_{false};
+};
+
+nlohmann::json PoseJson(const Eigen::Isometry3d& X) {
+  const Eigen::Quaterniond q(X.linear());
+  return {{"translation", {X.translation().x(), X.translation().y(), X.translation().z()}},
+          {"rotation", {q.x(), q.y(), q.z(), q.w()}}};
+}
+
+TEST(FoxgloveBridge, FoxglovesOwnClientSeesTheTestbed) {
+  BusWatcher bus;
+  StateWatcher watcher(&bus);
+  bus.Start();
+  lcm::LCM publisher;
+  ASSERT_TRUE(publisher.good());
+  RunningProcess sim({BinPath("orbed-iiwa-sim")});
+  RunningProcess bridge({BinPath("orbed-foxglove-bridge"), "--port", "8765", "--image-hz", "20"});
+  orbed::robot_state_t state{};
+  ASSERT_TRUE(WaitFor([&] { return watcher.Latest(&state); }, 30)) << "no ROBOT_STATE";
+
+  // What the bus says (the arm does not move: this state is the one the bridge sends).
+  const sim::RobotModel model = sim::RobotModel::LoadFile(SourcePath("sim/models/iiwa7.urdf"));
+  const sim::Scene scene = sim::LoadSceneFile(SourcePath("sim/models/scenes/trocar_or.yaml"));
+  ASSERT_FALSE(scene.objects.empty());
+  const Eigen::Isometry3d X_R_ee =
+      model.CalcLinkPoses(ToVectorX(state.joint_position))[model.FindLink("iiwa_link_ee")];
+  const std::string dir = MakeTempDir("foxglove");
+  std::vector<uint8_t> jpeg;
+  cv::imencode(".jpg", cv::Mat(48, 64, CV_8UC3, cv::Scalar(30, 60, 90)), jpeg);
+  std::ofstream(dir + "/camera.jpg", std::ios::binary)
+      .write(reinterpret_cast<const char*>(jpeg.data()), jpeg.size());
+  const nlohmann::json expected = {{"X_WR", PoseJson(FromPose(state.X_WR))},
+                                   {"X_R_ee", PoseJson(X_R_ee)},
+                                   {"jpeg_path", dir + "/camera.jpg"},
+                                   {"scene_object", scene.objects[0].name}};
+  std::ofstream(dir + "/expected.json") << expected.dump(2);
+
+  orbed::image_t image{};
+  image.width = 64;
+  image.height = 48;
+  image.pixel_format = orbed::image_t::FORMAT_JPEG;
+  image.fx_px = image.fy_px = 500;
+  image.X_WC.quaternion_wxyz[0] = 1;
+  image.data = jpeg;
+  image.num_bytes = static_cast<int32_t>(jpeg.size());
+
+  RunningProcess client(
+      {ORBED_NODE, "--test", std::string(ORBED_FOXGLOVE_CLIENT_DIR) + "/client.test.mjs"},
+      {{"ORBED_EXPECT_JSON", dir + "/expected.json"}, {"ORBED_FOXGLOVE_URL", "ws://127.0.0.1:8765"}});
+  // The camera keeps sending while the client runs (it may subscribe at any moment).
+  ASSERT_TRUE(WaitFor(
+      [&] {
+        image.utime = NowMicros();
+        publisher.publish("HMD_CAMERA", &image);
+        return !client.running();
+      },
+      120))
+      << "the Foxglove client did not finish";
+  EXPECT_EQ(client.exit_code(), 0) << "see the client's output above";
+  const auto beats = bus.Heartbeats("orbed-foxglove-bridge");
+  ASSERT_FALSE(beats.empty());
+  EXPECT_EQ(beats.back().status.rejected_inputs, 0);
+}
+
+}  // namespace
+}  // namespace orbed::testing
