@@ -3,18 +3,12 @@
 #include <exception>
 
 #include <CLI/CLI.hpp>
-#include <orbed/guidance_t.hpp>
-#include <orbed/registration_t.hpp>
-#include <orbed/robot_state_t.hpp>
 
 #include "base/source_paths.h"
 #include "procs/common/conversions.h"
 #include "procs/common/flags.h"
 #include "procs/common/log.h"
-#include "procs/common/requests.h"
-#include "procs/common/validation.h"
 #include "procs/drake_viewer/viewer_messages.h"
-#include "sim/guidance_messages.h"
 
 namespace orbed::viewer {
 namespace {
@@ -32,32 +26,10 @@ ViewerBridge::ViewerBridge(const CommonFlags& flags, const ViewerOptions& option
       scene_(LoadScene(options.scene_path)),
       model_(sim::RobotModel::LoadFile(options.urdf_path.empty()
                                            ? SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath)
-                                           : options.urdf_path)) {
-  const int n = model_.num_joints();
-  process_.Subscribe<orbed::robot_state_t>(
-      options_.robot_state_channel,
-      [this, n](const orbed::robot_state_t& msg, const std::string& channel, int64_t) {
-        const std::string problem = CheckRobotState(msg, n);
-        if (!problem.empty()) return process_.Reject(channel + "/field", problem);
-        X_WR_ = FromPose(msg.X_WR);
-        q_real_ = Eigen::Map<const Eigen::VectorXd>(msg.joint_position.data(), n);
-      });
-  process_.Subscribe<orbed::registration_t>(
-      options_.registration_channel,
-      [this](const orbed::registration_t& msg, const std::string& channel, int64_t) {
-        if (!msg.valid) return;  // no mean yet
-        const std::string problem = CheckPose(msg.X_WV_mean, "REGISTRATION.X_WV_mean");
-        if (!problem.empty()) return process_.Reject(channel + "/pose", problem);
-        X_WV_ = FromPose(msg.X_WV_mean);
-      });
-  process_.Subscribe<orbed::guidance_t>(
-      options_.guidance_channel,
-      [this, n](const orbed::guidance_t& msg, const std::string& channel, int64_t) {
-        const std::string problem = guidance::CheckGuidance(msg, model_, 0.01);
-        if (!problem.empty()) return process_.Reject(channel + "/field", problem);
-        q_target_ = Eigen::Map<const Eigen::VectorXd>(msg.target_position.data(), n);
-        have_target_ = true;
-      });
+                                           : options.urdf_path)),
+      poses_(
+          &process_, model_,
+          {options.robot_state_channel, options.registration_channel, options.guidance_channel, "HMD_POSE"}) {
   const orbed::viewer_load_robot_t load = MakeLoadRobot(model_, scene_ ? &*scene_ : nullptr);
   process_.AddTimer(
       options_.load_period_s, [this, load] { process_.Publish(options_.load_channel, load); },
@@ -76,9 +48,9 @@ ViewerBridge::ViewerBridge(const CommonFlags& flags, const ViewerOptions& option
 }
 
 std::optional<orbed::viewer_draw_t> ViewerBridge::DrawNow(int64_t utime) const {
-  if (!X_WR_) return std::nullopt;
-  return MakeDraw(model_, scene_ ? &*scene_ : nullptr, *X_WR_, q_real_, X_WV_,
-                  have_target_ ? q_target_ : q_real_, utime);
+  if (!poses_.X_WR()) return std::nullopt;
+  return MakeDraw(model_, scene_ ? &*scene_ : nullptr, *poses_.X_WR(), poses_.q(), poses_.X_WV(),
+                  poses_.q_virtual(), utime);
 }
 
 int RunViewerBridge(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {

@@ -3,10 +3,10 @@
 /// orbed-drake-viewer: the testbed in Drake's viewer (Meldis: `python3 -m pydrake.visualization.meldis`
 /// on the same LCM URL). viewer_messages.h says what is drawn.
 ///
-///   Subscribes: ROBOT_STATE (X_WR and q: the real robot; checked: pose, joint count, finite
-///               values), REGISTRATION (the latest valid X_WV_mean: the virtual robot), GUIDANCE
-///               (guidance::CheckGuidance; its target is the virtual robot's configuration during a
-///               set-up; without GUIDANCE the virtual robot takes the real q, as in an alignment).
+///   Subscribes (sim/testbed_poses.h): ROBOT_STATE (X_WR and q: the real robot), REGISTRATION (the
+///               latest valid X_WV_mean: the virtual robot), GUIDANCE (its target is the virtual
+///               robot's configuration during a set-up; without GUIDANCE the virtual robot takes the
+///               real q, as in an alignment), each checked, refusals counted.
 ///   Publishes:  DRAKE_VIEWER_LOAD_ROBOT at start and every load_period_s (a viewer started later
 ///               loads the model too); DRAKE_VIEWER_DRAW every 1/rate_hz from the first good
 ///               ROBOT_STATE on.
@@ -23,6 +23,7 @@
 #include "procs/common/process.h"
 #include "sim/robot_model.h"
 #include "sim/scene.h"
+#include "sim/testbed_poses.h"
 
 namespace orbed::viewer {
 
@@ -52,9 +53,7 @@ class ViewerBridge {
   ViewerOptions options_;
   std::optional<sim::Scene> scene_;
   sim::RobotModel model_;
-  std::optional<Eigen::Isometry3d> X_WR_, X_WV_;
-  Eigen::VectorXd q_real_, q_target_;
-  bool have_target_{false};
+  sim::TestbedPoses poses_;
 };
 
 /// orbed-drake-viewer's command line (flags: --help). Exit 0; 2 or CLI11's usage code (106-109) on

@@ -4,11 +4,9 @@
 
 #include <CLI/CLI.hpp>
 #include <orbed/guidance_t.hpp>
-#include <orbed/hmd_pose_t.hpp>
 #include <orbed/image_t.hpp>
 #include <orbed/reflective_view_t.hpp>
 #include <orbed/registration_t.hpp>
-#include <orbed/robot_state_t.hpp>
 
 #include "base/format.h"
 #include "base/source_paths.h"
@@ -44,57 +42,18 @@ FoxgloveBridge::FoxgloveBridge(const CommonFlags& flags, const BridgeOptions& op
                                            ? SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath)
                                            : options.urdf_path)),
       scene_(LoadScene(options.scene_path)),
-      server_(options.server, [this](const ServerEvent& e) {
-        if (e.kind == ServerEvent::kConnected)
-          ORBED_LOG(kInfo) << "foxglove: client " << e.peer << " connected";
-        if (e.kind == ServerEvent::kDisconnected)
-          ORBED_LOG(kInfo) << "foxglove: client " << e.peer << " left";
-        if (e.kind == ServerEvent::kRefused) process_.Reject("foxglove/refused", e.peer + ": " + e.detail);
-      }) {
-  const int n = model_.num_joints();
-  process_.Subscribe<orbed::robot_state_t>(
-      channels::kRobotState, [this, n](const orbed::robot_state_t& msg, const std::string& channel, int64_t) {
-        const std::string problem = CheckRobotState(msg, n);
-        if (!problem.empty()) return process_.Reject(channel + "/field", problem);
-        X_WR_ = FromPose(msg.X_WR);
-        q_ = Eigen::Map<const Eigen::VectorXd>(msg.joint_position.data(), n);
-      });
-  process_.Subscribe<orbed::registration_t>(
-      channels::kRegistration, [this](const orbed::registration_t& msg, const std::string& channel, int64_t) {
-        if (!msg.valid) return;  // no mean yet
-        const std::string problem = CheckPose(msg.X_WV_mean, "REGISTRATION.X_WV_mean");
-        if (!problem.empty()) return process_.Reject(channel + "/pose", problem);
-        X_WV_ = FromPose(msg.X_WV_mean);
-        if (!server_.HasSubscribers(kRegistration)) return;
-        const nlohmann::json j = {{"utime", msg.utime},
-                                  {"session_id", EscapeText(msg.session_id)},
-                                  {"valid", true},
-                                  {"num_used", msg.num_used},
-                                  {"X_WV_mean", PoseJson(*X_WV_)}};
-        Send(kRegistration, msg.utime, j.dump());
-      });
-  process_.Subscribe<orbed::guidance_t>(
-      channels::kGuidance, [this, n](const orbed::guidance_t& msg, const std::string& channel, int64_t) {
-        const std::string problem = guidance::CheckGuidance(msg, model_, 0.01);
-        if (!problem.empty()) return process_.Reject(channel + "/field", problem);
-        q_target_ = Eigen::Map<const Eigen::VectorXd>(msg.target_position.data(), n);
-        have_target_ = true;
-        if (!server_.HasSubscribers(kGuidance) || !Due("guidance", options_.rate_hz, NowMicros())) return;
-        const nlohmann::json j = {{"utime", msg.utime},
-                                  {"mode", guidance::GuidanceModeName(msg.mode)},
-                                  {"error_deg", msg.error_deg},
-                                  {"next_joint", msg.next_joint},
-                                  {"done", static_cast<bool>(msg.done)}};
-        Send(kGuidance, msg.utime, j.dump());
-      });
-  process_.Subscribe<orbed::hmd_pose_t>(
-      channels::kHmdPose, [this](const orbed::hmd_pose_t& msg, const std::string& channel, int64_t) {
-        std::string problem = CheckPose(msg.X_WH, "X_WH");
-        if (problem.empty()) problem = CheckPose(msg.X_WC, "X_WC");
-        if (!problem.empty()) return process_.Reject(channel + "/pose", problem);
-        X_WH_ = FromPose(msg.X_WH);
-        X_WC_ = FromPose(msg.X_WC);
-      });
+      server_(options.server,
+              [this](const ServerEvent& e) {
+                if (e.kind == ServerEvent::kConnected)
+                  ORBED_LOG(kInfo) << "foxglove: client " << e.peer << " connected";
+                if (e.kind == ServerEvent::kDisconnected)
+                  ORBED_LOG(kInfo) << "foxglove: client " << e.peer << " left";
+                if (e.kind == ServerEvent::kRefused)
+                  process_.Reject("foxglove/refused", e.peer + ": " + e.detail);
+              }),
+      poses_(&process_, model_, sim::TestbedPoses::Channels{},
+             {[this](const orbed::registration_t& msg) { SendRegistration(msg); },
+              [this](const orbed::guidance_t& msg) { SendGuidance(msg); }}) {
   const auto on_image = [this](const orbed::image_t& img, uint32_t channel_id, const std::string& frame,
                                const std::string& channel) {
     if (!server_.HasSubscribers(channel_id) || !Due(frame, options_.image_hz, NowMicros())) return;
@@ -117,10 +76,11 @@ FoxgloveBridge::FoxgloveBridge(const CommonFlags& flags, const BridgeOptions& op
   process_.AddTimer(
       1.0 / options_.rate_hz,
       [this] {
-        if (!X_WR_ || !server_.HasSubscribers(kTf)) return;
-        std::vector<Frame> frames = RobotFrames(model_, *X_WR_, q_, X_WV_, have_target_ ? q_target_ : q_);
-        if (X_WH_) frames.push_back({"W", "H", *X_WH_});
-        if (X_WC_) frames.push_back({"W", "C", *X_WC_});
+        if (!poses_.X_WR() || !server_.HasSubscribers(kTf)) return;
+        std::vector<Frame> frames =
+            RobotFrames(model_, *poses_.X_WR(), poses_.q(), poses_.X_WV(), poses_.q_virtual());
+        if (poses_.X_WH()) frames.push_back({"W", "H", *poses_.X_WH()});
+        if (poses_.X_WC()) frames.push_back({"W", "C", *poses_.X_WC()});
         const int64_t now = NowMicros();
         Send(kTf, now, FrameTransforms(frames, now).dump());
       },
@@ -130,7 +90,8 @@ FoxgloveBridge::FoxgloveBridge(const CommonFlags& flags, const BridgeOptions& op
       [this] {
         if (!server_.HasSubscribers(kScene)) return;
         const int64_t now = NowMicros();
-        Send(kScene, now, SceneUpdate(model_, scene_ ? &*scene_ : nullptr, X_WV_.has_value(), now).dump());
+        Send(kScene, now,
+             SceneUpdate(model_, scene_ ? &*scene_ : nullptr, poses_.X_WV().has_value(), now).dump());
       },
       "foxglove/scene");
   process_.AddTimer(
@@ -138,6 +99,26 @@ FoxgloveBridge::FoxgloveBridge(const CommonFlags& flags, const BridgeOptions& op
   ORBED_LOG(kInfo)
       << "foxglove bridge: ws://" << options_.server.bind_address << ":" << server_.port()
       << " (foxglove.websocket.v1: /tf, /scene, /hmd/camera, /reflective, /registration, /guidance)";
+}
+
+void FoxgloveBridge::SendRegistration(const orbed::registration_t& msg) {
+  if (!server_.HasSubscribers(kRegistration)) return;
+  const nlohmann::json j = {{"utime", msg.utime},
+                            {"session_id", EscapeText(msg.session_id)},
+                            {"valid", true},
+                            {"num_used", msg.num_used},
+                            {"X_WV_mean", PoseJson(*poses_.X_WV())}};
+  Send(kRegistration, msg.utime, j.dump());
+}
+
+void FoxgloveBridge::SendGuidance(const orbed::guidance_t& msg) {
+  if (!server_.HasSubscribers(kGuidance) || !Due("guidance", options_.rate_hz, NowMicros())) return;
+  const nlohmann::json j = {{"utime", msg.utime},
+                            {"mode", guidance::GuidanceModeName(msg.mode)},
+                            {"error_deg", msg.error_deg},
+                            {"next_joint", msg.next_joint},
+                            {"done", static_cast<bool>(msg.done)}};
+  Send(kGuidance, msg.utime, j.dump());
 }
 
 void FoxgloveBridge::Send(uint32_t channel, int64_t utime, const std::string& payload) {

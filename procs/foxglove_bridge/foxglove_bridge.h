@@ -4,9 +4,10 @@
 /// connection to ws://localhost:8765), over the foxglove.websocket.v1 protocol with JSON payloads
 /// (foxglove_messages.h says the channels, shapes and frames).
 ///
-///   Subscribes: ROBOT_STATE (X_WR, q; CheckRobotState), REGISTRATION (the latest valid X_WV_mean),
-///               GUIDANCE (CheckGuidance: its target is the virtual robot's configuration), HMD_POSE
-///               (X_WH, X_WC), HMD_CAMERA and REFLECTIVE_VIEW (CheckImage; JPEG passed on as sent).
+///   Subscribes: ROBOT_STATE, REGISTRATION, GUIDANCE and HMD_POSE through sim/testbed_poses.h (X_WR
+///               and q, the latest valid X_WV_mean, the guidance target as the virtual robot's
+///               configuration, X_WH and X_WC); HMD_CAMERA and REFLECTIVE_VIEW (CheckImage; JPEG
+///               passed on as sent).
 ///   Sends:      /tf at rate_hz from the first good ROBOT_STATE; /scene every scene_period_s;
 ///               /hmd/camera and /reflective at most image_hz per source; /registration and
 ///               /guidance as they come (at most rate_hz for the guidance). Nothing is encoded for a
@@ -29,6 +30,7 @@
 #include "procs/foxglove_bridge/foxglove_server.h"
 #include "sim/robot_model.h"
 #include "sim/scene.h"
+#include "sim/testbed_poses.h"
 
 namespace orbed::foxglove {
 
@@ -52,6 +54,8 @@ class FoxgloveBridge {
 
  private:
   void Send(uint32_t channel, int64_t utime, const std::string& payload);
+  void SendRegistration(const orbed::registration_t& msg);
+  void SendGuidance(const orbed::guidance_t& msg);
   bool Due(const std::string& source, double hz, int64_t now_us);
 
   Process process_;
@@ -59,9 +63,7 @@ class FoxgloveBridge {
   sim::RobotModel model_;
   std::optional<sim::Scene> scene_;
   FoxgloveServer server_;
-  std::optional<Eigen::Isometry3d> X_WR_, X_WH_, X_WC_, X_WV_;
-  Eigen::VectorXd q_, q_target_;
-  bool have_target_{false};
+  sim::TestbedPoses poses_;
   std::map<std::string, int64_t> last_sent_us_;
 };
 

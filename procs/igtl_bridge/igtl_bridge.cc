@@ -7,12 +7,9 @@
 #include <CLI/CLI.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <orbed/alignment_trial_t.hpp>
-#include <orbed/hmd_pose_t.hpp>
 #include <orbed/image_t.hpp>
 #include <orbed/process_status_t.hpp>
 #include <orbed/reflective_view_t.hpp>
-#include <orbed/registration_t.hpp>
-#include <orbed/robot_state_t.hpp>
 #include <orbed/session_control_t.hpp>
 #include <orbed/setup_result_t.hpp>
 #include <orbed/target_pose_t.hpp>
@@ -84,33 +81,11 @@ IgtlBridge::IgtlBridge(const CommonFlags& flags, const BridgeOptions& options)
       model_(sim::RobotModel::LoadFile(options.urdf_path.empty()
                                            ? SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath)
                                            : options.urdf_path)),
-      server_(options.server) {
+      server_(options.server),
+      poses_(&process_, model_, sim::TestbedPoses::Channels{}) {
   for (const sim::RobotLink& link : model_.links())
     if (link.name.size() > 20)
       throw std::runtime_error("link name '" + link.name + "' is longer than 20 bytes");
-  const int n = model_.num_joints();
-  process_.Subscribe<orbed::robot_state_t>(
-      channels::kRobotState, [this, n](const orbed::robot_state_t& msg, const std::string& channel, int64_t) {
-        const std::string problem = CheckRobotState(msg, n);
-        if (!problem.empty()) return process_.Reject(channel + "/field", problem);
-        X_WR_ = FromPose(msg.X_WR);
-        q_ = Eigen::Map<const Eigen::VectorXd>(msg.joint_position.data(), n);
-      });
-  process_.Subscribe<orbed::hmd_pose_t>(
-      channels::kHmdPose, [this](const orbed::hmd_pose_t& msg, const std::string& channel, int64_t) {
-        std::string problem = CheckPose(msg.X_WH, "X_WH");
-        if (problem.empty()) problem = CheckPose(msg.X_WC, "X_WC");
-        if (!problem.empty()) return process_.Reject(channel + "/pose", problem);
-        X_WH_ = FromPose(msg.X_WH);
-        X_WC_ = FromPose(msg.X_WC);
-      });
-  process_.Subscribe<orbed::registration_t>(
-      channels::kRegistration, [this](const orbed::registration_t& msg, const std::string& channel, int64_t) {
-        if (!msg.valid) return;  // no mean yet
-        const std::string problem = CheckPose(msg.X_WV_mean, "REGISTRATION.X_WV_mean");
-        if (!problem.empty()) return process_.Reject(channel + "/pose", problem);
-        X_WV_ = FromPose(msg.X_WV_mean);
-      });
   process_.Subscribe<orbed::process_status_t>(
       channels::kProcessStatus,
       [this](const orbed::process_status_t& msg, const std::string& channel, int64_t) {
@@ -231,11 +206,12 @@ bool IgtlBridge::ImageDue(const std::string& source, int64_t now_us) {
 void IgtlBridge::SendTransforms() {
   if (server_.num_clients() == 0) return;
   const int64_t now = NowMicros();
-  if (X_WR_)
-    for (const auto& [name, X] : RobotFrames(model_, *X_WR_, q_)) Send(PackTransform(name, X, now));
-  if (X_WH_) Send(PackTransform("HMD", *X_WH_, now));
-  if (X_WC_) Send(PackTransform("HMDCamera", *X_WC_, now));
-  if (X_WV_) Send(PackTransform("Registration", *X_WV_, now));
+  if (poses_.X_WR())
+    for (const auto& [name, X] : RobotFrames(model_, *poses_.X_WR(), poses_.q()))
+      Send(PackTransform(name, X, now));
+  if (poses_.X_WH()) Send(PackTransform("HMD", *poses_.X_WH(), now));
+  if (poses_.X_WC()) Send(PackTransform("HMDCamera", *poses_.X_WC(), now));
+  if (poses_.X_WV()) Send(PackTransform("Registration", *poses_.X_WV(), now));
 }
 
 int RunIgtlBridge(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {

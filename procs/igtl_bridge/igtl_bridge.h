@@ -17,6 +17,7 @@
 ///               RUNNING, NOT_READY when STARTING, SHUT_DOWN when STOPPING, UNKNOWN_ERROR when
 ///               FAILED; error name the state; status string its counts and last error.
 ///     STRING    (Events) for SESSION_CONTROL commands, ALIGNMENT_TRIAL and SETUP_RESULT: one line.
+///   Poses from sim/testbed_poses.h (ROBOT_STATE, HMD_POSE, REGISTRATION, checked there).
 ///   Receives: TRANSFORM or POSITION from a client → IGTL_TARGET (target_pose_t, source "igtl",
 ///             name = the device name, X_WT in metres): a target planned in Slicer, for the tools
 ///             on the bus. Other types are skipped; refusals as igtl_codec.h says.
@@ -41,6 +42,7 @@
 #include "procs/common/process.h"
 #include "procs/igtl_bridge/igtl_server.h"
 #include "sim/robot_model.h"
+#include "sim/testbed_poses.h"
 
 namespace orbed::igtl_bridge {
 
@@ -76,8 +78,7 @@ class IgtlBridge {
   BridgeOptions options_;
   sim::RobotModel model_;
   IgtlServer server_;
-  std::optional<Eigen::Isometry3d> X_WR_, X_WH_, X_WC_, X_WV_;
-  Eigen::VectorXd q_;
+  sim::TestbedPoses poses_;
   std::map<std::string, int64_t> last_image_us_;
   std::set<std::string> logged_targets_;  // "peer/device" of the targets logged once
 };

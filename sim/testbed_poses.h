@@ -1,0 +1,59 @@
+#pragma once
+/// @file
+/// TestbedPoses: the testbed's latest poses as the bridges to other tools need them (Drake's
+/// viewer, OpenIGTLink, Foxglove), subscribed and checked in one place:
+///   ROBOT_STATE   X_WR and the real joints q (CheckRobotState); refused: "ROBOT_STATE/field"
+///   REGISTRATION  the latest valid X_WV_mean (the registered virtual robot); invalid states (no
+///                 mean yet) are skipped; refused: "REGISTRATION/pose"
+///   GUIDANCE      its target configuration: the virtual robot's during a set-up (CheckGuidance
+///                 with 0.01 rad of slack); refused: "GUIDANCE/field"
+///   HMD_POSE      the headset X_WH and its camera X_WC (the SLAM estimate); refused: "HMD_POSE/pose"
+/// Each optional callback runs after its message was stored (e.g. to forward it).
+///
+/// Threading: handlers run on the Process::Run thread; read from that thread.
+
+#include <functional>
+#include <optional>
+#include <string>
+
+#include <Eigen/Geometry>
+#include <orbed/guidance_t.hpp>
+#include <orbed/registration_t.hpp>
+
+#include "procs/common/process.h"
+#include "sim/robot_model.h"
+
+namespace orbed::sim {
+
+class TestbedPoses {
+ public:
+  /// The channels (defaults: procs/common/channels.h).
+  struct Channels {
+    std::string robot_state{"ROBOT_STATE"};
+    std::string registration{"REGISTRATION"};
+    std::string guidance{"GUIDANCE"};
+    std::string hmd_pose{"HMD_POSE"};
+  };
+  struct Callbacks {
+    std::function<void(const orbed::registration_t&)> on_registration;
+    std::function<void(const orbed::guidance_t&)> on_guidance;
+  };
+  /// Subscribes on `process` (which must outlive this); `model` gives the joint count and limits.
+  TestbedPoses(Process* process, const RobotModel& model, const Channels& channels, Callbacks callbacks = {});
+
+  const std::optional<Eigen::Isometry3d>& X_WR() const { return X_WR_; }
+  const std::optional<Eigen::Isometry3d>& X_WV() const { return X_WV_; }
+  const std::optional<Eigen::Isometry3d>& X_WH() const { return X_WH_; }
+  const std::optional<Eigen::Isometry3d>& X_WC() const { return X_WC_; }
+  /// The real joints (empty before the first good ROBOT_STATE).
+  const Eigen::VectorXd& q() const { return q_; }
+  /// The virtual robot's joints: GUIDANCE's target once one came, else the real joints.
+  const Eigen::VectorXd& q_virtual() const { return have_target_ ? q_target_ : q_; }
+
+ private:
+  std::optional<Eigen::Isometry3d> X_WR_, X_WV_, X_WH_, X_WC_;
+  Eigen::VectorXd q_, q_target_;
+  bool have_target_{false};
+};
+
+}  // namespace orbed::sim
