@@ -3,7 +3,8 @@
 // node's test runner). This side writes what the bus says into the file the client checks against:
 // ROBOT_STATE's X_WR, the model's forward kinematics of its joints to iiwa_link_ee, the JPEG it
 // publishes on HMD_CAMERA (the client compares the image bytes exactly) and a scene object's name.
-// The client must see them on /tf, /hmd/camera and /scene and exit 0.
+// The client must see them on /tf, /hmd/camera and /scene and exit 0; and the same from a log
+// replayed through the bridge by LCM's lcm-logplayer.
 #include <fstream>
 #include <mutex>
 #include <string>
@@ -17,6 +18,7 @@
 #include <orbed/robot_state_t.hpp>
 
 #include "procs/common/conversions.h"
+#include "procs/logger/event_log_writer.h"
 #include "sim/robot_model.h"
 #include "sim/scene.h"
 #include "tests/integration/testbed_util.h"
@@ -104,6 +106,71 @@ TEST(FoxgloveBridge, FoxglovesOwnClientSeesTheTestbed) {
   const auto beats = bus.Heartbeats("orbed-foxglove-bridge");
   ASSERT_FALSE(beats.empty());
   EXPECT_EQ(beats.back().status.rejected_inputs, 0);
+}
+
+// A recorded session replayed through the bridge: a log written here (ROBOT_STATE at 50 Hz with a
+// base and joints of its own, HMD_CAMERA at 10 Hz, 30 s), played by LCM's lcm-logplayer with no
+// sim running; the same client must see the log's poses and image.
+TEST(FoxgloveBridge, AReplayedLogShowsTheRecordedSession) {
+  const sim::RobotModel model = sim::RobotModel::LoadFile(SourcePath("sim/models/iiwa7.urdf"));
+  const sim::Scene scene = sim::LoadSceneFile(SourcePath("sim/models/scenes/trocar_or.yaml"));
+  orbed::robot_state_t state{};
+  Eigen::Isometry3d X_WR = Eigen::Isometry3d::Identity();
+  X_WR.linear() = Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  X_WR.translation() = Eigen::Vector3d(0.1, 0.2, 0.3);
+  state.X_WR = ToPose(X_WR);
+  state.robot_name = "iiwa";
+  state.num_joints = 7;
+  state.joint_position = {0.5, 0.4, -0.3, -1.2, 0.1, 0.7, 0.2};
+  state.joint_limit_hit.assign(7, 0);
+  const std::string dir = MakeTempDir("foxglove_replay");
+  std::vector<uint8_t> jpeg;
+  cv::imencode(".jpg", cv::Mat(24, 32, CV_8UC3, cv::Scalar(200, 100, 50)), jpeg);
+  std::ofstream(dir + "/camera.jpg", std::ios::binary)
+      .write(reinterpret_cast<const char*>(jpeg.data()), jpeg.size());
+  orbed::image_t image{};
+  image.width = 32;
+  image.height = 24;
+  image.pixel_format = orbed::image_t::FORMAT_JPEG;
+  image.fx_px = image.fy_px = 300;
+  image.X_WC.quaternion_wxyz[0] = 1;
+  image.data = jpeg;
+  image.num_bytes = static_cast<int32_t>(jpeg.size());
+  {
+    logger::EventLogWriter log(dir + "/session.lcmlog");
+    ASSERT_TRUE(log.ok()) << log.error();
+    const auto write = [&log](int64_t t_us, const char* channel, const auto& msg) {
+      std::vector<uint8_t> bytes(static_cast<size_t>(msg.getEncodedSize()));
+      msg.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+      log.Write(t_us, channel, bytes.data(), bytes.size());
+    };
+    const int64_t start_us = 1'700'000'000'000'000;
+    for (int i = 0; i < 1500; ++i) {
+      state.utime = start_us + i * 20'000;
+      write(state.utime, "ROBOT_STATE", state);
+      if (i % 5 == 0) {
+        image.utime = state.utime;
+        write(image.utime, "HMD_CAMERA", image);
+      }
+    }
+  }
+  const nlohmann::json expected = {
+      {"X_WR", PoseJson(FromPose(state.X_WR))},
+      {"X_R_ee",
+       PoseJson(model.CalcLinkPoses(ToVectorX(state.joint_position))[model.FindLink("iiwa_link_ee")])},
+      {"jpeg_path", dir + "/camera.jpg"},
+      {"scene_object", scene.objects[0].name}};
+  std::ofstream(dir + "/expected.json") << expected.dump(2);
+
+  BusWatcher bus;
+  bus.Start();
+  RunningProcess bridge({BinPath("orbed-foxglove-bridge"), "--port", "8765", "--image-hz", "20"});
+  RunningProcess player({"/usr/bin/lcm-logplayer", dir + "/session.lcmlog"});
+  RunningProcess client(
+      {ORBED_NODE, "--test", std::string(ORBED_FOXGLOVE_CLIENT_DIR) + "/client.test.mjs"},
+      {{"ORBED_EXPECT_JSON", dir + "/expected.json"}, {"ORBED_FOXGLOVE_URL", "ws://127.0.0.1:8765"}});
+  ASSERT_TRUE(client.Wait(120)) << "the Foxglove client did not finish";
+  EXPECT_EQ(client.exit_code(), 0) << "see the client's output above";
 }
 
 }  // namespace
