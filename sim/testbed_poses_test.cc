@@ -26,7 +26,7 @@ TEST(TestbedPoses, StoresGoodMessagesAndRefusesBadOnes) {
   const RobotModel model = RobotModel::LoadFile(SourceTreePath(RobotModel::kDefaultUrdfRelativePath));
   CommonFlags flags("testbed-poses-test");
   flags.lcm_url = "memq://";
-  flags.duration_s = 0.05;
+  flags.duration_s = 0.5;  // the messages below are queued before Run and handled at its start
   Process process(flags);
   int registrations = 0, guidances = 0;
   TestbedPoses poses(&process, model, TestbedPoses::Channels{},
