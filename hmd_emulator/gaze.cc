@@ -50,14 +50,14 @@ void SideRoots(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double r, dou
 
 }  // namespace
 
-RayHit IntersectPrimitive(const Primitive& g, const Eigen::Vector3d& p_WO, const Eigen::Vector3d& direction_W,
-                          double max_distance_m) {
+RayHit IntersectPrimitive(const render::Primitive& g, const Eigen::Vector3d& p_WO,
+                          const Eigen::Vector3d& direction_W, double max_distance_m) {
   const Eigen::Matrix3d R_GW = g.X_WG.linear().transpose();
   const Eigen::Vector3d o = R_GW * (p_WO - g.X_WG.translation());
   const Eigen::Vector3d d = R_GW * direction_W;
   Nearest best;
   switch (g.shape) {
-    case Primitive::Shape::kBox: {
+    case render::Primitive::Shape::kBox: {
       // Slab test: the ray is inside all three slabs for t in [t_enter, t_exit].
       const Eigen::Vector3d h = 0.5 * g.size_m;
       double t_enter = -std::numeric_limits<double>::infinity();
@@ -91,11 +91,11 @@ RayHit IntersectPrimitive(const Primitive& g, const Eigen::Vector3d& p_WO, const
       }
       break;
     }
-    case Primitive::Shape::kSphere:
+    case render::Primitive::Shape::kSphere:
       SphereRoots(
           o, d, Eigen::Vector3d::Zero(), g.radius_m, [](const Eigen::Vector3d&) { return true; }, &best);
       break;
-    case Primitive::Shape::kCylinder: {
+    case render::Primitive::Shape::kCylinder: {
       const double h = 0.5 * g.length_m, r = g.radius_m;
       SideRoots(o, d, r, h, &best);
       if (std::abs(d.z()) > 1e-18) {
@@ -107,7 +107,7 @@ RayHit IntersectPrimitive(const Primitive& g, const Eigen::Vector3d& p_WO, const
       }
       break;
     }
-    case Primitive::Shape::kCapsule: {
+    case render::Primitive::Shape::kCapsule: {
       const double h = 0.5 * g.length_m, r = g.radius_m;
       SideRoots(o, d, r, h, &best);
       // Only the outer hemispheres of the two end spheres are on the capsule's surface.
@@ -127,15 +127,15 @@ RayHit IntersectPrimitive(const Primitive& g, const Eigen::Vector3d& p_WO, const
   return hit;
 }
 
-RayHit CastRay(const SceneGeometry& geometry, const Eigen::Vector3d& p_WO, const Eigen::Vector3d& direction_W,
-               KindMask kinds, double max_distance_m) {
+RayHit CastRay(const render::SceneGeometry& geometry, const Eigen::Vector3d& p_WO,
+               const Eigen::Vector3d& direction_W, render::KindMask kinds, double max_distance_m) {
   const double len = direction_W.norm();
   if (!std::isfinite(len) || !(len > 0) || !p_WO.allFinite())
     throw std::invalid_argument("CastRay: origin and direction must be finite, direction non-zero");
   const Eigen::Vector3d d = direction_W / len;
   RayHit best;
-  for (const Primitive& p : geometry.primitives()) {
-    if (!(kinds & KindBit(geometry.bodies()[p.body].kind))) continue;
+  for (const render::Primitive& p : geometry.primitives()) {
+    if (!(kinds & render::KindBit(geometry.bodies()[p.body].kind))) continue;
     RayHit h = IntersectPrimitive(p, p_WO, d, std::min(max_distance_m, best.distance_m));
     if (h.hit && h.distance_m < best.distance_m) {
       best = h;

@@ -11,7 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "base/source_paths.h"
-#include "hmd_emulator/renderer.h"
+#include "render/renderer.h"
 #include "sim/robot_model.h"
 #include "sim/scene.h"
 
@@ -25,9 +25,9 @@ Eigen::Isometry3d Pose(const Eigen::Vector3d& rpy_deg, const Eigen::Vector3d& p)
   return X;
 }
 
-Primitive Make(Primitive::Shape shape, const Eigen::Isometry3d& X_WG, double r = 0, double l = 0,
-               const Eigen::Vector3d& size = Eigen::Vector3d::Zero()) {
-  Primitive p;
+render::Primitive Make(render::Primitive::Shape shape, const Eigen::Isometry3d& X_WG, double r = 0,
+                       double l = 0, const Eigen::Vector3d& size = Eigen::Vector3d::Zero()) {
+  render::Primitive p;
   p.shape = shape;
   p.X_WG = X_WG;
   p.radius_m = r;
@@ -36,11 +36,11 @@ Primitive Make(Primitive::Shape shape, const Eigen::Isometry3d& X_WG, double r =
   return p;
 }
 
-using Shape = Primitive::Shape;
+using Shape = render::Primitive::Shape;
 
 TEST(Gaze, BoxFacesByHand) {
   const Eigen::Isometry3d X_WG = Pose({0, 0, 0}, {1, 2, 3});
-  const Primitive box = Make(Shape::kBox, X_WG, 0, 0, {0.4, 0.6, 0.8});
+  const render::Primitive box = Make(Shape::kBox, X_WG, 0, 0, {0.4, 0.6, 0.8});
   // Along +x from 2 m away: hits the -x face at x = 0.8, distance 2 - 0.2.
   RayHit h = IntersectPrimitive(box, {-1, 2.1, 3.1}, {1, 0, 0});
   ASSERT_TRUE(h.hit);
@@ -71,7 +71,7 @@ TEST(Gaze, BoxFacesByHand) {
 TEST(Gaze, RotatedBoxHitsLieOnTheSurfaceAndAreFirst) {
   const Eigen::Isometry3d X_WG = Pose({20, -35, 50}, {0.2, -0.1, 1.0});
   const Eigen::Vector3d half(0.3, 0.2, 0.1);
-  const Primitive box = Make(Shape::kBox, X_WG, 0, 0, 2 * half);
+  const render::Primitive box = Make(Shape::kBox, X_WG, 0, 0, 2 * half);
   const Eigen::Isometry3d X_GW = X_WG.inverse();
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> U(-1, 1);
@@ -101,7 +101,7 @@ TEST(Gaze, RotatedBoxHitsLieOnTheSurfaceAndAreFirst) {
 }
 
 TEST(Gaze, SphereByHand) {
-  const Primitive s = Make(Shape::kSphere, Pose({0, 0, 0}, {0, 0, 1}), 0.5);
+  const render::Primitive s = Make(Shape::kSphere, Pose({0, 0, 0}, {0, 0, 1}), 0.5);
   RayHit h = IntersectPrimitive(s, {0, -3, 1}, {0, 1, 0});
   ASSERT_TRUE(h.hit);
   EXPECT_NEAR(h.distance_m, 2.5, 1e-12);
@@ -121,7 +121,7 @@ TEST(Gaze, CylinderSideAndCapsByHand) {
   // Pitch 90 deg: the axis z_G lies along W's x; the checks below use z_G from the pose itself.
   const Eigen::Isometry3d X_WG = Pose({0, 90, 0}, {1, 0, 1});
   const Eigen::Vector3d axis_W = X_WG.linear().col(2);
-  const Primitive c = Make(Shape::kCylinder, X_WG, 0.2, 1.0);
+  const render::Primitive c = Make(Shape::kCylinder, X_WG, 0.2, 1.0);
   // Perpendicular to the axis at its middle, from 2 m: hits the side at 2 - 0.2.
   const Eigen::Vector3d perp = axis_W.unitOrthogonal();
   RayHit h = IntersectPrimitive(c, X_WG.translation() + 2 * perp, -perp);
@@ -152,7 +152,7 @@ TEST(Gaze, CapsuleBodyAndCapsByHand) {
   const Eigen::Isometry3d X_WG = Pose({30, 0, 10}, {0, 0, 1});
   const Eigen::Vector3d z = X_WG.linear().col(2);
   const Eigen::Vector3d x = X_WG.linear().col(0);
-  const Primitive c = Make(Shape::kCapsule, X_WG, 0.1, 0.6);  // caps at ±0.3
+  const render::Primitive c = Make(Shape::kCapsule, X_WG, 0.1, 0.6);  // caps at ±0.3
   // Along the axis from 2 m: the cap's pole at 2 - 0.3 - 0.1.
   RayHit h = IntersectPrimitive(c, X_WG.translation() + 2 * z, -z);
   ASSERT_TRUE(h.hit);
@@ -179,7 +179,7 @@ TEST(Gaze, OperatingRoomNamesTheBodyAndSkipsTheHologram) {
   const sim::Scene scene = sim::LoadSceneFile(orbed::SourceTreePath(sim::kDefaultSceneRelativePath));
   const Eigen::VectorXd q = Eigen::VectorXd::Zero(7);  // arm straight up
   const Eigen::Isometry3d X_WV = scene.X_WR;           // hologram exactly on the real robot
-  SceneGeometry g = SceneGeometry::MakeOperatingRoom(scene, robot, q, scene.X_WR, &X_WV);
+  render::SceneGeometry g = render::SceneGeometry::MakeOperatingRoom(scene, robot, q, scene.X_WR, &X_WV);
   // Straight down onto the patient's legs (top at 0.88 + 0.08).
   RayHit h = CastRay(g, {0.9, 0.0, 2.0}, {0, 0, -1});
   ASSERT_TRUE(h.hit);
@@ -197,7 +197,7 @@ TEST(Gaze, OperatingRoomNamesTheBodyAndSkipsTheHologram) {
   ASSERT_TRUE(h.hit);
   EXPECT_EQ(h.body_name, "iiwa_link_3");
   EXPECT_NEAR(h.distance_m, 2.0 - 0.07, 1e-9);
-  h = CastRay(g, o, {1, 0, 0}, kVirtualOnly);
+  h = CastRay(g, o, {1, 0, 0}, render::kVirtualOnly);
   ASSERT_TRUE(h.hit);
   EXPECT_EQ(h.body_name, "virtual/iiwa_link_3");
   EXPECT_THROW(CastRay(g, o, {0, 0, 0}), std::invalid_argument);
@@ -207,11 +207,12 @@ TEST(Gaze, AgreesWithTheRendererOnAFlatFace) {
   const sim::RobotModel robot =
       sim::RobotModel::LoadFile(orbed::SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath));
   const sim::Scene scene = sim::LoadSceneFile(orbed::SourceTreePath(sim::kDefaultSceneRelativePath));
-  SceneGeometry g = SceneGeometry::MakeOperatingRoom(scene, robot, Eigen::VectorXd::Zero(7), scene.X_WR);
-  Mesh mesh;
-  Tessellate(g, kRealWorld, {}, &mesh);
+  render::SceneGeometry g =
+      render::SceneGeometry::MakeOperatingRoom(scene, robot, Eigen::VectorXd::Zero(7), scene.X_WR);
+  render::Mesh mesh;
+  render::Tessellate(g, render::kRealWorld, {}, &mesh);
   const geometry::Intrinsics K = geometry::Intrinsics::HoloLensPv();
-  Renderer renderer(K);
+  render::Renderer renderer(K);
   // Looking down at 60 deg onto the patient's torso from the bedside.
   Eigen::Isometry3d X_WC = Eigen::Isometry3d::Identity();
   const Eigen::Vector3d eye(0.0, -1.2, 1.9), target(0.0, 0.0, 1.02);

@@ -29,8 +29,8 @@
 #include "base/units.h"
 #include "hmd_emulator/gaze.h"
 #include "hmd_emulator/headset_trial.h"
-#include "hmd_emulator/renderer.h"
 #include "procs/common/conversions.h"
+#include "render/renderer.h"
 
 namespace orbed::hmd {
 namespace {
@@ -520,7 +520,7 @@ TEST(HmdProcess, CameraReflectiveAndArViewCarryTheirGeometry) {
   EXPECT_EQ(cam.pose_utime, got.est[0].utime);
   EXPECT_EQ(cam.utime, got.est[0].utime);
   for (int i = 0; i < 3; ++i) EXPECT_EQ(cam.X_WC.position_m[i], got.est[0].X_WC.position_m[i]);
-  const cv::Mat frame = DecodeJpeg(cam.data);
+  const cv::Mat frame = render::DecodeJpeg(cam.data);
   ASSERT_EQ(frame.cols, 1280);
   ASSERT_EQ(frame.rows, 720);
 
@@ -545,22 +545,22 @@ TEST(HmdProcess, CameraReflectiveAndArViewCarryTheirGeometry) {
   // casting the capture-time line of sight against the real robot alone.
   const sim::RobotModel robot =
       sim::RobotModel::LoadFile(HmdSourcePath(sim::RobotModel::kDefaultUrdfRelativePath));
-  SceneGeometry robot_only;
+  render::SceneGeometry robot_only;
   Eigen::VectorXd q(kQDeg.size());
   for (std::size_t i = 0; i < kQDeg.size(); ++i) q[i] = kQDeg[i] * kDegToRad;
-  robot_only.PoseRobot(robot_only.AddRobot(robot, BodyKind::kRealRobot), q, SceneX_WR());
+  robot_only.PoseRobot(robot_only.AddRobot(robot, render::BodyKind::kRealRobot), q, SceneX_WR());
   ASSERT_EQ(got.truth.size(), 1u);
   const Eigen::Isometry3d X_WH_true = FromPose(got.truth[0].X_WH);
   const RayHit on_robot = CastRay(robot_only, X_WH_true.translation(), X_WH_true.linear().col(2));
   ASSERT_TRUE(on_robot.hit);
   EXPECT_NEAR(rv.distance_m, (on_robot.p_WQ - FromPose(got.truth[0].X_WC).translation()).norm(), 1e-6);
-  const cv::Mat mirror = DecodeJpeg(rv.image.data);
+  const cv::Mat mirror = render::DecodeJpeg(rv.image.data);
   ASSERT_EQ(mirror.cols, 1280);
   ASSERT_EQ(mirror.rows, 720);
 
   // The AR view is the camera frame with the hologram drawn over it: same size, not the same picture.
   ASSERT_EQ(got.ar.size(), 1u);
-  const cv::Mat ar = DecodeJpeg(got.ar[0].data);
+  const cv::Mat ar = render::DecodeJpeg(got.ar[0].data);
   ASSERT_EQ(ar.cols, 1280);
   cv::Mat diff;
   cv::absdiff(ar, frame, diff);

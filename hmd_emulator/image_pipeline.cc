@@ -33,7 +33,7 @@ orbed::image_t JpegImage(const std::vector<std::uint8_t>& jpeg, const geometry::
 }
 
 void Encode(const cv::Mat& bgr, int quality, std::vector<std::uint8_t>* jpeg) {
-  if (!EncodeJpeg(bgr, quality, jpeg)) throw std::runtime_error("JPEG encoding failed");
+  if (!render::EncodeJpeg(bgr, quality, jpeg)) throw std::runtime_error("JPEG encoding failed");
 }
 
 }  // namespace
@@ -47,7 +47,7 @@ ImagePipelineClocks ImagePipelineClocks::System() {
   return clocks;
 }
 
-ImagePipeline::ImagePipeline(const sim::RobotModel& robot, const SceneGeometry& scene_objects,
+ImagePipeline::ImagePipeline(const sim::RobotModel& robot, const render::SceneGeometry& scene_objects,
                              ImagePipelineOptions options, ImagePipelineOutputs outputs,
                              ImagePipelineClocks clocks)
     : options_(std::move(options)),
@@ -55,8 +55,8 @@ ImagePipeline::ImagePipeline(const sim::RobotModel& robot, const SceneGeometry& 
       clocks_(std::move(clocks)),
       renderer_(options_.intrinsics),
       compositor_(robot) {
-  robot_geometry_.AddRobot(robot, BodyKind::kRealRobot);
-  Tessellate(scene_objects, kAllKinds, {}, &scene_mesh_);
+  robot_geometry_.AddRobot(robot, render::BodyKind::kRealRobot);
+  render::Tessellate(scene_objects, render::kAllKinds, {}, &scene_mesh_);
   mesh_ = scene_mesh_;
   for (double t_s : options_.display_capture_t_s) {
     Display d;
@@ -159,7 +159,7 @@ void ImagePipeline::PoseRobot(const RobotState& robot) {
   mesh_ = scene_mesh_;
   if (robot.known()) {
     robot_geometry_.PoseRobot(0, robot.q_rad, robot.X_WR);
-    Tessellate(robot_geometry_, kAllKinds, {}, &mesh_);
+    render::Tessellate(robot_geometry_, render::kAllKinds, {}, &mesh_);
   }
   robot_ = robot;
 }
@@ -173,7 +173,7 @@ double ImagePipeline::GazeDistance(const Eigen::Isometry3d& X_WH, const Eigen::I
   const double fallback_m = options_.gaze_fallback_distance_m;
   if (!robot_.known()) return fallback_m;
   const Eigen::Vector3d p_WH = X_WH.translation(), d_W = X_WH.linear().col(2);
-  const RayHit hit = CastRay(robot_geometry_, p_WH, d_W, kRealWorld, options_.max_gaze_distance_m);
+  const RayHit hit = CastRay(robot_geometry_, p_WH, d_W, render::kRealWorld, options_.max_gaze_distance_m);
   if (!hit.hit) return fallback_m;
   const double D_m = (hit.p_WQ - X_WC.translation()).norm();
   return std::isfinite(D_m) && D_m > 0.01 ? D_m : fallback_m;

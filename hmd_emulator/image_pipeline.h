@@ -50,10 +50,10 @@
 
 #include "geometry/camera_model.h"
 #include "hmd_emulator/reflective.h"
-#include "hmd_emulator/renderer.h"
 #include "hmd_emulator/robot_state.h"
-#include "hmd_emulator/scene_geometry.h"
 #include "hmd_emulator/slam_model.h"
+#include "render/renderer.h"
+#include "render/scene_geometry.h"
 #include "sim/robot_model.h"
 
 namespace orbed::hmd {
@@ -106,7 +106,7 @@ class ImagePipeline {
 
   /// `robot` must outlive the pipeline; `scene_objects` is tessellated now (not kept).
   /// Starts the worker when options.threaded.
-  ImagePipeline(const sim::RobotModel& robot, const SceneGeometry& scene_objects,
+  ImagePipeline(const sim::RobotModel& robot, const render::SceneGeometry& scene_objects,
                 ImagePipelineOptions options, ImagePipelineOutputs outputs,
                 ImagePipelineClocks clocks = ImagePipelineClocks::System());
   /// Joins the worker (a job in progress finishes; pending ones are dropped).
@@ -164,11 +164,11 @@ class ImagePipeline {
   const ImagePipelineClocks clocks_;
 
   // Worker state (the worker thread, or the caller's inline).
-  Renderer renderer_;
+  render::Renderer renderer_;
   Compositor compositor_;
-  SceneGeometry robot_geometry_;  // the real robot only, handle 0
-  Mesh scene_mesh_, mesh_;        // mesh_ = scene_mesh_ + the robot at robot_ when known
-  RobotState robot_;              // the robot drawn in mesh_, bgr_ and robot_geometry_
+  render::SceneGeometry robot_geometry_;  // the real robot only, handle 0
+  render::Mesh scene_mesh_, mesh_;        // mesh_ = scene_mesh_ + the robot at robot_ when known
+  RobotState robot_;                      // the robot drawn in mesh_, bgr_ and robot_geometry_
   // The latest camera frame.
   bool have_frame_{false};
   cv::Mat bgr_;

@@ -199,7 +199,7 @@ TEST(ImagePipeline, ThreadedPublishesWhatInlinePublishes) {
     EXPECT_EQ(a.camera[i].pose_utime, steps[i].in.sample_utime);
     const orbed::pose_t X_WC_est = ToPose(steps[i].in.sample.X_WC_est);
     for (int k = 0; k < 3; ++k) EXPECT_EQ(a.camera[i].X_WC.position_m[k], X_WC_est.position_m[k]);
-    const cv::Mat decoded = DecodeJpeg(b.camera[i].data);
+    const cv::Mat decoded = render::DecodeJpeg(b.camera[i].data);
     EXPECT_EQ(decoded.cols, 1280);
     EXPECT_EQ(decoded.rows, 720);
   }

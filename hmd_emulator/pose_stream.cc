@@ -17,7 +17,7 @@ PoseStream::PoseStream(const HmdConfigSet& config, const sim::Scene& scene, cons
       trajectory_(config.walk),
       slam_(config.slam) {
   scene_objects_.AddSceneObjects(scene);
-  robot_geometry_.AddRobot(robot, BodyKind::kRealRobot);
+  robot_geometry_.AddRobot(robot, render::BodyKind::kRealRobot);
 }
 
 void PoseStream::ScheduleFault(double t_s, const ForcedFault& fault) { scheduled_.push_back({t_s, fault}); }
@@ -50,10 +50,10 @@ std::optional<orbed::gaze_ray_t> PoseStream::Gaze(const RobotState& robot) {
   if (!have_sample_) return std::nullopt;
   const SlamSample& s = sample_;
   const Eigen::Vector3d p_true = s.X_WH_true.translation(), d_true = s.X_WH_true.linear().col(2);
-  RayHit hit = CastRay(scene_objects_, p_true, d_true, kRealWorld, max_gaze_distance_m_);
+  RayHit hit = CastRay(scene_objects_, p_true, d_true, render::kRealWorld, max_gaze_distance_m_);
   if (robot.known()) {
     robot_geometry_.PoseRobot(0, robot.q_rad, robot.X_WR);
-    const RayHit r = CastRay(robot_geometry_, p_true, d_true, kRealWorld, max_gaze_distance_m_);
+    const RayHit r = CastRay(robot_geometry_, p_true, d_true, render::kRealWorld, max_gaze_distance_m_);
     if (r.hit && r.distance_m < hit.distance_m) hit = r;
   }
   const Eigen::Vector3d p_est = s.X_WH_est.translation(), d_est = s.X_WH_est.linear().col(2);

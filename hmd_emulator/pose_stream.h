@@ -29,7 +29,7 @@
 
 #include "hmd_emulator/hmd_config.h"
 #include "hmd_emulator/robot_state.h"
-#include "hmd_emulator/scene_geometry.h"
+#include "render/scene_geometry.h"
 #include "sim/robot_model.h"
 #include "sim/scene.h"
 
@@ -62,15 +62,15 @@ class PoseStream {
   double t_s() const { return t_s_; }
   const HeadTrajectory& trajectory() const { return trajectory_; }
   /// The scene objects (no robot), as the headset's spatial map holds them.
-  const SceneGeometry& scene_objects() const { return scene_objects_; }
+  const render::SceneGeometry& scene_objects() const { return scene_objects_; }
 
  private:
   std::string hmd_name_;
   double max_gaze_distance_m_;
   HeadTrajectory trajectory_;
   SlamModel slam_;
-  SceneGeometry scene_objects_;   // read-only after construction
-  SceneGeometry robot_geometry_;  // the real robot only, handle 0; posed per Gaze()
+  render::SceneGeometry scene_objects_;   // read-only after construction
+  render::SceneGeometry robot_geometry_;  // the real robot only, handle 0; posed per Gaze()
   bool have_sample_{false};
   SlamSample sample_;
   int64_t sample_utime_{0};

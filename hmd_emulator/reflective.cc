@@ -37,10 +37,10 @@ Eigen::Vector3d DisplayPanelPoint(const ReflectiveGeometry& g, double u_px, doub
   return g.X_WM * p_MQ;
 }
 
-Compositor::Compositor(const sim::RobotModel& robot, const OverlayStyle& style,
-                       const TessellationOptions& tessellation)
+Compositor::Compositor(const sim::RobotModel& robot, const render::OverlayStyle& style,
+                       const render::TessellationOptions& tessellation)
     : robot_(robot), style_(style), tessellation_(tessellation) {
-  handle_ = virtual_robot_.AddRobot(robot, BodyKind::kVirtualRobot);
+  handle_ = virtual_robot_.AddRobot(robot, render::BodyKind::kVirtualRobot);
 }
 
 void Compositor::Overlay(const geometry::Intrinsics& intrinsics, const Eigen::Isometry3d& X_WC,
@@ -50,10 +50,10 @@ void Compositor::Overlay(const geometry::Intrinsics& intrinsics, const Eigen::Is
     throw std::invalid_argument("compositor: q has " + std::to_string(q_rad.size()) + " entries, the robot " +
                                 std::to_string(robot_.num_joints()));
   if (!renderer_ || !SameIntrinsics(renderer_->intrinsics(), intrinsics))
-    renderer_ = std::make_unique<Renderer>(intrinsics);
+    renderer_ = std::make_unique<render::Renderer>(intrinsics);
   virtual_robot_.PoseRobot(handle_, q_rad, X_WV);
   mesh_.Clear();
-  Tessellate(virtual_robot_, kVirtualOnly, tessellation_, &mesh_);
+  render::Tessellate(virtual_robot_, render::kVirtualOnly, tessellation_, &mesh_);
   renderer_->RenderOverlay(mesh_, X_WC, style_, image, body_id);
 }
 

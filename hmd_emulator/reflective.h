@@ -48,8 +48,8 @@
 #include <opencv2/core.hpp>
 
 #include "geometry/camera_model.h"
-#include "hmd_emulator/renderer.h"
-#include "hmd_emulator/scene_geometry.h"
+#include "render/renderer.h"
+#include "render/scene_geometry.h"
 #include "sim/robot_model.h"
 
 namespace orbed::hmd {
@@ -97,8 +97,8 @@ struct ReflectiveView {
 /// Draws the virtual robot over camera frames. Holds a reference to `robot` (must outlive it).
 class Compositor {
  public:
-  explicit Compositor(const sim::RobotModel& robot, const OverlayStyle& style = {},
-                      const TessellationOptions& tessellation = {});
+  explicit Compositor(const sim::RobotModel& robot, const render::OverlayStyle& style = {},
+                      const render::TessellationOptions& tessellation = {});
 
   /// Reflective display: `frame` + the virtual robot at (frame.q_rad, X_WV) drawn with P_o of
   /// frame.X_WC_est, and the geometry for D. `body_id` (optional, CV_32S) receives the overlay's
@@ -114,19 +114,19 @@ class Compositor {
                      const Eigen::Isometry3d& X_WV, cv::Mat* out, cv::Mat* body_id = nullptr);
 
   /// The virtual robot's bodies (names "virtual/<link>"), posed at the last call.
-  const SceneGeometry& virtual_geometry() const { return virtual_robot_; }
+  const render::SceneGeometry& virtual_geometry() const { return virtual_robot_; }
 
  private:
   void Overlay(const geometry::Intrinsics& intrinsics, const Eigen::Isometry3d& X_WC,
                const Eigen::VectorXd& q_rad, const Eigen::Isometry3d& X_WV, cv::Mat* image, cv::Mat* body_id);
 
   const sim::RobotModel& robot_;
-  OverlayStyle style_;
-  TessellationOptions tessellation_;
-  SceneGeometry virtual_robot_;
+  render::OverlayStyle style_;
+  render::TessellationOptions tessellation_;
+  render::SceneGeometry virtual_robot_;
   int handle_{0};
-  Mesh mesh_;
-  std::unique_ptr<Renderer> renderer_;  // rebuilt when the intrinsics change
+  render::Mesh mesh_;
+  std::unique_ptr<render::Renderer> renderer_;  // rebuilt when the intrinsics change
 };
 
 }  // namespace orbed::hmd

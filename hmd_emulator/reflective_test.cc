@@ -13,8 +13,8 @@
 #include "base/source_paths.h"
 #include "geometry/camera_model.h"
 #include "hmd_emulator/gaze.h"
-#include "hmd_emulator/renderer.h"
-#include "hmd_emulator/scene_geometry.h"
+#include "render/renderer.h"
+#include "render/scene_geometry.h"
 #include "sim/scene.h"
 
 namespace orbed::hmd {
@@ -43,11 +43,11 @@ class ReflectiveTest : public ::testing::Test {
 
   // The frame the camera captures: the real scene from the TRUE pose; ids of the real bodies.
   CapturedFrame Capture(const Eigen::Isometry3d& X_WC_est, cv::Mat* real_ids) {
-    SceneGeometry g = SceneGeometry::MakeOperatingRoom(scene_, robot_, q_, scene_.X_WR);
+    render::SceneGeometry g = render::SceneGeometry::MakeOperatingRoom(scene_, robot_, q_, scene_.X_WR);
     real_geometry_ = g;
-    Mesh mesh;
-    Tessellate(g, kRealWorld, {}, &mesh);
-    Renderer renderer(geometry::Intrinsics::HoloLensPv());
+    render::Mesh mesh;
+    render::Tessellate(g, render::kRealWorld, {}, &mesh);
+    render::Renderer renderer(geometry::Intrinsics::HoloLensPv());
     CapturedFrame f;
     renderer.Render(mesh, X_WC_true_, &f.bgr, nullptr, real_ids);
     f.intrinsics = geometry::Intrinsics::HoloLensPv();
@@ -65,7 +65,7 @@ class ReflectiveTest : public ::testing::Test {
 
   sim::RobotModel robot_;
   sim::Scene scene_;
-  SceneGeometry real_geometry_;
+  render::SceneGeometry real_geometry_;
   Eigen::VectorXd q_;
   Eigen::Isometry3d X_WC_true_;
 };
@@ -80,7 +80,7 @@ TEST_F(ReflectiveTest, HologramLandsWhereProjectSaysWithTheEstimatedCapturePose)
   const CapturedFrame frame = Capture(X_WC_est, &real_ids);
   const Eigen::Isometry3d X_WV = scene_.X_WR;  // a perfect registration
 
-  Compositor compositor(robot_, OverlayStyle{}, TessellationOptions{24, 40, 20});
+  Compositor compositor(robot_, render::OverlayStyle{}, render::TessellationOptions{24, 40, 20});
   ReflectiveView view;
   cv::Mat holo_ids;
   compositor.ComposeReflective(frame, 1.8, X_WV, &view, &holo_ids);
@@ -90,17 +90,17 @@ TEST_F(ReflectiveTest, HologramLandsWhereProjectSaysWithTheEstimatedCapturePose)
 
   // Every virtual primitive's centre, projected with the device's belief P_o(X_WC_est), lands on a
   // hologram pixel showing the body that an analytic ray from X_WC_est through that pixel hits.
-  const SceneGeometry& holo = compositor.virtual_geometry();
+  const render::SceneGeometry& holo = compositor.virtual_geometry();
   const geometry::CameraMatrix P_est = geometry::MakeCameraMatrix(frame.intrinsics.K(), X_WC_est);
   int agree = 0, total = 0;
-  for (const Primitive& p : holo.primitives()) {
+  for (const render::Primitive& p : holo.primitives()) {
     Eigen::Vector2d uv;
     ASSERT_TRUE(geometry::Project(P_est, p.X_WG.translation(), &uv));
     const int u = static_cast<int>(std::lround(uv.x())), v = static_cast<int>(std::lround(uv.y()));
     if (u < 0 || v < 0 || u >= holo_ids.cols || v >= holo_ids.rows) continue;
     const Eigen::Vector3d ray_C((u - frame.intrinsics.cx_px) / frame.intrinsics.fx_px,
                                 (v - frame.intrinsics.cy_px) / frame.intrinsics.fy_px, 1.0);
-    const RayHit hit = CastRay(holo, X_WC_est.translation(), X_WC_est.linear() * ray_C, kVirtualOnly);
+    const RayHit hit = CastRay(holo, X_WC_est.translation(), X_WC_est.linear() * ray_C, render::kVirtualOnly);
     ASSERT_TRUE(hit.hit);
     ++total;
     if (holo_ids.at<int>(v, u) == hit.body) ++agree;

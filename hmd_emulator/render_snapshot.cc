@@ -14,8 +14,8 @@
 #include "geometry/camera_model.h"
 #include "hmd_emulator/gaze.h"
 #include "hmd_emulator/reflective.h"
-#include "hmd_emulator/renderer.h"
-#include "hmd_emulator/scene_geometry.h"
+#include "render/renderer.h"
+#include "render/scene_geometry.h"
 #include "sim/robot_model.h"
 #include "sim/scene.h"
 
@@ -36,11 +36,11 @@ void WriteSnapshots(const std::string& dir) {
   Eigen::VectorXd q_deg(7);
   q_deg << -10, 40, 0, -65, 0, 55, 0;
   const Eigen::VectorXd q = sim::DegToRad(q_deg);
-  SceneGeometry g = SceneGeometry::MakeOperatingRoom(scene, robot, q, scene.X_WR);
-  Mesh mesh;
-  Tessellate(g, kRealWorld, {}, &mesh);
+  render::SceneGeometry g = render::SceneGeometry::MakeOperatingRoom(scene, robot, q, scene.X_WR);
+  render::Mesh mesh;
+  render::Tessellate(g, render::kRealWorld, {}, &mesh);
   const geometry::Intrinsics K = geometry::Intrinsics::HoloLensPv();
-  Renderer renderer(K);
+  render::Renderer renderer(K);
 
   // 1. A camera frame from the bedside.
   cv::Mat frame;

@@ -22,8 +22,8 @@
 #include "base/source_paths.h"
 #include "hmd_emulator/gaze.h"
 #include "hmd_emulator/reflective.h"
-#include "hmd_emulator/renderer.h"
-#include "hmd_emulator/scene_geometry.h"
+#include "render/renderer.h"
+#include "render/scene_geometry.h"
 #include "sim/robot_model.h"
 #include "sim/scene.h"
 
@@ -60,20 +60,22 @@ Fixture& F() {
 }
 
 // Renders frame `i` of the walk into `bgr`; returns the triangles rasterised.
-int RenderOne(SceneGeometry* g, Mesh* mesh, Renderer* renderer, size_t i, cv::Mat* bgr) {
+int RenderOne(render::SceneGeometry* g, render::Mesh* mesh, render::Renderer* renderer, size_t i,
+              cv::Mat* bgr) {
   Fixture& f = F();
   g->PoseRobot(0, f.q_pool[i % f.q_pool.size()], f.scene.X_WR);
   mesh->Clear();
-  Tessellate(*g, kRealWorld, {}, mesh);
+  render::Tessellate(*g, render::kRealWorld, {}, mesh);
   renderer->Render(*mesh, f.cameras[i % f.cameras.size()], bgr);
   return renderer->last_triangle_count();
 }
 
 void BM_RenderFrame(benchmark::State& state) {
   Fixture& f = F();
-  SceneGeometry g = SceneGeometry::MakeOperatingRoom(f.scene, f.robot, f.q_pool[0], f.scene.X_WR);
-  Mesh mesh;
-  Renderer renderer(geometry::Intrinsics::HoloLensPv());
+  render::SceneGeometry g =
+      render::SceneGeometry::MakeOperatingRoom(f.scene, f.robot, f.q_pool[0], f.scene.X_WR);
+  render::Mesh mesh;
+  render::Renderer renderer(geometry::Intrinsics::HoloLensPv());
   cv::Mat bgr;
   size_t i = 0;
   double triangles = 0;
@@ -87,14 +89,15 @@ BENCHMARK(BM_RenderFrame)->Unit(benchmark::kMillisecond);
 
 void BM_JpegEncode(benchmark::State& state) {
   Fixture& f = F();
-  SceneGeometry g = SceneGeometry::MakeOperatingRoom(f.scene, f.robot, f.q_pool[0], f.scene.X_WR);
-  Mesh mesh;
-  Renderer renderer(geometry::Intrinsics::HoloLensPv());
+  render::SceneGeometry g =
+      render::SceneGeometry::MakeOperatingRoom(f.scene, f.robot, f.q_pool[0], f.scene.X_WR);
+  render::Mesh mesh;
+  render::Renderer renderer(geometry::Intrinsics::HoloLensPv());
   cv::Mat bgr;
   RenderOne(&g, &mesh, &renderer, 3, &bgr);
   std::vector<std::uint8_t> jpeg;
   for (auto _ : state) {
-    EncodeJpeg(bgr, 85, &jpeg);
+    render::EncodeJpeg(bgr, 85, &jpeg);
     benchmark::DoNotOptimize(jpeg.data());
   }
   state.counters["jpeg_kB"] = jpeg.size() / 1000.0;
@@ -103,16 +106,17 @@ BENCHMARK(BM_JpegEncode)->Unit(benchmark::kMillisecond);
 
 void BM_RenderAndJpeg(benchmark::State& state) {
   Fixture& f = F();
-  SceneGeometry g = SceneGeometry::MakeOperatingRoom(f.scene, f.robot, f.q_pool[0], f.scene.X_WR);
-  Mesh mesh;
-  Renderer renderer(geometry::Intrinsics::HoloLensPv());
+  render::SceneGeometry g =
+      render::SceneGeometry::MakeOperatingRoom(f.scene, f.robot, f.q_pool[0], f.scene.X_WR);
+  render::Mesh mesh;
+  render::Renderer renderer(geometry::Intrinsics::HoloLensPv());
   cv::Mat bgr;
   std::vector<std::uint8_t> jpeg;
   size_t i = 0;
   double bytes = 0;
   for (auto _ : state) {
     RenderOne(&g, &mesh, &renderer, i++, &bgr);
-    EncodeJpeg(bgr, 85, &jpeg);
+    render::EncodeJpeg(bgr, 85, &jpeg);
     bytes += jpeg.size();
     benchmark::DoNotOptimize(jpeg.data());
   }
@@ -122,9 +126,10 @@ BENCHMARK(BM_RenderAndJpeg)->Unit(benchmark::kMillisecond);
 
 void BM_ReflectiveCompose(benchmark::State& state) {
   Fixture& f = F();
-  SceneGeometry g = SceneGeometry::MakeOperatingRoom(f.scene, f.robot, f.q_pool[0], f.scene.X_WR);
-  Mesh mesh;
-  Renderer renderer(geometry::Intrinsics::HoloLensPv());
+  render::SceneGeometry g =
+      render::SceneGeometry::MakeOperatingRoom(f.scene, f.robot, f.q_pool[0], f.scene.X_WR);
+  render::Mesh mesh;
+  render::Renderer renderer(geometry::Intrinsics::HoloLensPv());
   // A few captured frames, each with a slightly wrong capture-pose estimate.
   std::vector<CapturedFrame> frames;
   for (size_t k = 0; k < 8; ++k) {
@@ -150,7 +155,8 @@ BENCHMARK(BM_ReflectiveCompose)->Unit(benchmark::kMillisecond);
 
 void BM_GazeRay(benchmark::State& state) {
   Fixture& f = F();
-  SceneGeometry g = SceneGeometry::MakeOperatingRoom(f.scene, f.robot, f.q_pool[0], f.scene.X_WR);
+  render::SceneGeometry g =
+      render::SceneGeometry::MakeOperatingRoom(f.scene, f.robot, f.q_pool[0], f.scene.X_WR);
   size_t i = 0;
   for (auto _ : state) {
     const Eigen::Isometry3d& X_WC = f.cameras[i++ % f.cameras.size()];

@@ -25,9 +25,9 @@
 #include <opencv2/core.hpp>
 
 #include "geometry/camera_model.h"
-#include "hmd_emulator/scene_geometry.h"
+#include "render/scene_geometry.h"
 
-namespace orbed::hmd {
+namespace orbed::render {
 
 struct RenderOptions {
   ColorBgr background_top{72, 66, 62};  ///< vertical gradient behind everything (walls)
@@ -94,4 +94,4 @@ bool EncodeJpeg(const cv::Mat& image, int quality, std::vector<std::uint8_t>* by
 /// Decodes JPEG bytes to BGR; empty Mat on failure.
 cv::Mat DecodeJpeg(const std::vector<std::uint8_t>& bytes);
 
-}  // namespace orbed::hmd
+}  // namespace orbed::render

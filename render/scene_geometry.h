@@ -24,7 +24,7 @@
 #include "sim/robot_model.h"
 #include "sim/scene.h"
 
-namespace orbed::hmd {
+namespace orbed::render {
 
 /// 8-bit colour in OpenCV's channel order (blue, green, red).
 struct ColorBgr {
@@ -136,4 +136,4 @@ void Tessellate(const SceneGeometry& geometry, KindMask kinds, const Tessellatio
 void TessellatePrimitive(const Primitive& primitive, int body, ColorBgr color,
                          const TessellationOptions& options, Mesh* mesh);
 
-}  // namespace orbed::hmd
+}  // namespace orbed::render

@@ -1,7 +1,7 @@
 // Renderer oracles: analytic silhouette areas (convex hull of hand-projected box corners), depth of
 // a fronto-parallel face, z-order of overlapping bodies, the principal point, near-plane clipping
 // of a floor, the hologram overlay and JPEG coding; plus the OR scene renders with every link shown.
-#include "hmd_emulator/renderer.h"
+#include "render/renderer.h"
 
 #include <algorithm>
 #include <cmath>
@@ -13,11 +13,11 @@
 #include <gtest/gtest.h>
 
 #include "base/source_paths.h"
-#include "hmd_emulator/scene_geometry.h"
+#include "render/scene_geometry.h"
 #include "sim/robot_model.h"
 #include "sim/scene.h"
 
-namespace orbed::hmd {
+namespace orbed::render {
 namespace {
 
 Primitive Box(const Eigen::Vector3d& size, const Eigen::Isometry3d& X_WG) {
@@ -296,4 +296,4 @@ TEST(Renderer, JpegRoundTripIsSmallAndFaithful) {
 }
 
 }  // namespace
-}  // namespace orbed::hmd
+}  // namespace orbed::render

@@ -1,4 +1,4 @@
-#include "hmd_emulator/scene_geometry.h"
+#include "render/scene_geometry.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +7,7 @@
 
 #include "base/units.h"
 
-namespace orbed::hmd {
+namespace orbed::render {
 namespace {
 
 // Muted OR colours for scene objects (BGR), cycled by object index.
@@ -279,4 +279,4 @@ void Tessellate(const SceneGeometry& geometry, KindMask kinds, const Tessellatio
   }
 }
 
-}  // namespace orbed::hmd
+}  // namespace orbed::render

@@ -1,4 +1,4 @@
-#include "hmd_emulator/renderer.h"
+#include "render/renderer.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +7,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 
-namespace orbed::hmd {
+namespace orbed::render {
 
 // Where Draw() writes: the colour image, the 1/z buffer and (optionally) the body-id image.
 struct Renderer::Target {
@@ -271,4 +271,4 @@ cv::Mat DecodeJpeg(const std::vector<std::uint8_t>& bytes) {
   }
 }
 
-}  // namespace orbed::hmd
+}  // namespace orbed::render
