@@ -13,25 +13,6 @@ namespace {
 
 bool SamePose(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) { return a.matrix() == b.matrix(); }
 
-orbed::image_t JpegImage(const std::vector<std::uint8_t>& jpeg, const geometry::Intrinsics& K, int64_t utime,
-                         const Eigen::Isometry3d& X_WC_est, int64_t pose_utime) {
-  orbed::image_t img{};
-  img.utime = utime;
-  img.width = K.width_px;
-  img.height = K.height_px;
-  img.row_stride = 0;
-  img.pixel_format = orbed::image_t::FORMAT_JPEG;
-  img.fx_px = K.fx_px;
-  img.fy_px = K.fy_px;
-  img.cx_px = K.cx_px;
-  img.cy_px = K.cy_px;
-  img.X_WC = ToPose(X_WC_est);
-  img.pose_utime = pose_utime;
-  img.num_bytes = static_cast<int32_t>(jpeg.size());
-  img.data = jpeg;
-  return img;
-}
-
 void Encode(const cv::Mat& bgr, int quality, std::vector<std::uint8_t>* jpeg) {
   if (!render::EncodeJpeg(bgr, quality, jpeg)) throw std::runtime_error("JPEG encoding failed");
 }
@@ -222,8 +203,8 @@ void ImagePipeline::Camera(const FrameInputs& in) {
   frame_X_WC_est_ = in.sample.X_WC_est;
   frame_utime_ = in.sample_utime;
   if (outputs_.camera) {
-    outputs_.camera(
-        JpegImage(jpeg_, renderer_.intrinsics(), in.sample_utime, in.sample.X_WC_est, in.sample_utime));
+    outputs_.camera(JpegImageMessage(jpeg_, renderer_.intrinsics(), in.sample_utime, in.sample.X_WC_est,
+                                     in.sample_utime));
   }
 
   std::vector<int> now;
@@ -267,7 +248,7 @@ void ImagePipeline::Reflective(const FrameInputs& in) {
     orbed::reflective_view_t msg{};
     msg.utime = clocks_.wall_utime();
     msg.display_id = static_cast<int32_t>(i);
-    msg.image = JpegImage(d.jpeg, d.frame.intrinsics, d.frame.utime, d.frame.X_WC_est, d.frame.utime);
+    msg.image = JpegImageMessage(d.jpeg, d.frame.intrinsics, d.frame.utime, d.frame.X_WC_est, d.frame.utime);
     FromMatrix3(d.geometry.K_m, msg.K_m);
     msg.X_WM = ToPose(d.geometry.X_WM);
     msg.distance_m = d.geometry.distance_m;
@@ -295,7 +276,7 @@ void ImagePipeline::ArView(const FrameInputs& in, bool publish) {
   Encode(ar, options_.jpeg_quality, &ar_jpeg_);
   if (outputs_.ar_view) {
     outputs_.ar_view(
-        JpegImage(ar_jpeg_, renderer_.intrinsics(), frame_utime_, frame_X_WC_est_, frame_utime_));
+        JpegImageMessage(ar_jpeg_, renderer_.intrinsics(), frame_utime_, frame_X_WC_est_, frame_utime_));
   }
 }
 

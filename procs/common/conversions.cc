@@ -64,4 +64,23 @@ int64_t NowMicros() {
       .count();
 }
 
+orbed::image_t JpegImageMessage(const std::vector<std::uint8_t>& jpeg, const geometry::Intrinsics& K,
+                                int64_t utime, const Eigen::Isometry3d& X_WC, int64_t pose_utime) {
+  orbed::image_t img{};
+  img.utime = utime;
+  img.width = K.width_px;
+  img.height = K.height_px;
+  img.row_stride = 0;
+  img.pixel_format = orbed::image_t::FORMAT_JPEG;
+  img.fx_px = K.fx_px;
+  img.fy_px = K.fy_px;
+  img.cx_px = K.cx_px;
+  img.cy_px = K.cy_px;
+  img.X_WC = ToPose(X_WC);
+  img.pose_utime = pose_utime;
+  img.num_bytes = static_cast<int32_t>(jpeg.size());
+  img.data = jpeg;
+  return img;
+}
+
 }  // namespace orbed

@@ -6,10 +6,14 @@
 /// anything that came off the bus.
 
 #include <array>
+#include <cstdint>
 #include <vector>
 
 #include <Eigen/Geometry>
+#include <orbed/image_t.hpp>
 #include <orbed/pose_t.hpp>
+
+#include "geometry/camera_model.h"
 
 namespace orbed {
 
@@ -28,6 +32,11 @@ void FromMatrix3(const Eigen::Matrix3d& m, double out[3][3]);
 
 Eigen::VectorXd ToVectorX(const std::vector<double>& v);
 std::vector<double> FromVectorX(const Eigen::VectorXd& v);
+
+/// An image_t of JPEG bytes with the camera's intrinsics K, its pose X_WC (what the publisher knows:
+/// the headset's SLAM estimate, a rendering camera's truth) and the times of capture and of the pose.
+orbed::image_t JpegImageMessage(const std::vector<std::uint8_t>& jpeg, const geometry::Intrinsics& K,
+                                int64_t utime, const Eigen::Isometry3d& X_WC, int64_t pose_utime);
 
 /// Wall clock in microseconds since the Unix epoch (the utime of most messages).
 int64_t NowMicros();
