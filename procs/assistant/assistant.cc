@@ -184,7 +184,7 @@ std::vector<Eigen::Vector3d> Assistant::PerceiveTarget(int joint, const Eigen::V
   const Eigen::Vector3d p_WR = view.X_WR.translation();
   for (const Feature& f : FeaturesWithPivot(joint)) {
     const Eigen::Vector3d p = view.X_WR * (X_RL[f.link] * f.p_L);
-    seen.push_back(Perturb(p_WR + k * (R_turn * (p - p_WR)), config_.monitor_camera_m,
+    seen.push_back(Perturb(p_WR + k * (R_turn * (p - p_WR)), view.p_WD.value_or(config_.monitor_camera_m),
                            scale_ * config_.picture_noise_arcmin * kArcminToRad,
                            scale_ * config_.picture_depth_fraction_std, &rng_));
   }
@@ -268,7 +268,7 @@ double Assistant::TravelTime_s(double delta_rad) const {
 
 double Assistant::MonitorDisparityDeg(const Viewing& view) const {
   const Eigen::Vector3d p_WR = view.X_WR.translation();
-  Eigen::Vector2d a = (config_.monitor_camera_m - p_WR).head<2>();
+  Eigen::Vector2d a = (view.p_WD.value_or(config_.monitor_camera_m) - p_WR).head<2>();
   Eigen::Vector2d b = (view.p_WE - p_WR).head<2>();
   if (a.norm() < 1e-9 || b.norm() < 1e-9) return 0;
   const double cos_angle = std::clamp(a.normalized().dot(b.normalized()), -1.0, 1.0);

@@ -23,7 +23,8 @@
 ///    the SLAM error at that moment: user_model.h's A · X_WV), perceived from the eye p_WE with
 ///    lateral noise ρ·σ_lat (two components across the line of sight, ρ the distance) and depth
 ///    noise ρ·σ_depth along it, per point and look;
-///  - on the fixed monitor (MODE_FIXED_DISPLAY): as a picture rendered from the monitor's camera p_WD, which
+///  - on the fixed monitor (MODE_FIXED_DISPLAY): as a picture rendered from the monitor's camera p_WD
+///    (FIXED_VIEW's camera when orbed-fixed-display publishes one, else `monitor.camera_m`), which
 ///    the person must turn into their own view: a mental rotation about the vertical through the
 ///    base by δψ ~ N(0, σ_rot) and a scale k = exp(N(0, σ_scale)) about the base, per look, then
 ///    per-point noise ρ_D·σ_pic across and ρ_D·σ_pic_depth along the monitor camera's rays (a
@@ -54,6 +55,7 @@
 /// Threading: an Assistant is a value with its own random stream; one thread uses it.
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -108,6 +110,9 @@ struct Viewing {
   Eigen::Isometry3d X_WR{Eigen::Isometry3d::Identity()};       ///< the real base (truth)
   Eigen::Isometry3d X_WV_seen{Eigen::Isometry3d::Identity()};  ///< headset modes: the hologram's base
   Eigen::Vector3d p_WE{Eigen::Vector3d::Zero()};               ///< the eye
+  /// The fixed monitor's camera p_WD as FIXED_VIEW shows it (orbed-fixed-display: the view a user
+  /// turned); none: the config's monitor_camera_m.
+  std::optional<Eigen::Vector3d> p_WD;
 };
 
 /// One look at a joint and the hand's move.

@@ -9,6 +9,7 @@
 #include <orbed/hmd_pose_t.hpp>
 #include <orbed/iiwa_command_t.hpp>
 #include <orbed/iiwa_status_t.hpp>
+#include <orbed/image_t.hpp>
 #include <orbed/registration_t.hpp>
 #include <orbed/robot_state_t.hpp>
 
@@ -129,6 +130,19 @@ AssistantProcess::AssistantProcess(const CommonFlags& flags, const AssistantOpti
       }
     };
   };
+  process_.Subscribe<orbed::image_t>(
+      options_.fixed_view_channel, [this](const orbed::image_t& msg, const std::string& channel, int64_t) {
+        std::string problem = CheckImage(msg);
+        if (problem.empty()) problem = CheckPose(msg.X_WC, "FIXED_VIEW.X_WC");
+        if (!problem.empty()) return process_.Reject(channel + "/field", problem);
+        const Eigen::Vector3d p_WD = FromPose(msg.X_WC).translation();
+        if (!p_WD_ || (p_WD - *p_WD_).norm() > 1e-6) {
+          ORBED_LOG(kInfo) << "assistant: the monitor's camera is at (" << Fixed(p_WD.x(), 2) << ", "
+                           << Fixed(p_WD.y(), 2) << ", " << Fixed(p_WD.z(), 2) << ") m (" << channel << ")";
+        }
+        p_WD_ = p_WD;
+        p_WD_received_s_ = SteadySeconds();
+      });
   process_.Subscribe<orbed::hmd_pose_t>(options_.hmd_pose_channel, on_pose(false));
   process_.Subscribe<orbed::hmd_pose_t>(options_.hmd_pose_truth_channel, on_pose(true));
   process_.Subscribe<orbed::setup_task_t>(
@@ -162,6 +176,7 @@ Viewing AssistantProcess::CurrentView() const {
   view.X_WR = *X_WR_;
   view.X_WV_seen = (A_ ? *A_ : Eigen::Isometry3d::Identity()) * (X_WV_ ? *X_WV_ : *X_WR_);
   view.p_WE = p_WE_ ? *p_WE_ : assistant_.config().eye_position_m;
+  if (p_WD_ && SteadySeconds() - p_WD_received_s_ <= options_.fixed_view_stale_s) view.p_WD = p_WD_;
   return view;
 }
 
@@ -338,6 +353,7 @@ int RunAssistant(int argc, const char* const* argv, std::ostream& out, std::ostr
   app.add_option("--iiwa-command-channel", options.iiwa_command_channel)->capture_default_str();
   app.add_option("--setup-task-channel", options.setup_task_channel)->capture_default_str();
   app.add_option("--setup-result-channel", options.setup_result_channel)->capture_default_str();
+  app.add_option("--fixed-view-channel", options.fixed_view_channel)->capture_default_str();
   if (const auto code = ParseCommandLine(&app, common, argc, argv, out, err)) return *code;
   if (seed_flag->count() > 0) options.seed = seed;
   try {

@@ -10,7 +10,9 @@
 ///               sim/iiwa_status_check.h), ROBOT_STATE (the true X_WR and the motion state),
 ///               REGISTRATION (headset modes: the latest valid X_WV_mean is where the hologram is
 ///               drawn), HMD_POSE and HMD_POSE_TRUTH (optional: the pair of one seq gives the eye,
-///               and the SLAM error A = X_WH_true · X_WH_est⁻¹ that moves the hologram in the world).
+///               and the SLAM error A = X_WH_true · X_WH_est⁻¹ that moves the hologram in the world),
+///               FIXED_VIEW (optional, orbed-fixed-display: the monitor's camera position is its X_WC's,
+///               while one came within fixed_view_stale_s; else the config's monitor.camera_m).
 ///   Publishes:  IIWA_COMMAND (the measured q with the joint being moved set to where the person
 ///               puts it; re-sent every command_resend_s until the arm is there and at rest, or
 ///               stopped by a limit or a collision: then the joint stays where the sim stopped it).
@@ -72,6 +74,8 @@ struct AssistantOptions {
   std::string iiwa_command_channel{"IIWA_COMMAND"};
   std::string setup_task_channel{"SETUP_TASK"};
   std::string setup_result_channel{"SETUP_RESULT"};
+  std::string fixed_view_channel{"FIXED_VIEW"};
+  double fixed_view_stale_s{2.0};
 };
 
 /// What a finished set-up reports (also the result file's content).
@@ -118,6 +122,8 @@ class AssistantProcess {
   std::optional<std::pair<int64_t, Eigen::Isometry3d>> X_WH_est_, X_WH_true_;  // (seq, pose)
   std::optional<Eigen::Isometry3d> A_;   // X_WH_true · X_WH_est⁻¹ of the latest matching pair
   std::optional<Eigen::Vector3d> p_WE_;  // the true head position of that pair
+  std::optional<Eigen::Vector3d> p_WD_;  // FIXED_VIEW's camera position
+  double p_WD_received_s_{0};            // SteadySeconds() when it came
 
   // The run.
   Phase phase_{Phase::kIdle};

@@ -210,6 +210,24 @@ TEST(Assistant, TimesInClosedForm) {
   EXPECT_NEAR(look.q_rad * kRadToDeg, 20.0, 0.5);  // no mental rotation error: the picture is right
 }
 
+// FIXED_VIEW's camera (a view the user turned) replaces the config's: a picture taken from the
+// person's own side needs no mental rotation, one from the opposite side half a turn.
+TEST(Assistant, TheMonitorsCameraFromTheBusSetsTheMentalRotation) {
+  const sim::RobotModel model = Model();
+  AssistantConfig c = Perfect();
+  c.monitor_camera_m = Eigen::Vector3d(0, 2, 1.5);
+  Assistant a(model, c);
+  Viewing view = Overlay(Eigen::Isometry3d::Identity());
+  view.mode = orbed::guidance_t::MODE_FIXED_DISPLAY;
+  view.p_WE = Eigen::Vector3d(3, 0, 1.7);
+  view.p_WD = Eigen::Vector3d(2, 0, 2.5);  // beside the eye
+  EXPECT_NEAR(a.MonitorDisparityDeg(view), 0.0, 1e-9);
+  EXPECT_NEAR(a.Look(1, Deg({0, 0, 0, 0, 0, 0, 0}), Deg({0, 20, 0, 0, 0, 0, 0}), view, kInf).time_s, c.look_s,
+              1e-9);
+  view.p_WD = Eigen::Vector3d(-2, 0, 2.5);  // facing the person across the robot
+  EXPECT_NEAR(a.MonitorDisparityDeg(view), 180.0, 1e-9);
+}
+
 // The same seed is the same person making the same choices.
 TEST(Assistant, ASeedIsAPerson) {
   const sim::RobotModel model = Model();

@@ -30,6 +30,7 @@ inline constexpr char kSetupResult[] = "SETUP_RESULT";                  // setup
 inline constexpr char kProcessStatus[] = "PROCESS_STATUS";              // process_status_t, 1 Hz each
 inline constexpr char kLoggerStatus[] = "LOGGER_STATUS";                // logger_status_t, 1 Hz
 inline constexpr char kIgtlTarget[] = "IGTL_TARGET";                    // target_pose_t, orbed-igtl-bridge
+inline constexpr char kFixedView[] = "FIXED_VIEW";                      // image_t (JPEG), orbed-fixed-display
 
 /// Every channel above (tools that address channels by index: the fuzz targets and their corpora;
 /// new channels are appended so that the indices of the old ones stay).
@@ -38,6 +39,7 @@ inline constexpr const char* kAllChannels[] = {
     kPlanCheckReply,  kHmdPose,        kHmdPoseTruth,        kHmdCamera,       kArView,
     kGazeRay,         kReflectiveView, kAlignmentTrial,      kRegistration,    kSessionControl,
     kLandmarkRequest, kLandmark,       kMisalignmentRequest, kMisalignment,    kGuidance,
-    kProcessStatus,   kLoggerStatus,   kSetupTask,           kSetupResult,     kIgtlTarget};
+    kProcessStatus,   kLoggerStatus,   kSetupTask,           kSetupResult,     kIgtlTarget,
+    kFixedView};
 
 }  // namespace orbed::channels

@@ -73,6 +73,13 @@ FoxgloveBridge::FoxgloveBridge(const CommonFlags& flags, const BridgeOptions& op
           return process_.Reject(channel + "/field", "display_id outside 0..999");
         on_image(msg.image, kReflective, "reflective_" + std::to_string(msg.display_id), channel);
       });
+  process_.Subscribe<orbed::image_t>(
+      channels::kFixedView, [this, on_image](const orbed::image_t& msg, const std::string& channel, int64_t) {
+        const std::string problem = CheckPose(msg.X_WC, "FIXED_VIEW.X_WC");
+        if (!problem.empty()) return process_.Reject(channel + "/pose", problem);
+        X_WD_ = FromPose(msg.X_WC);
+        on_image(msg, kFixedView, "D", channel);
+      });
   process_.AddTimer(
       1.0 / options_.rate_hz,
       [this] {
@@ -81,6 +88,7 @@ FoxgloveBridge::FoxgloveBridge(const CommonFlags& flags, const BridgeOptions& op
             RobotFrames(model_, *poses_.X_WR(), poses_.q(), poses_.X_WV(), poses_.q_virtual());
         if (poses_.X_WH()) frames.push_back({"W", "H", *poses_.X_WH()});
         if (poses_.X_WC()) frames.push_back({"W", "C", *poses_.X_WC()});
+        if (X_WD_) frames.push_back({"W", "D", *X_WD_});
         const int64_t now = NowMicros();
         Send(kTf, now, FrameTransforms(frames, now).dump());
       },
@@ -96,9 +104,9 @@ FoxgloveBridge::FoxgloveBridge(const CommonFlags& flags, const BridgeOptions& op
       "foxglove/scene");
   process_.AddTimer(
       options_.poll_period_s, [this] { server_.Poll(); }, "foxglove/poll");
-  ORBED_LOG(kInfo)
-      << "foxglove bridge: ws://" << options_.server.bind_address << ":" << server_.port()
-      << " (foxglove.websocket.v1: /tf, /scene, /hmd/camera, /reflective, /registration, /guidance)";
+  ORBED_LOG(kInfo) << "foxglove bridge: ws://" << options_.server.bind_address << ":" << server_.port()
+                   << " (foxglove.websocket.v1: /tf, /scene, /hmd/camera, /reflective, /registration, "
+                      "/guidance, /fixed_view)";
 }
 
 void FoxgloveBridge::SendRegistration(const orbed::registration_t& msg) {

@@ -6,10 +6,10 @@
 ///
 ///   Subscribes: ROBOT_STATE, REGISTRATION, GUIDANCE and HMD_POSE through sim/testbed_poses.h (X_WR
 ///               and q, the latest valid X_WV_mean, the guidance target as the virtual robot's
-///               configuration, X_WH and X_WC); HMD_CAMERA and REFLECTIVE_VIEW (CheckImage; JPEG
-///               passed on as sent).
+///               configuration, X_WH and X_WC); HMD_CAMERA, REFLECTIVE_VIEW and FIXED_VIEW (CheckImage;
+///               JPEG passed on as sent; FIXED_VIEW's X_WC is the monitor camera's frame D on /tf).
 ///   Sends:      /tf at rate_hz from the first good ROBOT_STATE; /scene every scene_period_s;
-///               /hmd/camera and /reflective at most image_hz per source; /registration and
+///               /hmd/camera, /reflective and /fixed_view at most image_hz per source; /registration and
 ///               /guidance as they come (at most rate_hz for the guidance). Nothing is encoded for a
 ///               channel nobody subscribed to.
 ///
@@ -65,6 +65,7 @@ class FoxgloveBridge {
   FoxgloveServer server_;
   sim::TestbedPoses poses_;
   std::map<std::string, int64_t> last_sent_us_;
+  std::optional<Eigen::Isometry3d> X_WD_;  // the fixed monitor's camera (FIXED_VIEW)
 };
 
 /// orbed-foxglove-bridge's command line (--help). Exit 0; 2 or CLI11's usage code on bad arguments;

@@ -26,14 +26,15 @@ namespace {
 
 using json = nlohmann::json;
 
-TEST(FoxgloveMessages, AdvertisesSixChannelsWithSchemas) {
+TEST(FoxgloveMessages, AdvertisesSevenChannelsWithSchemas) {
   const json a = Advertise();
   EXPECT_EQ(a["op"], "advertise");
-  ASSERT_EQ(a["channels"].size(), 6u);
+  ASSERT_EQ(a["channels"].size(), 7u);
   const std::vector<std::pair<std::string, std::string>> expected = {
       {"/tf", "foxglove.FrameTransforms"},         {"/scene", "foxglove.SceneUpdate"},
       {"/hmd/camera", "foxglove.CompressedImage"}, {"/reflective", "foxglove.CompressedImage"},
-      {"/registration", "orbed.Registration"},     {"/guidance", "orbed.Guidance"}};
+      {"/registration", "orbed.Registration"},     {"/guidance", "orbed.Guidance"},
+      {"/fixed_view", "foxglove.CompressedImage"}};
   for (size_t i = 0; i < expected.size(); ++i) {
     const json& c = a["channels"][i];
     EXPECT_EQ(c["id"], i + 1);

@@ -137,15 +137,16 @@ json Advertise() {
                                 {"error_deg", ArrayOf(Number())},
                                 {"next_joint", Number()},
                                 {"done", {{"type", "boolean"}}}});
-  return {
-      {"op", "advertise"},
-      {"channels",
-       json::array({Channel(kTf, "/tf", "foxglove.FrameTransforms", FrameTransformsSchema()),
-                    Channel(kScene, "/scene", "foxglove.SceneUpdate", SceneUpdateSchema()),
-                    Channel(kCamera, "/hmd/camera", "foxglove.CompressedImage", CompressedImageSchema()),
-                    Channel(kReflective, "/reflective", "foxglove.CompressedImage", CompressedImageSchema()),
-                    Channel(kRegistration, "/registration", "orbed.Registration", registration),
-                    Channel(kGuidance, "/guidance", "orbed.Guidance", guidance)})}};
+  return {{"op", "advertise"},
+          {"channels",
+           json::array(
+               {Channel(kTf, "/tf", "foxglove.FrameTransforms", FrameTransformsSchema()),
+                Channel(kScene, "/scene", "foxglove.SceneUpdate", SceneUpdateSchema()),
+                Channel(kCamera, "/hmd/camera", "foxglove.CompressedImage", CompressedImageSchema()),
+                Channel(kReflective, "/reflective", "foxglove.CompressedImage", CompressedImageSchema()),
+                Channel(kRegistration, "/registration", "orbed.Registration", registration),
+                Channel(kGuidance, "/guidance", "orbed.Guidance", guidance),
+                Channel(kFixedView, "/fixed_view", "foxglove.CompressedImage", CompressedImageSchema())})}};
 }
 
 std::vector<Frame> RobotFrames(const sim::RobotModel& model, const Eigen::Isometry3d& X_WR,

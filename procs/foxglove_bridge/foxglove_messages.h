@@ -36,6 +36,7 @@ enum ChannelId : uint32_t {
   kReflective = 4,    ///< /reflective   foxglove.CompressedImage (every display; frame reflective_<id>)
   kRegistration = 5,  ///< /registration orbed.Registration (JSON)
   kGuidance = 6,      ///< /guidance     orbed.Guidance (JSON)
+  kFixedView = 7,     ///< /fixed_view   foxglove.CompressedImage (FIXED_VIEW: the fixed monitor, frame D)
 };
 
 /// {"op":"serverInfo",...} and {"op":"advertise",...}: what a client receives on connecting.

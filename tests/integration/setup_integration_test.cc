@@ -28,12 +28,16 @@
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 #include <lcm/lcm-cpp.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <orbed/iiwa_status_t.hpp>
+#include <orbed/image_t.hpp>
 #include <orbed/registration_t.hpp>
 #include <orbed/robot_state_t.hpp>
 #include <orbed/setup_task_t.hpp>
 
 #include "base/units.h"
+#include "procs/logger/event_log_reader.h"
+#include "procs/logger/manifest.h"
 #include "procs/setup/setup_process.h"
 #include "sim/guidance_messages.h"
 #include "tests/integration/testbed_util.h"
@@ -171,9 +175,33 @@ TEST(SetupStudy, OneUserThroughTheLaunchFile) {
   }
   const YAML::Node manifest = YAML::LoadFile(log_dir + "/manifest.json");
   EXPECT_TRUE(manifest["complete"].as<bool>());
-  for (const char* channel : {"SETUP_TASK", "SETUP_RESULT", "GUIDANCE", "IIWA_COMMAND", "ALIGNMENT_TRIAL"}) {
+  for (const char* channel :
+       {"SETUP_TASK", "SETUP_RESULT", "GUIDANCE", "IIWA_COMMAND", "ALIGNMENT_TRIAL", "FIXED_VIEW"}) {
     EXPECT_TRUE(manifest["channels"][channel]) << channel << " missing from the log";
   }
+  // The fixed mode's monitor: pictures from the assistant's monitor camera (assistant.yaml's
+  // monitor.camera_m, orbed-fixed-display's home view), each a whole JPEG of the announced size.
+  const logger::Manifest parts = logger::ReadManifestFile(log_dir + "/manifest.json");
+  int pictures = 0;
+  for (const logger::ManifestPart& part : parts.parts) {
+    const logger::MappedLog log(log_dir + "/" + part.file);
+    ASSERT_TRUE(log.ok()) << log.error();
+    logger::EventLogScanner scanner = log.Scanner();
+    logger::LogEvent event;
+    while (scanner.Next(&event)) {
+      if (event.channel != "FIXED_VIEW") continue;
+      orbed::image_t image;
+      ASSERT_EQ(image.decode(event.data, 0, static_cast<int>(event.size)), static_cast<int>(event.size));
+      EXPECT_NEAR(image.X_WC.position_m[0], 1.5, 1e-9);
+      EXPECT_NEAR(image.X_WC.position_m[1], 0.3, 1e-9);
+      EXPECT_NEAR(image.X_WC.position_m[2], 1.8, 1e-9);
+      const cv::Mat picture = cv::imdecode(image.data, cv::IMREAD_COLOR);
+      EXPECT_EQ(picture.cols, image.width);
+      EXPECT_EQ(picture.rows, image.height);
+      ++pictures;
+    }
+  }
+  EXPECT_GT(pictures, 0);
 }
 
 int LatestPid(const BusWatcher& bus, const std::string& name) {
