@@ -190,6 +190,18 @@ TEST(FoxgloveServer, SubprotocolServerInfoSubscriptions) {
     return !events.empty() && events.back().kind == ServerEvent::kRefused &&
            events.back().detail.find("client message") != std::string::npos;
   }));
+  // Every advertised channel can be subscribed to (the last one too); the next id is no channel.
+  const json advertised = Advertise()["channels"];
+  const int last = advertised.back()["id"].get<int>();
+  EXPECT_EQ(last, static_cast<int>(kLastChannel));
+  client.Send(R"({"op":"subscribe","subscriptions":[{"id":43,"channelId":)" + std::to_string(last) + "}]}");
+  ASSERT_TRUE(Until(server, client, [&] { return server.HasSubscribers(kFixedView); }));
+  client.Send(R"({"op":"subscribe","subscriptions":[{"id":44,"channelId":)" + std::to_string(last + 1) +
+              "}]}");
+  ASSERT_TRUE(Until(server, client, [&] {
+    return !events.empty() && events.back().kind == ServerEvent::kRefused &&
+           events.back().detail.find("no channel " + std::to_string(last + 1)) != std::string::npos;
+  }));
 }
 
 }  // namespace

@@ -37,6 +37,7 @@ enum ChannelId : uint32_t {
   kRegistration = 5,  ///< /registration orbed.Registration (JSON)
   kGuidance = 6,      ///< /guidance     orbed.Guidance (JSON)
   kFixedView = 7,     ///< /fixed_view   foxglove.CompressedImage (FIXED_VIEW: the fixed monitor, frame D)
+  kLastChannel = kFixedView,
 };
 
 /// {"op":"serverInfo",...} and {"op":"advertise",...}: what a client receives on connecting.

@@ -43,7 +43,7 @@ struct FoxgloveServer::Impl {
     auto& subs = it->second.subscription_of_channel;
     if (request.kind == ClientRequest::kSubscribe) {
       for (const auto& [sub, channel] : request.subscribe) {
-        if (channel < kTf || channel > kGuidance) {
+        if (channel < kTf || channel > kLastChannel) {
           Refuse(h, "subscribe: no channel " + std::to_string(channel));
           continue;
         }

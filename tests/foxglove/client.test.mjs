@@ -4,9 +4,10 @@
 // JPEG on HMD_CAMERA and writes what the bus said into $ORBED_EXPECT_JSON:
 //   { "X_WR": {"translation": [x, y, z], "rotation": [x, y, z, w]},
 //     "X_R_ee": {...},                      // forward kinematics of ROBOT_STATE's joints
-//     "jpeg_path": "<the JPEG file it publishes>", "scene_object": "<name of an object of the scene>" }
-// The test subscribes to /tf, /scene and /hmd/camera and checks the frames against those values,
-// the image bytes exactly, and the scene's entities.
+//     "jpeg_path": "<the JPEG file it publishes>", "scene_object": "<name of an object of the scene>",
+//     "X_WD": {...}, "fixed_view_jpeg_path": "..." }  // optional: FIXED_VIEW's camera pose and picture
+// The test subscribes to /tf, /scene and /hmd/camera (and /fixed_view when expected) and checks the
+// frames against those values, the image bytes exactly, and the scene's entities.
 import { test } from "node:test";
 import assert from "node:assert/strict";
 import { readFileSync } from "node:fs";
@@ -17,6 +18,7 @@ const { FoxgloveClient } = wsProtocol;
 
 const expected = JSON.parse(readFileSync(process.env.ORBED_EXPECT_JSON, "utf8"));
 const url = process.env.ORBED_FOXGLOVE_URL;
+const topics = ["/tf", "/scene", "/hmd/camera"].concat(expected.fixed_view_jpeg_path ? ["/fixed_view"] : []);
 
 function assertPose(transform, pose, what) {
   const t = transform.translation, r = transform.rotation;
@@ -38,12 +40,12 @@ test("the testbed over foxglove.websocket.v1", async () => {
     client.on("serverInfo", (info) => { serverInfo = info; });
     client.on("advertise", (channels) => {
       for (const c of channels) {
-        if (["/tf", "/scene", "/hmd/camera"].includes(c.topic)) topicOf.set(client.subscribe(c.id), c.topic);
+        if (topics.includes(c.topic)) topicOf.set(client.subscribe(c.id), c.topic);
       }
     });
     client.on("message", ({ subscriptionId, data }) => {
       latest.set(topicOf.get(subscriptionId), JSON.parse(decoder.decode(data)));
-      if (latest.size === 3) {
+      if (latest.size === topics.length) {
         clearTimeout(timer);
         resolve();
       }
@@ -66,6 +68,14 @@ test("the testbed over foxglove.websocket.v1", async () => {
   assert.equal(image.format, "jpeg");
   assert.equal(image.frame_id, "C");
   assert.equal(image.data, readFileSync(expected.jpeg_path).toString("base64"));
+
+  if (expected.fixed_view_jpeg_path) {
+    assertPose(frame("W", "D"), expected.X_WD, "X_WD");
+    const picture = latest.get("/fixed_view");
+    assert.equal(picture.format, "jpeg");
+    assert.equal(picture.frame_id, "D");
+    assert.equal(picture.data, readFileSync(expected.fixed_view_jpeg_path).toString("base64"));
+  }
 
   const entities = latest.get("/scene").entities;
   assert.ok(entities.some((e) => e.id === "robot/iiwa_link_1" && e.frame_id === "iiwa_link_1" && e.frame_locked));

@@ -2,9 +2,10 @@
 // read by a client built on Foxglove's own @foxglove/ws-protocol (tests/foxglove/client.test.mjs in
 // node's test runner). This side writes what the bus says into the file the client checks against:
 // ROBOT_STATE's X_WR, the model's forward kinematics of its joints to iiwa_link_ee, the JPEG it
-// publishes on HMD_CAMERA (the client compares the image bytes exactly) and a scene object's name.
-// The client must see them on /tf, /hmd/camera and /scene and exit 0; and the same from a log
-// replayed through the bridge by LCM's lcm-logplayer.
+// publishes on HMD_CAMERA (the client compares the image bytes exactly), a scene object's name, and
+// the fixed monitor's picture and camera pose as orbed-fixed-display put them on FIXED_VIEW. The
+// client must see them on /tf, /hmd/camera, /fixed_view and /scene and exit 0; and the same
+// (without the monitor) from a log replayed through the bridge by LCM's lcm-logplayer.
 #include <fstream>
 #include <mutex>
 #include <string>
@@ -26,26 +27,34 @@
 namespace orbed::testing {
 namespace {
 
-class StateWatcher {
+// The latest message of one channel.
+template <typename Msg>
+class LatestWatcher {
  public:
-  explicit StateWatcher(BusWatcher* bus) { bus->lcm().subscribe("ROBOT_STATE", &StateWatcher::On, this); }
-  bool Latest(orbed::robot_state_t* out) const {
+  LatestWatcher(BusWatcher* bus, const std::string& channel) {
+    bus->lcm().subscribe(channel, &LatestWatcher::On, this);
+  }
+  bool Latest(Msg* out) const {
     std::lock_guard<std::mutex> lock(mutex_);
     if (!have_) return false;
-    *out = state_;
+    *out = msg_;
     return true;
   }
 
  private:
-  void On(const lcm::ReceiveBuffer*, const std::string&, const orbed::robot_state_t* msg) {
+  void On(const lcm::ReceiveBuffer*, const std::string&, const Msg* msg) {
     std::lock_guard<std::mutex> lock(mutex_);
-    state_ = *msg;
+    msg_ = *msg;
     have_ = true;
   }
   mutable std::mutex mutex_;
-  orbed::robot_state_t state_{};
+  Msg msg_{};
   bool have_{false};
 };
+
+void WriteBytes(const std::string& path, const std::vector<uint8_t>& bytes) {
+  std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), bytes.size());
+}
 
 nlohmann::json PoseJson(const Eigen::Isometry3d& X) {
   const Eigen::Quaterniond q(X.linear());
@@ -55,14 +64,22 @@ nlohmann::json PoseJson(const Eigen::Isometry3d& X) {
 
 TEST(FoxgloveBridge, FoxglovesOwnClientSeesTheTestbed) {
   BusWatcher bus;
-  StateWatcher watcher(&bus);
+  LatestWatcher<orbed::robot_state_t> watcher(&bus, "ROBOT_STATE");
+  LatestWatcher<orbed::image_t> fixed_views(&bus, "FIXED_VIEW");
   bus.Start();
   lcm::LCM publisher;
   ASSERT_TRUE(publisher.good());
   RunningProcess sim({BinPath("orbed-iiwa-sim")});
   RunningProcess bridge({BinPath("orbed-foxglove-bridge"), "--port", "8765", "--image-hz", "20"});
+  // The fixed monitor showing a target: its picture does not change while the target, the base
+  // and the view stay, so the client must receive these very bytes.
+  RunningProcess guidance(
+      {BinPath("orbed-guidance"), "--target-deg", "20,40,0,-70,10,50,0", "--mode", "fixed"});
+  RunningProcess fixed_display({BinPath("orbed-fixed-display")});
   orbed::robot_state_t state{};
   ASSERT_TRUE(WaitFor([&] { return watcher.Latest(&state); }, 30)) << "no ROBOT_STATE";
+  orbed::image_t fixed_view{};
+  ASSERT_TRUE(WaitFor([&] { return fixed_views.Latest(&fixed_view); }, 30)) << "no FIXED_VIEW";
 
   // What the bus says (the arm does not move: this state is the one the bridge sends).
   const sim::RobotModel model = sim::RobotModel::LoadFile(SourcePath("sim/models/iiwa7.urdf"));
@@ -73,11 +90,13 @@ TEST(FoxgloveBridge, FoxglovesOwnClientSeesTheTestbed) {
   const std::string dir = MakeTempDir("foxglove");
   std::vector<uint8_t> jpeg;
   cv::imencode(".jpg", cv::Mat(48, 64, CV_8UC3, cv::Scalar(30, 60, 90)), jpeg);
-  std::ofstream(dir + "/camera.jpg", std::ios::binary)
-      .write(reinterpret_cast<const char*>(jpeg.data()), jpeg.size());
+  WriteBytes(dir + "/camera.jpg", jpeg);
+  WriteBytes(dir + "/fixed_view.jpg", fixed_view.data);
   const nlohmann::json expected = {{"X_WR", PoseJson(FromPose(state.X_WR))},
                                    {"X_R_ee", PoseJson(X_R_ee)},
                                    {"jpeg_path", dir + "/camera.jpg"},
+                                   {"X_WD", PoseJson(FromPose(fixed_view.X_WC))},
+                                   {"fixed_view_jpeg_path", dir + "/fixed_view.jpg"},
                                    {"scene_object", scene.objects[0].name}};
   std::ofstream(dir + "/expected.json") << expected.dump(2);
 
@@ -126,8 +145,7 @@ TEST(FoxgloveBridge, AReplayedLogShowsTheRecordedSession) {
   const std::string dir = MakeTempDir("foxglove_replay");
   std::vector<uint8_t> jpeg;
   cv::imencode(".jpg", cv::Mat(24, 32, CV_8UC3, cv::Scalar(200, 100, 50)), jpeg);
-  std::ofstream(dir + "/camera.jpg", std::ios::binary)
-      .write(reinterpret_cast<const char*>(jpeg.data()), jpeg.size());
+  WriteBytes(dir + "/camera.jpg", jpeg);
   orbed::image_t image{};
   image.width = 32;
   image.height = 24;
