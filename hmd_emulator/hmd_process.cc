@@ -167,6 +167,8 @@ FrameInputs HmdProcess::Inputs() const {
   const HologramShown hologram = Hologram();
   in.hide_hologram = hologram.hidden;
   in.q_hologram_rad = hologram.q_rad;
+  in.hide_reflective_hologram = hologram.reflective_hidden;
+  in.q_reflective_rad = hologram.reflective_q_rad;
   in.t_s = stream_->t_s();
   return in;
 }
@@ -240,10 +242,15 @@ HmdProcess::HologramShown HmdProcess::Hologram() const {
     return shown;
   }
   if (guidance_->mode == orbed::guidance_t::MODE_FIXED_DISPLAY) {
-    shown.hidden = true;
+    shown.hidden = shown.reflective_hidden = true;
     return shown;
   }
   shown.q_rad = Eigen::Map<const Eigen::VectorXd>(guidance_->target_position.data(), guidance_->num_joints);
+  if (guidance_->mode == orbed::guidance_t::MODE_AR_REFLECTIVE) {
+    shown.reflective_q_rad = shown.q_rad;
+  } else {
+    shown.reflective_hidden = true;
+  }
   return shown;
 }
 

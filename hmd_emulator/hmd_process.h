@@ -175,9 +175,15 @@ class HmdProcess {
   /// What the hologram shows: the real arm's joints (q_rad empty) during an alignment session or
   /// when no GUIDANCE came in the last kGuidanceFreshS, else GUIDANCE's target (ar, ar_reflective)
   /// or nothing (hidden: fixed display).
+  /// What the hologram shows now. During a set-up (a GUIDANCE fresher than kGuidanceFreshS, no
+  /// alignment session): ar: AR_VIEW at the target, the displays without a hologram (the mode has
+  /// none); ar_reflective: both at the target; fixed: neither (the guidance is on the monitor).
+  /// Otherwise the real arm's joints everywhere (empty q: the joints of the frame drawn on).
   struct HologramShown {
     bool hidden{false};
     Eigen::VectorXd q_rad;
+    bool reflective_hidden{false};
+    Eigen::VectorXd reflective_q_rad;
   };
   static constexpr double kGuidanceFreshS = 1.0;
   HologramShown Hologram() const;

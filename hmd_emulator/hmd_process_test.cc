@@ -753,9 +753,9 @@ orbed::guidance_t Guidance(int8_t mode, const std::vector<double>& target_deg) {
   return g;
 }
 
-// During a set-up the hologram shows GUIDANCE's target (ar, ar_reflective) or nothing (fixed), and
-// the real arm's joints again once GUIDANCE is no longer fresh; a bad GUIDANCE is refused, counted
-// and changes nothing.
+// During a set-up the hologram shows GUIDANCE's target (ar, ar_reflective) or nothing (fixed), in
+// the reflective displays only in ar_reflective; during an alignment session the real arm's joints;
+// a bad GUIDANCE is refused, counted and changes nothing.
 TEST(HmdProcess, TheHologramShowsTheGuidancesTarget) {
   HmdProcess hmd(MemqFlags(0.05), Inline());
   lcm::LCM& lcm = hmd.process().lcm();
@@ -767,6 +767,15 @@ TEST(HmdProcess, TheHologramShowsTheGuidancesTarget) {
   Drain(lcm);
   ASSERT_EQ(hmd.Hologram().q_rad.size(), 7);
   EXPECT_NEAR(hmd.Hologram().q_rad[1], 35 * kDegToRad, 1e-12);
+  EXPECT_TRUE(hmd.Hologram().reflective_hidden);  // the ar mode has no reflective display
+  const auto reflective = Guidance(+orbed::guidance_t::MODE_AR_REFLECTIVE, target);
+  lcm.publish("GUIDANCE", &reflective);
+  Drain(lcm);
+  EXPECT_FALSE(hmd.Hologram().reflective_hidden);
+  ASSERT_EQ(hmd.Hologram().reflective_q_rad.size(), 7);
+  EXPECT_NEAR(hmd.Hologram().reflective_q_rad[3], -50 * kDegToRad, 1e-12);
+  lcm.publish("GUIDANCE", &ar);
+  Drain(lcm);
   auto bad = Guidance(+orbed::guidance_t::MODE_AR, {1, 2, 3});
   lcm.publish("GUIDANCE", &bad);
   Drain(lcm);
@@ -776,6 +785,7 @@ TEST(HmdProcess, TheHologramShowsTheGuidancesTarget) {
   lcm.publish("GUIDANCE", &fixed);
   Drain(lcm);
   EXPECT_TRUE(hmd.Hologram().hidden);
+  EXPECT_TRUE(hmd.Hologram().reflective_hidden);
   // An alignment session: the hologram is aligned at the real joints whatever the guidance says.
   const auto start = Control("align", +SC::START);
   lcm.publish("SESSION_CONTROL", &start);
@@ -783,6 +793,8 @@ TEST(HmdProcess, TheHologramShowsTheGuidancesTarget) {
   Drain(lcm);
   EXPECT_FALSE(hmd.Hologram().hidden);
   EXPECT_EQ(hmd.Hologram().q_rad.size(), 0);
+  EXPECT_FALSE(hmd.Hologram().reflective_hidden);
+  EXPECT_EQ(hmd.Hologram().reflective_q_rad.size(), 0);
 }
 
 }  // namespace

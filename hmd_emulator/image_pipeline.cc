@@ -229,11 +229,19 @@ void ImagePipeline::Reflective(const FrameInputs& in) {
   for (std::size_t i = 0; i < displays_.size(); ++i) {
     Display& d = displays_[i];
     if (!d.captured) continue;
-    if (d.composed_version != d.version || !SamePose(d.composed_X_WV, in.X_WV)) {
+    // The hologram: at the set-up's target, at the captured frame's joints, or none (no robot
+    // known at capture, or a set-up mode without a display).
+    const bool hidden = in.hide_reflective_hologram || !d.robot.known();
+    const Eigen::VectorXd& q =
+        in.q_reflective_rad.size() == d.frame.q_rad.size() ? in.q_reflective_rad : d.frame.q_rad;
+    if (d.composed_version != d.version || !SamePose(d.composed_X_WV, in.X_WV) ||
+        hidden != d.composed_hidden || (!hidden && q != d.composed_q_rad)) {
       ReflectiveView view;
-      if (d.robot.known()) {
-        compositor_.ComposeReflective(d.frame, d.D_m, in.X_WV, &view);
-      } else {  // no robot known at capture: the frame without a hologram
+      if (!hidden) {
+        CapturedFrame frame = d.frame;  // shares the pixels
+        frame.q_rad = q;
+        compositor_.ComposeReflective(frame, d.D_m, in.X_WV, &view);
+      } else {
         view.bgr = d.frame.bgr.clone();
         view.geometry = MakeReflectiveGeometry(d.frame.intrinsics, d.frame.X_WC_est, d.D_m);
       }
@@ -241,6 +249,8 @@ void ImagePipeline::Reflective(const FrameInputs& in) {
       d.geometry = view.geometry;
       d.composed_version = d.version;
       d.composed_X_WV = in.X_WV;
+      d.composed_hidden = hidden;
+      d.composed_q_rad = hidden ? Eigen::VectorXd() : q;
       std::lock_guard<std::mutex> lock(out_mutex_);
       if (reflective_latest_.size() < displays_.size()) reflective_latest_.resize(displays_.size());
       reflective_latest_[i] = view.bgr;

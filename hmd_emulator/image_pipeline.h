@@ -69,6 +69,12 @@ struct FrameInputs {
   Eigen::VectorXd q_hologram_rad;
   /// No hologram in AR_VIEW (the fixed-display mode: the guidance is on a monitor).
   bool hide_hologram{false};
+  /// The hologram's joints in the reflective displays during a set-up (GUIDANCE's target in the
+  /// ar_reflective mode); empty = the joints of the captured frame (the alignment's view).
+  Eigen::VectorXd q_reflective_rad;
+  /// The displays show their captured frame alone (a set-up in the ar and fixed modes, which have
+  /// no reflective display).
+  bool hide_reflective_hologram{false};
   double t_s{0};  ///< walk time of the sample [s]
 };
 
@@ -142,9 +148,11 @@ class ImagePipeline {
     double D_m{0};
     int64_t version{0};
     double captured_at_s{0};
-    // The composed view, cached until the frame or X_WV changes.
+    // The composed view, cached until the frame, X_WV or the hologram's joints change.
     int64_t composed_version{-1};
     Eigen::Isometry3d composed_X_WV{Eigen::Isometry3d::Identity()};
+    Eigen::VectorXd composed_q_rad;  // empty: no hologram
+    bool composed_hidden{false};
     ReflectiveGeometry geometry;
     std::vector<std::uint8_t> jpeg;
   };

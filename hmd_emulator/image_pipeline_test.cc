@@ -251,6 +251,50 @@ TEST(ImagePipeline, ReusesCapturesAndRecaptures) {
   EXPECT_EQ(p.reflective[7].source_utime, steps[6].in.sample_utime);
 }
 
+// The guidance in the reflective displays: the display's captured frame with the hologram at the
+// set-up's target (a new composition; the frame's own joints give back the alignment's picture
+// byte for byte), or with none: then it is the captured camera frame itself, the same JPEG bytes
+// as HMD_CAMERA sent at the capture.
+TEST(ImagePipeline, TheDisplaysShowTheSetUpsTargetOrNoHologram) {
+  World world;
+  const Eigen::Isometry3d X_WR = world.scene.X_WR;
+  const RobotState arm = Robot({0, 30, 0, -60, 0, 45, 0}, X_WR);
+  std::vector<orbed::image_t> camera;
+  std::vector<orbed::reflective_view_t> reflective;
+  ImagePipelineOptions options;
+  options.display_capture_t_s = {0.0};
+  options.threaded = false;
+  ImagePipelineOutputs outputs;
+  outputs.camera = [&](const orbed::image_t& m) { camera.push_back(m); };
+  outputs.reflective = [&](const orbed::reflective_view_t& m) { reflective.push_back(m); };
+  ImagePipelineClocks clocks;
+  clocks.wall_utime = [] { return int64_t{5'000}; };
+  clocks.monotonic_s = [] { return 0.0; };
+  ImagePipeline pipeline(world.robot, world.stream.scene_objects(), options, outputs, clocks);
+  FrameInputs in = world.Sample(0.0, 1'700'000'000'000'000);
+  in.robot = arm;
+  in.X_WV = X_WR * Eigen::Translation3d(0.02, 0.01, 0.0);
+  auto show = [&](const FrameInputs& inputs) {
+    pipeline.Post(ImagePipeline::Job::kCamera, inputs);
+    pipeline.Post(ImagePipeline::Job::kReflective, inputs);
+    return reflective.back().image.data;
+  };
+  const std::vector<std::uint8_t> alignment = show(in);  // the frame's joints
+  ASSERT_EQ(camera.size(), 1u);
+  FrameInputs target = in;
+  target.q_reflective_rad = Robot({30, 60, 0, -30, 0, 20, 0}, X_WR).q_rad;
+  const std::vector<std::uint8_t> at_target = show(target);
+  EXPECT_NE(at_target, alignment);
+  FrameInputs same = in;
+  same.q_reflective_rad = arm.q_rad;
+  EXPECT_EQ(show(same), alignment);
+  FrameInputs none = in;
+  none.hide_reflective_hologram = true;
+  EXPECT_EQ(show(none), camera.front().data);
+  EXPECT_EQ(show(target), at_target);
+  EXPECT_EQ(reflective.back().source_utime, in.sample_utime);  // one capture throughout
+}
+
 TEST(ImagePipeline, WorkerIsLatestWinsAndCountsSkipped) {
   World world;
   const RobotState arm = Robot({0, 30, 0, -60, 0, 45, 0}, world.scene.X_WR);
