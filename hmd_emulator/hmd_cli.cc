@@ -51,6 +51,9 @@ int RunHmd(int argc, const char* const* argv, std::ostream& out, std::ostream& e
                  "(crash recovery)");
   app.add_option("--iiwa-status-channel", o.iiwa_status_channel)->capture_default_str();
   app.add_option("--robot-state-channel", o.robot_state_channel)->capture_default_str();
+  app.add_option("--iiwa-command-channel", o.iiwa_command_channel,
+                 "Interactive: where keys , and . turn the arm")
+      ->capture_default_str();
   app.add_option("--session-control-channel", o.session_control_channel)->capture_default_str();
   app.add_option("--registration-channel", o.registration_channel)->capture_default_str();
   app.add_option("--guidance-channel", o.guidance_channel)->capture_default_str();

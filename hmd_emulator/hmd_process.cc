@@ -1,5 +1,6 @@
 #include "hmd_emulator/hmd_process.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <stdexcept>
@@ -7,8 +8,10 @@
 
 #include <opencv2/highgui.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <orbed/iiwa_command_t.hpp>
 
 #include "base/format.h"
+#include "base/units.h"
 #include "hmd_emulator/headset_trial.h"
 #include "procs/common/alignment_trial.h"
 #include "procs/common/conversions.h"
@@ -69,7 +72,8 @@ HmdProcess::HmdProcess(const orbed::CommonFlags& flags, const HmdOptions& option
                        << session_.state().next_index << " (state file " << options_.state_file << ")";
     }
   }
-  interactive_.emplace(options_.displays, X_WV_start_, options_.scripted_keys, MonotonicSeconds());
+  interactive_.emplace(options_.displays, X_WV_start_, options_.scripted_keys, MonotonicSeconds(),
+                       robot_model_->num_joints());
   stream_ = std::make_unique<PoseStream>(config_, scene, *robot_model_);
 
   process_ = std::make_unique<orbed::Process>(flags);
@@ -411,9 +415,43 @@ void HmdProcess::HandleKey(int key) {
       return process_->RequestStop();
     case InteractiveSession::Request::kSubmit:
       return SubmitInteractiveTrial();
+    case InteractiveSession::Request::kMoveJoint:
+      return TurnArmJoint(interactive_->selected_joint(), interactive_->joint_step_rad());
     default:
       return;
   }
+}
+
+void HmdProcess::TurnArmJoint(int joint, double delta_rad) {
+  if (!robot_.have_q) {
+    interactive_->SetEvent("cannot turn a joint yet: no " + options_.iiwa_status_channel);
+    return;
+  }
+  // Presses on one joint add up on the last command (the arm may still be moving); turning another
+  // joint starts from the measured joints.
+  if (arm_command_q_.size() != robot_.q_rad.size() || joint != arm_command_joint_)
+    arm_command_q_ = robot_.q_rad;
+  arm_command_joint_ = joint;
+  const Eigen::VectorXd lower = robot_model_->lower_limits_rad(), upper = robot_model_->upper_limits_rad();
+  arm_command_q_[joint] = std::clamp(arm_command_q_[joint] + delta_rad, lower[joint], upper[joint]);
+  orbed::iiwa_command_t command{};
+  command.utime = NowMicros();
+  command.num_joints = static_cast<int32_t>(arm_command_q_.size());
+  command.joint_position = FromVectorX(arm_command_q_);
+  process_->Publish(options_.iiwa_command_channel, command);
+  char text[96];
+  std::snprintf(text, sizeof(text), "joint %d to %+.1f deg", joint + 1, arm_command_q_[joint] * kRadToDeg);
+  interactive_->SetEvent(text);
+}
+
+std::string HmdProcess::GuidanceStatus() const {
+  if (!guidance_ ||
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - guidance_received_).count() >
+          kGuidanceFreshS) {
+    return "";
+  }
+  return GuidanceLine(guidance::GuidanceModeName(guidance_->mode), guidance_->error_deg,
+                      guidance_->next_joint, guidance_->done);
 }
 
 void HmdProcess::SubmitInteractiveTrial() {
@@ -448,7 +486,7 @@ cv::Mat HmdProcess::CurrentWindowImage() {
   const std::string tracking = stream_->have_sample() ? TrackingStateName(stream_->sample().state) : "-";
   return interactive_->Window(pipeline_->LatestArView(),
                               pipeline_->LatestReflective(interactive_->shown_display()), session_.state(),
-                              CurrentX_WV(), robot_.known(), tracking);
+                              CurrentX_WV(), robot_.known(), tracking, GuidanceStatus());
 }
 
 void HmdProcess::InteractiveTick() {

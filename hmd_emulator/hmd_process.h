@@ -21,8 +21,11 @@
 ///               hmd.ar_view_hz (image_pipeline.h), from the latest sample, robot and X_WV;
 ///               GAZE_RAY (gaze_ray_t) at hmd.gaze_hz (pose_stream.h);
 ///               ALIGNMENT_TRIAL (alignment_trial_t): one per accepted REQUEST_TRIAL (emulated user)
-///               or Enter (interactive); SESSION_CONTROL START once, for a local session, when a
-///               person submits in interactive mode with no session active; PROCESS_STATUS at 1 Hz.
+///               or Enter (interactive); IIWA_COMMAND (interactive, keys , and .: the measured joints
+///               with the selected one turned by the rotation step, within the model's limits;
+///               presses on one joint add up on the last command); SESSION_CONTROL START once, for a local
+///               session, when a person submits in interactive mode with no session active; PROCESS_STATUS at
+///               1 Hz.
 /// Drops under load, counted on the heartbeat (Process::CountDrop): "timer/<channel>" for a stream's
 /// skipped deadlines (e.g. timer/HMD_POSE), "<channel>/busy" for an image request that replaced one
 /// the renderer had not started (HMD_CAMERA/busy, REFLECTIVE_VIEW/busy, AR_VIEW/busy).
@@ -137,6 +140,8 @@ struct HmdOptions {
   std::string reflective_channel{channels::kReflectiveView};
   std::string ar_view_channel{channels::kArView};
   std::string trial_channel{channels::kAlignmentTrial};
+  /// Interactive: the person turns a joint of the real arm (keys 1-7 and , .) through the sim.
+  std::string iiwa_command_channel{channels::kIiwaCommand};
 };
 
 class HmdProcess {
@@ -203,6 +208,8 @@ class HmdProcess {
   void SaveState();
   void EmulateTrial(const std::string& channel);
   void SubmitInteractiveTrial();
+  void TurnArmJoint(int joint, double delta_rad);
+  std::string GuidanceStatus() const;
   void PublishTrial(const Eigen::Isometry3d& X_WV, double duration_s, const std::string& user_id,
                     const TrackingFaultRecord& faults = {});
   void PublishEmulatedTrial(const TrialOutcome& outcome);
@@ -231,6 +238,10 @@ class HmdProcess {
   std::string user_id_;
   // An emulated trial waiting for its tracking faults to play on HMD_POSE (see the file comment).
   std::optional<TrialOutcome> pending_trial_;
+  // The arm as the person commands it (interactive): the joints last sent on IIWA_COMMAND, so that
+  // presses on one joint add up while the arm is still moving, and the joint they turned.
+  Eigen::VectorXd arm_command_q_;
+  int arm_command_joint_{-1};
 };
 
 }  // namespace orbed::hmd

@@ -23,6 +23,7 @@
 #include <gtest/gtest.h>
 #include <orbed/gaze_ray_t.hpp>
 #include <orbed/hmd_pose_t.hpp>
+#include <orbed/iiwa_command_t.hpp>
 #include <orbed/image_t.hpp>
 #include <orbed/reflective_view_t.hpp>
 
@@ -653,6 +654,59 @@ TEST(HmdProcess, InteractiveKeysMoveTheHologramAndEnterSubmits) {
   cv::Mat diff;
   cv::absdiff(with_help, without_help, diff);
   EXPECT_GT(cv::countNonZero(diff.reshape(1)), 1000);
+}
+
+// The person as the set-up assistant: a digit selects a joint, , and . turn it by the rotation step
+// through IIWA_COMMAND (the measured joints, the selected one turned; presses on one joint add up;
+// the model's limits hold); the guidance shows as one status line.
+TEST(HmdProcess, InteractiveKeysTurnAJointOfTheRealArm) {
+  HmdOptions options = Inline();
+  options.interactive = true;
+  HmdProcess hmd(MemqFlags(0), options);
+  lcm::LCM& lcm = hmd.process().lcm();
+  struct Commands {
+    std::vector<orbed::iiwa_command_t> seen;
+    void On(const lcm::ReceiveBuffer*, const std::string&, const orbed::iiwa_command_t* m) {
+      seen.push_back(*m);
+    }
+  } commands;
+  lcm.subscribe("IIWA_COMMAND", &Commands::On, &commands);
+  hmd.HandleKey('.');  // no IIWA_STATUS yet: nothing is sent
+  Drain(lcm);
+  EXPECT_TRUE(commands.seen.empty());
+  const auto status = Status(kQDeg);
+  lcm.publish("IIWA_STATUS", &status);
+  Drain(lcm);
+  hmd.HandleKey('3');
+  hmd.HandleKey('.');
+  hmd.HandleKey('.');
+  hmd.HandleKey(',');
+  Drain(lcm);
+  ASSERT_EQ(commands.seen.size(), 3u);
+  const std::vector<double> turned = {0.5, 1.0, 0.5};  // the default step, 0.5 deg
+  for (size_t k = 0; k < 3; ++k) {
+    ASSERT_EQ(commands.seen[k].num_joints, 7);
+    for (int i = 0; i < 7; ++i) {
+      const double expected = (kQDeg[i] + (i == 2 ? turned[k] : 0.0)) * kDegToRad;
+      EXPECT_NEAR(commands.seen[k].joint_position[i], expected, 1e-12) << k << " " << i;
+    }
+  }
+  for (int i = 0; i < 5; ++i) hmd.HandleKey('=');  // 10 deg steps (the cap)
+  hmd.HandleKey('2');
+  for (int i = 0; i < 12; ++i) hmd.HandleKey('.');  // 30 + 120 deg: held at joint 2's 120 deg limit
+  Drain(lcm);
+  EXPECT_NEAR(commands.seen.back().joint_position[1], 120 * kDegToRad, 1e-12);
+  EXPECT_NEAR(commands.seen.back().joint_position[2], 0.0, 1e-12);  // another joint: from the measured q
+  const size_t sent = commands.seen.size();
+  hmd.HandleKey('8');  // the iiwa has 7 joints: nothing
+  hmd.HandleKey('.');
+  Drain(lcm);
+  EXPECT_EQ(commands.seen.size(), sent + 1);
+  EXPECT_NEAR(commands.seen.back().joint_position[1], 120 * kDegToRad, 1e-12);  // still joint 2
+
+  EXPECT_EQ(GuidanceLine("ar", {1.0, -12.46}, 1, false),
+            "guidance (ar): next joint 2 | error [deg] +1.0 -12.5");
+  EXPECT_EQ(GuidanceLine("fixed", {0.0}, -1, true), "guidance (fixed): done | error [deg] +0.0");
 }
 
 TEST(HmdConfig, ErrorsNameTheFileAndTheKey) {

@@ -33,11 +33,24 @@ cv::Mat Panel(const cv::Mat& image, int width, int height, const std::string& ti
   return panel;
 }
 
+// The direction of a joint key: ',' turns back, '.' forward.
+double ApplyKeySign(int key) { return (key & 0xFF) == ',' ? -1.0 : 1.0; }
+
 }  // namespace
 
-KeyAction ApplyKey(int key, int num_displays, InteractiveState* s, Eigen::Isometry3d* X_WV) {
+KeyAction ApplyKey(int key, int num_displays, InteractiveState* s, Eigen::Isometry3d* X_WV, int num_joints) {
   const double t = s->step_m, r = s->step_deg * kDegToRad;
-  switch (key & 0xFF) {
+  const int k = key & 0xFF;
+  if (k >= '1' && k <= '9') {
+    if (k - '1' >= num_joints) return KeyAction::kNone;
+    s->selected_joint = k - '1';
+    return KeyAction::kSelectJoint;
+  }
+  switch (k) {
+    case ',':
+      return KeyAction::kJointMinus;
+    case '.':
+      return KeyAction::kJointPlus;
     case 'a':
       X_WV->translation().x() -= t;
       return KeyAction::kMoved;
@@ -118,6 +131,7 @@ std::vector<std::string> InteractiveHelpLines() {
       "c        re-capture the shown display from where you stand",
       "Enter    submit the alignment trial (ALIGNMENT_TRIAL)",
       "h        this help on/off                 q / Esc  quit",
+      "1 .. 7   select a joint of the real arm   , / .    turn it -/+ by the rotation step",
   };
 }
 
@@ -176,15 +190,23 @@ std::vector<int> ScriptedKeys(const std::string& text) {
 }
 
 InteractiveSession::InteractiveSession(int num_displays, const Eigen::Isometry3d& X_WV_start,
-                                       const std::string& scripted_keys, double now_s)
+                                       const std::string& scripted_keys, double now_s, int num_joints)
     : num_displays_(num_displays),
       X_WV_start_(X_WV_start),
       X_WV_(X_WV_start),
       scripted_(ScriptedKeys(scripted_keys)),
-      trial_started_s_(now_s) {}
+      trial_started_s_(now_s),
+      num_joints_(num_joints) {}
 
 InteractiveSession::Request InteractiveSession::HandleKey(int key) {
-  switch (ApplyKey(key, num_displays_, &ui_, &X_WV_)) {
+  switch (ApplyKey(key, num_displays_, &ui_, &X_WV_, num_joints_)) {
+    case KeyAction::kSelectJoint:
+      last_event_ = "joint " + std::to_string(ui_.selected_joint + 1) + " selected (, and . turn it)";
+      return Request::kNone;
+    case KeyAction::kJointMinus:
+    case KeyAction::kJointPlus:
+      joint_step_rad_ = (ApplyKeySign(key) * ui_.step_deg) * kDegToRad;
+      return Request::kMoveJoint;
     case KeyAction::kReset:
       X_WV_ = X_WV_start_;
       last_event_ = "back at the start pose";
@@ -224,9 +246,23 @@ double InteractiveSession::Submitted(const std::string& session_id, int32_t inde
   return duration_s;
 }
 
+std::string GuidanceLine(const std::string& mode, const std::vector<double>& error_deg, int next_joint,
+                         bool done) {
+  std::string line = "guidance (" + mode + "): ";
+  line += done ? std::string("done") : "next joint " + std::to_string(next_joint + 1);
+  line += " | error [deg]";
+  char cell[16];
+  for (double e : error_deg) {
+    std::snprintf(cell, sizeof(cell), " %+.1f", e);
+    line += cell;
+  }
+  return line;
+}
+
 cv::Mat InteractiveSession::Window(const cv::Mat& ar_view, const cv::Mat& reflective,
                                    const HmdSessionState& session, const Eigen::Isometry3d& X_WV_shown,
-                                   bool robot_known, const std::string& tracking) const {
+                                   bool robot_known, const std::string& tracking,
+                                   const std::string& guidance) const {
   std::vector<std::string> lines;
   std::string line = session.active()
                          ? session.Describe() + ", next trial " + std::to_string(session.next_index)
@@ -243,6 +279,8 @@ cv::Mat InteractiveSession::Window(const cv::Mat& ar_view, const cv::Mat& reflec
                 dp_mm.x(), dp_mm.y(), dp_mm.z(), dtheta_deg,
                 robot_known ? "live" : "waiting for IIWA_STATUS + ROBOT_STATE", tracking.c_str());
   lines.push_back(text);
+  lines.push_back((guidance.empty() ? std::string("guidance: none") : guidance) + "   arm: joint " +
+                  std::to_string(ui_.selected_joint + 1) + " selected");
   lines.push_back(last_event_.empty() ? std::string(" ") : last_event_);
   return WindowImage(ar_view, reflective, ui_, lines);
 }

@@ -13,6 +13,9 @@
 ///   0       back to the start pose       n   show the next reflective display
 ///   c       re-capture the shown display from the current view
 ///   Enter   submit the alignment trial   h   help overlay on/off      q / Esc   quit
+/// The person as the set-up assistant (paper Fig. 4 c-e), with the guidance in the status bar:
+///   1 … 7   select a joint of the real arm   , / .   turn it −/+ by the rotation step (the shell
+///           sends IIWA_COMMAND, so the sim's speeds, limits and collision stops hold)
 ///
 /// InteractiveSession holds the rest of the person's side without a window, a bus or a clock: the
 /// hologram pose they set, the requested-trial flag and its timer (times come in as arguments),
@@ -37,7 +40,8 @@ struct InteractiveState {
   double step_m{0.005};  ///< translation per key press [m]
   double step_deg{0.5};  ///< rotation per key press [deg]
   bool show_help{false};
-  int shown_display{0};  ///< index of the reflective display in the right panel
+  int shown_display{0};   ///< index of the reflective display in the right panel
+  int selected_joint{0};  ///< 0-based joint of the real arm that , and . turn
 };
 
 enum class KeyAction {
@@ -50,11 +54,15 @@ enum class KeyAction {
   kRecapture,
   kSubmit,
   kQuit,
+  kSelectJoint,  ///< selected_joint changed
+  kJointMinus,   ///< turn the selected joint by −step_deg
+  kJointPlus,    ///< … by +step_deg
 };
 
 /// Applies one key code (cv::waitKey's, low byte) to the state and to X_WV (in place).
-/// `num_displays` bounds shown_display.
-KeyAction ApplyKey(int key, int num_displays, InteractiveState* state, Eigen::Isometry3d* X_WV);
+/// `num_displays` bounds shown_display, `num_joints` the joint keys (a digit beyond it: kNone).
+KeyAction ApplyKey(int key, int num_displays, InteractiveState* state, Eigen::Isometry3d* X_WV,
+                   int num_joints = 7);
 
 /// The help overlay's lines (also printed by --help).
 std::vector<std::string> InteractiveHelpLines();
@@ -64,6 +72,11 @@ std::vector<std::string> InteractiveHelpLines();
 /// overlay when state.show_help. Returns CV_8UC3.
 cv::Mat WindowImage(const cv::Mat& ar_view, const cv::Mat& reflective, const InteractiveState& state,
                     const std::vector<std::string>& status_lines, int panel_width_px = 800);
+
+/// The guidance as one status line: "guidance (ar): next joint 3 | error [deg] +0.0 -12.5 … | done"
+/// (joints 1-based; `next_joint` 0-based, −1 when done).
+std::string GuidanceLine(const std::string& mode, const std::vector<double>& error_deg, int next_joint,
+                         bool done);
 
 /// Decodes the two-character escapes "\n" (Enter, 13) and "\e" (Esc, 27) of --scripted-keys; every
 /// other byte is its own key code.
@@ -76,13 +89,14 @@ class InteractiveSession {
     kNone,
     kRecapture,  ///< re-capture shown_display() from the current view
     kQuit,
-    kSubmit,  ///< submit an ALIGNMENT_TRIAL at X_WV() (then Submitted() or CannotSubmit())
+    kSubmit,     ///< submit an ALIGNMENT_TRIAL at X_WV() (then Submitted() or CannotSubmit())
+    kMoveJoint,  ///< turn joint selected_joint() of the real arm by joint_step_rad()
   };
 
   /// The hologram starts at X_WV_start; `scripted_keys` as --scripted-keys; the trial timer starts
   /// at now_s [s, any monotonic origin].
   InteractiveSession(int num_displays, const Eigen::Isometry3d& X_WV_start, const std::string& scripted_keys,
-                     double now_s);
+                     double now_s, int num_joints = 7);
 
   /// Applies one key (ApplyKey(); 0 puts the hologram back at the start pose).
   Request HandleKey(int key);
@@ -103,14 +117,19 @@ class InteractiveSession {
   const Eigen::Isometry3d& X_WV() const { return X_WV_; }
   const Eigen::Isometry3d& X_WV_start() const { return X_WV_start_; }
   int shown_display() const { return ui_.shown_display; }
+  int selected_joint() const { return ui_.selected_joint; }
+  /// The turn kMoveJoint asks for [rad]: ±step_deg.
+  double joint_step_rad() const { return joint_step_rad_; }
   bool trial_requested() const { return trial_requested_; }
   const std::string& last_event() const { return last_event_; }
 
   /// The window (WindowImage()) with the status lines: the session, the offset of the hologram
   /// drawn (X_WV_shown) from the start pose, whether the robot is live, the tracking state
-  /// (`tracking`, "-" when none), and the last event.
+  /// (`tracking`, "-" when none), the guidance (`guidance`: one line, GuidanceLine()) with the
+  /// selected joint, and the last event.
   cv::Mat Window(const cv::Mat& ar_view, const cv::Mat& reflective, const HmdSessionState& session,
-                 const Eigen::Isometry3d& X_WV_shown, bool robot_known, const std::string& tracking) const;
+                 const Eigen::Isometry3d& X_WV_shown, bool robot_known, const std::string& tracking,
+                 const std::string& guidance = "") const;
 
  private:
   int num_displays_;
@@ -122,6 +141,8 @@ class InteractiveSession {
   bool trial_requested_{false};
   double trial_started_s_{0};
   std::string last_event_;
+  int num_joints_{7};
+  double joint_step_rad_{0};
 };
 
 }  // namespace orbed::hmd
