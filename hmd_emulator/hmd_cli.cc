@@ -54,6 +54,9 @@ int RunHmd(int argc, const char* const* argv, std::ostream& out, std::ostream& e
   app.add_option("--iiwa-command-channel", o.iiwa_command_channel,
                  "Interactive: where keys , and . turn the arm")
       ->capture_default_str();
+  app.add_option("--setup-task-channel", o.setup_task_channel,
+                 "Interactive: where t, Enter sends the planned target")
+      ->capture_default_str();
   app.add_option("--session-control-channel", o.session_control_channel)->capture_default_str();
   app.add_option("--registration-channel", o.registration_channel)->capture_default_str();
   app.add_option("--guidance-channel", o.guidance_channel)->capture_default_str();

@@ -9,6 +9,7 @@
 #include <opencv2/highgui.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <orbed/iiwa_command_t.hpp>
+#include <orbed/setup_task_t.hpp>
 
 #include "base/format.h"
 #include "base/units.h"
@@ -238,6 +239,11 @@ void HmdProcess::OnGuidance(const orbed::guidance_t& msg, const std::string& cha
 
 HmdProcess::HologramShown HmdProcess::Hologram() const {
   HologramShown shown;
+  // A person planning a target sees it.
+  if (options_.interactive && interactive_->editing_target() && planned_target_q_.size() > 0) {
+    shown.q_rad = shown.reflective_q_rad = planned_target_q_;
+    return shown;
+  }
   // An alignment session in progress aligns the hologram at the real arm's joints.
   if (session_.state().active()) return shown;
   if (!guidance_ ||
@@ -417,6 +423,12 @@ void HmdProcess::HandleKey(int key) {
       return SubmitInteractiveTrial();
     case InteractiveSession::Request::kMoveJoint:
       return TurnArmJoint(interactive_->selected_joint(), interactive_->joint_step_rad());
+    case InteractiveSession::Request::kEditTarget:
+      return EditTarget(std::nullopt);
+    case InteractiveSession::Request::kMoveTarget:
+      return EditTarget(std::make_pair(interactive_->selected_joint(), interactive_->joint_step_rad()));
+    case InteractiveSession::Request::kSendTarget:
+      return SendPlannedTarget();
     default:
       return;
   }
@@ -442,6 +454,45 @@ void HmdProcess::TurnArmJoint(int joint, double delta_rad) {
   char text[96];
   std::snprintf(text, sizeof(text), "joint %d to %+.1f deg", joint + 1, arm_command_q_[joint] * kRadToDeg);
   interactive_->SetEvent(text);
+}
+
+// Planning starts from the guidance's target while one is fresh, else from the arm as it is.
+void HmdProcess::EditTarget(std::optional<std::pair<int, double>> turn) {
+  if (!interactive_->editing_target()) return;
+  if (planned_target_q_.size() == 0) {
+    const std::string shown = GuidanceStatus();
+    if (!shown.empty()) {
+      planned_target_q_ = ToVectorX(guidance_->target_position);
+    } else if (robot_.have_q) {
+      planned_target_q_ = robot_.q_rad;
+    } else {
+      interactive_->SetEvent("cannot plan yet: no " + options_.iiwa_status_channel + " and no GUIDANCE");
+      return;
+    }
+  }
+  if (!turn) return;
+  const auto [joint, delta_rad] = *turn;
+  planned_target_q_[joint] =
+      std::clamp(planned_target_q_[joint] + delta_rad, robot_model_->lower_limits_rad()[joint],
+                 robot_model_->upper_limits_rad()[joint]);
+  char text[96];
+  std::snprintf(text, sizeof(text), "planned target: joint %d at %+.1f deg", joint + 1,
+                planned_target_q_[joint] * kRadToDeg);
+  interactive_->SetEvent(text);
+}
+
+void HmdProcess::SendPlannedTarget() {
+  if (planned_target_q_.size() == 0) return EditTarget(std::nullopt);
+  orbed::setup_task_t task{};
+  task.utime = NowMicros();
+  task.request_id = task.utime;
+  task.task_id = "interactive-" + std::to_string(++planned_targets_sent_);
+  task.mode = GuidanceStatus().empty() ? +orbed::guidance_t::MODE_AR : guidance_->mode;
+  task.num_joints = static_cast<int32_t>(planned_target_q_.size());
+  task.target_position = FromVectorX(planned_target_q_);
+  process_->Publish(options_.setup_task_channel, task);
+  interactive_->SetEvent("sent " + task.task_id + " on " + options_.setup_task_channel);
+  ORBED_LOG(kInfo) << interactive_->last_event();
 }
 
 std::string HmdProcess::GuidanceStatus() const {

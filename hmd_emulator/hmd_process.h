@@ -23,9 +23,10 @@
 ///               ALIGNMENT_TRIAL (alignment_trial_t): one per accepted REQUEST_TRIAL (emulated user)
 ///               or Enter (interactive); IIWA_COMMAND (interactive, keys , and .: the measured joints
 ///               with the selected one turned by the rotation step, within the model's limits;
-///               presses on one joint add up on the last command); SESSION_CONTROL START once, for a local
-///               session, when a person submits in interactive mode with no session active; PROCESS_STATUS at
-///               1 Hz.
+///               presses on one joint add up on the last command); SETUP_TASK (interactive, t then
+///               Enter: the planned target, task id "interactive-<n>", the guidance's mode or ar);
+///               SESSION_CONTROL START once, for a local session, when a person submits in interactive mode
+///               with no session active; PROCESS_STATUS at 1 Hz.
 /// Drops under load, counted on the heartbeat (Process::CountDrop): "timer/<channel>" for a stream's
 /// skipped deadlines (e.g. timer/HMD_POSE), "<channel>/busy" for an image request that replaced one
 /// the renderer had not started (HMD_CAMERA/busy, REFLECTIVE_VIEW/busy, AR_VIEW/busy).
@@ -142,6 +143,7 @@ struct HmdOptions {
   std::string trial_channel{channels::kAlignmentTrial};
   /// Interactive: the person turns a joint of the real arm (keys 1-7 and , .) through the sim.
   std::string iiwa_command_channel{channels::kIiwaCommand};
+  std::string setup_task_channel{channels::kSetupTask};  ///< interactive: the planned target
 };
 
 class HmdProcess {
@@ -209,6 +211,8 @@ class HmdProcess {
   void EmulateTrial(const std::string& channel);
   void SubmitInteractiveTrial();
   void TurnArmJoint(int joint, double delta_rad);
+  void EditTarget(std::optional<std::pair<int, double>> turn);
+  void SendPlannedTarget();
   std::string GuidanceStatus() const;
   void PublishTrial(const Eigen::Isometry3d& X_WV, double duration_s, const std::string& user_id,
                     const TrackingFaultRecord& faults = {});
@@ -242,6 +246,9 @@ class HmdProcess {
   // presses on one joint add up while the arm is still moving, and the joint they turned.
   Eigen::VectorXd arm_command_q_;
   int arm_command_joint_{-1};
+  // The target the person plans (interactive, key t): drawn as the hologram while planning.
+  Eigen::VectorXd planned_target_q_;
+  int planned_targets_sent_{0};
 };
 
 }  // namespace orbed::hmd

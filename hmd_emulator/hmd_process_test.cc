@@ -26,12 +26,14 @@
 #include <orbed/iiwa_command_t.hpp>
 #include <orbed/image_t.hpp>
 #include <orbed/reflective_view_t.hpp>
+#include <orbed/setup_task_t.hpp>
 
 #include "base/units.h"
 #include "hmd_emulator/gaze.h"
 #include "hmd_emulator/headset_trial.h"
 #include "procs/common/conversions.h"
 #include "render/renderer.h"
+#include "sim/guidance_messages.h"
 
 namespace orbed::hmd {
 namespace {
@@ -656,59 +658,6 @@ TEST(HmdProcess, InteractiveKeysMoveTheHologramAndEnterSubmits) {
   EXPECT_GT(cv::countNonZero(diff.reshape(1)), 1000);
 }
 
-// The person as the set-up assistant: a digit selects a joint, , and . turn it by the rotation step
-// through IIWA_COMMAND (the measured joints, the selected one turned; presses on one joint add up;
-// the model's limits hold); the guidance shows as one status line.
-TEST(HmdProcess, InteractiveKeysTurnAJointOfTheRealArm) {
-  HmdOptions options = Inline();
-  options.interactive = true;
-  HmdProcess hmd(MemqFlags(0), options);
-  lcm::LCM& lcm = hmd.process().lcm();
-  struct Commands {
-    std::vector<orbed::iiwa_command_t> seen;
-    void On(const lcm::ReceiveBuffer*, const std::string&, const orbed::iiwa_command_t* m) {
-      seen.push_back(*m);
-    }
-  } commands;
-  lcm.subscribe("IIWA_COMMAND", &Commands::On, &commands);
-  hmd.HandleKey('.');  // no IIWA_STATUS yet: nothing is sent
-  Drain(lcm);
-  EXPECT_TRUE(commands.seen.empty());
-  const auto status = Status(kQDeg);
-  lcm.publish("IIWA_STATUS", &status);
-  Drain(lcm);
-  hmd.HandleKey('3');
-  hmd.HandleKey('.');
-  hmd.HandleKey('.');
-  hmd.HandleKey(',');
-  Drain(lcm);
-  ASSERT_EQ(commands.seen.size(), 3u);
-  const std::vector<double> turned = {0.5, 1.0, 0.5};  // the default step, 0.5 deg
-  for (size_t k = 0; k < 3; ++k) {
-    ASSERT_EQ(commands.seen[k].num_joints, 7);
-    for (int i = 0; i < 7; ++i) {
-      const double expected = (kQDeg[i] + (i == 2 ? turned[k] : 0.0)) * kDegToRad;
-      EXPECT_NEAR(commands.seen[k].joint_position[i], expected, 1e-12) << k << " " << i;
-    }
-  }
-  for (int i = 0; i < 5; ++i) hmd.HandleKey('=');  // 10 deg steps (the cap)
-  hmd.HandleKey('2');
-  for (int i = 0; i < 12; ++i) hmd.HandleKey('.');  // 30 + 120 deg: held at joint 2's 120 deg limit
-  Drain(lcm);
-  EXPECT_NEAR(commands.seen.back().joint_position[1], 120 * kDegToRad, 1e-12);
-  EXPECT_NEAR(commands.seen.back().joint_position[2], 0.0, 1e-12);  // another joint: from the measured q
-  const size_t sent = commands.seen.size();
-  hmd.HandleKey('8');  // the iiwa has 7 joints: nothing
-  hmd.HandleKey('.');
-  Drain(lcm);
-  EXPECT_EQ(commands.seen.size(), sent + 1);
-  EXPECT_NEAR(commands.seen.back().joint_position[1], 120 * kDegToRad, 1e-12);  // still joint 2
-
-  EXPECT_EQ(GuidanceLine("ar", {1.0, -12.46}, 1, false),
-            "guidance (ar): next joint 2 | error [deg] +1.0 -12.5");
-  EXPECT_EQ(GuidanceLine("fixed", {0.0}, -1, true), "guidance (fixed): done | error [deg] +0.0");
-}
-
 TEST(HmdConfig, ErrorsNameTheFileAndTheKey) {
   const std::string dir = ::testing::TempDir();
   const std::string bad_waypoint = dir + "/hmd_bad_waypoint.yaml";
@@ -849,6 +798,95 @@ TEST(HmdProcess, TheHologramShowsTheGuidancesTarget) {
   EXPECT_EQ(hmd.Hologram().q_rad.size(), 0);
   EXPECT_FALSE(hmd.Hologram().reflective_hidden);
   EXPECT_EQ(hmd.Hologram().reflective_q_rad.size(), 0);
+}
+
+// The person as the set-up assistant: a digit selects a joint, , and . turn it by the rotation step
+// through IIWA_COMMAND (the measured joints, the selected one turned; presses on one joint add up;
+// the model's limits hold); the guidance shows as one status line.
+TEST(HmdProcess, InteractiveKeysTurnAJointOfTheRealArm) {
+  HmdOptions options = Inline();
+  options.interactive = true;
+  HmdProcess hmd(MemqFlags(0), options);
+  lcm::LCM& lcm = hmd.process().lcm();
+  struct Commands {
+    std::vector<orbed::iiwa_command_t> seen;
+    void On(const lcm::ReceiveBuffer*, const std::string&, const orbed::iiwa_command_t* m) {
+      seen.push_back(*m);
+    }
+  } commands;
+  lcm.subscribe("IIWA_COMMAND", &Commands::On, &commands);
+  hmd.HandleKey('.');  // no IIWA_STATUS yet: nothing is sent
+  Drain(lcm);
+  EXPECT_TRUE(commands.seen.empty());
+  const auto status = Status(kQDeg);
+  lcm.publish("IIWA_STATUS", &status);
+  Drain(lcm);
+  hmd.HandleKey('3');
+  hmd.HandleKey('.');
+  hmd.HandleKey('.');
+  hmd.HandleKey(',');
+  Drain(lcm);
+  ASSERT_EQ(commands.seen.size(), 3u);
+  const std::vector<double> turned = {0.5, 1.0, 0.5};  // the default step, 0.5 deg
+  for (size_t k = 0; k < 3; ++k) {
+    ASSERT_EQ(commands.seen[k].num_joints, 7);
+    for (int i = 0; i < 7; ++i) {
+      const double expected = (kQDeg[i] + (i == 2 ? turned[k] : 0.0)) * kDegToRad;
+      EXPECT_NEAR(commands.seen[k].joint_position[i], expected, 1e-12) << k << " " << i;
+    }
+  }
+  for (int i = 0; i < 5; ++i) hmd.HandleKey('=');  // 10 deg steps (the cap)
+  hmd.HandleKey('2');
+  for (int i = 0; i < 12; ++i) hmd.HandleKey('.');  // 30 + 120 deg: held at joint 2's 120 deg limit
+  Drain(lcm);
+  EXPECT_NEAR(commands.seen.back().joint_position[1], 120 * kDegToRad, 1e-12);
+  EXPECT_NEAR(commands.seen.back().joint_position[2], 0.0, 1e-12);  // another joint: from the measured q
+  const size_t sent = commands.seen.size();
+  hmd.HandleKey('8');  // the iiwa has 7 joints: nothing
+  hmd.HandleKey('.');
+  Drain(lcm);
+  EXPECT_EQ(commands.seen.size(), sent + 1);
+  EXPECT_NEAR(commands.seen.back().joint_position[1], 120 * kDegToRad, 1e-12);  // still joint 2
+
+  // Planning (t): the target starts at the fresh GUIDANCE's (else the arm's), , and . turn its
+  // joints and the hologram shows it; Enter sends it as a SETUP_TASK in the guidance's mode.
+  struct Tasks {
+    std::vector<orbed::setup_task_t> seen;
+    void On(const lcm::ReceiveBuffer*, const std::string&, const orbed::setup_task_t* m) {
+      seen.push_back(*m);
+    }
+  } tasks;
+  lcm.subscribe("SETUP_TASK", &Tasks::On, &tasks);
+  const std::vector<double> target_deg = {20, 35, 0, -50, 0, 40, 10};
+  const auto guidance = Guidance(+orbed::guidance_t::MODE_AR_REFLECTIVE, target_deg);
+  lcm.publish("GUIDANCE", &guidance);
+  Drain(lcm);
+  hmd.HandleKey('t');
+  hmd.HandleKey('4');
+  hmd.HandleKey(',');  // 10 deg steps still
+  ASSERT_EQ(hmd.Hologram().q_rad.size(), 7);
+  EXPECT_NEAR(hmd.Hologram().q_rad[3], -60 * kDegToRad, 1e-12);
+  EXPECT_NEAR(hmd.Hologram().reflective_q_rad[3], -60 * kDegToRad, 1e-12);
+  hmd.HandleKey(13);
+  Drain(lcm);
+  ASSERT_EQ(tasks.seen.size(), 1u);
+  EXPECT_EQ(tasks.seen[0].task_id, "interactive-1");
+  EXPECT_EQ(tasks.seen[0].mode, +orbed::guidance_t::MODE_AR_REFLECTIVE);
+  const sim::RobotModel model =
+      sim::RobotModel::LoadFile(HmdSourcePath(sim::RobotModel::kDefaultUrdfRelativePath));
+  EXPECT_EQ(guidance::CheckSetupTask(tasks.seen[0], model, 0.0), "");
+  for (int i = 0; i < 7; ++i) {
+    EXPECT_NEAR(tasks.seen[0].target_position[i], (i == 3 ? -60.0 : target_deg[i]) * kDegToRad, 1e-12);
+  }
+  EXPECT_EQ(commands.seen.size(), sent + 1);  // planning moved no arm
+  hmd.HandleKey('t');                         // back to the arm
+  hmd.HandleKey('.');
+  Drain(lcm);
+  EXPECT_EQ(commands.seen.size(), sent + 2);
+
+  EXPECT_EQ(GuidanceLine("ar", {1.0, -12.46}, 1, false),
+            "guidance (ar): next joint 2 | error [deg] +1.0 -12.5");
+  EXPECT_EQ(GuidanceLine("fixed", {0.0}, -1, true), "guidance (fixed): done | error [deg] +0.0");
 }
 
 }  // namespace

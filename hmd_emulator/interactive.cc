@@ -47,6 +47,9 @@ KeyAction ApplyKey(int key, int num_displays, InteractiveState* s, Eigen::Isomet
     return KeyAction::kSelectJoint;
   }
   switch (k) {
+    case 't':
+      s->edit_target = !s->edit_target;
+      return KeyAction::kToggleTarget;
     case ',':
       return KeyAction::kJointMinus;
     case '.':
@@ -132,6 +135,7 @@ std::vector<std::string> InteractiveHelpLines() {
       "Enter    submit the alignment trial (ALIGNMENT_TRIAL)",
       "h        this help on/off                 q / Esc  quit",
       "1 .. 7   select a joint of the real arm   , / .    turn it -/+ by the rotation step",
+      "t        plan the target instead (, / . turn its joints, Enter sends it); t: back to the arm",
   };
 }
 
@@ -206,7 +210,11 @@ InteractiveSession::Request InteractiveSession::HandleKey(int key) {
     case KeyAction::kJointMinus:
     case KeyAction::kJointPlus:
       joint_step_rad_ = (ApplyKeySign(key) * ui_.step_deg) * kDegToRad;
-      return Request::kMoveJoint;
+      return ui_.edit_target ? Request::kMoveTarget : Request::kMoveJoint;
+    case KeyAction::kToggleTarget:
+      last_event_ = ui_.edit_target ? "planning the target: , and . turn its joints, Enter sends it"
+                                    : "back to the arm: , and . turn its joints";
+      return Request::kEditTarget;
     case KeyAction::kReset:
       X_WV_ = X_WV_start_;
       last_event_ = "back at the start pose";
@@ -217,7 +225,7 @@ InteractiveSession::Request InteractiveSession::HandleKey(int key) {
     case KeyAction::kQuit:
       return Request::kQuit;
     case KeyAction::kSubmit:
-      return Request::kSubmit;
+      return ui_.edit_target ? Request::kSendTarget : Request::kSubmit;
     default:
       return Request::kNone;
   }
@@ -279,7 +287,8 @@ cv::Mat InteractiveSession::Window(const cv::Mat& ar_view, const cv::Mat& reflec
                 dp_mm.x(), dp_mm.y(), dp_mm.z(), dtheta_deg,
                 robot_known ? "live" : "waiting for IIWA_STATUS + ROBOT_STATE", tracking.c_str());
   lines.push_back(text);
-  lines.push_back((guidance.empty() ? std::string("guidance: none") : guidance) + "   arm: joint " +
+  lines.push_back((guidance.empty() ? std::string("guidance: none") : guidance) +
+                  (ui_.edit_target ? "   PLANNING the target: joint " : "   arm: joint ") +
                   std::to_string(ui_.selected_joint + 1) + " selected");
   lines.push_back(last_event_.empty() ? std::string(" ") : last_event_);
   return WindowImage(ar_view, reflective, ui_, lines);

@@ -16,6 +16,9 @@
 /// The person as the set-up assistant (paper Fig. 4 c-e), with the guidance in the status bar:
 ///   1 … 7   select a joint of the real arm   , / .   turn it −/+ by the rotation step (the shell
 ///           sends IIWA_COMMAND, so the sim's speeds, limits and collision stops hold)
+///   t       plan the target instead (the paper's interactive planning): , and . turn the
+///           selected joint of the hologram's target configuration, Enter sends it as a SETUP_TASK
+///           (orbed-guidance shows it); t again: back to the arm
 ///
 /// InteractiveSession holds the rest of the person's side without a window, a bus or a clock: the
 /// hologram pose they set, the requested-trial flag and its timer (times come in as arguments),
@@ -40,8 +43,9 @@ struct InteractiveState {
   double step_m{0.005};  ///< translation per key press [m]
   double step_deg{0.5};  ///< rotation per key press [deg]
   bool show_help{false};
-  int shown_display{0};   ///< index of the reflective display in the right panel
-  int selected_joint{0};  ///< 0-based joint of the real arm that , and . turn
+  int shown_display{0};     ///< index of the reflective display in the right panel
+  int selected_joint{0};    ///< 0-based joint that , and . turn
+  bool edit_target{false};  ///< , and . turn the target's joint (t), not the real arm's
 };
 
 enum class KeyAction {
@@ -54,9 +58,10 @@ enum class KeyAction {
   kRecapture,
   kSubmit,
   kQuit,
-  kSelectJoint,  ///< selected_joint changed
-  kJointMinus,   ///< turn the selected joint by −step_deg
-  kJointPlus,    ///< … by +step_deg
+  kSelectJoint,   ///< selected_joint changed
+  kJointMinus,    ///< turn the selected joint by −step_deg
+  kJointPlus,     ///< … by +step_deg
+  kToggleTarget,  ///< edit_target toggled
 };
 
 /// Applies one key code (cv::waitKey's, low byte) to the state and to X_WV (in place).
@@ -89,8 +94,11 @@ class InteractiveSession {
     kNone,
     kRecapture,  ///< re-capture shown_display() from the current view
     kQuit,
-    kSubmit,     ///< submit an ALIGNMENT_TRIAL at X_WV() (then Submitted() or CannotSubmit())
-    kMoveJoint,  ///< turn joint selected_joint() of the real arm by joint_step_rad()
+    kSubmit,      ///< submit an ALIGNMENT_TRIAL at X_WV() (then Submitted() or CannotSubmit())
+    kMoveJoint,   ///< turn joint selected_joint() of the real arm by joint_step_rad()
+    kEditTarget,  ///< planning began (editing_target()) or ended
+    kMoveTarget,  ///< turn joint selected_joint() of the planned target by joint_step_rad()
+    kSendTarget,  ///< Enter while planning: send the planned target
   };
 
   /// The hologram starts at X_WV_start; `scripted_keys` as --scripted-keys; the trial timer starts
@@ -118,6 +126,7 @@ class InteractiveSession {
   const Eigen::Isometry3d& X_WV_start() const { return X_WV_start_; }
   int shown_display() const { return ui_.shown_display; }
   int selected_joint() const { return ui_.selected_joint; }
+  bool editing_target() const { return ui_.edit_target; }
   /// The turn kMoveJoint asks for [rad]: ±step_deg.
   double joint_step_rad() const { return joint_step_rad_; }
   bool trial_requested() const { return trial_requested_; }
