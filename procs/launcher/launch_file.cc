@@ -1,6 +1,7 @@
 #include "procs/launcher/launch_file.h"
 
 #include <csignal>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <set>
@@ -67,26 +68,68 @@ ProcessSpec ParseProcess(const YamlFields& f, const YAML::Node& node, const std:
   return spec;
 }
 
-LaunchSpec ParseLaunch(const YAML::Node& root, const std::string& path,
-                       const std::map<std::string, std::string>& environment) {
+// What the files of one launch share while they are read: the names taken so far and the files
+// being read (an include of one of them is a cycle).
+struct ReadState {
+  std::set<std::string> process_names, group_names;
+  std::vector<std::string> chain;
+};
+
+constexpr int kMaxIncludeDepth = 8;
+constexpr std::uintmax_t kMaxLaunchFileBytes = 1 << 20;  // a device or a huge file is no launch file
+
+void ReadLaunchFile(const std::string& path, const std::map<std::string, std::string>& environment,
+                    ReadState* state, LaunchSpec* spec);
+
+void ParseLaunch(const YAML::Node& root, const std::string& path,
+                 const std::map<std::string, std::string>& environment, ReadState* state, LaunchSpec* spec) {
   const YamlFields f(path);
   if (!root.IsMap()) f.Fail(root, "(top level)", "expected a mapping with a 'groups' list");
-  f.CheckKeys(root, "", {"name", "groups"});
-  LaunchSpec spec;
-  spec.path = path;
-  spec.name = f.StringOr(root, "name", "", "orbed");
+  f.CheckKeys(root, "", {"name", "include", "groups"});
+  if (state->chain.empty()) spec->name = f.StringOr(root, "name", "", "orbed");  // the top file's
+  state->chain.push_back(path);
+  // Included files first, in order, relative to this file's folder.
+  if (const YAML::Node include = root["include"]) {
+    if (!include.IsSequence()) f.Fail(include, "include", "expected a list of launch files");
+    const std::filesystem::path folder = std::filesystem::path(path).parent_path();
+    for (std::size_t i = 0; i < include.size(); ++i) {
+      const std::string key = "include[" + std::to_string(i) + "]";
+      std::string name = f.String(include[i], key);
+      try {
+        name = ExpandVariables(name, environment);
+      } catch (const std::invalid_argument& e) {
+        f.Fail(include[i], key, e.what());
+      }
+      const std::string included = (folder / name).lexically_normal().string();
+      for (const std::string& open : state->chain) {
+        if (std::filesystem::path(open).lexically_normal() == std::filesystem::path(included)) {
+          f.Fail(include[i], key,
+                 "expected a file not being read already, got '" + name + "' (an include cycle)");
+        }
+      }
+      if (state->chain.size() > kMaxIncludeDepth) {
+        f.Fail(include[i], key, "expected at most " + std::to_string(kMaxIncludeDepth) + " nested includes");
+      }
+      ReadLaunchFile(included, environment, state, spec);
+    }
+  }
   const YAML::Node groups = root["groups"];
-  if (!groups || !groups.IsSequence() || groups.size() == 0) {
+  if (groups && !groups.IsSequence()) f.Fail(groups, "groups", "expected a list of {name, processes}");
+  const std::size_t num_groups = groups ? groups.size() : 0;
+  if (num_groups == 0 && spec->groups.empty()) {
     f.Fail(groups ? groups : root, "groups", "expected a non-empty list of {name, processes}");
   }
-  std::set<std::string> names;
-  for (std::size_t g = 0; g < groups.size(); ++g) {
+  for (std::size_t g = 0; g < num_groups; ++g) {
     const YAML::Node group_node = groups[g];
     const std::string key = "groups[" + std::to_string(g) + "]";
     if (!group_node.IsMap()) f.Fail(group_node, key, "expected a mapping {name, processes}");
     f.CheckKeys(group_node, key, {"name", "processes"});
     GroupSpec group;
     group.name = f.String(f.Required(group_node, "name", key + ".name", "a string"), key + ".name");
+    if (!state->group_names.insert(group.name).second) {
+      f.Fail(group_node["name"], key + ".name",
+             "expected a name not used by another group (included ones too), got '" + group.name + "'");
+    }
     const YAML::Node processes = group_node["processes"];
     if (!processes || !processes.IsSequence() || processes.size() == 0) {
       f.Fail(processes ? processes : group_node, key + ".processes",
@@ -95,15 +138,47 @@ LaunchSpec ParseLaunch(const YAML::Node& root, const std::string& path,
     for (std::size_t p = 0; p < processes.size(); ++p) {
       const std::string process_key = key + ".processes[" + std::to_string(p) + "]";
       ProcessSpec process = ParseProcess(f, processes[p], process_key, environment);
-      if (!names.insert(process.name).second) {
+      if (!state->process_names.insert(process.name).second) {
         f.Fail(processes[p]["name"], process_key + ".name",
                "expected a name not used by another process, got '" + process.name + "' (used twice)");
       }
       group.processes.push_back(std::move(process));
     }
-    spec.groups.push_back(std::move(group));
+    spec->groups.push_back(std::move(group));
   }
-  return spec;
+  state->chain.pop_back();
+}
+
+void ParseLaunchText(const std::string& yaml, const std::string& path,
+                     const std::map<std::string, std::string>& environment, ReadState* state,
+                     LaunchSpec* spec) {
+  try {
+    ParseLaunch(YamlFields::LoadString(yaml, path), path, environment, state, spec);
+  } catch (const LaunchFileError&) {
+    throw;  // an included file's error, already in the launcher's form
+  } catch (const YAML::Exception& e) {
+    // Anything the explicit checks did not anticipate.
+    throw LaunchFileError(path + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
+  } catch (const std::runtime_error& e) {
+    // YamlFields' "file:line: key: expected ..." as the launcher's error type.
+    throw LaunchFileError(e.what());
+  }
+}
+
+void ReadLaunchFile(const std::string& path, const std::map<std::string, std::string>& environment,
+                    ReadState* state, LaunchSpec* spec) {
+  const std::string by = state->chain.empty() ? "" : " (included by " + state->chain.back() + ")";
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec))
+    throw LaunchFileError(path + ": cannot read the launch file" + by);
+  if (std::filesystem::file_size(path, ec) > kMaxLaunchFileBytes) {
+    throw LaunchFileError(path + ": a launch file of over 1 MiB" + by);
+  }
+  std::ifstream in(path);
+  if (!in) throw LaunchFileError(path + ": cannot read the launch file" + by);
+  std::stringstream text;
+  text << in.rdbuf();
+  ParseLaunchText(text.str(), path, environment, state, spec);
 }
 
 }  // namespace
@@ -149,23 +224,20 @@ std::map<std::string, std::string> CurrentEnvironment() {
 
 LaunchSpec ParseLaunchYaml(const std::string& yaml, const std::string& path,
                            const std::map<std::string, std::string>& environment) {
-  try {
-    return ParseLaunch(YamlFields::LoadString(yaml, path), path, environment);
-  } catch (const YAML::Exception& e) {
-    // Anything the explicit checks did not anticipate.
-    throw LaunchFileError(path + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
-  } catch (const std::runtime_error& e) {
-    // YamlFields' "file:line: key: expected ..." as the launcher's error type.
-    throw LaunchFileError(e.what());
-  }
+  LaunchSpec spec;
+  spec.path = path;
+  ReadState state;
+  state.chain.reserve(kMaxIncludeDepth + 2);
+  ParseLaunchText(yaml, path, environment, &state, &spec);
+  return spec;
 }
 
 LaunchSpec LoadLaunchFile(const std::string& path, const std::map<std::string, std::string>& environment) {
-  std::ifstream in(path);
-  if (!in) throw LaunchFileError(path + ": cannot read the launch file");
-  std::stringstream text;
-  text << in.rdbuf();
-  return ParseLaunchYaml(text.str(), path, environment);
+  LaunchSpec spec;
+  spec.path = path;
+  ReadState state;
+  ReadLaunchFile(path, environment, &state, &spec);
+  return spec;
 }
 
 }  // namespace orbed::launcher

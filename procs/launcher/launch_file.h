@@ -3,8 +3,11 @@
 /// The YAML launch file of orbed-launch: groups started in order, processes within a group
 /// started together. Schema (unknown keys are errors, so typos do not pass silently):
 ///
-///   name: testbed                      # optional, for messages
-///   groups:
+///   name: testbed                      # optional, for messages (the top file's)
+///   include: [base.yaml]               # optional: launch files read first, their groups before
+///                                      # this file's (paths relative to this file; ${VAR} expands;
+///                                      # nested up to 8 deep, no cycles)
+///   groups:                            # may be left out when an include has groups
 ///     - name: recording
 ///       processes:
 ///         - name: logger               # unique; passed to the child as --name for heartbeats
@@ -19,9 +22,11 @@
 ///           ready_timeout_s: 10      # (default 10)
 ///           exit_stops_all: false      # when it exits, stop the testbed with its exit status
 ///
-/// ${VAR} in command, args and env values expands from the environment; an unset variable is an
-/// error. The file is read with the project's checked YAML reader (base/yaml_fields.h): errors
-/// throw LaunchFileError with "file:line: dotted.key: expected ..., got ...", e.g.
+/// ${VAR} in command, args and env values expands from the environment (orbed-launch adds
+/// ORBED_BIN_DIR, its own folder, and ORBED_LAUNCH_FILE, the file it was given); an unset variable is an
+/// error. Group and process names are unique across a file and everything it includes. The file is read with
+/// the project's checked YAML reader (base/yaml_fields.h): errors throw LaunchFileError with "file:line:
+/// dotted.key: expected ..., got ...", e.g.
 ///   "testbed.yaml:12: groups[1].processes[0].stop_signal: expected SIGINT, ... or SIGKILL, got 'SIGFOO'".
 
 #include <map>

@@ -48,6 +48,7 @@ int RunLauncher(int argc, const char* const* argv, std::ostream& out, std::ostre
   const std::string bin_dir = std::filesystem::read_symlink("/proc/self/exe", ec).parent_path().string();
   auto environment = CurrentEnvironment();
   environment.emplace("ORBED_BIN_DIR", bin_dir);
+  environment["ORBED_LAUNCH_FILE"] = std::filesystem::absolute(launch_file, ec).lexically_normal().string();
   LaunchSpec spec;
   try {
     spec = LoadLaunchFile(launch_file, environment);

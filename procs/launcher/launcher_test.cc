@@ -121,6 +121,67 @@ TEST(LaunchFile, MissingFileIsNamed) {
   }
 }
 
+// Includes: the included groups come first, in order, and nest; paths are relative to the
+// including file; names stay unique across files; a cycle, a missing file and too deep a nesting
+// are refused with the file and line of the include.
+TEST(LaunchFile, IncludesReadTheirGroupsFirst) {
+  const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / "launch_include";
+  std::filesystem::create_directories(dir / "sub");
+  auto write = [&](const std::string& name, const std::string& text) { std::ofstream(dir / name) << text; };
+  write("sub/base.yaml",
+        "name: base\ngroups:\n  - name: robot\n    processes:\n      - {name: sim, command: s}\n");
+  write("sub/more.yaml",
+        "include: [base.yaml]\ngroups:\n  - name: health\n    processes:\n      - {name: mon, command: m}\n");
+  write("top.yaml",
+        "name: top\ninclude: [sub/more.yaml]\ngroups:\n  - name: run\n    processes:\n"
+        "      - {name: conductor, command: c, args: [\"${LOGS}\"]}\n");
+  const LaunchSpec spec = LoadLaunchFile((dir / "top.yaml").string(), kEnv);
+  EXPECT_EQ(spec.name, "top");
+  ASSERT_EQ(spec.groups.size(), 3u);
+  EXPECT_EQ(spec.groups[0].name, "robot");
+  EXPECT_EQ(spec.groups[1].name, "health");
+  EXPECT_EQ(spec.groups[2].name, "run");
+  EXPECT_EQ(spec.groups[2].processes[0].args[0], "/tmp/logs");
+  write("only.yaml", "include: [sub/base.yaml]\n");  // groups may come only from includes
+  EXPECT_EQ(LoadLaunchFile((dir / "only.yaml").string(), kEnv).groups.size(), 1u);
+
+  auto error = [&](const std::string& name) -> std::string {
+    try {
+      LoadLaunchFile((dir / name).string(), kEnv);
+    } catch (const LaunchFileError& e) {
+      return e.what();
+    }
+    return "(accepted)";
+  };
+  write(
+      "twice.yaml",
+      "include: [sub/base.yaml]\ngroups:\n  - name: robot\n    processes:\n      - {name: x, command: x}\n");
+  EXPECT_NE(
+      error("twice.yaml").find("twice.yaml:3: groups[0].name: expected a name not used by another group"),
+      std::string::npos)
+      << error("twice.yaml");
+  write("same_process.yaml",
+        "include: [sub/base.yaml]\ngroups:\n  - name: g\n    processes:\n      - {name: sim, command: x}\n");
+  EXPECT_NE(error("same_process.yaml").find("used twice"), std::string::npos) << error("same_process.yaml");
+  write("a.yaml", "include: [b.yaml]\n");
+  write("b.yaml", "include: [a.yaml]\n");
+  EXPECT_NE(error("a.yaml").find("b.yaml:1: include[0]: expected a file not being read already"),
+            std::string::npos)
+      << error("a.yaml");
+  write("missing.yaml", "include: [nowhere.yaml]\n");
+  EXPECT_NE(error("missing.yaml").find("nowhere.yaml: cannot read the launch file (included by"),
+            std::string::npos)
+      << error("missing.yaml");
+  write("unset.yaml", "include: [\"${NOPE}.yaml\"]\n");
+  EXPECT_NE(error("unset.yaml").find("${NOPE}"), std::string::npos) << error("unset.yaml");
+  // A chain of 10 files, each including the next: deeper than 8.
+  for (int i = 0; i < 10; ++i) {
+    write("deep" + std::to_string(i) + ".yaml", "include: [deep" + std::to_string(i + 1) + ".yaml]\n");
+  }
+  write("deep10.yaml", "groups:\n  - name: g\n    processes:\n      - {name: x, command: x}\n");
+  EXPECT_NE(error("deep0.yaml").find("nested includes"), std::string::npos) << error("deep0.yaml");
+}
+
 TEST(LaunchFile, ExpandVariables) {
   EXPECT_EQ(ExpandVariables("a${LOGS}b${BIN}", kEnv), "a/tmp/logsb/opt/b");
   EXPECT_EQ(ExpandVariables("plain $LOGS", kEnv), "plain $LOGS");

@@ -10,6 +10,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     std::map<std::string, std::string> environment = orbed::launcher::CurrentEnvironment();
     environment["ORBED_LOG_DIR"] = "/tmp";
     environment["ORBED_SOURCE_DIR"] = orbed::SourceDir();
+    environment["ORBED_LAUNCH_FILE"] = orbed::SourceTreePath("scripts/launch/viraal.yaml");
     orbed::launcher::LaunchSpec spec =
         orbed::launcher::LoadLaunchFile(orbed::SourceTreePath("scripts/launch/viraal.yaml"), environment);
     return new orbed::launcher::Launcher(orbed::fuzz::FuzzFlags("orbed-launch"), spec, "/nonexistent");

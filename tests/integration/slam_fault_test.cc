@@ -116,6 +116,12 @@ std::string LaunchWithHeadsetConfig(const std::string& dir, const std::string& c
     }
   }
   EXPECT_TRUE(found) << "no process 'hmd' in scripts/launch/viraal.yaml";
+  // Written elsewhere, the file includes what viraal.yaml includes from scripts/launch.
+  YAML::Node includes(YAML::NodeType::Sequence);
+  for (const YAML::Node& include : launch["include"]) {
+    includes.push_back(SourcePath("scripts/launch/" + include.as<std::string>()));
+  }
+  launch["include"] = includes;
   const std::string path = dir + "/viraal_faults.yaml";
   std::ofstream(path) << YAML::Dump(launch) << "\n";
   return path;
