@@ -7,6 +7,7 @@
 
 #include <orbed/guidance_t.hpp>
 
+#include "base/hash.h"
 #include "base/units.h"
 #include "base/yaml_fields.h"
 
@@ -14,6 +15,9 @@ namespace orbed::assistant {
 namespace {
 
 constexpr double kArcminToRad = kDegToRad / 60.0;
+// Tags the pace's random stream apart from the person's main one (any constant; changing it changes
+// every person's pace).
+constexpr std::uint64_t kPaceStreamTag = 0x70616365;  // "pace"
 
 // Two unit vectors across the unit ray n.
 void Across(const Eigen::Vector3d& n, Eigen::Vector3d* e1, Eigen::Vector3d* e2) {
@@ -82,8 +86,8 @@ void CheckConfig(const AssistantConfig& c) {
       c.match_margin > 0 && c.looks_per_joint >= 1 && c.looks_per_joint <= 10 && c.correction_window_deg > 0,
       "match_margin > 0, looks_per_joint 1..10, correction_window_deg > 0");
   require(c.joint_overhead_s >= 0 && c.look_s >= 0 && c.mental_rotation_deg_per_s > 0 &&
-              c.hand_speed_deg_per_s > 0,
-          "times >= 0 and speeds > 0");
+              c.hand_speed_deg_per_s > 0 && c.pace_log_sigma >= 0 && c.pace_log_sigma <= 2,
+          "times >= 0, speeds > 0, pace_log_sigma 0..2");
 }
 
 }  // namespace
@@ -136,14 +140,16 @@ AssistantConfig LoadAssistantConfig(const std::string& path) {
       f.NumberOr(act, "flange_marker_offset_m", "assistant.acting", c.flange_marker_offset_m, 0, 0.5, "m");
 
   const YAML::Node t = f.Section(a, "time", "assistant.time");
-  f.CheckKeys(t, "assistant.time",
-              {"joint_overhead_s", "look_s", "mental_rotation_deg_per_s", "hand_speed_deg_per_s"});
+  f.CheckKeys(
+      t, "assistant.time",
+      {"joint_overhead_s", "look_s", "mental_rotation_deg_per_s", "hand_speed_deg_per_s", "pace_log_sigma"});
   c.joint_overhead_s = f.NumberOr(t, "joint_overhead_s", "assistant.time", c.joint_overhead_s, 0, 600, "s");
   c.look_s = f.NumberOr(t, "look_s", "assistant.time", c.look_s, 0, 600, "s");
   c.mental_rotation_deg_per_s = f.NumberOr(t, "mental_rotation_deg_per_s", "assistant.time",
                                            c.mental_rotation_deg_per_s, 1e-3, 1e4, "deg/s");
   c.hand_speed_deg_per_s =
       f.NumberOr(t, "hand_speed_deg_per_s", "assistant.time", c.hand_speed_deg_per_s, 1e-3, 1e4, "deg/s");
+  c.pace_log_sigma = f.NumberOr(t, "pace_log_sigma", "assistant.time", c.pace_log_sigma, 0, 2);
   return c;
 }
 
@@ -151,6 +157,10 @@ Assistant::Assistant(const sim::RobotModel& model, const AssistantConfig& config
     : model_(&model), config_(config), rng_(config.seed) {
   CheckConfig(config_);
   scale_ = rng_.LogNormalUnitMedian(config_.user_scale_log_sigma);
+  // The pace from a stream of its own: the person's other draws stay what they were without it.
+  Random pace_stream(SplitMix64(config_.seed ^ kPaceStreamTag));
+  const double sigma = config_.pace_log_sigma;
+  pace_ = std::exp(sigma * pace_stream.Normal() - 0.5 * sigma * sigma);
   const int n = model.num_joints();
   features_.resize(n);
   for (int j = 0; j < n; ++j) {
@@ -256,14 +266,14 @@ JointLook Assistant::Look(int joint, const Eigen::VectorXd& q_now, const Eigen::
   }
   const double placed = look.aim_rad + scale_ * config_.placement_noise_deg * kDegToRad * rng_.Normal();
   look.q_rad = std::clamp(placed, info.lower_rad, info.upper_rad);
-  look.time_s = config_.look_s;
+  look.time_s = pace_ * config_.look_s;
   if (view.mode == orbed::guidance_t::MODE_FIXED_DISPLAY)
-    look.time_s += MonitorDisparityDeg(view) / config_.mental_rotation_deg_per_s;
+    look.time_s += pace_ * MonitorDisparityDeg(view) / config_.mental_rotation_deg_per_s;
   return look;
 }
 
 double Assistant::TravelTime_s(double delta_rad) const {
-  return std::abs(delta_rad) * kRadToDeg / config_.hand_speed_deg_per_s;
+  return pace_ * std::abs(delta_rad) * kRadToDeg / config_.hand_speed_deg_per_s;
 }
 
 double Assistant::MonitorDisparityDeg(const Viewing& view) const {

@@ -48,7 +48,9 @@
 /// fixed monitor plus the mental rotation of the picture into the person's view, at
 /// `mental_rotation_deg_per_s` over the horizontal angle between the monitor's camera and the eye
 /// seen from the base (Shepard & Metzler 1971: time grows linearly with the angle), and the hand's
-/// travel |Δq| at `hand_speed_deg_per_s`.
+/// travel |Δq| at `hand_speed_deg_per_s`; all of it times the person's pace p, drawn once per person
+/// from its own stream (seeded by SplitMix64 of the seed, so the pace changes no other draw):
+/// log-normal with mean 1, p = exp(σ z − σ²/2), σ = `pace_log_sigma`.
 ///
 /// Frames: W world, R real base, V virtual base (as seen), L links, E eye, D monitor camera.
 /// Units: m, rad inside; arcmin, deg, s where the name says so.
@@ -96,6 +98,7 @@ struct AssistantConfig {
   double look_s{3.0};
   double mental_rotation_deg_per_s{60.0};
   double hand_speed_deg_per_s{15.0};
+  double pace_log_sigma{0.59};  ///< person-to-person spread of every time (log-normal, mean 1)
 };
 
 /// Reads the `assistant:` mapping of a YAML file (every key optional, checked: ranges, units);
@@ -153,6 +156,10 @@ class Assistant {
                                               const Viewing& view);
   /// The time of the hand's travel |delta_rad| [s].
   double TravelTime_s(double delta_rad) const;
+  /// The time per joint before its looks: joint_overhead_s times the pace.
+  double JointOverhead_s() const { return pace_ * config_.joint_overhead_s; }
+  /// The person's pace p (the file comment): every time of theirs is p times the model's.
+  double pace() const { return pace_; }
   /// Horizontal angle between the monitor's camera and the eye, seen from the base [deg].
   double MonitorDisparityDeg(const Viewing& view) const;
 
@@ -164,6 +171,7 @@ class Assistant {
   AssistantConfig config_;
   Random rng_;
   double scale_{1.0};
+  double pace_{1.0};
   std::vector<std::vector<Feature>> features_;
 };
 

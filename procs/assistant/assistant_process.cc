@@ -166,7 +166,8 @@ AssistantProcess::AssistantProcess(const CommonFlags& flags, const AssistantOpti
   process_.AddTimer(
       options_.step_period_s, [this] { Step(); }, "step");
   ORBED_LOG(kInfo) << "assistant: person seed " << assistant_.config().seed << " (noise scale "
-                   << assistant_.person_scale() << "), " << assistant_.config().looks_per_joint
+                   << assistant_.person_scale() << ", pace " << assistant_.pace() << "), "
+                   << assistant_.config().looks_per_joint
                    << " looks per joint; waiting for GUIDANCE, IIWA_STATUS and ROBOT_STATE";
 }
 
@@ -230,7 +231,7 @@ void AssistantProcess::Step() {
                                        : assistant_.config().correction_window_deg * kDegToRad;
       const JointLook look = assistant_.Look(joint_, q_rad_, q_target, CurrentView(), window);
       if (look_ == 0) {
-        partial_.execution_s += assistant_.config().joint_overhead_s;
+        partial_.execution_s += assistant_.JointOverhead_s();
         partial_.ranges.push_back(look.ranges);
       }
       partial_.execution_s += look.time_s + assistant_.TravelTime_s(look.q_rad - q_rad_[joint_]);

@@ -32,6 +32,7 @@ AssistantConfig Perfect() {
   c.picture_scale_log_sigma = 0;
   c.picture_noise_arcmin = 1e-3;
   c.picture_depth_fraction_std = 1e-5;
+  c.pace_log_sigma = 0;
   return c;
 }
 
@@ -73,6 +74,7 @@ TEST(Assistant, ShippedConfigEqualsTheDefaults) {
   EXPECT_EQ(file.look_s, d.look_s);
   EXPECT_EQ(file.mental_rotation_deg_per_s, d.mental_rotation_deg_per_s);
   EXPECT_EQ(file.hand_speed_deg_per_s, d.hand_speed_deg_per_s);
+  EXPECT_EQ(file.pace_log_sigma, d.pace_log_sigma);
 }
 
 TEST(Assistant, RefusesBadConfigsNamingTheKey) {
@@ -226,6 +228,45 @@ TEST(Assistant, TheMonitorsCameraFromTheBusSetsTheMentalRotation) {
               1e-9);
   view.p_WD = Eigen::Vector3d(-2, 0, 2.5);  // facing the person across the robot
   EXPECT_NEAR(a.MonitorDisparityDeg(view), 180.0, 1e-9);
+}
+
+// The pace: every time of a person is p times the model's (closed form at p from the person), p is
+// log-normal with mean 1 and log-spread sigma over many persons, and drawing it changes none of the
+// person's other draws (the same joint the person puts at the same place with and without it).
+TEST(Assistant, APersonsPaceScalesEveryTimeAndNothingElse) {
+  const sim::RobotModel model = Model();
+  AssistantConfig c = Perfect();
+  c.placement_noise_deg = 1.0;  // a draw the pace must not change
+  c.pace_log_sigma = 0.59;
+  c.seed = 11;
+  Assistant paced(model, c);
+  const double p = paced.pace();
+  EXPECT_NE(p, 1.0);
+  EXPECT_NEAR(paced.TravelTime_s(90 * kDegToRad), p * 90.0 / c.hand_speed_deg_per_s, 1e-12);
+  EXPECT_NEAR(paced.JointOverhead_s(), p * c.joint_overhead_s, 1e-12);
+  AssistantConfig unpaced_config = c;
+  unpaced_config.pace_log_sigma = 0;
+  Assistant unpaced(model, unpaced_config);
+  EXPECT_EQ(unpaced.pace(), 1.0);
+  const Viewing view = Overlay(Eigen::Isometry3d::Identity());
+  const JointLook a = paced.Look(1, Deg({0, 0, 0, 0, 0, 0, 0}), Deg({0, 20, 0, 0, 0, 0, 0}), view, kInf);
+  const JointLook b = unpaced.Look(1, Deg({0, 0, 0, 0, 0, 0, 0}), Deg({0, 20, 0, 0, 0, 0, 0}), view, kInf);
+  EXPECT_EQ(a.q_rad, b.q_rad);
+  EXPECT_NEAR(a.time_s, p * b.time_s, 1e-12);
+  // Over 4000 persons: mean 1 (3 standard errors), the log's std sigma (within 3 %).
+  double sum = 0, sum_log = 0, sum_log2 = 0;
+  const int n = 4000;
+  for (int i = 0; i < n; ++i) {
+    c.seed = 1000 + i;
+    const double q = Assistant(model, c).pace();
+    sum += q;
+    sum_log += std::log(q);
+    sum_log2 += std::log(q) * std::log(q);
+  }
+  const double cv = std::sqrt(std::exp(0.59 * 0.59) - 1);
+  EXPECT_NEAR(sum / n, 1.0, 3 * cv / std::sqrt(n));
+  const double mean_log = sum_log / n;
+  EXPECT_NEAR(std::sqrt(sum_log2 / n - mean_log * mean_log), 0.59, 0.03 * 0.59);
 }
 
 // The same seed is the same person making the same choices.
