@@ -124,8 +124,10 @@ void Renderer::Draw(const Mesh& mesh, const Eigen::Isometry3d& X_WC, Target* t) 
     const Eigen::Vector3f& p0 = p_C_[tri.v[0]];
     const Eigen::Vector3f& p1 = p_C_[tri.v[1]];
     const Eigen::Vector3f& p2 = p_C_[tri.v[2]];
-    if (p0.z() < near && p1.z() < near && p2.z() < near) continue;
     const Eigen::Vector3f n_C = R_CW * tri.normal_W;
+    // Geometry far beyond single precision (a pose from the bus thousands of km off) is not drawn.
+    if (!(p0.allFinite() && p1.allFinite() && p2.allFinite() && n_C.allFinite())) continue;
+    if (p0.z() < near && p1.z() < near && p2.z() < near) continue;
     const Eigen::Vector3f centroid_C = (p0 + p1 + p2) * (1.0f / 3.0f);
     const float facing = n_C.dot(centroid_C);  // < 0: front face (camera at C's origin)
     if (options_.cull_back_faces && facing >= 0) continue;

@@ -8,7 +8,8 @@
 /// Conventions (camera_model.h): C has z forward along the principal ray, x right, y down; pixel
 /// (u, v) = K (x/z, y/z, 1); pixel centres are at integers and a pixel is covered when its centre
 /// lies inside a triangle (half-open edges, so shared edges are drawn once). Depth is the z_C
-/// coordinate [m]; triangles are clipped at z_C = near_m; back faces (seen from C) are culled.
+/// coordinate [m]; triangles are clipped at z_C = near_m; back faces (seen from C) are culled; a
+/// triangle with a non-finite vertex or normal in C (float overflow of far-off geometry) is skipped.
 /// The z-test is on 1/z_C, which is affine in (u, v) and so interpolates exactly.
 ///
 /// Overlay (the hologram look): RenderOverlay() draws a mesh (the virtual robot) semi-transparently

@@ -128,6 +128,33 @@ TEST(Renderer, DepthOfAFrontoParallelFaceIsItsDistance) {
   EXPECT_EQ(depth.at<float>(5, 5), 0.0f);  // nothing there
 }
 
+// Geometry beyond single precision (a box 1e300 m off, as a hostile pose on the bus could place it)
+// tessellates to infinities: those triangles are skipped and the rest of the mesh is drawn as
+// without them (found by fuzz_fixed_display: NaN shading cast to a colour byte).
+TEST(Renderer, TrianglesBeyondFloatRangeAreSkipped) {
+  const geometry::Intrinsics K = geometry::Intrinsics::HoloLensPv();
+  Renderer renderer(K);
+  SceneGeometry near_only, with_far;
+  Eigen::Isometry3d X_WG = Eigen::Isometry3d::Identity();
+  X_WG.translation() = Eigen::Vector3d(0, 0, 1.0);
+  near_only.AddBody("box", BodyKind::kSceneObject, ColorBgr{}, Box(Eigen::Vector3d(0.5, 0.5, 0.5), X_WG));
+  with_far.AddBody("box", BodyKind::kSceneObject, ColorBgr{}, Box(Eigen::Vector3d(0.5, 0.5, 0.5), X_WG));
+  Eigen::Isometry3d X_WF = Eigen::Isometry3d::Identity();
+  X_WF.translation() = Eigen::Vector3d(0, 1e300, 1.0);
+  with_far.AddBody("far", BodyKind::kSceneObject, ColorBgr{},
+                   Box(Eigen::Vector3d(1e300, 1e300, 1e300), X_WF));
+  Mesh a, b;
+  Tessellate(near_only, kAllKinds, {}, &a);
+  Tessellate(with_far, kAllKinds, {}, &b);
+  const Eigen::Isometry3d X_WC = geometry::LookAt({0, -2.0, 1.0}, {0, 0, 1.0});
+  cv::Mat bgr_a, bgr_b;
+  renderer.Render(a, X_WC, &bgr_a);
+  const int drawn_a = renderer.last_triangle_count();
+  renderer.Render(b, X_WC, &bgr_b);
+  EXPECT_EQ(renderer.last_triangle_count(), drawn_a);
+  EXPECT_EQ(cv::norm(bgr_a, bgr_b, cv::NORM_INF), 0.0);
+}
+
 TEST(Renderer, NearerObjectWinsWhereTwoOverlapInEitherOrder) {
   const geometry::Intrinsics K = geometry::Intrinsics::HoloLensPv();
   Renderer renderer(K);
