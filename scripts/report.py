@@ -188,8 +188,9 @@ def report(study_dir):
              "<p>Every number here was measured on the emulated testbed over the bus "
              "(scripts/orbed study). Grey columns are the paper's (%s). "
              "Which model parameters were fitted and to what: docs/parameters.md. In the set-up "
-             "half only the assistant's time per joint was fitted (to Table 4's AR execution "
-             "mean); every joint error and the other modes' times are predictions.</p>"
+             "half only the assistant's time per joint and its person-to-person pace were fitted "
+             "(to Table 4's AR execution mean and spread); every joint error and the other modes' "
+             "times are predictions.</p>"
              % html.escape(paper.get("setup_source", paper.get("source", "")))]
     if tables.get("table1"):
         parts.append("<h2>Table 1: ViRAAl landmark misalignment [mm]</h2><table>"
@@ -257,6 +258,11 @@ def report(study_dir):
                     LABELS[mode], fmt(statistics.mean(t)), fmt(statistics.stdev(t) if len(t) > 1 else 0.0),
                     fmt(statistics.mean(a), 2), fmt(statistics.stdev(a) if len(a) > 1 else 0.0, 2)))
         parts.append("</table>")
+    # The page checks itself once loaded: how many of its pictures decoded, as data-images-loaded on
+    # <body> (what a headless browser's DOM dump shows; tests/tools/report_test.sh reads it).
+    parts.append("<script>addEventListener('load', () => { const i = [...document.images]; "
+                 "document.body.dataset.imagesLoaded = i.filter(m => m.complete && m.naturalWidth > 0).length"
+                 " + '/' + i.length; });</script>")
     with open(os.path.join(study_dir, "report.html"), "w") as f:
         f.write("\n".join(parts) + "\n")
 

@@ -1,0 +1,53 @@
+#!/usr/bin/env bash
+# report_test.sh ROOT WORKDIR: scripts/report.py on a study's files (tests/testdata/study: the
+# tables.json and CSVs of a real `scripts/orbed study --registration-share`, seed 1), the page then
+# opened in headless Chromium:
+#   - every picture the page shows decodes in the browser (report.html sets data-images-loaded on
+#     <body> once loaded: "4/4");
+#   - Tables 1-4 are there, and Table 2's means per mode equal the means recomputed here from
+#     setup_joints.csv with Python's statistics module (the page formats them from tables.json);
+#   - a screenshot of the page (WORKDIR/report.png) is a real picture.
+# Needs Debian's chromium and python3-matplotlib (`scripts/orbed setup` installs them).
+set -euo pipefail
+root=$1 work=$2
+rm -rf "$work"
+mkdir -p "$work/study"
+cp "$root"/tests/testdata/study/* "$work/study/"
+/usr/bin/python3 "$root/scripts/report.py" "$work/study" >/dev/null
+for f in joint_errors total_errors joint_rank power; do
+  [[ -s "$work/study/figures/$f.png" ]] || { echo "report_test: no figures/$f.png"; exit 1; }
+done
+
+chrome() {
+  chromium --headless --no-sandbox --disable-gpu --disable-dev-shm-usage --hide-scrollbars \
+    --user-data-dir="$work/profile" --virtual-time-budget=10000 "$@" 2>"$work/chromium.err"
+}
+page="file://$work/study/report.html"
+chrome --dump-dom "$page" >"$work/dom.html"
+chrome --window-size=1200,2400 --screenshot="$work/report.png" "$page" >/dev/null
+
+/usr/bin/python3 - "$work" <<'PY'
+import csv, re, statistics, struct, sys
+work = sys.argv[1]
+dom = open(work + "/dom.html").read()
+m = re.search(r'data-images-loaded="(\d+)/(\d+)"', dom)
+assert m, "the page did not report its pictures (no data-images-loaded on <body>)"
+assert m.group(1) == m.group(2) == "4", "pictures decoded in the browser: %s/%s" % m.groups()
+for heading in ("Table 1", "Table 2", "Table 3", "Table 4"):
+    assert heading in dom, heading + " is missing"
+table2 = dom[dom.index("Table 2"):dom.index("Table 3")]
+rows = list(csv.DictReader(open(work + "/study/setup_joints.csv")))
+labels = {"ar_reflective": "AR + reflective display", "ar": "AR", "fixed": "fixed display"}
+for mode, label in labels.items():
+    mean = statistics.mean(float(r["error_deg"]) for r in rows if r["mode"] == mode)
+    row = re.search(r"<tr><th>%s</th><td>([^<]*)</td>" % re.escape(label), table2)
+    assert row, "no Table 2 row for " + label
+    assert row.group(1) == "%.1f" % mean, "%s: page %s, CSV mean %.1f" % (label, row.group(1), mean)
+png = open(work + "/report.png", "rb").read()
+assert png[:8] == b"\x89PNG\r\n\x1a\n", "the screenshot is no PNG"
+width, height = struct.unpack(">II", png[16:24])
+assert (width, height) == (1200, 2400), "screenshot %dx%d" % (width, height)
+assert len(png) > 50_000, "the screenshot is nearly empty (%d bytes)" % len(png)
+print("report_test: 4/4 pictures decoded, Tables 1-4 present, Table 2 means equal the CSV's, "
+      "screenshot %dx%d (%d bytes)" % (width, height, len(png)))
+PY
