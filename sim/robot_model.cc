@@ -11,6 +11,7 @@
 #include <tinyxml.h>
 #include <urdf_parser/urdf_parser.h>
 
+#include "base/source_paths.h"
 #include "base/units.h"
 #include "base/utf8.h"
 
@@ -138,6 +139,10 @@ std::vector<CollisionPrimitive> FuseCapsules(const std::vector<CollisionPrimitiv
 
 Eigen::VectorXd DegToRad(const Eigen::VectorXd& q_deg) { return q_deg * kDegToRad; }
 Eigen::VectorXd RadToDeg(const Eigen::VectorXd& q_rad) { return q_rad * kRadToDeg; }
+
+RobotModel RobotModel::LoadFlag(const std::string& path) {
+  return LoadFile(path.empty() ? SourceTreePath(kDefaultUrdfRelativePath) : path);
+}
 
 RobotModel RobotModel::LoadFile(const std::string& path, const std::string& flange_link,
                                 const std::string& tool_tip_link) {

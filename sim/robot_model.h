@@ -65,6 +65,9 @@ class RobotModel {
   /// `flange_link` and `tool_tip_link` name F and T; the tool tip may be absent (then T = F).
   static RobotModel LoadFile(const std::string& path, const std::string& flange_link = "iiwa_link_ee",
                              const std::string& tool_tip_link = "tool_tip");
+  /// The model a process's --urdf flag names: `path`, or "" for the shipped one
+  /// (kDefaultUrdfRelativePath under the source tree, base/source_paths.h).
+  static RobotModel LoadFlag(const std::string& path);
   /// The same from a string; `source_name` is used in error messages.
   static RobotModel LoadString(const std::string& urdf_xml, const std::string& source_name,
                                const std::string& flange_link = "iiwa_link_ee",

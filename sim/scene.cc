@@ -4,6 +4,7 @@
 #include <set>
 #include <stdexcept>
 
+#include "base/source_paths.h"
 #include "base/units.h"
 #include "base/yaml_fields.h"
 
@@ -127,6 +128,11 @@ RobotModel LoadRobotForScene(const std::string& urdf_path, const Scene& scene) {
 
 Scene LoadSceneString(const std::string& yaml_text, const std::string& source_name) {
   return LoadScene(YamlFields::LoadString(yaml_text, source_name), source_name);
+}
+
+std::optional<Scene> LoadSceneFlag(const std::string& path) {
+  if (path == "none") return std::nullopt;
+  return LoadSceneFile(path.empty() ? SourceTreePath(kDefaultSceneRelativePath) : path);
 }
 
 }  // namespace orbed::sim

@@ -36,6 +36,7 @@
 ///
 /// Threading: plain data; the loaders are reentrant.
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -88,5 +89,9 @@ Eigen::Matrix3d RotationFromRpyDeg(const Eigen::Vector3d& rpy_deg);
 
 /// The scene shipped in the source tree for the trocar-placement experiment, relative to the root.
 inline constexpr const char* kDefaultSceneRelativePath = "sim/models/scenes/trocar_or.yaml";
+
+/// The scene a tool's --scene flag names: `path`; "" the shipped one (under the source tree,
+/// base/source_paths.h); "none" no scene (the robot alone). Throws as LoadSceneFile.
+std::optional<Scene> LoadSceneFlag(const std::string& path);
 
 }  // namespace orbed::sim

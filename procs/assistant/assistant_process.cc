@@ -67,10 +67,6 @@ std::string SetupResultJson(const SetupResult& r) {
 }
 
 namespace {
-sim::RobotModel LoadModel(const std::string& urdf_path) {
-  return sim::RobotModel::LoadFile(
-      urdf_path.empty() ? SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath) : urdf_path);
-}
 AssistantConfig LoadConfig(const AssistantOptions& o) {
   AssistantConfig c =
       LoadAssistantConfig(o.config_path.empty() ? SourceTreePath(kDefaultConfigRelativePath) : o.config_path);
@@ -81,7 +77,7 @@ AssistantConfig LoadConfig(const AssistantOptions& o) {
 
 AssistantProcess::AssistantProcess(const CommonFlags& flags, const AssistantOptions& options)
     : process_(flags),
-      model_(LoadModel(options.urdf_path)),
+      model_(sim::RobotModel::LoadFlag(options.urdf_path)),
       options_(options),
       assistant_(model_, LoadConfig(options)) {
   process_.Subscribe<orbed::guidance_t>(

@@ -4,29 +4,19 @@
 
 #include <CLI/CLI.hpp>
 
-#include "base/source_paths.h"
 #include "procs/common/conversions.h"
 #include "procs/common/flags.h"
 #include "procs/common/log.h"
 #include "procs/drake_viewer/viewer_messages.h"
 
 namespace orbed::viewer {
-namespace {
-
-std::optional<sim::Scene> LoadScene(const std::string& path) {
-  if (path == "none") return std::nullopt;
-  return sim::LoadSceneFile(path.empty() ? SourceTreePath(sim::kDefaultSceneRelativePath) : path);
-}
-
-}  // namespace
+namespace {}  // namespace
 
 ViewerBridge::ViewerBridge(const CommonFlags& flags, const ViewerOptions& options)
     : process_(flags),
       options_(options),
-      scene_(LoadScene(options.scene_path)),
-      model_(sim::RobotModel::LoadFile(options.urdf_path.empty()
-                                           ? SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath)
-                                           : options.urdf_path)),
+      scene_(sim::LoadSceneFlag(options.scene_path)),
+      model_(sim::RobotModel::LoadFlag(options.urdf_path)),
       poses_(
           &process_, model_,
           {options.robot_state_channel, options.registration_channel, options.guidance_channel, "HMD_POSE"}) {

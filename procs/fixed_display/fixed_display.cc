@@ -12,7 +12,6 @@
 #include "base/format.h"
 #include "base/number_list.h"
 #include "base/replace_file.h"
-#include "base/source_paths.h"
 #include "base/units.h"
 #include "procs/common/conversions.h"
 #include "procs/common/flags.h"
@@ -23,11 +22,6 @@ namespace orbed::fixed_display {
 namespace {
 
 constexpr char kWindowName[] = "orbed-fixed-display";
-
-std::optional<sim::Scene> LoadScene(const std::string& path) {
-  if (path == "none") return std::nullopt;
-  return sim::LoadSceneFile(path.empty() ? SourceTreePath(sim::kDefaultSceneRelativePath) : path);
-}
 
 bool SameView(const OrbitView& a, const OrbitView& b) {
   return a.azimuth_rad == b.azimuth_rad && a.elevation_rad == b.elevation_rad && a.distance_m == b.distance_m;
@@ -43,10 +37,8 @@ std::string Caption(const OrbitView& v) {
 FixedDisplay::FixedDisplay(const CommonFlags& flags, const FixedDisplayOptions& options)
     : process_(flags),
       options_(options),
-      model_(sim::RobotModel::LoadFile(options.urdf_path.empty()
-                                           ? SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath)
-                                           : options.urdf_path)),
-      scene_(LoadScene(options.scene_path)),
+      model_(sim::RobotModel::LoadFlag(options.urdf_path)),
+      scene_(sim::LoadSceneFlag(options.scene_path)),
       poses_(&process_, model_,
              {options.robot_state_channel, "REGISTRATION", options.guidance_channel, "HMD_POSE"},
              {nullptr,

@@ -9,7 +9,6 @@
 #include <orbed/registration_t.hpp>
 
 #include "base/format.h"
-#include "base/source_paths.h"
 #include "procs/common/channels.h"
 #include "procs/common/conversions.h"
 #include "procs/common/flags.h"
@@ -22,11 +21,6 @@
 namespace orbed::foxglove {
 namespace {
 
-std::optional<sim::Scene> LoadScene(const std::string& path) {
-  if (path == "none") return std::nullopt;
-  return sim::LoadSceneFile(path.empty() ? SourceTreePath(sim::kDefaultSceneRelativePath) : path);
-}
-
 nlohmann::json PoseJson(const Eigen::Isometry3d& X) {
   const Eigen::Quaterniond q(X.linear());
   return {{"position", {{"x", X.translation().x()}, {"y", X.translation().y()}, {"z", X.translation().z()}}},
@@ -38,10 +32,8 @@ nlohmann::json PoseJson(const Eigen::Isometry3d& X) {
 FoxgloveBridge::FoxgloveBridge(const CommonFlags& flags, const BridgeOptions& options)
     : process_(flags),
       options_(options),
-      model_(sim::RobotModel::LoadFile(options.urdf_path.empty()
-                                           ? SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath)
-                                           : options.urdf_path)),
-      scene_(LoadScene(options.scene_path)),
+      model_(sim::RobotModel::LoadFlag(options.urdf_path)),
+      scene_(sim::LoadSceneFlag(options.scene_path)),
       server_(options.server,
               [this](const ServerEvent& e) {
                 if (e.kind == ServerEvent::kConnected)

@@ -27,16 +27,11 @@ namespace {
 // The sim clamps to the limits; this absorbs rounding (as orbed-hmd).
 constexpr double kJointLimitSlackRad = 0.01;
 
-sim::RobotModel LoadModel(const std::string& urdf_path) {
-  return sim::RobotModel::LoadFile(
-      urdf_path.empty() ? SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath) : urdf_path);
-}
-
 }  // namespace
 
 GuidanceProcess::GuidanceProcess(const CommonFlags& flags, const GuidanceOptions& options)
     : process_(flags),
-      model_(LoadModel(options.urdf_path)),
+      model_(sim::RobotModel::LoadFlag(options.urdf_path)),
       core_(options.target.q_target_rad.size() > 0
                 ? std::optional<GuidanceCore>(GuidanceCore(model_, options.target))
                 : std::nullopt),
@@ -209,9 +204,7 @@ int RunGuidance(int argc, const char* const* argv, std::ostream& out, std::ostre
   }
   try {
     if (!plan_path.empty()) {
-      const sim::RobotModel model = sim::RobotModel::LoadFile(
-          options.urdf_path.empty() ? SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath)
-                                    : options.urdf_path);
+      const sim::RobotModel model = sim::RobotModel::LoadFlag(options.urdf_path);
       options.target.q_target_rad = ReadPlanTarget(plan_path, plan_target, model.num_joints());
     }
     GuidanceProcess guidance(common, options);

@@ -15,7 +15,6 @@
 #include <orbed/target_pose_t.hpp>
 
 #include "base/format.h"
-#include "base/source_paths.h"
 #include "procs/common/alignment_trial.h"
 #include "procs/common/channels.h"
 #include "procs/common/conversions.h"
@@ -78,9 +77,7 @@ std::vector<std::pair<std::string, Eigen::Isometry3d>> RobotFrames(const sim::Ro
 IgtlBridge::IgtlBridge(const CommonFlags& flags, const BridgeOptions& options)
     : process_(flags),
       options_(options),
-      model_(sim::RobotModel::LoadFile(options.urdf_path.empty()
-                                           ? SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath)
-                                           : options.urdf_path)),
+      model_(sim::RobotModel::LoadFlag(options.urdf_path)),
       server_(options.server),
       poses_(&process_, model_, sim::TestbedPoses::Channels{}) {
   for (const sim::RobotLink& link : model_.links())
