@@ -245,12 +245,7 @@ HmdProcess::HologramShown HmdProcess::Hologram() const {
     return shown;
   }
   // An alignment session in progress aligns the hologram at the real arm's joints.
-  if (session_.state().active()) return shown;
-  if (!guidance_ ||
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - guidance_received_).count() >
-          kGuidanceFreshS) {
-    return shown;
-  }
+  if (session_.state().active() || !FreshGuidance()) return shown;
   if (guidance_->mode == orbed::guidance_t::MODE_FIXED_DISPLAY) {
     shown.hidden = shown.reflective_hidden = true;
     return shown;
@@ -439,20 +434,18 @@ void HmdProcess::TurnArmJoint(int joint, double delta_rad) {
     interactive_->SetEvent("cannot turn a joint yet: no " + options_.iiwa_status_channel);
     return;
   }
-  // Presses on one joint add up on the last command (the arm may still be moving); turning another
-  // joint starts from the measured joints.
-  if (arm_command_q_.size() != robot_.q_rad.size() || joint != arm_command_joint_)
-    arm_command_q_ = robot_.q_rad;
-  arm_command_joint_ = joint;
-  const Eigen::VectorXd lower = robot_model_->lower_limits_rad(), upper = robot_model_->upper_limits_rad();
-  arm_command_q_[joint] = std::clamp(arm_command_q_[joint] + delta_rad, lower[joint], upper[joint]);
+  // Every press starts from the arm as measured, so nothing else the arm did since is undone and a
+  // press back after a collision stop backs it out.
+  Eigen::VectorXd q = robot_.q_rad;
+  q[joint] = std::clamp(q[joint] + delta_rad, robot_model_->lower_limits_rad()[joint],
+                        robot_model_->upper_limits_rad()[joint]);
   orbed::iiwa_command_t command{};
   command.utime = NowMicros();
-  command.num_joints = static_cast<int32_t>(arm_command_q_.size());
-  command.joint_position = FromVectorX(arm_command_q_);
+  command.num_joints = static_cast<int32_t>(q.size());
+  command.joint_position = FromVectorX(q);
   process_->Publish(options_.iiwa_command_channel, command);
   char text[96];
-  std::snprintf(text, sizeof(text), "joint %d to %+.1f deg", joint + 1, arm_command_q_[joint] * kRadToDeg);
+  std::snprintf(text, sizeof(text), "joint %d to %+.1f deg", joint + 1, q[joint] * kRadToDeg);
   interactive_->SetEvent(text);
 }
 
@@ -460,9 +453,8 @@ void HmdProcess::TurnArmJoint(int joint, double delta_rad) {
 void HmdProcess::EditTarget(std::optional<std::pair<int, double>> turn) {
   if (!interactive_->editing_target()) return;
   if (planned_target_q_.size() == 0) {
-    const std::string shown = GuidanceStatus();
-    if (!shown.empty()) {
-      planned_target_q_ = ToVectorX(guidance_->target_position);
+    if (const orbed::guidance_t* guidance = FreshGuidance()) {
+      planned_target_q_ = ToVectorX(guidance->target_position);
     } else if (robot_.have_q) {
       planned_target_q_ = robot_.q_rad;
     } else {
@@ -487,7 +479,7 @@ void HmdProcess::SendPlannedTarget() {
   task.utime = NowMicros();
   task.request_id = task.utime;
   task.task_id = "interactive-" + std::to_string(++planned_targets_sent_);
-  task.mode = GuidanceStatus().empty() ? +orbed::guidance_t::MODE_AR : guidance_->mode;
+  task.mode = FreshGuidance() ? guidance_->mode : +orbed::guidance_t::MODE_AR;
   task.num_joints = static_cast<int32_t>(planned_target_q_.size());
   task.target_position = FromVectorX(planned_target_q_);
   process_->Publish(options_.setup_task_channel, task);
@@ -495,14 +487,15 @@ void HmdProcess::SendPlannedTarget() {
   ORBED_LOG(kInfo) << interactive_->last_event();
 }
 
+const orbed::guidance_t* HmdProcess::FreshGuidance() const {
+  const double age_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - guidance_received_).count();
+  return guidance_ && age_s <= kGuidanceFreshS ? &*guidance_ : nullptr;
+}
+
 std::string HmdProcess::GuidanceStatus() const {
-  if (!guidance_ ||
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - guidance_received_).count() >
-          kGuidanceFreshS) {
-    return "";
-  }
-  return GuidanceLine(guidance::GuidanceModeName(guidance_->mode), guidance_->error_deg,
-                      guidance_->next_joint, guidance_->done);
+  const orbed::guidance_t* g = FreshGuidance();
+  return g ? GuidanceLine(guidance::GuidanceModeName(g->mode), g->error_deg, g->next_joint, g->done) : "";
 }
 
 void HmdProcess::SubmitInteractiveTrial() {

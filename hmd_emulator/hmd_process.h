@@ -22,8 +22,8 @@
 ///               GAZE_RAY (gaze_ray_t) at hmd.gaze_hz (pose_stream.h);
 ///               ALIGNMENT_TRIAL (alignment_trial_t): one per accepted REQUEST_TRIAL (emulated user)
 ///               or Enter (interactive); IIWA_COMMAND (interactive, keys , and .: the measured joints
-///               with the selected one turned by the rotation step, within the model's limits;
-///               presses on one joint add up on the last command); SETUP_TASK (interactive, t then
+///               with the selected one turned by the rotation step, within the model's limits);
+///               SETUP_TASK (interactive, t then
 ///               Enter: the planned target, task id "interactive-<n>", the guidance's mode or ar);
 ///               SESSION_CONTROL START once, for a local session, when a person submits in interactive mode
 ///               with no session active; PROCESS_STATUS at 1 Hz.
@@ -179,10 +179,8 @@ class HmdProcess {
   /// Waits until the worker has finished every pending request (no-op inline).
   void Flush();
 
-  /// What the hologram shows: the real arm's joints (q_rad empty) during an alignment session or
-  /// when no GUIDANCE came in the last kGuidanceFreshS, else GUIDANCE's target (ar, ar_reflective)
-  /// or nothing (hidden: fixed display).
-  /// What the hologram shows now. During a set-up (a GUIDANCE fresher than kGuidanceFreshS, no
+  /// What the hologram shows now. A person planning a target (interactive, t): that target in
+  /// AR_VIEW and the displays. Else during a set-up (a GUIDANCE fresher than kGuidanceFreshS, no
   /// alignment session): ar: AR_VIEW at the target, the displays without a hologram (the mode has
   /// none); ar_reflective: both at the target; fixed: neither (the guidance is on the monitor).
   /// Otherwise the real arm's joints everywhere (empty q: the joints of the frame drawn on).
@@ -214,6 +212,8 @@ class HmdProcess {
   void EditTarget(std::optional<std::pair<int, double>> turn);
   void SendPlannedTarget();
   std::string GuidanceStatus() const;
+  /// The latest valid GUIDANCE if it came within kGuidanceFreshS, else null.
+  const orbed::guidance_t* FreshGuidance() const;
   void PublishTrial(const Eigen::Isometry3d& X_WV, double duration_s, const std::string& user_id,
                     const TrackingFaultRecord& faults = {});
   void PublishEmulatedTrial(const TrialOutcome& outcome);
@@ -242,10 +242,6 @@ class HmdProcess {
   std::string user_id_;
   // An emulated trial waiting for its tracking faults to play on HMD_POSE (see the file comment).
   std::optional<TrialOutcome> pending_trial_;
-  // The arm as the person commands it (interactive): the joints last sent on IIWA_COMMAND, so that
-  // presses on one joint add up while the arm is still moving, and the joint they turned.
-  Eigen::VectorXd arm_command_q_;
-  int arm_command_joint_{-1};
   // The target the person plans (interactive, key t): drawn as the hologram while planning.
   Eigen::VectorXd planned_target_q_;
   int planned_targets_sent_{0};

@@ -801,8 +801,8 @@ TEST(HmdProcess, TheHologramShowsTheGuidancesTarget) {
 }
 
 // The person as the set-up assistant: a digit selects a joint, , and . turn it by the rotation step
-// through IIWA_COMMAND (the measured joints, the selected one turned; presses on one joint add up;
-// the model's limits hold); the guidance shows as one status line.
+// through IIWA_COMMAND (each press from the measured joints; the model's limits hold); the guidance
+// shows as one status line; t plans a target instead.
 TEST(HmdProcess, InteractiveKeysTurnAJointOfTheRealArm) {
   HmdOptions options = Inline();
   options.interactive = true;
@@ -827,7 +827,7 @@ TEST(HmdProcess, InteractiveKeysTurnAJointOfTheRealArm) {
   hmd.HandleKey(',');
   Drain(lcm);
   ASSERT_EQ(commands.seen.size(), 3u);
-  const std::vector<double> turned = {0.5, 1.0, 0.5};  // the default step, 0.5 deg
+  const std::vector<double> turned = {0.5, 0.5, -0.5};  // the default step from the measured q
   for (size_t k = 0; k < 3; ++k) {
     ASSERT_EQ(commands.seen[k].num_joints, 7);
     for (int i = 0; i < 7; ++i) {
@@ -836,11 +836,16 @@ TEST(HmdProcess, InteractiveKeysTurnAJointOfTheRealArm) {
     }
   }
   for (int i = 0; i < 5; ++i) hmd.HandleKey('=');  // 10 deg steps (the cap)
+  std::vector<double> near_limit = kQDeg;
+  near_limit[1] = 115;
+  const auto moved = Status(near_limit);
+  lcm.publish("IIWA_STATUS", &moved);
+  Drain(lcm);
   hmd.HandleKey('2');
-  for (int i = 0; i < 12; ++i) hmd.HandleKey('.');  // 30 + 120 deg: held at joint 2's 120 deg limit
+  hmd.HandleKey('.');  // 115 + 10 deg: held at joint 2's 120 deg limit
   Drain(lcm);
   EXPECT_NEAR(commands.seen.back().joint_position[1], 120 * kDegToRad, 1e-12);
-  EXPECT_NEAR(commands.seen.back().joint_position[2], 0.0, 1e-12);  // another joint: from the measured q
+  EXPECT_NEAR(commands.seen.back().joint_position[2], 0.0, 1e-12);  // the others as measured
   const size_t sent = commands.seen.size();
   hmd.HandleKey('8');  // the iiwa has 7 joints: nothing
   hmd.HandleKey('.');

@@ -136,6 +136,7 @@ void Renderer::Draw(const Mesh& mesh, const Eigen::Isometry3d& X_WC, Target* t) 
     const float centroid_dist = centroid_C.norm();
     const float n_dot_eye = centroid_dist > 0 ? std::abs(facing) / centroid_dist : 1.0f;
     float shade = ambient + key * std::max(0.0f, tri.normal_W.dot(light_W_)) + head * n_dot_eye;
+    if (!std::isfinite(shade)) continue;  // finite vertices whose sums overflow (near FLT_MAX)
     shade = std::min(shade, 1.0f);
     const std::uint8_t color[3] = {static_cast<std::uint8_t>(tri.color.b * shade + 0.5f),
                                    static_cast<std::uint8_t>(tri.color.g * shade + 0.5f),

@@ -1,9 +1,9 @@
 #pragma once
 /// @file
-/// A z-buffered software rasteriser for the HMD camera: renders a tessellated scene (Mesh, in W)
-/// from a camera at X_WC with pinhole geometry::Intrinsics into an 8-bit BGR cv::Mat, flat Lambert-shaded
-/// (ambient + a key light fixed in W + a headlight at the camera), optionally with a depth image
-/// and a body-id image. OpenCV is used only for the image containers and JPEG coding.
+/// A z-buffered software rasteriser for the testbed's cameras (the headset's, the fixed monitor's): renders a
+/// tessellated scene (Mesh, in W) from a camera at X_WC with pinhole geometry::Intrinsics into an 8-bit BGR
+/// cv::Mat, flat Lambert-shaded (ambient + a key light fixed in W + a headlight at the camera), optionally
+/// with a depth image and a body-id image. OpenCV is used only for the image containers and JPEG coding.
 ///
 /// Conventions (camera_model.h): C has z forward along the principal ray, x right, y down; pixel
 /// (u, v) = K (x/z, y/z, 1); pixel centres are at integers and a pixel is covered when its centre

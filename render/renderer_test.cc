@@ -143,6 +143,10 @@ TEST(Renderer, TrianglesBeyondFloatRangeAreSkipped) {
   X_WF.translation() = Eigen::Vector3d(0, 1e300, 1.0);
   with_far.AddBody("far", BodyKind::kSceneObject, ColorBgr{},
                    Box(Eigen::Vector3d(1e300, 1e300, 1e300), X_WF));
+  // Finite in single precision, but their centroid's sum overflows: skipped too.
+  Eigen::Isometry3d X_WN = Eigen::Isometry3d::Identity();
+  X_WN.translation() = Eigen::Vector3d(0, 2e38, 1.0);
+  with_far.AddBody("near_max", BodyKind::kSceneObject, ColorBgr{}, Box(Eigen::Vector3d(1, 1, 1), X_WN));
   Mesh a, b;
   Tessellate(near_only, kAllKinds, {}, &a);
   Tessellate(with_far, kAllKinds, {}, &b);

@@ -1,6 +1,7 @@
 #pragma once
 /// @file
-/// The world-frame geometry the HMD sees and ray-casts against: the OR scene's objects, the real
+/// The world-frame geometry a camera sees (the headset's, the fixed monitor's) and the headset
+/// ray-casts against: the OR scene's objects, the real
 /// robot's link collision primitives posed by forward kinematics at X_WR, and the virtual robot's at
 /// X_WV. One Body per scene object and per robot link with geometry (so links are told apart in the
 /// image and in gaze hits); each body has a name, a kind and a colour. Tessellate() turns the

@@ -259,7 +259,7 @@ def report(study_dir):
                     fmt(statistics.mean(a), 2), fmt(statistics.stdev(a) if len(a) > 1 else 0.0, 2)))
         parts.append("</table>")
     # The page checks itself once loaded: how many of its pictures decoded, as data-images-loaded on
-    # <body> (what a headless browser's DOM dump shows; tests/tools/report_test.sh reads it).
+    # <body> (what a headless browser's DOM dump shows; tests/report_test.sh reads it).
     parts.append("<script>addEventListener('load', () => { const i = [...document.images]; "
                  "document.body.dataset.imagesLoaded = i.filter(m => m.complete && m.naturalWidth > 0).length"
                  " + '/' + i.length; });</script>")

@@ -3,11 +3,12 @@
 /// TestbedPoses: the testbed's latest poses as the bridges to other tools need them (Drake's
 /// viewer, OpenIGTLink, Foxglove), subscribed and checked in one place:
 ///   ROBOT_STATE   X_WR and the real joints q (CheckRobotState); refused: "ROBOT_STATE/field"
-///   REGISTRATION  the latest valid X_WV_mean (the registered virtual robot); invalid states (no
-///                 mean yet) are skipped; refused: "REGISTRATION/pose"
+///   REGISTRATION  the latest valid X_WV_mean (the registered virtual robot; a world pose,
+///                 CheckWorldPose); invalid states (no mean yet) are skipped; refused: "REGISTRATION/pose"
 ///   GUIDANCE      its target configuration: the virtual robot's during a set-up (CheckGuidance
 ///                 with 0.01 rad of slack); refused: "GUIDANCE/field"
-///   HMD_POSE      the headset X_WH and its camera X_WC (the SLAM estimate); refused: "HMD_POSE/pose"
+///   HMD_POSE      the headset X_WH and its camera X_WC (the SLAM estimate; world poses);
+///                 refused: "HMD_POSE/pose"
 /// Each optional callback runs after its message was stored (e.g. to forward it).
 ///
 /// Threading: handlers run on the Process::Run thread; read from that thread.
@@ -27,7 +28,7 @@ namespace orbed::sim {
 
 class TestbedPoses {
  public:
-  /// The channels (defaults: procs/common/channels.h).
+  /// The channels (defaults: procs/common/channels.h); one named "" is not subscribed.
   struct Channels {
     std::string robot_state{"ROBOT_STATE"};
     std::string registration{"REGISTRATION"};

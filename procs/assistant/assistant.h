@@ -123,7 +123,7 @@ struct JointLook {
   double q_rad{0};    ///< where the hand put the joint (within its limits)
   double aim_rad{0};  ///< where the person meant to put it (before the hand's noise)
   int ranges{0};      ///< separate ranges of angles that looked right
-  double time_s{0};   ///< look_s (+ the mental rotation on the monitor)
+  double time_s{0};   ///< (look_s + the mental rotation on the monitor) times the pace
 };
 
 /// A point of a body's skeleton in its link frame.

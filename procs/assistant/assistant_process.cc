@@ -32,6 +32,11 @@ namespace {
 // The sim clamps to the limits; this absorbs rounding (as orbed-hmd and orbed-guidance).
 constexpr double kJointLimitSlackRad = 0.01;
 
+// The distances from the base at which FIXED_VIEW's camera is taken as the monitor's [m]
+// (orbed-fixed-display's orbit keeps 0.8-6 m from a point 0.5 m above the base).
+constexpr double kMinMonitorDistance_m = 0.3;
+constexpr double kMaxMonitorDistance_m = 20.0;
+
 double SteadySeconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
@@ -128,8 +133,7 @@ AssistantProcess::AssistantProcess(const CommonFlags& flags, const AssistantOpti
   };
   process_.Subscribe<orbed::image_t>(
       options_.fixed_view_channel, [this](const orbed::image_t& msg, const std::string& channel, int64_t) {
-        std::string problem = CheckImage(msg);
-        if (problem.empty()) problem = CheckPose(msg.X_WC, "FIXED_VIEW.X_WC");
+        const std::string problem = CheckImage(msg);
         if (!problem.empty()) return process_.Reject(channel + "/field", problem);
         const Eigen::Vector3d p_WD = FromPose(msg.X_WC).translation();
         if (!p_WD_ || (p_WD - *p_WD_).norm() > 1e-6) {
@@ -173,7 +177,11 @@ Viewing AssistantProcess::CurrentView() const {
   view.X_WR = *X_WR_;
   view.X_WV_seen = (A_ ? *A_ : Eigen::Isometry3d::Identity()) * (X_WV_ ? *X_WV_ : *X_WR_);
   view.p_WE = p_WE_ ? *p_WE_ : assistant_.config().eye_position_m;
-  if (p_WD_ && SteadySeconds() - p_WD_received_s_ <= options_.fixed_view_stale_s) view.p_WD = p_WD_;
+  // A monitor camera on or far from the robot is no view of it: the configured one instead.
+  if (p_WD_ && SteadySeconds() - p_WD_received_s_ <= options_.fixed_view_stale_s) {
+    const double d_m = (*p_WD_ - X_WR_->translation()).norm();
+    if (d_m >= kMinMonitorDistance_m && d_m <= kMaxMonitorDistance_m) view.p_WD = p_WD_;
+  }
   return view;
 }
 

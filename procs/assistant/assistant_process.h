@@ -12,7 +12,8 @@
 ///               drawn), HMD_POSE and HMD_POSE_TRUTH (optional: the pair of one seq gives the eye,
 ///               and the SLAM error A = X_WH_true · X_WH_est⁻¹ that moves the hologram in the world),
 ///               FIXED_VIEW (optional, orbed-fixed-display: the monitor's camera position is its X_WC's,
-///               while one came within fixed_view_stale_s; else the config's monitor.camera_m).
+///               while one came within fixed_view_stale_s and it lies 0.3-20 m from the base; else
+///               the config's monitor.camera_m).
 ///   Publishes:  IIWA_COMMAND (the measured q with the joint being moved set to where the person
 ///               puts it; re-sent every command_resend_s until the arm is there and at rest, or
 ///               stopped by a limit or a collision: then the joint stays where the sim stopped it).

@@ -86,7 +86,7 @@ std::variant<MisalignmentRequest, Refusal> CheckMisalignmentRequest(const orbed:
 
 std::string CheckRobotState(const orbed::robot_state_t& msg, int num_joints) {
   return FirstError(
-      {CheckPose(msg.X_WR, "ROBOT_STATE.X_WR"),
+      {CheckWorldPose(msg.X_WR, "ROBOT_STATE.X_WR"),
        CheckSize(msg.num_joints, num_joints, "ROBOT_STATE.num_joints"),
        CheckLength(msg.num_joints, msg.joint_position.size(), num_joints, "ROBOT_STATE.num_joints"),
        CheckLength(msg.num_joints, msg.joint_limit_hit.size(), num_joints, "ROBOT_STATE.joint_limit_hit"),
@@ -103,7 +103,7 @@ std::string CheckImage(const orbed::image_t& msg) {
   if (msg.num_bytes != static_cast<int64_t>(msg.data.size())) return "image: num_bytes differs from the data";
   if (!(msg.fx_px > 0) || !(msg.fy_px > 0) || !std::isfinite(msg.fx_px) || !std::isfinite(msg.fy_px))
     return "image: fx_px, fy_px must be finite and > 0";
-  const std::string pose = CheckPose(msg.X_WC, "image.X_WC");
+  const std::string pose = CheckWorldPose(msg.X_WC, "image.X_WC");
   if (!pose.empty()) return pose;
   if (msg.pixel_format == orbed::image_t::FORMAT_JPEG) return "";
   const int channels = msg.pixel_format == orbed::image_t::FORMAT_GRAY8 ? 1 : 3;

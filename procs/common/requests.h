@@ -15,8 +15,9 @@
 ///                                          of 0 (origins [m], directions). Key: invalid.
 ///   MISALIGNMENT_REQUEST (misalignment_request_t)  num_pairs in [0, max_pairs], equal to both
 ///                                          arrays' lengths; rows as above [m]. Key: invalid.
-///   ROBOT_STATE (robot_state_t), read by the conductors, the assistant and the viewer bridge:
-///                                          X_WR a valid pose; num_joints == the arm's and equal to
+///   ROBOT_STATE (robot_state_t), read by the conductors, the assistant, the bridges and the
+///                                          fixed display: X_WR a valid world pose (CheckWorldPose:
+///                                          within 10 km of W's origin); num_joints == the arm's and equal to
 ///                                          the joint arrays' lengths; finite angles [rad]; num_links
 ///                                          equal to the link arrays' lengths and at most kMaxLinks;
 ///                                          motion_state in range. The reason names the field.
@@ -24,9 +25,10 @@
 ///                                          (no pair checked), never NaN or −inf; num_contacts and
 ///                                          num_links equal to their arrays' lengths, at most
 ///                                          kMaxRobotStateLinks. The reason names the field.
-///   HMD_CAMERA, AR_VIEW, REFLECTIVE_VIEW.image (image_t), read by the bridges: width and height in
-///                                          1..kMaxImageSide [px]; num_bytes equal to the data's length;
-///                                          fx_px, fy_px finite and > 0; X_WC a valid pose; a known
+///   HMD_CAMERA, AR_VIEW, REFLECTIVE_VIEW.image, FIXED_VIEW (image_t), read by the bridges and the
+///                                          assistant: width and height in 1..kMaxImageSide [px];
+///                                          num_bytes equal to the data's length; fx_px, fy_px finite
+///                                          and > 0; X_WC a valid world pose; a known
 ///                                          pixel_format; raw formats: row_stride * height == num_bytes
 ///                                          and rows at least width pixels. The reason names the field.
 /// Whether a landmark's rays can be triangulated, or pairs evaluated, is the server's computation,

@@ -37,6 +37,14 @@ TEST(Requests, RobotState) {
             std::string::npos);
   EXPECT_NE(reason([](auto& m) { m.X_WR.quaternion_wxyz[0] = 0.5; }).find("X_WR"), std::string::npos);
   EXPECT_NE(reason([](auto& m) { m.motion_state = 9; }).find("motion_state"), std::string::npos);
+  // A base beyond 10 km of the world origin is no place (and would overflow a renderer's floats).
+  EXPECT_EQ(reason([](auto& m) { m.X_WR.position_m[1] = -9999.0; }), "");
+  EXPECT_NE(reason([](auto& m) {
+              m.X_WR.position_m[0] = 6000;
+              m.X_WR.position_m[1] = 8000.1;
+            }).find("beyond 10000 m"),
+            std::string::npos);
+  EXPECT_NE(reason([](auto& m) { m.X_WR.position_m[2] = 2e38; }).find("X_WR.position_m"), std::string::npos);
   EXPECT_NE(reason([](auto& m) { m.num_links = 1; }).find("num_links"), std::string::npos);
   EXPECT_NE(reason([](auto& m) {
               m.num_links = kMaxRobotStateLinks + 1;

@@ -71,6 +71,21 @@ std::string CheckPose(const orbed::pose_t& pose, const std::string& what) {
                      CheckUnitQuaternion(pose.quaternion_wxyz, what + ".quaternion_wxyz")});
 }
 
+std::string CheckWorldPose(const orbed::pose_t& pose, const std::string& what) {
+  std::string error = CheckPose(pose, what);
+  if (!error.empty()) return error;
+  const double d =
+      std::sqrt(pose.position_m[0] * pose.position_m[0] + pose.position_m[1] * pose.position_m[1] +
+                pose.position_m[2] * pose.position_m[2]);
+  if (d > kMaxWorldDistance_m) {
+    std::ostringstream out;
+    out << what << ".position_m is " << d << " m from the world origin, beyond " << kMaxWorldDistance_m
+        << " m";
+    return out.str();
+  }
+  return "";
+}
+
 std::string CheckEnum(int64_t value, int64_t lo, int64_t hi, const std::string& what) {
   if (value >= lo && value <= hi) return "";
   std::ostringstream out;

@@ -35,6 +35,12 @@ std::string CheckUnitQuaternion(const double q_wxyz[4], const std::string& what,
                                 double tolerance = kUnitQuaternionTolerance);
 /// Finite position and unit quaternion.
 std::string CheckPose(const orbed::pose_t& pose, const std::string& what);
+/// Any operating room, and any lab around it, lies within this of its world origin [m]; farther
+/// positions are not a place but a hostile or broken message (and overflow single precision when
+/// drawn).
+inline constexpr double kMaxWorldDistance_m = 1e4;
+/// CheckPose, and the position within kMaxWorldDistance_m of W's origin: a pose in the world frame.
+std::string CheckWorldPose(const orbed::pose_t& pose, const std::string& what);
 /// Integer enum value in [lo, hi].
 std::string CheckEnum(int64_t value, int64_t lo, int64_t hi, const std::string& what);
 /// Each value within [lower[i], upper[i]] (inclusive, plus `slack`); sizes must agree.

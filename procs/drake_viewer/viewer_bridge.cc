@@ -10,8 +10,6 @@
 #include "procs/drake_viewer/viewer_messages.h"
 
 namespace orbed::viewer {
-namespace {}  // namespace
-
 ViewerBridge::ViewerBridge(const CommonFlags& flags, const ViewerOptions& options)
     : process_(flags),
       options_(options),

@@ -39,8 +39,7 @@ FixedDisplay::FixedDisplay(const CommonFlags& flags, const FixedDisplayOptions& 
       options_(options),
       model_(sim::RobotModel::LoadFlag(options.urdf_path)),
       scene_(sim::LoadSceneFlag(options.scene_path)),
-      poses_(&process_, model_,
-             {options.robot_state_channel, "REGISTRATION", options.guidance_channel, "HMD_POSE"},
+      poses_(&process_, model_, {options.robot_state_channel, "", options.guidance_channel, ""},
              {nullptr,
               [this](const orbed::guidance_t& g) {
                 q_target_ = ToVectorX(g.target_position);

@@ -1,6 +1,7 @@
 // The fixed monitor. Oracles: the orbit's closed form (the camera at the configured point, looking
-// at the centre), the keys' stated steps, the pinhole projection of the robot's flange computed
-// here from the model's forward kinematics (the picture shows a robot body exactly there), and
+// at the centre), the keys' stated steps, the pinhole projection of the robot's wrist (link 6's
+// origin) computed here from the model's forward kinematics (the picture shows a robot body exactly
+// there), and
 // procs/assistant/assistant.yaml (the emulated assistant's monitor camera is this default).
 #include <cmath>
 #include <string>
@@ -144,15 +145,14 @@ orbed::guidance_t Guidance(const sim::RobotModel& model, int8_t mode, const Eige
 }
 
 TEST(FixedDisplayProcess, PublishesTheTargetInTheFixedModeRenderedOnceFromTheHomeCamera) {
-  CommonFlags flags("fixed-display-test");
-  flags.lcm_url = "memq://";
-  flags.duration_s = 1.0;  // the messages below are queued before Run and handled at its start
-  FixedDisplayOptions options;
-  options.rate_hz = 40;
-  options.stale_after_s = 3600;  // however slowly this machine runs
-  FixedDisplay display(flags, options);
   const sim::RobotModel model = Model();
   const sim::Scene scene = sim::LoadSceneFile(SourceTreePath(sim::kDefaultSceneRelativePath));
+  CommonFlags flags("fixed-display-test");
+  flags.lcm_url = "memq://";
+  flags.duration_s = 2.0;  // counted from here: the messages below are queued and handled at Run's start
+  FixedDisplayOptions options;
+  options.stale_after_s = 3600;  // however slowly this machine runs
+  FixedDisplay display(flags, options);
   struct Collector {
     std::vector<orbed::image_t> seen;
     void On(const lcm::ReceiveBuffer*, const std::string&, const orbed::image_t* msg) {
@@ -170,36 +170,41 @@ TEST(FixedDisplayProcess, PublishesTheTargetInTheFixedModeRenderedOnceFromTheHom
   lcm.publish("GUIDANCE", &good);
   EXPECT_EQ(display.Run(), 0);
 
-  ASSERT_GE(collector.seen.size(), 2u);
-  EXPECT_EQ(display.renders(), 1);  // the same target, base and view: sent again, not rendered again
-  const orbed::image_t& last = collector.seen.back();
-  EXPECT_EQ(last.pixel_format, int{orbed::image_t::FORMAT_JPEG});
-  EXPECT_EQ(last.utime, last.pose_utime);
-  EXPECT_GT(last.utime, collector.seen.front().utime);
-  EXPECT_NEAR((FromPose(last.X_WC).translation() - kDefaultCamera_m).norm(), 0.0, 1e-9);
-  const cv::Mat decoded = cv::imdecode(last.data, cv::IMREAD_COLOR);
+  ASSERT_GE(collector.seen.size(), 1u);
+  const orbed::image_t& first = collector.seen.front();
+  EXPECT_EQ(first.pixel_format, int{orbed::image_t::FORMAT_JPEG});
+  EXPECT_EQ(first.utime, first.pose_utime);
+  EXPECT_NEAR((FromPose(first.X_WC).translation() - kDefaultCamera_m).norm(), 0.0, 1e-9);
+  const cv::Mat decoded = cv::imdecode(first.data, cv::IMREAD_COLOR);
   EXPECT_EQ(decoded.cols, 640);
   EXPECT_EQ(decoded.rows, 480);
   EXPECT_EQ(display.process().rejections().counts().at("GUIDANCE/field"), 1);
 
-  // In a headset mode the monitor shows nothing; a key moves the camera (and renders anew).
-  const int64_t now = NowMicros();
+  // The same target, base and view later: the same picture sent again with the new time, not
+  // rendered again; a key moves the camera and renders anew.
+  const int renders = display.renders();
+  const int64_t later = first.utime + 5'000'000;
+  const auto again = display.PictureNow(later);
+  ASSERT_TRUE(again.has_value());
+  EXPECT_EQ(display.renders(), renders);
+  EXPECT_EQ(again->data, first.data);
+  EXPECT_EQ(again->utime, later);
   display.PressKey('d');
-  EXPECT_TRUE(display.PictureNow(now).has_value());
-  EXPECT_EQ(display.renders(), 2);
+  ASSERT_TRUE(display.PictureNow(later).has_value());
+  EXPECT_EQ(display.renders(), renders + 1);
   EXPECT_NEAR(display.view().azimuth_rad,
               OrbitView::Through(kDefaultCamera_m, OrbitCentre(scene.X_WR)).azimuth_rad + 15 * kDegToRad,
               1e-12);
 }
 
 TEST(FixedDisplayProcess, NothingInTheHeadsetModesOrWithoutAFreshGuidance) {
+  const sim::RobotModel model = Model();
   CommonFlags flags("fixed-display-test");
   flags.lcm_url = "memq://";
-  flags.duration_s = 0.3;
+  flags.duration_s = 1.0;
   FixedDisplayOptions options;
-  options.stale_after_s = 3600;
+  options.stale_after_s = 2.0;
   FixedDisplay display(flags, options);
-  const sim::RobotModel model = Model();
   EXPECT_FALSE(display.PictureNow(NowMicros()).has_value());  // nothing yet
   lcm::LCM& lcm = display.process().lcm();
   auto state = State(Eigen::Isometry3d::Identity());
@@ -207,8 +212,22 @@ TEST(FixedDisplayProcess, NothingInTheHeadsetModesOrWithoutAFreshGuidance) {
   auto ar = Guidance(model, orbed::guidance_t::MODE_AR, Deg({0, 30, 0, -60, 0, 45, 0}));
   lcm.publish("GUIDANCE", &ar);
   EXPECT_EQ(display.Run(), 0);
+  ASSERT_EQ(display.process().messages_in(), 2);  // both handled
   EXPECT_FALSE(display.PictureNow(NowMicros()).has_value());
   EXPECT_EQ(display.renders(), 0);
+
+  // The fixed mode: a picture while the GUIDANCE is fresh, none once it is older than stale_after_s.
+  FixedDisplayOptions all = options;
+  all.all_modes = true;
+  flags.duration_s = 1.0;
+  FixedDisplay every_mode(flags, all);
+  every_mode.process().lcm().publish("ROBOT_STATE", &state);
+  every_mode.process().lcm().publish("GUIDANCE", &ar);
+  EXPECT_EQ(every_mode.Run(), 0);
+  ASSERT_EQ(every_mode.process().messages_in(), 2);
+  const int64_t now = NowMicros();
+  EXPECT_TRUE(every_mode.PictureNow(now).has_value());
+  EXPECT_FALSE(every_mode.PictureNow(now + 3'000'000).has_value());
 }
 
 TEST(FixedDisplayProcess, CommandLine) {
