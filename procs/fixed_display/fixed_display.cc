@@ -42,7 +42,6 @@ FixedDisplay::FixedDisplay(const CommonFlags& flags, const FixedDisplayOptions& 
       poses_(&process_, model_, {options.robot_state_channel, "", options.guidance_channel, ""},
              {nullptr,
               [this](const orbed::guidance_t& g) {
-                q_target_ = ToVectorX(g.target_position);
                 mode_ = g.mode;
                 guidance_received_utime_ = NowMicros();
               }}),
@@ -71,16 +70,16 @@ std::optional<orbed::image_t> FixedDisplay::PictureNow(int64_t utime) {
   if (!poses_.X_WR() || !fresh) return std::nullopt;
   if (!options_.all_modes && mode_ != orbed::guidance_t::MODE_FIXED_DISPLAY) return std::nullopt;
   const Eigen::Isometry3d& X_WR = *poses_.X_WR();
+  const Eigen::VectorXd& q_target = poses_.q_virtual();  // GUIDANCE's target (one came: fresh)
   const Eigen::Isometry3d X_WD = view_.X_WD(OrbitCentre(X_WR));
-  if (!last_ || last_q_ != q_target_ || X_WR.matrix() != last_X_WR_.matrix() ||
-      !SameView(last_view_, view_)) {
-    const cv::Mat bgr = renderer_.Render(q_target_, X_WR, X_WD, Caption(view_));
+  if (!last_ || last_q_ != q_target || X_WR.matrix() != last_X_WR_.matrix() || !SameView(last_view_, view_)) {
+    const cv::Mat bgr = renderer_.Render(q_target, X_WR, X_WD, Caption(view_));
     std::vector<std::uint8_t> jpeg;
     if (!render::EncodeJpeg(bgr, options_.picture.jpeg_quality, &jpeg)) {
       throw std::runtime_error("JPEG encoding failed");
     }
     last_ = JpegImageMessage(jpeg, renderer_.intrinsics(), utime, X_WD, utime);
-    last_q_ = q_target_;
+    last_q_ = q_target;
     last_X_WR_ = X_WR;
     last_view_ = view_;
     ++renders_;

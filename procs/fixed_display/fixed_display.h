@@ -74,8 +74,7 @@ class FixedDisplay {
   sim::TestbedPoses poses_;
   FixedViewRenderer renderer_;
   OrbitView home_, view_;
-  Eigen::VectorXd q_target_;
-  int8_t mode_{-1};
+  int8_t mode_{-1};  // of the latest valid GUIDANCE (its target: poses_.q_virtual())
   int64_t guidance_received_utime_{0};
   // The last picture and what it showed.
   std::optional<orbed::image_t> last_;
