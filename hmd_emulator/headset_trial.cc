@@ -30,10 +30,50 @@ TrialSetup MakeHeadsetTrialSetup(const HmdConfigSet& config, const HeadsetTrialI
     if (f.AppliesTo(inputs.session_id, inputs.trial_index)) setup.faults.push_back(f.timed);
   }
   setup.intrinsics = geometry::Intrinsics::HoloLensPv();
+  setup.p_RL = inputs.p_RL;
+  setup.annotation.pointing_std_deg = config.hmd.annotation_pointing_std_deg;
+  setup.annotation.dwell_s = config.hmd.annotation_dwell_s;
+  setup.annotation.walk_speed_m_per_s = config.hmd.annotation_walk_speed_m_per_s;
+  setup.annotation_view_angle_deg = config.hmd.annotation_view_angle_deg;
   for (int i = 0; i < inputs.num_mirrors; ++i) {
     setup.capture_waypoints.push_back(config.hmd.displays[i].capture_waypoint);
   }
   return setup;
+}
+
+std::vector<Eigen::Vector3d> AnnotationLandmarkPoints(const sim::RobotModel& model, const HmdConfig& hmd,
+                                                      const Eigen::VectorXd& q_rad) {
+  std::vector<int> links;
+  for (const std::string& name : hmd.annotation_landmarks) {
+    const int link = model.FindLink(name);
+    if (link < 0) {
+      throw std::invalid_argument("hmd.annotation_landmarks: the robot model " + model.source_name() +
+                                  " has no link '" + name + "'");
+    }
+    links.push_back(link);
+  }
+  std::vector<Eigen::Vector3d> p_RL;
+  if (links.empty()) return p_RL;
+  const std::vector<Eigen::Isometry3d> X_RL = model.CalcLinkPoses(q_rad);
+  for (int link : links) p_RL.push_back(X_RL[link].translation());
+  return p_RL;
+}
+
+void SetAnnotationFields(const std::vector<AnnotationRay>& annotation, orbed::alignment_trial_t* msg) {
+  msg->num_annotation_rays = static_cast<std::int32_t>(annotation.size());
+  msg->annotation_landmark.clear();
+  msg->annotation_side.clear();
+  msg->annotation_origin_W_m.clear();
+  msg->annotation_direction_W.clear();
+  for (const AnnotationRay& a : annotation) {
+    msg->annotation_landmark.push_back(a.landmark);
+    msg->annotation_side.push_back(a.hologram ? +orbed::alignment_trial_t::ANNOTATION_VIRTUAL
+                                              : +orbed::alignment_trial_t::ANNOTATION_REAL);
+    const Eigen::Vector3d& o = a.ray.origin_W;
+    const Eigen::Vector3d& u = a.ray.direction_W;
+    msg->annotation_origin_W_m.push_back({o.x(), o.y(), o.z()});
+    msg->annotation_direction_W.push_back({u.x(), u.y(), u.z()});
+  }
 }
 
 TrialOutcome RunHeadsetTrial(const HmdConfigSet& config, const HeadsetTrialInputs& inputs) {

@@ -9,7 +9,8 @@
 /// config.hmd.displays capture their frames at their waypoints, and the person aligns the virtual
 /// robot at config.hmd.align_waypoint (after config.hmd.settle_s, waiting up to
 /// config.hmd.max_wait_s for tracking), starting from X_WV_start, against the real robot at X_WR
-/// whose model points at the trial's q are p_RQ. The forced faults of config.slam.faults for this
+/// whose model points at the trial's q are p_RQ, and then annotates the landmarks p_RL (the
+/// config.hmd.annotation_* style). The forced faults of config.slam.faults for this
 /// session and trial index happen while the person aligns (viraal_trial.h), who re-does the
 /// alignment at most config.hmd.max_repeats times.
 ///
@@ -27,9 +28,11 @@
 #include <vector>
 
 #include <Eigen/Geometry>
+#include <orbed/alignment_trial_t.hpp>
 
 #include "hmd_emulator/hmd_config.h"
 #include "hmd_emulator/viraal_trial.h"
+#include "sim/robot_model.h"
 
 namespace orbed::hmd {
 
@@ -56,13 +59,25 @@ struct HeadsetTrialInputs {
   std::int32_t trial_index{0};  ///< per session, from 0
   /// Displays used (the session's num_mirrors): the first num_mirrors of config.hmd.displays.
   std::int32_t num_mirrors{0};
+  /// The landmarks the person annotates after the alignment, in R at q (AnnotationLandmarkPoints);
+  /// empty = no annotation.
+  std::vector<Eigen::Vector3d> p_RL;
 };
+
+/// The origins of config.hmd.annotation_landmarks' links at q [rad], in R [m], in that order.
+/// Throws std::invalid_argument naming a link the model does not have.
+std::vector<Eigen::Vector3d> AnnotationLandmarkPoints(const sim::RobotModel& model, const HmdConfig& hmd,
+                                                      const Eigen::VectorXd& q_rad);
 
 /// The TrialSetup (viraal_trial.h) of a headset trial: the walk, the capture and alignment
 /// waypoints and times of `config`, the HoloLens PV intrinsics, X_WR and p_RQ of `inputs`, and
 /// the forced faults of config.slam.faults that apply to inputs' session and trial index.
 /// Throws std::invalid_argument when num_mirrors is negative or exceeds the displays placed.
 TrialSetup MakeHeadsetTrialSetup(const HmdConfigSet& config, const HeadsetTrialInputs& inputs);
+
+/// Writes outcome.annotation into ALIGNMENT_TRIAL's annotation fields (contract change 5),
+/// replacing what they held.
+void SetAnnotationFields(const std::vector<AnnotationRay>& annotation, orbed::alignment_trial_t* msg);
 
 /// Runs the trial (see the file comment). Throws std::invalid_argument as MakeHeadsetTrialSetup()
 /// and RunTrial() do.

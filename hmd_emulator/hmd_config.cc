@@ -30,10 +30,11 @@ std::vector<std::string> DefaultHmdConfigRelativePaths() {
 HmdConfig ParseHmdConfig(const YAML::Node& node, const std::string& source, const std::string& key,
                          const HmdConfig& base) {
   const YamlFields f(source);
-  f.CheckKeys(
-      node, key,
-      {"name", "gaze_hz", "reflective_hz", "ar_view_hz", "align_waypoint", "settle_s", "max_wait_s",
-       "max_repeats", "recapture_period_s", "gaze_fallback_distance_m", "max_gaze_distance_m", "displays"});
+  f.CheckKeys(node, key,
+              {"name", "gaze_hz", "reflective_hz", "ar_view_hz", "align_waypoint", "settle_s", "max_wait_s",
+               "max_repeats", "recapture_period_s", "gaze_fallback_distance_m", "max_gaze_distance_m",
+               "displays", "annotation_landmarks", "annotation_pointing_std_deg", "annotation_dwell_s",
+               "annotation_view_angle_deg", "annotation_walk_speed_m_per_s"});
   HmdConfig c = base;
   c.name = Text(f, node, "name", key, c.name);
   c.gaze_hz = f.NumberOr(node, "gaze_hz", key, c.gaze_hz, 0.1, 1000, "Hz");
@@ -47,6 +48,22 @@ HmdConfig ParseHmdConfig(const YAML::Node& node, const std::string& source, cons
   c.gaze_fallback_distance_m =
       f.NumberOr(node, "gaze_fallback_distance_m", key, c.gaze_fallback_distance_m, 0.05, 100, "m");
   c.max_gaze_distance_m = f.NumberOr(node, "max_gaze_distance_m", key, c.max_gaze_distance_m, 0.1, 1000, "m");
+  const YAML::Node landmarks = node["annotation_landmarks"];
+  if (landmarks.IsDefined() && !landmarks.IsNull()) {
+    if (!landmarks.IsSequence() || landmarks.size() > kMaxAnnotationLandmarks) {
+      f.Fail(landmarks, key + ".annotation_landmarks",
+             "expected a list of at most " + std::to_string(kMaxAnnotationLandmarks) + " link names");
+    }
+    c.annotation_landmarks.clear();  // [] = no annotation
+    if (landmarks.size() > 0) c.annotation_landmarks = f.Strings(landmarks, key + ".annotation_landmarks");
+  }
+  c.annotation_pointing_std_deg =
+      f.NumberOr(node, "annotation_pointing_std_deg", key, c.annotation_pointing_std_deg, 0, 10, "deg");
+  c.annotation_dwell_s = f.NumberOr(node, "annotation_dwell_s", key, c.annotation_dwell_s, 0.01, 60, "s");
+  c.annotation_view_angle_deg =
+      f.NumberOr(node, "annotation_view_angle_deg", key, c.annotation_view_angle_deg, 5, 150, "deg");
+  c.annotation_walk_speed_m_per_s =
+      f.NumberOr(node, "annotation_walk_speed_m_per_s", key, c.annotation_walk_speed_m_per_s, 0.05, 5, "m/s");
   const YAML::Node displays = node["displays"];
   if (displays.IsDefined() && !displays.IsNull()) {
     if (!displays.IsSequence() || displays.size() == 0 || displays.size() > 16) {

@@ -34,6 +34,13 @@
 ///   recapture_period_s: 0.5      # a display re-captures at most this often after the robot moved [s]
 ///   gaze_fallback_distance_m: 1.5  # D when the gaze ray misses the robot [m]
 ///   max_gaze_distance_m: 10      # ray-casting range [m]
+///   # Landmark annotation after each emulated trial (viraal_trial.h, annotation.h): the links
+///   # whose origins the person marks on the real robot and on the hologram ([] = none), in order.
+///   annotation_landmarks: [iiwa_link_4, iiwa_link_6, iiwa_link_ee]
+///   annotation_pointing_std_deg: 0.2   # head-gaze pointing error per axis [deg]
+///   annotation_dwell_s: 1.0            # cursor held on a landmark before the tap [s]
+///   annotation_view_angle_deg: 40      # between the lines of sight of the two positions [deg]
+///   annotation_walk_speed_m_per_s: 0.5 # speed of that step [m/s]
 ///   # displays: a list of {capture_waypoint: NAME}, where each reflective display captures its
 ///   # frame, in order; default (absent): one display at the walk's first waypoint.
 /// @endcode
@@ -71,7 +78,16 @@ struct HmdConfig {
   double max_gaze_distance_m{10.0};
   /// Empty after parsing a file without `displays` = one display at the walk's first waypoint.
   std::vector<DisplayPlacement> displays;
+  /// Landmark annotation (TrialSetup::p_RL, annotation_*): link names of the robot model.
+  std::vector<std::string> annotation_landmarks{"iiwa_link_4", "iiwa_link_6", "iiwa_link_ee"};
+  double annotation_pointing_std_deg{0.2};
+  double annotation_dwell_s{1.0};
+  double annotation_view_angle_deg{40.0};
+  double annotation_walk_speed_m_per_s{0.5};
 };
+
+/// The most landmarks a person annotates per trial (ALIGNMENT_TRIAL carries 4 rays per landmark).
+inline constexpr int kMaxAnnotationLandmarks = 16;
 
 /// Reads the `hmd:` mapping (the node itself) over `base`, key by key (a `displays` list replaces
 /// base's list); errors name `source`, the line and the key.

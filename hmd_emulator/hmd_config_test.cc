@@ -27,6 +27,11 @@ void ExpectSame(const HmdConfig& a, const HmdConfig& b, const std::string& what)
   EXPECT_EQ(a.recapture_period_s, b.recapture_period_s);
   EXPECT_EQ(a.gaze_fallback_distance_m, b.gaze_fallback_distance_m);
   EXPECT_EQ(a.max_gaze_distance_m, b.max_gaze_distance_m);
+  EXPECT_EQ(a.annotation_landmarks, b.annotation_landmarks);
+  EXPECT_EQ(a.annotation_pointing_std_deg, b.annotation_pointing_std_deg);
+  EXPECT_EQ(a.annotation_dwell_s, b.annotation_dwell_s);
+  EXPECT_EQ(a.annotation_view_angle_deg, b.annotation_view_angle_deg);
+  EXPECT_EQ(a.annotation_walk_speed_m_per_s, b.annotation_walk_speed_m_per_s);
   ASSERT_EQ(a.displays.size(), b.displays.size());
   for (std::size_t i = 0; i < a.displays.size(); ++i) {
     EXPECT_EQ(a.displays[i].capture_waypoint, b.displays[i].capture_waypoint) << i;

@@ -63,6 +63,8 @@ HmdProcess::HmdProcess(const orbed::CommonFlags& flags, const HmdOptions& option
   const sim::Scene scene = sim::LoadSceneFile(options_.scene_path);
   // With the scene's tool length, before any geometry copies the tool's primitives.
   robot_model_ = std::make_unique<sim::RobotModel>(sim::LoadRobotForScene(options_.urdf_path, scene));
+  // Names every annotation landmark the model lacks now rather than at the first trial.
+  AnnotationLandmarkPoints(*robot_model_, config_.hmd, Eigen::VectorXd::Zero(robot_model_->num_joints()));
   user_id_ = "emulated-seed-" + std::to_string(config_.user.seed);
   X_WV_start_ = EmulatedUser(config_.user).StartPose(scene.X_WR);
   session_ = HmdSession({placed, options_.iiwa_status_channel, options_.robot_state_channel});
@@ -330,6 +332,7 @@ void HmdProcess::EmulateTrial(const std::string& channel) {
   TrialOutcome outcome;
   try {
     inputs.p_RQ = RobotModelPoints(*robot_model_, robot_.q_rad);
+    inputs.p_RL = AnnotationLandmarkPoints(*robot_model_, config_.hmd, robot_.q_rad);
     outcome = RunHeadsetTrial(config_, inputs);
   } catch (const std::exception& e) {
     return process_->Reject(channel + "/trial_failed", std::string("the emulated trial failed: ") + e.what());
@@ -346,7 +349,8 @@ void HmdProcess::PublishEmulatedTrial(const TrialOutcome& outcome) {
   const HmdSessionState& s = session_.state();
   const std::int32_t index = s.next_index;
   X_WV_user_ = outcome.alignment.X_WV;
-  PublishTrial(outcome.alignment.X_WV, outcome.alignment.duration_s, user_id_, outcome.faults);
+  PublishTrial(outcome.alignment.X_WV, outcome.alignment.duration_s, user_id_, outcome.faults,
+               outcome.annotation);
   const TrackingFaultRecord& f = outcome.faults;
   ORBED_LOG(kInfo) << "trial " << index << " of '" << s.id << "' (" << DisplayModeName(s.display_mode) << ", "
                    << s.num_mirrors << " display(s)): " << outcome.alignment.stop_reason << " after "
@@ -361,7 +365,8 @@ void HmdProcess::PublishEmulatedTrial(const TrialOutcome& outcome) {
 }
 
 void HmdProcess::PublishTrial(const Eigen::Isometry3d& X_WV, double duration_s, const std::string& user_id,
-                              const TrackingFaultRecord& faults) {
+                              const TrackingFaultRecord& faults,
+                              const std::vector<AnnotationRay>& annotation) {
   orbed::alignment_trial_t msg{};
   msg.utime = NowMicros();
   msg.session_id = session_.state().id;
@@ -378,6 +383,7 @@ void HmdProcess::PublishTrial(const Eigen::Isometry3d& X_WV, double duration_s, 
   msg.relocalizations = faults.relocalizations;
   msg.tracking_wait_s = faults.wait_s;
   msg.alignment_repeats = faults.repeats;
+  SetAnnotationFields(annotation, &msg);
   // Saved before it goes out: a headset killed in between restores this very message as the answer
   // to its request id, so the conductor's retry gets these bytes (utime included), never a second,
   // different trial with the same index.

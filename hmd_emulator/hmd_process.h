@@ -215,7 +215,8 @@ class HmdProcess {
   /// The latest valid GUIDANCE if it came within kGuidanceFreshS, else null.
   const orbed::guidance_t* FreshGuidance() const;
   void PublishTrial(const Eigen::Isometry3d& X_WV, double duration_s, const std::string& user_id,
-                    const TrackingFaultRecord& faults = {});
+                    const TrackingFaultRecord& faults = {},
+                    const std::vector<AnnotationRay>& annotation = {});
   void PublishEmulatedTrial(const TrialOutcome& outcome);
   void InteractiveTick();
   FrameInputs Inputs() const;

@@ -4,6 +4,9 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "base/hash.h"
+#include "base/units.h"
+
 namespace orbed::hmd {
 namespace {
 
@@ -54,6 +57,31 @@ void AlignThroughFaults(const TrialSetup& setup, const EmulatedUser& user, std::
     }
   }
   out->alignment.duration_s += attempt_start_s + paused_s;
+}
+
+// The landmark annotation after the alignment (viraal_trial.h's file comment).
+void AnnotateLandmarks(const TrialSetup& setup, std::uint64_t trial_seed, SlamModel* model,
+                       TrialOutcome* out) {
+  constexpr std::uint64_t kAnnotationSalt = 0x616e6e6f74617465ULL;  // "annotate"
+  AnnotatingPerson person(model, out->at_end.t_s + 1.0 / model->config().rate_hz, setup.annotation,
+                          SplitMix64(trial_seed ^ kAnnotationSalt));
+  person.set_last(out->at_end);
+  Eigen::Vector3d p_RL_mean = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& p : setup.p_RL) p_RL_mean += p;
+  const Eigen::Vector3d look_at = setup.X_WR * (p_RL_mean / static_cast<double>(setup.p_RL.size()));
+  const Eigen::Vector3d p_WH1 = out->at_end.X_WH_true.translation();
+  // To the right of the line of sight (x of a head looking at look_at) is clockwise seen from above.
+  const Eigen::AngleAxisd around(-setup.annotation_view_angle_deg * kDegToRad, Eigen::Vector3d::UnitZ());
+  const Eigen::Vector3d p_WH2 = look_at + around * (p_WH1 - look_at);
+  for (const Eigen::Vector3d& p_WH : {p_WH1, p_WH2}) {
+    if (p_WH != p_WH1) person.Walk(p_WH1, p_WH2, look_at);
+    for (std::size_t l = 0; l < setup.p_RL.size(); ++l) {
+      out->annotation.push_back(
+          {static_cast<int>(l), false, person.Annotate(p_WH, setup.X_WR * setup.p_RL[l])});
+      out->annotation.push_back(
+          {static_cast<int>(l), true, person.AnnotateHologram(p_WH, out->alignment.X_WV, setup.p_RL[l])});
+    }
+  }
 }
 
 }  // namespace
@@ -116,6 +144,7 @@ TrialOutcome RunTrial(const TrialSetup& setup, const SlamConfig& slam, const Emu
   out.registration = EvaluatePose(out.alignment.X_WV, setup.X_WR, setup.p_RQ, p_W_eye);
   out.augmentation = EvaluatePose(ApparentPose(out.at_end.X_WH_true, out.at_end.X_WH_est, out.alignment.X_WV),
                                   setup.X_WR, setup.p_RQ, p_W_eye);
+  if (!setup.p_RL.empty()) AnnotateLandmarks(setup, trial_seed, &model, &out);
   return out;
 }
 

@@ -33,12 +33,23 @@
 /// Sources: the wait is the device's (the fault's duration); a repeat costs what the user model's
 /// looks and nudges cost (config/user.yaml); max_repeats is chosen (hmd.yaml).
 ///
+/// Landmark annotation (paper Sec. III-B, annotation.h), when setup.p_RL names landmarks: after
+/// submitting, the person annotates each landmark l on the real robot (X_WR · p_RL[l]) and on the
+/// hologram (X_WV · p_RL[l], aimed where it appears) from where they stand (at_end's true head
+/// position), walks to their right around the landmarks' centroid (about the vertical through it, at
+/// the same distance) until the lines of sight to it from the two positions meet at
+/// annotation_view_angle_deg, and annotates them again in the same order: two rays per landmark and
+/// side, recorded from the estimated head (map coordinates). The SLAM model is stepped on from
+/// at_end (no random tracking losses) and the pointing errors have their own seed (from
+/// trial_seed), so nothing the trial measured before changes with the annotation.
+///
 /// Threading: pure function of its inputs (seeds included); reentrant.
 
 #include <cstdint>
 #include <string>
 #include <vector>
 
+#include "hmd_emulator/annotation.h"
 #include "hmd_emulator/head_trajectory.h"
 #include "hmd_emulator/slam_model.h"
 #include "hmd_emulator/user_model.h"
@@ -63,6 +74,18 @@ struct TrialSetup {
   std::vector<TimedFault> faults;
   /// The most alignments the person re-does in one trial after seeing the hologram jump.
   int max_repeats{2};
+  /// Landmarks to annotate after the alignment, in R at the trial's q [m]; empty = none.
+  std::vector<Eigen::Vector3d> p_RL;
+  AnnotationStyle annotation;
+  /// The angle between the lines of sight of the two annotation positions [deg].
+  double annotation_view_angle_deg{40.0};
+};
+
+/// One gaze ray of the landmark annotation (see the file comment).
+struct AnnotationRay {
+  int landmark{0};       ///< index into TrialSetup::p_RL
+  bool hologram{false};  ///< aimed at the virtual robot (else the real one)
+  GazeRayRecord ray;     ///< map coordinates
 };
 
 /// What tracking faults did to the person while aligning (between the alignment sample and the
@@ -87,6 +110,8 @@ struct TrialOutcome {
   std::vector<SlamSample> at_capture;
   int relocalizations{0};      ///< RELOCALIZED samples during the walk (and the wait before aligning)
   TrackingFaultRecord faults;  ///< while aligning
+  /// The landmark annotation: for each head position, for each landmark, real then hologram.
+  std::vector<AnnotationRay> annotation;
 };
 
 /// Runs one trial. slam.seed and trial_seed make it reproducible; X_WV_start is in map coordinates.

@@ -10,7 +10,10 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "base/source_paths.h"
+#include "geometry/triangulation.h"
 #include "sim/scene.h"
 
 namespace orbed::hmd {
@@ -212,6 +215,95 @@ TEST(TrackingFaults, AfterTheSubmissionNothingHappens) {
   EXPECT_TRUE(o.faults.met.empty());
   EXPECT_TRUE(o.alignment.X_WV.isApprox(base.alignment.X_WV, 0));
   EXPECT_EQ(o.alignment.duration_s, base.alignment.duration_s);
+}
+
+// The landmark annotation after the alignment (viraal_trial.h): each landmark triangulated from its
+// rays, for one side.
+Eigen::Vector3d Triangulated(const TrialOutcome& o, int landmark, bool hologram) {
+  std::vector<Eigen::Vector3d> origins, directions;
+  for (const AnnotationRay& a : o.annotation) {
+    if (a.landmark != landmark || a.hologram != hologram) continue;
+    origins.push_back(a.ray.origin_W);
+    directions.push_back(a.ray.direction_W);
+  }
+  const geometry::TriangulationResult r = geometry::TriangulateRays(origins, directions);
+  EXPECT_TRUE(r.valid) << r.reason;
+  return r.p_W;
+}
+
+Fixture AnnotatingFixture(double pointing_std_deg) {
+  Fixture f;
+  const sim::Scene scene = sim::LoadSceneFile(orbed::SourceDir() + "/" + sim::kDefaultSceneRelativePath);
+  const sim::RobotModel robot =
+      sim::LoadRobotForScene(orbed::SourceDir() + "/" + sim::RobotModel::kDefaultUrdfRelativePath, scene);
+  const std::vector<Eigen::Isometry3d> X_RL =
+      robot.CalcLinkPoses(sim::DegToRad((Eigen::VectorXd(7) << 0, 30, 0, -60, 0, 45, 0).finished()));
+  for (const char* link : {"iiwa_link_4", "iiwa_link_6", "iiwa_link_ee"}) {
+    f.setup.p_RL.push_back(X_RL[robot.FindLink(link)].translation());
+  }
+  f.setup.annotation.pointing_std_deg = pointing_std_deg;
+  return f;
+}
+
+// Two positions, each landmark real then hologram, in landmark order; the second position is the
+// first turned by the view angle about the vertical through the landmarks' centroid.
+TEST(LandmarkAnnotation, TwoRaysPerLandmarkAndSideInTheDocumentedOrder) {
+  const Fixture f = AnnotatingFixture(0.2);
+  const TrialOutcome o = f.Run({});
+  ASSERT_EQ(o.annotation.size(), 12u);
+  for (std::size_t k = 0; k < o.annotation.size(); ++k) {
+    EXPECT_EQ(o.annotation[k].landmark, static_cast<int>((k % 6) / 2)) << k;
+    EXPECT_EQ(o.annotation[k].hologram, k % 2 == 1) << k;
+    EXPECT_NEAR(o.annotation[k].ray.direction_W.norm(), 1.0, 1e-12);
+  }
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (const auto& p : f.setup.p_RL) centroid += f.setup.X_WR * p / 3.0;
+  Eigen::Vector3d a = o.annotation[0].ray.origin_W - centroid, b = o.annotation[6].ray.origin_W - centroid;
+  a.z() = b.z() = 0;
+  EXPECT_NEAR(std::acos(a.normalized().dot(b.normalized())) * 180 / M_PI, f.setup.annotation_view_angle_deg,
+              1e-6);
+  // The annotation comes after the alignment and draws from its own seed: the trial is unchanged.
+  Fixture plain;
+  const TrialOutcome without = plain.Run({});
+  EXPECT_TRUE(without.annotation.empty());
+  EXPECT_TRUE(o.alignment.X_WV.isApprox(without.alignment.X_WV, 0));
+}
+
+// A perfect perceiver (no pointing error) in an exact map measures the registration exactly: the
+// triangulated landmarks are the real robot's and the hologram's link origins.
+TEST(LandmarkAnnotation, PerfectPerceiverInAnExactMapMeasuresTheTruth) {
+  const Fixture f = AnnotatingFixture(0.0);
+  const TrialOutcome o = f.Run({});
+  for (int l = 0; l < 3; ++l) {
+    EXPECT_LT((Triangulated(o, l, false) - f.setup.X_WR * f.setup.p_RL[l]).norm(), 1e-9) << l;
+    EXPECT_LT((Triangulated(o, l, true) - o.alignment.X_WV * f.setup.p_RL[l]).norm(), 1e-9) << l;
+  }
+}
+
+// The same perceiver after a relocalization jump J of the map that they did not re-align for: the
+// measurement is made in the headset's own map, so each pair's difference is the truth's difference
+// plus J (the hologram appears moved by J, the measurement sees exactly that, not the registration).
+TEST(LandmarkAnnotation, PerfectPerceiverMeasuresTheViewNotTheMap) {
+  const Fixture f = AnnotatingFixture(0.0);
+  const Eigen::Vector3d jump_W_m(0.05, -0.02, 0);
+  const TrialOutcome o = f.Run({Fault(10.0, TrackingState::kLost, 2.0, jump_W_m)}, /*max_repeats=*/0);
+  ASSERT_EQ(o.faults.losses, 1);
+  for (int l = 0; l < 3; ++l) {
+    const Eigen::Vector3d measured = Triangulated(o, l, true) - Triangulated(o, l, false);
+    const Eigen::Vector3d truth = o.alignment.X_WV * f.setup.p_RL[l] - f.setup.X_WR * f.setup.p_RL[l];
+    EXPECT_LT((measured - (truth + jump_W_m)).norm(), 1e-9) << l;
+  }
+}
+
+// A person's pointing error scatters the landmarks (at a few metres, by millimetres to centimetres).
+TEST(LandmarkAnnotation, PointingErrorScattersTheLandmarks) {
+  const Fixture f = AnnotatingFixture(0.2);
+  const TrialOutcome o = f.Run({});
+  for (int l = 0; l < 3; ++l) {
+    const double off_m = (Triangulated(o, l, false) - f.setup.X_WR * f.setup.p_RL[l]).norm();
+    EXPECT_GT(off_m, 1e-4) << l;
+    EXPECT_LT(off_m, 0.2) << l;
+  }
 }
 
 TEST(AlignmentResult, PoseAtATime) {

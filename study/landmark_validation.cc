@@ -11,80 +11,11 @@
 #include "base/random.h"
 #include "base/units.h"
 #include "geometry/triangulation.h"
+#include "hmd_emulator/annotation.h"
 #include "hmd_emulator/hmd_config.h"
 
 namespace orbed::study {
 namespace {
-
-// The head at p_WH looking at p_WQ: z along the line of sight, x to the right and horizontal, y
-// down (world z is up), as H is defined in head_trajectory.h.
-Eigen::Isometry3d HeadLookingAt(const Eigen::Vector3d& p_WH, const Eigen::Vector3d& p_WQ) {
-  const Eigen::Vector3d z = (p_WQ - p_WH).normalized();
-  const Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitZ()).normalized();
-  const Eigen::Vector3d y = z.cross(x);
-  Eigen::Isometry3d X_WH = Eigen::Isometry3d::Identity();
-  X_WH.linear().col(0) = x;
-  X_WH.linear().col(1) = y;
-  X_WH.linear().col(2) = z;
-  X_WH.translation() = p_WH;
-  return X_WH;
-}
-
-// One measurement's walk through the SLAM model: the clock and the samples it takes.
-class AnnotatingPerson {
- public:
-  AnnotatingPerson(const LandmarkValidationOptions& options, std::uint64_t seed)
-      : options_(options), slam_(SlamWithSeed(options.slam, seed)), rng_(seed ^ 0x9e3779b97f4a7c15ULL) {
-    slam_.set_random_losses(false);
-  }
-
-  // Holds the cursor on p_WQ from p_WH (with this annotation's pointing error) for the dwell time
-  // and taps: the ray the device records, in map coordinates.
-  void Annotate(const Eigen::Vector3d& p_WH, const Eigen::Vector3d& p_WQ,
-                std::vector<Eigen::Vector3d>* origins, std::vector<Eigen::Vector3d>* directions) {
-    const double sigma_rad = options_.pointing_std_deg * kDegToRad;
-    const double about_x = rng_.Normal(0.0, sigma_rad);
-    const double about_y = rng_.Normal(0.0, sigma_rad);
-    Eigen::Isometry3d X_WH_true = HeadLookingAt(p_WH, p_WQ);
-    X_WH_true.linear() = X_WH_true.linear() *
-                         Eigen::AngleAxisd(about_x, Eigen::Vector3d::UnitX()).toRotationMatrix() *
-                         Eigen::AngleAxisd(about_y, Eigen::Vector3d::UnitY()).toRotationMatrix();
-    const int samples = std::max(1, static_cast<int>(std::lround(options_.dwell_s * options_.slam.rate_hz)));
-    hmd::SlamSample last;
-    for (int k = 0; k < samples; ++k) last = Step(X_WH_true);
-    origins->push_back(last.X_WH_est.translation());
-    directions->push_back(last.X_WH_est.linear().col(2));
-  }
-
-  // Steps sideways from `from` to `to`, looking at `look_at`.
-  void Walk(const Eigen::Vector3d& from, const Eigen::Vector3d& to, const Eigen::Vector3d& look_at) {
-    const double distance = (to - from).norm();
-    const int samples = std::max(
-        1, static_cast<int>(std::ceil(distance / options_.walk_speed_m_per_s * options_.slam.rate_hz)));
-    for (int k = 1; k <= samples; ++k) {
-      const Eigen::Vector3d p = from + (to - from) * (static_cast<double>(k) / samples);
-      Step(HeadLookingAt(p, look_at));
-    }
-  }
-
- private:
-  static hmd::SlamConfig SlamWithSeed(hmd::SlamConfig config, std::uint64_t seed) {
-    config.seed = seed;
-    config.faults.clear();
-    return config;
-  }
-
-  hmd::SlamSample Step(const Eigen::Isometry3d& X_WH_true) {
-    const hmd::SlamSample s = slam_.Step(X_WH_true, t_s_);
-    t_s_ += 1.0 / options_.slam.rate_hz;
-    return s;
-  }
-
-  const LandmarkValidationOptions& options_;
-  hmd::SlamModel slam_;
-  Random rng_;
-  double t_s_{0};
-};
 
 Eigen::Vector3d Triangulate(const std::vector<Eigen::Vector3d>& origins,
                             const std::vector<Eigen::Vector3d>& directions, const char* target) {
@@ -138,6 +69,7 @@ LandmarkValidation RunLandmarkValidation(const LandmarkValidationOptions& option
   const Eigen::Vector3d p_WH1(0.0, 0.0, options.eye_height_m);
   const Eigen::Vector3d p_WH2 = p_WH1 + Eigen::Vector3d(0.0, options.baseline_m, 0.0);
   double sum_error_mm = 0;
+  const hmd::AnnotationStyle style{options.pointing_std_deg, options.dwell_s, options.walk_speed_m_per_s};
   for (double separation_mm : options.separations_mm) {
     for (int repeat = 0; repeat < options.repeats; ++repeat) {
       const double cx = rng.Uniform(-options.centre_jitter_m, options.centre_jitter_m);
@@ -149,13 +81,24 @@ LandmarkValidation RunLandmarkValidation(const LandmarkValidationOptions& option
           0.5e-3 * separation_mm * Eigen::Vector3d(std::cos(heading), std::sin(heading), 0);
       const Eigen::Vector3d p_WA = centre - half, p_WB = centre + half;
 
-      AnnotatingPerson person(options, person_seed);
+      hmd::SlamConfig slam = options.slam;
+      slam.seed = person_seed;
+      slam.faults.clear();
+      hmd::SlamModel model(slam);
+      hmd::AnnotatingPerson person(&model, 0.0, style, person_seed ^ 0x9e3779b97f4a7c15ULL);
       std::vector<Eigen::Vector3d> origins_A, directions_A, origins_B, directions_B;
-      person.Annotate(p_WH1, p_WA, &origins_A, &directions_A);
-      person.Annotate(p_WH1, p_WB, &origins_B, &directions_B);
+      auto record = [&person](const Eigen::Vector3d& p_WH, const Eigen::Vector3d& p_WQ,
+                              std::vector<Eigen::Vector3d>* origins,
+                              std::vector<Eigen::Vector3d>* directions) {
+        const hmd::GazeRayRecord ray = person.Annotate(p_WH, p_WQ);
+        origins->push_back(ray.origin_W);
+        directions->push_back(ray.direction_W);
+      };
+      record(p_WH1, p_WA, &origins_A, &directions_A);
+      record(p_WH1, p_WB, &origins_B, &directions_B);
       person.Walk(p_WH1, p_WH2, centre);
-      person.Annotate(p_WH2, p_WA, &origins_A, &directions_A);
-      person.Annotate(p_WH2, p_WB, &origins_B, &directions_B);
+      record(p_WH2, p_WA, &origins_A, &directions_A);
+      record(p_WH2, p_WB, &origins_B, &directions_B);
       const Eigen::Vector3d x_A = Triangulate(origins_A, directions_A, "A");
       const Eigen::Vector3d x_B = Triangulate(origins_B, directions_B, "B");
 

@@ -24,14 +24,15 @@ std::string Csv(double value) {
 }
 
 const char* kColumns =
-    "user,mode,trial,t_x_mm,t_y_mm,t_z_mm,misalignment_mm,true_translation_mm,true_rotation_deg,duration_s\n";
+    "user,mode,trial,t_x_mm,t_y_mm,t_z_mm,misalignment_mm,true_translation_mm,true_rotation_deg,duration_s,"
+    "landmarks,true_misalignment_mm\n";
 
 std::string Row(const std::string& user, const std::string& mode, const std::string& trial,
                 const viraal::ErrorMeasures& e, const std::string& duration_s) {
   const Eigen::Vector3d& t = e.misalignment_axes_mm;
   return user + "," + mode + "," + trial + "," + Csv(t.x()) + "," + Csv(t.y()) + "," + Csv(t.z()) + "," +
          Csv(t.norm()) + "," + Csv(e.translation_error_mm) + "," + Csv(e.rotation_error_deg) + "," +
-         duration_s + "\n";
+         duration_s + "," + e.landmarks + "," + Csv(e.truth_misalignment_mm) + "\n";
 }
 
 void WriteRow(JsonWriter* json, const viraal::Table1Row& row) {

@@ -80,17 +80,20 @@ TEST(StudyTables, CsvsHaveTheStudyColumnsAndTheFilesValues) {
   const nlohmann::json pinned = PinnedJson();
   const std::vector<UserRun> runs = Users(2);
   const std::string header =
-      "user,mode,trial,t_x_mm,t_y_mm,t_z_mm,misalignment_mm,true_translation_mm,true_rotation_deg,duration_s";
+      "user,mode,trial,t_x_mm,t_y_mm,t_z_mm,misalignment_mm,true_translation_mm,true_rotation_deg,duration_s,"
+      "landmarks,true_misalignment_mm";
   const std::vector<std::string> trials = Lines(AlignmentTrialsCsv(runs));
   ASSERT_EQ(trials.size(), 1u + 2 * 2 * 3);
   EXPECT_EQ(trials[0], header);
   // u2's second ar trial: row 1 + 6 (u1) + 3 (u2's ar_reflective) + 1.
   char user[8], mode[32];
   int trial = 0;
-  double t[3], mis, translation, rotation, duration;
-  ASSERT_EQ(std::sscanf(trials[11].c_str(), "%7[^,],%31[^,],%d,%lf,%lf,%lf,%lf,%lf,%lf,%lf", user, mode,
-                        &trial, &t[0], &t[1], &t[2], &mis, &translation, &rotation, &duration),
-            10)
+  char landmarks[8];
+  double t[3], mis, translation, rotation, duration, true_mis;
+  ASSERT_EQ(std::sscanf(trials[11].c_str(), "%7[^,],%31[^,],%d,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%7[^,],%lf", user,
+                        mode, &trial, &t[0], &t[1], &t[2], &mis, &translation, &rotation, &duration,
+                        landmarks, &true_mis),
+            12)
       << trials[11];
   const nlohmann::json& expected = pinned["sessions"][1]["trials"][1];
   EXPECT_STREQ(user, "u2");
@@ -101,6 +104,8 @@ TEST(StudyTables, CsvsHaveTheStudyColumnsAndTheFilesValues) {
   EXPECT_DOUBLE_EQ(translation, expected["translation_error_mm"].get<double>());
   EXPECT_DOUBLE_EQ(rotation, expected["rotation_error_deg"].get<double>());
   EXPECT_DOUBLE_EQ(duration, expected["user_duration_s"].get<double>());
+  EXPECT_STREQ(landmarks, "gaze");
+  EXPECT_DOUBLE_EQ(true_mis, expected["truth_misalignment_mm"].get<double>());
 
   const std::vector<std::string> means = Lines(AlignmentMeansCsv(runs));
   ASSERT_EQ(means.size(), 1u + 2 * 2);

@@ -109,6 +109,7 @@ viraal::RunResults RunViraalStudy(const StudyOptions& options) {
       const Eigen::VectorXd q_rad = sim::DegToRad(ToVectorX(q_deg));
       hmd::HeadsetTrialInputs inputs;
       inputs.p_RQ = hmd::RobotModelPoints(headset_model, q_rad);
+      inputs.p_RL = hmd::AnnotationLandmarkPoints(headset_model, headset.hmd, q_rad);
       inputs.X_WR = FromPose(X_WR);
       inputs.X_WV_start = X_WV_start;
       inputs.process_seed = options.seed;
@@ -128,11 +129,24 @@ viraal::RunResults RunViraalStudy(const StudyOptions& options) {
       trial.X_WV = ToPose(outcome.alignment.X_WV);
       trial.duration_s = outcome.alignment.duration_s;
       trial.user_id = user_id;
+      hmd::SetAnnotationFields(outcome.annotation, &trial);
       service.HandleTrial(trial);
 
       const viraal::RobotPoints trial_points = viraal::TrialPoints(points, trial);
       session_points.push_back(trial_points);
-      const viraal::AlignmentError error = viraal::TrialError(X_WR, trial, trial_points);
+      viraal::AlignmentError error = viraal::TrialError(X_WR, trial, trial_points);
+      // The annotation, triangulated by the server as orbed-scenario asks it over the bus.
+      const auto checked = CheckAlignmentTrial(trial, conductor_model.num_joints());
+      if (const auto* refusal = std::get_if<orbed::Refusal>(&checked)) {
+        throw std::runtime_error("trial " + std::to_string(i) + " of '" + session.session_id +
+                                 "': " + refusal->reason);
+      }
+      std::vector<orbed::landmark_t> landmarks;
+      for (const orbed::landmark_request_t& request :
+           viraal::LandmarkRequests(std::get<orbed::AlignmentTrial>(checked), 0, 0)) {
+        landmarks.push_back(service.HandleLandmarkRequest(request));
+      }
+      if (!landmarks.empty()) error = viraal::WithAnnotation(error, landmarks);
       const orbed::misalignment_t misalignment = Checked(
           service.HandleMisalignmentRequest(viraal::MisalignmentRequest(error, session.session_id, 0, i)));
       session.trials.push_back(viraal::TrialResultFrom(trial, X_WR, viraal::Measures(error, misalignment)));

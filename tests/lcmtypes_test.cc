@@ -113,13 +113,14 @@ TEST(LcmTypes, EveryTypeRoundTripsAndHasAUniqueFingerprint) {
 // another fingerprint ("<channel>/decode/fingerprint"): any change of a type is a breaking change
 // on the wire. docs/design.md §3 "Changing the contract" says how one is made: fields appended at the
 // end, the change listed there with the old and new fingerprints, and this table updated in the same
-// commit. Last change: contract change 4 (types added: setup_task_t and setup_result_t for the robot
+// commit. Last change: contract change 5 (the landmark annotation appended to alignment_trial_t);
+// before it, contract change 4 (types added: setup_task_t and setup_result_t for the robot
 // set-up study, the four viewer_*_t types that are Drake's lcmt_viewer_*); before it, contract change 3
 // (dropped, drop_reason and drop_count appended to process_status_t); before it, contract change 2 (the
 // tracking fault record appended to alignment_trial_t) and contract change 1 (request_id appended to
 // session_control_t, alignment_trial_t and registration_t).
 TEST(LcmTypes, FingerprintsArePinned) {
-  const std::map<std::string, uint64_t> pinned = {{"alignment_trial_t", 0x92399efaae13478cULL},
+  const std::map<std::string, uint64_t> pinned = {{"alignment_trial_t", 0x271026afe7973c6dULL},
                                                   {"collision_status_t", 0x9f78934234cce93fULL},
                                                   {"contact_t", 0x2d8c8a472f48e7e9ULL},
                                                   {"gaze_ray_t", 0x65a37e31d5a2eea1ULL},

@@ -1,6 +1,9 @@
 #include "viraal/exchange.h"
 
+#include <stdexcept>
+
 #include "base/units.h"
+#include "geometry/misalignment.h"
 #include "procs/common/conversions.h"
 
 namespace orbed::viraal {
@@ -19,16 +22,61 @@ AlignmentError MeanError(const orbed::pose_t& X_WR, const orbed::registration_t&
   return EvaluateOverConfigurations(FromPose(X_WR), FromPose(mean.X_WV_mean), session_points);
 }
 
+std::vector<orbed::landmark_request_t> LandmarkRequests(const orbed::AlignmentTrial& trial, int64_t utime,
+                                                        int64_t first_request_id) {
+  std::vector<orbed::landmark_request_t> requests;
+  for (size_t l = 0; l < trial.annotation.size(); ++l) {
+    for (int side : {0, 1}) {
+      const orbed::LandmarkRays& rays = trial.annotation[l][side];
+      orbed::landmark_request_t request{};
+      request.utime = utime;
+      request.request_id = first_request_id + static_cast<int64_t>(requests.size());
+      request.name = trial.msg.session_id + "/" + std::to_string(trial.msg.trial_index) +
+                     (side == 0 ? "/real/" : "/virtual/") + std::to_string(l);
+      request.num_rays = static_cast<int32_t>(rays.origin_W_m.size());
+      for (size_t k = 0; k < rays.origin_W_m.size(); ++k) {
+        const Eigen::Vector3d& o = rays.origin_W_m[k];
+        const Eigen::Vector3d& u = rays.direction_W[k];
+        request.origin_W_m.push_back({o.x(), o.y(), o.z()});
+        request.direction_W.push_back({u.x(), u.y(), u.z()});
+      }
+      requests.push_back(request);
+    }
+  }
+  return requests;
+}
+
+AlignmentError WithAnnotation(AlignmentError error, const std::vector<orbed::landmark_t>& answers) {
+  if (answers.size() % 2 != 0 || answers.size() / 2 != error.p_W_real.size()) {
+    throw std::invalid_argument(
+        "the user annotated " + std::to_string(answers.size() / 2) + " landmark(s), the scenario scores " +
+        std::to_string(error.p_W_real.size()) +
+        " (hmd.annotation_landmarks and the scenario's landmarks must be the same list)");
+  }
+  error.p_W_real_annotated.clear();
+  error.p_W_virtual_annotated.clear();
+  for (size_t k = 0; k < answers.size(); ++k) {
+    const orbed::landmark_t& a = answers[k];
+    if (!a.valid)
+      throw std::invalid_argument("landmark " + a.name + " could not be triangulated: " + a.reason);
+    (k % 2 == 0 ? error.p_W_real_annotated : error.p_W_virtual_annotated).push_back(ToVector3(a.p_W_m));
+  }
+  return error;
+}
+
 orbed::misalignment_request_t MisalignmentRequest(const AlignmentError& error, const std::string& session_id,
                                                   int64_t utime, int64_t request_id) {
+  const bool annotated = !error.p_W_real_annotated.empty();
+  const std::vector<Eigen::Vector3d>& reals = annotated ? error.p_W_real_annotated : error.p_W_real;
+  const std::vector<Eigen::Vector3d>& virtuals = annotated ? error.p_W_virtual_annotated : error.p_W_virtual;
   orbed::misalignment_request_t request{};
   request.utime = utime;
   request.request_id = request_id;
   request.session_id = session_id;
-  request.num_pairs = static_cast<int32_t>(error.p_W_real.size());
-  for (size_t k = 0; k < error.p_W_real.size(); ++k) {
-    const Eigen::Vector3d& real = error.p_W_real[k];
-    const Eigen::Vector3d& virt = error.p_W_virtual[k];
+  request.num_pairs = static_cast<int32_t>(reals.size());
+  for (size_t k = 0; k < reals.size(); ++k) {
+    const Eigen::Vector3d& real = reals[k];
+    const Eigen::Vector3d& virt = virtuals[k];
     request.p_W_real_m.push_back({real.x(), real.y(), real.z()});
     request.p_W_virtual_m.push_back({virt.x(), virt.y(), virt.z()});
   }
@@ -44,6 +92,9 @@ ErrorMeasures Measures(const AlignmentError& error, const orbed::misalignment_t&
   m.misalignment_mm = misalignment.mean_error_norm_m * 1e3;
   m.misalignment_axes_mm = ToVector3(misalignment.mean_error_W_m) * 1e3;
   m.misalignment_mean_pair_distance_mm = misalignment.mean_pair_distance_m * 1e3;
+  m.landmarks = error.p_W_real_annotated.empty() ? "truth" : "gaze";
+  m.truth_misalignment_mm =
+      geometry::EvaluateMisalignment(error.p_W_real, error.p_W_virtual).mean_error_norm_m * 1e3;
   return m;
 }
 

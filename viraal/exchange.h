@@ -4,8 +4,12 @@
 /// scores a run: the conductor (orbed-scenario, from the bus) and the offline study (orbed-user-study,
 /// from the same messages built in-process). Given the same messages, both get the same numbers.
 ///
-///   trial:  ALIGNMENT_TRIAL (q, X_WV) and the truth X_WR (ROBOT_STATE) → TrialError → the landmark
-///           pairs as a MISALIGNMENT_REQUEST → orbed-registration's MISALIGNMENT → TrialResultFrom;
+///   trial:  ALIGNMENT_TRIAL (q, X_WV) and the truth X_WR (ROBOT_STATE) → TrialError (point errors
+///           and the truth's landmark pairs); if the user annotated the landmarks (the message's
+///           gaze rays), LandmarkRequests → orbed-registration's LANDMARKs → WithAnnotation: the
+///           triangulated pairs (the paper's measurement, Sec. III-B); → the pairs as a
+///           MISALIGNMENT_REQUEST (annotated ones if any, else the truth's) → MISALIGNMENT →
+///           TrialResultFrom;
 ///   mean:   REGISTRATION (reason COMPUTE, X_WV_mean) → MeanError over the session's configurations →
 ///           MISALIGNMENT_REQUEST → MISALIGNMENT → MeanResultFrom.
 ///
@@ -18,11 +22,14 @@
 #include <vector>
 
 #include <orbed/alignment_trial_t.hpp>
+#include <orbed/landmark_request_t.hpp>
+#include <orbed/landmark_t.hpp>
 #include <orbed/misalignment_request_t.hpp>
 #include <orbed/misalignment_t.hpp>
 #include <orbed/pose_t.hpp>
 #include <orbed/registration_t.hpp>
 
+#include "procs/common/alignment_trial.h"
 #include "viraal/metrics.h"
 #include "viraal/results.h"
 
@@ -39,11 +46,26 @@ AlignmentError TrialError(const orbed::pose_t& X_WR, const orbed::alignment_tria
 AlignmentError MeanError(const orbed::pose_t& X_WR, const orbed::registration_t& mean,
                          const std::vector<RobotPoints>& session_points);
 
-/// The landmark pairs of `error` as a request to orbed-registration.
+/// The annotation of a checked trial (procs/common/alignment_trial.h) as LANDMARK_REQUESTs: for each
+/// landmark l, the real robot's rays then the virtual one's, named "<session>/<index>/real/<l>" and
+/// ".../virtual/<l>", request ids first_request_id, +1, ... Empty for a trial without annotation.
+std::vector<orbed::landmark_request_t> LandmarkRequests(const orbed::AlignmentTrial& trial, int64_t utime,
+                                                        int64_t first_request_id);
+
+/// `error` with the annotated pairs from the LANDMARK answers to LandmarkRequests(), in its order.
+/// Throws std::invalid_argument when an answer is invalid (naming its landmark and reason), or when
+/// there is an odd number of answers, or as many landmarks as error's truth pairs do not match
+/// (the user annotated other landmarks than the scenario scores).
+AlignmentError WithAnnotation(AlignmentError error, const std::vector<orbed::landmark_t>& answers);
+
+/// The landmark pairs of `error` as a request to orbed-registration: the annotated pairs when there
+/// are, else the truth's.
 orbed::misalignment_request_t MisalignmentRequest(const AlignmentError& error, const std::string& session_id,
                                                   int64_t utime, int64_t request_id);
 
-/// The measures of one pose: point errors from `error`, the paper's misalignment from `misalignment`.
+/// The measures of one pose: point errors from `error`, the paper's misalignment from `misalignment`
+/// (landmarks "gaze" when `error` has annotated pairs), truth_misalignment_mm from error's truth
+/// pairs (geometry/misalignment.h, as orbed-registration computes it).
 ErrorMeasures Measures(const AlignmentError& error, const orbed::misalignment_t& misalignment);
 
 /// One row of results.json for a trial.

@@ -68,6 +68,10 @@ struct AlignmentError {
   /// One pair per landmark (and per configuration for EvaluateOverConfigurations), in W [m].
   std::vector<Eigen::Vector3d> p_W_real;
   std::vector<Eigen::Vector3d> p_W_virtual;
+  /// The same landmarks as the user annotated them (triangulated gaze rays, in the headset's map)
+  /// [m]; empty when nobody annotated (see exchange.h).
+  std::vector<Eigen::Vector3d> p_W_real_annotated;
+  std::vector<Eigen::Vector3d> p_W_virtual_annotated;
 };
 
 /// Geodesic angle between two rotations [rad], in [0, π]: the angle of R_a^T·R_b.

@@ -40,6 +40,8 @@ void WriteMeasures(JsonWriter* json, const ErrorMeasures& e) {
       .Array(std::vector<double>{e.misalignment_axes_mm.x(), e.misalignment_axes_mm.y(),
                                  e.misalignment_axes_mm.z()});
   json->Key("misalignment_mean_pair_distance_mm").Number(e.misalignment_mean_pair_distance_mm);
+  json->Key("landmarks").String(e.landmarks);
+  json->Key("truth_misalignment_mm").Number(e.truth_misalignment_mm);
 }
 
 // The measures that get trial statistics, by name.
@@ -48,6 +50,7 @@ const std::vector<std::pair<std::string, std::function<double(const ErrorMeasure
       {"translation_error_mm", [](const ErrorMeasures& e) { return e.translation_error_mm; }},
       {"rotation_error_deg", [](const ErrorMeasures& e) { return e.rotation_error_deg; }},
       {"misalignment_mm", [](const ErrorMeasures& e) { return e.misalignment_mm; }},
+      {"truth_misalignment_mm", [](const ErrorMeasures& e) { return e.truth_misalignment_mm; }},
       {"base_translation_error_mm", [](const ErrorMeasures& e) { return e.base_translation_error_mm; }},
       {"flange_translation_error_mm", [](const ErrorMeasures& e) { return e.flange_translation_error_mm; }}};
   return measures;
@@ -105,8 +108,11 @@ std::string ResultsJson(const RunResults& r) {
   json.Key("misalignment_definition")
       .String(
           "paper Table 1: norm of the mean absolute per-axis error over the landmark pairs, "
-          "||t_bar||_2 (orbed-registration MISALIGNMENT mean_error_norm_m); for a mean: the pairs of "
-          "all the session's configurations");
+          "||t_bar||_2 (orbed-registration MISALIGNMENT mean_error_norm_m); the pairs as the user "
+          "annotated them by head gaze, triangulated by orbed-registration (landmarks \"gaze\"), or "
+          "the link origins placed with the true X_WR and X_WV (landmarks \"truth\"; "
+          "truth_misalignment_mm always); for a mean: the truth's pairs of all the session's "
+          "configurations");
   json.Key("landmarks").BeginArray();
   for (const std::string& name : r.landmarks) json.String(name);
   json.EndArray();
@@ -294,6 +300,16 @@ ErrorMeasures ReadMeasures(const JsonFields& f, const JsonAt& at) {
   e.misalignment_axes_mm = Eigen::Vector3d(axes[0], axes[1], axes[2]);
   e.misalignment_mean_pair_distance_mm =
       f.Number(f.Member(at, "misalignment_mean_pair_distance_mm"), 0, kMaxMeasure);
+  e.landmarks = "truth";
+  e.truth_misalignment_mm = e.misalignment_mm;
+  if (const auto landmarks = f.OptionalMember(at, "landmarks")) {
+    e.landmarks = f.String(*landmarks, 8);
+    if (e.landmarks != "gaze" && e.landmarks != "truth")
+      f.Fail(landmarks->key, "\"gaze\" or \"truth\"", &landmarks->value);
+  }
+  if (const auto truth = f.OptionalMember(at, "truth_misalignment_mm")) {
+    e.truth_misalignment_mm = f.Number(*truth, 0, kMaxMeasure);
+  }
   return e;
 }
 

@@ -19,7 +19,10 @@
 ///                  "trials": [ {"index", "q_deg", "translation_error_mm", "rotation_error_deg",
 ///                               "misalignment_mm", "base_translation_error_mm",
 ///                               "flange_translation_error_mm", "misalignment_axes_mm" [t̄x,t̄y,t̄z],
-///                               "misalignment_mean_pair_distance_mm", "user_duration_s",
+///                               "misalignment_mean_pair_distance_mm", "landmarks" ("gaze" |
+///                               "truth"), "truth_misalignment_mm" (both absent in files written
+///                               before ALIGNMENT_TRIAL's contract change 5: read as "truth" and
+///                               misalignment_mm), "user_duration_s",
 ///                               "user_id", "X_WV", "X_WR",
 ///                               "tracking_faults": {"losses", "relocalizations", "wait_s",
 ///                                                   "repeats"} (only on a trial whose user met
@@ -32,8 +35,9 @@
 ///                  "mean": {"translation_error_mm", "rotation_error_deg", "misalignment_mm",
 ///                           "base_translation_error_mm", "flange_translation_error_mm",
 ///                           "misalignment_axes_mm", "misalignment_mean_pair_distance_mm",
-///                           "X_WV", "num_used", "rejected_indices", "rotation_rms_deg",
-///                           "translation_rms_mm", "iterations", "converged", "unique"} } ]
+///                           "landmarks", "truth_misalignment_mm", "X_WV", "num_used", "rejected_indices",
+///                           "rotation_rms_deg", "translation_rms_mm", "iterations", "converged", "unique"} }
+///                           ]
 /// A failed or partial run still writes what it had: the sessions and trials finished so far ("mean"
 /// is null for a session that did not get one).
 ///
@@ -62,6 +66,12 @@ struct ErrorMeasures {
   double flange_translation_error_mm{0};
   Eigen::Vector3d misalignment_axes_mm{Eigen::Vector3d::Zero()};  ///< t̄ = mean |virtual − real| per axis
   double misalignment_mean_pair_distance_mm{0};                   ///< mean of the pair distances
+  /// Where the landmark pairs of the three misalignment fields above came from: "gaze" (the user's
+  /// annotation, triangulated by orbed-registration: the paper's measurement) or "truth" (the link
+  /// origins placed with X_WR and X_WV: a trial nobody annotated, and every session mean).
+  std::string landmarks{"truth"};
+  /// ‖t̄‖₂ of the truth pairs, whatever `landmarks` says (= misalignment_mm when it says "truth").
+  double truth_misalignment_mm{0};
 };
 
 /// The tracking faults the user met while aligning (ALIGNMENT_TRIAL's contract change 2 fields).

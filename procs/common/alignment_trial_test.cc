@@ -108,5 +108,83 @@ TEST(AlignmentTrial, TrackingFaults) {
   }
 }
 
+// Contract change 5: the landmark annotation. Good() with two landmarks, two rays per side each.
+AT Annotated() {
+  AT m = Good();
+  for (int l = 0; l < 2; ++l) {
+    for (int8_t side : {AT::ANNOTATION_REAL, AT::ANNOTATION_VIRTUAL}) {
+      for (int k = 0; k < 2; ++k) {
+        m.annotation_landmark.push_back(l);
+        m.annotation_side.push_back(side);
+        m.annotation_origin_W_m.push_back({0.3 * k, 0.0, 1.6});
+        m.annotation_direction_W.push_back({0.0, 0.6, -0.8});
+      }
+    }
+  }
+  m.num_annotation_rays = static_cast<int32_t>(m.annotation_landmark.size());
+  return m;
+}
+
+TEST(AlignmentTrial, AnnotationIsDecodedByLandmarkAndSide) {
+  const auto checked = CheckAlignmentTrial(Annotated(), 64);
+  ASSERT_TRUE(std::holds_alternative<AlignmentTrial>(checked));
+  const AlignmentTrial& t = std::get<AlignmentTrial>(checked);
+  ASSERT_EQ(t.annotation.size(), 2u);
+  for (const auto& landmark : t.annotation) {
+    for (const LandmarkRays& rays : landmark) {
+      ASSERT_EQ(rays.origin_W_m.size(), 2u);
+      EXPECT_EQ(rays.origin_W_m[1], Eigen::Vector3d(0.3, 0.0, 1.6));
+      EXPECT_EQ(rays.direction_W[0], Eigen::Vector3d(0.0, 0.6, -0.8));
+    }
+  }
+  EXPECT_TRUE(std::get<AlignmentTrial>(CheckAlignmentTrial(Good(), 64)).annotation.empty());
+}
+
+TEST(AlignmentTrial, AnnotationRules) {
+  AT m = Annotated();
+  m.num_annotation_rays = 7;  // the arrays hold 8
+  EXPECT_EQ(Key(m), "annotation");
+  m = Annotated();
+  m.annotation_side.pop_back();  // one array shorter than the count
+  EXPECT_EQ(Key(m), "annotation");
+  m = Annotated();
+  m.annotation_landmark[0] = 16;
+  EXPECT_EQ(Key(m), "annotation");
+  m = Annotated();
+  m.annotation_landmark[0] = -1;
+  EXPECT_EQ(Key(m), "annotation");
+  m = Annotated();
+  m.annotation_side[0] = 2;
+  EXPECT_EQ(Key(m), "annotation");
+  m = Annotated();
+  m.annotation_origin_W_m[3][1] = NAN;
+  EXPECT_EQ(Key(m), "annotation");
+  m = Annotated();
+  m.annotation_origin_W_m[3][1] = 2e4;  // not in an operating room
+  EXPECT_EQ(Key(m), "annotation");
+  m = Annotated();
+  m.annotation_direction_W[5] = {0.0, 0.0, 1.01};  // not a unit vector
+  EXPECT_EQ(Key(m), "annotation");
+  m = Annotated();
+  m.annotation_direction_W[5] = {0.0, 0.0, INFINITY};
+  EXPECT_EQ(Key(m), "annotation");
+  m = Annotated();
+  m.annotation_origin_W_m[5] = {0.0, 0.0};  // a row of two values
+  EXPECT_EQ(Key(m), "annotation");
+  m = Annotated();
+  m.annotation_landmark[7] = 3;  // landmark 1 left with one virtual ray, landmarks 2 and 3 with one
+  EXPECT_EQ(Key(m), "annotation");
+  m = Annotated();
+  for (int k = 4; k < 8; ++k) m.annotation_landmark[k] = 2;  // landmark 1 has none
+  EXPECT_EQ(Key(m), "annotation");
+  m = Annotated();
+  m.num_annotation_rays = kMaxAnnotationRays + 1;
+  m.annotation_landmark.assign(m.num_annotation_rays, 0);
+  m.annotation_side.assign(m.num_annotation_rays, +AT::ANNOTATION_REAL);
+  m.annotation_origin_W_m.assign(m.num_annotation_rays, {0, 0, 1});
+  m.annotation_direction_W.assign(m.num_annotation_rays, {1, 0, 0});
+  EXPECT_EQ(Key(m), "annotation");
+}
+
 }  // namespace
 }  // namespace orbed

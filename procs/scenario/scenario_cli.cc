@@ -95,6 +95,8 @@ int RunScenario(int argc, const char* const* argv, std::ostream& out, std::ostre
   app.add_option("--session-control-channel", run.session_control_channel)->capture_default_str();
   app.add_option("--trial-channel", run.trial_channel)->capture_default_str();
   app.add_option("--registration-channel", run.registration_channel)->capture_default_str();
+  app.add_option("--landmark-request-channel", run.landmark_request_channel)->capture_default_str();
+  app.add_option("--landmark-channel", run.landmark_channel)->capture_default_str();
   app.add_option("--misalignment-request-channel", run.misalignment_request_channel)->capture_default_str();
   app.add_option("--misalignment-channel", run.misalignment_channel)->capture_default_str();
   std::string print_path;

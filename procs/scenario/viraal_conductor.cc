@@ -223,9 +223,61 @@ ConductorActions ViraalConductor::OnTrial(const orbed::alignment_trial_t& msg, c
   session_points_.push_back(points);
   pending_error_ = viraal::TrialError(robot_state_->X_WR, msg, points);
   Enter(Phase::kAwaitTrialResults);
-  SendMisalignment(pending_error_);
+  landmark_requests_ = viraal::LandmarkRequests(std::get<orbed::AlignmentTrial>(checked), now_.utime, 0);
+  landmark_answers_.assign(landmark_requests_.size(), std::nullopt);
+  misalignment_.reset();
+  misalignment_request_ = orbed::misalignment_request_t{};
+  if (landmark_requests_.empty()) {
+    SendMisalignment(pending_error_);
+  } else {
+    for (orbed::landmark_request_t& request : landmark_requests_) {
+      request.request_id = NewRequestId();
+      Publish(options_.landmark_request_channel, request);
+    }
+  }
   Step();
   return TakeActions();
+}
+
+ConductorActions ViraalConductor::OnLandmark(const orbed::landmark_t& msg, const ConductorTime& now) {
+  Begin(now);
+  if (phase_ != Phase::kAwaitTrialResults) return TakeActions();  // not ours, or a late repeat
+  size_t k = 0;
+  while (k < landmark_requests_.size() && landmark_requests_[k].request_id != msg.request_id) ++k;
+  if (k == landmark_requests_.size() || landmark_answers_[k]) return TakeActions();  // not ours, or a repeat
+  if (msg.valid) {
+    const std::string problem =
+        FirstError({CheckBounded(msg.p_W_m, 3, kMaxAlignmentCoordinate_m, "LANDMARK.p_W_m"),
+                    CheckFinite(&msg.ray_angle_deg, 1, "LANDMARK.ray_angle_deg"),
+                    CheckFinite(&msg.gap_m, 1, "LANDMARK.gap_m")});
+    if (!problem.empty()) {
+      Refuse(options_.landmark_channel + "/field", problem);
+      return TakeActions();
+    }
+  } else {
+    FailRun("orbed-registration could not triangulate landmark " + landmark_requests_[k].name + ": " +
+            msg.reason);
+    return TakeActions();
+  }
+  landmark_answers_[k] = msg;
+  if (LandmarksAnswered()) {
+    std::vector<orbed::landmark_t> answers;
+    for (const auto& a : landmark_answers_) answers.push_back(*a);
+    try {
+      pending_error_ = viraal::WithAnnotation(pending_error_, answers);
+    } catch (const std::invalid_argument& e) {
+      FailRun(e.what());
+      return TakeActions();
+    }
+    SendMisalignment(pending_error_);
+  }
+  Step();
+  return TakeActions();
+}
+
+bool ViraalConductor::LandmarksAnswered() const {
+  return std::all_of(landmark_answers_.begin(), landmark_answers_.end(),
+                     [](const std::optional<orbed::landmark_t>& a) { return a.has_value(); });
 }
 
 ConductorActions ViraalConductor::OnRegistration(const orbed::registration_t& msg, const ConductorTime& now) {
@@ -258,7 +310,7 @@ ConductorActions ViraalConductor::OnRegistration(const orbed::registration_t& ms
 ConductorActions ViraalConductor::OnMisalignment(const orbed::misalignment_t& msg, const ConductorTime& now) {
   Begin(now);
   if ((phase_ != Phase::kAwaitTrialResults && phase_ != Phase::kAwaitMeanMisalignment) ||
-      msg.request_id != misalignment_request_.request_id)
+      misalignment_request_.request_id == 0 || msg.request_id != misalignment_request_.request_id)
     return TakeActions();  // not ours, or a late repeat
   std::string problem;
   if (msg.valid) {
@@ -312,7 +364,11 @@ void ViraalConductor::RetryIfDue() {
         for (const orbed::alignment_trial_t& kept : kept_trials_) Publish(options_.trial_channel, kept);
         Publish(options_.session_control_channel, trial_request_);
       }
-      if (phase_ == Phase::kAwaitTrialResults && !misalignment_) {
+      if (phase_ == Phase::kAwaitTrialResults && !LandmarksAnswered()) {
+        for (size_t k = 0; k < landmark_requests_.size(); ++k) {
+          if (!landmark_answers_[k]) Publish(options_.landmark_request_channel, landmark_requests_[k]);
+        }
+      } else if (phase_ == Phase::kAwaitTrialResults && !misalignment_) {
         Publish(options_.misalignment_request_channel, misalignment_request_);
       }
       break;
@@ -425,11 +481,17 @@ void ViraalConductor::Step() {
       if (registered && misalignment_) {
         FinishTrial();
       } else if (waited > options_.reply_timeout_s) {
-        FailRun(std::string(registered ? "no MISALIGNMENT answer" : "no REGISTRATION (reason TRIAL)") +
-                " from orbed-registration for session '" + results_.sessions.back().session_id + "' trial " +
-                std::to_string(trial_index_) + " within " + Fixed(options_.reply_timeout_s, 1) + " s" +
-                Attempts() + " (is it running? did it refuse the trial? see its PROCESS_STATUS rejections)" +
-                refusal);
+        const size_t answered = std::count_if(landmark_answers_.begin(), landmark_answers_.end(),
+                                              [](const auto& a) { return a.has_value(); });
+        const std::string missing = !registered ? "no REGISTRATION (reason TRIAL)"
+                                    : !LandmarksAnswered()
+                                        ? "LANDMARK answers to " + std::to_string(answered) + " of " +
+                                              std::to_string(landmark_requests_.size()) + " LANDMARK_REQUESTs"
+                                        : "no MISALIGNMENT answer";
+        FailRun(missing + " from orbed-registration for session '" + results_.sessions.back().session_id +
+                "' trial " + std::to_string(trial_index_) + " within " + Fixed(options_.reply_timeout_s, 1) +
+                " s" + Attempts() +
+                " (is it running? did it refuse the trial? see its PROCESS_STATUS rejections)" + refusal);
       } else {
         RetryIfDue();
       }

@@ -9,7 +9,9 @@
 ///   PLAN_CHECK_REPLY → START(session "<run_id>-<mode>", method) → for trial i = 0..N−1:
 ///   IIWA_COMMAND q_i (configuration i mod K), wait until ROBOT_STATE has every |q − q_i| <
 ///   tolerance_deg and motion IDLE → REQUEST_TRIAL → the ALIGNMENT_TRIAL (session, index i) →
-///   MISALIGNMENT_REQUEST of the trial's landmark pairs, wait for the REGISTRATION (reason TRIAL, that
+///   if the user annotated the landmarks (the trial's gaze rays), a LANDMARK_REQUEST per landmark
+///   and side, and once every LANDMARK is in, the MISALIGNMENT_REQUEST of the triangulated pairs
+///   (else at once, of the truth's pairs); wait for the REGISTRATION (reason TRIAL, that
 ///   trial's utime, num_trials i+1) and the MISALIGNMENT answer → after N trials COMPUTE → the
 ///   REGISTRATION (reason COMPUTE) = the session mean → MISALIGNMENT_REQUEST of the mean's pairs →
 ///   the answer → STOP. After the last mode the status is kSucceeded. A timeout, an infeasible
@@ -22,11 +24,13 @@
 /// averages them, the headset moves its next index past them), then its next trial; the trials it
 /// re-sent, coming back, are ignored.
 ///
-/// Errors against the truth (viraal/metrics.h, scored by viraal/exchange.h): X_WR from the latest ROBOT_STATE
-/// (the sim's truth); translation_error_mm at the robot centroid, rotation_error_deg the geodesic angle of
-/// R_WR^T R_WV, misalignment_mm = MISALIGNMENT.mean_error_norm_m (the paper's ‖t̄‖₂) of the landmark
-/// pairs real = X_WR·X_RL(q)·0, virtual = X_WV·X_RL(q)·0, q = the trial's joint_position [rad].
-/// A session mean X_WV_mean is measured over the session's trial configurations.
+/// Errors (viraal/metrics.h, scored by viraal/exchange.h): X_WR from the latest ROBOT_STATE (the
+/// sim's truth); translation_error_mm at the robot centroid, rotation_error_deg the geodesic angle of
+/// R_WR^T R_WV; misalignment_mm = MISALIGNMENT.mean_error_norm_m (the paper's ‖t̄‖₂) of the user's
+/// annotated landmark pairs (the paper's measurement, in the headset's map), or for a trial without
+/// annotation of the truth's pairs real = X_WR·X_RL(q)·0, virtual = X_WV·X_RL(q)·0, q = the trial's
+/// joint_position [rad]; truth_misalignment_mm always from the truth's pairs. A session mean
+/// X_WV_mean is measured over the session's trial configurations, with the truth's pairs.
 ///
 /// Inputs: each On*() takes a decoded message and the time it arrived; Tick() only the time. Every
 /// message is checked (sizes, finite values, unit quaternions, enum ranges); a bad one is refused
@@ -38,18 +42,19 @@
 ///
 /// Requests and retries (datagrams may be lost, duplicated or reordered): every request carries a
 /// request id, distinct within the run (the Start() utime + 1, + 2, ...): PLAN_CHECK_REQUEST,
-/// SESSION_CONTROL (START, REQUEST_TRIAL, COMPUTE, STOP) and MISALIGNMENT_REQUEST. An answer counts
-/// only when it echoes the id of the request the phase waits for: PLAN_CHECK_REPLY and MISALIGNMENT
-/// their request's, ALIGNMENT_TRIAL its REQUEST_TRIAL's, REGISTRATION the COMPUTE's (reason
-/// COMPUTE) or the trial's (reason TRIAL, with the trial's utime and num_trials i + 1). An answer
+/// SESSION_CONTROL (START, REQUEST_TRIAL, COMPUTE, STOP), LANDMARK_REQUEST and MISALIGNMENT_REQUEST.
+/// An answer counts only when it echoes the id of the request the phase waits for: PLAN_CHECK_REPLY,
+/// LANDMARK and MISALIGNMENT their request's, ALIGNMENT_TRIAL its REQUEST_TRIAL's, REGISTRATION the COMPUTE's
+/// (reason COMPUTE) or the trial's (reason TRIAL, with the trial's utime and num_trials i + 1). An answer
 /// with an id this run used before (a repeat, a late duplicate) is ignored, not refused. While a
 /// phase waits, what is unanswered is re-sent, byte for byte, retry_initial_s after the phase began,
 /// then after intervals doubling up to retry_max_s, until the phase's timeout: the plan checks not
 /// yet answered; the REQUEST_TRIAL, preceded by the session's START (a receiver that missed the
 /// START opens the session; one that has it ignores the repeated id), until the trial is both
 /// received and registered (the headset answers a repeated REQUEST_TRIAL with the same trial, the
-/// server a repeat of that trial with the same REGISTRATION); the MISALIGNMENT_REQUEST; the
-/// COMPUTE. STOP is not retried: the next START replaces the session in every receiver.
+/// server a repeat of that trial with the same REGISTRATION); the LANDMARK_REQUESTs not yet
+/// answered, then the MISALIGNMENT_REQUEST; the COMPUTE. STOP is not retried: the next START replaces the
+/// session in every receiver.
 ///
 /// Outputs: every call returns the actions it produced, in order: messages to publish (with their
 /// channel), progress lines for the operator, log entries and refusals. The caller carries them out
@@ -71,6 +76,8 @@
 
 #include <orbed/alignment_trial_t.hpp>
 #include <orbed/iiwa_command_t.hpp>
+#include <orbed/landmark_request_t.hpp>
+#include <orbed/landmark_t.hpp>
 #include <orbed/misalignment_request_t.hpp>
 #include <orbed/misalignment_t.hpp>
 #include <orbed/plan_check_reply_t.hpp>
@@ -106,7 +113,7 @@ struct ConductorOptions {
   double tolerance_deg{0.1};
   /// Waiting for the first ROBOT_STATE [s] (orbed-iiwa-sim).
   double startup_timeout_s{10.0};
-  /// Waiting for the PLAN_CHECK_REPLYs, a REGISTRATION or a MISALIGNMENT [s].
+  /// Waiting for the PLAN_CHECK_REPLYs, a REGISTRATION, the LANDMARKs or a MISALIGNMENT [s].
   double reply_timeout_s{5.0};
   /// Waiting for the arm to reach a configuration [s].
   double move_timeout_s{30.0};
@@ -133,6 +140,8 @@ struct ConductorOptions {
   std::string session_control_channel{channels::kSessionControl};
   std::string trial_channel{channels::kAlignmentTrial};
   std::string registration_channel{channels::kRegistration};
+  std::string landmark_request_channel{channels::kLandmarkRequest};
+  std::string landmark_channel{channels::kLandmark};
   std::string misalignment_request_channel{channels::kMisalignmentRequest};
   std::string misalignment_channel{channels::kMisalignment};
 };
@@ -143,8 +152,9 @@ void CheckConductorOptions(const ConductorOptions& options);
 
 /// A message to publish on `channel`.
 struct Publication {
-  using Message = std::variant<orbed::plan_check_request_t, orbed::session_control_t, orbed::iiwa_command_t,
-                               orbed::misalignment_request_t, orbed::alignment_trial_t>;
+  using Message =
+      std::variant<orbed::plan_check_request_t, orbed::session_control_t, orbed::iiwa_command_t,
+                   orbed::landmark_request_t, orbed::misalignment_request_t, orbed::alignment_trial_t>;
   std::string channel;
   Message message;
 };
@@ -195,6 +205,7 @@ class ViraalConductor {
   ConductorActions OnPlanCheckReply(const orbed::plan_check_reply_t& msg, const ConductorTime& now);
   ConductorActions OnTrial(const orbed::alignment_trial_t& msg, const ConductorTime& now);
   ConductorActions OnRegistration(const orbed::registration_t& msg, const ConductorTime& now);
+  ConductorActions OnLandmark(const orbed::landmark_t& msg, const ConductorTime& now);
   ConductorActions OnMisalignment(const orbed::misalignment_t& msg, const ConductorTime& now);
   /// Advances what waits on time: timeouts, arrival checks, IIWA_COMMAND re-sends.
   ConductorActions Tick(const ConductorTime& now);
@@ -241,6 +252,8 @@ class ViraalConductor {
   bool IssuedRequestId(int64_t id) const {
     return id > request_id_base_ && id < request_id_base_ + next_request_id_;
   }
+  // Every LANDMARK_REQUEST of the trial is answered (true when there are none).
+  bool LandmarksAnswered() const;
   // The trial is in and the server registered it (REGISTRATION reason TRIAL for it).
   bool TrialRegistered() const;
   // ", sent N times": how often the phase's request went out, for timeout reasons.
@@ -295,6 +308,9 @@ class ViraalConductor {
   std::vector<orbed::alignment_trial_t> kept_trials_;  // resuming: re-sent after START
   orbed::session_control_t trial_request_;
   orbed::session_control_t compute_request_;
+  // The trial's landmark requests, as sent, and their answers (empty: not annotated).
+  std::vector<orbed::landmark_request_t> landmark_requests_;
+  std::vector<std::optional<orbed::landmark_t>> landmark_answers_;
   orbed::misalignment_request_t misalignment_request_;
   std::optional<orbed::alignment_trial_t> trial_;
   std::optional<orbed::registration_t> trial_registration_;

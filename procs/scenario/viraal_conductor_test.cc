@@ -112,6 +112,7 @@ class Bench {
   void Send(const orbed::alignment_trial_t& m) { Record(conductor_.OnTrial(m, clock_.Now())); }
   void Send(const orbed::registration_t& m) { Record(conductor_.OnRegistration(m, clock_.Now())); }
   void Send(const orbed::misalignment_t& m) { Record(conductor_.OnMisalignment(m, clock_.Now())); }
+  void Send(const orbed::landmark_t& m) { Record(conductor_.OnLandmark(m, clock_.Now())); }
 
   // Started, the robot seen and every plan check answered: the first IIWA_COMMAND is out.
   void StartAndCheckPlans() {
@@ -560,6 +561,142 @@ TEST(ViraalConductor, ATrialIsRetriedUntilItIsReceivedAndRegistered) {
   EXPECT_EQ(bench.conductor().phase(), Phase::kMove);
   EXPECT_TRUE(bench.refusals().empty());
   EXPECT_EQ(bench.conductor().results().sessions[0].trials.size(), 1u);
+}
+
+// An annotated trial (the user's gaze rays, contract change 5) is scored from the landmarks that
+// orbed-registration triangulates: a LANDMARK_REQUEST per landmark and side with exactly the
+// trial's rays, retried while unanswered, and once all are in, the MISALIGNMENT_REQUEST of the
+// answered points (real, virtual) in landmark order; the truth's misalignment stays beside it.
+TEST(ViraalConductor, AnAnnotatedTrialIsScoredFromTheTriangulatedLandmarks) {
+  using AT = orbed::alignment_trial_t;
+  Bench bench;
+  bench.StartAndCheckPlans();
+  const auto& q0 = bench.conductor().options().config.configurations_deg[0];
+  bench.Send(RobotState(Rad(q0)));
+  const Publication request = bench.sent().back();
+  AT trial = Trial("emu-ar_reflective", 0, Rad(q0), SceneBase(), 1234, AT::MODE_AR_REFLECTIVE, 1);
+  trial.request_id = std::get<orbed::session_control_t>(request.message).request_id;
+  for (int l = 0; l < 3; ++l) {
+    for (int8_t side : {AT::ANNOTATION_REAL, AT::ANNOTATION_VIRTUAL}) {
+      for (int k = 0; k < 2; ++k) {
+        trial.annotation_landmark.push_back(l);
+        trial.annotation_side.push_back(side);
+        trial.annotation_origin_W_m.push_back({0.1 * l, 0.01 * side, 1.5 + k});
+        trial.annotation_direction_W.push_back({1.0, 0.0, 0.0});
+      }
+    }
+  }
+  trial.num_annotation_rays = 12;
+  bench.Send(trial);
+  ASSERT_TRUE(bench.refusals().empty()) << bench.refusals()[0].reason;
+  const std::vector<Publication> requests = bench.Sent("LANDMARK_REQUEST");
+  ASSERT_EQ(requests.size(), 6u);
+  EXPECT_TRUE(bench.Sent("MISALIGNMENT_REQUEST").empty());
+  std::vector<orbed::landmark_request_t> sent;
+  for (size_t k = 0; k < 6; ++k) {
+    sent.push_back(std::get<orbed::landmark_request_t>(requests[k].message));
+    const int l = static_cast<int>(k / 2);
+    const bool virt = k % 2 == 1;
+    EXPECT_EQ(sent[k].name,
+              "emu-ar_reflective/0/" + std::string(virt ? "virtual/" : "real/") + std::to_string(l));
+    ASSERT_EQ(sent[k].num_rays, 2);
+    ASSERT_EQ(sent[k].origin_W_m.size(), 2u);
+    ASSERT_EQ(sent[k].origin_W_m[1].size(), 3u);
+    EXPECT_EQ(sent[k].origin_W_m[1][0], 0.1 * l);
+    EXPECT_EQ(sent[k].origin_W_m[1][1], virt ? 0.01 : 0.0);
+    EXPECT_EQ(sent[k].origin_W_m[1][2], 2.5);
+  }
+  // Answers: landmark l real at (l, 0, 1), virtual 3 mm further along x and 4 mm along y.
+  auto answer = [&](size_t k) {
+    orbed::landmark_t a{};
+    a.utime = sent[k].utime;
+    a.request_id = sent[k].request_id;
+    a.name = sent[k].name;
+    a.valid = true;
+    a.p_W_m[0] = static_cast<double>(k / 2) + (k % 2 ? 0.003 : 0.0);
+    a.p_W_m[1] = k % 2 ? 0.004 : 0.0;
+    a.p_W_m[2] = 1.0;
+    return a;
+  };
+  for (size_t k : {0, 2, 3, 5}) bench.Send(answer(k));
+  bench.Send(answer(0));  // a repeat: ignored
+  EXPECT_TRUE(bench.Sent("MISALIGNMENT_REQUEST").empty());
+  const double t_s = bench.clock().t_s();
+  bench.TickAt(t_s + 0.21);  // START, REQUEST_TRIAL (not registered) and the two unanswered
+  std::vector<int64_t> retried;
+  for (const Publication& p : bench.last()) {
+    if (p.channel == "LANDMARK_REQUEST")
+      retried.push_back(std::get<orbed::landmark_request_t>(p.message).request_id);
+  }
+  EXPECT_EQ(retried, (std::vector<int64_t>{sent[1].request_id, sent[4].request_id}));
+  bench.Send(answer(1));
+  bench.Send(answer(4));
+  ASSERT_EQ(bench.Sent("MISALIGNMENT_REQUEST").size(), 1u);
+  const auto m = std::get<orbed::misalignment_request_t>(bench.Sent("MISALIGNMENT_REQUEST")[0].message);
+  ASSERT_EQ(m.num_pairs, 3);
+  for (int l = 0; l < 3; ++l) {
+    EXPECT_EQ(m.p_W_real_m[l], (std::vector<double>{static_cast<double>(l), 0.0, 1.0}));
+    EXPECT_EQ(m.p_W_virtual_m[l], (std::vector<double>{l + 0.003, 0.004, 1.0}));
+  }
+  // The server's answer for those pairs: every pair 5 mm apart, (3, 4, 0) mm per axis.
+  orbed::misalignment_t reply{};
+  reply.utime = m.utime;
+  reply.request_id = m.request_id;
+  reply.session_id = m.session_id;
+  reply.valid = true;
+  reply.num_pairs = 3;
+  reply.error_norm_m.assign(3, 0.005);
+  reply.error_W_m.assign(3, {0.003, 0.004, 0});
+  reply.mean_error_W_m[0] = 0.003;
+  reply.mean_error_W_m[1] = 0.004;
+  reply.mean_error_norm_m = 0.005;
+  reply.mean_pair_distance_m = 0.005;
+  bench.Send(reply);
+  orbed::registration_t registration{};
+  registration.utime = trial.utime;
+  registration.session_id = trial.session_id;
+  registration.reason = orbed::registration_t::REASON_TRIAL;
+  registration.valid = true;
+  registration.X_WV_mean = trial.X_WV;
+  registration.num_trials = 1;
+  registration.request_id = trial.request_id;
+  bench.Send(registration);
+  ASSERT_EQ(bench.conductor().results().sessions[0].trials.size(), 1u);
+  const viraal::ErrorMeasures& e = bench.conductor().results().sessions[0].trials[0].errors;
+  EXPECT_EQ(e.landmarks, "gaze");
+  EXPECT_NEAR(e.misalignment_mm, 5.0, 1e-12);
+  // X_WV = X_WR (SceneBase): the truth's pairs coincide.
+  EXPECT_NEAR(e.truth_misalignment_mm, 0.0, 1e-9);
+}
+
+// A landmark orbed-registration cannot triangulate fails the run, naming it and the reason.
+TEST(ViraalConductor, ALandmarkThatCannotBeTriangulatedFailsTheRun) {
+  using AT = orbed::alignment_trial_t;
+  Bench bench;
+  bench.StartAndCheckPlans();
+  const auto& q0 = bench.conductor().options().config.configurations_deg[0];
+  bench.Send(RobotState(Rad(q0)));
+  AT trial = Trial("emu-ar_reflective", 0, Rad(q0), SceneBase(), 1234, AT::MODE_AR_REFLECTIVE, 1);
+  trial.request_id = LastControlId(bench, orbed::session_control_t::REQUEST_TRIAL);
+  for (int k = 0; k < 4; ++k) {
+    trial.annotation_landmark.push_back(0);
+    trial.annotation_side.push_back(k < 2 ? +AT::ANNOTATION_REAL : +AT::ANNOTATION_VIRTUAL);
+    trial.annotation_origin_W_m.push_back({0, 0, 1.5});
+    trial.annotation_direction_W.push_back({1, 0, 0});
+  }
+  trial.num_annotation_rays = 4;
+  bench.Send(trial);
+  const auto first = std::get<orbed::landmark_request_t>(bench.Sent("LANDMARK_REQUEST").at(0).message);
+  orbed::landmark_t a{};
+  a.request_id = first.request_id;
+  a.name = first.name;
+  a.valid = false;
+  a.reason = "rays are near-parallel";
+  bench.Send(a);
+  EXPECT_EQ(bench.conductor().status(), Status::kFailed);
+  EXPECT_EQ(
+      bench.conductor().results().error,
+      "orbed-registration could not triangulate landmark emu-ar_reflective/0/real/0: rays are near-parallel");
 }
 
 TEST(ViraalConductor, AbortEndsARunningRunOnly) {

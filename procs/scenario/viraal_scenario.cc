@@ -76,6 +76,10 @@ ViraalScenario::ViraalScenario(const orbed::CommonFlags& flags, const ScenarioOp
       o.registration_channel, [this](const orbed::registration_t& msg, const std::string&, int64_t) {
         Apply(conductor_->OnRegistration(msg, Now()));
       });
+  process_->Subscribe<orbed::landmark_t>(o.landmark_channel,
+                                         [this](const orbed::landmark_t& msg, const std::string&, int64_t) {
+                                           Apply(conductor_->OnLandmark(msg, Now()));
+                                         });
   process_->Subscribe<orbed::misalignment_t>(
       o.misalignment_channel, [this](const orbed::misalignment_t& msg, const std::string&, int64_t) {
         Apply(conductor_->OnMisalignment(msg, Now()));

@@ -5,9 +5,10 @@
 ///
 ///   Subscribes: ROBOT_STATE (robot_state_t: true X_WR, q, motion state), PLAN_CHECK_REPLY,
 ///               ALIGNMENT_TRIAL (alignment_trial_t, from orbed-hmd's emulated user),
-///               REGISTRATION (registration_t), MISALIGNMENT (misalignment_t).
+///               REGISTRATION (registration_t), LANDMARK (landmark_t), MISALIGNMENT (misalignment_t).
 ///   Publishes:  what the conductor asks for: PLAN_CHECK_REQUEST, SESSION_CONTROL (START /
-///               REQUEST_TRIAL / COMPUTE / STOP), IIWA_COMMAND, MISALIGNMENT_REQUEST; and
+///               REQUEST_TRIAL / COMPUTE / STOP), IIWA_COMMAND, LANDMARK_REQUEST,
+///               MISALIGNMENT_REQUEST; and
 ///               PROCESS_STATUS at 1 Hz (Process), where the conductor's refusals are counted.
 ///
 /// Each decoded message goes to the conductor with the time it was handled, and a timer calls its
