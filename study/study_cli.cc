@@ -69,15 +69,17 @@ const viraal::PaperFigure* PaperFor(const std::string& mode) {
 // the comparison of the first two modes.
 std::string Summary(const StudyOptions& options, const viraal::RunResults& results) {
   std::string text;
-  std::vector<std::vector<double>> misalignment;
+  std::vector<std::vector<double>> misalignment, truth_misalignment;
   for (const viraal::SessionResult& s : results.sessions) {
-    std::vector<double> mis, trans, rot;
+    std::vector<double> mis, truth_mis, trans, rot;
     for (const viraal::TrialResult& t : s.trials) {
       mis.push_back(t.errors.misalignment_mm);
+      truth_mis.push_back(t.errors.truth_misalignment_mm);
       trans.push_back(t.errors.translation_error_mm);
       rot.push_back(t.errors.rotation_error_deg);
     }
     misalignment.push_back(mis);
+    truth_misalignment.push_back(truth_mis);
     const viraal::Table1Row table1 = viraal::SessionTable1Row(s);
     const auto axes = [](const Eigen::Vector3d& v) {
       return "(" + Fixed(v.x(), 1) + ", " + Fixed(v.y(), 1) + ", " + Fixed(v.z(), 1) + ")";
@@ -90,19 +92,25 @@ std::string Summary(const StudyOptions& options, const viraal::RunResults& resul
     text += "\n    per axis x, y, z: means " + axes(table1.axes_mean_mm) + ", standard deviations " +
             axes(table1.axes_std_mm) + "\n";
     text += "  misalignment [mm]  " + MeanStdText(mis, 1) + "   (mean of the trials' ||t_bar||)\n";
+    text += "  true mis. [mm]     " + MeanStdText(truth_mis, 1) +
+            "   (the same from the truth's landmarks: the registration, not the user's view)\n";
     text += "  translation [mm]   " + MeanStdText(trans, 1) + "\n";
     text += "  rotation [deg]     " + MeanStdText(rot, 2) + "\n";
     const std::vector<double> triples = GroupMeanMisalignment_mm(options, s, 3);
     text += "  SE(3) means of N = 3 consecutive trials (" + std::to_string(triples.size()) +
-            "): misalignment " + MeanStdText(triples, 1) + " mm\n";
+            "): misalignment " + MeanStdText(triples, 1) + " mm (the truth's landmarks)\n";
   }
   if (misalignment.size() >= 2) {
-    const stats::MannWhitneyResult mw = stats::MannWhitneyU(misalignment[0], misalignment[1]);
     const std::string a = results.sessions[0].mode, b = results.sessions[1].mode;
-    text += "Mann-Whitney U, trial misalignment, one-sided (" + a + " < " + b + "): ";
-    text += mw.valid ? "U = " + Fixed(mw.u_x, 1) + ", z = " + Fixed(mw.z, 2) + ", p = " + PValue(mw.p_x_less)
-                     : std::string("not defined for these samples");
-    text += "\n";
+    for (const auto* samples : {&misalignment, &truth_misalignment}) {
+      const stats::MannWhitneyResult mw = stats::MannWhitneyU((*samples)[0], (*samples)[1]);
+      text += std::string("Mann-Whitney U, trial ") + (samples == &misalignment ? "" : "true ") +
+              "misalignment, one-sided (" + a + " < " + b + "): ";
+      text += mw.valid
+                  ? "U = " + Fixed(mw.u_x, 1) + ", z = " + Fixed(mw.z, 2) + ", p = " + PValue(mw.p_x_less)
+                  : std::string("not defined for these samples");
+      text += "\n";
+    }
   }
   text += "paper, SE(3) mean of N = 3 trials with the display: " +
           Fixed(viraal::kPaperArReflectiveMean.misalignment_mm, 1) + " +/- " +

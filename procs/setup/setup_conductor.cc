@@ -327,6 +327,7 @@ SetupConductor::Actions SetupConductor::OnRobotState(const orbed::robot_state_t&
 ORBED_FORWARD(OnPlanCheckReply, orbed::plan_check_reply_t)
 ORBED_FORWARD(OnTrial, orbed::alignment_trial_t)
 ORBED_FORWARD(OnRegistration, orbed::registration_t)
+ORBED_FORWARD(OnLandmark, orbed::landmark_t)
 ORBED_FORWARD(OnMisalignment, orbed::misalignment_t)
 #undef ORBED_FORWARD
 

@@ -165,6 +165,7 @@ class SetupConductor {
   Actions OnPlanCheckReply(const orbed::plan_check_reply_t& msg, const ConductorTime& now);
   Actions OnTrial(const orbed::alignment_trial_t& msg, const ConductorTime& now);
   Actions OnRegistration(const orbed::registration_t& msg, const ConductorTime& now);
+  Actions OnLandmark(const orbed::landmark_t& msg, const ConductorTime& now);
   Actions OnMisalignment(const orbed::misalignment_t& msg, const ConductorTime& now);
   Actions OnSetupResult(const orbed::setup_result_t& msg, const ConductorTime& now);
   Actions OnCollisionStatus(const orbed::collision_status_t& msg, const ConductorTime& now);

@@ -58,6 +58,10 @@ SetupProcess::SetupProcess(const CommonFlags& flags, const SetupOptions& options
       channels.registration_channel, [this](const orbed::registration_t& m, const std::string&, int64_t) {
         Apply(conductor_->OnRegistration(m, Now()));
       });
+  process_.Subscribe<orbed::landmark_t>(channels.landmark_channel,
+                                        [this](const orbed::landmark_t& m, const std::string&, int64_t) {
+                                          Apply(conductor_->OnLandmark(m, Now()));
+                                        });
   process_.Subscribe<orbed::misalignment_t>(
       channels.misalignment_channel, [this](const orbed::misalignment_t& m, const std::string&, int64_t) {
         Apply(conductor_->OnMisalignment(m, Now()));

@@ -4,11 +4,11 @@
 /// the bus.
 ///
 ///   Subscribes: ROBOT_STATE, COLLISION_STATUS (clearance during each set-up), PLAN_CHECK_REPLY,
-///   ALIGNMENT_TRIAL, REGISTRATION, MISALIGNMENT (for
+///   ALIGNMENT_TRIAL, REGISTRATION, LANDMARK, MISALIGNMENT (for
 ///               the alignments before the headset modes' set-ups, as orbed-scenario), SETUP_RESULT.
 ///   Publishes:  what the conductor asks for: SESSION_CONTROL, PLAN_CHECK_REQUEST,
-///               MISALIGNMENT_REQUEST and IIWA_COMMAND of the alignments; IIWA_COMMAND parking the
-///               arm; SETUP_TASK; with --registration truth, REGISTRATION (the true base pose).
+///               LANDMARK_REQUEST, MISALIGNMENT_REQUEST and IIWA_COMMAND of the alignments; IIWA_COMMAND
+///               parking the arm; SETUP_TASK; with --registration truth, REGISTRATION (the true base pose).
 ///
 /// setup_results.json (SetupRunJson) in results_dir is rewritten with status "partial" after each
 /// set-up and once at the end ("ok" or "failed"); then the process stops: exit 0 on success, 1 on a
