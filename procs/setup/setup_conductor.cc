@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <stdexcept>
 #include <utility>
 
@@ -9,6 +10,7 @@
 
 #include "base/format.h"
 #include "base/json.h"
+#include "base/json_fields.h"
 #include "base/units.h"
 #include "procs/common/requests.h"
 #include "procs/common/validation.h"
@@ -106,6 +108,137 @@ std::string SetupRunJson(const SetupRun& run, bool partial) {
   return json.str() + "\n";
 }
 
+namespace {
+
+constexpr size_t kMaxSetupResultsBytes = 4 << 20;
+constexpr int kMaxSetupResultsDepth = 6;
+constexpr size_t kMaxText = 4096;
+constexpr size_t kMaxSetups = 1000;
+constexpr size_t kMaxJoints = 64;
+
+std::vector<int> Integers(const JsonFields& f, const JsonAt& at, int64_t lo, int64_t hi) {
+  std::vector<int> out;
+  for (size_t k = 0, n = f.ArraySize(at, kMaxJoints); k < n; ++k)
+    out.push_back(static_cast<int>(f.Integer(f.Element(at, k), lo, hi)));
+  return out;
+}
+
+std::vector<double> Degrees(const JsonFields& f, const JsonAt& at) {
+  return f.Numbers(at, f.ArraySize(at, kMaxJoints), -1e4, 1e4);
+}
+
+int8_t ModeNamed(const JsonFields& f, const JsonAt& at) {
+  const std::string name = f.String(at, 64);
+  try {
+    return guidance::GuidanceModeFromName(name);
+  } catch (const std::invalid_argument&) {
+    f.Fail(at.key, "ar, ar_reflective or fixed", &at.value);
+  }
+}
+
+}  // namespace
+
+SetupRun ReadSetupRunFile(const std::string& path, std::string* status) {
+  std::string file = path;
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    file = (std::filesystem::path(path) / "setup_results.json").string();
+  const JsonFields f(file);
+  const nlohmann::json doc = f.ReadFile(file, kMaxSetupResultsBytes, kMaxSetupResultsDepth);
+  const JsonAt root{doc, ""};
+  SetupRun run;
+  run.user = f.String(f.Member(root, "user"), 256);
+  run.run_id = f.String(f.Member(root, "run_id"), 256);
+  const JsonAt status_at = f.Member(root, "status");
+  *status = f.String(status_at, 16);
+  if (*status != "ok" && *status != "failed" && *status != "partial")
+    f.Fail(status_at.key, "\"ok\", \"failed\" or \"partial\"", &status_at.value);
+  run.ok = *status == "ok";
+  run.error = f.String(f.Member(root, "error"), kMaxText);
+  const JsonAt order = f.Member(root, "order");
+  for (size_t k = 0, n = f.ArraySize(order, 3); k < n; ++k)
+    run.order.push_back(ModeName(ModeNamed(f, f.Element(order, k))));
+  const JsonAt setups = f.Member(root, "setups");
+  for (size_t k = 0, n = f.ArraySize(setups, kMaxSetups); k < n; ++k) {
+    const JsonAt at = f.Element(setups, k);
+    SetupRecord r;
+    r.task_id = f.String(f.Member(at, "task_id"), 256);
+    r.mode = ModeNamed(f, f.Member(at, "mode"));
+    r.order = static_cast<int>(f.Integer(f.Member(at, "order"), 1, 3));
+    r.target = static_cast<int>(f.Integer(f.Member(at, "target"), 1, 1000));
+    r.target_deg = Degrees(f, f.Member(at, "target_deg"));
+    r.reached_deg = Degrees(f, f.Member(at, "reached_deg"));
+    r.assistant_reached_deg = Degrees(f, f.Member(at, "assistant_reached_deg"));
+    if (r.reached_deg.size() != r.target_deg.size() || r.assistant_reached_deg.size() != r.target_deg.size())
+      f.Fail(at.key + ".reached_deg", "as many joints as target_deg");
+    r.twisting = Integers(f, f.Member(at, "twisting"), 0, 1);
+    r.ranges = Integers(f, f.Member(at, "ranges"), 0, 1000);
+    r.execution_s = f.Number(f.Member(at, "execution_s"), 0, 1e7);
+    if (const auto a = f.OptionalMember(at, "alignment_s")) r.alignment_s = f.Number(*a, 0, 1e7);
+    r.person_scale = f.Number(f.Member(at, "person_scale"), 1e-3, 1e3);
+    if (const auto reg = f.OptionalMember(at, "registration")) {
+      const std::string text = f.String(*reg, 16);
+      if (text != "measured" && text != "truth")
+        f.Fail(reg->key, "\"measured\", \"truth\" or null", &reg->value);
+      r.perfect_registration = text == "truth";
+    }
+    r.docking_tip_mm = f.Number(f.Member(at, "docking_tip_mm"), 0, 1e7);
+    r.docking_axis_deg = f.Number(f.Member(at, "docking_axis_deg"), 0, 180);
+    if (const auto c = f.OptionalMember(at, "min_clearance_m")) r.min_clearance_m = f.Number(*c, -100, 100);
+    r.contact = f.Bool(f.Member(at, "contact"));
+    r.collision_stops = static_cast<int>(f.Integer(f.Member(at, "collision_stops"), 0, 1 << 30));
+    if (const auto a = f.OptionalMember(at, "alignment")) {
+      viraal::SessionResult session;
+      session.session_id = f.String(f.Member(*a, "session_id"), 256);
+      session.trials.resize(static_cast<size_t>(f.Integer(f.Member(*a, "trials"), 0, 1000)));
+      viraal::MeanResult mean;
+      mean.errors.translation_error_mm = f.Number(f.Member(*a, "translation_error_mm"), 0, 1e9);
+      mean.errors.rotation_error_deg = f.Number(f.Member(*a, "rotation_error_deg"), 0, 180);
+      mean.errors.misalignment_mm = f.Number(f.Member(*a, "misalignment_mm"), 0, 1e9);
+      session.mean = mean;
+      r.alignment = session;
+    }
+    run.setups.push_back(std::move(r));
+  }
+  return run;
+}
+
+std::vector<SetupRecord> KeptSetups(const SetupRun& earlier, const std::string& status,
+                                    const SetupOptions& options) {
+  auto refuse = [](const std::string& why) { throw std::invalid_argument("cannot resume: " + why); };
+  if (status == "ok") refuse("that run finished (status ok): nothing is left to run");
+  if (earlier.user != options.user)
+    refuse("it is user " + earlier.user + "'s, this run is " + options.user + "'s");
+  if (earlier.run_id != options.run_id)
+    refuse("its run id is " + earlier.run_id + ", this run's " + options.run_id);
+  std::vector<std::string> order;
+  for (int8_t m : options.modes) order.push_back(ModeName(m));
+  if (earlier.order != order) refuse("its order of the modes is not this run's");
+  const size_t total = options.modes.size() * options.targets_deg.size();
+  if (earlier.setups.size() >= total) {
+    refuse("it holds " + std::to_string(earlier.setups.size()) + " set-ups, this run has " +
+           std::to_string(total) + ": nothing is left to run");
+  }
+  for (size_t i = 0; i < earlier.setups.size(); ++i) {
+    const SetupRecord& r = earlier.setups[i];
+    const size_t mode_index = i / options.targets_deg.size(), target_index = i % options.targets_deg.size();
+    const int8_t mode = options.modes[mode_index];
+    const std::string task_id = options.user + "-" + ModeName(mode) + "-" + std::to_string(target_index + 1);
+    if (r.task_id != task_id || r.mode != mode || r.order != static_cast<int>(mode_index) + 1 ||
+        r.target != static_cast<int>(target_index) + 1) {
+      refuse("set-up " + std::to_string(i + 1) + " is " + r.task_id + ", this run's is " + task_id);
+    }
+    const std::vector<double>& target = options.targets_deg[target_index];
+    bool same = r.target_deg.size() == target.size();
+    for (size_t j = 0; same && j < target.size(); ++j) same = std::abs(r.target_deg[j] - target[j]) <= 1e-9;
+    if (!same) refuse(task_id + "'s target is not this plan's target " + std::to_string(target_index + 1));
+    const bool truth = options.perfect_registration && mode != orbed::guidance_t::MODE_FIXED_DISPLAY;
+    if (r.perfect_registration != truth)
+      refuse(task_id + " was made with another registration (--registration)");
+  }
+  return earlier.setups;
+}
+
 SetupConductor::SetupConductor(SetupOptions options, sim::RobotModel model)
     : options_(std::move(options)), model_(std::make_unique<const sim::RobotModel>(std::move(model))) {
   if (options_.modes.empty()) throw std::invalid_argument("set-up study: no modes");
@@ -137,6 +270,11 @@ SetupConductor::SetupConductor(SetupOptions options, sim::RobotModel model)
   run_.user = options_.user;
   run_.run_id = options_.run_id;
   for (int8_t m : options_.modes) run_.order.push_back(ModeName(m));
+  if (options_.kept.size() >= options_.modes.size() * options_.targets_deg.size())
+    throw std::invalid_argument("set-up study: the kept set-ups leave nothing to run");
+  run_.setups = options_.kept;
+  mode_index_ = options_.kept.size() / options_.targets_deg.size();
+  target_index_ = options_.kept.size() % options_.targets_deg.size();
 }
 
 SetupConductor::~SetupConductor() = default;
@@ -165,7 +303,11 @@ SetupConductor::Actions SetupConductor::Start(const ConductorTime& now) {
   std::string order;
   for (const std::string& m : run_.order) order += (order.empty() ? "" : ", ") + m;
   actions_.progress.push_back("set-up study, user " + options_.user + ": modes " + order + ", " +
-                              std::to_string(options_.targets_deg.size()) + " target(s) each");
+                              std::to_string(options_.targets_deg.size()) + " target(s) each" +
+                              (options_.kept.empty()
+                                   ? ""
+                                   : "; resumed with the " + std::to_string(options_.kept.size()) +
+                                         " set-up(s) kept, next " + TaskId()));
   return Take();
 }
 

@@ -61,6 +61,8 @@ namespace orbed::setup {
 using scenario::ConductorActions;
 using scenario::ConductorTime;
 
+struct SetupRecord;
+
 struct SetupOptions {
   std::string user{"u1"};
   std::string run_id{"setup"};
@@ -86,6 +88,9 @@ struct SetupOptions {
   std::string setup_task_channel{"SETUP_TASK"};
   std::string setup_result_channel{"SETUP_RESULT"};
   std::string registration_channel{"REGISTRATION"};
+  /// Resuming (KeptSetups): the set-ups an earlier run of this user finished, in order; the run
+  /// starts with the next one. Empty = a new run.
+  std::vector<SetupRecord> kept;
 };
 
 /// One finished set-up.
@@ -136,6 +141,25 @@ struct SetupRun {
 /// min_clearance_m (null when unknown), contact, collision_stops, alignment: null | {session_id, trials,
 /// translation_error_mm, rotation_error_deg, misalignment_mm} of the mean}]}.
 std::string SetupRunJson(const SetupRun& run, bool partial);
+
+/// setup_results.json read back (orbed-setup --resume; `path` may be its folder), checked like any
+/// file from outside (base/json_fields.h): every field with its type and range, counts bounded;
+/// error_deg is derived and not read. A record's alignment comes back as what the file holds (the
+/// session id, as many empty trials as it counts, the mean's three errors), so that SetupRunJson
+/// writes it again byte for byte. `status` gets "ok", "failed" or "partial". Throws
+/// orbed::JsonReadError naming the file and the key.
+SetupRun ReadSetupRunFile(const std::string& path, std::string* status);
+
+/// What a resumed run keeps of an earlier one (`earlier`, with its `status`): all its set-ups, in
+/// order. Refused (std::invalid_argument with the reason): status "ok" (nothing to run); another
+/// user, run id or mode order; a set-up that is not the next of this run's (task id
+/// "<user>-<mode>-<k>", mode, order and target in sequence) or whose target differs from this
+/// plan's (1e-9 deg); a registration ("measured" / "truth") other than this run's; as many set-ups
+/// as the run has (nothing left) or more. The set-ups left are new draws of the same emulated
+/// person (the assistant's random stream starts afresh), not those an uninterrupted run would have
+/// made.
+std::vector<SetupRecord> KeptSetups(const SetupRun& earlier, const std::string& status,
+                                    const SetupOptions& options);
 
 /// A message of this conductor's own to publish.
 struct SetupPublication {

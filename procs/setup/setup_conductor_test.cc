@@ -5,11 +5,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <set>
 
 #include <gtest/gtest.h>
 #include <orbed/guidance_t.hpp>
 
+#include "base/json_fields.h"
 #include "base/source_paths.h"
 #include "base/units.h"
 #include "procs/setup/setup_process.h"
@@ -131,6 +133,132 @@ orbed::collision_status_t Clearance(double min_distance_m, bool in_collision) {
   m.min_distance_m = min_distance_m;
   m.in_collision = in_collision;
   return m;
+}
+
+// A run of FixedOnly() stopped after its first set-up, as the file it left says.
+SetupRun StoppedAfterOne(std::string* json) {
+  SetupConductor c(FixedOnly(), Model());
+  c.Start(At(0));
+  const orbed::setup_task_t first = *FindTask(c.OnRobotState(State({0, 20, 0, -60, 0, 40, 0}, 0), At(0.1)));
+  c.OnCollisionStatus(Clearance(0.03, false), At(0.2));
+  c.OnRobotState(State({11, 21, 0, -60, 0, 40, 0}, 0), At(0.5));
+  c.OnSetupResult(Answer(first, 80, 0.9), At(0.6));
+  *json = SetupRunJson(c.run(), true);
+  return c.run();
+}
+
+std::string WriteTemp(const std::string& name, const std::string& text) {
+  const std::string path = ::testing::TempDir() + "/" + name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+// setup_results.json read back gives the same document, byte for byte, alignment included.
+TEST(SetupResume, TheResultsFileReadsBackToTheSameDocument) {
+  std::string json;
+  SetupRun run = StoppedAfterOne(&json);
+  SetupRecord aligned = run.setups[0];
+  aligned.task_id = "u3-ar-1";
+  aligned.mode = orbed::guidance_t::MODE_AR;
+  aligned.alignment_s = 141.5;
+  viraal::SessionResult session;
+  session.session_id = "setup-u3-ar-1-ar";
+  session.trials.resize(3);
+  session.mean.emplace();
+  session.mean->errors.translation_error_mm = 12.25;
+  session.mean->errors.rotation_error_deg = 0.125;
+  session.mean->errors.misalignment_mm = 9.5;
+  aligned.alignment = session;
+  aligned.min_clearance_m.reset();
+  run.setups.push_back(aligned);
+  const std::string text = SetupRunJson(run, true);
+  std::string status;
+  const SetupRun back = ReadSetupRunFile(WriteTemp("setup_results.json", text), &status);
+  EXPECT_EQ(status, "partial");
+  EXPECT_EQ(SetupRunJson(back, true), text);
+  // A folder names its setup_results.json.
+  EXPECT_EQ(SetupRunJson(ReadSetupRunFile(::testing::TempDir(), &status), true), text);
+}
+
+TEST(SetupResume, DamagedFilesAreRefusedNamingTheKey) {
+  std::string json;
+  StoppedAfterOne(&json);
+  std::string status;
+  auto refusal = [&](const std::string& from, const std::string& to) {
+    std::string text = json;
+    const size_t at = text.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    text.replace(at, from.size(), to);
+    try {
+      ReadSetupRunFile(WriteTemp("damaged.json", text), &status);
+    } catch (const JsonReadError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_NE(refusal("\"status\": \"partial\"", "\"status\": \"maybe\"").find("status"), std::string::npos);
+  EXPECT_NE(refusal("\"mode\": \"fixed\"", "\"mode\": \"hologram\"").find("setups[0].mode"),
+            std::string::npos);
+  EXPECT_NE(refusal("\"execution_s\": 80", "\"execution_s\": -80").find("execution_s"), std::string::npos);
+  EXPECT_NE(refusal("\"contact\": false", "\"contact\": 0").find("contact"), std::string::npos);
+  EXPECT_NE(refusal("\"order\": 1", "\"order\": 9").find("order"), std::string::npos);
+  EXPECT_NE(refusal("\"user\": \"u3\",", "").find("user"), std::string::npos);
+}
+
+// A resumed run keeps the finished set-ups and starts with the next one; the final file holds both.
+TEST(SetupResume, ARunResumesWithTheNextSetUp) {
+  std::string json;
+  const SetupRun earlier = StoppedAfterOne(&json);
+  SetupOptions o = FixedOnly();
+  o.kept = KeptSetups(earlier, "partial", o);
+  ASSERT_EQ(o.kept.size(), 1u);
+  SetupConductor c(o, Model());
+  const SetupConductor::Actions started = c.Start(At(0));
+  ASSERT_FALSE(started.progress.empty());
+  EXPECT_NE(started.progress[0].find("resumed with the 1 set-up(s) kept, next u3-fixed-2"), std::string::npos)
+      << started.progress[0];
+  const SetupConductor::Actions parked = c.OnRobotState(State({0, 20, 0, -60, 0, 40, 0}, 0), At(0.1));
+  const orbed::setup_task_t* task = FindTask(parked);
+  ASSERT_NE(task, nullptr);
+  EXPECT_EQ(task->task_id, "u3-fixed-2");
+  EXPECT_NEAR(task->target_position[0], -10 * kDegToRad, 1e-12);
+  c.OnSetupResult(Answer(*task, 70, 0.9), At(0.5));
+  ASSERT_TRUE(c.done());
+  ASSERT_EQ(c.run().setups.size(), 2u);
+  EXPECT_EQ(c.run().setups[0].task_id, "u3-fixed-1");
+  EXPECT_NEAR(c.run().setups[0].reached_deg[0], 11.0, 1e-9);
+  EXPECT_EQ(c.run().setups[1].task_id, "u3-fixed-2");
+  EXPECT_TRUE(c.run().ok);
+}
+
+TEST(SetupResume, WhatDoesNotBelongToThisRunIsRefused) {
+  std::string json;
+  const SetupRun earlier = StoppedAfterOne(&json);
+  auto why = [&](SetupRun run, const std::string& status, SetupOptions o) {
+    try {
+      KeptSetups(run, status, o);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  const SetupOptions o = FixedOnly();
+  EXPECT_NE(why(earlier, "ok", o).find("nothing is left"), std::string::npos);
+  SetupOptions other = o;
+  other.user = "u4";
+  EXPECT_NE(why(earlier, "partial", other).find("user"), std::string::npos);
+  other = o;
+  other.run_id = "another";
+  EXPECT_NE(why(earlier, "partial", other).find("run id"), std::string::npos);
+  other = o;
+  other.targets_deg[0][2] = 1;
+  EXPECT_NE(why(earlier, "partial", other).find("target"), std::string::npos);
+  other = o;
+  other.targets_deg.resize(1);  // the one set-up is all this run has
+  EXPECT_NE(why(earlier, "partial", other).find("nothing is left"), std::string::npos);
+  SetupRun shuffled = earlier;
+  shuffled.setups[0].task_id = "u3-fixed-2";
+  EXPECT_NE(why(shuffled, "failed", o).find("set-up 1 is u3-fixed-2"), std::string::npos);
 }
 
 // Clearance and collision stops are what happened while the assistant had the arm: what came

@@ -201,6 +201,11 @@ int RunSetup(int argc, const char* const* argv, std::ostream& out, std::ostream&
   app.add_option("--move-timeout-s", options.move_timeout_s, "Wait for the arm to reach a configuration [s]")
       ->check(CLI::Range(1.0, 3600.0))
       ->capture_default_str();
+  std::string resume;
+  app.add_option("--resume", resume,
+                 "Continue a run that stopped before its end: its setup_results.json (or the folder). Its "
+                 "finished set-ups are kept, the rest are run (default $ORBED_SETUP_RESUME if set)")
+      ->envname("ORBED_SETUP_RESUME");
   if (const auto code = ParseCommandLine(&app, common, argc, argv, out, err)) return *code;
   try {
     if (modes.empty()) {
@@ -234,6 +239,11 @@ int RunSetup(int argc, const char* const* argv, std::ostream& out, std::ostream&
     }
     options.alignment = viraal::LoadScenarioFile(scenario_path);
     options.alignment.trials = trials;
+    if (!resume.empty()) {
+      std::string status;
+      const SetupRun earlier = ReadSetupRunFile(resume, &status);
+      options.kept = KeptSetups(earlier, status, options);
+    }
     SetupProcess setup(common, options, urdf_path, results_dir, &out);
     return setup.Run();
   } catch (const std::exception& e) {
