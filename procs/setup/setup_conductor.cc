@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <stdexcept>
 #include <utility>
 
@@ -143,8 +144,17 @@ SetupRun ReadSetupRunFile(const std::string& path, std::string* status) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec))
     file = (std::filesystem::path(path) / "setup_results.json").string();
-  const JsonFields f(file);
-  const nlohmann::json doc = f.ReadFile(file, kMaxSetupResultsBytes, kMaxSetupResultsDepth);
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw JsonReadError(file + ": cannot read it");
+  std::string text(kMaxSetupResultsBytes + 1, '\0');
+  in.read(text.data(), static_cast<std::streamsize>(text.size()));
+  text.resize(static_cast<size_t>(in.gcount()));
+  return ParseSetupRunJson(text, file, status);
+}
+
+SetupRun ParseSetupRunJson(const std::string& text, const std::string& source, std::string* status) {
+  const JsonFields f(source);
+  const nlohmann::json doc = f.Parse(text, kMaxSetupResultsBytes, kMaxSetupResultsDepth);
   const JsonAt root{doc, ""};
   SetupRun run;
   run.user = f.String(f.Member(root, "user"), 256);

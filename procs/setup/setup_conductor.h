@@ -149,6 +149,8 @@ std::string SetupRunJson(const SetupRun& run, bool partial);
 /// writes it again byte for byte. `status` gets "ok", "failed" or "partial". Throws
 /// orbed::JsonReadError naming the file and the key.
 SetupRun ReadSetupRunFile(const std::string& path, std::string* status);
+/// The same from the file's text (`source` names it in errors).
+SetupRun ParseSetupRunJson(const std::string& text, const std::string& source, std::string* status);
 
 /// What a resumed run keeps of an earlier one (`earlier`, with its `status`): all its set-ups, in
 /// order. Refused (std::invalid_argument with the reason): status "ok" (nothing to run); another
