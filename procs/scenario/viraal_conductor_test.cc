@@ -463,6 +463,19 @@ orbed::alignment_trial_t Trial(const std::string& session, int index, const std:
   return t;
 }
 
+// The server's REGISTRATION (reason TRIAL) for `trial`, the first of its session.
+orbed::registration_t FirstTrialRegistration(const orbed::alignment_trial_t& trial) {
+  orbed::registration_t registration{};
+  registration.utime = trial.utime;
+  registration.session_id = trial.session_id;
+  registration.reason = orbed::registration_t::REASON_TRIAL;
+  registration.valid = true;
+  registration.X_WV_mean = trial.X_WV;
+  registration.num_trials = 1;
+  registration.request_id = trial.request_id;
+  return registration;
+}
+
 // The request id of the last SESSION_CONTROL `command` the bench saw.
 int64_t LastControlId(const Bench& bench, int8_t command) {
   int64_t id = 0;
@@ -541,13 +554,7 @@ TEST(ViraalConductor, ATrialIsRetriedUntilItIsReceivedAndRegistered) {
   ASSERT_EQ(bench.last().size(), 2u);
   EXPECT_EQ(Label(bench.last()[1]), "SESSION_CONTROL REQUEST_TRIAL");
 
-  orbed::registration_t registration{};
-  registration.utime = trial.utime;
-  registration.session_id = trial.session_id;
-  registration.reason = orbed::registration_t::REASON_TRIAL;
-  registration.valid = true;
-  registration.X_WV_mean = trial.X_WV;
-  registration.num_trials = 1;
+  orbed::registration_t registration = FirstTrialRegistration(trial);
   registration.request_id = trial.request_id - 1;  // another request's: ignored
   bench.Send(registration);
   EXPECT_EQ(bench.conductor().phase(), Phase::kAwaitTrialResults);
@@ -652,15 +659,7 @@ TEST(ViraalConductor, AnAnnotatedTrialIsScoredFromTheTriangulatedLandmarks) {
   reply.mean_error_norm_m = 0.005;
   reply.mean_pair_distance_m = 0.005;
   bench.Send(reply);
-  orbed::registration_t registration{};
-  registration.utime = trial.utime;
-  registration.session_id = trial.session_id;
-  registration.reason = orbed::registration_t::REASON_TRIAL;
-  registration.valid = true;
-  registration.X_WV_mean = trial.X_WV;
-  registration.num_trials = 1;
-  registration.request_id = trial.request_id;
-  bench.Send(registration);
+  bench.Send(FirstTrialRegistration(trial));
   ASSERT_EQ(bench.conductor().results().sessions[0].trials.size(), 1u);
   const viraal::ErrorMeasures& e = bench.conductor().results().sessions[0].trials[0].errors;
   EXPECT_EQ(e.landmarks, "gaze");

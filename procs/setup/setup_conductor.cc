@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <stdexcept>
 #include <utility>
 
@@ -137,6 +136,9 @@ int8_t ModeNamed(const JsonFields& f, const JsonAt& at) {
   }
 }
 
+// The document's fields (ReadSetupRunFile, ParseSetupRunJson).
+SetupRun SetupRunFromJson(const JsonFields& f, const nlohmann::json& doc, std::string* status);
+
 }  // namespace
 
 SetupRun ReadSetupRunFile(const std::string& path, std::string* status) {
@@ -144,17 +146,18 @@ SetupRun ReadSetupRunFile(const std::string& path, std::string* status) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec))
     file = (std::filesystem::path(path) / "setup_results.json").string();
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw JsonReadError(file + ": cannot read it");
-  std::string text(kMaxSetupResultsBytes + 1, '\0');
-  in.read(text.data(), static_cast<std::streamsize>(text.size()));
-  text.resize(static_cast<size_t>(in.gcount()));
-  return ParseSetupRunJson(text, file, status);
+  const JsonFields f(file);
+  return SetupRunFromJson(f, f.ReadFile(file, kMaxSetupResultsBytes, kMaxSetupResultsDepth), status);
 }
 
 SetupRun ParseSetupRunJson(const std::string& text, const std::string& source, std::string* status) {
   const JsonFields f(source);
-  const nlohmann::json doc = f.Parse(text, kMaxSetupResultsBytes, kMaxSetupResultsDepth);
+  return SetupRunFromJson(f, f.Parse(text, kMaxSetupResultsBytes, kMaxSetupResultsDepth), status);
+}
+
+namespace {
+
+SetupRun SetupRunFromJson(const JsonFields& f, const nlohmann::json& doc, std::string* status) {
   const JsonAt root{doc, ""};
   SetupRun run;
   run.user = f.String(f.Member(root, "user"), 256);
@@ -212,6 +215,8 @@ SetupRun ParseSetupRunJson(const std::string& text, const std::string& source, s
   }
   return run;
 }
+
+}  // namespace
 
 std::vector<SetupRecord> KeptSetups(const SetupRun& earlier, const std::string& status,
                                     const SetupOptions& options) {
