@@ -73,15 +73,18 @@ void AnnotateLandmarks(const TrialSetup& setup, std::uint64_t trial_seed, SlamMo
   // To the right of the line of sight (x of a head looking at look_at) is clockwise seen from above.
   const Eigen::AngleAxisd around(-setup.annotation_view_angle_deg * kDegToRad, Eigen::Vector3d::UnitZ());
   const Eigen::Vector3d p_WH2 = look_at + around * (p_WH1 - look_at);
-  for (const Eigen::Vector3d& p_WH : {p_WH1, p_WH2}) {
-    if (p_WH != p_WH1) person.Walk(p_WH1, p_WH2, look_at);
+  // Every landmark, real then hologram, from where the person stands.
+  auto annotate_all = [&](const Eigen::Vector3d& p_WH) {
     for (std::size_t l = 0; l < setup.p_RL.size(); ++l) {
       out->annotation.push_back(
           {static_cast<int>(l), false, person.Annotate(p_WH, setup.X_WR * setup.p_RL[l])});
       out->annotation.push_back(
           {static_cast<int>(l), true, person.AnnotateHologram(p_WH, out->alignment.X_WV, setup.p_RL[l])});
     }
-  }
+  };
+  annotate_all(p_WH1);
+  person.Walk(p_WH1, p_WH2, look_at);
+  annotate_all(p_WH2);
 }
 
 }  // namespace

@@ -570,6 +570,23 @@ TEST(ViraalConductor, ATrialIsRetriedUntilItIsReceivedAndRegistered) {
   EXPECT_EQ(bench.conductor().results().sessions[0].trials.size(), 1u);
 }
 
+// The user's annotation of `landmarks` landmarks as the headset sends it: per landmark and side
+// two rays, from (0.1 l, 0.01 side, 1.5 + k) along x (the tests answer the LANDMARK_REQUESTs).
+void Annotate(orbed::alignment_trial_t* trial, int landmarks) {
+  using AT = orbed::alignment_trial_t;
+  for (int l = 0; l < landmarks; ++l) {
+    for (int8_t side : {AT::ANNOTATION_REAL, AT::ANNOTATION_VIRTUAL}) {
+      for (int k = 0; k < 2; ++k) {
+        trial->annotation_landmark.push_back(l);
+        trial->annotation_side.push_back(side);
+        trial->annotation_origin_W_m.push_back({0.1 * l, 0.01 * side, 1.5 + k});
+        trial->annotation_direction_W.push_back({1.0, 0.0, 0.0});
+      }
+    }
+  }
+  trial->num_annotation_rays = static_cast<int32_t>(trial->annotation_landmark.size());
+}
+
 // An annotated trial (the user's gaze rays, contract change 5) is scored from the landmarks that
 // orbed-registration triangulates: a LANDMARK_REQUEST per landmark and side with exactly the
 // trial's rays, retried while unanswered, and once all are in, the MISALIGNMENT_REQUEST of the
@@ -583,17 +600,7 @@ TEST(ViraalConductor, AnAnnotatedTrialIsScoredFromTheTriangulatedLandmarks) {
   const Publication request = bench.sent().back();
   AT trial = Trial("emu-ar_reflective", 0, Rad(q0), SceneBase(), 1234, AT::MODE_AR_REFLECTIVE, 1);
   trial.request_id = std::get<orbed::session_control_t>(request.message).request_id;
-  for (int l = 0; l < 3; ++l) {
-    for (int8_t side : {AT::ANNOTATION_REAL, AT::ANNOTATION_VIRTUAL}) {
-      for (int k = 0; k < 2; ++k) {
-        trial.annotation_landmark.push_back(l);
-        trial.annotation_side.push_back(side);
-        trial.annotation_origin_W_m.push_back({0.1 * l, 0.01 * side, 1.5 + k});
-        trial.annotation_direction_W.push_back({1.0, 0.0, 0.0});
-      }
-    }
-  }
-  trial.num_annotation_rays = 12;
+  Annotate(&trial, 3);
   bench.Send(trial);
   ASSERT_TRUE(bench.refusals().empty()) << bench.refusals()[0].reason;
   const std::vector<Publication> requests = bench.Sent("LANDMARK_REQUEST");
@@ -677,13 +684,7 @@ TEST(ViraalConductor, ALandmarkThatCannotBeTriangulatedFailsTheRun) {
   bench.Send(RobotState(Rad(q0)));
   AT trial = Trial("emu-ar_reflective", 0, Rad(q0), SceneBase(), 1234, AT::MODE_AR_REFLECTIVE, 1);
   trial.request_id = LastControlId(bench, orbed::session_control_t::REQUEST_TRIAL);
-  for (int k = 0; k < 4; ++k) {
-    trial.annotation_landmark.push_back(0);
-    trial.annotation_side.push_back(k < 2 ? +AT::ANNOTATION_REAL : +AT::ANNOTATION_VIRTUAL);
-    trial.annotation_origin_W_m.push_back({0, 0, 1.5});
-    trial.annotation_direction_W.push_back({1, 0, 0});
-  }
-  trial.num_annotation_rays = 4;
+  Annotate(&trial, 1);
   bench.Send(trial);
   const auto first = std::get<orbed::landmark_request_t>(bench.Sent("LANDMARK_REQUEST").at(0).message);
   orbed::landmark_t a{};
