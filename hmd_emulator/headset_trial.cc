@@ -1,6 +1,7 @@
 #include "hmd_emulator/headset_trial.h"
 
 #include <stdexcept>
+#include <utility>
 
 #include "base/hash.h"
 
@@ -78,12 +79,14 @@ void SetAnnotationFields(const std::vector<AnnotationRay>& annotation, orbed::al
 
 TrialOutcome RunHeadsetTrial(const HmdConfigSet& config, const HeadsetTrialInputs& inputs) {
   const TrialSetup setup = MakeHeadsetTrialSetup(config, inputs);
-  SlamConfig slam = config.slam;
-  slam.seed = TrialSeed(inputs.process_seed, inputs.session_id, inputs.trial_index, kSlamSeedPurpose);
+  const SlamConfig slam = SessionSlamConfig(
+      config.slam, TrialSeed(inputs.process_seed, inputs.session_id, 0, kSessionMapPurpose));
+  double t0_s = 0;
+  SlamModel map = SessionMapAtTrial(setup, slam, config.hmd.session_start_m, inputs.trial_index, &t0_s);
   const std::uint64_t trial_seed =
       TrialSeed(inputs.process_seed, inputs.session_id, inputs.trial_index, kTrialSeedPurpose);
   const EmulatedUser user(config.user);
-  return RunTrial(setup, slam, user, inputs.X_WV_start, trial_seed);
+  return RunTrialFrom(setup, std::move(map), t0_s, user, inputs.X_WV_start, trial_seed);
 }
 
 }  // namespace orbed::hmd

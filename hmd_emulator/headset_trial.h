@@ -4,8 +4,10 @@
 /// pure function: any program that passes the same inputs gets the same TrialOutcome, bit for bit
 /// (the process publishes outcome.alignment.X_WV and .duration_s on ALIGNMENT_TRIAL).
 ///
-/// The trial (viraal_trial.h): the emulated person of config.user walks config.walk with their own
-/// SLAM model (config.slam, its seed replaced by the trial's), the first num_mirrors displays of
+/// The trial (viraal_trial.h): the emulated person of config.user walks config.walk on the
+/// session's one continuous map (SessionMapAtTrial: put on at config.hmd.session_start_m, the
+/// earlier trials' walks replayed; config.slam with the session's seed and drift per metre,
+/// SessionSlamConfig), the first num_mirrors displays of
 /// config.hmd.displays capture their frames at their waypoints, and the person aligns the virtual
 /// robot at config.hmd.align_waypoint (after config.hmd.settle_s, waiting up to
 /// config.hmd.max_wait_s for tracking), starting from X_WV_start, against the real robot at X_WR
@@ -14,10 +16,11 @@
 /// session and trial index happen while the person aligns (viraal_trial.h), who re-does the
 /// alignment at most config.hmd.max_repeats times.
 ///
-/// Seeds: every trial draws from its own seeds, derived from (process seed, session id, trial
-/// index, purpose) by TrialSeed(): purpose kSlamSeedPurpose for the SLAM walk, kTrialSeedPurpose
-/// for the person's per-trial randomness. The same process seed, session and index give the same
-/// trial whatever happened before it; another index or session gives an independent draw.
+/// Seeds: derived from (process seed, session id, trial index, purpose) by TrialSeed(): purpose
+/// kSessionMapPurpose (index 0) for the session's map, kTrialSeedPurpose for the person's per-trial
+/// randomness. The same process seed, session and index give the same trial whatever happened
+/// before it (the map's earlier walks are replayed, not remembered); another session gives an
+/// independent map.
 ///
 /// Frames: W world (= the SLAM map for estimates), R real robot base, V virtual robot base.
 /// Units: m, rad, s.
@@ -37,8 +40,8 @@
 namespace orbed::hmd {
 
 /// TrialSeed() purposes.
-inline constexpr std::uint64_t kSlamSeedPurpose = 1;
 inline constexpr std::uint64_t kTrialSeedPurpose = 2;
+inline constexpr std::uint64_t kSessionMapPurpose = 3;  ///< 1 was a map per trial (until issue 10 item 4)
 
 /// The seed for one purpose of trial `index` of `session_id` in a process seeded with `seed`:
 /// SplitMix64 over the seed, the FNV-1a hash of the session id, the index and the purpose

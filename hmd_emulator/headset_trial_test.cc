@@ -132,12 +132,12 @@ TEST(HeadsetTrial, ForcedFaultsOfTheirTrialOnly) {
 
 TEST(HeadsetTrial, SeedsArePinned) {
   // Distinct per purpose, index and session; a pure function of its arguments.
-  const std::uint64_t slam = TrialSeed(1, "s", 0, kSlamSeedPurpose);
-  EXPECT_EQ(slam, TrialSeed(1, "s", 0, kSlamSeedPurpose));
+  const std::uint64_t slam = TrialSeed(1, "s", 0, kSessionMapPurpose);
+  EXPECT_EQ(slam, TrialSeed(1, "s", 0, kSessionMapPurpose));
   EXPECT_NE(slam, TrialSeed(1, "s", 0, kTrialSeedPurpose));
-  EXPECT_NE(slam, TrialSeed(1, "s", 1, kSlamSeedPurpose));
-  EXPECT_NE(slam, TrialSeed(1, "t", 0, kSlamSeedPurpose));
-  EXPECT_NE(slam, TrialSeed(2, "s", 0, kSlamSeedPurpose));
+  EXPECT_NE(slam, TrialSeed(1, "s", 1, kSessionMapPurpose));
+  EXPECT_NE(slam, TrialSeed(1, "t", 0, kSessionMapPurpose));
+  EXPECT_NE(slam, TrialSeed(2, "s", 0, kSessionMapPurpose));
 }
 
 }  // namespace

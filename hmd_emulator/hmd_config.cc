@@ -34,7 +34,7 @@ HmdConfig ParseHmdConfig(const YAML::Node& node, const std::string& source, cons
               {"name", "gaze_hz", "reflective_hz", "ar_view_hz", "align_waypoint", "settle_s", "max_wait_s",
                "max_repeats", "recapture_period_s", "gaze_fallback_distance_m", "max_gaze_distance_m",
                "displays", "annotation_landmarks", "annotation_pointing_std_deg", "annotation_dwell_s",
-               "annotation_view_angle_deg", "annotation_walk_speed_m_per_s"});
+               "annotation_view_angle_deg", "annotation_walk_speed_m_per_s", "session_start_m"});
   HmdConfig c = base;
   c.name = Text(f, node, "name", key, c.name);
   c.gaze_hz = f.NumberOr(node, "gaze_hz", key, c.gaze_hz, 0.1, 1000, "Hz");
@@ -64,6 +64,11 @@ HmdConfig ParseHmdConfig(const YAML::Node& node, const std::string& source, cons
       f.NumberOr(node, "annotation_view_angle_deg", key, c.annotation_view_angle_deg, 5, 150, "deg");
   c.annotation_walk_speed_m_per_s =
       f.NumberOr(node, "annotation_walk_speed_m_per_s", key, c.annotation_walk_speed_m_per_s, 0.05, 5, "m/s");
+  if (node["session_start_m"]) {
+    c.session_start_m = f.Vector3(node["session_start_m"], key + ".session_start_m", "m");
+    if (c.session_start_m.norm() > 100)
+      f.Fail(node["session_start_m"], key + ".session_start_m", "more than 100 m from W");
+  }
   const YAML::Node displays = node["displays"];
   if (displays.IsDefined() && !displays.IsNull()) {
     if (!displays.IsSequence() || displays.size() == 0 || displays.size() > 16) {

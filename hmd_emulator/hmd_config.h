@@ -41,6 +41,7 @@
 ///   annotation_dwell_s: 1.0            # cursor held on a landmark before the tap [s]
 ///   annotation_view_angle_deg: 40      # between the lines of sight of the two positions [deg]
 ///   annotation_walk_speed_m_per_s: 0.5 # speed of that step [m/s]
+///   session_start_m: [2.6, 0.3, 1.7]  # where the person puts the headset on: the map's origin [m]
 ///   # displays: a list of {capture_waypoint: NAME}, where each reflective display captures its
 ///   # frame, in order; default (absent): one display at the walk's first waypoint.
 /// @endcode
@@ -84,6 +85,8 @@ struct HmdConfig {
   double annotation_dwell_s{1.0};
   double annotation_view_angle_deg{40.0};
   double annotation_walk_speed_m_per_s{0.5};
+  /// Where the person puts the headset on, the session map's origin (SessionMapAtTrial) [m, W].
+  Eigen::Vector3d session_start_m{2.6, 0.3, 1.7};
 };
 
 /// The most landmarks a person annotates per trial (ALIGNMENT_TRIAL carries 4 rays per landmark).

@@ -32,6 +32,7 @@ void ExpectSame(const HmdConfig& a, const HmdConfig& b, const std::string& what)
   EXPECT_EQ(a.annotation_dwell_s, b.annotation_dwell_s);
   EXPECT_EQ(a.annotation_view_angle_deg, b.annotation_view_angle_deg);
   EXPECT_EQ(a.annotation_walk_speed_m_per_s, b.annotation_walk_speed_m_per_s);
+  EXPECT_EQ(a.session_start_m, b.session_start_m);
   ASSERT_EQ(a.displays.size(), b.displays.size());
   for (std::size_t i = 0; i < a.displays.size(); ++i) {
     EXPECT_EQ(a.displays[i].capture_waypoint, b.displays[i].capture_waypoint) << i;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "base/hash.h"
 #include "base/units.h"
 #include "base/yaml_fields.h"
 #include "sim/scene.h"
@@ -90,7 +91,8 @@ const char* TrackingStateName(TrackingState state) {
 SlamConfig ParseSlamConfig(const YAML::Node& node, const std::string& source, const std::string& key,
                            const SlamConfig& base) {
   const YamlFields f(source);
-  f.CheckKeys(node, key, {"seed", "rate_hz", "head_to_camera", "jitter", "drift", "tracking_loss", "faults"});
+  f.CheckKeys(node, key,
+              {"seed", "rate_hz", "head_to_camera", "jitter", "drift", "anchors", "tracking_loss", "faults"});
   SlamConfig c = base;
   c.seed = static_cast<std::uint64_t>(
       f.IntegerOr(node, "seed", key, static_cast<long long>(c.seed), 0, (1LL << 62)));
@@ -111,9 +113,12 @@ SlamConfig ParseSlamConfig(const YAML::Node& node, const std::string& source, co
   c.jitter_rotation_std_deg = f.NumberOr(j, "rotation_std_deg", kj, c.jitter_rotation_std_deg, 0, 5, "deg");
   const YAML::Node d = f.Section(node, "drift", key + ".drift");
   const std::string kd = key + ".drift";
-  f.CheckKeys(d, kd, {"fraction_of_distance", "yaw_deg_per_m", "direction_correlation_m", "band_fraction"});
+  f.CheckKeys(d, kd,
+              {"fraction_of_distance", "session_log_sigma", "yaw_deg_per_m", "direction_correlation_m",
+               "band_fraction"});
   c.drift_fraction_of_distance =
       f.NumberOr(d, "fraction_of_distance", kd, c.drift_fraction_of_distance, 0, 0.2);
+  c.drift_session_log_sigma = f.NumberOr(d, "session_log_sigma", kd, c.drift_session_log_sigma, 0, 2);
   c.drift_yaw_deg_per_m = f.NumberOr(d, "yaw_deg_per_m", kd, c.drift_yaw_deg_per_m, 0, 10, "deg/m");
   c.drift_direction_correlation_m =
       f.NumberOr(d, "direction_correlation_m", kd, c.drift_direction_correlation_m, 0.01, 1e6, "m");
@@ -124,6 +129,11 @@ SlamConfig ParseSlamConfig(const YAML::Node& node, const std::string& source, co
     c.drift_band_min_fraction = f.Number(b[0], kd + ".band_fraction[0]", 0, 0.2);
     c.drift_band_max_fraction = f.Number(b[1], kd + ".band_fraction[1]", c.drift_band_min_fraction, 0.2);
   }
+  const YAML::Node a = f.Section(node, "anchors", key + ".anchors");
+  const std::string ka = key + ".anchors";
+  f.CheckKeys(a, ka, {"radius_m", "relock_correction"});
+  c.anchor_radius_m = f.NumberOr(a, "radius_m", ka, c.anchor_radius_m, 0, 10, "m");
+  c.anchor_relock_correction = f.NumberOr(a, "relock_correction", ka, c.anchor_relock_correction, 0, 1);
   const YAML::Node t = f.Section(node, "tracking_loss", key + ".tracking_loss");
   const std::string kt = key + ".tracking_loss";
   f.CheckKeys(t, kt,
@@ -151,7 +161,40 @@ SlamConfig LoadSlamConfigFile(const std::string& path) {
   return ParseSlamConfig(f.Required(root, "slam", "slam"), path);
 }
 
+SlamConfig SessionSlamConfig(const SlamConfig& base, std::uint64_t session_seed) {
+  constexpr std::uint64_t kDriftSalt = 0x6472696674726174ULL;  // "driftrat"
+  SlamConfig c = base;
+  c.seed = session_seed;
+  Random rng(SplitMix64(session_seed ^ kDriftSalt));
+  c.drift_fraction_of_distance =
+      base.drift_fraction_of_distance * std::exp(base.drift_session_log_sigma * rng.Normal());
+  return c;
+}
+
 SlamModel::SlamModel(const SlamConfig& config) : config_(config), rng_(config.seed) {}
+
+void SlamModel::UpdateAnchors(const Eigen::Vector3d& p_WH, double ds_m) {
+  const double r = config_.anchor_radius_m;
+  bool near_one = false;
+  for (Anchor& a : anchors_) {
+    const bool inside = (p_WH - a.p_W).norm() <= r;
+    near_one = near_one || inside;
+    if (inside && !a.inside) {
+      // Back at a stored place: re-matched to what was stored there, about the head.
+      const double keep = 1.0 - config_.anchor_relock_correction;
+      const Eigen::Vector3d e_now = E_ * p_WH - p_WH;
+      const Eigen::Vector3d e_stored = a.E * p_WH - p_WH;
+      const double yaw_now = YawOf(E_);
+      const double yaw_stored = YawOf(a.E);
+      E_ = YawAboutPoint(p_WH, yaw_stored + keep * (yaw_now - yaw_stored),
+                         e_stored + keep * (e_now - e_stored));
+      ++relocks_;
+    }
+    a.inside = inside;
+  }
+  // Standing still away from every stored place: the device stores this one with today's error.
+  if (!near_one && ds_m == 0) anchors_.push_back({p_WH, E_, true});
+}
 
 void SlamModel::Force(const ForcedFault& fault) {
   if (fault.state != TrackingState::kLimited && fault.state != TrackingState::kLost) {
@@ -254,6 +297,7 @@ SlamSample SlamModel::Step(const Eigen::Isometry3d& X_WH_true, double t_s) {
   } else if (state_ != TrackingState::kLost) {
     Drift(p_WH, ds, state_ == TrackingState::kLimited ? config_.limited_drift_multiplier : 1.0);
   }
+  if (config_.anchor_radius_m > 0 && state_ == TrackingState::kTracking) UpdateAnchors(p_WH, ds);
 
   SlamSample s;
   s.t_s = t_s;

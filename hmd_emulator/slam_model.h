@@ -28,6 +28,18 @@
 ///    correlation decays as exp(−s / drift_direction_correlation_m) with the path s, so over short
 ///    paths the translation error grows at drift_fraction_of_distance per metre and over long ones
 ///    it wanders like a random walk. While standing still there is no drift (jitter only).
+///    The drift per metre differs from session to session (a different room state, lighting,
+///    texture): SessionSlamConfig draws it once per session, log-normal with median
+///    drift_fraction_of_distance and log-standard deviation drift_session_log_sigma (0: every
+///    session the same).
+///  - Stored places (spatial anchors, loop closure): a place where the head stands still (a sample
+///    with no displacement) farther than anchor_radius_m from every stored place is stored with the
+///    map error of that moment. Coming back within anchor_radius_m of a stored place while
+///    TRACKING re-matches the map there: the head's position error and the yaw error move
+///    anchor_relock_correction of the way from today's to the stored ones (1: exactly the stored
+///    error; 0 or anchor_radius_m 0: no stored places). The first sample stores the map origin.
+///    So a session that returns to the same places sees the errors those places were stored
+///    with, and errors of trials made at the same place are correlated.
 ///  - Jitter: J_H = (exp(ω), v), ω ~ N(0, σ_r² I), v ~ N(0, σ_t² I), independent per sample.
 ///  - Tracking loss: a Poisson process at tracking_loss_rate_per_min (while TRACKING). The state goes
 ///    LIMITED for an exponential time (mean limited_mean_s), drifting limited_drift_multiplier times
@@ -47,10 +59,14 @@
 ///   head_to_camera: {position_m: [0.0, -0.03, 0.06], rpy_deg: [0, 0, 0]}   # X_HC, HoloLens 1 PV camera
 ///   jitter: {translation_std_m: 0.0005, rotation_std_deg: 0.02}
 ///   drift:
-///     fraction_of_distance: 0.01       # translation drift per metre walked
+///     fraction_of_distance: 0.0065     # median translation drift per metre walked
+///     session_log_sigma: 0.47          # its spread over sessions (log-normal)
 ///     band_fraction: [0.003, 0.014]    # where the drift per metre is expected (tests only)
 ///     yaw_deg_per_m: 0.05              # [deg/m]
 ///     direction_correlation_m: 10.0    # [m]
+///   anchors:
+///     radius_m: 0.5                    # [m]
+///     relock_correction: 0.5
 ///   tracking_loss:
 ///     rate_per_min: 0.5                # [1/min]
 ///     limited_mean_s: 1.0              # [s]
@@ -134,12 +150,17 @@ struct SlamConfig {
   Eigen::Isometry3d X_HC{Eigen::Translation3d(0.0, -0.03, 0.06)};
   double jitter_translation_std_m{0.0005};
   double jitter_rotation_std_deg{0.02};
-  double drift_fraction_of_distance{0.01};
+  double drift_fraction_of_distance{0.0065};
+  /// Log-standard deviation of the per-session drift per metre (SessionSlamConfig).
+  double drift_session_log_sigma{0.47};
   double drift_yaw_deg_per_m{0.05};
   double drift_direction_correlation_m{10.0};
   /// The band the drift per metre is expected in (documentation and tests; not used by the model).
   double drift_band_min_fraction{0.003};
   double drift_band_max_fraction{0.014};
+  /// Stored places (see the file comment): radius [m] (0: none) and the share re-matched.
+  double anchor_radius_m{0.5};
+  double anchor_relock_correction{0.5};
   double tracking_loss_rate_per_min{0.5};
   double limited_mean_s{1.0};
   double limited_drift_multiplier{4.0};
@@ -157,6 +178,9 @@ struct SlamConfig {
 /// checked; errors name `source`, the line and the key.
 SlamConfig ParseSlamConfig(const YAML::Node& node, const std::string& source, const std::string& key = "slam",
                            const SlamConfig& base = SlamConfig{});
+/// The map of one session: `base` with `seed` = session_seed and the drift per metre drawn from
+/// the per-session log-normal (file comment), from its own stream of session_seed.
+SlamConfig SessionSlamConfig(const SlamConfig& base, std::uint64_t session_seed);
 /// Loads the `slam:` mapping of a YAML file (e.g. hmd_emulator/config/slam.yaml).
 SlamConfig LoadSlamConfigFile(const std::string& path);
 /// The shipped defaults, relative to the repository root.
@@ -205,9 +229,18 @@ class SlamModel {
   const SlamConfig& config() const { return config_; }
   /// The current drift part of the map error E = X_WW'.
   const Eigen::Isometry3d& X_WWmap() const { return E_; }
+  /// Places stored so far, and how many times the map was re-matched at one.
+  int anchors() const { return static_cast<int>(anchors_.size()); }
+  int relocks() const { return relocks_; }
 
  private:
+  struct Anchor {
+    Eigen::Vector3d p_W;  // the head's true position when stored [m]
+    Eigen::Isometry3d E;  // the map error then
+    bool inside{true};    // the head within anchor_radius_m at the last sample
+  };
   void Drift(const Eigen::Vector3d& p_WH, double ds_m, double multiplier);
+  void UpdateAnchors(const Eigen::Vector3d& p_WH, double ds_m);
   void AdvanceState(double dt_s);
 
   SlamConfig config_;
@@ -228,6 +261,8 @@ class SlamModel {
   std::optional<ForcedFault> pending_force_;  // Force() called, not yet applied by Step()
   std::optional<ForcedFault> forced_;         // under way: its jump is applied at RELOCALIZED
   long long forced_samples_left_{0};          // samples still in forced_->state after this one
+  std::vector<Anchor> anchors_;
+  int relocks_{0};
 };
 
 /// Samples a trajectory at config.rate_hz from t = 0 to t_end_s (inclusive of 0): one SlamModel

@@ -5,6 +5,7 @@
 // camera overlay lands where the true camera sees the apparent hologram).
 #include "hmd_emulator/slam_model.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -162,6 +163,7 @@ TEST(SlamModel, DriftPerMetreStaysInConfiguredBand) {
   for (const double fraction : {shipped.drift_fraction_of_distance, 0.005}) {
     SlamConfig c = shipped;
     c.drift_fraction_of_distance = fraction;
+    c.anchor_radius_m = 0;  // the drift law alone: the rectangle's corners would re-match the map
     c.seed = 7;
     // 300 s at 0.8 m/s: 240 m, 24 laps.
     const std::vector<SlamSample> s = SimulateWalk(walk, c, 300.0);
@@ -182,6 +184,85 @@ TEST(SlamModel, DriftPerMetreStaysInConfiguredBand) {
   // The shipped default is inside the documented band.
   EXPECT_GE(shipped.drift_fraction_of_distance, shipped.drift_band_min_fraction);
   EXPECT_LE(shipped.drift_fraction_of_distance, shipped.drift_band_max_fraction);
+}
+
+// Coming back to a stored place moves the head's error relock_correction of the way to the error
+// stored there. Oracle: the same model without stored places (same seed: stored places draw
+// nothing, so both are identical up to the sample that re-matches).
+TEST(SlamModel, ComingBackToAStoredPlaceReMatchesTheMapThere) {
+  SlamConfig c;
+  c.jitter_translation_std_m = c.jitter_rotation_std_deg = 0;
+  c.tracking_loss_rate_per_min = 0;
+  c.drift_fraction_of_distance = 0.01;
+  c.drift_yaw_deg_per_m = 0.5;
+  c.seed = 5;
+  for (const double correction : {1.0, 0.5}) {
+    SCOPED_TRACE(correction);
+    c.anchor_relock_correction = correction;
+    SlamConfig free = c;
+    free.anchor_radius_m = 0;
+    SlamModel anchored(c), unanchored(free);
+    // Stand at A (stored with E = I), walk 5 m out along x and straight back.
+    const Eigen::Vector3d p_A(0, 0, 1.7);
+    auto head_at = [](const Eigen::Vector3d& p) {
+      Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+      X.translation() = p;
+      return X;
+    };
+    double t = 0;
+    const double step_m = 0.8 / 60;
+    std::vector<Eigen::Vector3d> path = {p_A, p_A};
+    for (double x = step_m; x < 5.0; x += step_m) path.push_back(p_A + Eigen::Vector3d(x, 0, 0));
+    for (double x = 5.0; x > -1e-9; x -= step_m) path.push_back(p_A + Eigen::Vector3d(x, 0, 0));
+    bool relocked = false;
+    for (const Eigen::Vector3d& p : path) {
+      const SlamSample a = anchored.Step(head_at(p), t);
+      const SlamSample u = unanchored.Step(head_at(p), t);
+      t += 1.0 / 60;
+      if (relocked || anchored.relocks() == 0) {
+        if (!relocked) EXPECT_TRUE(a.X_WWmap.isApprox(u.X_WWmap, 0)) << "before the first re-match";
+        continue;
+      }
+      relocked = true;
+      EXPECT_LE((p - p_A).norm(), c.anchor_radius_m + 1e-12);
+      EXPECT_GT((p - p_A).norm(), c.anchor_radius_m - step_m);
+      const Eigen::Vector3d e_anchored = a.X_WWmap * p - p, e_free = u.X_WWmap * p - p;
+      EXPECT_GT(e_free.norm(), 0.01 * 4.0) << "drift over the 9.5 m walked before";
+      EXPECT_LT((e_anchored - (1 - correction) * e_free).norm(), 1e-12);
+      const Eigen::Matrix3d R = a.X_WWmap.linear(), R_free = u.X_WWmap.linear();
+      EXPECT_NEAR(std::atan2(R(1, 0), R(0, 0)), (1 - correction) * std::atan2(R_free(1, 0), R_free(0, 0)),
+                  1e-12);
+    }
+    EXPECT_TRUE(relocked);
+    EXPECT_EQ(anchored.relocks(), 1);
+    EXPECT_EQ(anchored.anchors(), 1) << "standing at the far end stores nothing: it never stood there";
+  }
+}
+
+// Per-session drift: the band is the 5-95 % range of the drawn rates, the median the configured
+// value; without a spread every session gets the median; the draw changes nothing else.
+TEST(SlamConfig, SessionDriftIsDrawnFromTheBand) {
+  const SlamConfig shipped = LoadSlamConfigFile(orbed::SourceTreePath(kDefaultSlamConfigRelativePath));
+  std::vector<double> drawn;
+  for (std::uint64_t seed = 1; seed <= 4000; ++seed) {
+    const SlamConfig c = SessionSlamConfig(shipped, seed);
+    EXPECT_EQ(c.seed, seed);
+    drawn.push_back(c.drift_fraction_of_distance);
+  }
+  EXPECT_EQ(SessionSlamConfig(shipped, 17).drift_fraction_of_distance,
+            SessionSlamConfig(shipped, 17).drift_fraction_of_distance);
+  std::sort(drawn.begin(), drawn.end());
+  const double p05 = drawn[200], p50 = drawn[2000], p95 = drawn[3800];
+  std::printf("per-session drift: 5 %% %.4f, median %.4f, 95 %% %.4f\n", p05, p50, p95);
+  EXPECT_NEAR(p05, shipped.drift_band_min_fraction, 0.1 * shipped.drift_band_min_fraction);
+  EXPECT_NEAR(p95, shipped.drift_band_max_fraction, 0.1 * shipped.drift_band_max_fraction);
+  EXPECT_NEAR(p50, shipped.drift_fraction_of_distance, 0.05 * shipped.drift_fraction_of_distance);
+  SlamConfig fixed = shipped;
+  fixed.drift_session_log_sigma = 0;
+  const SlamConfig one = SessionSlamConfig(fixed, 99);
+  EXPECT_EQ(one.drift_fraction_of_distance, shipped.drift_fraction_of_distance);
+  EXPECT_EQ(one.drift_yaw_deg_per_m, shipped.drift_yaw_deg_per_m);
+  EXPECT_EQ(one.anchor_radius_m, shipped.anchor_radius_m);
 }
 
 TEST(SlamModel, NoDriftWhileStandingAndMapStartsOnWorld) {
@@ -431,6 +512,9 @@ void ExpectSame(const SlamConfig& a, const SlamConfig& b, const std::string& wha
   EXPECT_EQ(a.jitter_translation_std_m, b.jitter_translation_std_m);
   EXPECT_EQ(a.jitter_rotation_std_deg, b.jitter_rotation_std_deg);
   EXPECT_EQ(a.drift_fraction_of_distance, b.drift_fraction_of_distance);
+  EXPECT_EQ(a.drift_session_log_sigma, b.drift_session_log_sigma);
+  EXPECT_EQ(a.anchor_radius_m, b.anchor_radius_m);
+  EXPECT_EQ(a.anchor_relock_correction, b.anchor_relock_correction);
   EXPECT_EQ(a.drift_yaw_deg_per_m, b.drift_yaw_deg_per_m);
   EXPECT_EQ(a.drift_direction_correlation_m, b.drift_direction_correlation_m);
   EXPECT_EQ(a.drift_band_min_fraction, b.drift_band_min_fraction);

@@ -89,8 +89,7 @@ void AnnotateLandmarks(const TrialSetup& setup, std::uint64_t trial_seed, SlamMo
 
 }  // namespace
 
-TrialOutcome RunTrial(const TrialSetup& setup, const SlamConfig& slam, const EmulatedUser& user,
-                      const Eigen::Isometry3d& X_WV_start, std::uint64_t trial_seed) {
+WalkSamples WalkToAlignment(const TrialSetup& setup, double t0_s, SlamModel* model) {
   const HeadTrajectory trajectory(setup.walk);
   auto waypoint = [&trajectory](const std::string& name) {
     const int i = trajectory.FindWaypoint(name);
@@ -102,15 +101,14 @@ TrialOutcome RunTrial(const TrialSetup& setup, const SlamConfig& slam, const Emu
   for (const auto& name : setup.capture_waypoints)
     t_capture.push_back(trajectory.ArrivalTime(waypoint(name)));
 
-  TrialOutcome out;
-  SlamModel model(slam);
-  const double dt = 1.0 / slam.rate_hz;
+  WalkSamples out;
+  const double dt = 1.0 / model->config().rate_hz;
   std::vector<bool> captured(t_capture.size(), false);
   out.at_capture.resize(t_capture.size());
   const long long steps = static_cast<long long>(std::ceil(t_align / dt - 1e-9));
   for (long long k = 0; k <= steps; ++k) {
     const double t = std::min(k * dt, t_align);
-    const SlamSample s = model.Step(trajectory.X_WH(t), t);
+    const SlamSample s = model->Step(trajectory.X_WH(t), t0_s + t);
     if (s.state == TrackingState::kRelocalized) ++out.relocalizations;
     for (std::size_t j = 0; j < t_capture.size(); ++j) {
       if (!captured[j] && t >= t_capture[j] - 1e-9) {
@@ -125,9 +123,63 @@ TrialOutcome RunTrial(const TrialSetup& setup, const SlamConfig& slam, const Emu
   const Eigen::Isometry3d X_WH_stand = trajectory.X_WH(t_align);
   for (double t = t_align + dt;
        out.at_alignment.state != TrackingState::kTracking && t <= t_align + setup.max_wait_s; t += dt) {
-    out.at_alignment = model.Step(X_WH_stand, t);
+    out.at_alignment = model->Step(X_WH_stand, t0_s + t);
     if (out.at_alignment.state == TrackingState::kRelocalized) ++out.relocalizations;
   }
+  return out;
+}
+
+double WalkStraight(const Eigen::Vector3d& p_W_from, const Eigen::Vector3d& p_W_to,
+                    const HeadTrajectoryConfig& walk, double t0_s, SlamModel* model) {
+  if ((p_W_to - p_W_from).norm() < 1e-6) return t0_s;
+  HeadTrajectoryConfig leg;
+  leg.speed_m_per_s = walk.speed_m_per_s;
+  leg.p_W_look_at = walk.p_W_look_at;
+  leg.waypoints = {{"from", p_W_from, 0.0, {}}, {"to", p_W_to, 0.0, {}}};
+  const HeadTrajectory trajectory(leg);
+  const double dt = 1.0 / model->config().rate_hz;
+  const double t_end = trajectory.ArrivalTime(1);
+  const long long steps = static_cast<long long>(std::ceil(t_end / dt - 1e-9));
+  for (long long k = 1; k <= steps; ++k) {
+    const double t = std::min(static_cast<double>(k) * dt, t_end);
+    model->Step(trajectory.X_WH(t), t0_s + t);
+  }
+  return t0_s + t_end;
+}
+
+SlamModel SessionMapAtTrial(const TrialSetup& setup, const SlamConfig& session_slam,
+                            const Eigen::Vector3d& p_W_session_start, int trial_index, double* t_s) {
+  if (trial_index < 0) throw std::invalid_argument("SessionMapAtTrial: negative trial index");
+  if (setup.walk.waypoints.empty())
+    throw std::invalid_argument("SessionMapAtTrial: the walk has no waypoints");
+  SlamModel model(session_slam);
+  const Eigen::Vector3d p_W_walk_start = setup.walk.waypoints.front().p_WH;
+  const double dt = 1.0 / session_slam.rate_hz;
+  // Where the person puts the headset on: the map's origin.
+  HeadTrajectoryConfig here = setup.walk;
+  here.waypoints = {{"start", p_W_session_start, 0.0, {}}};
+  model.Step(HeadTrajectory(here).X_WH(0), 0.0);
+  double t = WalkStraight(p_W_session_start, p_W_walk_start, setup.walk, 0.0, &model);
+  for (int k = 0; k < trial_index; ++k) {
+    const SlamSample aligned = WalkToAlignment(setup, t + dt, &model).at_alignment;
+    t = WalkStraight(aligned.X_WH_true.translation(), p_W_walk_start, setup.walk, aligned.t_s, &model);
+  }
+  *t_s = t + dt;
+  return model;
+}
+
+TrialOutcome RunTrial(const TrialSetup& setup, const SlamConfig& slam, const EmulatedUser& user,
+                      const Eigen::Isometry3d& X_WV_start, std::uint64_t trial_seed) {
+  return RunTrialFrom(setup, SlamModel(slam), 0.0, user, X_WV_start, trial_seed);
+}
+
+TrialOutcome RunTrialFrom(const TrialSetup& setup, SlamModel model, double t0_s, const EmulatedUser& user,
+                          const Eigen::Isometry3d& X_WV_start, std::uint64_t trial_seed) {
+  TrialOutcome out;
+  WalkSamples walked = WalkToAlignment(setup, t0_s, &model);
+  out.at_alignment = walked.at_alignment;
+  out.at_capture = std::move(walked.at_capture);
+  out.relocalizations = walked.relocalizations;
 
   ViewingContext ctx;
   ctx.X_WR = setup.X_WR;

@@ -114,9 +114,41 @@ struct TrialOutcome {
   std::vector<AnnotationRay> annotation;
 };
 
-/// Runs one trial. slam.seed and trial_seed make it reproducible; X_WV_start is in map coordinates.
-/// Throws std::invalid_argument naming a waypoint that the walk does not have.
+/// Runs one trial on a fresh map that starts at the walk's first waypoint (t = 0). slam.seed and
+/// trial_seed make it reproducible; X_WV_start is in map coordinates. Throws std::invalid_argument
+/// naming a waypoint that the walk does not have.
 TrialOutcome RunTrial(const TrialSetup& setup, const SlamConfig& slam, const EmulatedUser& user,
                       const Eigen::Isometry3d& X_WV_start, std::uint64_t trial_seed);
+
+/// The same trial on a map already under way: `model` as it is when the person stands at the
+/// walk's first waypoint at time t0_s (SessionMapAtTrial). The model is a copy: what the trial
+/// does to it (the alignment's faults, the annotation) stays in this trial.
+TrialOutcome RunTrialFrom(const TrialSetup& setup, SlamModel model, double t0_s, const EmulatedUser& user,
+                          const Eigen::Isometry3d& X_WV_start, std::uint64_t trial_seed);
+
+/// What the walk to the alignment gives (RunTrial's first part, also replayed by SessionMapAtTrial).
+struct WalkSamples {
+  SlamSample at_alignment;             ///< the sample the person starts aligning with
+  std::vector<SlamSample> at_capture;  ///< one per capture waypoint, at arrival
+  int relocalizations{0};
+};
+/// Steps `model` along setup.walk from its first waypoint (at t0_s) to the alignment sample (after
+/// settle_s, and any wait for TRACKING). Throws std::invalid_argument for an unknown waypoint.
+WalkSamples WalkToAlignment(const TrialSetup& setup, double t0_s, SlamModel* model);
+
+/// Steps `model` along a straight walk from p_W_from (at t0_s, not stepped) to p_W_to at the walk's
+/// speed, looking at its target; returns the arrival time [s] (t0_s for no distance).
+double WalkStraight(const Eigen::Vector3d& p_W_from, const Eigen::Vector3d& p_W_to,
+                    const HeadTrajectoryConfig& walk, double t0_s, SlamModel* model);
+
+/// The session's one continuous map (issue 10 item 4) as it is when trial `trial_index` begins:
+/// the person puts the headset on at p_W_session_start (the map's origin, stored as the first
+/// place), walks straight to the walk's first waypoint, and for each earlier trial walks the trial's
+/// walk to its alignment sample and straight back to the first waypoint. Only the walks are
+/// replayed: what happened while aligning and annotating stays in that trial (RunTrialFrom copies
+/// the model). Deterministic in (session_slam, the walk, trial_index), so a restarted headset
+/// rebuilds the same map. *t_s is the time at which the trial's walk begins.
+SlamModel SessionMapAtTrial(const TrialSetup& setup, const SlamConfig& session_slam,
+                            const Eigen::Vector3d& p_W_session_start, int trial_index, double* t_s);
 
 }  // namespace orbed::hmd

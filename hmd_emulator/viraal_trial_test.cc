@@ -306,6 +306,86 @@ TEST(LandmarkAnnotation, PointingErrorScattersTheLandmarks) {
   }
 }
 
+// The session's one map (SessionMapAtTrial). With a drift along one fixed direction (no jitter,
+// no yaw, no losses, a direction that does not decorrelate), the map error at the head is the drift
+// rate times the path walked since the map began, or since the place was last re-matched: the
+// oracles below are that product.
+struct SessionFixture : Fixture {
+  Eigen::Vector3d p_W_start{2.6, 0.3, 1.7};
+  SessionFixture() {
+    slam.drift_fraction_of_distance = 0.01;
+    slam.drift_direction_correlation_m = 1e12;
+  }
+  // The head's position error when trial k starts aligning.
+  Eigen::Vector3d ErrorAtAlignment(int k, SlamSample* sample = nullptr) const {
+    double t0 = 0;
+    SlamModel map = SessionMapAtTrial(setup, slam, p_W_start, k, &t0);
+    const SlamSample s = WalkToAlignment(setup, t0, &map).at_alignment;
+    if (sample) *sample = s;
+    const Eigen::Vector3d p = s.X_WH_true.translation();
+    return s.X_WWmap * p - p;
+  }
+};
+
+TEST(SessionMap, TheDisplayIsNotCapturedWhereTheMapBegan) {
+  const SessionFixture f;
+  double t0 = 0;
+  SlamModel map = SessionMapAtTrial(f.setup, f.slam, f.p_W_start, 0, &t0);
+  const SlamSample capture = WalkToAlignment(f.setup, t0, &map).at_capture.at(0);
+  const double leg_m = (f.setup.walk.waypoints.front().p_WH - f.p_W_start).norm();
+  EXPECT_GT(leg_m, 1.0);
+  EXPECT_NEAR(capture.path_m, leg_m, 1e-9);
+  const Eigen::Vector3d p = capture.X_WH_true.translation();
+  EXPECT_NEAR((capture.X_WWmap * p - p).norm(), 0.01 * leg_m, 1e-6);
+  // Put on at the first waypoint instead, the capture is where the map began: no error at all.
+  SessionFixture at_waypoint;
+  at_waypoint.p_W_start = f.setup.walk.waypoints.front().p_WH;
+  SlamModel map0 = SessionMapAtTrial(at_waypoint.setup, at_waypoint.slam, at_waypoint.p_W_start, 0, &t0);
+  EXPECT_TRUE(WalkToAlignment(at_waypoint.setup, t0, &map0)
+                  .at_capture.at(0)
+                  .X_WWmap.isApprox(Eigen::Isometry3d::Identity(), 1e-15));
+}
+
+TEST(SessionMap, WithoutStoredPlacesTheDriftAccumulatesOverTheSession) {
+  SessionFixture f;
+  f.slam.anchor_radius_m = 0;
+  for (int k : {0, 1, 3}) {
+    SlamSample s;
+    const Eigen::Vector3d e = f.ErrorAtAlignment(k, &s);
+    EXPECT_NEAR(e.norm(), 0.01 * s.path_m, 1e-5 * s.path_m) << "trial " << k;
+    if (k == 3) EXPECT_GT(s.path_m, 3 * 4.0) << "three walks and returns of more than 2 m each";
+  }
+}
+
+TEST(SessionMap, ComingBackToTheSamePlacesHoldsTheErrorOfTheFirstVisit) {
+  SessionFixture f;
+  f.slam.anchor_relock_correction = 1;
+  const Eigen::Vector3d e0 = f.ErrorAtAlignment(0);
+  const Eigen::Vector3d e1 = f.ErrorAtAlignment(1), e3 = f.ErrorAtAlignment(3);
+  // Re-matched to the error stored at the alignment place, then the drift of the last radius walked.
+  const double inside_m = f.slam.anchor_radius_m;
+  EXPECT_NEAR((e1 - e0).norm(), 0.01 * inside_m, 0.01 * 0.02);
+  EXPECT_LT((e3 - e1).norm(), 1e-6) << "the same walk from the same re-matched error";
+  SessionFixture unanchored = f;
+  unanchored.slam.anchor_radius_m = 0;
+  EXPECT_GT((unanchored.ErrorAtAlignment(3) - unanchored.ErrorAtAlignment(1)).norm(), 0.01 * 2 * 4.0);
+}
+
+TEST(SessionMap, ATrialIsAPureFunctionOfItsIndex) {
+  SessionFixture f;
+  f.slam = SlamConfig{};  // jitter, drift, yaw and drawn losses: everything random
+  f.slam.seed = 3;
+  double t_a = 0, t_b = 0;
+  const SlamModel a = SessionMapAtTrial(f.setup, f.slam, f.p_W_start, 4, &t_a);
+  const SlamModel b = SessionMapAtTrial(f.setup, f.slam, f.p_W_start, 4, &t_b);
+  EXPECT_EQ(t_a, t_b);
+  EXPECT_TRUE(a.X_WWmap().isApprox(b.X_WWmap(), 0));
+  const TrialOutcome o1 = RunTrialFrom(f.setup, a, t_a, f.user, f.X_WV_start, 1);
+  const TrialOutcome o2 = RunTrialFrom(f.setup, b, t_b, f.user, f.X_WV_start, 1);
+  EXPECT_TRUE(o1.alignment.X_WV.isApprox(o2.alignment.X_WV, 0));
+  EXPECT_GT(t_a, 4 * 5.0) << "four earlier trials' walks";
+}
+
 TEST(AlignmentResult, PoseAtATime) {
   AlignmentResult r;
   r.poses = {{0.0, Translation({0, 0, 0})}, {7.5, Translation({1, 0, 0})}, {13.0, Translation({2, 0, 0})}};

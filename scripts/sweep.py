@@ -6,11 +6,13 @@ persons (user.seed 1..USERS) with TRIALS trials per display mode, and reports th
 statistic over all their trials (results.json's table1, pooled: per axis of W the mean and sample
 std of the trials' mean absolute landmark errors, then the norms of the two vectors). Sweeps:
 
-  drift          slam.drift.fraction_of_distance (per metre walked); the shipped walk and display.
+  drift          slam.drift.fraction_of_distance (per metre walked), the same in every session
+                 (session_log_sigma 0); the shipped walk and display.
   capture_angle  the angle, about the robot's middle (the walk's look-at point), between where the
                  display's frame is captured and where the person aligns (head_end); the walk starts
-                 at the capture point (the map starts there) and goes straight to head_end, so the
-                 path, and the drift the alignment sees, grows with the angle (path_m says how much).
+                 at the capture point and goes straight to head_end, so the path, and the drift the
+                 alignment sees, grows with the angle (path_m says how much; the session's map begins
+                 at hmd.session_start_m, which the person walks from to the capture point first).
   displays       1, 2, 3 displays (reflective_mirrors) captured at 104.5 deg (foot_end, shipped),
                  60 deg and 150 deg; the walk visits them from the farthest to head_end.
 
@@ -112,7 +114,7 @@ def main():
 
     shipped_walk, shipped_path = walk_yaml([FOOT_END])
     sweeps = {
-        "drift": [(f, f"slam:\n  drift:\n    fraction_of_distance: {f}\n", scenario, shipped_path)
+        "drift": [(f, f"slam:\n  drift:\n    fraction_of_distance: {f}\n    session_log_sigma: 0\n", scenario, shipped_path)
                   for f in (0.0, 0.003, 0.006, 0.01, 0.014, 0.02)],
         "capture_angle": [],
         "displays": [],
