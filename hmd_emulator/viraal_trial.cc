@@ -111,7 +111,7 @@ WalkSamples WalkToAlignment(const TrialSetup& setup, double t0_s, SlamModel* mod
     const SlamSample s = model->Step(trajectory.X_WH(t), t0_s + t);
     if (s.state == TrackingState::kRelocalized) ++out.relocalizations;
     for (std::size_t j = 0; j < t_capture.size(); ++j) {
-      if (!captured[j] && t >= t_capture[j] - 1e-9) {
+      if (!captured[j] && t >= t_capture[j] - 1e-9 && s.state == TrackingState::kTracking) {
         out.at_capture[j] = s;
         captured[j] = true;
       }
@@ -125,6 +125,10 @@ WalkSamples WalkToAlignment(const TrialSetup& setup, double t0_s, SlamModel* mod
        out.at_alignment.state != TrackingState::kTracking && t <= t_align + setup.max_wait_s; t += dt) {
     out.at_alignment = model->Step(X_WH_stand, t0_s + t);
     if (out.at_alignment.state == TrackingState::kRelocalized) ++out.relocalizations;
+  }
+  // A display whose waypoint was passed while tracking never recovered takes the alignment's frame.
+  for (std::size_t j = 0; j < t_capture.size(); ++j) {
+    if (!captured[j]) out.at_capture[j] = out.at_alignment;
   }
   return out;
 }

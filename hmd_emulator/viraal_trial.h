@@ -60,7 +60,8 @@ struct TrialSetup {
   Eigen::Isometry3d X_WR{Eigen::Isometry3d::Identity()};  ///< real robot base (truth)
   std::vector<Eigen::Vector3d> p_RQ;                      ///< model points at the trial's q
   HeadTrajectoryConfig walk;
-  /// Waypoints where a reflective display captures its frame (at arrival); empty = AR only.
+  /// Waypoints where a reflective display captures its frame (at arrival, once tracking; see
+  /// WalkSamples::at_capture); empty = AR only.
   std::vector<std::string> capture_waypoints;
   /// Waypoint where the user aligns (at arrival, after `settle_s`, once tracking is TRACKING).
   std::string align_waypoint;
@@ -107,9 +108,9 @@ struct TrialOutcome {
   PoseError augmentation;   ///< apparent hologram against X_WR, at at_end
   SlamSample at_alignment;  ///< the sample the person started aligning with
   SlamSample at_end;        ///< the last one they aligned or waited with (= at_alignment without faults)
-  std::vector<SlamSample> at_capture;
-  int relocalizations{0};      ///< RELOCALIZED samples during the walk (and the wait before aligning)
-  TrackingFaultRecord faults;  ///< while aligning
+  std::vector<SlamSample> at_capture;  ///< the displays' frames (WalkSamples::at_capture)
+  int relocalizations{0};              ///< RELOCALIZED samples during the walk (and the wait before aligning)
+  TrackingFaultRecord faults;          ///< while aligning
   /// The landmark annotation: for each head position, for each landmark, real then hologram.
   std::vector<AnnotationRay> annotation;
 };
@@ -128,8 +129,11 @@ TrialOutcome RunTrialFrom(const TrialSetup& setup, SlamModel model, double t0_s,
 
 /// What the walk to the alignment gives (RunTrial's first part, also replayed by SessionMapAtTrial).
 struct WalkSamples {
-  SlamSample at_alignment;             ///< the sample the person starts aligning with
-  std::vector<SlamSample> at_capture;  ///< one per capture waypoint, at arrival
+  SlamSample at_alignment;  ///< the sample the person starts aligning with
+  /// One per capture waypoint: the first TRACKING sample from the arrival on (a frame taken while
+  /// tracking is limited or lost has no pose to place it with; the display waits), else the
+  /// alignment sample.
+  std::vector<SlamSample> at_capture;
   int relocalizations{0};
 };
 /// Steps `model` along setup.walk from its first waypoint (at t0_s) to the alignment sample (after

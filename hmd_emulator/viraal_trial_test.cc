@@ -346,6 +346,21 @@ TEST(SessionMap, TheDisplayIsNotCapturedWhereTheMapBegan) {
                   .X_WWmap.isApprox(Eigen::Isometry3d::Identity(), 1e-15));
 }
 
+// A frame taken while tracking is lost has no pose to place it with: the display waits for TRACKING.
+TEST(SessionMap, TheDisplayCapturesOnlyWhileTracking) {
+  const SessionFixture f;
+  SlamModel map(f.slam);
+  ForcedFault lost;
+  lost.state = TrackingState::kLost;
+  lost.duration_s = 1.0;
+  map.Force(lost);
+  const WalkSamples w = WalkToAlignment(f.setup, 0.0, &map);
+  EXPECT_EQ(w.at_capture.at(0).state, TrackingState::kTracking);
+  // 60 LOST samples (t = 0 .. 59/60), the RELOCALIZED one at t = 1, the first TRACKING one after it.
+  EXPECT_NEAR(w.at_capture.at(0).t_s, 61.0 / 60.0, 1e-9);
+  EXPECT_EQ(w.relocalizations, 1);
+}
+
 TEST(SessionMap, WithoutStoredPlacesTheDriftAccumulatesOverTheSession) {
   SessionFixture f;
   f.slam.anchor_radius_m = 0;
