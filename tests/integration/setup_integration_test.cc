@@ -12,15 +12,20 @@
 //  5. The registration's share over the bus: setup.yaml with ORBED_SETUP_REGISTRATION=truth, one AR
 //     set-up: no alignment, REGISTRATION carries exactly ROBOT_STATE's true base pose, the assistant
 //     finishes with it, and the record has the clearance the sim's COLLISION_STATUS gave.
+//  6. A resumed run (ORBED_SETUP_RESUME): a finished run's file cut back to its first set-up and
+//     marked partial; the launch keeps that set-up as it was, sends SETUP_TASK for the second only,
+//     and ends with both, the first exactly as the file had it.
 //  3. scripts/launch/setup.yaml for one user and one target per mode through orbed-launch: the run
 //     ends with exit 0; setup_results.json has the three set-ups in the order the user seed draws,
 //     each reached_deg equal to the assistant's (the sim's measured joints, twice read), an
 //     alignment of 3 trials before each headset set-up and none before the fixed one.
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <fstream>
+#include <map>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -38,6 +43,7 @@
 #include "base/units.h"
 #include "procs/logger/event_log_reader.h"
 #include "procs/logger/manifest.h"
+#include "procs/setup/setup_conductor.h"
 #include "procs/setup/setup_process.h"
 #include "sim/guidance_messages.h"
 #include "tests/integration/testbed_util.h"
@@ -340,6 +346,73 @@ TEST(SetupStudy, TheTrueRegistrationGoesOverTheBusInsteadOfAlignments) {
   const YAML::Node manifest = YAML::LoadFile(log_dir + "/manifest.json");
   EXPECT_FALSE(manifest["channels"]["ALIGNMENT_TRIAL"]) << "an alignment ran";
   EXPECT_TRUE(manifest["channels"]["REGISTRATION"]);
+}
+
+// The task ids of every SETUP_TASK in a run folder's log.
+std::vector<std::string> LoggedTaskIds(const std::string& log_dir) {
+  std::vector<std::string> ids;
+  const logger::Manifest parts = logger::ReadManifestFile(log_dir + "/manifest.json");
+  for (const logger::ManifestPart& part : parts.parts) {
+    const logger::MappedLog log(log_dir + "/" + part.file);
+    EXPECT_TRUE(log.ok()) << log.error();
+    logger::EventLogScanner scanner = log.Scanner();
+    logger::LogEvent event;
+    while (scanner.Next(&event)) {
+      if (event.channel != "SETUP_TASK") continue;
+      orbed::setup_task_t task;
+      EXPECT_EQ(task.decode(event.data, 0, static_cast<int>(event.size)), static_cast<int>(event.size));
+      ids.push_back(task.task_id);
+    }
+  }
+  return ids;
+}
+
+TEST(SetupStudy, AResumedRunKeepsTheFinishedSetUpAndRunsTheRest) {
+  const std::map<std::string, std::string> env = {{"ORBED_RUN_ID", "setup-resume"},
+                                                  {"ORBED_USER", "u3"},
+                                                  {"ORBED_USER_SEED", "5"},
+                                                  {"ORBED_SETUP_MODES", "fixed"},
+                                                  {"ORBED_SETUP_TARGETS", "2"}};
+  auto launch = [&env](const std::string& log_dir, const std::string& resume) {
+    std::map<std::string, std::string> vars = env;
+    vars["ORBED_LOG_DIR"] = log_dir;
+    if (!resume.empty()) vars["ORBED_SETUP_RESUME"] = resume;
+    RunningProcess launcher(
+        {BinPath("orbed-launch"), SourcePath("scripts/launch/setup.yaml"), "--duration-s", "400"}, vars);
+    EXPECT_TRUE(launcher.Wait(400)) << "the run did not finish";
+    return launcher.exit_code();
+  };
+  const std::string first_dir = MakeTempDir("setup_resume_first");
+  ASSERT_EQ(launch(first_dir, ""), 0);
+  std::string status;
+  setup::SetupRun first = setup::ReadSetupRunFile(first_dir + "/setup_results.json", &status);
+  ASSERT_EQ(status, "ok");
+  ASSERT_EQ(first.setups.size(), 2u);
+
+  // What a run stopped after its first set-up leaves: that set-up, "partial".
+  setup::SetupRun cut = first;
+  cut.ok = false;
+  cut.setups.resize(1);
+  const std::string cut_dir = MakeTempDir("setup_resume_cut");
+  std::ofstream(cut_dir + "/setup_results.json") << setup::SetupRunJson(cut, /*partial=*/true);
+
+  const std::string resumed_dir = MakeTempDir("setup_resume_second");
+  ASSERT_EQ(launch(resumed_dir, cut_dir), 0);
+  const setup::SetupRun resumed = setup::ReadSetupRunFile(resumed_dir + "/setup_results.json", &status);
+  ASSERT_EQ(status, "ok");
+  ASSERT_EQ(resumed.setups.size(), 2u);
+  // The kept set-up is the file's, to the last digit: the whole record written the same.
+  setup::SetupRun kept_only = resumed, first_only = first;
+  kept_only.setups.resize(1);
+  first_only.setups.resize(1);
+  EXPECT_EQ(setup::SetupRunJson(kept_only, false), setup::SetupRunJson(first_only, false));
+  EXPECT_EQ(resumed.setups[1].task_id, "u3-fixed-2");
+  // Only the second set-up went over the bus.
+  const std::vector<std::string> tasks = LoggedTaskIds(resumed_dir);
+  ASSERT_FALSE(tasks.empty());
+  for (const std::string& id : tasks) EXPECT_EQ(id, "u3-fixed-2");
+  const std::vector<std::string> first_tasks = LoggedTaskIds(first_dir);
+  EXPECT_NE(std::find(first_tasks.begin(), first_tasks.end(), "u3-fixed-1"), first_tasks.end());
 }
 
 }  // namespace
