@@ -77,12 +77,14 @@ void SetAnnotationFields(const std::vector<AnnotationRay>& annotation, orbed::al
   }
 }
 
-TrialOutcome RunHeadsetTrial(const HmdConfigSet& config, const HeadsetTrialInputs& inputs) {
+TrialOutcome RunHeadsetTrial(const HmdConfigSet& config, const HeadsetTrialInputs& inputs,
+                             SessionMapCache* cache) {
   const TrialSetup setup = MakeHeadsetTrialSetup(config, inputs);
   const SlamConfig slam = SessionSlamConfig(
       config.slam, TrialSeed(inputs.process_seed, inputs.session_id, 0, kSessionMapPurpose));
   double t0_s = 0;
-  SlamModel map = SessionMapAtTrial(setup, slam, config.hmd.session_start_m, inputs.trial_index, &t0_s);
+  SlamModel map =
+      SessionMapAtTrial(setup, slam, config.hmd.session_start_m, inputs.trial_index, &t0_s, cache);
   const std::uint64_t trial_seed =
       TrialSeed(inputs.process_seed, inputs.session_id, inputs.trial_index, kTrialSeedPurpose);
   const EmulatedUser user(config.user);

@@ -84,6 +84,9 @@ void SetAnnotationFields(const std::vector<AnnotationRay>& annotation, orbed::al
 
 /// Runs the trial (see the file comment). Throws std::invalid_argument as MakeHeadsetTrialSetup()
 /// and RunTrial() do.
-TrialOutcome RunHeadsetTrial(const HmdConfigSet& config, const HeadsetTrialInputs& inputs);
+/// `cache` (optional, one per process and configuration): the session's map as the last trial
+/// found it, so that consecutive trials of a session cost one walk each (SessionMapAtTrial).
+TrialOutcome RunHeadsetTrial(const HmdConfigSet& config, const HeadsetTrialInputs& inputs,
+                             SessionMapCache* cache = nullptr);
 
 }  // namespace orbed::hmd

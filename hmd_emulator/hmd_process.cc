@@ -333,7 +333,7 @@ void HmdProcess::EmulateTrial(const std::string& channel) {
   try {
     inputs.p_RQ = RobotModelPoints(*robot_model_, robot_.q_rad);
     inputs.p_RL = AnnotationLandmarkPoints(*robot_model_, config_.hmd, robot_.q_rad);
-    outcome = RunHeadsetTrial(config_, inputs);
+    outcome = RunHeadsetTrial(config_, inputs, &session_map_);
   } catch (const std::exception& e) {
     return process_->Reject(channel + "/trial_failed", std::string("the emulated trial failed: ") + e.what());
   }

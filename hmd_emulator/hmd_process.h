@@ -231,6 +231,7 @@ class HmdProcess {
   std::unique_ptr<ImagePipeline> pipeline_;
   HmdSession session_;
   SavedSession saved_;                             // what the state file holds
+  SessionMapCache session_map_;                    // the session's map after its last trial
   std::optional<InteractiveSession> interactive_;  // always set; the person only with --interactive
   std::chrono::steady_clock::time_point t0_;       // the walk's t = 0: the first pose tick
   bool started_{false};

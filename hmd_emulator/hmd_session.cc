@@ -1,6 +1,7 @@
 #include "hmd_emulator/hmd_session.h"
 
-#include <limits>
+#include "procs/common/alignment_trial.h"
+
 #include <utility>
 #include <variant>
 
@@ -116,13 +117,17 @@ SessionDecision HmdSession::Transition(const SessionCommand& command, RobotKnown
                       ": the user cannot align without the robot's configuration and base pose (is "
                       "orbed-iiwa-sim running?)");
   }
+  if (state_.next_index >= kMaxTrialsPerSession) {
+    return Refuse("session_full", "REQUEST_TRIAL for session '" + command.session_id + "': it has had its " +
+                                      std::to_string(kMaxTrialsPerSession) + " trials; START a new session");
+  }
   return Decide(Kind::kRequestedTrial);
 }
 
 bool HmdSession::ObserveTrial(const orbed::alignment_trial_t& msg) {
   if (!state_.active() || msg.session_id != state_.id || msg.display_mode != state_.display_mode ||
       msg.num_mirrors != state_.num_mirrors || msg.trial_index < state_.next_index ||
-      msg.trial_index == std::numeric_limits<std::int32_t>::max()) {
+      msg.trial_index >= kMaxTrialsPerSession) {
     return false;
   }
   state_.next_index = msg.trial_index + 1;

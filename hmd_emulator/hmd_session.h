@@ -10,7 +10,9 @@
 ///   - START: num_mirrors <= the displays placed in hmd.yaml (key "num_mirrors");
 ///   - RESET, STOP, REQUEST_TRIAL for a session that is not the active one (key "unknown_session");
 ///   - REQUEST_TRIAL before a valid joint vector q and base pose X_WR are known (key
-///     "no_robot_state": the person cannot align without the robot).
+///     "no_robot_state": the person cannot align without the robot);
+///   - REQUEST_TRIAL once the session has had kMaxTrialsPerSession trials (key "session_full":
+///     procs/common/alignment_trial.h; each trial replays the session's earlier walks).
 /// The emulated trial itself may still fail; the shell refuses that under "trial_failed".
 ///
 /// Transitions: START opens session s (mode, mirrors, method), trial index 0, replacing any other;

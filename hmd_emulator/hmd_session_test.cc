@@ -9,6 +9,8 @@
 #include <orbed/alignment_trial_t.hpp>
 #include <orbed/registration_t.hpp>
 
+#include "procs/common/alignment_trial.h"
+
 namespace orbed::hmd {
 namespace {
 
@@ -124,6 +126,28 @@ TEST(HmdSession, CommandsForAnUnknownSessionAreRefused) {
   EXPECT_EQ(session.state().next_index, 1);
   // An unknown session is refused as such even before the robot is known.
   EXPECT_EQ(session.Handle(Control("other", +SC::REQUEST_TRIAL), kNoRobot).refusal.key, "unknown_session");
+}
+
+// A session holds kMaxTrialsPerSession trials (each replays the session's earlier walks): a trial
+// published elsewhere cannot move the index beyond that, and the last request after it is refused.
+TEST(HmdSession, ASessionHoldsAThousandTrials) {
+  HmdSession session = TwoDisplays();
+  session.Handle(Control("s", +SC::START), kRobot);
+  AT trial{};
+  trial.session_id = "s";
+  trial.display_mode = +AT::MODE_AR;
+  trial.trial_index = kMaxTrialsPerSession;
+  EXPECT_FALSE(session.ObserveTrial(trial));
+  EXPECT_EQ(session.state().next_index, 0);
+  trial.trial_index = kMaxTrialsPerSession - 2;
+  EXPECT_TRUE(session.ObserveTrial(trial));
+  EXPECT_EQ(session.Handle(Control("s", +SC::REQUEST_TRIAL), kRobot).kind, Kind::kRequestedTrial);
+  EXPECT_EQ(session.TakeTrialIndex(), kMaxTrialsPerSession - 1);
+  trial.trial_index = kMaxTrialsPerSession - 1;
+  session.RecordTrial(trial);
+  const SessionDecision full = session.Handle(Control("s", +SC::REQUEST_TRIAL), kRobot);
+  EXPECT_EQ(full.kind, Kind::kRefuse);
+  EXPECT_EQ(full.refusal.key, "session_full");
 }
 
 TEST(HmdSession, RequestTrialNeedsTheRobot) {

@@ -152,24 +152,48 @@ double WalkStraight(const Eigen::Vector3d& p_W_from, const Eigen::Vector3d& p_W_
 }
 
 SlamModel SessionMapAtTrial(const TrialSetup& setup, const SlamConfig& session_slam,
-                            const Eigen::Vector3d& p_W_session_start, int trial_index, double* t_s) {
-  if (trial_index < 0) throw std::invalid_argument("SessionMapAtTrial: negative trial index");
+                            const Eigen::Vector3d& p_W_session_start, int trial_index, double* t_s,
+                            SessionMapCache* cache) {
+  if (trial_index < 0 || trial_index >= kMaxSessionTrials) {
+    throw std::invalid_argument("SessionMapAtTrial: trial index " + std::to_string(trial_index) +
+                                " outside 0.." + std::to_string(kMaxSessionTrials - 1));
+  }
   if (setup.walk.waypoints.empty())
     throw std::invalid_argument("SessionMapAtTrial: the walk has no waypoints");
-  SlamModel model(session_slam);
   const Eigen::Vector3d p_W_walk_start = setup.walk.waypoints.front().p_WH;
   const double dt = 1.0 / session_slam.rate_hz;
-  // Where the person puts the headset on: the map's origin.
-  HeadTrajectoryConfig here = setup.walk;
-  here.waypoints = {{"start", p_W_session_start, 0.0, {}}};
-  model.Step(HeadTrajectory(here).X_WH(0), 0.0);
-  double t = WalkStraight(p_W_session_start, p_W_walk_start, setup.walk, 0.0, &model);
-  for (int k = 0; k < trial_index; ++k) {
-    const SlamSample aligned = WalkToAlignment(setup, t + dt, &model).at_alignment;
-    t = WalkStraight(aligned.X_WH_true.translation(), p_W_walk_start, setup.walk, aligned.t_s, &model);
+  const bool cached = cache && cache->model && cache->seed == session_slam.seed &&
+                      cache->drift_fraction_of_distance == session_slam.drift_fraction_of_distance &&
+                      cache->p_W_session_start == p_W_session_start && cache->trial_index <= trial_index;
+  std::optional<SlamModel> model;
+  int k = 0;
+  double t = 0;  // when the walk of trial k begins, minus dt
+  if (cached) {
+    model = cache->model;
+    k = cache->trial_index;
+    t = cache->t_arrived_s;
+  } else {
+    model.emplace(session_slam);
+    // Where the person puts the headset on: the map's origin.
+    HeadTrajectoryConfig here = setup.walk;
+    here.waypoints = {{"start", p_W_session_start, 0.0, {}}};
+    model->Step(HeadTrajectory(here).X_WH(0), 0.0);
+    t = WalkStraight(p_W_session_start, p_W_walk_start, setup.walk, 0.0, &*model);
+  }
+  for (; k < trial_index; ++k) {
+    const SlamSample aligned = WalkToAlignment(setup, t + dt, &*model).at_alignment;
+    t = WalkStraight(aligned.X_WH_true.translation(), p_W_walk_start, setup.walk, aligned.t_s, &*model);
   }
   *t_s = t + dt;
-  return model;
+  if (cache) {
+    cache->model = model;
+    cache->trial_index = trial_index;
+    cache->t_arrived_s = t;
+    cache->seed = session_slam.seed;
+    cache->drift_fraction_of_distance = session_slam.drift_fraction_of_distance;
+    cache->p_W_session_start = p_W_session_start;
+  }
+  return std::move(*model);
 }
 
 TrialOutcome RunTrial(const TrialSetup& setup, const SlamConfig& slam, const EmulatedUser& user,

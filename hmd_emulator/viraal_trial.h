@@ -46,6 +46,7 @@
 /// Threading: pure function of its inputs (seeds included); reentrant.
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -152,7 +153,23 @@ double WalkStraight(const Eigen::Vector3d& p_W_from, const Eigen::Vector3d& p_W_
 /// replayed: what happened while aligning and annotating stays in that trial (RunTrialFrom copies
 /// the model). Deterministic in (session_slam, the walk, trial_index), so a restarted headset
 /// rebuilds the same map. *t_s is the time at which the trial's walk begins.
+/// With `cache` (the same cache for the same setup.walk, and cleared when it changes), a map at a
+/// later trial of the same session (same seed, drift and start) goes on from the one remembered
+/// instead of replaying the whole session, with the same result bit for bit. Throws
+/// std::invalid_argument for trial_index outside [0, kMaxSessionTrials).
+struct SessionMapCache {
+  std::optional<SlamModel> model;  ///< the map when trial `trial_index` begins
+  int trial_index{0};
+  double t_arrived_s{0};  ///< when the person arrived at the walk's start before that trial [s]
+  std::uint64_t seed{0};
+  double drift_fraction_of_distance{0};
+  Eigen::Vector3d p_W_session_start{Eigen::Vector3d::Zero()};
+};
 SlamModel SessionMapAtTrial(const TrialSetup& setup, const SlamConfig& session_slam,
-                            const Eigen::Vector3d& p_W_session_start, int trial_index, double* t_s);
+                            const Eigen::Vector3d& p_W_session_start, int trial_index, double* t_s,
+                            SessionMapCache* cache = nullptr);
+/// The most trials a session's map is rebuilt for (= kMaxTrialsPerSession of
+/// procs/common/alignment_trial.h, which the headset's session enforces on the bus).
+inline constexpr int kMaxSessionTrials = 1000;
 
 }  // namespace orbed::hmd

@@ -401,6 +401,36 @@ TEST(SessionMap, ATrialIsAPureFunctionOfItsIndex) {
   EXPECT_GT(t_a, 4 * 5.0) << "four earlier trials' walks";
 }
 
+// The cache gives the map a full replay gives, bit for bit, trial after trial, and a jump back or
+// another session falls back to the replay.
+TEST(SessionMap, TheCacheGivesTheReplaysMap) {
+  SessionFixture f;
+  f.slam = SlamConfig{};  // everything random, drawn tracking losses included
+  f.slam.seed = 9;
+  SessionMapCache cache;
+  for (int k : {0, 1, 2, 5, 3, 3}) {
+    SCOPED_TRACE(k);
+    double t_cached = 0, t_replayed = 0;
+    const SlamModel cached = SessionMapAtTrial(f.setup, f.slam, f.p_W_start, k, &t_cached, &cache);
+    const SlamModel replayed = SessionMapAtTrial(f.setup, f.slam, f.p_W_start, k, &t_replayed);
+    EXPECT_EQ(t_cached, t_replayed);
+    EXPECT_TRUE(cached.X_WWmap().isApprox(replayed.X_WWmap(), 0));
+    EXPECT_EQ(cached.relocks(), replayed.relocks());
+    SlamModel a = cached, b = replayed;
+    const WalkSamples wa = WalkToAlignment(f.setup, t_cached, &a),
+                      wb = WalkToAlignment(f.setup, t_replayed, &b);
+    EXPECT_TRUE(wa.at_alignment.X_WH_est.isApprox(wb.at_alignment.X_WH_est, 0))
+        << "the random streams agree too";
+  }
+  SlamConfig other = f.slam;
+  other.seed = 10;
+  double t = 0, t_other = 0;
+  const SlamModel from_cache = SessionMapAtTrial(f.setup, other, f.p_W_start, 2, &t, &cache);
+  const SlamModel fresh = SessionMapAtTrial(f.setup, other, f.p_W_start, 2, &t_other);
+  EXPECT_TRUE(from_cache.X_WWmap().isApprox(fresh.X_WWmap(), 0));
+  EXPECT_THROW(SessionMapAtTrial(f.setup, other, f.p_W_start, kMaxSessionTrials, &t), std::invalid_argument);
+}
+
 TEST(AlignmentResult, PoseAtATime) {
   AlignmentResult r;
   r.poses = {{0.0, Translation({0, 0, 0})}, {7.5, Translation({1, 0, 0})}, {13.0, Translation({2, 0, 0})}};

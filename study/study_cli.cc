@@ -1,4 +1,5 @@
 #include "study/study_cli.h"
+#include "procs/common/alignment_trial.h"
 
 #include <cerrno>
 #include <climits>
@@ -150,8 +151,9 @@ int RunUserStudy(int argc, const char* const* argv, std::ostream& out, std::ostr
   int trials = 0;
   std::string modes, json_path;
   bool quiet = false;
-  app.add_option("--trials", trials, "Trials per display mode (default: the scenario file's)")
-      ->transform(PositiveDecimalInt());
+  app.add_option("--trials", trials, "Trials per display mode, at most 1000 (default: the scenario file's)")
+      ->transform(PositiveDecimalInt())
+      ->check(CLI::Range(1, static_cast<int>(kMaxTrialsPerSession)));
   app.add_option("--modes", modes, "Comma-separated run order of ar_reflective, ar (default: the file's)");
   app.add_option("--seed", o.seed, "orbed-hmd's --seed: every trial's seeds derive from it")
       ->capture_default_str();

@@ -103,6 +103,7 @@ viraal::RunResults RunViraalStudy(const StudyOptions& options) {
         Control(orbed::session_control_t::START, session.session_id, mode, scenario.method));
 
     std::vector<viraal::RobotPoints> session_points;
+    hmd::SessionMapCache session_map;  // each trial one walk on from the last, as orbed-hmd does
     for (int i = 0; i < scenario.trials; ++i) {
       // The arm lands on the commanded configuration; the headset reads it from IIWA_STATUS.
       const std::vector<double>& q_deg = scenario.configurations_deg[i % scenario.configurations_deg.size()];
@@ -116,7 +117,7 @@ viraal::RunResults RunViraalStudy(const StudyOptions& options) {
       inputs.session_id = session.session_id;
       inputs.trial_index = i;
       inputs.num_mirrors = mode.num_mirrors;
-      const hmd::TrialOutcome outcome = hmd::RunHeadsetTrial(headset, inputs);
+      const hmd::TrialOutcome outcome = hmd::RunHeadsetTrial(headset, inputs, &session_map);
 
       // ALIGNMENT_TRIAL as orbed-hmd publishes it.
       orbed::alignment_trial_t trial{};

@@ -1,5 +1,7 @@
 #include "viraal/protocol.h"
 
+#include "procs/common/alignment_trial.h"
+
 #include <cmath>
 #include <fstream>
 #include <limits>
@@ -48,7 +50,11 @@ std::vector<double> ParseJointList(const std::string& text, const std::string& w
 }
 
 void ValidateScenarioConfig(const ScenarioConfig& config, int num_joints) {
-  if (config.trials < 1) throw std::invalid_argument("trials must be >= 1");
+  if (config.trials < 1 || config.trials > kMaxTrialsPerSession) {
+    throw std::invalid_argument("trials must be 1.." + std::to_string(kMaxTrialsPerSession) +
+                                " (the most one headset session holds), not " +
+                                std::to_string(config.trials));
+  }
   if (config.modes.empty()) throw std::invalid_argument("modes: at least one mode is needed");
   std::set<std::string> seen;
   for (const ModeSpec& m : config.modes) {
@@ -92,7 +98,7 @@ ScenarioConfig LoadScenario(const YAML::Node& root, const std::string& source) {
   f.CheckKeys(root, "",
               {"trials", "modes", "reflective_mirrors", "method", "configurations_deg", "landmarks"});
   ScenarioConfig config;
-  config.trials = static_cast<int>(f.IntegerOr(root, "trials", "", config.trials, 1, 1000000));
+  config.trials = static_cast<int>(f.IntegerOr(root, "trials", "", config.trials, 1, kMaxTrialsPerSession));
   const int mirrors =
       static_cast<int>(f.IntegerOr(root, "reflective_mirrors", "", kDefaultReflectiveMirrors, 1, 1000000));
   if (root["method"]) {

@@ -70,9 +70,9 @@ std::variant<AlignmentTrial, Refusal> CheckAlignmentTrial(const orbed::alignment
     return Refusal{"session_id", "ALIGNMENT_TRIAL.session_id is " + std::to_string(msg.session_id.size()) +
                                      " bytes, expected 1.." + std::to_string(kMaxSessionIdLength)};
   }
-  if (msg.trial_index < 0) {
-    return Refusal{"trial_index",
-                   "ALIGNMENT_TRIAL.trial_index " + std::to_string(msg.trial_index) + " is negative"};
+  if (msg.trial_index < 0 || msg.trial_index >= kMaxTrialsPerSession) {
+    return Refusal{"trial_index", "ALIGNMENT_TRIAL.trial_index " + std::to_string(msg.trial_index) +
+                                      " is outside 0.." + std::to_string(kMaxTrialsPerSession - 1)};
   }
   std::string error =
       CheckEnum(msg.display_mode, AT::MODE_AR, AT::MODE_AR_REFLECTIVE, "ALIGNMENT_TRIAL.display_mode");

@@ -6,7 +6,7 @@
 /// asked for, the robot model's joint count and limits).
 ///
 /// The contract:
-///   - session_id: 1..kMaxSessionIdLength bytes; trial_index >= 0;
+///   - session_id: 1..kMaxSessionIdLength bytes; trial_index in [0, kMaxTrialsPerSession);
 ///   - display_mode MODE_AR with num_mirrors 0, or MODE_AR_REFLECTIVE with 1..kMaxMirrors;
 ///   - num_joints == joint_position's length, at most `max_joints`; every joint angle finite [rad];
 ///   - X_WV: finite position within kMaxAlignmentCoordinate_m of the origin, unit quaternion;
@@ -40,6 +40,10 @@ namespace orbed {
 
 /// A base pose farther than this from the world origin is not an operating room [m].
 inline constexpr double kMaxAlignmentCoordinate_m = 1e4;
+
+/// The most trials one session holds (orbed-scenario's --trials goes up to 1000). Bounds the work a
+/// trial index costs: the headset rebuilds a session's map by replaying its earlier walks.
+inline constexpr std::int32_t kMaxTrialsPerSession = 1000;
 
 /// Bounds of the landmark annotation: rays per trial, landmarks per trial.
 inline constexpr int kMaxAnnotationRays = 256;

@@ -53,6 +53,10 @@ TEST(AlignmentTrial, EachRuleRefusesByFieldName) {
   m = Good();
   m.trial_index = -1;
   EXPECT_EQ(Key(m), "trial_index");
+  m.trial_index = kMaxTrialsPerSession;  // one beyond the last a session holds
+  EXPECT_EQ(Key(m), "trial_index");
+  m.trial_index = kMaxTrialsPerSession - 1;
+  EXPECT_EQ(Key(m), "");
   m = Good();
   m.display_mode = 2;
   EXPECT_EQ(Key(m), "display_mode");
