@@ -9,8 +9,8 @@
 /// ScenarioConfig default, which is the value written here and the value viraal/viraal.yaml ships
 /// (protocol_test.cc checks that the three agree); configurations_deg and landmarks are required.
 /// @code{.yaml}
-/// trials: 3                        # per mode, 1..1000 (kMaxTrialsPerSession; trial i uses configuration i
-/// mod K) modes: [ar_reflective, ar]       # run order; each of ar_reflective | ar, no repeats
+/// trials: 3                        # per mode, 1..1000 (trial i uses configuration i mod K)
+/// modes: [ar_reflective, ar]       # run order; each of ar_reflective | ar, no repeats
 /// reflective_mirrors: 1            # num_mirrors of the ar_reflective mode, >= 1
 /// method: karcher                  # chordal | karcher | robust (registration_t.METHOD_*)
 /// configurations_deg:              # required: K >= 1 joint vectors q1..q7 [deg], pairwise distinct

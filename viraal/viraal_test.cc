@@ -165,7 +165,7 @@ TEST(ScenarioConfig, ErrorsNameTheLineAndTheFix) {
   ExpectError("trails: 3\n" + good, "s.yaml:1: trails: unknown key");
   ExpectError(good + "modes: [ar, vr]\n",
               "s.yaml:4: modes\\[1\\]: unknown mode 'vr', expected ar_reflective or ar");
-  ExpectError(good + "trials: 0\n", "s.yaml:4: trials: expected an integer in \\[1, 1000000\\], got '0'");
+  ExpectError(good + "trials: 0\n", "s.yaml:4: trials: expected an integer in \\[1, 1000\\], got '0'");
   ExpectError(good + "method: mean\n", "s.yaml:4: method: expected chordal, karcher or robust");
   ExpectError("configurations_deg:\n  - [0, 30, 0, x, 0, 45, 0]\nlandmarks: [a]\n",
               "s.yaml:2: configurations_deg\\[0\\]\\[3\\]: expected a number");
