@@ -21,6 +21,9 @@
 #include "sim/guidance_messages.h"
 #include "sim/iiwa_status_check.h"
 
+static_assert(orbed::hmd::kMaxSessionTrials == orbed::kMaxTrialsPerSession,
+              "a session's map is rebuilt for exactly the trials a session holds on the bus");
+
 namespace orbed::hmd {
 namespace {
 

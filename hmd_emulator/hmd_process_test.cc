@@ -193,7 +193,7 @@ TEST(HmdProcess, AnswersEachRequestTrialWithOneAlignmentTrial) {
     const Eigen::Isometry3d X_WV = FromPose(t.X_WV);
     EXPECT_LT((X_WV.translation() - X_WR.translation()).norm(), start_offset_m) << "trial " << i;
   }
-  // Different trials of a session are different draws (their own SLAM walk and trial seed).
+  // Different trials of a session are different draws (their own walk on the session's map, their own seed).
   EXPECT_NE(got.trials[0].X_WV.position_m[0], got.trials[1].X_WV.position_m[0]);
   EXPECT_EQ(hmd.process().rejections().total(), 0);
   // After the trials the hologram is drawn where the user put it last.

@@ -117,7 +117,7 @@ SlamConfig ParseSlamConfig(const YAML::Node& node, const std::string& source, co
               {"fraction_of_distance", "session_log_sigma", "yaw_deg_per_m", "direction_correlation_m",
                "band_fraction"});
   c.drift_fraction_of_distance =
-      f.NumberOr(d, "fraction_of_distance", kd, c.drift_fraction_of_distance, 0, 0.2);
+      f.NumberOr(d, "fraction_of_distance", kd, c.drift_fraction_of_distance, 0, kMaxDriftFraction);
   c.drift_session_log_sigma = f.NumberOr(d, "session_log_sigma", kd, c.drift_session_log_sigma, 0, 2);
   c.drift_yaw_deg_per_m = f.NumberOr(d, "yaw_deg_per_m", kd, c.drift_yaw_deg_per_m, 0, 10, "deg/m");
   c.drift_direction_correlation_m =
@@ -166,8 +166,10 @@ SlamConfig SessionSlamConfig(const SlamConfig& base, std::uint64_t session_seed)
   SlamConfig c = base;
   c.seed = session_seed;
   Random rng(SplitMix64(session_seed ^ kDriftSalt));
+  // Within what the parser accepts for a fixed rate (a log-normal's tail reaches beyond it).
   c.drift_fraction_of_distance =
-      base.drift_fraction_of_distance * std::exp(base.drift_session_log_sigma * rng.Normal());
+      std::min(kMaxDriftFraction,
+               base.drift_fraction_of_distance * std::exp(base.drift_session_log_sigma * rng.Normal()));
   return c;
 }
 
@@ -184,10 +186,9 @@ void SlamModel::UpdateAnchors(const Eigen::Vector3d& p_WH, double ds_m) {
       const double keep = 1.0 - config_.anchor_relock_correction;
       const Eigen::Vector3d e_now = E_ * p_WH - p_WH;
       const Eigen::Vector3d e_stored = a.E * p_WH - p_WH;
-      const double yaw_now = YawOf(E_);
       const double yaw_stored = YawOf(a.E);
-      E_ = YawAboutPoint(p_WH, yaw_stored + keep * (yaw_now - yaw_stored),
-                         e_stored + keep * (e_now - e_stored));
+      const double d_yaw = std::remainder(YawOf(E_) - yaw_stored, 2 * M_PI);  // the short way round
+      E_ = YawAboutPoint(p_WH, yaw_stored + keep * d_yaw, e_stored + keep * (e_now - e_stored));
       ++relocks_;
     }
     a.inside = inside;
@@ -297,7 +298,10 @@ SlamSample SlamModel::Step(const Eigen::Isometry3d& X_WH_true, double t_s) {
   } else if (state_ != TrackingState::kLost) {
     Drift(p_WH, ds, state_ == TrackingState::kLimited ? config_.limited_drift_multiplier : 1.0);
   }
-  if (config_.anchor_radius_m > 0 && state_ == TrackingState::kTracking) UpdateAnchors(p_WH, ds);
+  if (config_.anchor_radius_m > 0 && config_.anchor_relock_correction > 0 &&
+      state_ == TrackingState::kTracking) {
+    UpdateAnchors(p_WH, ds);
+  }
 
   SlamSample s;
   s.t_s = t_s;

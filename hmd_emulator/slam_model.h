@@ -31,13 +31,15 @@
 ///    The drift per metre differs from session to session (a different room state, lighting,
 ///    texture): SessionSlamConfig draws it once per session, log-normal with median
 ///    drift_fraction_of_distance and log-standard deviation drift_session_log_sigma (0: every
-///    session the same).
+///    session the same), at most kMaxDriftFraction.
 ///  - Stored places (spatial anchors, loop closure): a place where the head stands still (a sample
 ///    with no displacement) farther than anchor_radius_m from every stored place is stored with the
 ///    map error of that moment. Coming back within anchor_radius_m of a stored place while
-///    TRACKING re-matches the map there: the head's position error and the yaw error move
-///    anchor_relock_correction of the way from today's to the stored ones (1: exactly the stored
-///    error; 0 or anchor_radius_m 0: no stored places). The first sample stores the map origin.
+///    TRACKING re-matches the map there: the head's position error and the yaw error (the short way
+///    round) move anchor_relock_correction of the way from today's to the stored ones (1: exactly
+///    the stored error; 0 or anchor_radius_m 0: no stored places). Places are stored and
+///    re-matched only while TRACKING (a place left and re-entered while LIMITED or LOST is not
+///    re-matched). The first sample stores the map origin (unless a fault was forced before it).
 ///    So a session that returns to the same places sees the errors those places were stored
 ///    with, and errors of trials made at the same place are correlated.
 ///  - Jitter: J_H = (exp(ω), v), ω ~ N(0, σ_r² I), v ~ N(0, σ_t² I), independent per sample.
@@ -141,6 +143,9 @@ struct ScheduledFault {
     return index == trial_index && (session_id.empty() || session_id == session);
   }
 };
+
+/// The largest drift per metre a config or a session's draw can have (20 %).
+inline constexpr double kMaxDriftFraction = 0.2;
 
 struct SlamConfig {
   std::uint64_t seed{1};

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <optional>
 #include <set>
 #include <string>
 
@@ -237,6 +238,62 @@ TEST(SlamModel, ComingBackToAStoredPlaceReMatchesTheMapThere) {
     EXPECT_EQ(anchored.relocks(), 1);
     EXPECT_EQ(anchored.anchors(), 1) << "standing at the far end stores nothing: it never stood there";
   }
+}
+
+// The same with an error stored away from the origin: stand at A (the origin), walk to B and stand
+// (B stored with the error of that moment, E_B), walk on to C and back to B. At the sample that
+// re-enters B the error at the head and the yaw move half of the way from the unanchored model's
+// to E_B's (both evaluated at the head), the yaw the short way round.
+TEST(SlamModel, ReMatchingMovesTheErrorTowardTheOneStoredThere) {
+  SlamConfig c;
+  c.jitter_translation_std_m = c.jitter_rotation_std_deg = 0;
+  c.tracking_loss_rate_per_min = 0;
+  c.drift_fraction_of_distance = 0.01;
+  c.drift_yaw_deg_per_m = 0.5;
+  c.anchor_relock_correction = 0.5;
+  c.seed = 8;
+  SlamConfig free = c;
+  free.anchor_radius_m = 0;
+  SlamModel anchored(c), unanchored(free);
+  auto head_at = [](const Eigen::Vector3d& p) {
+    Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+    X.translation() = p;
+    return X;
+  };
+  const Eigen::Vector3d A(0, 0, 1.7), B(4, 0, 1.7), C(4, 4, 1.7);
+  std::vector<Eigen::Vector3d> path = {A};
+  auto walk = [&path](const Eigen::Vector3d& from, const Eigen::Vector3d& to) {
+    const int n = static_cast<int>(std::ceil((to - from).norm() / (0.8 / 60)));
+    for (int i = 1; i <= n; ++i) path.push_back(from + (to - from) * (static_cast<double>(i) / n));
+  };
+  walk(A, B);
+  for (int i = 0; i < 60; ++i) path.push_back(B);  // a second standing at B
+  walk(B, C);
+  walk(C, B);
+  auto yaw = [](const Eigen::Isometry3d& E) { return std::atan2(E.linear()(1, 0), E.linear()(0, 0)); };
+  double t = 0;
+  std::optional<Eigen::Isometry3d> E_B;
+  bool checked = false;
+  for (const Eigen::Vector3d& p : path) {
+    const SlamSample a = anchored.Step(head_at(p), t);
+    const SlamSample u = unanchored.Step(head_at(p), t);
+    t += 1.0 / 60;
+    if (!E_B && p == B) E_B = u.X_WWmap;  // the first sample standing at B stores it
+    if (anchored.relocks() == 0) {
+      EXPECT_TRUE(a.X_WWmap.isApprox(u.X_WWmap, 0));
+      continue;
+    }
+    ASSERT_TRUE(E_B.has_value());
+    const Eigen::Vector3d e_free = u.X_WWmap * p - p, e_B = *E_B * p - p, e = a.X_WWmap * p - p;
+    EXPECT_GT((e_free - e_B).norm(), 0.01 * 7.0) << "8 m walked since B was stored";
+    EXPECT_GT(e_B.norm(), 0.01 * 3.0) << "B was stored 4 m from the origin";
+    EXPECT_LT((e - (e_B + 0.5 * (e_free - e_B))).norm(), 1e-12);
+    EXPECT_NEAR(yaw(a.X_WWmap), yaw(*E_B) + 0.5 * (yaw(u.X_WWmap) - yaw(*E_B)), 1e-12);
+    checked = true;
+    break;
+  }
+  EXPECT_TRUE(checked);
+  EXPECT_EQ(anchored.anchors(), 2) << "the origin and B; C was never stood at";
 }
 
 // Per-session drift: the band is the 5-95 % range of the drawn rates, the median the configured

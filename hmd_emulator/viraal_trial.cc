@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 
 #include "base/hash.h"
@@ -151,6 +152,30 @@ double WalkStraight(const Eigen::Vector3d& p_W_from, const Eigen::Vector3d& p_W_
   return t0_s + t_end;
 }
 
+std::string SessionMapKey(const TrialSetup& setup, const SlamConfig& slam, const Eigen::Vector3d& p_W_start) {
+  std::ostringstream key;
+  key << std::hexfloat;
+  auto v3 = [&key](const Eigen::Vector3d& v) { key << v.x() << ',' << v.y() << ',' << v.z() << ';'; };
+  key << slam.seed << ';' << slam.rate_hz << ';' << slam.jitter_translation_std_m << ';'
+      << slam.jitter_rotation_std_deg << ';' << slam.drift_fraction_of_distance << ';'
+      << slam.drift_yaw_deg_per_m << ';' << slam.drift_direction_correlation_m << ';' << slam.anchor_radius_m
+      << ';' << slam.anchor_relock_correction << ';' << slam.tracking_loss_rate_per_min << ';'
+      << slam.limited_mean_s << ';' << slam.limited_drift_multiplier << ';' << slam.lost_probability << ';'
+      << slam.lost_mean_s << ';' << slam.relocalization_correction << ';' << slam.jump_translation_std_m
+      << ';' << slam.jump_yaw_std_deg << ';';
+  v3(p_W_start);
+  key << setup.walk.speed_m_per_s << ';' << setup.walk.loop << ';';
+  v3(setup.walk.p_W_look_at);
+  for (const HeadWaypoint& w : setup.walk.waypoints) {
+    key << w.name.size() << ':' << w.name << ';' << w.dwell_s << ';';
+    v3(w.p_WH);
+    if (w.p_W_look_at) v3(*w.p_W_look_at);
+  }
+  key << setup.align_waypoint.size() << ':' << setup.align_waypoint << ';' << setup.settle_s << ';'
+      << setup.max_wait_s;
+  return key.str();
+}
+
 SlamModel SessionMapAtTrial(const TrialSetup& setup, const SlamConfig& session_slam,
                             const Eigen::Vector3d& p_W_session_start, int trial_index, double* t_s,
                             SessionMapCache* cache) {
@@ -162,9 +187,8 @@ SlamModel SessionMapAtTrial(const TrialSetup& setup, const SlamConfig& session_s
     throw std::invalid_argument("SessionMapAtTrial: the walk has no waypoints");
   const Eigen::Vector3d p_W_walk_start = setup.walk.waypoints.front().p_WH;
   const double dt = 1.0 / session_slam.rate_hz;
-  const bool cached = cache && cache->model && cache->seed == session_slam.seed &&
-                      cache->drift_fraction_of_distance == session_slam.drift_fraction_of_distance &&
-                      cache->p_W_session_start == p_W_session_start && cache->trial_index <= trial_index;
+  const std::string key = cache ? SessionMapKey(setup, session_slam, p_W_session_start) : std::string();
+  const bool cached = cache && cache->model && cache->key == key && cache->trial_index <= trial_index;
   std::optional<SlamModel> model;
   int k = 0;
   double t = 0;  // when the walk of trial k begins, minus dt
@@ -189,9 +213,7 @@ SlamModel SessionMapAtTrial(const TrialSetup& setup, const SlamConfig& session_s
     cache->model = model;
     cache->trial_index = trial_index;
     cache->t_arrived_s = t;
-    cache->seed = session_slam.seed;
-    cache->drift_fraction_of_distance = session_slam.drift_fraction_of_distance;
-    cache->p_W_session_start = p_W_session_start;
+    cache->key = key;
   }
   return std::move(*model);
 }

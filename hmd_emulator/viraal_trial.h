@@ -43,7 +43,8 @@
 /// at_end (no random tracking losses) and the pointing errors have their own seed (from
 /// trial_seed), so nothing the trial measured before changes with the annotation.
 ///
-/// Threading: pure function of its inputs (seeds included); reentrant.
+/// Threading: pure functions of their inputs (seeds included), reentrant, except that a
+/// SessionMapCache is written by the call that is given it (one cache per thread).
 
 #include <cstdint>
 #include <optional>
@@ -153,18 +154,19 @@ double WalkStraight(const Eigen::Vector3d& p_W_from, const Eigen::Vector3d& p_W_
 /// replayed: what happened while aligning and annotating stays in that trial (RunTrialFrom copies
 /// the model). Deterministic in (session_slam, the walk, trial_index), so a restarted headset
 /// rebuilds the same map. *t_s is the time at which the trial's walk begins.
-/// With `cache` (the same cache for the same setup.walk, and cleared when it changes), a map at a
-/// later trial of the same session (same seed, drift and start) goes on from the one remembered
-/// instead of replaying the whole session, with the same result bit for bit. Throws
-/// std::invalid_argument for trial_index outside [0, kMaxSessionTrials).
+/// With `cache`, a map at a later trial of the same session (the same SessionMapKey: every input of
+/// the replay) goes on from the one remembered instead of replaying the whole session, with the
+/// same result bit for bit; anything else replays. Throws std::invalid_argument for trial_index
+/// outside [0, kMaxSessionTrials).
 struct SessionMapCache {
   std::optional<SlamModel> model;  ///< the map when trial `trial_index` begins
   int trial_index{0};
   double t_arrived_s{0};  ///< when the person arrived at the walk's start before that trial [s]
-  std::uint64_t seed{0};
-  double drift_fraction_of_distance{0};
-  Eigen::Vector3d p_W_session_start{Eigen::Vector3d::Zero()};
+  std::string key;        ///< SessionMapKey of the inputs it was made with
 };
+/// Every input the replay of SessionMapAtTrial depends on, exactly (hexadecimal floats): the SLAM
+/// model's parameters and seed, the start, the walk, the alignment waypoint, settle_s, max_wait_s.
+std::string SessionMapKey(const TrialSetup& setup, const SlamConfig& slam, const Eigen::Vector3d& p_W_start);
 SlamModel SessionMapAtTrial(const TrialSetup& setup, const SlamConfig& session_slam,
                             const Eigen::Vector3d& p_W_session_start, int trial_index, double* t_s,
                             SessionMapCache* cache = nullptr);
