@@ -187,16 +187,28 @@ TEST(SlamModel, DriftPerMetreStaysInConfiguredBand) {
   EXPECT_LE(shipped.drift_fraction_of_distance, shipped.drift_band_max_fraction);
 }
 
-// Coming back to a stored place moves the head's error relock_correction of the way to the error
-// stored there. Oracle: the same model without stored places (same seed: stored places draw
-// nothing, so both are identical up to the sample that re-matches).
-TEST(SlamModel, ComingBackToAStoredPlaceReMatchesTheMapThere) {
+// A model that only drifts (1 % per metre, 0.5 deg of yaw per metre): no jitter, no tracking loss.
+SlamConfig DriftOnly(std::uint64_t seed) {
   SlamConfig c;
   c.jitter_translation_std_m = c.jitter_rotation_std_deg = 0;
   c.tracking_loss_rate_per_min = 0;
   c.drift_fraction_of_distance = 0.01;
   c.drift_yaw_deg_per_m = 0.5;
-  c.seed = 5;
+  c.seed = seed;
+  return c;
+}
+
+Eigen::Isometry3d HeadAt(const Eigen::Vector3d& p_W) {
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  X.translation() = p_W;
+  return X;
+}
+
+// Coming back to a stored place moves the head's error relock_correction of the way to the error
+// stored there. Oracle: the same model without stored places (same seed: stored places draw
+// nothing, so both are identical up to the sample that re-matches).
+TEST(SlamModel, ComingBackToAStoredPlaceReMatchesTheMapThere) {
+  SlamConfig c = DriftOnly(5);
   for (const double correction : {1.0, 0.5}) {
     SCOPED_TRACE(correction);
     c.anchor_relock_correction = correction;
@@ -205,11 +217,6 @@ TEST(SlamModel, ComingBackToAStoredPlaceReMatchesTheMapThere) {
     SlamModel anchored(c), unanchored(free);
     // Stand at A (stored with E = I), walk 5 m out along x and straight back.
     const Eigen::Vector3d p_A(0, 0, 1.7);
-    auto head_at = [](const Eigen::Vector3d& p) {
-      Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
-      X.translation() = p;
-      return X;
-    };
     double t = 0;
     const double step_m = 0.8 / 60;
     std::vector<Eigen::Vector3d> path = {p_A, p_A};
@@ -217,8 +224,8 @@ TEST(SlamModel, ComingBackToAStoredPlaceReMatchesTheMapThere) {
     for (double x = 5.0; x > -1e-9; x -= step_m) path.push_back(p_A + Eigen::Vector3d(x, 0, 0));
     bool relocked = false;
     for (const Eigen::Vector3d& p : path) {
-      const SlamSample a = anchored.Step(head_at(p), t);
-      const SlamSample u = unanchored.Step(head_at(p), t);
+      const SlamSample a = anchored.Step(HeadAt(p), t);
+      const SlamSample u = unanchored.Step(HeadAt(p), t);
       t += 1.0 / 60;
       if (relocked || anchored.relocks() == 0) {
         if (!relocked) EXPECT_TRUE(a.X_WWmap.isApprox(u.X_WWmap, 0)) << "before the first re-match";
@@ -245,21 +252,11 @@ TEST(SlamModel, ComingBackToAStoredPlaceReMatchesTheMapThere) {
 // re-enters B the error at the head and the yaw move half of the way from the unanchored model's
 // to E_B's (both evaluated at the head), the yaw the short way round.
 TEST(SlamModel, ReMatchingMovesTheErrorTowardTheOneStoredThere) {
-  SlamConfig c;
-  c.jitter_translation_std_m = c.jitter_rotation_std_deg = 0;
-  c.tracking_loss_rate_per_min = 0;
-  c.drift_fraction_of_distance = 0.01;
-  c.drift_yaw_deg_per_m = 0.5;
+  SlamConfig c = DriftOnly(8);
   c.anchor_relock_correction = 0.5;
-  c.seed = 8;
   SlamConfig free = c;
   free.anchor_radius_m = 0;
   SlamModel anchored(c), unanchored(free);
-  auto head_at = [](const Eigen::Vector3d& p) {
-    Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
-    X.translation() = p;
-    return X;
-  };
   const Eigen::Vector3d A(0, 0, 1.7), B(4, 0, 1.7), C(4, 4, 1.7);
   std::vector<Eigen::Vector3d> path = {A};
   auto walk = [&path](const Eigen::Vector3d& from, const Eigen::Vector3d& to) {
@@ -275,8 +272,8 @@ TEST(SlamModel, ReMatchingMovesTheErrorTowardTheOneStoredThere) {
   std::optional<Eigen::Isometry3d> E_B;
   bool checked = false;
   for (const Eigen::Vector3d& p : path) {
-    const SlamSample a = anchored.Step(head_at(p), t);
-    const SlamSample u = unanchored.Step(head_at(p), t);
+    const SlamSample a = anchored.Step(HeadAt(p), t);
+    const SlamSample u = unanchored.Step(HeadAt(p), t);
     t += 1.0 / 60;
     if (!E_B && p == B) E_B = u.X_WWmap;  // the first sample standing at B stores it
     if (anchored.relocks() == 0) {

@@ -51,6 +51,28 @@
 namespace orbed::testing {
 namespace {
 
+// Every message on `channel` in a run folder's log (every part the manifest lists), decoded; a
+// message that does not decode whole is a test failure.
+template <class Msg>
+std::vector<Msg> Logged(const std::string& log_dir, const std::string& channel) {
+  std::vector<Msg> out;
+  const logger::Manifest parts = logger::ReadManifestFile(log_dir + "/manifest.json");
+  for (const logger::ManifestPart& part : parts.parts) {
+    const logger::MappedLog log(log_dir + "/" + part.file);
+    EXPECT_TRUE(log.ok()) << log.error();
+    logger::EventLogScanner scanner = log.Scanner();
+    logger::LogEvent event;
+    while (scanner.Next(&event)) {
+      if (event.channel != channel) continue;
+      Msg msg;
+      EXPECT_EQ(msg.decode(event.data, 0, static_cast<int>(event.size)), static_cast<int>(event.size))
+          << channel;
+      out.push_back(std::move(msg));
+    }
+  }
+  return out;
+}
+
 constexpr char kPerfectConfig[] = R"(assistant:
   user_scale_log_sigma: 0
   headset: {lateral_noise_arcmin: 0.001, depth_noise_fraction_std: 0.00001}
@@ -187,27 +209,16 @@ TEST(SetupStudy, OneUserThroughTheLaunchFile) {
   }
   // The fixed mode's monitor: pictures from the assistant's monitor camera (assistant.yaml's
   // monitor.camera_m, orbed-fixed-display's home view), each a whole JPEG of the announced size.
-  const logger::Manifest parts = logger::ReadManifestFile(log_dir + "/manifest.json");
-  int pictures = 0;
-  for (const logger::ManifestPart& part : parts.parts) {
-    const logger::MappedLog log(log_dir + "/" + part.file);
-    ASSERT_TRUE(log.ok()) << log.error();
-    logger::EventLogScanner scanner = log.Scanner();
-    logger::LogEvent event;
-    while (scanner.Next(&event)) {
-      if (event.channel != "FIXED_VIEW") continue;
-      orbed::image_t image;
-      ASSERT_EQ(image.decode(event.data, 0, static_cast<int>(event.size)), static_cast<int>(event.size));
-      EXPECT_NEAR(image.X_WC.position_m[0], 1.5, 1e-9);
-      EXPECT_NEAR(image.X_WC.position_m[1], 0.3, 1e-9);
-      EXPECT_NEAR(image.X_WC.position_m[2], 1.8, 1e-9);
-      const cv::Mat picture = cv::imdecode(image.data, cv::IMREAD_COLOR);
-      EXPECT_EQ(picture.cols, image.width);
-      EXPECT_EQ(picture.rows, image.height);
-      ++pictures;
-    }
+  const std::vector<orbed::image_t> pictures = Logged<orbed::image_t>(log_dir, "FIXED_VIEW");
+  for (const orbed::image_t& image : pictures) {
+    EXPECT_NEAR(image.X_WC.position_m[0], 1.5, 1e-9);
+    EXPECT_NEAR(image.X_WC.position_m[1], 0.3, 1e-9);
+    EXPECT_NEAR(image.X_WC.position_m[2], 1.8, 1e-9);
+    const cv::Mat picture = cv::imdecode(image.data, cv::IMREAD_COLOR);
+    EXPECT_EQ(picture.cols, image.width);
+    EXPECT_EQ(picture.rows, image.height);
   }
-  EXPECT_GT(pictures, 0);
+  EXPECT_GT(pictures.size(), 0u);
 }
 
 int LatestPid(const BusWatcher& bus, const std::string& name) {
@@ -351,19 +362,8 @@ TEST(SetupStudy, TheTrueRegistrationGoesOverTheBusInsteadOfAlignments) {
 // The task ids of every SETUP_TASK in a run folder's log.
 std::vector<std::string> LoggedTaskIds(const std::string& log_dir) {
   std::vector<std::string> ids;
-  const logger::Manifest parts = logger::ReadManifestFile(log_dir + "/manifest.json");
-  for (const logger::ManifestPart& part : parts.parts) {
-    const logger::MappedLog log(log_dir + "/" + part.file);
-    EXPECT_TRUE(log.ok()) << log.error();
-    logger::EventLogScanner scanner = log.Scanner();
-    logger::LogEvent event;
-    while (scanner.Next(&event)) {
-      if (event.channel != "SETUP_TASK") continue;
-      orbed::setup_task_t task;
-      EXPECT_EQ(task.decode(event.data, 0, static_cast<int>(event.size)), static_cast<int>(event.size));
-      ids.push_back(task.task_id);
-    }
-  }
+  for (const orbed::setup_task_t& task : Logged<orbed::setup_task_t>(log_dir, "SETUP_TASK"))
+    ids.push_back(task.task_id);
   return ids;
 }
 
