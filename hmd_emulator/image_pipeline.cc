@@ -214,7 +214,10 @@ void ImagePipeline::Camera(const FrameInputs& in) {
   }
   for (std::size_t i = 0; i < displays_.size(); ++i) {
     Display& d = displays_[i];
-    bool wanted = !d.captured && in.t_s >= d.capture_t_s - 1e-9;
+    // Due at the arrival, once tracking: a frame taken while tracking is limited or lost has no
+    // pose to place it with (as the emulated trial's display, viraal_trial.h).
+    bool wanted =
+        !d.captured && in.t_s >= d.capture_t_s - 1e-9 && in.sample.state == TrackingState::kTracking;
     for (int k : now) wanted = wanted || k == static_cast<int>(i);
     if (wanted) {
       Capture(&d, in);

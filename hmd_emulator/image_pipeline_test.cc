@@ -295,6 +295,36 @@ TEST(ImagePipeline, TheDisplaysShowTheSetUpsTargetOrNoHologram) {
   EXPECT_EQ(reflective.back().source_utime, in.sample_utime);  // one capture throughout
 }
 
+// A display due at a time when tracking is lost waits for the first TRACKING frame.
+TEST(ImagePipeline, ADisplayCapturesOnlyWhileTracking) {
+  World world;
+  std::vector<orbed::reflective_view_t> reflective;
+  ImagePipelineOptions options;
+  options.display_capture_t_s = {0.0};
+  options.threaded = false;
+  ImagePipelineOutputs outputs;
+  outputs.camera = [](const orbed::image_t&) {};
+  outputs.reflective = [&](const orbed::reflective_view_t& m) { reflective.push_back(m); };
+  ImagePipelineClocks clocks;
+  clocks.wall_utime = [] { return int64_t{5'000}; };
+  clocks.monotonic_s = [] { return 0.0; };
+  ImagePipeline pipeline(world.robot, world.stream.scene_objects(), options, outputs, clocks);
+  const RobotState arm = Robot({0, 30, 0, -60, 0, 45, 0}, world.scene.X_WR);
+  auto frame = [&](double t_s, int64_t utime, TrackingState state) {
+    FrameInputs in = world.Sample(t_s, utime);
+    in.robot = arm;
+    in.sample.state = state;
+    pipeline.Post(ImagePipeline::Job::kCamera, in);
+    pipeline.Post(ImagePipeline::Job::kReflective, in);
+  };
+  frame(0.0, 1'000, TrackingState::kLost);
+  frame(0.5, 2'000, TrackingState::kRelocalized);
+  EXPECT_TRUE(reflective.empty()) << "nothing captured while not tracking";
+  frame(1.0, 3'000, TrackingState::kTracking);
+  ASSERT_EQ(reflective.size(), 1u);
+  EXPECT_EQ(reflective.back().source_utime, 3'000);
+}
+
 TEST(ImagePipeline, WorkerIsLatestWinsAndCountsSkipped) {
   World world;
   const RobotState arm = Robot({0, 30, 0, -60, 0, 45, 0}, world.scene.X_WR);
