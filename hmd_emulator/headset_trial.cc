@@ -13,6 +13,11 @@ std::uint64_t TrialSeed(std::uint64_t seed, const std::string& session_id, std::
   return SplitMix64(SplitMix64(SplitMix64(seed ^ h) ^ static_cast<std::uint64_t>(index)) ^ purpose);
 }
 
+void SetRobotAt(const sim::RobotModel& model, const Eigen::VectorXd& q_rad, HeadsetTrialInputs* inputs) {
+  inputs->p_RQ = RobotModelPoints(model, q_rad);
+  inputs->solids_R = RobotSightSolids(model, q_rad);
+}
+
 TrialSetup MakeHeadsetTrialSetup(const HmdConfigSet& config, const HeadsetTrialInputs& inputs) {
   const int placed = static_cast<int>(config.hmd.displays.size());
   if (inputs.num_mirrors < 0 || inputs.num_mirrors > placed) {
@@ -22,6 +27,7 @@ TrialSetup MakeHeadsetTrialSetup(const HmdConfigSet& config, const HeadsetTrialI
   TrialSetup setup;
   setup.X_WR = inputs.X_WR;
   setup.p_RQ = inputs.p_RQ;
+  setup.solids_R = inputs.solids_R;
   setup.walk = config.walk;
   setup.align_waypoint = config.hmd.align_waypoint;
   setup.settle_s = config.hmd.settle_s;
@@ -36,8 +42,16 @@ TrialSetup MakeHeadsetTrialSetup(const HmdConfigSet& config, const HeadsetTrialI
   setup.annotation.dwell_s = config.hmd.annotation_dwell_s;
   setup.annotation.walk_speed_m_per_s = config.hmd.annotation_walk_speed_m_per_s;
   setup.annotation_view_angle_deg = config.hmd.annotation_view_angle_deg;
+  if (!inputs.capture_waypoints.empty() &&
+      static_cast<int>(inputs.capture_waypoints.size()) != inputs.num_mirrors) {
+    throw std::invalid_argument("headset trial: " + std::to_string(inputs.capture_waypoints.size()) +
+                                " capture waypoints for " + std::to_string(inputs.num_mirrors) +
+                                " display(s)");
+  }
   for (int i = 0; i < inputs.num_mirrors; ++i) {
-    setup.capture_waypoints.push_back(config.hmd.displays[i].capture_waypoint);
+    setup.capture_waypoints.push_back(inputs.capture_waypoints.empty()
+                                          ? config.hmd.displays[i].capture_waypoint
+                                          : inputs.capture_waypoints[i]);
   }
   return setup;
 }

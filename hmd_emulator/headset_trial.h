@@ -53,6 +53,9 @@ std::uint64_t TrialSeed(std::uint64_t seed, const std::string& session_id, std::
 struct HeadsetTrialInputs {
   /// Model points of the robot at the trial's joint vector q, in R (RobotModelPoints(model, q)) [m].
   std::vector<Eigen::Vector3d> p_RQ;
+  std::vector<SightSolid> solids_R;  ///< RobotSightSolids at the same q (what hides what)
+  /// Where each display captures (the session's START); empty: hmd.displays' capture_waypoint.
+  std::vector<std::string> capture_waypoints;
   /// The real robot base (truth) [m].
   Eigen::Isometry3d X_WR{Eigen::Isometry3d::Identity()};
   /// Where the hologram starts, in map coordinates (orbed-hmd: X_WR_nominal · user.X_RV_start).
@@ -71,6 +74,10 @@ struct HeadsetTrialInputs {
 /// Throws std::invalid_argument naming a link the model does not have.
 std::vector<Eigen::Vector3d> AnnotationLandmarkPoints(const sim::RobotModel& model, const HmdConfig& hmd,
                                                       const Eigen::VectorXd& q_rad);
+
+/// Sets inputs->p_RQ and inputs->solids_R for the robot `model` at q_rad (RobotModelPoints,
+/// RobotSightSolids). Throws std::invalid_argument on a wrong q size.
+void SetRobotAt(const sim::RobotModel& model, const Eigen::VectorXd& q_rad, HeadsetTrialInputs* inputs);
 
 /// The TrialSetup (viraal_trial.h) of a headset trial: the walk, the capture and alignment
 /// waypoints and times of `config`, the HoloLens PV intrinsics, X_WR and p_RQ of `inputs`, and

@@ -30,7 +30,7 @@ HeadsetTrialInputs Inputs(const HmdConfigSet& config) {
   Eigen::VectorXd q(7);
   q << 0, 30 * kDegToRad, 0, -60 * kDegToRad, 0, 45 * kDegToRad, 0;
   HeadsetTrialInputs in;
-  in.p_RQ = RobotModelPoints(robot, q);
+  SetRobotAt(robot, q, &in);
   in.X_WR = scene.X_WR;
   in.X_WV_start = EmulatedUser(config.user).StartPose(scene.X_WR);
   in.process_seed = 1;
@@ -99,6 +99,27 @@ TEST(HeadsetTrial, NumMirrorsChoosesTheDisplays) {
   EXPECT_THROW(MakeHeadsetTrialSetup(config, in), std::invalid_argument);
   in.num_mirrors = -1;
   EXPECT_THROW(RunHeadsetTrial(config, in), std::invalid_argument);
+}
+
+// The session's START may choose where the display captures (contract change 6): the trial then
+// captures its frame there, the pose the walk has at that waypoint, not where hmd.displays says.
+TEST(HeadsetTrial, TheSessionsCaptureWaypointsChooseWhereTheDisplayCaptures) {
+  const HmdConfigSet config = ShippedConfigs();
+  HeadsetTrialInputs in = Inputs(config);
+  in.capture_waypoints = {config.hmd.align_waypoint};
+  ASSERT_NE(config.hmd.displays[0].capture_waypoint, config.hmd.align_waypoint);
+  const TrialSetup setup = MakeHeadsetTrialSetup(config, in);
+  EXPECT_EQ(setup.capture_waypoints, (std::vector<std::string>{config.hmd.align_waypoint}));
+  const TrialOutcome o = RunHeadsetTrial(config, in);
+  ASSERT_EQ(o.at_capture.size(), 1u);
+  const HeadWaypoint* align = nullptr;
+  for (const HeadWaypoint& w : config.walk.waypoints) {
+    if (w.name == config.hmd.align_waypoint) align = &w;
+  }
+  ASSERT_NE(align, nullptr);
+  EXPECT_LT((o.at_capture[0].X_WH_true.translation() - align->p_WH).norm(), 1e-9);
+  in.capture_waypoints = {"foot_end", "head_end"};  // two names for one display
+  EXPECT_THROW(MakeHeadsetTrialSetup(config, in), std::invalid_argument);
 }
 
 // slam.faults picks its trials: the session's (or every session's) trial of that index gets the

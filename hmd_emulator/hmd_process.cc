@@ -70,7 +70,12 @@ HmdProcess::HmdProcess(const orbed::CommonFlags& flags, const HmdOptions& option
   AnnotationLandmarkPoints(*robot_model_, config_.hmd, Eigen::VectorXd::Zero(robot_model_->num_joints()));
   user_id_ = "emulated-seed-" + std::to_string(config_.user.seed);
   X_WV_start_ = EmulatedUser(config_.user).StartPose(scene.X_WR);
-  session_ = HmdSession({placed, options_.iiwa_status_channel, options_.robot_state_channel});
+  HmdSessionOptions session_options;
+  session_options.displays_placed = placed;
+  for (const HeadWaypoint& w : config_.walk.waypoints) session_options.waypoint_names.push_back(w.name);
+  session_options.iiwa_status_channel = options_.iiwa_status_channel;
+  session_options.robot_state_channel = options_.robot_state_channel;
+  session_ = HmdSession(session_options);
   if (!options_.state_file.empty()) {
     saved_ = RestoreSession(options_.state_file, &session_);
     if (session_.state().active()) {
@@ -332,9 +337,10 @@ void HmdProcess::EmulateTrial(const std::string& channel) {
   inputs.session_id = s.id;
   inputs.trial_index = s.next_index;
   inputs.num_mirrors = s.num_mirrors;
+  inputs.capture_waypoints = s.capture_waypoints;
   TrialOutcome outcome;
   try {
-    inputs.p_RQ = RobotModelPoints(*robot_model_, robot_.q_rad);
+    SetRobotAt(*robot_model_, robot_.q_rad, &inputs);
     inputs.p_RL = AnnotationLandmarkPoints(*robot_model_, config_.hmd, robot_.q_rad);
     outcome = RunHeadsetTrial(config_, inputs, &session_map_);
   } catch (const std::exception& e) {

@@ -305,10 +305,9 @@ TEST(HmdProcess, ATrialWithATrackingFaultIsAnsweredAfterItPlaysOnHmdPose) {
   EXPECT_EQ(t.alignment_repeats, 1);  // 3 cm at ~2 m is ~50 arcmin: the person re-aligns
   // The emulated trial itself, as the pure function makes it.
   HeadsetTrialInputs in;
-  in.p_RQ = RobotModelPoints(
-      sim::LoadRobotForScene(HmdSourcePath(sim::RobotModel::kDefaultUrdfRelativePath),
-                             sim::LoadSceneFile(HmdSourcePath(sim::kDefaultSceneRelativePath))),
-      sim::DegToRad(Eigen::Map<const Eigen::VectorXd>(kQDeg.data(), 7)));
+  SetRobotAt(sim::LoadRobotForScene(HmdSourcePath(sim::RobotModel::kDefaultUrdfRelativePath),
+                                    sim::LoadSceneFile(HmdSourcePath(sim::kDefaultSceneRelativePath))),
+             sim::DegToRad(Eigen::Map<const Eigen::VectorXd>(kQDeg.data(), 7)), &in);
   in.X_WR = SceneX_WR();
   in.X_WV_start = EmulatedUser(hmd.config().user).StartPose(SceneX_WR());
   in.process_seed = hmd.process().seed();
@@ -371,7 +370,7 @@ TEST(HmdProcess, PublishedTrialIsTheHeadsetTrialFunction) {
   const sim::RobotModel robot =
       sim::LoadRobotForScene(HmdSourcePath(sim::RobotModel::kDefaultUrdfRelativePath), scene);
   HeadsetTrialInputs in;
-  in.p_RQ = RobotModelPoints(robot, ToVectorX(status.joint_position_measured));
+  SetRobotAt(robot, ToVectorX(status.joint_position_measured), &in);
   in.X_WR = FromPose(state.X_WR);
   in.X_WV_start = EmulatedUser(hmd.config().user).StartPose(scene.X_WR);
   in.process_seed = 7;
@@ -715,7 +714,7 @@ TEST(HmdConfig, OverlaysMergeKeyByKey) {
   EXPECT_TRUE(set.user.X_RV_start.translation().isApprox(shipped.user.X_RV_start.translation(), 0));
   EXPECT_NEAR(set.user.X_RV_start.translation().x(), 0.10, 1e-12);
   EXPECT_DOUBLE_EQ(set.user.depth_bias_fraction_std, shipped.user.depth_bias_fraction_std);
-  EXPECT_DOUBLE_EQ(set.user.assumed_display_px, shipped.user.assumed_display_px);
+  EXPECT_DOUBLE_EQ(set.user.fov_v_deg, shipped.user.fov_v_deg);
   EXPECT_EQ(set.user.max_nudges, shipped.user.max_nudges);
   EXPECT_TRUE(set.slam.X_HC.isApprox(shipped.slam.X_HC, 0));
   EXPECT_NE(set.slam.X_HC.translation().norm(), 0.0);

@@ -1,5 +1,7 @@
 #include "hmd_emulator/hmd_session.h"
 
+#include <algorithm>
+
 #include "procs/common/alignment_trial.h"
 
 #include <utility>
@@ -80,11 +82,30 @@ SessionDecision HmdSession::Transition(const SessionCommand& command, RobotKnown
                                        std::to_string(command.num_mirrors) + ", but hmd.displays places " +
                                        std::to_string(options_.displays_placed) + " display(s)");
     }
+    for (const std::string& name : command.capture_waypoints) {
+      if (std::find(options_.waypoint_names.begin(), options_.waypoint_names.end(), name) ==
+          options_.waypoint_names.end()) {
+        return Refuse("capture_waypoint", "SESSION_CONTROL START '" + command.session_id +
+                                              "': capture waypoint '" + name +
+                                              "' is not a waypoint of the walk");
+      }
+    }
     if (command.RepeatsStartOf(state_.id, state_.display_mode, state_.num_mirrors)) {
+      // Every reader takes this START as a repeat (the registration server keeps the session's
+      // trials), so the headset may not start over either: other capture points need a new session.
+      if (command.capture_waypoints != state_.capture_waypoints) {
+        return Refuse("capture_waypoint", "SESSION_CONTROL START '" + command.session_id +
+                                              "' repeats the active session with other capture waypoints; "
+                                              "START a new session to capture elsewhere");
+      }
       return Decide(Kind::kRepeatedStart);
     }
-    state_ =
-        HmdSessionState{command.session_id, command.display_mode, command.num_mirrors, command.method, 0};
+    state_ = HmdSessionState{};
+    state_.id = command.session_id;
+    state_.display_mode = command.display_mode;
+    state_.num_mirrors = command.num_mirrors;
+    state_.method = command.method;
+    state_.capture_waypoints = command.capture_waypoints;
     return Decide(Kind::kStart, "session '" + state_.id + "' started (" +
                                     DisplayModeName(state_.display_mode) + ", " +
                                     std::to_string(state_.num_mirrors) + " display(s))");

@@ -6,8 +6,11 @@
 ///
 /// Every message is first checked by the common validator (orbed::CheckSessionControl,
 /// procs/common/session_control.h: refusal keys session_id, command, display_mode, num_mirrors,
-/// method); the headset then adds its own checks:
-///   - START: num_mirrors <= the displays placed in hmd.yaml (key "num_mirrors");
+/// method, capture_waypoint); the headset then adds its own checks:
+///   - START: num_mirrors <= the displays placed in hmd.yaml (key "num_mirrors"); every capture
+///     waypoint a waypoint of the walk, and a START repeating the active session (same id, mode
+///     and mirrors) with the same capture waypoints (key "capture_waypoint": every other reader
+///     takes such a START as a repeat, so the headset may not start over);
 ///   - RESET, STOP, REQUEST_TRIAL for a session that is not the active one (key "unknown_session");
 ///   - REQUEST_TRIAL before a valid joint vector q and base pose X_WR are known (key
 ///     "no_robot_state": the person cannot align without the robot);
@@ -16,7 +19,8 @@
 /// The emulated trial itself may still fail; the shell refuses that under "trial_failed".
 ///
 /// Transitions: START opens session s (mode, mirrors, method), trial index 0, replacing any other;
-/// a repeated START of the active session with the same mode and mirrors is a no-op (e.g. the
+/// a repeated START of the active session with the same mode, mirrors and capture waypoints is a
+/// no-op (e.g. the
 /// headset's own local START, echoed back); RESET sets the index to 0; STOP closes the session;
 /// COMPUTE is for the registration server (ignored); REQUEST_TRIAL accepted means "run trial
 /// next_index now" for request state().requested_id, and the caller takes the index with
@@ -38,6 +42,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <orbed/alignment_trial_t.hpp>
 #include <orbed/session_control_t.hpp>
@@ -59,6 +64,8 @@ struct HmdSessionState {
   std::int32_t next_index{0};
   /// The request_id of the REQUEST_TRIAL being answered (0: none, or it had no id).
   std::int64_t requested_id{0};
+  /// Where each display captures, as the START named them (empty: hmd.displays').
+  std::vector<std::string> capture_waypoints;
 
   bool active() const { return !id.empty(); }
   /// "session 's' (ar_reflective, 1 display(s))".
@@ -96,6 +103,8 @@ struct HmdSessionOptions {
   /// Named in the no_robot_state reason.
   std::string iiwa_status_channel{"IIWA_STATUS"};
   std::string robot_state_channel{"ROBOT_STATE"};
+  /// The walk's waypoint names: a START's capture waypoints must be among them.
+  std::vector<std::string> waypoint_names;
 };
 
 class HmdSession {

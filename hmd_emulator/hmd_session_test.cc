@@ -195,6 +195,34 @@ TEST(HmdSession, RefusalsOfTheCommonValidatorKeepTheirKeys) {
   EXPECT_EQ(session.state().id, "s");  // nothing changed
 }
 
+// Contract change 6: a START may say where each display captures; the names must be waypoints of the
+// headset's walk and the session keeps them. A START of the active session with other waypoints is
+// refused: every other reader takes it as a repeat, so the headset may not start over.
+TEST(HmdSession, CaptureWaypointsMustBeOnTheWalk) {
+  HmdSession session({2, "IIWA_STATUS", "ROBOT_STATE", {"foot_end", "head_end"}});
+  orbed::session_control_t start = Control("s", +SC::START, +AT::MODE_AR_REFLECTIVE, 1);
+  start.capture_waypoint = {"nowhere"};
+  start.num_capture_waypoints = 1;
+  const SessionDecision refused = session.Handle(start, kRobot);
+  EXPECT_EQ(refused.kind, Kind::kRefuse);
+  EXPECT_EQ(refused.refusal.key, "capture_waypoint");
+  EXPECT_FALSE(session.state().active());
+  start.capture_waypoint = {"head_end"};
+  EXPECT_EQ(session.Handle(start, kRobot).kind, Kind::kStart);
+  EXPECT_EQ(session.state().capture_waypoints, (std::vector<std::string>{"head_end"}));
+  EXPECT_EQ(session.TakeTrialIndex(), 0);
+  EXPECT_EQ(session.Handle(start, kRobot).kind, Kind::kRepeatedStart);
+  start.capture_waypoint = {"foot_end"};
+  const SessionDecision other = session.Handle(start, kRobot);
+  EXPECT_EQ(other.kind, Kind::kRefuse);
+  EXPECT_EQ(other.refusal.key, "capture_waypoint");
+  EXPECT_EQ(session.state().next_index, 1);  // the session goes on as it was
+  EXPECT_EQ(session.state().capture_waypoints, (std::vector<std::string>{"head_end"}));
+  start.session_id = "t";  // a new session may capture elsewhere
+  EXPECT_EQ(session.Handle(start, kRobot).kind, Kind::kStart);
+  EXPECT_EQ(session.state().capture_waypoints, (std::vector<std::string>{"foot_end"}));
+}
+
 TEST(HmdSession, StartBeyondThePlacedDisplaysIsRefused) {
   HmdSession session = TwoDisplays();
   const SessionDecision d = session.Handle(Control("s", +SC::START, +AT::MODE_AR_REFLECTIVE, 3), kRobot);

@@ -1,11 +1,13 @@
 #include "hmd_emulator/user_model.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
 #include "base/random.h"
 #include "base/units.h"
 #include "base/yaml_fields.h"
+#include "sim/distance_closed_form.h"
 #include "sim/scene.h"
 
 namespace orbed::hmd {
@@ -62,8 +64,7 @@ Eigen::Isometry3d DefaultStartOffset() {
 UserConfig ParseUserConfig(const YAML::Node& node, const std::string& source, const std::string& key,
                            const UserConfig& base) {
   const YamlFields f(source);
-  f.CheckKeys(node, key,
-              {"seed", "start_offset", "direct_view", "reflective_display", "belief", "nudging", "time"});
+  f.CheckKeys(node, key, {"seed", "start_offset", "direct_view", "perception", "belief", "nudging", "time"});
   UserConfig c = base;
   c.seed = static_cast<std::uint64_t>(
       f.IntegerOr(node, "seed", key, static_cast<long long>(c.seed), 0, (1LL << 62)));
@@ -95,35 +96,40 @@ UserConfig ParseUserConfig(const YAML::Node& node, const std::string& source, co
     c.user_scale_log_sigma = f.NumberOr(d, "user_scale_log_sigma", k, c.user_scale_log_sigma, 0, 3);
   }
   {
-    const std::string k = key + ".reflective_display";
-    const YAML::Node d = f.Section(node, "reflective_display", k);
-    f.CheckKeys(d, k, {"noise_px", "bias_px"});
-    c.display_noise_px = f.NumberOr(d, "noise_px", k, c.display_noise_px, 0, 1000, "px");
-    c.display_bias_px = f.NumberOr(d, "bias_px", k, c.display_bias_px, 0, 1000, "px");
+    const std::string k = key + ".perception";
+    const YAML::Node d = f.Section(node, "perception", k);
+    f.CheckKeys(d, k, {"fov_h_deg", "fov_v_deg", "occlusion"});
+    c.fov_h_deg = f.NumberOr(d, "fov_h_deg", k, c.fov_h_deg, 1, 179, "deg");
+    c.fov_v_deg = f.NumberOr(d, "fov_v_deg", k, c.fov_v_deg, 1, 179, "deg");
+    c.occlusion = f.BoolOr(d, "occlusion", k, c.occlusion);
   }
   {
     const std::string k = key + ".belief";
     const YAML::Node d = f.Section(node, "belief", k);
-    f.CheckKeys(d, k, {"lateral_arcmin", "depth_fraction", "display_px"});
+    f.CheckKeys(d, k, {"lateral_arcmin", "depth_fraction"});
     c.assumed_lateral_arcmin =
         f.NumberOr(d, "lateral_arcmin", k, c.assumed_lateral_arcmin, 1e-3, 600, "arcmin");
     c.assumed_depth_fraction = f.NumberOr(d, "depth_fraction", k, c.assumed_depth_fraction, 1e-5, 1);
-    c.assumed_display_px = f.NumberOr(d, "display_px", k, c.assumed_display_px, 1e-3, 1000, "px");
   }
   {
     const std::string k = key + ".nudging";
     const YAML::Node d = f.Section(node, "nudging", k);
     f.CheckKeys(d, k,
-                {"gain", "motor_noise_fraction", "max_nudges", "stop_lateral_arcmin", "stop_depth_fraction",
-                 "stop_display_px", "min_step_m", "min_step_deg"});
+                {"gain", "motor_noise_fraction", "motor_noise_translation_mm", "motor_noise_rotation_deg",
+                 "max_nudges", "stop_lateral_arcmin", "stop_depth_fraction", "min_step_m", "min_step_deg",
+                 "patience_nudges"});
     c.gain = f.NumberOr(d, "gain", k, c.gain, 0.01, 1.5);
     c.motor_noise_fraction = f.NumberOr(d, "motor_noise_fraction", k, c.motor_noise_fraction, 0, 1);
+    c.motor_noise_translation_mm =
+        f.NumberOr(d, "motor_noise_translation_mm", k, c.motor_noise_translation_mm, 0, 1000, "mm");
+    c.motor_noise_rotation_deg =
+        f.NumberOr(d, "motor_noise_rotation_deg", k, c.motor_noise_rotation_deg, 0, 90, "deg");
     c.max_nudges = static_cast<int>(f.IntegerOr(d, "max_nudges", k, c.max_nudges, 1, 10000));
     c.stop_lateral_arcmin = f.NumberOr(d, "stop_lateral_arcmin", k, c.stop_lateral_arcmin, 0, 600, "arcmin");
     c.stop_depth_fraction = f.NumberOr(d, "stop_depth_fraction", k, c.stop_depth_fraction, 0, 1);
-    c.stop_display_px = f.NumberOr(d, "stop_display_px", k, c.stop_display_px, 0, 1000, "px");
     c.min_step_m = f.NumberOr(d, "min_step_m", k, c.min_step_m, 0, 1, "m");
     c.min_step_deg = f.NumberOr(d, "min_step_deg", k, c.min_step_deg, 0, 45, "deg");
+    c.patience_nudges = static_cast<int>(f.IntegerOr(d, "patience_nudges", k, c.patience_nudges, 0, 10000));
   }
   {
     const std::string k = key + ".time";
@@ -168,6 +174,72 @@ std::vector<Eigen::Vector3d> RobotModelPoints(const sim::RobotModel& model, cons
   return points;
 }
 
+std::vector<SightSolid> RobotSightSolids(const sim::RobotModel& model, const Eigen::VectorXd& q_rad) {
+  const std::vector<Eigen::Isometry3d> X_RL = model.CalcLinkPoses(q_rad);
+  std::vector<SightSolid> solids;
+  for (int i = 0; i < model.num_links(); ++i) {
+    for (const auto& g : model.links()[i].collision) {
+      const Eigen::Isometry3d X_RG = X_RL[i] * g.X_LG;
+      SightSolid s;
+      s.p_RA = s.p_RB = X_RG.translation();
+      s.radius_m = g.radius_m;
+      if (g.kind == sim::CollisionPrimitive::Kind::kCylinder ||
+          g.kind == sim::CollisionPrimitive::Kind::kCapsule) {
+        const Eigen::Vector3d half = 0.5 * g.length_m * X_RG.linear().col(2);
+        s.p_RA -= half;
+        s.p_RB += half;
+      } else if (g.kind == sim::CollisionPrimitive::Kind::kBox) {
+        Eigen::Index longest = 0;
+        g.size_m.maxCoeff(&longest);
+        Eigen::Vector3d sorted = g.size_m;
+        std::sort(sorted.data(), sorted.data() + 3);
+        s.radius_m = 0.5 * sorted[1];
+        const double core = std::max(0.0, 0.5 * sorted[2] - s.radius_m);
+        const Eigen::Vector3d half = core * X_RG.linear().col(longest);
+        s.p_RA -= half;
+        s.p_RB += half;
+      }
+      solids.push_back(s);
+    }
+  }
+  return solids;
+}
+
+bool SeenPast(const std::vector<SightSolid>& solids_R, const Eigen::Vector3d& p_R_eye,
+              const Eigen::Vector3d& p_R) {
+  // A point this close to a solid's surface belongs to it (model points are link origins and axis
+  // points, inside their own links) [m].
+  constexpr double kContainsTolM = 1e-3;
+  for (const SightSolid& solid : solids_R) {
+    double s = 0, t = 0;
+    const double own2 = sim::ClosestSegmentSegment(p_R, p_R, solid.p_RA, solid.p_RB, &s, &t);
+    if (own2 <= std::pow(solid.radius_m + kContainsTolM, 2)) continue;
+    const double sight2 = sim::ClosestSegmentSegment(p_R_eye, p_R, solid.p_RA, solid.p_RB, &s, &t);
+    if (sight2 < solid.radius_m * solid.radius_m) return false;
+  }
+  return true;
+}
+
+double CaptureGazeDistance(const Eigen::Isometry3d& X_WC, const Eigen::Isometry3d& X_WR,
+                           const std::vector<Eigen::Vector3d>& p_RQ) {
+  const Eigen::Vector3d p_C = X_WC.inverse() * (X_WR * Centroid(p_RQ));
+  return std::max(0.1, p_C.z());
+}
+
+PanelView SeePanel(const ReflectiveDisplayView& d, const Eigen::Isometry3d& A, const Eigen::Vector3d& p_W_eye,
+                   double fov_h_deg, double fov_v_deg) {
+  if (!std::isfinite(d.D_m) || !(d.D_m > 0))
+    throw std::invalid_argument("reflective display: D must be finite and > 0, got " + std::to_string(d.D_m));
+  const double s_m = 0.5 * d.D_m;
+  const Eigen::Vector3d p_W_panel = A * (d.X_WC_est * Eigen::Vector3d(0, 0, s_m));
+  PanelView v;
+  v.distance_m = std::max(1e-3, (p_W_panel - p_W_eye).norm());
+  v.px_per_rad = Eigen::Vector2d(d.intrinsics.fx_px, d.intrinsics.fy_px) * (v.distance_m / s_m);
+  v.half_view_px = Eigen::Vector2d(std::tan(0.5 * fov_h_deg * kDegToRad) * v.px_per_rad.x(),
+                                   std::tan(0.5 * fov_v_deg * kDegToRad) * v.px_per_rad.y());
+  return v;
+}
+
 EmulatedUser::EmulatedUser(const UserConfig& config) : config_(config) {
   Random person(config.seed);
   depth_scale_ = person.LogNormalUnitMedian(config.user_scale_log_sigma);
@@ -188,11 +260,11 @@ AlignmentResult EmulatedUser::Align(const ViewingContext& ctx, const std::vector
   const double alpha_x = c.lateral_bias_arcmin * kArcminToRad * rng.Normal();
   const Eigen::Vector2d alpha_rad(alpha_x, alpha_y);
   const double beta = depth_scale_ * (depth_user_bias_ + c.depth_bias_fraction_std * rng.Normal());
-  std::vector<Eigen::Vector2d> display_bias_px;
+  std::vector<Eigen::Vector2d> display_bias_rad;  // the same acuity on each panel
   for (std::size_t j = 0; j < ctx.displays.size(); ++j) {
-    const double bias_y = c.display_bias_px * rng.Normal();
-    const double bias_x = c.display_bias_px * rng.Normal();
-    display_bias_px.emplace_back(bias_x, bias_y);
+    const double bias_y = c.lateral_bias_arcmin * kArcminToRad * rng.Normal();
+    const double bias_x = c.lateral_bias_arcmin * kArcminToRad * rng.Normal();
+    display_bias_rad.emplace_back(bias_x, bias_y);
   }
 
   // The scene as it is: real points, the eye, the hologram's apparent-pose map A.
@@ -204,17 +276,42 @@ AlignmentResult EmulatedUser::Align(const ViewingContext& ctx, const std::vector
   const Eigen::Vector3d p_RC = Centroid(p_RQ);
   const Eigen::Vector3d real_c = ctx.X_WR * p_RC;
 
+  // What the robot does not hide of itself, seen from p_W_viewer.
+  const Eigen::Isometry3d X_RW = ctx.X_WR.inverse();
+  auto unhidden_from = [&](const Eigen::Vector3d& p_W_viewer) {
+    std::vector<bool> seen(n, true);
+    if (!c.occlusion) return seen;
+    const Eigen::Vector3d p_R_viewer = X_RW * p_W_viewer;
+    for (std::size_t k = 0; k < n; ++k) seen[k] = SeenPast(ctx.solids_R, p_R_viewer, p_RQ[k]);
+    return seen;
+  };
+  const std::vector<bool> direct_unhidden = unhidden_from(p_W_eye);
+  // The see-through display's field of view about the head's line of sight (z of H).
+  const Eigen::Isometry3d X_HW = ctx.X_WH_true.inverse();
+  const double tan_half_h = std::tan(0.5 * c.fov_h_deg * kDegToRad);
+  const double tan_half_v = std::tan(0.5 * c.fov_v_deg * kDegToRad);
+  auto in_view = [&](const Eigen::Vector3d& p_H) {
+    return p_H.z() > 1e-6 && std::abs(p_H.x()) <= tan_half_h * p_H.z() &&
+           std::abs(p_H.y()) <= tan_half_v * p_H.z();
+  };
+
   // Each display's captured image of the real robot (true camera pose), and its overlay camera.
   struct DisplayState {
     Eigen::Isometry3d X_CW_est;
     std::vector<bool> seen;
     std::vector<Eigen::Vector2d> u_real;
     Eigen::Vector2d u_centroid{Eigen::Vector2d::Zero()};  // the real centroid in the image
+    Eigen::Vector2d px_per_rad{Eigen::Vector2d::Ones()};  // camera px per radian at the eye (u, v)
   };
   std::vector<DisplayState> displays;
   for (const auto& d : ctx.displays) {
     DisplayState s;
     s.X_CW_est = d.X_WC_est.inverse();
+    const PanelView panel = SeePanel(d, A, p_W_eye, c.fov_h_deg, c.fov_v_deg);
+    s.px_per_rad = panel.px_per_rad;
+    const Eigen::Vector2d& half_view_px = panel.half_view_px;
+    const Eigen::Vector2d image_centre(d.intrinsics.cx_px, d.intrinsics.cy_px);  // the panel's centre
+    const std::vector<bool> unhidden = unhidden_from(d.X_WC_true.translation());
     const geometry::CameraMatrix P_true = geometry::MakeCameraMatrix(d.intrinsics.K(), d.X_WC_true);
     s.seen.assign(n, false);
     s.u_real.assign(n, Eigen::Vector2d::Zero());
@@ -222,7 +319,9 @@ AlignmentResult EmulatedUser::Align(const ViewingContext& ctx, const std::vector
     int num_seen = 0;
     for (std::size_t k = 0; k < n; ++k) {
       Eigen::Vector2d uv;
-      if (geometry::Project(P_true, r[k], &uv) && InImage(d.intrinsics, uv)) {
+      if (unhidden[k] && geometry::Project(P_true, r[k], &uv) && InImage(d.intrinsics, uv) &&
+          std::abs(uv.x() - image_centre.x()) <= half_view_px.x() &&
+          std::abs(uv.y() - image_centre.y()) <= half_view_px.y()) {
         s.seen[k] = true;
         s.u_real[k] = uv;
         sum += uv;
@@ -237,9 +336,9 @@ AlignmentResult EmulatedUser::Align(const ViewingContext& ctx, const std::vector
     displays.push_back(std::move(s));
   }
 
-  const double w_lat = 1.0 / std::pow(c.assumed_lateral_arcmin * kArcminToRad, 2);  // × 1/ρ²
-  const double w_depth = 1.0 / std::pow(c.assumed_depth_fraction, 2);               // × 1/ρ²
-  const double w_px = 1.0 / std::pow(c.assumed_display_px, 2);
+  const double w_lat =
+      1.0 / std::pow(c.assumed_lateral_arcmin * kArcminToRad, 2);      // × 1/ρ² (× 1/px_per_rad²)
+  const double w_depth = 1.0 / std::pow(c.assumed_depth_fraction, 2);  // × 1/ρ²
 
   // Unknowns of the person's fit: the nudge ξ (0..5); when they are blind to small size
   // differences, the apparent image scale σ of the hologram in the direct view (6) and in each
@@ -248,6 +347,8 @@ AlignmentResult EmulatedUser::Align(const ViewingContext& ctx, const std::vector
   AlignmentResult result;
   Eigen::Isometry3d X_WV = X_WV_start;
   result.poses.push_back({0.0, X_WV});
+  double best_unsatisfied = INFINITY;  // patience: the best look so far
+  int nudges_since_better = 0;
   while (true) {
     // Look.
     result.duration_s += c.look_time_s + c.display_look_time_s * static_cast<double>(displays.size());
@@ -260,6 +361,7 @@ AlignmentResult EmulatedUser::Align(const ViewingContext& ctx, const std::vector
     for (std::size_t k = 0; k < n; ++k) {
       const Eigen::Vector3d x = X_WV * p_RQ[k];
       const Eigen::Vector3d h = A * x;
+      if (!direct_unhidden[k] || !in_view(X_HW * h)) continue;
       const Eigen::Vector3d ray = r[k] - p_W_eye;
       const double rho = ray.norm();
       if (!(rho > 1e-3)) continue;
@@ -306,8 +408,10 @@ AlignmentResult EmulatedUser::Align(const ViewingContext& ctx, const std::vector
         if (!ProjectWithJacobian(ctx.displays[j].intrinsics, s.X_CW_est, x, &u_virtual, &du_dx)) continue;
         const double noise_y = rng.Normal();
         const double noise_x = rng.Normal();
-        const Eigen::Vector2d perceived = u_virtual - s.u_real[k] + display_bias_px[j] +
-                                          c.display_noise_px * Eigen::Vector2d(noise_x, noise_y);
+        const Eigen::Vector2d perceived =
+            u_virtual - s.u_real[k] +
+            s.px_per_rad.cwiseProduct(display_bias_rad[j] + c.lateral_noise_arcmin * kArcminToRad *
+                                                                Eigen::Vector2d(noise_x, noise_y));
         Eigen::MatrixXd J = Eigen::MatrixXd::Zero(2, num_unknowns);
         J.leftCols<6>() = du_dx * PointJacobian(x, c_W);
         // The display is a picture too: a hologram moved along the capture camera's line of sight
@@ -319,8 +423,9 @@ AlignmentResult EmulatedUser::Align(const ViewingContext& ctx, const std::vector
         display_px.push_back(perceived);
         display_size_dir.push_back(size_dir);
         display_of.push_back(static_cast<int>(j));
-        H += w_px * J.transpose() * J;
-        g += w_px * J.transpose() * perceived;
+        const Eigen::Vector2d w = w_lat * s.px_per_rad.cwiseInverse().cwiseAbs2();
+        H += J.transpose() * w.asDiagonal() * J;
+        g += J.transpose() * w.asDiagonal() * perceived;
       }
     }
     // Decide the nudge: one Gauss–Newton step on the perceived discrepancies (tiny damping keeps an
@@ -329,8 +434,8 @@ AlignmentResult EmulatedUser::Align(const ViewingContext& ctx, const std::vector
     if (!c.size_blind) {
       for (int i = 6; i < num_unknowns; ++i) H(i, i) = 1.0;  // every σ fixed at 0
     }
-    for (int i = 7; i < num_unknowns; ++i) {
-      if (!(H(i, i) > 0)) H(i, i) = 1.0;  // a display that shows no point: its σ is fixed at 0
+    for (int i = 6; i < num_unknowns; ++i) {
+      if (!(H(i, i) > 0)) H(i, i) = 1.0;  // a view that shows no point: its σ is fixed at 0
     }
     const Eigen::VectorXd solution =
         -(H + damping * Eigen::MatrixXd::Identity(num_unknowns, num_unknowns)).ldlt().solve(g);
@@ -343,23 +448,43 @@ AlignmentResult EmulatedUser::Align(const ViewingContext& ctx, const std::vector
     for (std::size_t k = 0; k < lateral_rad.size(); ++k) {
       lat2 += (lateral_rad[k] - sigma * size_dir_rad[k]).squaredNorm();
     }
-    double px2 = 0;
+    double display2_rad = 0;  // as the eye sees it on the panels
     for (std::size_t k = 0; k < display_px.size(); ++k) {
-      const double sigma_j = -solution[7 + display_of[k]];
-      px2 += (display_px[k] - sigma_j * display_size_dir[k]).squaredNorm();
+      const int j = display_of[k];
+      const double sigma_j = -solution[7 + j];
+      display2_rad += (display_px[k] - sigma_j * display_size_dir[k])
+                          .cwiseQuotient(displays[static_cast<std::size_t>(j)].px_per_rad)
+                          .squaredNorm();
     }
     const int num_px = static_cast<int>(display_px.size());
     const double num_direct = std::max<double>(1.0, static_cast<double>(lateral_rad.size()));
     result.perceived_lateral_arcmin = std::sqrt(lat2 / num_direct) / kArcminToRad;
     result.perceived_depth_fraction = std::sqrt(depth2 / num_direct);
-    result.perceived_display_px = num_px > 0 ? std::sqrt(px2 / num_px) : 0.0;
+    result.perceived_display_arcmin = num_px > 0 ? std::sqrt(display2_rad / num_px) / kArcminToRad : 0.0;
+    result.direct_points_seen = static_cast<int>(lateral_rad.size());
     result.display_points_seen = num_px;
 
+    if (lateral_rad.empty() && num_px == 0) {
+      result.stop_reason = "nothing_in_view";
+      break;
+    }
     const bool satisfied = result.perceived_lateral_arcmin <= c.stop_lateral_arcmin &&
                            result.perceived_depth_fraction <= c.stop_depth_fraction &&
-                           (num_px == 0 || result.perceived_display_px <= c.stop_display_px);
+                           (num_px == 0 || result.perceived_display_arcmin <= c.stop_lateral_arcmin);
     if (satisfied) {
       result.stop_reason = "aligned";
+      break;
+    }
+    // How far from satisfied the person sees it: the largest discrepancy over its threshold.
+    const auto over = [](double value, double threshold) { return threshold > 0 ? value / threshold : 0.0; };
+    const double unsatisfied = std::max({over(result.perceived_lateral_arcmin, c.stop_lateral_arcmin),
+                                         over(result.perceived_depth_fraction, c.stop_depth_fraction),
+                                         over(result.perceived_display_arcmin, c.stop_lateral_arcmin)});
+    if (unsatisfied < best_unsatisfied) {
+      best_unsatisfied = unsatisfied;
+      nudges_since_better = 0;
+    } else if (c.patience_nudges > 0 && ++nudges_since_better >= c.patience_nudges) {
+      result.stop_reason = "gave_up";
       break;
     }
     if (result.nudges >= c.max_nudges) {
@@ -375,6 +500,13 @@ AlignmentResult EmulatedUser::Align(const ViewingContext& ctx, const std::vector
     // Carry it out: a fraction of it, with motor noise on each component.
     Eigen::Matrix<double, 6, 1> applied;
     for (int i = 0; i < 6; ++i) applied[i] = c.gain * xi[i] * (1.0 + c.motor_noise_fraction * rng.Normal());
+    if (c.motor_noise_translation_mm > 0 || c.motor_noise_rotation_deg > 0) {
+      for (int i = 0; i < 6; ++i) {
+        const double sigma =
+            i < 3 ? c.motor_noise_rotation_deg * kDegToRad : c.motor_noise_translation_mm * 1e-3;
+        applied[i] += sigma * rng.Normal();
+      }
+    }
     const Eigen::Vector3d w_applied = applied.head<3>();
     Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
     if (w_applied.norm() > 0)

@@ -27,8 +27,23 @@
 ///    P_m (camera_model.h) only re-places and y-flips that image (the paper: D "does not affect the
 ///    rendering content"; the flip is an isometry of the image), so the 2D discrepancy the person
 ///    sees is, up to the sign of v, Δu = Π(K, X_WC_est, X_WV·p) − Π(K, X_WC_true, X_WR·p) [px] for
-///    the points inside the captured frame, perceived with a per-trial common offset (σ bias) and
-///    per-point pixel noise.
+///    the points inside the captured frame, perceived with a per-trial common offset and per-point
+///    noise. Both are the direct view's angular acuity (lateral_bias/noise_arcmin: the same eye on
+///    the same HoloLens pixels) carried onto the panel: the panel shows pixel (u, v) at
+///    s·((u − cx)/fx, (v − cy)/fy) from its centre, s = D/2 (reflective.h), and the person sees it
+///    face on from L away, so one radian at the eye is L·fx/s camera px. A small or far panel
+///    therefore shows the robot coarsely; the person's belief and stop threshold for a display are
+///    the same angles (assumed_lateral_arcmin, stop_lateral_arcmin) converted the same way.
+/// Perception limits (perception:):
+///  - Field of view: the see-through display shows holograms only inside fov_h_deg × fov_v_deg
+///    (HoloLens 1: 30 × 17.5 deg) about the head's line of sight (z of X_WH_true, which the walk turns toward
+///    its look-at point). A model point whose hologram is outside it is not compared. A display is
+///    looked at on its own (display_look_s), with the head turned to the panel's centre: the parts
+///    of a panel wider than the field of view are not seen.
+///  - Occlusion: a model point counts only where the line of sight from the eye (direct view) or
+///    from the capture camera (display) to the real point meets no solid of the robot other than
+///    those containing the point (RobotSightSolids: each collision primitive as a swept segment).
+///  If nothing is in view the person cannot align and stops ("nothing_in_view").
 /// How the person acts: they combine everything by weighted least squares over the 6 DOF of a
 /// nudge (a twist ξ = (ω, v) of the hologram about its centroid, in map coordinates), weighting each
 /// perceived component by the reliability they believe it has (assumed_* parameters), take one
@@ -41,8 +56,10 @@
 /// scale σ_j of the image about the real centroid's pixel u_c,j (Jacobian column u_real,k − u_c,j),
 /// so a shift along that camera's line of sight is not read from the display either, and the
 /// perceived display discrepancy is judged net of σ_j. They stop when every perceived discrepancy
-/// (net of the scales) is below their thresholds (lateral [arcmin], depth [fraction of ρ], display
-/// [px]), when the step they would take is too small to bother (min_step_*), or after max_nudges.
+/// (net of the scales) is below their thresholds (lateral and display [arcmin], depth [fraction of
+/// ρ]), when the step they would take is too small to bother (min_step_*), when patience_nudges
+/// nudges in a row made nothing look better (the hand's own noise, motor_noise_*, can keep them
+/// from ever meeting the thresholds), or after max_nudges.
 /// Nothing about "the mirror helps" is written in: the display's image plane, seen from another
 /// viewpoint, contains the direct view's ray direction, so it constrains the depth that the direct
 /// view leaves ambiguous, with its own (SLAM) error; a display captured from the alignment
@@ -62,22 +79,24 @@
 ///   direct_view:
 ///     lateral_noise_arcmin: 1.5
 ///     lateral_bias_arcmin: 1.0
-///     depth_bias_fraction_std: 0.012        # of the viewing distance, per trial
+///     depth_bias_fraction_std: 0.014        # of the viewing distance, per trial
 ///     depth_user_bias_fraction_std: 0.006   # per person
 ///     depth_noise_fraction_std: 0.004       # per look, per point
-///     user_scale_log_sigma: 0.5
+///     user_scale_log_sigma: 0.45
 ///     size_blind: true
-///   reflective_display: {noise_px: 2.0, bias_px: 1.5}
-///   belief: {lateral_arcmin: 2.0, depth_fraction: 0.02, display_px: 3.0}
+///   perception: {fov_h_deg: 30.0, fov_v_deg: 17.5, occlusion: true}
+///   belief: {lateral_arcmin: 2.0, depth_fraction: 0.02}
 ///   nudging:
 ///     gain: 0.6
 ///     motor_noise_fraction: 0.15
+///     motor_noise_translation_mm: 0.5       # per axis, per nudge, whatever its size
+///     motor_noise_rotation_deg: 0.5
 ///     max_nudges: 40
 ///     stop_lateral_arcmin: 3.0
 ///     stop_depth_fraction: 0.01
-///     stop_display_px: 4.0
 ///     min_step_m: 0.001
 ///     min_step_deg: 0.1
+///     patience_nudges: 2                    # nudges without a better look before giving up (0: never)
 ///   time: {look_s: 2.0, display_look_s: 4.0, nudge_s: 5.5}   # [s]
 /// @endcode
 /// Threading: an EmulatedUser is immutable after construction; Align is const and draws its
@@ -104,30 +123,37 @@ struct UserConfig {
   // Direct view (see-through display).
   double lateral_noise_arcmin{1.5};
   double lateral_bias_arcmin{1.0};
-  double depth_bias_fraction_std{0.012};
+  double depth_bias_fraction_std{0.014};
   double depth_user_bias_fraction_std{0.006};
   double depth_noise_fraction_std{0.004};
-  double user_scale_log_sigma{0.5};
+  double user_scale_log_sigma{0.45};
   /// The person does not see small differences in the hologram's overall size, in the direct view
   /// and in each display: the perspective scale change that a shift along the line of sight causes
   /// is not taken as misalignment.
   bool size_blind{true};
-  // Reflective display.
-  double display_noise_px{2.0};
-  double display_bias_px{1.5};
+  // Perception limits: the see-through display's field of view (horizontal, vertical) [deg] and
+  // whether the robot hides parts of itself.
+  double fov_h_deg{30.0};
+  double fov_v_deg{17.5};
+  bool occlusion{true};
   // What the person believes their perception is worth (weights of the least squares).
   double assumed_lateral_arcmin{2.0};
   double assumed_depth_fraction{0.02};
-  double assumed_display_px{3.0};
   // Nudging.
   double gain{0.6};
   double motor_noise_fraction{0.15};
+  /// Hand-motor noise that does not scale with the nudge: each nudge lands this far off per axis
+  /// (translation [mm], rotation [deg] about the pivot), e.g. the jitter of releasing a drag.
+  double motor_noise_translation_mm{0.5};
+  double motor_noise_rotation_deg{0.5};
   int max_nudges{40};
   double stop_lateral_arcmin{3.0};
   double stop_depth_fraction{0.01};
-  double stop_display_px{4.0};
   double min_step_m{0.001};
   double min_step_deg{0.1};
+  /// The person gives up ("gave_up") after this many nudges in a row that did not
+  /// make what they see better (the largest perceived discrepancy over its threshold); 0: never.
+  int patience_nudges{2};
   // Time.
   double look_time_s{2.0};
   double display_look_time_s{4.0};
@@ -145,6 +171,28 @@ UserConfig ParseUserConfig(const YAML::Node& node, const std::string& source, co
 UserConfig LoadUserConfigFile(const std::string& path);
 inline constexpr const char* kDefaultUserConfigRelativePath = "hmd_emulator/config/user.yaml";
 
+/// A solid of the robot as a line of sight meets it: the segment [p_RA, p_RB] swept by a ball of
+/// radius_m, in R. Spheres, capsules and cylinders are exact or (cylinders) rounded at the ends;
+/// a box is its centre segment along its longest axis swept by half its middle extent.
+struct SightSolid {
+  Eigen::Vector3d p_RA{Eigen::Vector3d::Zero()};
+  Eigen::Vector3d p_RB{Eigen::Vector3d::Zero()};
+  double radius_m{0};
+};
+/// The collision primitives of every link at q as sight solids. Throws on a wrong q size.
+std::vector<SightSolid> RobotSightSolids(const sim::RobotModel& model, const Eigen::VectorXd& q_rad);
+/// Whether p_R can be seen from p_R_eye (both in R): the sight line between them passes through no
+/// solid that does not itself contain p_R (a point inside a link is seen on that link's surface).
+bool SeenPast(const std::vector<SightSolid>& solids_R, const Eigen::Vector3d& p_R_eye,
+              const Eigen::Vector3d& p_R);
+
+/// The reversed frustum's D for a frame captured with the camera at X_WC: the depth in front of the
+/// camera of the model points' centroid [m] (at least 0.1 m). The live display takes the gaze ray's
+/// hit on the robot instead (image_pipeline.h); toward the robot's middle they differ by about a
+/// link's radius.
+double CaptureGazeDistance(const Eigen::Isometry3d& X_WC, const Eigen::Isometry3d& X_WR,
+                           const std::vector<Eigen::Vector3d>& p_RQ);
+
 /// Points on the robot in its base frame R at joint vector q: each link origin and the centre and
 /// axis end points of each collision primitive. Throws std::invalid_argument on a wrong q size.
 std::vector<Eigen::Vector3d> RobotModelPoints(const sim::RobotModel& model, const Eigen::VectorXd& q_rad);
@@ -155,8 +203,25 @@ struct ReflectiveDisplayView {
   geometry::Intrinsics intrinsics;
   Eigen::Isometry3d X_WC_true{Eigen::Isometry3d::Identity()};
   Eigen::Isometry3d X_WC_est{Eigen::Isometry3d::Identity()};
-  double D_m{1.5};  ///< gaze distance of the reversed frustum (places the display; no effect here)
+  /// Gaze distance D of the reversed frustum [m]: the panel stands D/2 in front of the capture
+  /// camera and shows the image at scale s = D/2 (its size and, with the eye's distance, its
+  /// angular resolution).
+  double D_m{1.5};
 };
+
+/// How an eye at p_W_eye sees a display's panel, turned toward its centre: the panel stands D/2 in
+/// front of the capture camera as the device places it (at A · X_WC_est, A the apparent-pose map
+/// of ViewingContext), faces the eye L = distance_m away and shows pixel offsets at s / f metres
+/// per px (s = D/2), so one radian at the eye is L·f/s camera px; the field of view (fov_*_deg)
+/// takes in tan(fov/2)·L·f/s px either side of the image centre.
+struct PanelView {
+  double distance_m{0};                                   ///< L [m]
+  Eigen::Vector2d px_per_rad{Eigen::Vector2d::Zero()};    ///< (u, v) [camera px / rad]
+  Eigen::Vector2d half_view_px{Eigen::Vector2d::Zero()};  ///< (u, v) [camera px]
+};
+/// Throws std::invalid_argument unless D is finite and > 0.
+PanelView SeePanel(const ReflectiveDisplayView& display, const Eigen::Isometry3d& A,
+                   const Eigen::Vector3d& p_W_eye, double fov_h_deg, double fov_v_deg);
 
 /// Everything that decides what the person sees during one trial.
 struct ViewingContext {
@@ -164,6 +229,8 @@ struct ViewingContext {
   Eigen::Isometry3d X_WH_true{Eigen::Isometry3d::Identity()};  ///< head while aligning
   Eigen::Isometry3d X_WH_est{Eigen::Isometry3d::Identity()};   ///< the device's estimate then
   std::vector<ReflectiveDisplayView> displays;                 ///< empty: AR only
+  /// The robot's solids in R at the trial's q (RobotSightSolids); empty: nothing is hidden.
+  std::vector<SightSolid> solids_R;
 };
 
 /// The hologram's pose (map coordinates) from t_s on, t_s from the start of an alignment [s].
@@ -181,14 +248,18 @@ struct AlignmentResult {
   /// Where the hologram is t_s into the alignment (the last of `poses` at or before t_s).
   Eigen::Isometry3d X_WV_at(double t_s) const;
   int nudges{0};
-  /// "aligned" (thresholds met), "no_visible_improvement" (step below min_step), "max_nudges".
+  /// "aligned" (thresholds met), "no_visible_improvement" (step below min_step), "gave_up"
+  /// (patience_nudges nudges in a row without a better look), "max_nudges", "nothing_in_view" (no
+  /// model point in the field of view, unhidden).
   std::string stop_reason;
   /// At the last look: RMS of the perceived lateral [arcmin] and depth [fraction of ρ] discrepancy in
-  /// the direct view, and of the display discrepancy [px] (0 without displays).
+  /// the direct view, and of the display discrepancy as the eye sees it on the panels [arcmin] (0
+  /// without displays).
   double perceived_lateral_arcmin{0};
   double perceived_depth_fraction{0};
-  double perceived_display_px{0};
-  int display_points_seen{0};  ///< model points inside the captured frame(s) at the last look
+  double perceived_display_arcmin{0};
+  int direct_points_seen{0};   ///< model points compared in the direct view at the last look
+  int display_points_seen{0};  ///< model points compared in the display(s) at the last look
 };
 
 class EmulatedUser {

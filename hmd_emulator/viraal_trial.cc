@@ -218,6 +218,24 @@ SlamModel SessionMapAtTrial(const TrialSetup& setup, const SlamConfig& session_s
   return std::move(*model);
 }
 
+ViewingContext TrialViewingContext(const TrialSetup& setup, const SlamSample& at,
+                                   const std::vector<SlamSample>& at_capture) {
+  ViewingContext ctx;
+  ctx.X_WR = setup.X_WR;
+  ctx.X_WH_true = at.X_WH_true;
+  ctx.X_WH_est = at.X_WH_est;
+  ctx.solids_R = setup.solids_R;
+  for (const auto& cap : at_capture) {
+    ReflectiveDisplayView view;
+    view.intrinsics = setup.intrinsics;
+    view.X_WC_true = cap.X_WC_true;
+    view.X_WC_est = cap.X_WC_est;
+    view.D_m = CaptureGazeDistance(cap.X_WC_true, setup.X_WR, setup.p_RQ);
+    ctx.displays.push_back(view);
+  }
+  return ctx;
+}
+
 TrialOutcome RunTrial(const TrialSetup& setup, const SlamConfig& slam, const EmulatedUser& user,
                       const Eigen::Isometry3d& X_WV_start, std::uint64_t trial_seed) {
   return RunTrialFrom(setup, SlamModel(slam), 0.0, user, X_WV_start, trial_seed);
@@ -231,17 +249,7 @@ TrialOutcome RunTrialFrom(const TrialSetup& setup, SlamModel model, double t0_s,
   out.at_capture = std::move(walked.at_capture);
   out.relocalizations = walked.relocalizations;
 
-  ViewingContext ctx;
-  ctx.X_WR = setup.X_WR;
-  ctx.X_WH_true = out.at_alignment.X_WH_true;
-  ctx.X_WH_est = out.at_alignment.X_WH_est;
-  for (const auto& cap : out.at_capture) {
-    ReflectiveDisplayView view;
-    view.intrinsics = setup.intrinsics;
-    view.X_WC_true = cap.X_WC_true;
-    view.X_WC_est = cap.X_WC_est;
-    ctx.displays.push_back(view);
-  }
+  ViewingContext ctx = TrialViewingContext(setup, out.at_alignment, out.at_capture);
   out.alignment = user.Align(ctx, setup.p_RQ, X_WV_start, trial_seed);
   out.at_end = out.at_alignment;
   if (!setup.faults.empty()) AlignThroughFaults(setup, user, trial_seed, ctx, &model, &out);

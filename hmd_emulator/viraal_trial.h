@@ -61,6 +61,7 @@ namespace orbed::hmd {
 struct TrialSetup {
   Eigen::Isometry3d X_WR{Eigen::Isometry3d::Identity()};  ///< real robot base (truth)
   std::vector<Eigen::Vector3d> p_RQ;                      ///< model points at the trial's q
+  std::vector<SightSolid> solids_R;  ///< the robot's solids at the trial's q; empty: nothing hidden
   HeadTrajectoryConfig walk;
   /// Waypoints where a reflective display captures its frame (at arrival, once tracking; see
   /// WalkSamples::at_capture); empty = AR only.
@@ -116,6 +117,12 @@ struct TrialOutcome {
   /// The landmark annotation: for each head position, for each landmark, real then hologram.
   std::vector<AnnotationRay> annotation;
 };
+
+/// What the person sees while aligning at the sample `at`: the real robot, the head's true and
+/// estimated pose, the robot's solids, and one display per captured frame (at_capture), each with
+/// the gaze distance D of CaptureGazeDistance.
+ViewingContext TrialViewingContext(const TrialSetup& setup, const SlamSample& at,
+                                   const std::vector<SlamSample>& at_capture);
 
 /// Runs one trial on a fresh map that starts at the walk's first waypoint (t = 0). slam.seed and
 /// trial_seed make it reproducible; X_WV_start is in map coordinates. Throws std::invalid_argument

@@ -50,18 +50,7 @@ struct Fixture {
   }
   // What the person sees with the head at `sample` (the displays as the trial captured them).
   ViewingContext Context(const TrialOutcome& o, const SlamSample& sample) const {
-    ViewingContext ctx;
-    ctx.X_WR = setup.X_WR;
-    ctx.X_WH_true = sample.X_WH_true;
-    ctx.X_WH_est = sample.X_WH_est;
-    for (const auto& cap : o.at_capture) {
-      ReflectiveDisplayView view;
-      view.intrinsics = setup.intrinsics;
-      view.X_WC_true = cap.X_WC_true;
-      view.X_WC_est = cap.X_WC_est;
-      ctx.displays.push_back(view);
-    }
-    return ctx;
+    return TrialViewingContext(setup, sample, o.at_capture);
   }
 };
 
@@ -368,7 +357,9 @@ TEST(SessionMap, WithoutStoredPlacesTheDriftAccumulatesOverTheSession) {
     SlamSample s;
     const Eigen::Vector3d e = f.ErrorAtAlignment(k, &s);
     EXPECT_NEAR(e.norm(), 0.01 * s.path_m, 1e-5 * s.path_m) << "trial " << k;
-    if (k == 3) EXPECT_GT(s.path_m, 3 * 4.0) << "three walks and returns of more than 2 m each";
+    if (k == 3) {
+      EXPECT_GT(s.path_m, 3 * 4.0) << "three walks and returns of more than 2 m each";
+    }
   }
 }
 

@@ -196,8 +196,9 @@ def report(study_dir):
         parts.append("<h2>Table 1: ViRAAl landmark misalignment [mm]</h2>"
                      "<p>Measured as the paper did: three landmarks on the real robot and on the hologram, "
                      "each annotated by head gaze from two positions (rays from the headset's estimated "
-                     "pose) and triangulated by orbed-registration. The SE(3) means are scored with the "
-                     "truth's landmarks (nobody annotated them).</p><table>"
+                     "pose) and triangulated by orbed-registration. Nobody looks at an SE(3) mean: it is scored "
+                     "against the real landmarks annotated in the user's trials, its virtual landmarks "
+                     "placed by the mean.</p><table>"
                      "<tr><th></th><th>norm of means</th><th>norm of stds</th>"
                      "<th class=paper>paper</th></tr>")
         for mode in ("ar_reflective", "ar"):

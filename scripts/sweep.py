@@ -65,13 +65,16 @@ def walk_yaml(captures):
     return "\n".join(lines) + "\n", path
 
 
-def run_point(study, tmp, trials, users, overlay_text, scenario_text):
-    """Table 1 per mode over USERS persons for one model setting."""
+def run_point(study, tmp, trials, users, overlay_text, scenario_text, user_text=""):
+    """Table 1 per mode over USERS persons for one model setting.
+
+    overlay_text: headset config (no `user:` mapping); user_text: more keys of each person's `user:`
+    mapping, each line indented by two spaces. Returns {mode: (mean, std, n)} for the modes run."""
     axes = {m: [] for m in MODES}
     for user in range(1, users + 1):
         overlay = os.path.join(tmp, "overlay.yaml")
         with open(overlay, "w") as f:
-            f.write(overlay_text + f"user:\n  seed: {user}\n")
+            f.write(overlay_text + f"user:\n  seed: {user}\n" + user_text)
         scenario = os.path.join(tmp, "scenario.yaml")
         with open(scenario, "w") as f:
             f.write(scenario_text)
@@ -88,6 +91,8 @@ def run_point(study, tmp, trials, users, overlay_text, scenario_text):
     row = {}
     for mode, values in axes.items():
         n = len(values)
+        if n == 0:
+            continue
         means = [sum(v[k] for v in values) / n for k in range(3)]
         stds = [math.sqrt(sum((v[k] - means[k]) ** 2 for v in values) / (n - 1)) if n > 1 else 0.0 for k in range(3)]
         row[mode] = (math.hypot(*means), math.hypot(*stds), n)

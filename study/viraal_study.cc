@@ -109,7 +109,7 @@ viraal::RunResults RunViraalStudy(const StudyOptions& options) {
       const std::vector<double>& q_deg = scenario.configurations_deg[i % scenario.configurations_deg.size()];
       const Eigen::VectorXd q_rad = sim::DegToRad(ToVectorX(q_deg));
       hmd::HeadsetTrialInputs inputs;
-      inputs.p_RQ = hmd::RobotModelPoints(headset_model, q_rad);
+      hmd::SetRobotAt(headset_model, q_rad, &inputs);
       inputs.p_RL = hmd::AnnotationLandmarkPoints(headset_model, headset.hmd, q_rad);
       inputs.X_WR = FromPose(X_WR);
       inputs.X_WV_start = X_WV_start;
@@ -117,6 +117,7 @@ viraal::RunResults RunViraalStudy(const StudyOptions& options) {
       inputs.session_id = session.session_id;
       inputs.trial_index = i;
       inputs.num_mirrors = mode.num_mirrors;
+      if (mode.num_mirrors > 0) inputs.capture_waypoints = scenario.capture_waypoints;
       const hmd::TrialOutcome outcome = hmd::RunHeadsetTrial(headset, inputs, &session_map);
 
       // ALIGNMENT_TRIAL as orbed-hmd publishes it.
@@ -150,7 +151,8 @@ viraal::RunResults RunViraalStudy(const StudyOptions& options) {
       if (!landmarks.empty()) error = viraal::WithAnnotation(error, landmarks);
       const orbed::misalignment_t misalignment = Checked(
           service.HandleMisalignmentRequest(viraal::MisalignmentRequest(error, session.session_id, 0, i)));
-      session.trials.push_back(viraal::TrialResultFrom(trial, X_WR, viraal::Measures(error, misalignment)));
+      session.trials.push_back(viraal::TrialResultFrom(trial, X_WR, viraal::Measures(error, misalignment),
+                                                       error.p_W_real_annotated));
       if (options.progress) options.progress(++done, total);
     }
 
@@ -159,7 +161,8 @@ viraal::RunResults RunViraalStudy(const StudyOptions& options) {
     if (!mean || !mean->valid) {
       throw std::runtime_error("session '" + session.session_id + "': orbed-registration has no valid mean");
     }
-    const viraal::AlignmentError error = viraal::MeanError(X_WR, *mean, session_points);
+    const viraal::AlignmentError error =
+        viraal::MeanError(X_WR, *mean, session_points, viraal::AnnotatedRealLandmarks(session));
     const orbed::misalignment_t misalignment = Checked(
         service.HandleMisalignmentRequest(viraal::MisalignmentRequest(error, session.session_id, 0, -1)));
     session.mean = viraal::MeanResultFrom(*mean, viraal::Measures(error, misalignment));

@@ -53,8 +53,9 @@ viraal::RunResults RunViraalStudy(const StudyOptions& options);
 
 /// The paper's registration statistic: the trials of `session` taken `group_size` at a time in
 /// order (the last incomplete group left out), each group averaged on SE(3) by the registration
-/// server's core with the scenario's method, and scored over the group's configurations as the
-/// conductor scores a session mean. Returns each group mean's misalignment [mm].
+/// server's core with the scenario's method, and scored over the group's configurations with the
+/// truth's landmark pairs (a group is not a session the conductor measured; its mean is scored as a
+/// trial without annotation would be). Returns each group mean's misalignment [mm].
 std::vector<double> GroupMeanMisalignment_mm(const StudyOptions& options,
                                              const viraal::SessionResult& session, int group_size);
 

@@ -141,7 +141,7 @@ TEST(LcmTypes, FingerprintsArePinned) {
                                                   {"reflective_view_t", 0xba9d743e2da58034ULL},
                                                   {"registration_t", 0xa59c0b3d053d0d83ULL},
                                                   {"robot_state_t", 0x3af0ecdeab2a6837ULL},
-                                                  {"session_control_t", 0xcdbe036ad16d76feULL},
+                                                  {"session_control_t", 0x875cddac9b006a4fULL},
                                                   {"setup_result_t", 0x7b1a0cab822c59c1ULL},
                                                   {"setup_task_t", 0x45ebcc451fbad1b9ULL},
                                                   {"target_pose_t", 0x861ba235288a4402ULL},

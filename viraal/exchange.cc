@@ -18,8 +18,30 @@ AlignmentError TrialError(const orbed::pose_t& X_WR, const orbed::alignment_tria
 }
 
 AlignmentError MeanError(const orbed::pose_t& X_WR, const orbed::registration_t& mean,
-                         const std::vector<RobotPoints>& session_points) {
-  return EvaluateOverConfigurations(FromPose(X_WR), FromPose(mean.X_WV_mean), session_points);
+                         const std::vector<RobotPoints>& session_points,
+                         const std::vector<std::vector<Eigen::Vector3d>>& session_real_annotated) {
+  AlignmentError error = EvaluateOverConfigurations(FromPose(X_WR), FromPose(mean.X_WV_mean), session_points);
+  if (session_real_annotated.empty()) return error;
+  if (session_real_annotated.size() != session_points.size()) {
+    throw std::invalid_argument("MeanError: " + std::to_string(session_real_annotated.size()) +
+                                " trials' annotations for " + std::to_string(session_points.size()) +
+                                " trials");
+  }
+  std::vector<Eigen::Vector3d> reals;
+  for (size_t i = 0; i < session_real_annotated.size(); ++i) {
+    const auto& trial = session_real_annotated[i];
+    if (trial.empty()) return error;  // a trial nobody annotated: the truth's pairs alone
+    if (trial.size() != session_points[i].p_RL.size()) {
+      throw std::invalid_argument(
+          "MeanError: trial " + std::to_string(i) + " has " + std::to_string(trial.size()) +
+          " annotated landmarks, the scenario scores " + std::to_string(session_points[i].p_RL.size()));
+    }
+    reals.insert(reals.end(), trial.begin(), trial.end());
+  }
+  error.p_W_real_annotated = std::move(reals);
+  error.p_W_virtual_annotated = error.p_W_virtual;  // X_WV_mean at each trial's q
+  error.virtual_annotated = false;
+  return error;
 }
 
 std::vector<orbed::landmark_request_t> LandmarkRequests(const orbed::AlignmentTrial& trial, int64_t utime,
@@ -92,15 +114,23 @@ ErrorMeasures Measures(const AlignmentError& error, const orbed::misalignment_t&
   m.misalignment_mm = misalignment.mean_error_norm_m * 1e3;
   m.misalignment_axes_mm = ToVector3(misalignment.mean_error_W_m) * 1e3;
   m.misalignment_mean_pair_distance_mm = misalignment.mean_pair_distance_m * 1e3;
-  m.landmarks = error.p_W_real_annotated.empty() ? "truth" : "gaze";
+  m.landmarks = error.p_W_real_annotated.empty() ? "truth" : error.virtual_annotated ? "gaze" : "gaze_real";
   m.truth_misalignment_mm =
       geometry::EvaluateMisalignment(error.p_W_real, error.p_W_virtual).mean_error_norm_m * 1e3;
   return m;
 }
 
+std::vector<std::vector<Eigen::Vector3d>> AnnotatedRealLandmarks(const SessionResult& session) {
+  std::vector<std::vector<Eigen::Vector3d>> out;
+  for (const TrialResult& t : session.trials) out.push_back(t.annotated_real_W_m);
+  return out;
+}
+
 TrialResult TrialResultFrom(const orbed::alignment_trial_t& trial, const orbed::pose_t& X_WR,
-                            const ErrorMeasures& errors) {
+                            const ErrorMeasures& errors,
+                            const std::vector<Eigen::Vector3d>& annotated_real_W_m) {
   TrialResult result;
+  result.annotated_real_W_m = annotated_real_W_m;
   result.index = trial.trial_index;
   for (double q : trial.joint_position) result.q_deg.push_back(q * kRadToDeg);
   result.errors = errors;

@@ -10,8 +10,9 @@
 ///           triangulated pairs (the paper's measurement, Sec. III-B); → the pairs as a
 ///           MISALIGNMENT_REQUEST (annotated ones if any, else the truth's) → MISALIGNMENT →
 ///           TrialResultFrom;
-///   mean:   REGISTRATION (reason COMPUTE, X_WV_mean) → MeanError over the session's configurations →
-///           MISALIGNMENT_REQUEST → MISALIGNMENT → MeanResultFrom.
+///   mean:   REGISTRATION (reason COMPUTE, X_WV_mean) → MeanError over the session's configurations
+///           (with the real landmarks the user annotated in the session's trials, when every trial
+///           has them) → MISALIGNMENT_REQUEST → MISALIGNMENT → MeanResultFrom.
 ///
 /// Frames and units as in metrics.h: W world, R real base, V virtual base; messages in SI, results in
 /// mm and deg as results.h names them.
@@ -42,9 +43,16 @@ RobotPoints TrialPoints(const RobotPointSet& points, const orbed::alignment_tria
 AlignmentError TrialError(const orbed::pose_t& X_WR, const orbed::alignment_trial_t& trial,
                           const RobotPoints& points);
 
-/// The errors of a session mean (REGISTRATION.X_WV_mean) over the session's trial points.
+/// The errors of a session mean (REGISTRATION.X_WV_mean) over the session's trial points. Nobody
+/// annotates a mean: when every trial of the session has the real robot's landmarks as the user
+/// annotated them (session_real_annotated[i] = trial i's TrialResult::annotated_real_W_m, in the
+/// headset's map), the mean is measured against those, its virtual landmarks placed by X_WV_mean
+/// at each trial's q (virtual_annotated = false); otherwise (a trial without annotation) with the
+/// truth's pairs alone. Throws std::invalid_argument when session_real_annotated is not empty and
+/// its size or a trial's landmark count does not match.
 AlignmentError MeanError(const orbed::pose_t& X_WR, const orbed::registration_t& mean,
-                         const std::vector<RobotPoints>& session_points);
+                         const std::vector<RobotPoints>& session_points,
+                         const std::vector<std::vector<Eigen::Vector3d>>& session_real_annotated = {});
 
 /// The annotation of a checked trial (procs/common/alignment_trial.h) as LANDMARK_REQUESTs: for each
 /// landmark l, the real robot's rays then the virtual one's, named "<session>/<index>/real/<l>" and
@@ -64,13 +72,18 @@ orbed::misalignment_request_t MisalignmentRequest(const AlignmentError& error, c
                                                   int64_t utime, int64_t request_id);
 
 /// The measures of one pose: point errors from `error`, the paper's misalignment from `misalignment`
-/// (landmarks "gaze" when `error` has annotated pairs), truth_misalignment_mm from error's truth
+/// (landmarks "gaze" when `error` has annotated pairs, "gaze_real" when only their real side was
+/// annotated), truth_misalignment_mm from error's truth
 /// pairs (geometry/misalignment.h, as orbed-registration computes it).
 ErrorMeasures Measures(const AlignmentError& error, const orbed::misalignment_t& misalignment);
 
-/// One row of results.json for a trial.
+/// One row of results.json for a trial; `annotated_real_W_m`: error's p_W_real_annotated.
 TrialResult TrialResultFrom(const orbed::alignment_trial_t& trial, const orbed::pose_t& X_WR,
-                            const ErrorMeasures& errors);
+                            const ErrorMeasures& errors,
+                            const std::vector<Eigen::Vector3d>& annotated_real_W_m = {});
+
+/// Each trial's annotated_real_W_m, in order: MeanError's session_real_annotated.
+std::vector<std::vector<Eigen::Vector3d>> AnnotatedRealLandmarks(const SessionResult& session);
 
 /// The ALIGNMENT_TRIAL a row of results.json came from (TrialResultFrom's inverse, up to the round
 /// trips of X_WV through a rotation matrix and q through degrees), stamped `utime`: how a resumed

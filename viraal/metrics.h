@@ -72,6 +72,9 @@ struct AlignmentError {
   /// [m]; empty when nobody annotated (see exchange.h).
   std::vector<Eigen::Vector3d> p_W_real_annotated;
   std::vector<Eigen::Vector3d> p_W_virtual_annotated;
+  /// With annotated pairs: false when the virtual side was placed by the pose itself rather than
+  /// annotated (a session mean, which no hologram ever showed: exchange.h MeanError).
+  bool virtual_annotated{true};
 };
 
 /// Geodesic angle between two rotations [rad], in [0, π]: the angle of R_a^T·R_b.

@@ -56,6 +56,20 @@ void ValidateScenarioConfig(const ScenarioConfig& config, int num_joints) {
                                 std::to_string(config.trials));
   }
   if (config.modes.empty()) throw std::invalid_argument("modes: at least one mode is needed");
+  for (const ModeSpec& m : config.modes) {
+    if (m.num_mirrors > 0 && !config.capture_waypoints.empty() &&
+        static_cast<int>(config.capture_waypoints.size()) != m.num_mirrors) {
+      throw std::invalid_argument("capture_waypoints: " + std::to_string(config.capture_waypoints.size()) +
+                                  " waypoint(s) for the " + std::to_string(m.num_mirrors) +
+                                  " display(s) of mode " + m.name +
+                                  ": one per display, or [] for the headset's own");
+    }
+  }
+  for (const std::string& w : config.capture_waypoints) {
+    if (w.empty() || w.size() > 64 || w.find_first_of(" \t\n") != std::string::npos)
+      throw std::invalid_argument("capture_waypoints: '" + w +
+                                  "' is not a waypoint name (1..64 bytes, no spaces)");
+  }
   std::set<std::string> seen;
   for (const ModeSpec& m : config.modes) {
     if (!seen.insert(m.name).second) throw std::invalid_argument("modes: '" + m.name + "' is listed twice");
@@ -96,7 +110,8 @@ namespace {
 ScenarioConfig LoadScenario(const YAML::Node& root, const std::string& source) {
   const YamlFields f(source);
   f.CheckKeys(root, "",
-              {"trials", "modes", "reflective_mirrors", "method", "configurations_deg", "landmarks"});
+              {"trials", "modes", "reflective_mirrors", "method", "capture_waypoints", "configurations_deg",
+               "landmarks"});
   ScenarioConfig config;
   config.trials = static_cast<int>(f.IntegerOr(root, "trials", "", config.trials, 1, kMaxTrialsPerSession));
   const int mirrors =
@@ -119,6 +134,11 @@ ScenarioConfig LoadScenario(const YAML::Node& root, const std::string& source) {
     } catch (const std::invalid_argument& e) {
       f.Fail(modes[i], "modes[" + std::to_string(i) + "]", e.what());
     }
+  }
+  if (const YAML::Node w = root["capture_waypoints"]) {
+    if (!w.IsSequence())
+      f.Fail(w, "capture_waypoints", "expected a list of waypoint names ([] = the headset's)");
+    if (w.size() > 0) config.capture_waypoints = f.Strings(w, "capture_waypoints");
   }
   const YAML::Node configurations = f.Required(root, "configurations_deg", "configurations_deg");
   if (!configurations.IsSequence() || configurations.size() == 0) {

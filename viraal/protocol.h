@@ -5,7 +5,7 @@
 /// the landmarks of the paper's misalignment protocol. Every key is checked; unknown keys and bad
 /// values are errors naming the file, the line and what was expected.
 ///
-/// trials, modes, reflective_mirrors and method are optional: an absent key keeps the
+/// trials, modes, reflective_mirrors, method and capture_waypoints are optional: an absent key keeps the
 /// ScenarioConfig default, which is the value written here and the value viraal/viraal.yaml ships
 /// (protocol_test.cc checks that the three agree); configurations_deg and landmarks are required.
 /// @code{.yaml}
@@ -13,6 +13,8 @@
 /// modes: [ar_reflective, ar]       # run order; each of ar_reflective | ar, no repeats
 /// reflective_mirrors: 1            # num_mirrors of the ar_reflective mode, >= 1
 /// method: karcher                  # chordal | karcher | robust (registration_t.METHOD_*)
+/// capture_waypoints: []            # where each display captures: reflective_mirrors waypoint names
+///                                  # of the headset's walk, e.g. [foot_end] ([] = its hmd.displays)
 /// configurations_deg:              # required: K >= 1 joint vectors q1..q7 [deg], pairwise distinct
 ///   - [0, 30, 0, -60, 0, 45, 0]
 /// landmarks: [iiwa_link_4, iiwa_link_6, iiwa_link_ee]   # required: link origins, >= 1 (paper: 3)
@@ -49,6 +51,10 @@ struct ScenarioConfig {
       {"ar_reflective", orbed::alignment_trial_t::MODE_AR_REFLECTIVE, kDefaultReflectiveMirrors},
       {"ar", orbed::alignment_trial_t::MODE_AR, 0}};
   int8_t method{orbed::registration_t::METHOD_KARCHER};
+  /// Where each display of the reflective mode captures its frame, waypoints of the headset's walk
+  /// in display order, sent with START (session_control_t, contract change 6); empty = the
+  /// headset's own hmd.displays. Otherwise one per display of every reflective mode.
+  std::vector<std::string> capture_waypoints;
   std::vector<std::vector<double>> configurations_deg;
   std::vector<std::string> landmarks;
 };

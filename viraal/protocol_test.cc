@@ -17,6 +17,7 @@ void ExpectSameDefaults(const ScenarioConfig& a, const ScenarioConfig& b, const 
   SCOPED_TRACE(what);
   EXPECT_EQ(a.trials, b.trials);
   EXPECT_EQ(a.method, b.method);
+  EXPECT_EQ(a.capture_waypoints, b.capture_waypoints);
   ASSERT_EQ(a.modes.size(), b.modes.size());
   for (std::size_t i = 0; i < a.modes.size(); ++i) {
     EXPECT_EQ(a.modes[i].name, b.modes[i].name) << i;

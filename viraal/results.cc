@@ -111,8 +111,9 @@ std::string ResultsJson(const RunResults& r) {
           "||t_bar||_2 (orbed-registration MISALIGNMENT mean_error_norm_m); the pairs as the user "
           "annotated them by head gaze, triangulated by orbed-registration (landmarks \"gaze\"), or "
           "the link origins placed with the true X_WR and X_WV (landmarks \"truth\"; "
-          "truth_misalignment_mm always); for a mean: the truth's pairs of all the session's "
-          "configurations");
+          "truth_misalignment_mm always); for a mean, over all the session's configurations: the real "
+          "landmarks annotated in its trials against the virtual ones placed by the mean (landmarks "
+          "\"gaze_real\"), or the truth's pairs when a trial has no annotation");
   json.Key("landmarks").BeginArray();
   for (const std::string& name : r.landmarks) json.String(name);
   json.EndArray();
@@ -164,6 +165,10 @@ std::string ResultsJson(const RunResults& r) {
       WritePose(&json, t.X_WV);
       json.Key("X_WR");
       WritePose(&json, t.X_WR);
+      json.Key("annotated_real_W_m").BeginArray();
+      for (const Eigen::Vector3d& p : t.annotated_real_W_m)
+        json.Array(std::vector<double>{p.x(), p.y(), p.z()});
+      json.EndArray();
       if (t.tracking_faults.any()) {
         json.Key("tracking_faults").BeginObject();
         json.Key("losses").Int(t.tracking_faults.losses);
@@ -223,7 +228,10 @@ std::string ResultsTable(const RunResults& r) {
                        const ErrorMeasures& e) {
     out << PadRight(mode, 15) << PadRight(what, 8) << PadRight(q, 44)
         << PadLeft(Fixed(e.translation_error_mm, 1), 9) << PadLeft(Fixed(e.rotation_error_deg, 2), 9)
-        << PadLeft(Fixed(e.misalignment_mm, 1) + (e.landmarks == "gaze" ? "" : "*"), 10)
+        << PadLeft(Fixed(e.misalignment_mm, 1) + (e.landmarks == "gaze"        ? ""
+                                                  : e.landmarks == "gaze_real" ? "^"
+                                                                               : "*"),
+                   10)
         << PadLeft(Fixed(e.truth_misalignment_mm, 1), 10) << PadLeft(Fixed(e.base_translation_error_mm, 1), 9)
         << "\n";
   };
@@ -263,8 +271,10 @@ std::string ResultsTable(const RunResults& r) {
         << Fixed(stats.std, 1) << " mm\n";
   }
   out << "t = translation error at the robot centroid, R = rotation error, mis = a trial's landmark "
-         "misalignment ||t_bar||_2 from the landmarks the user annotated by gaze (* = from the truth's "
-         "landmarks: nobody annotated; every SE(3) mean), true mis = the same from the truth's landmarks, "
+         "misalignment ||t_bar||_2 from the landmarks the user annotated by gaze (^ = an SE(3) mean: the "
+         "real "
+         "landmarks as annotated in the session's trials, the virtual ones placed by the mean; * = from the "
+         "truth's landmarks: nobody annotated), true mis = the same from the truth's landmarks, "
          "base = translation error at the base origin; Table 1 = the paper's statistic: the norms of the "
          "per-axis means and standard deviations of t_bar over the trials\n";
   return out.str();
@@ -280,6 +290,7 @@ constexpr size_t kMaxTrials = 100000;
 constexpr size_t kMaxJoints = 64;
 constexpr double kMaxMeasure = 1e9;  // mm or deg: anything beyond is not a measure
 constexpr double kMaxCoordinate = 1e4;
+constexpr size_t kMaxAnnotatedLandmarks = 64;
 
 Eigen::Isometry3d ReadPose(const JsonFields& f, const JsonAt& at) {
   const std::vector<double> p = f.Numbers(f.Member(at, "position_m"), 3, -kMaxCoordinate, kMaxCoordinate);
@@ -307,9 +318,9 @@ ErrorMeasures ReadMeasures(const JsonFields& f, const JsonAt& at) {
   e.landmarks = "truth";
   e.truth_misalignment_mm = e.misalignment_mm;
   if (const auto landmarks = f.OptionalMember(at, "landmarks")) {
-    e.landmarks = f.String(*landmarks, 8);
-    if (e.landmarks != "gaze" && e.landmarks != "truth")
-      f.Fail(landmarks->key, "\"gaze\" or \"truth\"", &landmarks->value);
+    e.landmarks = f.String(*landmarks, 16);
+    if (e.landmarks != "gaze" && e.landmarks != "gaze_real" && e.landmarks != "truth")
+      f.Fail(landmarks->key, "\"gaze\", \"gaze_real\" or \"truth\"", &landmarks->value);
   }
   if (const auto truth = f.OptionalMember(at, "truth_misalignment_mm")) {
     e.truth_misalignment_mm = f.Number(*truth, 0, kMaxMeasure);
@@ -374,6 +385,13 @@ RunResults ParseResultsJson(const std::string& text, const std::string& source) 
       t.user_id = f.String(f.Member(t_at, "user_id"), kMaxName);
       t.X_WV = ReadPose(f, f.Member(t_at, "X_WV"));
       t.X_WR = ReadPose(f, f.Member(t_at, "X_WR"));
+      if (const auto annotated = f.OptionalMember(t_at, "annotated_real_W_m")) {
+        for (size_t l = 0, n = f.ArraySize(*annotated, kMaxAnnotatedLandmarks); l < n; ++l) {
+          const std::vector<double> p =
+              f.Numbers(f.Element(*annotated, l), 3, -kMaxCoordinate, kMaxCoordinate);
+          t.annotated_real_W_m.emplace_back(p[0], p[1], p[2]);
+        }
+      }
       if (const auto faults = f.OptionalMember(t_at, "tracking_faults")) {
         t.tracking_faults.losses = static_cast<int>(f.Integer(f.Member(*faults, "losses"), 0, 1000000));
         t.tracking_faults.relocalizations =

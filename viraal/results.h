@@ -19,11 +19,13 @@
 ///                  "trials": [ {"index", "q_deg", "translation_error_mm", "rotation_error_deg",
 ///                               "misalignment_mm", "base_translation_error_mm",
 ///                               "flange_translation_error_mm", "misalignment_axes_mm" [t̄x,t̄y,t̄z],
-///                               "misalignment_mean_pair_distance_mm", "landmarks" ("gaze" |
-///                               "truth"), "truth_misalignment_mm" (both absent in files written
+///                               "misalignment_mean_pair_distance_mm", "landmarks" ("gaze" | "gaze_real" (a
+///                               mean) | "truth"), "truth_misalignment_mm" (both absent in files written
 ///                               before ALIGNMENT_TRIAL's contract change 5: read as "truth" and
 ///                               misalignment_mm), "user_duration_s",
-///                               "user_id", "X_WV", "X_WR",
+///                               "user_id", "X_WV", "X_WR", "annotated_real_W_m" ([[x, y, z], ...]
+///                               [m], the triangulated real landmarks; [] without annotation; absent
+///                               in older files, read as []),
 ///                               "tracking_faults": {"losses", "relocalizations", "wait_s",
 ///                                                   "repeats"} (only on a trial whose user met
 ///                                                   a tracking fault while aligning: see
@@ -67,8 +69,10 @@ struct ErrorMeasures {
   Eigen::Vector3d misalignment_axes_mm{Eigen::Vector3d::Zero()};  ///< t̄ = mean |virtual − real| per axis
   double misalignment_mean_pair_distance_mm{0};                   ///< mean of the pair distances
   /// Where the landmark pairs of the three misalignment fields above came from: "gaze" (the user's
-  /// annotation, triangulated by orbed-registration: the paper's measurement) or "truth" (the link
-  /// origins placed with X_WR and X_WV: a trial nobody annotated, and every session mean).
+  /// annotation, triangulated by orbed-registration: the paper's measurement), "gaze_real" (a
+  /// session mean: the real landmarks as annotated in the session's trials, the virtual ones placed
+  /// by the mean) or "truth" (the link origins placed with X_WR and X_WV: a trial nobody annotated,
+  /// and a mean of a session with such a trial).
   std::string landmarks{"truth"};
   /// ‖t̄‖₂ of the truth pairs, whatever `landmarks` says (= misalignment_mm when it says "truth").
   double truth_misalignment_mm{0};
@@ -93,6 +97,10 @@ struct TrialResult {
   Eigen::Isometry3d X_WV{Eigen::Isometry3d::Identity()};
   Eigen::Isometry3d X_WR{Eigen::Isometry3d::Identity()};
   TrackingFaults tracking_faults;  ///< written only when any()
+  /// The real robot's landmarks as the user annotated them, triangulated (in the headset's map, W)
+  /// [m], in the scenario's landmark order; empty when nobody annotated. What the session mean is
+  /// measured against (exchange.h MeanError), kept here so that a resumed run measures it too.
+  std::vector<Eigen::Vector3d> annotated_real_W_m;
 };
 
 struct MeanResult {

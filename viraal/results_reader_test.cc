@@ -141,6 +141,14 @@ TEST(ViraalResultsReader, DamagedDocumentsAreRefusedNamingTheKey) {
                   {"losses", 1}, {"relocalizations", 1}, {"wait_s", 1e6}, {"repeats", 0}};
             }).substr(0, 54),
             "r.json: sessions[0].trials[0].tracking_faults.wait_s: ");
+  EXPECT_EQ(RefusalOf([](nlohmann::json& d) {
+              d["sessions"][0]["trials"][0]["annotated_real_W_m"][1] = {0.1, 0.2};
+            }).substr(0, 54),
+            "r.json: sessions[0].trials[0].annotated_real_W_m[1]: e");
+  EXPECT_EQ(RefusalOf([](nlohmann::json& d) {
+              d["sessions"][0]["trials"][0]["annotated_real_W_m"][0] = {0.1, 0.2, 1e5};
+            }).substr(0, 57),
+            "r.json: sessions[0].trials[0].annotated_real_W_m[0][2]: e");
   EXPECT_THROW(ReadResultsFile("/nonexistent/results.json"), JsonReadError);
 }
 

@@ -12,6 +12,7 @@
 #include "base/source_paths.h"
 #include "base/units.h"
 #include "sim/robot_model.h"
+#include "viraal/exchange.h"
 #include "viraal/metrics.h"
 #include "viraal/protocol.h"
 #include "viraal/results.h"
@@ -101,6 +102,44 @@ TEST(ViraalErrors, MeanOverConfigurationsAveragesPointErrorsAndPoolsLandmarks) {
   EXPECT_THROW(EvaluateOverConfigurations(X_WR, X_WV, {}), std::invalid_argument);
 }
 
+// A session mean nobody annotated is measured against the real landmarks the user annotated in the
+// session's trials, its virtual landmarks placed by the mean itself: here the mean is 10 mm off in
+// x and the annotated real landmarks 2 mm off in y, so every pair differs by (10, -2, 0) mm.
+TEST(ViraalErrors, TheMeanIsMeasuredAgainstTheAnnotatedRealLandmarks) {
+  orbed::pose_t X_WR{};
+  X_WR.quaternion_wxyz[0] = 1;
+  orbed::registration_t mean{};
+  mean.X_WV_mean = X_WR;
+  mean.X_WV_mean.position_m[0] = 0.01;
+  RobotPoints a, b;
+  a.p_RL = {Eigen::Vector3d(1, 0, 0)};
+  b.p_RL = {Eigen::Vector3d(2, 0, 0), Eigen::Vector3d(0, 0, 3)};
+  const Eigen::Vector3d off(0, 0.002, 0);
+  const std::vector<std::vector<Eigen::Vector3d>> annotated = {{a.p_RL[0] + off},
+                                                               {b.p_RL[0] + off, b.p_RL[1] + off}};
+  const AlignmentError e = MeanError(X_WR, mean, {a, b}, annotated);
+  ASSERT_EQ(e.p_W_real_annotated.size(), 3u);
+  EXPECT_FALSE(e.virtual_annotated);
+  const orbed::misalignment_request_t request = MisalignmentRequest(e, "s", 0, 1);
+  ASSERT_EQ(request.num_pairs, 3);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_NEAR(request.p_W_virtual_m[k][0] - request.p_W_real_m[k][0], 0.01, 1e-15);
+    EXPECT_NEAR(request.p_W_virtual_m[k][1] - request.p_W_real_m[k][1], -0.002, 1e-15);
+    EXPECT_NEAR(request.p_W_virtual_m[k][2] - request.p_W_real_m[k][2], 0, 1e-15);
+  }
+  orbed::misalignment_t answer{};
+  EXPECT_EQ(Measures(e, answer).landmarks, "gaze_real");
+  // The truth's pairs stay: the mean alone is 10 mm off.
+  EXPECT_NEAR(Measures(e, answer).truth_misalignment_mm, 10.0, 1e-9);
+  // One trial without annotation, or none given: the truth's pairs alone.
+  EXPECT_TRUE(MeanError(X_WR, mean, {a, b}, {{a.p_RL[0]}, {}}).p_W_real_annotated.empty());
+  EXPECT_EQ(Measures(MeanError(X_WR, mean, {a, b}), answer).landmarks, "truth");
+  EXPECT_THROW(MeanError(X_WR, mean, {a, b}, {{a.p_RL[0]}}), std::invalid_argument);
+  EXPECT_THROW(MeanError(X_WR, mean, {a, b}, {{a.p_RL[0]}, {b.p_RL[0]}}), std::invalid_argument);
+  // The right total, the wrong split between the trials: refused, not shifted.
+  EXPECT_THROW(MeanError(X_WR, mean, {a, b}, {{a.p_RL[0], b.p_RL[0]}, {b.p_RL[1]}}), std::invalid_argument);
+}
+
 TEST(ViraalErrors, RobotPointsOfTheIiwaUpright) {
   const auto model = orbed::sim::RobotModel::LoadFile(Source("sim/models/iiwa7.urdf"));
   const RobotPointSet set(model, {"iiwa_link_4", "iiwa_link_6", "iiwa_link_ee"});
@@ -173,6 +212,11 @@ TEST(ScenarioConfig, ErrorsNameTheLineAndTheFix) {
       "configurations_deg:\n  - [0, 30, 0, -60, 0, 45, 0]\n  - [0, 30, 0, -60, 0, 45, 0.5]\nlandmarks: [a]\n",
       "configurations 0 and 1 are the same");
   ExpectError("landmarks: [a]\n", "s.yaml:1: configurations_deg: missing");
+  ExpectError(good + "reflective_mirrors: 2\ncapture_waypoints: [foot_end]\n",
+              "capture_waypoints: 1 waypoint\\(s\\) for the 2 display\\(s\\) of mode ar_reflective");
+  ExpectError(good + "capture_waypoints: foot_end\n", "s.yaml:4: capture_waypoints: expected a list");
+  EXPECT_EQ(LoadScenarioString(good + "capture_waypoints: [head_end]\n", "s.yaml").capture_waypoints,
+            (std::vector<std::string>{"head_end"}));
   EXPECT_THROW(ParseJointList("1,2,x", "--q-deg"), std::invalid_argument);
   EXPECT_EQ(ParseJointList("1, 2.5,-3", "--q-deg"), (std::vector<double>{1, 2.5, -3}));
 }

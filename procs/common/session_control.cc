@@ -1,5 +1,7 @@
 #include "procs/common/session_control.h"
 
+#include <algorithm>
+
 #include <orbed/alignment_trial_t.hpp>
 #include <orbed/registration_t.hpp>
 
@@ -76,6 +78,27 @@ std::variant<SessionCommand, Refusal> CheckSessionControl(const orbed::session_c
   }
   error = CheckEnum(msg.method, RT::METHOD_CHORDAL, RT::METHOD_ROBUST, "SESSION_CONTROL.method");
   if (!error.empty()) return Refusal{"method", error};
+  const std::string start = "SESSION_CONTROL START '" + msg.session_id + "': ";
+  if (msg.num_capture_waypoints < 0 ||
+      static_cast<size_t>(msg.num_capture_waypoints) != msg.capture_waypoint.size()) {
+    return Refusal{"capture_waypoint", start + "num_capture_waypoints " +
+                                           std::to_string(msg.num_capture_waypoints) + " for " +
+                                           std::to_string(msg.capture_waypoint.size()) + " names"};
+  }
+  if (msg.num_capture_waypoints != 0 && msg.num_capture_waypoints != msg.num_mirrors) {
+    return Refusal{"capture_waypoint", start + std::to_string(msg.num_capture_waypoints) +
+                                           " capture waypoints for " + std::to_string(msg.num_mirrors) +
+                                           " display(s), expected none or one per display"};
+  }
+  for (const std::string& name : msg.capture_waypoint) {
+    const bool printable = std::all_of(name.begin(), name.end(), [](char c) { return c > ' ' && c < 127; });
+    if (name.empty() || name.size() > kMaxWaypointNameLength || !printable) {
+      return Refusal{"capture_waypoint", start + "a capture waypoint name must be 1.." +
+                                             std::to_string(kMaxWaypointNameLength) +
+                                             " printable bytes without spaces"};
+    }
+  }
+  command.capture_waypoints = msg.capture_waypoint;
   return command;
 }
 

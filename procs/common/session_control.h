@@ -8,13 +8,17 @@
 ///   - session_id: 1..kMaxSessionIdLength bytes;
 ///   - command: START, RESET, COMPUTE, STOP or REQUEST_TRIAL;
 ///   - START only: display_mode MODE_AR with num_mirrors 0, or MODE_AR_REFLECTIVE with
-///     1..kMaxMirrors mirrors; method one of registration_t's METHOD_*. The other commands name a
-///     session that START opened; their mode, mirror and method fields are not read.
+///     1..kMaxMirrors mirrors; method one of registration_t's METHOD_*; capture waypoints (contract
+///     change 6): none, or exactly num_mirrors names of 1..kMaxWaypointNameLength printable bytes
+///     (num_capture_waypoints equal to the array's length). The other commands name a session that
+///     START opened; their mode, mirror, method and waypoint fields are not read.
 /// A repeated START of the session that is already active with the same mode and mirrors is a
 /// no-op for every reader (SessionCommand::RepeatsStartOf tells it): it neither clears trials nor
-/// restarts the trial count. How many displays a headset has placed is that headset's own check.
+/// restarts the trial count. The headset refuses one that names other capture waypoints. How many displays a
+/// headset has placed is that headset's own check.
 ///
-/// Refusal keys are "<field>" (session_id, command, display_mode, num_mirrors, method); processes
+/// Refusal keys are "<field>" (session_id, command, display_mode, num_mirrors, method,
+/// capture_waypoint); processes
 /// count them as "<channel>/<field>" on PROCESS_STATUS.
 ///
 /// request_id is not checked (any value): a reader acts on a nonzero id once and answers a repeat
@@ -25,6 +29,7 @@
 #include <cstdint>
 #include <string>
 #include <variant>
+#include <vector>
 
 #include <orbed/session_control_t.hpp>
 
@@ -32,6 +37,7 @@ namespace orbed {
 
 inline constexpr size_t kMaxSessionIdLength = 256;
 inline constexpr int32_t kMaxMirrors = 64;
+inline constexpr size_t kMaxWaypointNameLength = 64;
 
 /// Why a message was refused: `key` names the field (the counter's class), `reason` is one line.
 struct Refusal {
@@ -48,8 +54,11 @@ struct SessionCommand {
   int32_t num_mirrors{0};  ///< (START; else as sent)
   int8_t method{0};        ///< registration_t::METHOD_* (START; else as sent)
   int64_t request_id{0};   ///< the sender's request id; 0 = none
+  /// Where each display captures (START; empty = the headset's own configuration).
+  std::vector<std::string> capture_waypoints;
 
-  /// True when this START names the active session `session_id` with the same mode and mirrors.
+  /// True when this START names the active session `session_id` with the same mode and mirrors
+  /// (a reader to whom the capture waypoints matter compares those too).
   bool RepeatsStartOf(const std::string& active_session_id, int8_t active_display_mode,
                       int32_t active_num_mirrors) const {
     return kind == Kind::kStart && session_id == active_session_id && display_mode == active_display_mode &&

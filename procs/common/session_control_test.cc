@@ -46,6 +46,38 @@ TEST(SessionControl, ValidStartBecomesACommandWithItsFields) {
   EXPECT_FALSE(command.RepeatsStartOf("other", AT::MODE_AR_REFLECTIVE, 2));
 }
 
+// Contract change 6: a START may name where each display captures, none or one per display, each
+// a printable name of 1..64 bytes; the command carries them.
+TEST(SessionControl, CaptureWaypointsAreNoneOrOnePerDisplay) {
+  SC msg = Start(AT::MODE_AR_REFLECTIVE, 2);
+  msg.capture_waypoint = {"foot_end", "side"};
+  msg.num_capture_waypoints = 2;
+  const auto checked = CheckSessionControl(msg);
+  ASSERT_TRUE(std::holds_alternative<SessionCommand>(checked));
+  EXPECT_EQ(std::get<SessionCommand>(checked).capture_waypoints,
+            (std::vector<std::string>{"foot_end", "side"}));
+  msg.num_capture_waypoints = 3;  // the count must be the array's
+  EXPECT_EQ(RefusalKey(msg), "capture_waypoint");
+  msg.num_capture_waypoints = -1;
+  EXPECT_EQ(RefusalKey(msg), "capture_waypoint");
+  msg.capture_waypoint = {"foot_end"};
+  msg.num_capture_waypoints = 1;  // one for two displays
+  EXPECT_EQ(RefusalKey(msg), "capture_waypoint");
+  msg.capture_waypoint = {"foot_end", ""};
+  msg.num_capture_waypoints = 2;
+  EXPECT_EQ(RefusalKey(msg), "capture_waypoint");
+  msg.capture_waypoint = {"foot_end", std::string(kMaxWaypointNameLength + 1, 'w')};
+  EXPECT_EQ(RefusalKey(msg), "capture_waypoint");
+  msg.capture_waypoint = {"foot_end", "head end"};
+  EXPECT_EQ(RefusalKey(msg), "capture_waypoint");
+  msg.capture_waypoint = {"foot_end", std::string(kMaxWaypointNameLength, 'w')};
+  EXPECT_EQ(RefusalKey(msg), "");
+  msg = Start(AT::MODE_AR, 0);
+  msg.capture_waypoint = {"foot_end"};
+  msg.num_capture_waypoints = 1;  // AR only has no display
+  EXPECT_EQ(RefusalKey(msg), "capture_waypoint");
+}
+
 TEST(SessionControl, EachFieldIsRefusedByName) {
   SC msg = Start(AT::MODE_AR, 0);
   EXPECT_EQ(RefusalKey(msg), "");

@@ -506,7 +506,13 @@ void ViraalConductor::Step() {
                   "), expected " + std::to_string(options_.config.trials));
           return;
         }
-        pending_error_ = viraal::MeanError(robot_state_->X_WR, mean, session_points_);
+        try {
+          pending_error_ = viraal::MeanError(robot_state_->X_WR, mean, session_points_,
+                                             viraal::AnnotatedRealLandmarks(results_.sessions.back()));
+        } catch (const std::invalid_argument& e) {
+          FailRun(e.what());
+          return;
+        }
         Enter(Phase::kAwaitMeanMisalignment);
         SendMisalignment(pending_error_);
       } else if (waited > options_.reply_timeout_s) {
@@ -559,6 +565,10 @@ orbed::session_control_t ViraalConductor::SendSessionControl(int8_t command) {
   msg.num_mirrors = mode.num_mirrors;
   msg.method = options_.config.method;
   msg.request_id = NewRequestId();
+  if (command == orbed::session_control_t::START && mode.num_mirrors > 0) {
+    msg.capture_waypoint = options_.config.capture_waypoints;  // empty: the headset's own
+    msg.num_capture_waypoints = static_cast<int32_t>(msg.capture_waypoint.size());
+  }
   Publish(options_.session_control_channel, msg);
   return msg;
 }
@@ -629,7 +639,8 @@ void ViraalConductor::SendMisalignment(const viraal::AlignmentError& error) {
 void ViraalConductor::FinishTrial() {
   const orbed::alignment_trial_t& trial = *trial_;
   const viraal::TrialResult result =
-      viraal::TrialResultFrom(trial, robot_state_->X_WR, viraal::Measures(pending_error_, *misalignment_));
+      viraal::TrialResultFrom(trial, robot_state_->X_WR, viraal::Measures(pending_error_, *misalignment_),
+                              pending_error_.p_W_real_annotated);
   results_.sessions.back().trials.push_back(result);
   Say(StepLabel() + ": robot at q=" + JointList(result.q_deg, 1) + " deg (reached in " + Fixed(reach_s_, 1) +
       " s); aligned in " + Fixed(trial.duration_s, 1) + " s of user time: " +

@@ -30,7 +30,10 @@
 /// annotated landmark pairs (the paper's measurement, in the headset's map), or for a trial without
 /// annotation of the truth's pairs real = X_WR·X_RL(q)·0, virtual = X_WV·X_RL(q)·0, q = the trial's
 /// joint_position [rad]; truth_misalignment_mm always from the truth's pairs. A session mean
-/// X_WV_mean is measured over the session's trial configurations, with the truth's pairs.
+/// X_WV_mean is measured over the session's trial configurations: against the real landmarks the
+/// user annotated in the session's trials, its virtual ones placed by the mean (landmarks
+/// "gaze_real"; kept trials carry theirs in results.json), or with the truth's pairs when a trial
+/// has no annotation.
 ///
 /// Inputs: each On*() takes a decoded message and the time it arrived; Tick() only the time. Every
 /// message is checked (sizes, finite values, unit quaternions, enum ranges); a bad one is refused

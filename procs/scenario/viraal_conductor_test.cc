@@ -172,6 +172,30 @@ bool Contains(const std::string& text, const std::string& part) {
   return text.find(part) != std::string::npos;
 }
 
+// The scenario chooses where the reflective display captures (contract change 6): its START says
+// so; without a choice (the shipped file) the START names none and the headset uses its own.
+TEST(ViraalConductor, TheReflectiveStartCarriesTheScenariosCaptureWaypoints) {
+  for (const bool chosen : {false, true}) {
+    ConductorOptions options = Bench::Options();
+    if (chosen) options.config.capture_waypoints = {"head_end"};
+    Bench bench(options);
+    bench.StartAndCheckPlans();
+    const std::vector<Publication> controls = bench.Sent("SESSION_CONTROL");
+    ASSERT_FALSE(controls.empty());
+    const auto start = std::get<orbed::session_control_t>(controls[0].message);
+    ASSERT_EQ(start.command, +orbed::session_control_t::START);
+    ASSERT_GT(start.num_mirrors, 0);
+    EXPECT_EQ(start.num_capture_waypoints, chosen ? 1 : 0);
+    EXPECT_EQ(start.capture_waypoint,
+              chosen ? std::vector<std::string>{"head_end"} : std::vector<std::string>{});
+  }
+  ConductorOptions two = Bench::Options();
+  two.config.capture_waypoints = {"foot_end", "head_end"};  // two for the one display
+  EXPECT_THROW(ViraalConductor(two, orbed::sim::RobotModel::LoadFile(orbed::SourceTreePath(
+                                        orbed::sim::RobotModel::kDefaultUrdfRelativePath))),
+               std::invalid_argument);
+}
+
 TEST(ViraalConductor, InputsBeforeStartAreALogicError) {
   Bench bench;
   EXPECT_THROW(bench.Tick(), std::logic_error);
@@ -1053,6 +1077,16 @@ TEST(ViraalConductor, AResumedSessionWithAllItsTrialsAsksForItsMeanAtOnce) {
   ASSERT_EQ(stopped.conductor().results().sessions[0].trials.size(), 3u);
   ConductorOptions options = Bench::Options();
   options.kept_sessions = KeptSessions(stopped.conductor().results(), "emu", 0, options.config);
+  // The kept trials carry the real landmarks their user annotated (results.json's
+  // annotated_real_W_m): the mean is measured against them, trial by trial, in order.
+  std::vector<std::vector<double>> annotated;
+  for (size_t i = 0; i < options.kept_sessions[0].trials.size(); ++i) {
+    auto& kept = options.kept_sessions[0].trials[i].annotated_real_W_m;
+    for (int l = 0; l < 3; ++l) {
+      kept.emplace_back(0.1 * static_cast<double>(i), 0.01 * l, 1.0);
+      annotated.push_back({0.1 * static_cast<double>(i), 0.01 * l, 1.0});
+    }
+  }
   Bench resumed(options);
   resumed.Start();
   resumed.Send(RobotState(std::vector<double>(7, 0.0)));
@@ -1064,6 +1098,21 @@ TEST(ViraalConductor, AResumedSessionWithAllItsTrialsAsksForItsMeanAtOnce) {
             (std::vector<std::string>{"SESSION_CONTROL START", "ALIGNMENT_TRIAL", "ALIGNMENT_TRIAL",
                                       "ALIGNMENT_TRIAL", "SESSION_CONTROL COMPUTE"}));
   EXPECT_EQ(resumed.conductor().phase(), Phase::kAwaitMean);
+  const auto compute = std::get<orbed::session_control_t>(resumed.sent().back().message);
+  orbed::registration_t mean{};
+  mean.utime = compute.utime;
+  mean.session_id = compute.session_id;
+  mean.reason = orbed::registration_t::REASON_COMPUTE;
+  mean.method = orbed::registration_t::METHOD_KARCHER;
+  mean.valid = true;
+  mean.X_WV_mean = ToPose(SceneBase());
+  mean.num_trials = mean.num_used = 3;
+  mean.request_id = compute.request_id;
+  resumed.Send(mean);
+  ASSERT_EQ(resumed.Sent("MISALIGNMENT_REQUEST").size(), 1u);
+  const auto request =
+      std::get<orbed::misalignment_request_t>(resumed.Sent("MISALIGNMENT_REQUEST")[0].message);
+  EXPECT_EQ(request.p_W_real_m, annotated);
 }
 
 // The request id a publication carries (STOP and IIWA_COMMAND, which are not retried: none).

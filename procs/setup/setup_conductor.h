@@ -139,7 +139,8 @@ struct SetupRun {
 /// assistant_reached_deg, error_deg, twisting, ranges, execution_s, alignment_s (null for fixed),
 /// person_scale, registration ("measured" | "truth" | null for fixed), docking_tip_mm, docking_axis_deg,
 /// min_clearance_m (null when unknown), contact, collision_stops, alignment: null | {session_id, trials,
-/// translation_error_mm, rotation_error_deg, misalignment_mm} of the mean}]}.
+/// translation_error_mm, rotation_error_deg, misalignment_mm} of the mean (misalignment_mm as the
+/// conductor measured it: viraal/exchange.h MeanError)}]}.
 std::string SetupRunJson(const SetupRun& run, bool partial);
 
 /// setup_results.json read back (orbed-setup --resume; `path` may be its folder), checked like any

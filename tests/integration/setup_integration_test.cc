@@ -64,7 +64,7 @@ std::vector<Msg> Logged(const std::string& log_dir, const std::string& channel) 
     logger::LogEvent event;
     while (scanner.Next(&event)) {
       if (event.channel != channel) continue;
-      Msg msg;
+      Msg msg{};
       EXPECT_EQ(msg.decode(event.data, 0, static_cast<int>(event.size)), static_cast<int>(event.size))
           << channel;
       out.push_back(std::move(msg));

@@ -10,6 +10,8 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <set>
 #include <string>
 
@@ -78,6 +80,49 @@ TEST(ViraalRun, LaunchFileRunsTheStudyAndWritesResults) {
     EXPECT_TRUE(manifest["channels"][channel]) << channel << " missing from the log";
   }
   EXPECT_EQ(manifest["channels"]["ALIGNMENT_TRIAL"]["events"].as<int>(), 6);
+}
+
+// The scenario chooses where the display captures (contract change 6): a scenario naming head_end,
+// the alignment viewpoint, runs over the bus (sim, registration, headset, conductor) to the same
+// results.json as orbed-user-study with that scenario, which differs from the default choice's.
+TEST(ViraalRun, TheScenariosCaptureWaypointReachesTheHeadset) {
+  const std::string dir = MakeTempDir("viraal_capture");
+  std::string text;
+  {
+    std::ifstream in(SourcePath("viraal/viraal.yaml"));
+    text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  auto replaced = [](std::string s, const std::string& from, const std::string& to) {
+    const size_t at = s.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    return at == std::string::npos ? s : s.replace(at, from.size(), to);
+  };
+  text = replaced(replaced(text, "modes: [ar_reflective, ar]", "modes: [ar_reflective]"), "trials: 3",
+                  "trials: 2");
+  const std::string chosen = replaced(text, "capture_waypoints: []", "capture_waypoints: [head_end]");
+  for (const auto& [name, content] : {std::pair{"default", text}, std::pair{"chosen", chosen}}) {
+    std::ofstream(dir + "/" + name + ".yaml") << content;
+    RunningProcess study({BinPath("orbed-user-study"), "--scenario", dir + "/" + name + ".yaml", "--run-id",
+                          "capture", "--json", dir + "/" + name + ".json", "--quiet"});
+    ASSERT_TRUE(study.Wait(60));
+    ASSERT_EQ(study.exit_code(), 0) << name;
+  }
+
+  RunningProcess sim({BinPath("orbed-iiwa-sim"), "--name", "sim"});
+  RunningProcess registration({BinPath("orbed-registration"), "--name", "registration"});
+  RunningProcess hmd({BinPath("orbed-hmd"), "--name", "hmd"});
+  RunningProcess conductor({BinPath("orbed-scenario"), "--name", "scenario", "--scenario",
+                            dir + "/chosen.yaml", "--run-id", "capture", "--results-dir", dir,
+                            "--startup-timeout-s", "20"});
+  ASSERT_TRUE(conductor.Wait(120)) << "orbed-scenario did not finish";
+  ASSERT_EQ(conductor.exit_code(), 0);
+  const YAML::Node bus = YAML::LoadFile(dir + "/results.json");
+  ExpectSameTree(YAML::LoadFile(dir + "/chosen.json"), bus, "results", {"started_utime", "duration_s"});
+  // Captured at head_end instead of foot_end: other frames, so another alignment.
+  const YAML::Node by_default = YAML::LoadFile(dir + "/default.json");
+  ASSERT_EQ(bus["sessions"][0]["trials"].size(), 2u);
+  EXPECT_NE(bus["sessions"][0]["trials"][0]["X_WV"]["position_m"][0].as<double>(),
+            by_default["sessions"][0]["trials"][0]["X_WV"]["position_m"][0].as<double>());
 }
 
 }  // namespace
