@@ -99,6 +99,7 @@ viraal::RunResults RunViraalStudy(const StudyOptions& options) {
     session.session_id = options.run_id + "-" + mode.name;
     session.display_mode = mode.display_mode;
     session.num_mirrors = mode.num_mirrors;
+    if (mode.num_mirrors > 0) session.capture_waypoints = scenario.capture_waypoints;
     service.HandleSessionControl(
         Control(orbed::session_control_t::START, session.session_id, mode, scenario.method));
 

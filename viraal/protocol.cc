@@ -1,6 +1,7 @@
 #include "viraal/protocol.h"
 
 #include "procs/common/alignment_trial.h"
+#include "procs/common/session_control.h"
 
 #include <cmath>
 #include <fstream>
@@ -66,9 +67,9 @@ void ValidateScenarioConfig(const ScenarioConfig& config, int num_joints) {
     }
   }
   for (const std::string& w : config.capture_waypoints) {
-    if (w.empty() || w.size() > 64 || w.find_first_of(" \t\n") != std::string::npos)
-      throw std::invalid_argument("capture_waypoints: '" + w +
-                                  "' is not a waypoint name (1..64 bytes, no spaces)");
+    if (!IsWaypointName(w))
+      throw std::invalid_argument("capture_waypoints: '" + w + "' is not a waypoint name (1.." +
+                                  std::to_string(kMaxWaypointNameLength) + " printable bytes, no spaces)");
   }
   std::set<std::string> seen;
   for (const ModeSpec& m : config.modes) {

@@ -14,6 +14,7 @@
 #include "base/json_fields.h"
 #include "base/replace_file.h"
 #include "base/stats.h"
+#include "procs/common/session_control.h"
 #include "viraal/paper_reference.h"
 
 namespace orbed::viraal {
@@ -153,6 +154,11 @@ std::string ResultsJson(const RunResults& r) {
     json.Key("session_id").String(s.session_id);
     json.Key("display_mode").Int(s.display_mode);
     json.Key("num_mirrors").Int(s.num_mirrors);
+    if (!s.capture_waypoints.empty()) {
+      json.Key("capture_waypoints").BeginArray();
+      for (const std::string& w : s.capture_waypoints) json.String(w);
+      json.EndArray();
+    }
     json.Key("trials").BeginArray();
     for (const TrialResult& t : s.trials) {
       json.BeginObject();
@@ -374,6 +380,16 @@ RunResults ParseResultsJson(const std::string& text, const std::string& source) 
     s.session_id = f.String(f.Member(at, "session_id"), kMaxName);
     s.display_mode = static_cast<int>(f.Integer(f.Member(at, "display_mode"), 0, 1));
     s.num_mirrors = static_cast<int>(f.Integer(f.Member(at, "num_mirrors"), 0, 64));
+    if (const auto waypoints = f.OptionalMember(at, "capture_waypoints")) {
+      for (size_t k = 0, m = f.ArraySize(*waypoints, static_cast<size_t>(s.num_mirrors)); k < m; ++k) {
+        const JsonAt w = f.Element(*waypoints, k);
+        s.capture_waypoints.push_back(f.String(w, kMaxWaypointNameLength));
+        if (!IsWaypointName(s.capture_waypoints.back()))
+          f.Fail(w.key, "a waypoint name (printable, no spaces)", &w.value);
+      }
+      if (static_cast<int>(s.capture_waypoints.size()) != s.num_mirrors)
+        f.Fail(waypoints->key, "one waypoint per display (" + std::to_string(s.num_mirrors) + ")");
+    }
     const JsonAt trials = f.Member(at, "trials");
     for (size_t k = 0, m = f.ArraySize(trials, kMaxTrials); k < m; ++k) {
       const JsonAt t_at = f.Element(trials, k);

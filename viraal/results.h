@@ -15,7 +15,8 @@
 ///   "landmarks" (link names), "X_WR" (truth at the first trial), "configurations_deg",
 ///   "rejected_inputs" (count of invalid messages the scenario refused),
 ///   "paper_reference" (Table 1 / Sec. III-B figures, mm),
-///   "sessions": [ {"mode", "session_id", "display_mode", "num_mirrors",
+///   "sessions": [ {"mode", "session_id", "display_mode", "num_mirrors", "capture_waypoints" (only
+///                  when the scenario chose them: one name per display; absent: the headset's own),
 ///                  "trials": [ {"index", "q_deg", "translation_error_mm", "rotation_error_deg",
 ///                               "misalignment_mm", "base_translation_error_mm",
 ///                               "flange_translation_error_mm", "misalignment_axes_mm" [t̄x,t̄y,t̄z],
@@ -120,6 +121,9 @@ struct SessionResult {
   std::string session_id;
   int display_mode{0};
   int num_mirrors{0};
+  /// Where the displays captured: the waypoint names the conductor sent in START (one per
+  /// display); empty: the headset's own (hmd.displays), and always for a mode without displays.
+  std::vector<std::string> capture_waypoints;
   std::vector<TrialResult> trials;
   std::optional<MeanResult> mean;
 };

@@ -86,6 +86,12 @@ TEST(ViraalResultsReader, PartialRunsAndTheirOriginSurvive) {
   EXPECT_EQ(back.resumed_from, "logs/x/results.json");
   EXPECT_FALSE(back.sessions[1].mean.has_value());
   EXPECT_EQ(back.sessions[1].trials.size(), 1u);
+  // Capture waypoints are written only when the scenario chose them, and read back.
+  EXPECT_EQ(text.find("capture_waypoints"), std::string::npos);
+  r.sessions[0].capture_waypoints = {"head_end"};
+  const RunResults chosen = ParseResultsJson(ResultsJson(r), "chosen.json");
+  EXPECT_EQ(chosen.sessions[0].capture_waypoints, (std::vector<std::string>{"head_end"}));
+  EXPECT_TRUE(chosen.sessions[1].capture_waypoints.empty());
 }
 
 // A trial's tracking faults are written only when there were any, and read back.
@@ -149,6 +155,16 @@ TEST(ViraalResultsReader, DamagedDocumentsAreRefusedNamingTheKey) {
               d["sessions"][0]["trials"][0]["annotated_real_W_m"][0] = {0.1, 0.2, 1e5};
             }).substr(0, 57),
             "r.json: sessions[0].trials[0].annotated_real_W_m[0][2]: e");
+  EXPECT_EQ(RefusalOf([](nlohmann::json& d) {
+              d["sessions"][0]["capture_waypoints"] = {"head end"};
+            }).substr(0, 55),
+            "r.json: sessions[0].capture_waypoints[0]: expected a wa");
+  EXPECT_EQ(RefusalOf([](nlohmann::json& d) {
+              d["sessions"][0]["capture_waypoints"] = {"a", "b"};
+            }).substr(0, 40),
+            "r.json: sessions[0].capture_waypoints: e");
+  EXPECT_EQ(RefusalOf([](nlohmann::json& d) { d["sessions"][1]["capture_waypoints"] = {"a"}; }).substr(0, 40),
+            "r.json: sessions[1].capture_waypoints: e");
   EXPECT_THROW(ReadResultsFile("/nonexistent/results.json"), JsonReadError);
 }
 

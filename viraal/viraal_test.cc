@@ -215,6 +215,10 @@ TEST(ScenarioConfig, ErrorsNameTheLineAndTheFix) {
   ExpectError(good + "reflective_mirrors: 2\ncapture_waypoints: [foot_end]\n",
               "capture_waypoints: 1 waypoint\\(s\\) for the 2 display\\(s\\) of mode ar_reflective");
   ExpectError(good + "capture_waypoints: foot_end\n", "s.yaml:4: capture_waypoints: expected a list");
+  ExpectError(good + "capture_waypoints: [\"foot end\"]\n",
+              "capture_waypoints: 'foot end' is not a waypoint name");
+  ExpectError(good + "capture_waypoints: [" + std::string(65, 'w') + "]\n",
+              "is not a waypoint name \\(1..64");
   EXPECT_EQ(LoadScenarioString(good + "capture_waypoints: [head_end]\n", "s.yaml").capture_waypoints,
             (std::vector<std::string>{"head_end"}));
   EXPECT_THROW(ParseJointList("1,2,x", "--q-deg"), std::invalid_argument);

@@ -8,6 +8,12 @@
 #include "procs/common/validation.h"
 
 namespace orbed {
+
+bool IsWaypointName(const std::string& name) {
+  return !name.empty() && name.size() <= kMaxWaypointNameLength &&
+         std::all_of(name.begin(), name.end(), [](char c) { return c > ' ' && c < 127; });
+}
+
 namespace {
 
 using SC = orbed::session_control_t;
@@ -91,8 +97,7 @@ std::variant<SessionCommand, Refusal> CheckSessionControl(const orbed::session_c
                                            " display(s), expected none or one per display"};
   }
   for (const std::string& name : msg.capture_waypoint) {
-    const bool printable = std::all_of(name.begin(), name.end(), [](char c) { return c > ' ' && c < 127; });
-    if (name.empty() || name.size() > kMaxWaypointNameLength || !printable) {
+    if (!IsWaypointName(name)) {
       return Refusal{"capture_waypoint", start + "a capture waypoint name must be 1.." +
                                              std::to_string(kMaxWaypointNameLength) +
                                              " printable bytes without spaces"};

@@ -39,6 +39,10 @@ inline constexpr size_t kMaxSessionIdLength = 256;
 inline constexpr int32_t kMaxMirrors = 64;
 inline constexpr size_t kMaxWaypointNameLength = 64;
 
+/// A capture waypoint's name as SESSION_CONTROL carries it (and a scenario file names it):
+/// 1..kMaxWaypointNameLength printable ASCII bytes, no spaces.
+bool IsWaypointName(const std::string& name);
+
 /// Why a message was refused: `key` names the field (the counter's class), `reason` is one line.
 struct Refusal {
   std::string key;

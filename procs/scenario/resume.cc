@@ -47,6 +47,17 @@ std::vector<viraal::SessionResult> KeptSessions(const viraal::RunResults& earlie
       throw refuse(where + " is not this scenario's mode " + mode.name + " (session '" + run_id + "-" +
                    mode.name + "', " + std::to_string(mode.num_mirrors) + " mirror(s))");
     }
+    const std::vector<std::string> waypoints =
+        mode.num_mirrors > 0 ? config.capture_waypoints : std::vector<std::string>{};
+    if (s.capture_waypoints != waypoints) {
+      const auto list = [](const std::vector<std::string>& names) {
+        std::string text;
+        for (const std::string& n : names) text += (text.empty() ? "" : ", ") + n;
+        return names.empty() ? std::string("the headset's own") : "[" + text + "]";
+      };
+      throw refuse(where + " captured at " + list(s.capture_waypoints) + ", this scenario at " +
+                   list(waypoints));
+    }
     if (static_cast<int>(s.trials.size()) > config.trials) {
       throw refuse(where + " has " + std::to_string(s.trials.size()) + " trials, the scenario " +
                    std::to_string(config.trials));

@@ -13,12 +13,12 @@
 ///
 /// Refused (std::invalid_argument with the reason): results whose status is "ok" (nothing to run)
 /// or that have nothing left; another run id than the one asked for (it decides every trial);
-/// another seed; configurations, landmarks, modes (order, display mode, mirrors) or a trial count
-/// that are not this scenario's; sessions that are not the scenario's first ones in order with
-/// their ids "<run_id>-<mode>"; trials that are not 0, 1, ... at their configurations (trial i at
-/// configuration i mod K, within 1e-9 deg); more trials than the scenario's; a session with a
-/// mean but not all its trials; a session without a mean before one with a mean. (The averaging
-/// method is not in results.json and is not checked: the scenario's is used.)
+/// another seed; configurations, landmarks, modes (order, display mode, mirrors), where a
+/// session's displays captured (capture_waypoints) or a trial count that are not this scenario's; sessions
+/// that are not the scenario's first ones in order with their ids "<run_id>-<mode>"; trials that are not 0,
+/// 1, ... at their configurations (trial i at configuration i mod K, within 1e-9 deg); more trials than the
+/// scenario's; a session with a mean but not all its trials; a session without a mean before one with a mean.
+/// (The averaging method is not in results.json and is not checked: the scenario's is used.)
 
 #include <cstdint>
 #include <string>

@@ -99,6 +99,21 @@ TEST(Resume, RefusesWhatDoesNotBelongToThisRun) {
   EXPECT_EQ(RefusalOf(Stopped(2), "pinned", 1, config),
             prefix + "it has more sessions than this scenario's modes");
   EXPECT_EQ(RefusalOf(Stopped(0), "pinned", 1, config), prefix + "every session has its mean");
+  // The displays captured elsewhere than this scenario says (both ways round).
+  config = Shipped();
+  config.capture_waypoints = {"head_end"};
+  EXPECT_EQ(
+      RefusalOf(Stopped(2), "pinned", 1, config),
+      prefix +
+          "session 0 ('pinned-ar_reflective') captured at the headset's own, this scenario at [head_end]");
+  EXPECT_EQ(KeptSessions(With([](viraal::RunResults& r) { r.sessions[0].capture_waypoints = {"head_end"}; }),
+                         "pinned", 1, config)
+                .size(),
+            2u);
+  EXPECT_EQ(
+      RefusalOf(With([](viraal::RunResults& r) { r.sessions[0].capture_waypoints = {"head_end"}; })),
+      prefix +
+          "session 0 ('pinned-ar_reflective') captured at [head_end], this scenario at the headset's own");
 }
 
 TEST(Resume, RefusesTrialsAndSessionsOutOfOrder) {

@@ -581,6 +581,7 @@ void ViraalConductor::StartSession() {
     session.session_id = options_.run_id + "-" + mode.name;
     session.display_mode = mode.display_mode;
     session.num_mirrors = mode.num_mirrors;
+    if (mode.num_mirrors > 0) session.capture_waypoints = options_.config.capture_waypoints;
     results_.sessions.push_back(session);
   }
   const viraal::SessionResult& session = results_.sessions.back();

@@ -440,10 +440,15 @@ void SetupConductor::Step() {
     }
     case Phase::kTask:
       if (now_.t_s - phase_start_s_ > options_.task_timeout_s) {
+        if (pending_result_) {
+          return Fail(TaskId() +
+                      ": SETUP_RESULT came but no ROBOT_STATE with the arm at rest followed within " +
+                      Fixed(options_.task_timeout_s, 1) + " s: is orbed-iiwa-sim running?");
+        }
         return Fail(TaskId() + ": no SETUP_RESULT within " + Fixed(options_.task_timeout_s, 1) +
                     " s: is orbed-assistant running (and orbed-guidance)?");
       }
-      if (now_.t_s - last_send_s_ >= options_.task_resend_s) SendTask();
+      if (!pending_result_ && now_.t_s - last_send_s_ >= options_.task_resend_s) SendTask();
       return;
   }
 }
@@ -463,6 +468,12 @@ SetupConductor::Actions SetupConductor::OnRobotState(const orbed::robot_state_t&
     if (msg.motion_state == orbed::robot_state_t::MOTION_IN_COLLISION) task_contact_ = true;
   }
   robot_state_ = msg;
+  if (phase_ == Phase::kTask && pending_result_ && msg.motion_state != orbed::robot_state_t::MOTION_MOVING) {
+    const orbed::setup_result_t result = *pending_result_;
+    pending_result_.reset();
+    Record(result);
+    return Take();
+  }
   if (phase_ == Phase::kAlign) {
     ConductorActions more = alignment_->OnRobotState(msg, now);
     actions_.viraal.insert(actions_.viraal.end(), more.begin(), more.end());
@@ -497,6 +508,13 @@ SetupConductor::Actions SetupConductor::OnSetupResult(const orbed::setup_result_
     actions_.refusals.push_back({options_.setup_result_channel + "/field", problem});
     return Take();
   }
+  // The arm's joints are recorded from the first ROBOT_STATE handled after this answer with the
+  // arm not moving: the last one handled before it may predate the assistant's final reading.
+  if (!pending_result_) pending_result_ = msg;
+  return Take();
+}
+
+void SetupConductor::Record(const orbed::setup_result_t& msg) {
   SetupRecord r;
   r.task_id = task_.task_id;
   r.mode = Mode();
@@ -537,10 +555,9 @@ SetupConductor::Actions SetupConductor::OnSetupResult(const orbed::setup_result_
   if (mode_index_ >= options_.modes.size()) {
     run_.ok = true;
     phase_ = Phase::kDone;
-    return Take();
+    return;
   }
   StartTask();
-  return Take();
 }
 
 SetupConductor::Actions SetupConductor::OnCollisionStatus(const orbed::collision_status_t& msg,

@@ -16,8 +16,10 @@
 ///     is within tolerance_deg and the motion is IDLE: the experimenter parks the arm.
 ///   kTask: SETUP_TASK (task "<user>-<mode>-<k>", the target, the mode; a new request id) re-sent
 ///     every task_resend_s until the SETUP_RESULT with its id comes back (from orbed-assistant);
-///     orbed-guidance shows the target. The record: the target, the joints the sim measured when
-///     the answer came (ROBOT_STATE: the truth, not the assistant's word), the assistant's execution
+///     orbed-guidance shows the target. The record: the target, the joints the sim measured after
+///     the answer came (the first ROBOT_STATE handled after it with the arm not MOVING: the truth,
+///     not the assistant's word; the state handled just before the answer may be older than the
+///     assistant's last reading), the assistant's execution
 ///     time and ranges, the alignment's time (the sum of the N trials' duration_s) and its mean's
 ///     errors against the truth; the docking error those joints cause (DockingError); and, from
 ///     COLLISION_STATUS and ROBOT_STATE while the assistant moved the arm, the smallest clearance
@@ -210,6 +212,7 @@ class SetupConductor {
   void StartTask();  // enters kAlign or kPark for task_index_
   void EnterPark();
   void SendTask();
+  void Record(const orbed::setup_result_t& msg);  // the answered task's SetupRecord; then the next task
   void Fail(const std::string& reason);
   std::string TaskId() const;
   int8_t Mode() const { return options_.modes[mode_index_]; }
@@ -227,6 +230,8 @@ class SetupConductor {
   std::optional<double> task_min_clearance_m_;
   bool task_contact_{false};
   int task_collision_stops_{0};
+  // The current task's answer, until a ROBOT_STATE with the arm at rest follows it.
+  std::optional<orbed::setup_result_t> pending_result_;
   size_t mode_index_{0};
   size_t target_index_{0};
   std::unique_ptr<scenario::ViraalConductor> alignment_;

@@ -93,8 +93,9 @@ TEST(SetupConductor, ParksThenAsksForEachTargetAndRecordsTheSimsJoints) {
   ASSERT_NE(FindTask(a), nullptr);
   EXPECT_EQ(FindTask(a)->request_id, first.request_id);
 
-  // The assistant's answer; the sim says the arm is at (12, 20, ...): the record takes the sim's.
-  c.OnRobotState(State({12, 20, 0, -60, 0, 40, 0}, 0), At(2.0));
+  // The assistant's answer; the sim says the arm is at (12, 20, ...): the record takes the sim's,
+  // from the first state at rest handled after the answer (not the one before it, nor a moving one).
+  c.OnRobotState(State({11, 20, 0, -60, 0, 40, 0}, 0), At(2.0));
   orbed::setup_result_t r = Answer(first, 95, 1.1);
   orbed::setup_result_t other = r;
   other.request_id = first.request_id + 100;  // someone else's: ignored
@@ -104,6 +105,14 @@ TEST(SetupConductor, ParksThenAsksForEachTargetAndRecordsTheSimsJoints) {
   bad.execution_s = -1;
   EXPECT_EQ(c.OnSetupResult(bad, At(2.15)).refusals.size(), 1u);
   c.OnSetupResult(r, At(2.2));
+  EXPECT_TRUE(c.run().setups.empty());
+  c.OnSetupResult(r, At(2.21));  // a repeat while waiting changes nothing
+  EXPECT_TRUE(
+      c.OnRobotState(State({11.5, 20, 0, -60, 0, 40, 0}, orbed::robot_state_t::MOTION_MOVING), At(2.22))
+          .publish.empty());
+  EXPECT_TRUE(c.run().setups.empty());
+  EXPECT_EQ(FindTask(c.Tick(At(3.5))), nullptr);  // answered: no more re-sends while waiting
+  c.OnRobotState(State({12, 20, 0, -60, 0, 40, 0}, 0), At(3.6));
   ASSERT_EQ(c.run().setups.size(), 1u);
   const SetupRecord& rec = c.run().setups[0];
   EXPECT_EQ(rec.target, 1);
@@ -114,13 +123,15 @@ TEST(SetupConductor, ParksThenAsksForEachTargetAndRecordsTheSimsJoints) {
   EXPECT_FALSE(rec.alignment_s.has_value());
   EXPECT_EQ(rec.twisting, (std::vector<int>{1, 0, 1, 0, 1, 0, 1}));
   // A repeat of the answer changes nothing; the second target is next (after parking again).
-  c.OnSetupResult(r, At(2.3));
+  c.OnSetupResult(r, At(3.7));
   EXPECT_EQ(c.run().setups.size(), 1u);
-  a = c.OnRobotState(State({0, 20, 0, -60, 0, 40, 0}, 0), At(2.4));
+  a = c.OnRobotState(State({0, 20, 0, -60, 0, 40, 0}, 0), At(3.8));
   ASSERT_NE(FindTask(a), nullptr);
   EXPECT_EQ(FindTask(a)->task_id, "u3-fixed-2");
   r.request_id = FindTask(a)->request_id;
-  c.OnSetupResult(r, At(3.0));
+  c.OnSetupResult(r, At(4.0));
+  EXPECT_FALSE(c.done());
+  c.OnRobotState(State({10, 20, 0, -60, 0, 40, 0}, 0), At(4.1));
   EXPECT_TRUE(c.done());
   EXPECT_TRUE(c.run().ok);
   const std::string json = SetupRunJson(c.run(), false);
@@ -141,8 +152,8 @@ SetupRun StoppedAfterOne(std::string* json) {
   c.Start(At(0));
   const orbed::setup_task_t first = *FindTask(c.OnRobotState(State({0, 20, 0, -60, 0, 40, 0}, 0), At(0.1)));
   c.OnCollisionStatus(Clearance(0.03, false), At(0.2));
-  c.OnRobotState(State({11, 21, 0, -60, 0, 40, 0}, 0), At(0.5));
-  c.OnSetupResult(Answer(first, 80, 0.9), At(0.6));
+  c.OnSetupResult(Answer(first, 80, 0.9), At(0.5));
+  c.OnRobotState(State({11, 21, 0, -60, 0, 40, 0}, 0), At(0.6));
   *json = SetupRunJson(c.run(), true);
   return c.run();
 }
@@ -223,6 +234,7 @@ TEST(SetupResume, ARunResumesWithTheNextSetUp) {
   EXPECT_EQ(task->task_id, "u3-fixed-2");
   EXPECT_NEAR(task->target_position[0], -10 * kDegToRad, 1e-12);
   c.OnSetupResult(Answer(*task, 70, 0.9), At(0.5));
+  c.OnRobotState(State({-9, 20, 0, -60, 0, 40, 0}, 0), At(0.6));
   ASSERT_TRUE(c.done());
   ASSERT_EQ(c.run().setups.size(), 2u);
   EXPECT_EQ(c.run().setups[0].task_id, "u3-fixed-1");
@@ -283,8 +295,8 @@ TEST(SetupConductor, RecordsClearanceAndStopsDuringTheSetUpOnly) {
   c.OnRobotState(State({4, 20, 0, -60, 0, 40, 0}, kStopped), At(0.8));
   EXPECT_EQ(c.OnCollisionStatus(Clearance(std::nan(""), true), At(0.85)).refusals.size(), 1u);
   c.OnCollisionStatus(Clearance(0.05, false), At(0.9));
-  c.OnRobotState(State({10, 20, 0, -60, 0, 40, 0}, 0), At(1.0));
-  c.OnSetupResult(Answer(first, 60, 1), At(1.1));
+  c.OnSetupResult(Answer(first, 60, 1), At(1.0));
+  c.OnRobotState(State({10, 20, 0, -60, 0, 40, 0}, 0), At(1.1));
   ASSERT_EQ(c.run().setups.size(), 1u);
   const SetupRecord& rec = c.run().setups[0];
   ASSERT_TRUE(rec.min_clearance_m.has_value());
@@ -369,6 +381,7 @@ TEST(SetupConductor, PerfectRegistrationPublishesTheTrueBasePose) {
   ASSERT_EQ(a.publish.size(), 2u);
   EXPECT_NE(std::get_if<orbed::registration_t>(&a.publish[0].message), nullptr);
   c.OnSetupResult(Answer(task, 60, 1), At(1.5));
+  c.OnRobotState(state, At(1.6));
   ASSERT_TRUE(c.done());
   ASSERT_EQ(c.run().setups.size(), 1u);
   EXPECT_TRUE(c.run().setups[0].perfect_registration);
@@ -394,6 +407,18 @@ TEST(SetupConductor, TimeoutsNameWhoDidNotAnswer) {
     EXPECT_TRUE(c.done());
     EXPECT_FALSE(c.run().ok);
     EXPECT_NE(c.run().error.find("orbed-assistant"), std::string::npos) << c.run().error;
+  }
+  {
+    SetupOptions o = FixedOnly();
+    o.task_timeout_s = 5;
+    SetupConductor c(o, Model());
+    c.Start(At(0));
+    const orbed::setup_task_t task = *FindTask(c.OnRobotState(State({0, 20, 0, -60, 0, 40, 0}, 0), At(0.1)));
+    c.OnSetupResult(Answer(task, 60, 1), At(1.0));
+    c.Tick(At(6));
+    EXPECT_TRUE(c.done());
+    EXPECT_FALSE(c.run().ok);
+    EXPECT_NE(c.run().error.find("no ROBOT_STATE with the arm at rest"), std::string::npos) << c.run().error;
   }
 }
 

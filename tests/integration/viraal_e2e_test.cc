@@ -120,6 +120,9 @@ TEST(ViraalRun, TheScenariosCaptureWaypointReachesTheHeadset) {
   ExpectSameTree(YAML::LoadFile(dir + "/chosen.json"), bus, "results", {"started_utime", "duration_s"});
   // Captured at head_end instead of foot_end: other frames, so another alignment.
   const YAML::Node by_default = YAML::LoadFile(dir + "/default.json");
+  ASSERT_EQ(bus["sessions"][0]["capture_waypoints"].size(), 1u);
+  EXPECT_EQ(bus["sessions"][0]["capture_waypoints"][0].as<std::string>(), "head_end");
+  EXPECT_FALSE(by_default["sessions"][0]["capture_waypoints"].IsDefined());
   ASSERT_EQ(bus["sessions"][0]["trials"].size(), 2u);
   EXPECT_NE(bus["sessions"][0]["trials"][0]["X_WV"]["position_m"][0].as<double>(),
             by_default["sessions"][0]["trials"][0]["X_WV"]["position_m"][0].as<double>());
