@@ -54,6 +54,11 @@ IiwaSimOptions Resolved(IiwaSimOptions options) {
   if (!(options.state_save_period_s > 0) || !std::isfinite(options.state_save_period_s)) {
     throw std::invalid_argument("--state-save-period-s must be a finite number > 0");
   }
+  if (options.realtime_rate < 1 || options.realtime_rate > IiwaSim::kMaxRealtimeRate) {
+    throw std::invalid_argument("--realtime-rate must be a whole number in [1, " +
+                                std::to_string(IiwaSim::kMaxRealtimeRate) + "], not " +
+                                std::to_string(options.realtime_rate));
+  }
   return options;
 }
 
@@ -99,7 +104,8 @@ IiwaSim::IiwaSim(const orbed::CommonFlags& flags, const IiwaSimOptions& options)
   }
   arm_ = std::make_unique<ManualArm>(model, &scene_, *q0, arm_options);
   saved_q_ = FromVectorX(*q0);
-  save_every_ticks_ = std::max<int64_t>(1, std::llround(options_.state_save_period_s * 1e6 / period_us_));
+  save_every_ticks_ = std::max<int64_t>(
+      1, std::llround(options_.state_save_period_s * 1e6 / (period_us_ * options_.realtime_rate)));
   for (int i = 0; i < model.num_links(); ++i) {
     if (!arm_->world().LinkPrimitives(i).empty() && std::isfinite(arm_->collision().link_clearance_m[i])) {
       reported_links_.push_back(i);
@@ -126,7 +132,10 @@ IiwaSim::IiwaSim(const orbed::CommonFlags& flags, const IiwaSimOptions& options)
   process_->AddTimer(
       options_.period_s, [this] { Tick(); }, "tick");
   ORBED_LOG(kInfo) << "robot " << options_.urdf_path << " (" << model.num_joints() << " joints), scene "
-                   << options_.scene_path << ", tick " << options_.period_s * 1e3 << " ms";
+                   << options_.scene_path << ", tick " << options_.period_s * 1e3 << " ms"
+                   << (options_.realtime_rate > 1
+                           ? ", " + std::to_string(options_.realtime_rate) + "x faster than real time"
+                           : std::string());
 }
 
 IiwaSim::~IiwaSim() = default;
@@ -187,7 +196,14 @@ void IiwaSim::OnPlanCheck(const orbed::plan_check_request_t& msg, const std::str
 }
 
 void IiwaSim::Tick() {
+  // COLLISION_STATUS reports the step of this tick that came closest to contact, so that the near
+  // misses it shows do not depend on the realtime rate.
   arm_->Step(options_.period_s);
+  CollisionResult closest = arm_->collision();
+  for (int step = 1; step < options_.realtime_rate; ++step) {
+    arm_->Step(options_.period_s);
+    if (arm_->collision().min_distance_m < closest.min_distance_m) closest = arm_->collision();
+  }
   ++ticks_;
   // After a stall the loop skipped deadlines rather than run them: tick k jumps to the last deadline
   // passed, so the sim clock does not fall behind for good. The arm made one step of P: the speed
@@ -205,12 +221,12 @@ void IiwaSim::Tick() {
       last_skip_warning_ = now;
     }
   }
-  PublishAll(start_utime_ + ticks_ * period_us_);
+  PublishAll(start_utime_ + ticks_ * options_.realtime_rate * period_us_, closest);
 }
 
 int64_t IiwaSim::MaxLagMicros() const { return std::max<int64_t>(100'000, 20 * period_us_); }
 
-void IiwaSim::PublishAll(int64_t utime) {
+void IiwaSim::PublishAll(int64_t utime, const CollisionResult& r) {
   const RobotModel& model = arm_->model();
   const int n = model.num_joints();
   const std::vector<double> q = FromVectorX(arm_->q_rad());
@@ -247,7 +263,6 @@ void IiwaSim::PublishAll(int64_t utime) {
   state.stop_reason = arm_->stop_reason();
   process_->Publish(options_.robot_state_channel, state);
 
-  const CollisionResult& r = arm_->collision();
   orbed::collision_status_t collision{};
   collision.utime = utime;
   collision.in_collision = r.in_collision;

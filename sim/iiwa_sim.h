@@ -50,6 +50,16 @@
 /// one per call the same way. Wall clock: the stale-command check (senders stamp commands with their wall
 /// clocks), PLAN_CHECK_REPLY and PROCESS_STATUS.
 ///
+/// Faster than real time (realtime_rate R > 1, for studies without a person in the loop): tick k
+/// steps the arm R times by P (each step checked for collisions as at R = 1) and stamps
+///     utime_k = start_utime + k * R * P,
+/// so the sim clock runs R times faster than the wall clock and the arm moves R times faster in
+/// wall time while every step, and the speed read from the stamps, keeps the joint's velocity
+/// limit in sim time. The outputs still go out once per tick (200 Hz of wall time, 200/R Hz of sim
+/// time), COLLISION_STATUS with the tick's step that came closest to contact (so near misses are
+/// seen at every rate). The other processes keep the wall clock: their periods and timeouts are
+/// wall seconds.
+///
 /// Crash recovery (state_file, sim_state.h): the sim saves its measured q while the arm moves, at most
 /// every state_save_period_s of sim time and whenever the arm comes to rest, and a sim started on an
 /// existing state file starts there instead of at initial_q_deg (a damaged file: it does not start).
@@ -83,6 +93,9 @@ struct IiwaSimOptions {
   std::string scene_path;
   /// Tick = status period [s]; rounded to whole microseconds, which must leave >= 1 us.
   double period_s{0.005};
+  /// Sim seconds per wall second, 1..kMaxRealtimeRate (Drake's target realtime rate, whole numbers
+  /// here): each tick steps the arm this many times by P and publishes once (see Clocks).
+  int realtime_rate{1};
   /// Initial joint vector [deg]; empty = all zero (the arm upright). Must be within the limits.
   std::vector<double> initial_q_deg;
   /// The state file (sim_state.h): read at start (over initial_q_deg) and written as the arm moves;
@@ -123,6 +136,7 @@ class IiwaSim {
   /// start_utime() + ticks() * period_us().
   int64_t period_us() const { return period_us_; }
   int64_t start_utime() const { return start_utime_; }
+  static constexpr int kMaxRealtimeRate = 100;
   int64_t ticks() const { return ticks_; }
   /// How far behind its deadline a tick may run before the sim clock skips ahead [us].
   int64_t MaxLagMicros() const;
@@ -137,7 +151,7 @@ class IiwaSim {
  private:
   void OnCommand(const orbed::iiwa_command_t& msg, const std::string& channel);
   void OnPlanCheck(const orbed::plan_check_request_t& msg, const std::string& channel);
-  void PublishAll(int64_t utime);
+  void PublishAll(int64_t utime, const CollisionResult& r);
   void SaveState(const orbed::iiwa_status_t& status);
 
   IiwaSimOptions options_;

@@ -25,6 +25,11 @@ int RunIiwaSim(int argc, const char* const* argv, std::ostream& out, std::ostrea
   app.add_option("--period-s", options.period_s, "Tick and status period [s] (0.005 = 200 Hz)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  app.add_option("--realtime-rate", options.realtime_rate,
+                 "Sim seconds per wall second: each tick steps the arm this many times (1-100; for "
+                 "studies without a person in the loop; default $ORBED_SIM_RATE if set)")
+      ->envname("ORBED_SIM_RATE")
+      ->capture_default_str();
   app.add_option("--initial-q-deg", options.initial_q_deg,
                  "Initial joint angles q1,...,q7 [deg] (default: all 0)")
       ->delimiter(',');

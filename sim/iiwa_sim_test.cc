@@ -365,6 +365,41 @@ TEST(IiwaSim, StampsTicksOnTheSimClockHoweverLateTheyRun) {
   EXPECT_EQ(got.collision.back().utime, got.status.back().utime);
 }
 
+// Faster than real time (realtime_rate R = 4, P = 10 ms): tick k steps the arm 4 times and is
+// stamped start_utime + 4 k P; joint 1 (toward 30 deg at 98 deg/s) is at 4 k x 98 deg/s x P after
+// tick k, worked out by hand: four times as far per tick as at R = 1, and still 98 deg/s read from
+// the stamps.
+TEST(IiwaSim, ARealtimeRateStepsTheArmThatManyTimesPerTickOnTheSimClock) {
+  IiwaSimOptions options;
+  options.period_s = 0.01;
+  options.realtime_rate = 4;
+  IiwaSim sim(MemqFlags(0.1), options);
+  Collector got;
+  lcm::LCM& lcm = sim.process().lcm();
+  got.Attach(lcm);
+  const orbed::iiwa_command_t cmd = Command({30, 0, 0, 0, 0, 0, 0});
+  lcm.publish("IIWA_COMMAND", &cmd);
+  while (lcm.handleTimeout(0) > 0) {
+  }
+  for (int n = 1; n <= 3; ++n) {
+    sim.Tick();
+    while (lcm.handleTimeout(0) > 0) {
+    }
+  }
+  ASSERT_EQ(got.status.size(), 3u);
+  for (int n = 1; n <= 3; ++n) {
+    const orbed::iiwa_status_t& s = got.status[n - 1];
+    EXPECT_EQ(s.utime, sim.start_utime() + n * 4 * 10000) << "tick " << n;
+    EXPECT_NEAR(s.joint_position_measured[0], n * 4 * 98 * 0.01 * kDegToRad, 1e-12) << "tick " << n;
+    EXPECT_NEAR(s.joint_velocity_estimated[0], 98 * kDegToRad, 1e-9) << "tick " << n;
+    EXPECT_EQ(got.state[n - 1].utime, s.utime);
+  }
+  for (int bad : {0, -1, 101}) {
+    options.realtime_rate = bad;
+    EXPECT_THROW(IiwaSim(MemqFlags(0.1), options), std::invalid_argument) << bad;
+  }
+}
+
 // The published frames against independent facts: X_WR from the scene file (position
 // (0.25, -0.55, 0.75), yaw 90 deg), the upright flange at z = 0.34 + 0.4 + 0.4 + 0.126 = 1.266 m
 // in R (the data sheet's DH d), the tool tip 0.25 m (scene tool_length_m) above it.
