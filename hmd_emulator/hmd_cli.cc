@@ -34,6 +34,11 @@ int RunHmd(int argc, const char* const* argv, std::ostream& out, std::ostream& e
       ->capture_default_str();
   app.add_option("--pose-hz", o.pose_hz, "HMD_POSE / HMD_POSE_TRUTH rate [Hz], (0, 1000]")
       ->capture_default_str();
+  app.add_option("--realtime-rate", o.realtime_rate,
+                 "The walk's seconds per wall second, 1..100, as orbed-iiwa-sim's (default $ORBED_SIM_RATE "
+                 "if set)")
+      ->envname("ORBED_SIM_RATE")
+      ->capture_default_str();
   app.add_option("--jpeg-quality", o.jpeg_quality, "JPEG quality of every image, 1..100")
       ->capture_default_str();
   app.add_option("--displays", o.displays,

@@ -45,6 +45,8 @@ HmdProcess::HmdProcess(const orbed::CommonFlags& flags, const HmdOptions& option
   }
   if (!(options_.pose_hz > 0 && options_.pose_hz <= 1000))
     throw std::invalid_argument("--pose-hz must be in (0, 1000] Hz");
+  if (options_.realtime_rate < 1 || options_.realtime_rate > 100)
+    throw std::invalid_argument("--realtime-rate must be a whole number in [1, 100]");
   if (options_.jpeg_quality < 1 || options_.jpeg_quality > 100) {
     throw std::invalid_argument("--jpeg-quality must be in [1, 100]");
   }
@@ -195,7 +197,7 @@ void HmdProcess::PublishPose() {
     t0_ = now;
   }
   const PoseStream::Poses poses =
-      stream_->Step(std::chrono::duration<double>(now - t0_).count(), NowMicros());
+      stream_->Step(options_.realtime_rate * std::chrono::duration<double>(now - t0_).count(), NowMicros());
   process_->Publish(options_.hmd_pose_channel, poses.estimate);
   process_->Publish(options_.hmd_pose_truth_channel, poses.truth);
   if (pending_trial_ && !stream_->playing_faults()) {

@@ -118,6 +118,11 @@ struct HmdOptions {
   std::optional<std::uint64_t> user_seed;
   double camera_hz{30.0};
   double pose_hz{60.0};
+  /// The walk's seconds per wall second, 1..100: with the sim faster than real time
+  /// (orbed-iiwa-sim --realtime-rate, both from $ORBED_SIM_RATE in a launch) the person walks as
+  /// fast, so that the arm and the head keep their sim-time order. Streams keep their wall rates
+  /// and stamps.
+  int realtime_rate{1};
   int jpeg_quality{85};         ///< 1..100
   int displays{1};              ///< live reflective displays, 0..hmd.displays.size()
   bool interactive{false};      ///< a person in an OpenCV window instead of the emulated user

@@ -41,37 +41,14 @@
 #include <orbed/setup_task_t.hpp>
 
 #include "base/units.h"
-#include "procs/logger/event_log_reader.h"
-#include "procs/logger/manifest.h"
 #include "procs/setup/setup_conductor.h"
 #include "procs/setup/setup_process.h"
 #include "sim/guidance_messages.h"
+#include "tests/integration/logged.h"
 #include "tests/integration/testbed_util.h"
 
 namespace orbed::testing {
 namespace {
-
-// Every message on `channel` in a run folder's log (every part the manifest lists), decoded; a
-// message that does not decode whole is a test failure.
-template <class Msg>
-std::vector<Msg> Logged(const std::string& log_dir, const std::string& channel) {
-  std::vector<Msg> out;
-  const logger::Manifest parts = logger::ReadManifestFile(log_dir + "/manifest.json");
-  for (const logger::ManifestPart& part : parts.parts) {
-    const logger::MappedLog log(log_dir + "/" + part.file);
-    EXPECT_TRUE(log.ok()) << log.error();
-    logger::EventLogScanner scanner = log.Scanner();
-    logger::LogEvent event;
-    while (scanner.Next(&event)) {
-      if (event.channel != channel) continue;
-      Msg msg{};
-      EXPECT_EQ(msg.decode(event.data, 0, static_cast<int>(event.size)), static_cast<int>(event.size))
-          << channel;
-      out.push_back(std::move(msg));
-    }
-  }
-  return out;
-}
 
 constexpr char kPerfectConfig[] = R"(assistant:
   user_scale_log_sigma: 0

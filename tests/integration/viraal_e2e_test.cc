@@ -18,7 +18,9 @@
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 #include <lcm/lcm-cpp.hpp>
+#include <orbed/iiwa_status_t.hpp>
 
+#include "tests/integration/logged.h"
 #include "tests/integration/testbed_util.h"
 #include "tests/same_tree.h"
 
@@ -80,6 +82,36 @@ TEST(ViraalRun, LaunchFileRunsTheStudyAndWritesResults) {
     EXPECT_TRUE(manifest["channels"][channel]) << channel << " missing from the log";
   }
   EXPECT_EQ(manifest["channels"]["ALIGNMENT_TRIAL"]["events"].as<int>(), 6);
+}
+
+// Faster than real time ($ORBED_SIM_RATE = 8: the sim steps the arm 8 times per tick, the person
+// walks 8 times as fast): the arm reaches the same configurations, so the run equals the pinned
+// results number for number, and its log is whole.
+TEST(ViraalRun, FasterThanRealTimeTheRunIsTheSame) {
+  const std::string log_dir = MakeTempDir("viraal_fast");
+  RunningProcess launcher(
+      {BinPath("orbed-launch"), SourcePath("scripts/launch/viraal.yaml"), "--duration-s", "240"},
+      {{"ORBED_LOG_DIR", log_dir}, {"ORBED_RUN_ID", "pinned"}, {"ORBED_SIM_RATE", "8"}});
+  ASSERT_TRUE(launcher.Wait(240)) << "the run did not finish";
+  ASSERT_EQ(launcher.exit_code(), 0);
+  const YAML::Node pinned =
+      YAML::LoadFile(SourcePath("tests/integration/testdata/viraal_pinned_results.json"));
+  ExpectSameTree(pinned, YAML::LoadFile(log_dir + "/results.json"), "results",
+                 {"started_utime", "duration_s"});
+  const YAML::Node manifest = YAML::LoadFile(log_dir + "/manifest.json");
+  EXPECT_TRUE(manifest["complete"].as<bool>());
+  EXPECT_EQ(manifest["drops"].as<int>(), 0);
+  // The sim clock ran 8 times faster: IIWA_STATUS stamps 8 x 5 ms apart (a whole multiple of that
+  // after a stall of the loop), where at the wall clock's pace they would be 5 ms apart.
+  const std::vector<orbed::iiwa_status_t> status = Logged<orbed::iiwa_status_t>(log_dir, "IIWA_STATUS");
+  ASSERT_GT(status.size(), 100u);
+  size_t exact = 0;
+  for (size_t k = 1; k < status.size(); ++k) {
+    const int64_t step_us = status[k].utime - status[k - 1].utime;
+    EXPECT_TRUE(step_us > 0 && step_us % 40000 == 0) << "stamp step " << step_us << " us at " << k;
+    exact += step_us == 40000;
+  }
+  EXPECT_GT(exact, status.size() / 2);
 }
 
 // The scenario chooses where the display captures (contract change 6): a scenario naming head_end,
