@@ -206,8 +206,8 @@ void IiwaSim::Tick() {
   }
   ++ticks_;
   // After a stall the loop skipped deadlines rather than run them: tick k jumps to the last deadline
-  // passed, so the sim clock does not fall behind for good. The arm made one step of P: the speed
-  // read from the stamps only drops.
+  // passed, so the sim clock does not fall behind for good. The arm made only this tick's R steps
+  // of P: the speed read from the stamps only drops.
   const auto now = std::chrono::steady_clock::now();
   const int64_t elapsed_us = std::chrono::duration_cast<std::chrono::microseconds>(now - start_mono_).count();
   const int64_t due = elapsed_us / period_us_;
