@@ -14,6 +14,7 @@ int RunHmd(int argc, const char* const* argv, std::ostream& out, std::ostream& e
       "REQUEST_TRIAL; --interactive puts a person in its place (OpenCV window)."};
   orbed::CommonFlags common("orbed-hmd");
   orbed::AddCommonFlags(&app, &common);
+  orbed::AddSimTimeFlag(&app, &common);
   HmdOptions o;
   app.add_option("--urdf", o.urdf_path,
                  "Robot URDF (default: sim/models/iiwa7.urdf under $ORBED_SOURCE_DIR, else the source tree)");
@@ -33,11 +34,6 @@ int RunHmd(int argc, const char* const* argv, std::ostream& out, std::ostream& e
                  "finds the previous one still waiting replaces it, counted as the drop HMD_CAMERA/busy")
       ->capture_default_str();
   app.add_option("--pose-hz", o.pose_hz, "HMD_POSE / HMD_POSE_TRUTH rate [Hz], (0, 1000]")
-      ->capture_default_str();
-  app.add_option("--realtime-rate", o.realtime_rate,
-                 "The walk's seconds per wall second, 1..100, as orbed-iiwa-sim's (default $ORBED_SIM_RATE "
-                 "if set)")
-      ->envname("ORBED_SIM_RATE")
       ->capture_default_str();
   app.add_option("--jpeg-quality", o.jpeg_quality, "JPEG quality of every image, 1..100")
       ->capture_default_str();

@@ -45,8 +45,6 @@ HmdProcess::HmdProcess(const orbed::CommonFlags& flags, const HmdOptions& option
   }
   if (!(options_.pose_hz > 0 && options_.pose_hz <= 1000))
     throw std::invalid_argument("--pose-hz must be in (0, 1000] Hz");
-  if (options_.realtime_rate < 1 || options_.realtime_rate > 100)
-    throw std::invalid_argument("--realtime-rate must be a whole number in [1, 100]");
   if (options_.jpeg_quality < 1 || options_.jpeg_quality > 100) {
     throw std::invalid_argument("--jpeg-quality must be in [1, 100]");
   }
@@ -191,13 +189,14 @@ FrameInputs HmdProcess::Inputs() const {
 }
 
 void HmdProcess::PublishPose() {
-  const Clock::time_point now = Clock::now();
+  // The process clock: the monotonic one, or the sim's (--sim-time), on which the walk keeps its
+  // order with the arm at any realtime rate of the sim.
+  const double now_s = process_->ClockSeconds();
   if (!started_) {
     started_ = true;
-    t0_ = now;
+    t0_s_ = now_s;
   }
-  const PoseStream::Poses poses =
-      stream_->Step(options_.realtime_rate * std::chrono::duration<double>(now - t0_).count(), NowMicros());
+  const PoseStream::Poses poses = stream_->Step(now_s - t0_s_, process_->ClockUtime());
   process_->Publish(options_.hmd_pose_channel, poses.estimate);
   process_->Publish(options_.hmd_pose_truth_channel, poses.truth);
   if (pending_trial_ && !stream_->playing_faults()) {
@@ -246,7 +245,7 @@ void HmdProcess::OnGuidance(const orbed::guidance_t& msg, const std::string& cha
   const std::string problem = guidance::CheckGuidance(msg, *robot_model_, kJointLimitSlackRad);
   if (!problem.empty()) return process_->Reject(channel + "/field", problem);
   guidance_ = msg;
-  guidance_received_ = std::chrono::steady_clock::now();
+  guidance_received_s_ = process_->ClockSeconds();
 }
 
 HmdProcess::HologramShown HmdProcess::Hologram() const {
@@ -379,7 +378,7 @@ void HmdProcess::PublishTrial(const Eigen::Isometry3d& X_WV, double duration_s, 
                               const TrackingFaultRecord& faults,
                               const std::vector<AnnotationRay>& annotation) {
   orbed::alignment_trial_t msg{};
-  msg.utime = NowMicros();
+  msg.utime = process_->ClockUtime();
   msg.session_id = session_.state().id;
   msg.trial_index = session_.TakeTrialIndex();
   msg.display_mode = session_.state().display_mode;
@@ -505,8 +504,7 @@ void HmdProcess::SendPlannedTarget() {
 }
 
 const orbed::guidance_t* HmdProcess::FreshGuidance() const {
-  const double age_s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - guidance_received_).count();
+  const double age_s = process_->ClockSeconds() - guidance_received_s_;
   return guidance_ && age_s <= kGuidanceFreshS ? &*guidance_ : nullptr;
 }
 

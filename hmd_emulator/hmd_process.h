@@ -73,8 +73,10 @@
 /// (LCM's publish is thread-safe), so that a frame never delays a 60 Hz pose. Without it
 /// everything runs inline on the Run() thread (deterministic, for tests).
 ///
-/// Clocks: message utimes are the wall clock (NowMicros) at sampling; the walk's time t [s] runs on
-/// the monotonic clock from the first pose tick.
+/// Clocks: the process clock (Process::ClockSeconds / ClockUtime: the monotonic and wall clocks, or
+/// with --sim-time the sim's) runs the streams' timers, the walk's time t [s] from the first pose
+/// tick, and stamps the poses and trials; the images keep the wall clock of their sample or render
+/// (the pipeline's worker thread does not read the process clock), the interactive window too.
 /// Frames: W world (= the SLAM map for estimates), H head, C camera, M reversed frustum, R real
 /// robot base, V virtual robot base. Units: m, rad, px, Hz; utime µs.
 
@@ -118,11 +120,6 @@ struct HmdOptions {
   std::optional<std::uint64_t> user_seed;
   double camera_hz{30.0};
   double pose_hz{60.0};
-  /// The walk's seconds per wall second, 1..100: with the sim faster than real time
-  /// (orbed-iiwa-sim --realtime-rate, both from $ORBED_SIM_RATE in a launch) the person walks as
-  /// fast, so that the arm and the head keep their sim-time order. Streams keep their wall rates
-  /// and stamps.
-  int realtime_rate{1};
   int jpeg_quality{85};         ///< 1..100
   int displays{1};              ///< live reflective displays, 0..hmd.displays.size()
   bool interactive{false};      ///< a person in an OpenCV window instead of the emulated user
@@ -228,8 +225,8 @@ class HmdProcess {
 
   HmdOptions options_;
   HmdConfigSet config_;
-  std::optional<orbed::guidance_t> guidance_;                // the latest valid GUIDANCE
-  std::chrono::steady_clock::time_point guidance_received_;  // when it came
+  std::optional<orbed::guidance_t> guidance_;  // the latest valid GUIDANCE
+  double guidance_received_s_{0};              // when it came [process clock s]
   std::unique_ptr<sim::RobotModel> robot_model_;
   std::unique_ptr<orbed::Process> process_;
   std::unique_ptr<PoseStream> stream_;
@@ -238,7 +235,7 @@ class HmdProcess {
   SavedSession saved_;                             // what the state file holds
   SessionMapCache session_map_;                    // the session's map after its last trial
   std::optional<InteractiveSession> interactive_;  // always set; the person only with --interactive
-  std::chrono::steady_clock::time_point t0_;       // the walk's t = 0: the first pose tick
+  double t0_s_{0};                                 // the walk's t = 0: the first pose tick [process clock s]
   bool started_{false};
   bool window_open_{false};
 

@@ -489,14 +489,6 @@ TEST(HmdProcess, PoseAndTruthShareSeqAndStartAtTheFirstWaypoint) {
   EXPECT_NEAR(ToVector3(got.gaze.back().direction_W).norm(), 1.0, 1e-9);
 }
 
-TEST(HmdProcess, RefusesARealtimeRateOutsideOneToAHundred) {
-  for (int bad : {0, -2, 101}) {
-    HmdOptions options = Inline();
-    options.realtime_rate = bad;
-    EXPECT_THROW(HmdProcess(MemqFlags(0), options), std::invalid_argument) << bad;
-  }
-}
-
 TEST(HmdProcess, CameraReflectiveAndArViewCarryTheirGeometry) {
   HmdOptions options = Inline();
   options.displays = 1;

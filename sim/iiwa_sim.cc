@@ -54,9 +54,9 @@ IiwaSimOptions Resolved(IiwaSimOptions options) {
   if (!(options.state_save_period_s > 0) || !std::isfinite(options.state_save_period_s)) {
     throw std::invalid_argument("--state-save-period-s must be a finite number > 0");
   }
-  if (options.realtime_rate < 1 || options.realtime_rate > IiwaSim::kMaxRealtimeRate) {
+  if (options.realtime_rate < 1 || options.realtime_rate > kMaxRealtimeRate) {
     throw std::invalid_argument("--realtime-rate must be a whole number in [1, " +
-                                std::to_string(IiwaSim::kMaxRealtimeRate) + "], not " +
+                                std::to_string(kMaxRealtimeRate) + "], not " +
                                 std::to_string(options.realtime_rate));
   }
   return options;
@@ -124,9 +124,26 @@ IiwaSim::IiwaSim(const orbed::CommonFlags& flags, const IiwaSimOptions& options)
       [this](const orbed::plan_check_request_t& msg, const std::string& channel, int64_t) {
         OnPlanCheck(msg, channel);
       });
-  // The sim clock starts with the timer: tick k is due k * P after start_mono_.
+  // The sim clock starts with the timer: tick k is due k * P after start_mono_ (after the hold, if
+  // any, from the release).
   start_utime_ = NowMicros();
   start_mono_ = std::chrono::steady_clock::now();
+  holding_ = !options_.hold_for.empty();
+  if (holding_) {
+    process_->Subscribe<orbed::process_status_t>(
+        channels::kProcessStatus, [this](const orbed::process_status_t& msg, const std::string&, int64_t) {
+          if (!holding_ || msg.name != options_.hold_for ||
+              msg.state != orbed::process_status_t::STATE_RUNNING)
+            return;
+          holding_ = false;
+          ticks_ = 0;
+          start_mono_ = std::chrono::steady_clock::now();
+          ORBED_LOG(kInfo) << "the sim clock runs: " << options_.hold_for << " is running";
+        });
+    process_->AddTimer(5.0, [this] {
+      if (holding_) ORBED_LOG(kInfo) << "holding the sim clock until " << options_.hold_for << " runs";
+    });
+  }
   // Deadlines the loop skips (more than a few periods behind) are counted as "timer/tick" drops: no
   // IIWA_STATUS, ROBOT_STATE or COLLISION_STATUS went out for them.
   process_->AddTimer(
@@ -148,12 +165,18 @@ void IiwaSim::OnCommand(const orbed::iiwa_command_t& msg, const std::string& cha
   }
   const IiwaCommand& command = std::get<IiwaCommand>(checked);
   if (options_.stale_command_s > 0) {
+    // A sender stamps with the wall clock, or, following SIM_CLOCK (--sim-time), with the sim clock,
+    // which at a realtime rate R runs R times as fast: its age is taken in wall seconds (sim ones / R).
     // In double: a wild utime (e.g. INT64_MIN) must not overflow the subtraction.
-    const double age_s = (static_cast<double>(NowMicros()) - static_cast<double>(msg.utime)) * 1e-6;
+    const double wall_age_s = (static_cast<double>(NowMicros()) - static_cast<double>(msg.utime)) * 1e-6;
+    const double sim_now_us =
+        static_cast<double>(start_utime_ + ticks_ * options_.realtime_rate * period_us_);
+    const double sim_age_s = (sim_now_us - static_cast<double>(msg.utime)) * 1e-6 / options_.realtime_rate;
+    const double age_s = std::abs(sim_age_s) < std::abs(wall_age_s) ? sim_age_s : wall_age_s;
     if (std::abs(age_s) > options_.stale_command_s) {
       process_->Reject(channel + "/stale",
                        "utime " + std::to_string(msg.utime) + " is " + Fixed(std::abs(age_s), 3) + " s " +
-                           (age_s > 0 ? "older than" : "ahead of") + " the wall clock (limit " +
+                           (age_s > 0 ? "older than" : "ahead of") + " the wall and the sim clock (limit " +
                            Fixed(options_.stale_command_s, 3) + " s)");
       return;
     }
@@ -196,6 +219,13 @@ void IiwaSim::OnPlanCheck(const orbed::plan_check_request_t& msg, const std::str
 }
 
 void IiwaSim::Tick() {
+  if (holding_) {
+    orbed::sim_clock_t clock{};
+    clock.utime = start_utime_;
+    clock.realtime_rate = options_.realtime_rate;
+    if (!options_.sim_clock_channel.empty()) process_->Publish(options_.sim_clock_channel, clock);
+    return;
+  }
   // COLLISION_STATUS reports the step of this tick that came closest to contact, so that the near
   // misses it shows do not depend on the realtime rate.
   arm_->Step(options_.period_s);
@@ -227,6 +257,13 @@ void IiwaSim::Tick() {
 int64_t IiwaSim::MaxLagMicros() const { return std::max<int64_t>(100'000, 20 * period_us_); }
 
 void IiwaSim::PublishAll(int64_t utime, const CollisionResult& r) {
+  // The clock first: a process that follows it (--sim-time) runs its timers up to this tick while
+  // it still holds the previous tick's state, as it would at real time.
+  orbed::sim_clock_t clock{};
+  clock.utime = utime;
+  clock.realtime_rate = options_.realtime_rate;
+  if (!options_.sim_clock_channel.empty()) process_->Publish(options_.sim_clock_channel, clock);
+
   const RobotModel& model = arm_->model();
   const int n = model.num_joints();
   const std::vector<double> q = FromVectorX(arm_->q_rad());

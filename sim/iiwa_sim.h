@@ -117,6 +117,13 @@ struct IiwaSimOptions {
   std::string collision_status_channel{channels::kCollisionStatus};
   std::string plan_check_request_channel{channels::kPlanCheckRequest};
   std::string plan_check_reply_channel{channels::kPlanCheckReply};
+  /// SIM_CLOCK (sim_clock_t, each tick's stamp, before the tick's other outputs); "" = not published.
+  std::string sim_clock_channel{channels::kSimClock};
+  /// "" = the clock runs from the start. Else the sim holds its clock (publishes only SIM_CLOCK, at
+  /// the start stamp, and does not step) until PROCESS_STATUS shows the process of this name
+  /// running: a launch whose last process is NAME then starts every follower of the sim clock at
+  /// the same sim moment, whatever the rate and however long each took to start.
+  std::string hold_for;
 };
 
 class IiwaSim {
@@ -136,8 +143,9 @@ class IiwaSim {
   /// start_utime() + ticks() * period_us().
   int64_t period_us() const { return period_us_; }
   int64_t start_utime() const { return start_utime_; }
-  static constexpr int kMaxRealtimeRate = 100;
   int64_t ticks() const { return ticks_; }
+  /// Whether the clock is still held (IiwaSimOptions::hold_for).
+  bool holding() const { return holding_; }
   /// How far behind its deadline a tick may run before the sim clock skips ahead [us].
   int64_t MaxLagMicros() const;
   const Scene& scene() const { return scene_; }
@@ -163,6 +171,7 @@ class IiwaSim {
   int64_t period_us_{0};
   int64_t start_utime_{0};
   std::chrono::steady_clock::time_point start_mono_;
+  bool holding_{false};
   int64_t ticks_{0};
   int64_t skipped_ticks_{0};  // since the last warning
   std::chrono::steady_clock::time_point last_skip_warning_{};

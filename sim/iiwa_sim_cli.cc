@@ -30,6 +30,11 @@ int RunIiwaSim(int argc, const char* const* argv, std::ostream& out, std::ostrea
                  "studies without a person in the loop; default $ORBED_SIM_RATE if set)")
       ->envname("ORBED_SIM_RATE")
       ->capture_default_str();
+  app.add_option("--hold-for", options.hold_for,
+                 "Hold the sim clock (publish only SIM_CLOCK, do not step) until PROCESS_STATUS shows the "
+                 "process of this name running, so that a launch's followers of the clock start together "
+                 "(default $ORBED_SIM_HOLD_FOR; empty: run from the start)")
+      ->envname("ORBED_SIM_HOLD_FOR");
   app.add_option("--initial-q-deg", options.initial_q_deg,
                  "Initial joint angles q1,...,q7 [deg] (default: all 0)")
       ->delimiter(',');
@@ -58,6 +63,10 @@ int RunIiwaSim(int argc, const char* const* argv, std::ostream& out, std::ostrea
   app.add_option("--collision-status-channel", options.collision_status_channel)->capture_default_str();
   app.add_option("--plan-check-request-channel", options.plan_check_request_channel)->capture_default_str();
   app.add_option("--plan-check-reply-channel", options.plan_check_reply_channel)->capture_default_str();
+  app.add_option("--sim-clock-channel", options.sim_clock_channel,
+                 "Where each tick's stamp goes for the processes that follow the sim clock (--sim-time); "
+                 "\"\" = nowhere")
+      ->capture_default_str();
   if (const auto code = ParseCommandLine(&app, common, argc, argv, out, err)) return *code;
   try {
     IiwaSim sim(common, options);

@@ -37,10 +37,6 @@ constexpr double kJointLimitSlackRad = 0.01;
 constexpr double kMinMonitorDistance_m = 0.3;
 constexpr double kMaxMonitorDistance_m = 20.0;
 
-double SteadySeconds() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-
 std::vector<double> Degrees(const Eigen::VectorXd& q_rad) {
   std::vector<double> out;
   for (int i = 0; i < q_rad.size(); ++i) out.push_back(q_rad[i] * kRadToDeg);
@@ -141,7 +137,7 @@ AssistantProcess::AssistantProcess(const CommonFlags& flags, const AssistantOpti
                            << Fixed(p_WD.y(), 2) << ", " << Fixed(p_WD.z(), 2) << ") m (" << channel << ")";
         }
         p_WD_ = p_WD;
-        p_WD_received_s_ = SteadySeconds();
+        p_WD_received_s_ = process_.ClockSeconds();
       });
   process_.Subscribe<orbed::hmd_pose_t>(options_.hmd_pose_channel, on_pose(false));
   process_.Subscribe<orbed::hmd_pose_t>(options_.hmd_pose_truth_channel, on_pose(true));
@@ -178,7 +174,7 @@ Viewing AssistantProcess::CurrentView() const {
   view.X_WV_seen = (A_ ? *A_ : Eigen::Isometry3d::Identity()) * (X_WV_ ? *X_WV_ : *X_WR_);
   view.p_WE = p_WE_ ? *p_WE_ : assistant_.config().eye_position_m;
   // A monitor camera on or far from the robot is no view of it: the configured one instead.
-  if (p_WD_ && SteadySeconds() - p_WD_received_s_ <= options_.fixed_view_stale_s) {
+  if (p_WD_ && process_.ClockSeconds() - p_WD_received_s_ <= options_.fixed_view_stale_s) {
     const double d_m = (*p_WD_ - X_WR_->translation()).norm();
     if (d_m >= kMinMonitorDistance_m && d_m <= kMaxMonitorDistance_m) view.p_WD = p_WD_;
   }
@@ -186,7 +182,7 @@ Viewing AssistantProcess::CurrentView() const {
 }
 
 void AssistantProcess::Step() {
-  const double t_s = SteadySeconds();
+  const double t_s = process_.ClockSeconds();
   const int n = model_.num_joints();
   switch (phase_) {
     case Phase::kIdle:
@@ -278,7 +274,7 @@ void AssistantProcess::Step() {
       }
       if (t_s - last_command_s_ >= options_.command_resend_s) {
         orbed::iiwa_command_t command{};
-        command.utime = NowMicros();
+        command.utime = process_.ClockUtime();
         command.num_joints = n;
         for (int i = 0; i < n; ++i) command.joint_position.push_back(q_goal_[i]);
         command.num_torques = 0;
@@ -303,7 +299,7 @@ void AssistantProcess::Finish() {
                    << worst * kRadToDeg << " deg";
   if (task_) {
     orbed::setup_result_t r{};
-    r.utime = NowMicros();
+    r.utime = process_.ClockUtime();
     r.request_id = task_->request_id;
     r.task_id = task_->task_id;
     r.mode = partial_.mode;
@@ -332,6 +328,7 @@ int RunAssistant(int argc, const char* const* argv, std::ostream& out, std::ostr
       "SETUP_TASK (orbed-setup) with SETUP_RESULT, or with --once one set-up on its own."};
   CommonFlags common("orbed-assistant");
   AddCommonFlags(&app, &common);
+  AddSimTimeFlag(&app, &common);
   AssistantOptions options;
   uint64_t seed = 0;
   app.add_option("--config", options.config_path,

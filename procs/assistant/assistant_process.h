@@ -37,6 +37,11 @@
 /// from GUIDANCE), ranges (per joint, at its first look: how many separate ranges looked right),
 /// execution_s, headset_pose (whether HMD poses were used).
 ///
+/// Clocks: the process clock (Process::ClockSeconds / ClockUtime; with --sim-time the sim's) runs
+/// the step timer, the move timeout, the command re-sends and the monitor's staleness, and stamps
+/// IIWA_COMMAND and SETUP_RESULT: with the sim faster than real time, all of them keep their
+/// sim-time relation to the arm's motion.
+///
 /// Threading: everything on the Process::Run thread.
 
 #include <optional>
@@ -124,7 +129,7 @@ class AssistantProcess {
   std::optional<Eigen::Isometry3d> A_;   // X_WH_true · X_WH_est⁻¹ of the latest matching pair
   std::optional<Eigen::Vector3d> p_WE_;  // the true head position of that pair
   std::optional<Eigen::Vector3d> p_WD_;  // FIXED_VIEW's camera position
-  double p_WD_received_s_{0};            // SteadySeconds() when it came
+  double p_WD_received_s_{0};            // when it came [process clock s]
 
   // The run.
   Phase phase_{Phase::kIdle};

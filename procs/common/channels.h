@@ -31,6 +31,7 @@ inline constexpr char kProcessStatus[] = "PROCESS_STATUS";              // proce
 inline constexpr char kLoggerStatus[] = "LOGGER_STATUS";                // logger_status_t, 1 Hz
 inline constexpr char kIgtlTarget[] = "IGTL_TARGET";                    // target_pose_t, orbed-igtl-bridge
 inline constexpr char kFixedView[] = "FIXED_VIEW";                      // image_t (JPEG), orbed-fixed-display
+inline constexpr char kSimClock[] = "SIM_CLOCK";                        // sim_clock_t, sim, once per tick
 
 /// Every channel above (tools that address channels by index: the fuzz targets and their corpora;
 /// new channels are appended so that the indices of the old ones stay).
@@ -40,6 +41,6 @@ inline constexpr const char* kAllChannels[] = {
     kGazeRay,         kReflectiveView, kAlignmentTrial,      kRegistration,    kSessionControl,
     kLandmarkRequest, kLandmark,       kMisalignmentRequest, kMisalignment,    kGuidance,
     kProcessStatus,   kLoggerStatus,   kSetupTask,           kSetupResult,     kIgtlTarget,
-    kFixedView};
+    kFixedView,       kSimClock};
 
 }  // namespace orbed::channels

@@ -55,6 +55,14 @@ void AddCommonFlags(CLI::App* app, CommonFlags* flags) {
                   "seed=1,channels=REGEX (default: $ORBED_CHAOS; none when empty)");
 }
 
+void AddSimTimeFlag(CLI::App* app, CommonFlags* flags) {
+  app->add_flag(
+         "--sim-time", flags->sim_time,
+         "Run timers, timeouts and stamps on the sim's clock (SIM_CLOCK from orbed-iiwa-sim, which may "
+         "run faster than real time) instead of the wall clock (default: $ORBED_SIM_TIME)")
+      ->envname("ORBED_SIM_TIME");
+}
+
 void ApplyCommonFlags(const CommonFlags& flags) {
   LogLevel level;
   if (!ParseLogLevel(flags.log_level, &level)) {

@@ -7,6 +7,8 @@
 ///   --duration-s S   stop cleanly after S seconds (0 = run until SIGINT/SIGTERM)
 ///   --log-level L      debug | info | warn | error
 ///   --chaos SPEC       fault injection on received datagrams (default: $ORBED_CHAOS; chaos.h)
+/// and, for the processes that can follow the sim clock (AddSimTimeFlag):
+///   --sim-time         timers, timeouts and stamps on SIM_CLOCK (default: $ORBED_SIM_TIME)
 /// Usage in a thin main:
 ///   CLI::App app{"what it does"};
 ///   orbed::CommonFlags common("orbed-foo");
@@ -36,6 +38,9 @@ struct CommonFlags {
   std::string log_level = "info";
   /// Fault injection spec (procs/common/chaos.h); "" = none.
   std::string chaos;
+  /// Follow the sim clock (SIM_CLOCK, procs/common/sim_clock.h) instead of the monotonic and wall
+  /// clocks (Process, process.h).
+  bool sim_time = false;
 };
 
 /// The URL a process uses when --lcm-url is not given.
@@ -47,6 +52,9 @@ std::string DefaultLcmUrl();
 std::string WithRecvBufSize(const std::string& url, int64_t bytes);
 
 void AddCommonFlags(CLI::App* app, CommonFlags* flags);
+/// Adds --sim-time ($ORBED_SIM_TIME) for a process whose timers may follow the sim clock. The sim
+/// (the clock's source), the logger, the launcher and the monitor do not take it.
+void AddSimTimeFlag(CLI::App* app, CommonFlags* flags);
 
 /// Sets the log name and level; throws CLI::ValidationError on a bad level or chaos spec.
 void ApplyCommonFlags(const CommonFlags& flags);

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <csignal>
+#include <limits>
 #include <regex>
 #include <stdexcept>
 #include <thread>
@@ -59,7 +60,8 @@ Process::Process(const CommonFlags& flags)
       seed_(flags.seed),
       duration_sec_(flags.duration_s),
       lcm_(std::make_unique<lcm::LCM>(UrlWithReceiveBuffer(flags.lcm_url))),
-      start_(std::chrono::steady_clock::now()) {
+      start_(std::chrono::steady_clock::now()),
+      sim_time_(flags.sim_time) {
   // Before any slow set-up (models, meshes, hashes), so that a stop request during it is a clean
   // stop (Run() returns at once) rather than the default action.
   InstallStopSignalHandlers();
@@ -68,7 +70,20 @@ Process::Process(const CommonFlags& flags)
                              "' (is there a multicast route? run inside `scripts/orbed launch` or "
                              "add one: ip route add 224.0.0.0/4 dev lo)");
   }
-  AddTimer(1.0, [this] { PublishStatus(); });
+  AddWallTimer(1.0, [this] { PublishStatus(); });
+  if (sim_time_) {
+    Subscribe<orbed::sim_clock_t>(channels::kSimClock,
+                                  [this](const orbed::sim_clock_t& msg, const std::string& channel, int64_t) {
+                                    OnSimClock(msg, channel);
+                                  });
+    // Its timers wait for the sim: say so while there is none.
+    AddWallTimer(5.0, [this] {
+      if (!sim_clock_.started()) {
+        ORBED_LOG(kWarn) << "no " << channels::kSimClock
+                         << " yet (--sim-time): the timers wait for orbed-iiwa-sim's clock";
+      }
+    });
+  }
   const ChaosSpec chaos = ParseChaosSpec(flags.chaos);
   if (chaos.active()) {
     chaos_ = std::make_unique<ChaosQueue>(chaos, name_);
@@ -79,13 +94,64 @@ Process::Process(const CommonFlags& flags)
 Process::~Process() = default;
 
 void Process::AddTimer(double period_s, std::function<void()> callback, const std::string& name) {
-  if (!(period_s > 0)) throw std::invalid_argument("timer period must be > 0 s");
+  AddTimerOn(sim_time_, period_s, std::move(callback), name);
+}
+
+void Process::AddWallTimer(double period_s, std::function<void()> callback, const std::string& name) {
+  AddTimerOn(false, period_s, std::move(callback), name);
+}
+
+void Process::AddTimerOn(bool sim, double period_s, std::function<void()> callback, const std::string& name) {
+  if (!(period_s > 0) || !std::isfinite(period_s) || period_s > 1e6) {
+    throw std::invalid_argument("timer period must be > 0 s (and at most 1e6 s)");
+  }
   Timer timer;
+  timer.sim = sim;
   timer.drop_key = "timer/" + (name.empty() ? std::to_string(timers_.size()) : name);
-  timer.period = Seconds(period_s);
-  timer.next = std::chrono::steady_clock::now() + timer.period;
+  timer.period_ns = std::max<int64_t>(1, std::llround(period_s * 1e9));
+  timer.next_ns = (sim ? sim_clock_.elapsed_us() * 1000 : UptimeNanos()) + timer.period_ns;
   timer.callback = std::move(callback);
   timers_.push_back(std::move(timer));
+}
+
+int64_t Process::UptimeNanos() const {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start_)
+      .count();
+}
+
+int64_t Process::TimerNow(const Timer& timer) const {
+  if (!timer.sim) return UptimeNanos();
+  return sim_clock_.started() ? sim_clock_.elapsed_us() * 1000 : std::numeric_limits<int64_t>::min();
+}
+
+double Process::ClockSeconds() const {
+  if (!sim_time_) return UptimeSeconds();
+  return sim_deadline_ns_ ? 1e-9 * static_cast<double>(*sim_deadline_ns_) : sim_clock_.elapsed_s();
+}
+
+int64_t Process::ClockUtime() const {
+  if (!sim_time_ || !sim_clock_.started()) return NowMicros();
+  return sim_deadline_ns_ ? sim_clock_.UtimeAt(*sim_deadline_ns_) : sim_clock_.utime();
+}
+
+void Process::OnSimClock(const orbed::sim_clock_t& msg, const std::string& channel) {
+  const std::string problem = CheckSimClock(msg);
+  if (!problem.empty()) return Reject(channel + "/field", problem);
+  const int64_t before = sim_clock_.utime();
+  switch (sim_clock_.Advance(msg.utime)) {
+    case SimClock::Step::kFirst:
+      ORBED_LOG(kInfo) << "following the sim clock (" << channel << ", " << msg.realtime_rate
+                       << "x real time)";
+      break;
+    case SimClock::Step::kReanchored:
+      // A respawned sim, or a stamp from nowhere: counted and logged, the clock goes on from it.
+      Reject(channel + "/jump", "sim clock jumped by " + std::to_string(msg.utime - before) +
+                                    " us; going on from the new stamp without advancing");
+      break;
+    case SimClock::Step::kAdvanced:
+    case SimClock::Step::kSame:
+      break;
+  }
 }
 
 lcm::Subscription* Process::Add(std::unique_ptr<SubscriptionBase> subscription, const std::string& channel) {
@@ -219,6 +285,28 @@ void Process::PublishStatus() {
   Publish(channels::kProcessStatus, status);
 }
 
+void Process::RunTimer(size_t i) {
+  Timer& timer = timers_[i];
+  if (timer.sim) sim_deadline_ns_ = timer.next_ns;
+  try {
+    timer.callback();
+  } catch (const std::exception& e) {
+    // A bug or a bad input surfacing in a periodic task must not end the process.
+    Reject("timer/" + std::to_string(i), std::string("exception: ") + e.what());
+  }
+  sim_deadline_ns_.reset();
+  const int64_t now_ns = TimerNow(timer);
+  timer.next_ns += timer.period_ns;
+  // A few periods late (a busy moment, or a sim tick of several periods): the missed ticks run
+  // back to back, so a 200 Hz stream keeps its average rate. Further behind (a stall): they are
+  // skipped, not bunched.
+  if (now_ns - timer.next_ns > kMaxCatchUpPeriods * timer.period_ns) {
+    const int64_t behind = (now_ns - timer.next_ns) / timer.period_ns + 1;
+    timer.next_ns += behind * timer.period_ns;
+    CountDrop(timer.drop_key, behind);
+  }
+}
+
 int Process::Run() {
   InstallStopSignalHandlers();
   running_ = true;
@@ -229,34 +317,38 @@ int Process::Run() {
   // Waits are capped so that a stop request is noticed within 50 ms.
   const auto max_wait = std::chrono::milliseconds(50);
   while (!stop_requested_ && !StopSignalled()) {
-    auto now = std::chrono::steady_clock::now();
-    if (now >= deadline) {
+    if (std::chrono::steady_clock::now() >= deadline) {
       ORBED_LOG(kInfo) << "--duration-s reached";
       break;
     }
+    // The monotonic timers, each once if due; then the sim timers in the order of their deadlines
+    // (a SIM_CLOCK may have made several due), as they would have run at real time.
     for (size_t i = 0; i < timers_.size(); ++i) {
-      Timer& timer = timers_[i];
-      if (now >= timer.next) {
-        try {
-          timer.callback();
-        } catch (const std::exception& e) {
-          // A bug or a bad input surfacing in a periodic task must not end the process.
-          Reject("timer/" + std::to_string(i), std::string("exception: ") + e.what());
-        }
-        now = std::chrono::steady_clock::now();
-        timer.next += timer.period;
-        // A few periods late (a busy moment): the missed ticks run back to back, so a 200 Hz
-        // stream keeps its average rate. Further behind (a stall): they are skipped, not bunched.
-        if (now - timer.next > kMaxCatchUpPeriods * timer.period) {
-          const auto behind = (now - timer.next) / timer.period + 1;
-          timer.next += behind * timer.period;
-          CountDrop(timer.drop_key, static_cast<int64_t>(behind));
+      if (!timers_[i].sim && TimerNow(timers_[i]) >= timers_[i].next_ns) RunTimer(i);
+    }
+    while (sim_clock_.started()) {
+      std::optional<size_t> first;
+      for (size_t i = 0; i < timers_.size(); ++i) {
+        const Timer& timer = timers_[i];
+        if (timer.sim && TimerNow(timer) >= timer.next_ns &&
+            (!first || timer.next_ns < timers_[*first].next_ns)) {
+          first = i;
         }
       }
+      if (!first) break;
+      RunTimer(*first);
     }
     DeliverDueDatagrams();
+    const auto now = std::chrono::steady_clock::now();
     auto next = std::min(deadline, now + max_wait);
-    for (const Timer& timer : timers_) next = std::min(next, timer.next);
+    for (const Timer& timer : timers_) {
+      // A sim timer already due runs at once; the others wait for the next SIM_CLOCK.
+      if (!timer.sim) {
+        next = std::min(next, start_ + std::chrono::nanoseconds(timer.next_ns));
+      } else if (TimerNow(timer) >= timer.next_ns) {
+        next = now;
+      }
+    }
     if (chaos_ && std::isfinite(chaos_->NextDue()))
       next = std::min(next, start_ + Seconds(chaos_->NextDue()));
     const auto wait_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(next - now).count();

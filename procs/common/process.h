@@ -10,8 +10,15 @@
 /// process owns (e.g. the logger's writer) may count too. RequestStop() and the signal handler may
 /// be called from any thread.
 ///
-/// Clock: timers and uptime use the monotonic clock; message utimes use the wall clock
-/// (NowMicros()).
+/// Clocks: uptime, --duration-s, the heartbeat and the fault injection's delays use the monotonic
+/// clock, the heartbeat's utime the wall clock. The process clock (AddTimer, ClockSeconds,
+/// ClockUtime) is the monotonic and the wall clock too, unless the process follows the sim clock
+/// (CommonFlags::sim_time, --sim-time, AddSimTimeFlag): then it subscribes to SIM_CLOCK
+/// (sim_clock.h), its timers fire when the sim time reaches their deadlines (none before the first
+/// SIM_CLOCK), inside a timer's callback the clock reads that deadline (so a 60 Hz stream samples
+/// at exact multiples of 1/60 s of sim time, however many sim steps one tick of the sim makes), and
+/// elsewhere the latest SIM_CLOCK. The sim itself, the logger, the launcher and the monitor keep
+/// the wall clock.
 ///
 /// Fault injection: with a chaos spec (CommonFlags::chaos, i.e. --chaos or $ORBED_CHAOS;
 /// procs/common/chaos.h) every datagram of a matching channel passes, before decoding, through a
@@ -31,6 +38,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -41,6 +49,7 @@
 #include "lcmtypes/bounded_decode.h"
 #include "procs/common/chaos.h"
 #include "procs/common/flags.h"
+#include "procs/common/sim_clock.h"
 #include "procs/common/validation.h"
 
 namespace orbed {
@@ -87,12 +96,27 @@ class Process {
     ++messages_out_;
   }
 
-  /// Calls `callback` every `period_s` seconds on the Run() thread, first at start + period.
+  /// Calls `callback` every `period_s` seconds of the process clock on the Run() thread, first at
+  /// start + period (with sim_time: the first SIM_CLOCK + period, or now + period if later).
   /// Up to 5 missed ticks run back to back (the average rate holds through a busy moment); beyond
   /// that they are skipped, each skipped deadline a counted drop "timer/<name>" (`name` defaults
   /// to the timer's index). An exception from a callback is a counted rejection ("timer/<i>").
   /// Exceptions from message handlers likewise ("<channel>/handler"): the process keeps running.
   void AddTimer(double period_s, std::function<void()> callback, const std::string& name = "");
+  /// As AddTimer, on the monotonic clock whether or not the process follows the sim clock.
+  void AddWallTimer(double period_s, std::function<void()> callback, const std::string& name = "");
+
+  /// Whether the process clock is the sim's (CommonFlags::sim_time).
+  bool sim_time() const { return sim_time_; }
+  /// The process clock [s] since the start: the monotonic seconds since construction, or with
+  /// sim_time the sim seconds since the first SIM_CLOCK (0 before it; a sim timer's deadline inside
+  /// its callback).
+  double ClockSeconds() const;
+  /// The process clock as a message stamp [µs since the epoch]: NowMicros(), or with sim_time the
+  /// sim's stamp of ClockSeconds() (NowMicros() before the first SIM_CLOCK).
+  int64_t ClockUtime() const;
+  /// The sim clock this process follows (not started without sim_time).
+  const SimClock& sim_clock() const { return sim_clock_; }
 
   /// Counts `count` units of work dropped under load under `key` (thread-safe; logged: the first of
   /// a key, then every 1000th). At most kMaxRejectionClasses keys, further ones under "other".
@@ -126,9 +150,12 @@ class Process {
   void DeliverDueDatagrams();
 
  private:
+  // Deadlines in whole nanoseconds, so that timers of commensurate periods (20 and 30 ms) meet
+  // exactly and run in the order they were added.
   struct Timer {
-    std::chrono::steady_clock::duration period;
-    std::chrono::steady_clock::time_point next;
+    bool sim{false};       // on the sim clock (else the monotonic one)
+    int64_t period_ns{0};  // of its clock
+    int64_t next_ns{0};    // deadline on its clock: since the start / the first SIM_CLOCK
     std::function<void()> callback;
     std::string drop_key;  // "timer/<name>"
   };
@@ -152,6 +179,14 @@ class Process {
   // Registers a subscription (sets its process and index) and subscribes it to LCM.
   lcm::Subscription* Add(std::unique_ptr<SubscriptionBase> subscription, const std::string& channel);
   void PublishStatus();
+  void AddTimerOn(bool sim, double period_s, std::function<void()> callback, const std::string& name);
+  // Now on the timer's clock [ns]; INT64_MIN for a sim timer before the first SIM_CLOCK.
+  int64_t TimerNow(const Timer& timer) const;
+  int64_t UptimeNanos() const;
+  // Runs timers_[i]'s callback (a sim timer's with the clock at its deadline) and sets its next
+  // deadline, skipping (and counting) those more than kMaxCatchUpPeriods behind.
+  void RunTimer(size_t i);
+  void OnSimClock(const orbed::sim_clock_t& msg, const std::string& channel);
 
   std::string name_;
   uint64_t seed_;
@@ -160,6 +195,9 @@ class Process {
   std::vector<std::unique_ptr<SubscriptionBase>> subscriptions_;
   std::vector<Timer> timers_;
   std::chrono::steady_clock::time_point start_;
+  bool sim_time_{false};
+  SimClock sim_clock_;
+  std::optional<int64_t> sim_deadline_ns_;  // the running sim timer's deadline
   std::atomic<bool> stop_requested_{false};
   std::atomic<bool> running_{false};
   std::atomic<bool> failed_{false};

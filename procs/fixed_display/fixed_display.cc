@@ -43,7 +43,7 @@ FixedDisplay::FixedDisplay(const CommonFlags& flags, const FixedDisplayOptions& 
              {nullptr,
               [this](const orbed::guidance_t& g) {
                 mode_ = g.mode;
-                guidance_received_utime_ = NowMicros();
+                guidance_received_utime_ = process_.ClockUtime();
               }}),
       renderer_(model_, scene_ ? &*scene_ : nullptr, options.picture) {
   // The home view is the configured camera about the scene's base (the robot alone: the origin);
@@ -103,7 +103,8 @@ std::optional<orbed::image_t> FixedDisplay::PictureNow(int64_t utime) {
 
 void FixedDisplay::Tick() {
   if (window_open_) PressKey(cv::waitKey(1));
-  if (const auto picture = PictureNow(NowMicros())) process_.Publish(options_.fixed_view_channel, *picture);
+  if (const auto picture = PictureNow(process_.ClockUtime()))
+    process_.Publish(options_.fixed_view_channel, *picture);
 }
 
 int RunFixedDisplay(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
@@ -115,6 +116,7 @@ int RunFixedDisplay(int argc, const char* const* argv, std::ostream& out, std::o
       std::string(kKeyHelp)};
   CommonFlags common("orbed-fixed-display");
   AddCommonFlags(&app, &common);
+  AddSimTimeFlag(&app, &common);
   FixedDisplayOptions options;
   std::string camera_m = "1.5,0.3,1.8";
   app.add_option("--urdf", options.urdf_path, "Robot URDF (default: the shipped iiwa 7)");

@@ -56,7 +56,8 @@ class FixedDisplay {
   int Run() { return process_.Run(); }
   Process& process() { return process_; }
 
-  /// What the timer publishes at wall time `utime` [us]: none without a fresh target and a base.
+  /// What the timer publishes at `utime` [us, the process clock: wall, or the sim's with --sim-time]: none
+  /// without a fresh target and a base.
   std::optional<orbed::image_t> PictureNow(int64_t utime);
   /// The current view and the home view (the configured camera); a key applied as in the window.
   const OrbitView& view() const { return view_; }

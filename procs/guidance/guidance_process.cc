@@ -38,7 +38,7 @@ GuidanceProcess::GuidanceProcess(const CommonFlags& flags, const GuidanceOptions
       options_(options) {
   process_.Subscribe<orbed::iiwa_status_t>(
       options_.iiwa_status_channel,
-      [this](const orbed::iiwa_status_t& msg, const std::string& channel, int64_t received_utime) {
+      [this](const orbed::iiwa_status_t& msg, const std::string& channel, int64_t) {
         Eigen::VectorXd q;
         const sim::IiwaStatusProblem problem = sim::CheckIiwaStatus(msg, model_, kJointLimitSlackRad, &q);
         if (!problem.rejection_class.empty()) {
@@ -47,7 +47,7 @@ GuidanceProcess::GuidanceProcess(const CommonFlags& flags, const GuidanceOptions
         }
         q_rad_ = q;
         have_q_ = true;
-        q_received_utime_ = received_utime;
+        q_received_utime_ = process_.ClockUtime();
       });
   process_.Subscribe<orbed::setup_task_t>(
       options_.setup_task_channel,
@@ -76,7 +76,7 @@ GuidanceProcess::GuidanceProcess(const CommonFlags& flags, const GuidanceOptions
   process_.AddTimer(
       1.0 / options_.rate_hz,
       [this] {
-        const auto guidance = GuidanceNow(NowMicros());
+        const auto guidance = GuidanceNow(process_.ClockUtime());
         if (guidance) process_.Publish(options_.guidance_channel, *guidance);
         if (core_ && have_q_ && !guidance != stale_logged_) {
           stale_logged_ = !guidance;
@@ -155,6 +155,7 @@ int RunGuidance(int argc, const char* const* argv, std::ostream& out, std::ostre
       "with the trocar IK's docking configuration."};
   CommonFlags common("orbed-guidance");
   AddCommonFlags(&app, &common);
+  AddSimTimeFlag(&app, &common);
   GuidanceOptions options;
   std::string target_deg, mode = "ar", plan_path;
   int plan_target = 1;

@@ -53,8 +53,9 @@ class GuidanceProcess {
   GuidanceProcess(const CommonFlags& flags, const GuidanceOptions& options);
   int Run() { return process_.Run(); }
   Process& process() { return process_; }
-  /// The GUIDANCE the timer would publish at `utime` (wall clock [µs]): none before the first good
-  /// IIWA_STATUS or when the latest was received more than stale_after_s before.
+  /// The GUIDANCE the timer would publish at `utime` (the process clock [µs]: wall, or the sim's
+  /// with --sim-time): none before the first good IIWA_STATUS or when the latest was received more
+  /// than stale_after_s before.
   std::optional<orbed::guidance_t> GuidanceNow(int64_t utime) const;
 
  private:

@@ -37,6 +37,7 @@ int RunScenario(int argc, const char* const* argv, std::ostream& out, std::ostre
       "mean, and the errors of every trial and mean against the simulator's truth."};
   orbed::CommonFlags common("orbed-scenario");
   orbed::AddCommonFlags(&app, &common);
+  orbed::AddSimTimeFlag(&app, &common);
   ScenarioOptions options;
   ConductorOptions& run = options.conductor;
   std::string scenario_path;

@@ -55,7 +55,7 @@ ScenarioOptions Resolved(ScenarioOptions options, uint64_t seed) {
 std::string ScenarioSourcePath(const std::string& relative) { return orbed::SourceTreePath(relative); }
 
 ViraalScenario::ViraalScenario(const orbed::CommonFlags& flags, const ScenarioOptions& options)
-    : options_(Resolved(options, flags.seed)), clock_origin_(std::chrono::steady_clock::now()) {
+    : options_(Resolved(options, flags.seed)) {
   conductor_ = std::make_unique<ViraalConductor>(options_.conductor,
                                                  orbed::sim::RobotModel::LoadFile(options_.urdf_path));
   process_ = std::make_unique<orbed::Process>(flags);
@@ -107,8 +107,7 @@ int ViraalScenario::Run() {
 void ViraalScenario::Tick() { Apply(conductor_->Tick(Now())); }
 
 ConductorTime ViraalScenario::Now() const {
-  const std::chrono::duration<double> t = std::chrono::steady_clock::now() - clock_origin_;
-  return ConductorTime{t.count(), NowMicros()};
+  return ConductorTime{process_->ClockSeconds(), process_->ClockUtime()};
 }
 
 void ViraalScenario::Apply(const ConductorActions& actions) {

@@ -25,8 +25,8 @@
 /// read (viraal/results.h) and checked against this run (resume.h); the run id is the earlier
 /// run's unless one is given (it must then be the same); the conductor keeps what they hold.
 ///
-/// Clocks: the conductor's t_s is std::chrono::steady_clock (seconds since construction), its
-/// utime the wall clock (NowMicros()).
+/// Clocks: the conductor's t_s and utime are the process clock (Process::ClockSeconds / ClockUtime:
+/// monotonic seconds since the start and the wall clock, or with --sim-time the sim's).
 /// Threading: everything on the Process::Run() thread.
 
 #include <chrono>
@@ -93,7 +93,6 @@ class ViraalScenario {
   ScenarioOptions options_;
   std::unique_ptr<ViraalConductor> conductor_;
   std::unique_ptr<orbed::Process> process_;
-  std::chrono::steady_clock::time_point clock_origin_;
   bool finished_{false};
   viraal::RunResults results_;
   std::string results_path_;

@@ -37,7 +37,7 @@ std::vector<int8_t> ModeOrderForSeed(uint64_t user_seed) {
 
 SetupProcess::SetupProcess(const CommonFlags& flags, const SetupOptions& options,
                            const std::string& urdf_path, const std::string& results_dir, std::ostream* out)
-    : process_(flags), results_dir_(results_dir), out_(out), origin_(std::chrono::steady_clock::now()) {
+    : process_(flags), results_dir_(results_dir), out_(out) {
   conductor_ = std::make_unique<SetupConductor>(options, sim::RobotModel::LoadFile(urdf_path));
   process_.Subscribe<orbed::robot_state_t>(
       options.robot_state_channel, [this](const orbed::robot_state_t& m, const std::string&, int64_t) {
@@ -75,8 +75,7 @@ SetupProcess::SetupProcess(const CommonFlags& flags, const SetupOptions& options
 }
 
 ConductorTime SetupProcess::Now() const {
-  const std::chrono::duration<double> t = std::chrono::steady_clock::now() - origin_;
-  return ConductorTime{t.count(), NowMicros()};
+  return ConductorTime{process_.ClockSeconds(), process_.ClockUtime()};
 }
 
 void SetupProcess::Start() {
@@ -151,6 +150,7 @@ int RunSetup(int argc, const char* const* argv, std::ostream& out, std::ostream&
       "to set the arm up to the target (orbed-guidance shows it). Writes setup_results.json."};
   CommonFlags common("orbed-setup");
   AddCommonFlags(&app, &common);
+  AddSimTimeFlag(&app, &common);
   SetupOptions options;
   std::string plan_path, scenario_path, urdf_path, results_dir, modes, start_deg = "0,20,0,-60,0,40,0";
   uint64_t user_seed = 1;

@@ -18,8 +18,9 @@
 /// Fisher-Yates with base/random.h), so a study's users meet the modes in randomized orders as the
 /// paper's did, reproducibly.
 ///
-/// Clocks: steady_clock for the conductor's t_s, the wall clock for utimes. Threading: everything on
-/// the Process::Run thread.
+/// Clocks: the process clock (Process::ClockSeconds / ClockUtime: monotonic and wall, or with
+/// --sim-time the sim's) for the conductor's t_s and utimes. Threading: everything on the
+/// Process::Run thread.
 
 #include <chrono>
 #include <iosfwd>
@@ -54,7 +55,6 @@ class SetupProcess {
   std::unique_ptr<SetupConductor> conductor_;
   std::string results_dir_;
   std::ostream* out_;
-  std::chrono::steady_clock::time_point origin_;
   size_t written_setups_{0};
   bool finished_{false};
   bool started_{false};

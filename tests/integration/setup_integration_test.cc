@@ -15,6 +15,11 @@
 //  6. A resumed run (ORBED_SETUP_RESUME): a finished run's file cut back to its first set-up and
 //     marked partial; the launch keeps that set-up as it was, sends SETUP_TASK for the second only,
 //     and ends with both, the first exactly as the file had it.
+//  7. The sim clock (issue 11 item 6): the same user's first set-up (fixed monitor, made while the
+//     person still walks in) on the sim's clock at real time and at 8 times real time: every joint
+//     ends the same to within 2 deg (8 steps of the assistant's grid; with only the sim faster, the
+//     other processes on the wall clock, one joint ended 275 deg away), and the R = 8 log's
+//     SIM_CLOCK carries rate 8 and every IIWA_STATUS stamp.
 //  3. scripts/launch/setup.yaml for one user and one target per mode through orbed-launch: the run
 //     ends with exit 0; setup_results.json has the three set-ups in the order the user seed draws,
 //     each reached_deg equal to the assistant's (the sim's measured joints, twice read), an
@@ -27,6 +32,7 @@
 #include <fstream>
 #include <map>
 #include <mutex>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -39,6 +45,7 @@
 #include <orbed/registration_t.hpp>
 #include <orbed/robot_state_t.hpp>
 #include <orbed/setup_task_t.hpp>
+#include <orbed/sim_clock_t.hpp>
 
 #include "base/units.h"
 #include "procs/setup/setup_conductor.h"
@@ -390,6 +397,51 @@ TEST(SetupStudy, AResumedRunKeepsTheFinishedSetUpAndRunsTheRest) {
   for (const std::string& id : tasks) EXPECT_EQ(id, "u3-fixed-2");
   const std::vector<std::string> first_tasks = LoggedTaskIds(first_dir);
   EXPECT_NE(std::find(first_tasks.begin(), first_tasks.end(), "u3-fixed-1"), first_tasks.end());
+}
+
+// Runs setup.yaml for user u1 (seed 1), the fixed mode's first target, on the sim's clock at rate R.
+std::string RunOnTheSimClock(int rate) {
+  const std::string log_dir = MakeTempDir("setup_sim_clock_" + std::to_string(rate));
+  RunningProcess launcher(
+      {BinPath("orbed-launch"), SourcePath("scripts/launch/setup.yaml"), "--duration-s", "300"},
+      {{"ORBED_LOG_DIR", log_dir},
+       {"ORBED_RUN_ID", "setup-sim-clock"},
+       {"ORBED_USER", "u1"},
+       {"ORBED_USER_SEED", "1"},
+       {"ORBED_SETUP_MODES", "fixed"},
+       {"ORBED_SETUP_TARGETS", "1"},
+       {"ORBED_SIM_TIME", "1"},
+       {"ORBED_SIM_HOLD_FOR", "setup"},
+       {"ORBED_SIM_RATE", std::to_string(rate)}});
+  EXPECT_TRUE(launcher.Wait(300)) << "the run at rate " << rate << " did not finish";
+  EXPECT_EQ(launcher.exit_code(), 0);
+  return log_dir;
+}
+
+TEST(SetupStudy, OnTheSimClockEightTimesFasterIsTheSameSetUp) {
+  const std::string real = RunOnTheSimClock(1);
+  const std::string fast = RunOnTheSimClock(8);
+  const YAML::Node a = YAML::LoadFile(real + "/setup_results.json")["setups"];
+  const YAML::Node b = YAML::LoadFile(fast + "/setup_results.json")["setups"];
+  ASSERT_EQ(a.size(), 1u);
+  ASSERT_EQ(b.size(), 1u);
+  for (int i = 0; i < 7; ++i) {
+    EXPECT_NEAR(a[0]["reached_deg"][i].as<double>(), b[0]["reached_deg"][i].as<double>(), 2.0)
+        << "joint " << i + 1;
+  }
+  // The fast run's clock: rate 8 on every SIM_CLOCK, and each IIWA_STATUS stamped with one of them.
+  const std::vector<orbed::sim_clock_t> clock = Logged<orbed::sim_clock_t>(fast, "SIM_CLOCK");
+  const std::vector<orbed::iiwa_status_t> status = Logged<orbed::iiwa_status_t>(fast, "IIWA_STATUS");
+  ASSERT_GT(clock.size(), 100u);
+  ASSERT_GT(status.size(), 100u);
+  std::set<int64_t> stamps;
+  for (const orbed::sim_clock_t& c : clock) {
+    EXPECT_EQ(c.realtime_rate, 8);
+    stamps.insert(c.utime);
+  }
+  size_t stamped = 0;
+  for (const orbed::iiwa_status_t& s : status) stamped += stamps.count(s.utime);
+  EXPECT_EQ(stamped, status.size());
 }
 
 }  // namespace

@@ -84,14 +84,19 @@ TEST(ViraalRun, LaunchFileRunsTheStudyAndWritesResults) {
   EXPECT_EQ(manifest["channels"]["ALIGNMENT_TRIAL"]["events"].as<int>(), 6);
 }
 
-// Faster than real time ($ORBED_SIM_RATE = 8: the sim steps the arm 8 times per tick, the person
-// walks 8 times as fast): the arm reaches the same configurations, so the run equals the pinned
-// results number for number, and its log is whole.
+// Faster than real time ($ORBED_SIM_RATE = 8: the sim steps the arm 8 times per tick; every other
+// process on its clock, $ORBED_SIM_TIME, which it holds until the conductor runs): the arm reaches
+// the same configurations, so the run equals the pinned results number for number, and its log is
+// whole.
 TEST(ViraalRun, FasterThanRealTimeTheRunIsTheSame) {
   const std::string log_dir = MakeTempDir("viraal_fast");
   RunningProcess launcher(
       {BinPath("orbed-launch"), SourcePath("scripts/launch/viraal.yaml"), "--duration-s", "240"},
-      {{"ORBED_LOG_DIR", log_dir}, {"ORBED_RUN_ID", "pinned"}, {"ORBED_SIM_RATE", "8"}});
+      {{"ORBED_LOG_DIR", log_dir},
+       {"ORBED_RUN_ID", "pinned"},
+       {"ORBED_SIM_RATE", "8"},
+       {"ORBED_SIM_TIME", "1"},
+       {"ORBED_SIM_HOLD_FOR", "scenario"}});
   ASSERT_TRUE(launcher.Wait(240)) << "the run did not finish";
   ASSERT_EQ(launcher.exit_code(), 0);
   const YAML::Node pinned =
