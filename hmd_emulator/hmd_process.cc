@@ -196,7 +196,7 @@ void HmdProcess::PublishPose() {
     started_ = true;
     t0_s_ = now_s;
   }
-  const PoseStream::Poses poses = stream_->Step(now_s - t0_s_, process_->ClockUtime());
+  const PoseStream::Poses poses = stream_->Step(now_s - t0_s_ + walk_offset_s_, process_->ClockUtime());
   process_->Publish(options_.hmd_pose_channel, poses.estimate);
   process_->Publish(options_.hmd_pose_truth_channel, poses.truth);
   if (pending_trial_ && !stream_->playing_faults()) {
@@ -359,6 +359,10 @@ void HmdProcess::PublishEmulatedTrial(const TrialOutcome& outcome) {
   const HmdSessionState& s = session_.state();
   const std::int32_t index = s.next_index;
   X_WV_user_ = outcome.alignment.X_WV;
+  // The person spent the trial's emulated seconds aligning: the live walk goes on from there (a
+  // trial is computed at once, in however much wall time; on the sim clock at a rate R that wall
+  // time would otherwise decide where the person stands when the set-up after the alignment starts).
+  walk_offset_s_ += outcome.alignment.duration_s;
   PublishTrial(outcome.alignment.X_WV, outcome.alignment.duration_s, user_id_, outcome.faults,
                outcome.annotation);
   const TrackingFaultRecord& f = outcome.faults;

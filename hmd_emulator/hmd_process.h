@@ -75,7 +75,8 @@
 ///
 /// Clocks: the process clock (Process::ClockSeconds / ClockUtime: the monotonic and wall clocks, or
 /// with --sim-time the sim's) runs the streams' timers, the walk's time t [s] from the first pose
-/// tick, and stamps the poses and trials; the images keep the wall clock of their sample or render
+/// tick (plus the emulated durations of the trials published: the person walked on while
+/// aligning), and stamps the poses and trials; the images keep the wall clock of their sample or render
 /// (the pipeline's worker thread does not read the process clock), the interactive window too.
 /// Frames: W world (= the SLAM map for estimates), H head, C camera, M reversed frustum, R real
 /// robot base, V virtual robot base. Units: m, rad, px, Hz; utime µs.
@@ -236,6 +237,7 @@ class HmdProcess {
   SessionMapCache session_map_;                    // the session's map after its last trial
   std::optional<InteractiveSession> interactive_;  // always set; the person only with --interactive
   double t0_s_{0};                                 // the walk's t = 0: the first pose tick [process clock s]
+  double walk_offset_s_{0};                        // emulated seconds of the trials published [s]
   bool started_{false};
   bool window_open_{false};
 
