@@ -48,7 +48,8 @@
 /// (utime_k - utime_j), never exceeds the joint's velocity limit, however loaded the machine: utime says when
 /// the state holds in simulated time, not when it was computed. Tick() called directly (tests) advances k by
 /// one per call the same way. Wall clock: the stale-command check (senders stamp commands with their wall
-/// clocks), PLAN_CHECK_REPLY and PROCESS_STATUS.
+/// clocks, or with this sim clock when they follow it: a command near either is fresh),
+/// PLAN_CHECK_REPLY and PROCESS_STATUS.
 ///
 /// Faster than real time (realtime_rate R > 1, for studies without a person in the loop): tick k
 /// steps the arm R times by P (each step checked for collisions as at R = 1) and stamps
@@ -57,8 +58,9 @@
 /// wall time while every step, and the speed read from the stamps, keeps the joint's velocity
 /// limit in sim time. The outputs still go out once per tick (200 Hz of wall time, 200/R Hz of sim
 /// time), COLLISION_STATUS with the tick's step that came closest to contact (so near misses are
-/// seen at every rate). The other processes keep the wall clock: their periods and timeouts are
-/// wall seconds.
+/// seen at every rate). Each tick's stamp goes out first on SIM_CLOCK (sim_clock_t), the clock the
+/// processes started with --sim-time follow (procs/common/sim_clock.h); with hold_for it stays at
+/// start_utime, and the arm does not step, until that process runs. The others keep the wall clock.
 ///
 /// Crash recovery (state_file, sim_state.h): the sim saves its measured q while the arm moves, at most
 /// every state_save_period_s of sim time and whenever the arm comes to rest, and a sim started on an

@@ -20,6 +20,7 @@
 #include <orbed/iiwa_status_t.hpp>
 #include <orbed/plan_check_reply_t.hpp>
 #include <orbed/robot_state_t.hpp>
+#include <orbed/sim_clock_t.hpp>
 
 #include "base/test_command.h"
 #include "base/units.h"
@@ -403,6 +404,89 @@ TEST(IiwaSim, ARealtimeRateStepsTheArmThatManyTimesPerTickOnTheSimClock) {
 // The published frames against independent facts: X_WR from the scene file (position
 // (0.25, -0.55, 0.75), yaw 90 deg), the upright flange at z = 0.34 + 0.4 + 0.4 + 0.126 = 1.266 m
 // in R (the data sheet's DH d), the tool tip 0.25 m (scene tool_length_m) above it.
+// The sim clock's source (R = 4, P = 10 ms, held for "setup"): while held, a tick sends SIM_CLOCK
+// at the start stamp only and the arm does not step; heartbeats of another process, or of "setup"
+// not yet running, do not release it; "setup" running does. Then each tick's SIM_CLOCK goes out
+// before its IIWA_STATUS with the same stamp, start + 4 k P. A command stamped on the sim clock is
+// fresh within R x 1 s of sim time, whatever the wall clock says.
+TEST(IiwaSim, SendsItsClockFirstAndHoldsItUntilTheNamedProcessRuns) {
+  IiwaSimOptions options;
+  options.period_s = 0.01;
+  options.realtime_rate = 4;
+  options.hold_for = "setup";
+  IiwaSim sim(MemqFlags(0.1), options);
+  lcm::LCM& lcm = sim.process().lcm();
+  std::vector<std::pair<std::string, int64_t>> order;  // (channel, utime) as received
+  struct Recorder {
+    std::vector<std::pair<std::string, int64_t>>* order;
+    void OnClock(const lcm::ReceiveBuffer*, const std::string& ch, const orbed::sim_clock_t* m) {
+      EXPECT_EQ(m->realtime_rate, 4);
+      order->emplace_back(ch, m->utime);
+    }
+    void OnStatus(const lcm::ReceiveBuffer*, const std::string& ch, const orbed::iiwa_status_t* m) {
+      order->emplace_back(ch, m->utime);
+    }
+  } recorder{&order};
+  lcm.subscribe("SIM_CLOCK", &Recorder::OnClock, &recorder);
+  lcm.subscribe("IIWA_STATUS", &Recorder::OnStatus, &recorder);
+  auto drain = [&] {
+    while (lcm.handleTimeout(0) > 0) {
+    }
+  };
+  const orbed::iiwa_command_t cmd = Command({30, 0, 0, 0, 0, 0, 0});
+  lcm.publish("IIWA_COMMAND", &cmd);
+  auto heartbeat = [&](const std::string& name, int8_t state) {
+    orbed::process_status_t status{};
+    status.utime = 1;
+    status.name = name;
+    status.state = state;
+    lcm.publish("PROCESS_STATUS", &status);
+  };
+  heartbeat("guidance", orbed::process_status_t::STATE_RUNNING);
+  heartbeat("setup", orbed::process_status_t::STATE_STARTING);
+  drain();
+  for (int n = 0; n < 2; ++n) {
+    sim.Tick();
+    drain();
+  }
+  EXPECT_TRUE(sim.holding());
+  ASSERT_EQ(order.size(), 2u);
+  for (const auto& [channel, utime] : order) {
+    EXPECT_EQ(channel, "SIM_CLOCK");
+    EXPECT_EQ(utime, sim.start_utime());
+  }
+  EXPECT_EQ(sim.arm().q_rad()[0], 0.0);
+
+  heartbeat("setup", orbed::process_status_t::STATE_RUNNING);
+  drain();
+  EXPECT_FALSE(sim.holding());
+  order.clear();
+  for (int n = 1; n <= 2; ++n) {
+    sim.Tick();
+    drain();
+  }
+  ASSERT_EQ(order.size(), 4u);
+  for (int n = 1; n <= 2; ++n) {
+    const int64_t stamp = sim.start_utime() + n * 4 * 10000;
+    EXPECT_EQ(order[2 * (n - 1)], std::make_pair(std::string("SIM_CLOCK"), stamp)) << n;
+    EXPECT_EQ(order[2 * (n - 1) + 1], std::make_pair(std::string("IIWA_STATUS"), stamp)) << n;
+  }
+  EXPECT_NEAR(sim.arm().q_rad()[0], 2 * 4 * 98 * 0.01 * kDegToRad, 1e-12);
+
+  // Stamped 3 s of sim time ahead of the sim clock (0.75 s of wall time at R = 4; 3 s ahead of the
+  // wall clock): fresh. 5 s ahead (1.25 s at R = 4): stale.
+  const int64_t sim_now = sim.start_utime() + 2 * 4 * 10000;
+  orbed::iiwa_command_t ahead = cmd;
+  ahead.utime = sim_now + 3'000'000;
+  lcm.publish("IIWA_COMMAND", &ahead);
+  drain();
+  EXPECT_EQ(sim.process().rejections().total(), 0);
+  ahead.utime = sim_now + 5'000'000;
+  lcm.publish("IIWA_COMMAND", &ahead);
+  drain();
+  EXPECT_EQ(sim.process().rejections().counts().at("IIWA_COMMAND/stale"), 1);
+}
+
 TEST(IiwaSim, PublishesTrueFramesAndClearances) {
   IiwaSim sim(MemqFlags(0.1), IiwaSimOptions{});
   Collector got;
