@@ -74,12 +74,13 @@
 /// everything runs inline on the Run() thread (deterministic, for tests).
 ///
 /// Clocks: the process clock (Process::ClockSeconds / ClockUtime: the monotonic and wall clocks, or
-/// with --sim-time the sim's) runs the streams' timers, the walk's time t [s] from the first pose
-/// tick (plus the emulated durations of the trials published: the person walked on while
-/// aligning), and stamps the poses and trials; the images keep the wall clock of their sample or render
-/// (the pipeline's worker thread does not read the process clock), the interactive window too.
-/// Frames: W world (= the SLAM map for estimates), H head, C camera, M reversed frustum, R real
-/// robot base, V virtual robot base. Units: m, rad, px, Hz; utime µs.
+/// with --sim-time the sim's) runs the pose and gaze timers (the rendered streams' timers stay on
+/// the monotonic clock: a renderer's rate is wall frames per second), the walk's time t [s] from the first
+/// pose tick (plus the emulated durations of the trials published: the person walked on while aligning), and
+/// stamps the poses and trials; the images keep the wall clock of their sample or render (the pipeline's
+/// worker thread does not read the process clock), the interactive window too. Frames: W world (= the SLAM
+/// map for estimates), H head, C camera, M reversed frustum, R real robot base, V virtual robot base. Units:
+/// m, rad, px, Hz; utime µs.
 
 #include <chrono>
 #include <cstdint>
