@@ -152,7 +152,7 @@ HmdProcess::HmdProcess(const orbed::CommonFlags& flags, const HmdOptions& option
   process_->AddWallTimer(
       1.0 / config_.hmd.ar_view_hz, [this] { RequestArView(); }, options_.ar_view_channel);
   if (options_.interactive)
-    process_->AddTimer(
+    process_->AddWallTimer(
         1.0 / kInteractiveHz, [this] { InteractiveTick(); }, "interactive");
 
   ORBED_LOG(kInfo) << "robot " << options_.urdf_path << ", scene " << options_.scene_path << "; walk of "
@@ -363,9 +363,10 @@ void HmdProcess::PublishEmulatedTrial(const TrialOutcome& outcome) {
   const HmdSessionState& s = session_.state();
   const std::int32_t index = s.next_index;
   X_WV_user_ = outcome.alignment.X_WV;
-  // The person spent the trial's emulated seconds aligning: the live walk goes on from there (a
-  // trial is computed at once, in however much wall time; on the sim clock at a rate R that wall
-  // time would otherwise decide where the person stands when the set-up after the alignment starts).
+  // The person spent the trial's emulated seconds aligning: the live walk goes on from there, so
+  // that where the person stands after an alignment is the walk's (its end, for trials of a minute)
+  // rather than where the wall time the computation took has put the live walk (on the sim clock
+  // at a rate R, R times that).
   walk_offset_s_ += outcome.alignment.duration_s;
   PublishTrial(outcome.alignment.X_WV, outcome.alignment.duration_s, user_id_, outcome.faults,
                outcome.annotation);

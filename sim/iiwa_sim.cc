@@ -223,6 +223,7 @@ void IiwaSim::Tick() {
     orbed::sim_clock_t clock{};
     clock.utime = start_utime_;
     clock.realtime_rate = options_.realtime_rate;
+    clock.start_utime = start_utime_;
     if (!options_.sim_clock_channel.empty()) process_->Publish(options_.sim_clock_channel, clock);
     return;
   }
@@ -262,6 +263,7 @@ void IiwaSim::PublishAll(int64_t utime, const CollisionResult& r) {
   orbed::sim_clock_t clock{};
   clock.utime = utime;
   clock.realtime_rate = options_.realtime_rate;
+  clock.start_utime = start_utime_;
   if (!options_.sim_clock_channel.empty()) process_->Publish(options_.sim_clock_channel, clock);
 
   const RobotModel& model = arm_->model();

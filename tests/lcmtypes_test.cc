@@ -144,7 +144,7 @@ TEST(LcmTypes, FingerprintsArePinned) {
                                                   {"session_control_t", 0x875cddac9b006a4fULL},
                                                   {"setup_result_t", 0x7b1a0cab822c59c1ULL},
                                                   {"setup_task_t", 0x45ebcc451fbad1b9ULL},
-                                                  {"sim_clock_t", 0x26b2714b1b480c22ULL},
+                                                  {"sim_clock_t", 0x7c6f4709999be963ULL},
                                                   {"target_pose_t", 0x861ba235288a4402ULL},
                                                   {"viewer_draw_t", 0x414f0bfe5b2f4244ULL},
                                                   {"viewer_geometry_data_t", 0x5d2e34cb3257db07ULL},

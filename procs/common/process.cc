@@ -76,12 +76,17 @@ Process::Process(const CommonFlags& flags)
                                   [this](const orbed::sim_clock_t& msg, const std::string& channel, int64_t) {
                                     OnSimClock(msg, channel);
                                   });
-    // Its timers wait for the sim: say so while there is none.
+    // Its timers wait for the sim: say so while there is none, and fail when none came at all
+    // (a held sim sends SIM_CLOCK too).
     AddWallTimer(5.0, [this] {
-      if (!sim_clock_.started()) {
-        ORBED_LOG(kWarn) << "no " << channels::kSimClock
-                         << " yet (--sim-time): the timers wait for orbed-iiwa-sim's clock";
+      if (sim_clock_.started()) return;
+      if (UptimeSeconds() >= kSimClockStartTimeoutS) {
+        return Fail("no " + std::string(channels::kSimClock) + " within " +
+                    std::to_string(static_cast<int>(kSimClockStartTimeoutS)) +
+                    " s (--sim-time): is orbed-iiwa-sim running?");
       }
+      ORBED_LOG(kWarn) << "no " << channels::kSimClock
+                       << " yet (--sim-time): the timers wait for orbed-iiwa-sim's clock";
     });
   }
   const ChaosSpec chaos = ParseChaosSpec(flags.chaos);
@@ -138,13 +143,22 @@ void Process::OnSimClock(const orbed::sim_clock_t& msg, const std::string& chann
   const std::string problem = CheckSimClock(msg);
   if (!problem.empty()) return Reject(channel + "/field", problem);
   const int64_t before = sim_clock_.utime();
-  switch (sim_clock_.Advance(msg.utime)) {
+  switch (sim_clock_.Advance(msg.utime, msg.start_utime)) {
     case SimClock::Step::kFirst:
       ORBED_LOG(kInfo) << "following the sim clock (" << channel << ", " << msg.realtime_rate
                        << "x real time)";
       break;
-    case SimClock::Step::kReanchored:
-      // A respawned sim, or a stamp from nowhere: counted and logged, the clock goes on from it.
+    case SimClock::Step::kRestarted:
+      ORBED_LOG(kWarn) << "the sim restarted (" << channel << " from a new start " << msg.start_utime
+                       << "): the clock goes on from its stamps";
+      break;
+    case SimClock::Step::kLate:
+      // A delayed or reordered datagram: counted, not a step back.
+      Reject(channel + "/late", "stamp " + std::to_string(msg.utime) + " is " +
+                                    std::to_string(before - msg.utime) + " us behind the latest");
+      break;
+    case SimClock::Step::kJumped:
+      // A stamp from nowhere: counted and logged, the clock goes on from it without advancing.
       Reject(channel + "/jump", "sim clock jumped by " + std::to_string(msg.utime - before) +
                                     " us; going on from the new stamp without advancing");
       break;
@@ -300,7 +314,10 @@ void Process::RunTimer(size_t i) {
   // A few periods late (a busy moment, or a sim tick of several periods): the missed ticks run
   // back to back, so a 200 Hz stream keeps its average rate. Further behind (a stall): they are
   // skipped, not bunched.
-  if (now_ns - timer.next_ns > kMaxCatchUpPeriods * timer.period_ns) {
+  // A sim timer catches up over the whole last SIM_CLOCK step too (R x P of sim time at once).
+  const int64_t allowed_ns =
+      kMaxCatchUpPeriods * timer.period_ns + (timer.sim ? sim_clock_.last_step_us() * 1000 : 0);
+  if (now_ns - timer.next_ns > allowed_ns) {
     const int64_t behind = (now_ns - timer.next_ns) / timer.period_ns + 1;
     timer.next_ns += behind * timer.period_ns;
     CountDrop(timer.drop_key, behind);

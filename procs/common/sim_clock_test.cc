@@ -23,32 +23,47 @@ TEST(SimClock, AdvancesByTheStampsAndNeverRunsBackwards) {
   SimClock clock;
   EXPECT_FALSE(clock.started());
   EXPECT_EQ(clock.elapsed_us(), 0);
-  EXPECT_EQ(clock.Advance(kStart), SimClock::Step::kFirst);
+  EXPECT_EQ(clock.Advance(kStart, kStart), SimClock::Step::kFirst);
   EXPECT_EQ(clock.elapsed_us(), 0);
-  EXPECT_EQ(clock.Advance(kStart + 50'000), SimClock::Step::kAdvanced);
-  EXPECT_EQ(clock.Advance(kStart + 50'000), SimClock::Step::kSame);
-  EXPECT_EQ(clock.Advance(kStart + 100'000), SimClock::Step::kAdvanced);
+  EXPECT_EQ(clock.Advance(kStart + 50'000, kStart), SimClock::Step::kAdvanced);
+  EXPECT_EQ(clock.last_step_us(), 50'000);
+  EXPECT_EQ(clock.Advance(kStart + 50'000, kStart), SimClock::Step::kSame);
+  EXPECT_EQ(clock.last_step_us(), 0);
+  EXPECT_EQ(clock.Advance(kStart + 100'000, kStart), SimClock::Step::kAdvanced);
   EXPECT_EQ(clock.elapsed_us(), 100'000);
   EXPECT_DOUBLE_EQ(clock.elapsed_s(), 0.1);
   // A deadline between two stamps: 0.07 s after the first is kStart + 70 000 µs.
   EXPECT_EQ(clock.UtimeAt(70'000'000), kStart + 70'000);
-  // A respawned sim starts behind: re-anchored, the elapsed time stays, later steps count on.
-  EXPECT_EQ(clock.Advance(kStart - 5'000'000), SimClock::Step::kReanchored);
-  EXPECT_EQ(clock.elapsed_us(), 100'000);
-  EXPECT_EQ(clock.Advance(kStart - 4'990'000), SimClock::Step::kAdvanced);
-  EXPECT_EQ(clock.elapsed_us(), 110'000);
+  // A late datagram of the same sim is ignored: the next stamp counts from the latest, not twice.
+  EXPECT_EQ(clock.Advance(kStart + 50'000, kStart), SimClock::Step::kLate);
+  EXPECT_EQ(clock.utime(), kStart + 100'000);
+  EXPECT_EQ(clock.Advance(kStart + 150'000, kStart), SimClock::Step::kAdvanced);
+  EXPECT_EQ(clock.elapsed_us(), 150'000);
+  // A respawned sim (a new start) behind the old stamps: re-anchored, the elapsed time stays, later
+  // steps count on.
+  const int64_t restart = kStart - 5'000'000;
+  EXPECT_EQ(clock.Advance(restart, restart), SimClock::Step::kRestarted);
+  EXPECT_EQ(clock.elapsed_us(), 150'000);
+  EXPECT_EQ(clock.Advance(restart + 10'000, restart), SimClock::Step::kAdvanced);
+  EXPECT_EQ(clock.elapsed_us(), 160'000);
   // A stamp from nowhere (an hour ahead) moves nothing; exactly the largest step does.
-  EXPECT_EQ(clock.Advance(kStart + 3'600'000'000), SimClock::Step::kReanchored);
-  EXPECT_EQ(clock.elapsed_us(), 110'000);
-  EXPECT_EQ(clock.Advance(kStart + 3'600'000'000 + kMaxSimClockStepUs), SimClock::Step::kAdvanced);
-  EXPECT_EQ(clock.elapsed_us(), 110'000 + kMaxSimClockStepUs);
+  EXPECT_EQ(clock.Advance(restart + 3'600'000'000, restart), SimClock::Step::kJumped);
+  EXPECT_EQ(clock.elapsed_us(), 160'000);
+  EXPECT_EQ(clock.Advance(restart + 3'600'000'000 + kMaxSimClockStepUs, restart), SimClock::Step::kAdvanced);
+  EXPECT_EQ(clock.elapsed_us(), 160'000 + kMaxSimClockStepUs);
 }
 
 TEST(SimClock, CheckRefusesNonTimesAndRatesOutsideTheSims) {
   orbed::sim_clock_t msg{};
   msg.utime = kStart;
+  msg.start_utime = kStart;
   msg.realtime_rate = 1;
   EXPECT_EQ(CheckSimClock(msg), "");
+  msg.start_utime = kStart + 1;  // after its stamp
+  EXPECT_NE(CheckSimClock(msg), "");
+  msg.start_utime = 0;
+  EXPECT_NE(CheckSimClock(msg), "");
+  msg.start_utime = kStart;
   msg.realtime_rate = kMaxRealtimeRate;
   EXPECT_EQ(CheckSimClock(msg), "");
   for (int bad : {0, -1, kMaxRealtimeRate + 1}) {
@@ -63,7 +78,8 @@ TEST(SimClock, CheckRefusesNonTimesAndRatesOutsideTheSims) {
 }
 
 // A process with sim_time: its "sim" (a wall timer of its own) publishes SIM_CLOCK 50 ms of sim
-// time apart, as orbed-iiwa-sim does at R = 10, first one bad message and one backwards jump.
+// time apart, as orbed-iiwa-sim does at R = 10, first one bad message and a restart 1 s behind,
+// later one late datagram.
 // A 20 ms and a 30 ms sim timer run at exactly their deadlines, in the order of the deadlines, with
 // the clock reading each deadline; none ran before the first SIM_CLOCK.
 TEST(ProcessSimTime, TimersRunAtSimDeadlinesInDeadlineOrder) {
@@ -76,19 +92,20 @@ TEST(ProcessSimTime, TimersRunAtSimDeadlinesInDeadlineOrder) {
   std::vector<std::pair<std::string, double>> runs;  // (timer, ClockSeconds)
   std::vector<int64_t> stamps;
   int published = 0;
-  // The stamps the "sim" sends: a bad rate, the start, a jump back, then 50 ms steps.
+  // The stamps the "sim" sends: a bad rate, the start, a restart 1 s behind (a respawned sim),
+  // then 50 ms steps, one datagram of which arrives again late.
+  const int64_t restart = kStart - 1'000'000;
+  int64_t next = restart;
   process.AddWallTimer(0.002, [&] {
     orbed::sim_clock_t msg{};
     msg.realtime_rate = 10;
+    msg.utime = msg.start_utime = kStart;
     if (published == 0) {
-      msg.utime = kStart;
       msg.realtime_rate = 0;  // refused: not a clock
-    } else if (published == 1) {
-      msg.utime = kStart;
-    } else if (published == 2) {
-      msg.utime = kStart - 1'000'000;  // re-anchors, does not advance
-    } else {
-      msg.utime = kStart - 1'000'000 + (published - 2) * 50'000;
+    } else if (published >= 2) {
+      msg.start_utime = restart;
+      msg.utime = published == 5 ? restart + 50'000 : next;  // late: the first step again
+      if (published != 5) next += 50'000;
     }
     ++published;
     process.lcm().publish(channels::kSimClock, &msg);
@@ -119,11 +136,13 @@ TEST(ProcessSimTime, TimersRunAtSimDeadlinesInDeadlineOrder) {
     EXPECT_EQ(runs[k].first, expected[k].first) << k;
     EXPECT_NEAR(runs[k].second, expected[k].second, 1e-9) << k;
   }
-  // a's stamps: the anchor after the jump (kStart - 1 s) + its deadline.
-  for (size_t k = 0; k < 10; ++k) EXPECT_EQ(stamps[k], kStart - 1'000'000 + 20'000 * (k + 1)) << k;
-  const auto& rejections = process.rejections().counts();
+  // a's stamps: the anchor after the restart (kStart - 1 s) + its deadline; the late datagram
+  // did not count its step twice.
+  for (size_t k = 0; k < 10; ++k) EXPECT_EQ(stamps[k], restart + 20'000 * (k + 1)) << k;
+  const auto rejections = process.rejections().counts();
   EXPECT_EQ(rejections.at(std::string(channels::kSimClock) + "/field"), 1);
-  EXPECT_EQ(rejections.at(std::string(channels::kSimClock) + "/jump"), 1);
+  EXPECT_EQ(rejections.at(std::string(channels::kSimClock) + "/late"), 1);
+  EXPECT_EQ(rejections.count(std::string(channels::kSimClock) + "/jump"), 0u);
   EXPECT_EQ(process.dropped(), 0);  // 50 ms steps are 2.5 and 1.7 periods: caught up, not skipped
 }
 

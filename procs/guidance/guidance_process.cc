@@ -38,7 +38,7 @@ GuidanceProcess::GuidanceProcess(const CommonFlags& flags, const GuidanceOptions
       options_(options) {
   process_.Subscribe<orbed::iiwa_status_t>(
       options_.iiwa_status_channel,
-      [this](const orbed::iiwa_status_t& msg, const std::string& channel, int64_t) {
+      [this](const orbed::iiwa_status_t& msg, const std::string& channel, int64_t received_utime) {
         Eigen::VectorXd q;
         const sim::IiwaStatusProblem problem = sim::CheckIiwaStatus(msg, model_, kJointLimitSlackRad, &q);
         if (!problem.rejection_class.empty()) {
@@ -47,7 +47,7 @@ GuidanceProcess::GuidanceProcess(const CommonFlags& flags, const GuidanceOptions
         }
         q_rad_ = q;
         have_q_ = true;
-        q_received_utime_ = process_.ClockUtime();
+        q_received_utime_ = process_.sim_time() ? process_.ClockUtime() : received_utime;
       });
   process_.Subscribe<orbed::setup_task_t>(
       options_.setup_task_channel,
