@@ -219,14 +219,7 @@ void IiwaSim::OnPlanCheck(const orbed::plan_check_request_t& msg, const std::str
 }
 
 void IiwaSim::Tick() {
-  if (holding_) {
-    orbed::sim_clock_t clock{};
-    clock.utime = start_utime_;
-    clock.realtime_rate = options_.realtime_rate;
-    clock.start_utime = start_utime_;
-    if (!options_.sim_clock_channel.empty()) process_->Publish(options_.sim_clock_channel, clock);
-    return;
-  }
+  if (holding_) return PublishClock(start_utime_);
   // COLLISION_STATUS reports the step of this tick that came closest to contact, so that the near
   // misses it shows do not depend on the realtime rate.
   arm_->Step(options_.period_s);
@@ -257,14 +250,19 @@ void IiwaSim::Tick() {
 
 int64_t IiwaSim::MaxLagMicros() const { return std::max<int64_t>(100'000, 20 * period_us_); }
 
-void IiwaSim::PublishAll(int64_t utime, const CollisionResult& r) {
-  // The clock first: a process that follows it (--sim-time) runs its timers up to this tick while
-  // it still holds the previous tick's state, as it would at real time.
+void IiwaSim::PublishClock(int64_t utime) {
+  if (options_.sim_clock_channel.empty()) return;
   orbed::sim_clock_t clock{};
   clock.utime = utime;
   clock.realtime_rate = options_.realtime_rate;
   clock.start_utime = start_utime_;
-  if (!options_.sim_clock_channel.empty()) process_->Publish(options_.sim_clock_channel, clock);
+  process_->Publish(options_.sim_clock_channel, clock);
+}
+
+void IiwaSim::PublishAll(int64_t utime, const CollisionResult& r) {
+  // The clock first: a process that follows it (--sim-time) runs its timers up to this tick while
+  // it still holds the previous tick's state, as it would at real time.
+  PublishClock(utime);
 
   const RobotModel& model = arm_->model();
   const int n = model.num_joints();

@@ -162,6 +162,8 @@ class IiwaSim {
   void OnCommand(const orbed::iiwa_command_t& msg, const std::string& channel);
   void OnPlanCheck(const orbed::plan_check_request_t& msg, const std::string& channel);
   void PublishAll(int64_t utime, const CollisionResult& r);
+  // SIM_CLOCK at `utime` (nothing without a sim_clock_channel).
+  void PublishClock(int64_t utime);
   void SaveState(const orbed::iiwa_status_t& status);
 
   IiwaSimOptions options_;
