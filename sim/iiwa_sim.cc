@@ -59,7 +59,22 @@ IiwaSimOptions Resolved(IiwaSimOptions options) {
                                 std::to_string(kMaxRealtimeRate) + "], not " +
                                 std::to_string(options.realtime_rate));
   }
+  if (options.steps_per_tick == 0) options.steps_per_tick = options.realtime_rate;
+  if (options.steps_per_tick < 1 || options.steps_per_tick > kMaxStepsPerTick) {
+    throw std::invalid_argument("--steps-per-tick must be a whole number in [1, " +
+                                std::to_string(kMaxStepsPerTick) + "] (or 0: the realtime rate), not " +
+                                std::to_string(options.steps_per_tick));
+  }
+  if (!(options.lockstep_timeout_s > 0) || !std::isfinite(options.lockstep_timeout_s)) {
+    throw std::invalid_argument("--lockstep-timeout-s must be a finite number > 0");
+  }
   return options;
+}
+
+double MonotonicS() {
+  return 1e-9 * static_cast<double>(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                        std::chrono::steady_clock::now().time_since_epoch())
+                                        .count());
 }
 
 Eigen::VectorXd InitialQ(const RobotModel& model, const std::vector<double>& q_deg) {
@@ -90,7 +105,11 @@ orbed::contact_t ToContact(const PairDistance& pair) {
 IiwaSim::IiwaSim(const orbed::CommonFlags& flags, const IiwaSimOptions& options)
     : options_(Resolved(options)),
       scene_(LoadSceneFile(options_.scene_path)),
-      period_us_(std::llround(options_.period_s * 1e6)) {
+      period_us_(std::llround(options_.period_s * 1e6)),
+      steps_per_tick_(options_.steps_per_tick),
+      tick_us_(steps_per_tick_ * period_us_),
+      tick_wall_ns_(std::max<int64_t>(1, tick_us_ * 1000 / options_.realtime_rate)),
+      barrier_(options_.lockstep_timeout_s) {
   const RobotModel model = LoadRobotForScene(options_.urdf_path, scene_);
   ManualArmOptions arm_options;
   arm_options.stop_margin_m = options_.stop_margin_m;
@@ -104,8 +123,8 @@ IiwaSim::IiwaSim(const orbed::CommonFlags& flags, const IiwaSimOptions& options)
   }
   arm_ = std::make_unique<ManualArm>(model, &scene_, *q0, arm_options);
   saved_q_ = FromVectorX(*q0);
-  save_every_ticks_ = std::max<int64_t>(
-      1, std::llround(options_.state_save_period_s * 1e6 / (period_us_ * options_.realtime_rate)));
+  save_every_ticks_ =
+      std::max<int64_t>(1, std::llround(options_.state_save_period_s * 1e6 / static_cast<double>(tick_us_)));
   for (int i = 0; i < model.num_links(); ++i) {
     if (!arm_->world().LinkPrimitives(i).empty() && std::isfinite(arm_->collision().link_clearance_m[i])) {
       reported_links_.push_back(i);
@@ -144,15 +163,26 @@ IiwaSim::IiwaSim(const orbed::CommonFlags& flags, const IiwaSimOptions& options)
       if (holding_) ORBED_LOG(kInfo) << "holding the sim clock until " << options_.hold_for << " runs";
     });
   }
-  // Deadlines the loop skips (more than a few periods behind) are counted as "timer/tick" drops: no
-  // IIWA_STATUS, ROBOT_STATE or COLLISION_STATUS went out for them.
-  process_->AddTimer(
-      options_.period_s, [this] { Tick(); }, "tick");
+  const double tick_wall_s = 1e-9 * static_cast<double>(tick_wall_ns_);
+  if (options_.lockstep) {
+    process_->Subscribe<orbed::sim_clock_ack_t>(
+        channels::kSimClockAck, [this](const orbed::sim_clock_ack_t& msg, const std::string& channel,
+                                       int64_t) { OnAck(msg, channel); });
+    // The ticks come from Advance(): from this poll and from each answer.
+    process_->AddWallPoll(tick_wall_s, [this] { holding_ ? Tick() : Advance(); });
+  } else {
+    // Deadlines the loop skips (more than a few periods behind) are counted as "timer/tick" drops:
+    // no IIWA_STATUS, ROBOT_STATE or COLLISION_STATUS went out for them.
+    process_->AddTimer(
+        tick_wall_s, [this] { Tick(); }, "tick");
+  }
   ORBED_LOG(kInfo) << "robot " << options_.urdf_path << " (" << model.num_joints() << " joints), scene "
                    << options_.scene_path << ", tick " << options_.period_s * 1e3 << " ms"
+                   << ", " << steps_per_tick_ << " step(s) of " << period_us_ << " us per tick"
                    << (options_.realtime_rate > 1
                            ? ", " + std::to_string(options_.realtime_rate) + "x faster than real time"
-                           : std::string());
+                           : std::string())
+                   << (options_.lockstep ? ", in lockstep with the processes that follow its clock" : "");
 }
 
 IiwaSim::~IiwaSim() = default;
@@ -169,8 +199,7 @@ void IiwaSim::OnCommand(const orbed::iiwa_command_t& msg, const std::string& cha
     // which at a realtime rate R runs R times as fast: its age is taken in wall seconds (sim ones / R).
     // In double: a wild utime (e.g. INT64_MIN) must not overflow the subtraction.
     const double wall_age_s = (static_cast<double>(NowMicros()) - static_cast<double>(msg.utime)) * 1e-6;
-    const double sim_now_us =
-        static_cast<double>(start_utime_ + ticks_ * options_.realtime_rate * period_us_);
+    const double sim_now_us = static_cast<double>(NowUtime());
     const double sim_age_s = (sim_now_us - static_cast<double>(msg.utime)) * 1e-6 / options_.realtime_rate;
     const double age_s = std::abs(sim_age_s) < std::abs(wall_age_s) ? sim_age_s : wall_age_s;
     if (std::abs(age_s) > options_.stale_command_s) {
@@ -221,31 +250,104 @@ void IiwaSim::OnPlanCheck(const orbed::plan_check_request_t& msg, const std::str
 void IiwaSim::Tick() {
   if (holding_) return PublishClock(start_utime_);
   // COLLISION_STATUS reports the step of this tick that came closest to contact, so that the near
-  // misses it shows do not depend on the realtime rate.
+  // misses it shows do not depend on the steps per tick.
   arm_->Step(options_.period_s);
   CollisionResult closest = arm_->collision();
-  for (int step = 1; step < options_.realtime_rate; ++step) {
+  for (int step = 1; step < steps_per_tick_; ++step) {
     arm_->Step(options_.period_s);
     if (arm_->collision().min_distance_m < closest.min_distance_m) closest = arm_->collision();
   }
   ++ticks_;
-  // After a stall the loop skipped deadlines rather than run them: tick k jumps to the last deadline
-  // passed, so the sim clock does not fall behind for good. The arm made only this tick's R steps
-  // of P: the speed read from the stamps only drops.
   const auto now = std::chrono::steady_clock::now();
-  const int64_t elapsed_us = std::chrono::duration_cast<std::chrono::microseconds>(now - start_mono_).count();
-  const int64_t due = elapsed_us / period_us_;
-  if ((due - ticks_) * period_us_ > MaxLagMicros()) {
+  const int64_t elapsed_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(now - start_mono_).count();
+  const int64_t due = elapsed_ns / tick_wall_ns_;
+  if (options_.lockstep) {
+    // Waiting for the followers is not a stall of the sim: its clock never skips. After a long
+    // wait the pace starts again from now instead of rushing through the ticks it owes.
+    if ((due - ticks_) * tick_wall_ns_ > MaxLagMicros() * 1000) {
+      start_mono_ += std::chrono::nanoseconds((due - ticks_) * tick_wall_ns_);
+    }
+  } else if ((due - ticks_) * tick_wall_ns_ > MaxLagMicros() * 1000) {
+    // After a stall the loop skipped deadlines rather than run them: tick k jumps to the last
+    // deadline passed, so the sim clock does not fall behind for good. The arm made only this
+    // tick's K steps of P: the speed read from the stamps only drops.
     skipped_ticks_ += due - ticks_;
     ticks_ = due;
     if (now - last_skip_warning_ >= std::chrono::seconds(10)) {
-      ORBED_LOG(kWarn) << "the process loop skipped " << skipped_ticks_ << " tick(s) of " << period_us_
-                       << " us (stalled); the sim clock jumped to the current tick";
+      ORBED_LOG(kWarn) << "the process loop skipped " << skipped_ticks_ << " tick(s) of "
+                       << tick_wall_ns_ / 1000 << " us (stalled); the sim clock jumped to the current tick";
       skipped_ticks_ = 0;
       last_skip_warning_ = now;
     }
   }
-  PublishAll(start_utime_ + ticks_ * options_.realtime_rate * period_us_, closest);
+  if (options_.lockstep) {
+    // Round 1 is the clock alone: the followers' timers run on the previous tick's state. The state
+    // opens round 2, after everything round 1 caused, so each follower handles it in the same order
+    // relative to what the others sent.
+    PublishClock(NowUtime());
+    unpublished_state_ = closest;
+    return;
+  }
+  PublishAll(NowUtime(), closest);
+}
+
+void IiwaSim::Advance() {
+  if (holding_) return;  // the held clock's rounds (the poll's) wait for nobody
+  const double now_s = MonotonicS();
+  if (round_ > 0) {
+    const LockstepBarrier::Status status = barrier_.Check(now_s);
+    for (const std::string& name : status.left_out) {
+      process_->CountDrop("lockstep/" + name);
+      ORBED_LOG(kWarn) << "lockstep: " << name << " did not answer round " << round_ << " of tick " << ticks_
+                       << " within " << options_.lockstep_timeout_s
+                       << " s; going on without it until it answers again";
+    }
+    if (!status.complete) return;
+    // What the sim published during the round counts too (PLAN_CHECK_REPLY; the tick's state in
+    // round 1): someone may still be handling it.
+    bool published = process_->TakePublished();
+    if (unpublished_state_) {
+      PublishState(NowUtime(), *unpublished_state_);
+      unpublished_state_.reset();
+      process_->TakePublished();  // the state is round 2's cause, the followers' answers its effects
+      published = true;
+    }
+    if (status.published || published) {
+      ++round_;
+      PublishClock(NowUtime());
+      return;
+    }
+  }
+  // A quiet round: the next tick once its wall time has come (half a poll early: the poll's grid
+  // and the ticks' are the same period, in some phase).
+  const int64_t elapsed_ns =
+      std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start_mono_)
+          .count();
+  if (elapsed_ns < (ticks_ + 1) * tick_wall_ns_ - tick_wall_ns_ / 2) return;
+  round_ = 1;
+  Tick();
+}
+
+void IiwaSim::OnAck(const orbed::sim_clock_ack_t& msg, const std::string& channel) {
+  const std::string problem = CheckSimClockAck(msg);
+  if (!problem.empty()) return process_->Reject(channel + "/field", problem);
+  if (msg.start_utime != start_utime_) return;  // a follower of another sim
+  switch (barrier_.OnAck(msg)) {
+    case LockstepBarrier::Answer::kJoined:
+      ORBED_LOG(kInfo) << "lockstep: " << msg.process << " follows the clock";
+      break;
+    case LockstepBarrier::Answer::kRejoined:
+      ORBED_LOG(kInfo) << "lockstep: " << msg.process << " answers again";
+      break;
+    case LockstepBarrier::Answer::kRefused:
+      return process_->Reject(channel + "/followers", "more than " + std::to_string(kMaxLockstepFollowers) +
+                                                          " followers; '" + msg.process +
+                                                          "' is not waited for");
+    case LockstepBarrier::Answer::kCounted:
+    case LockstepBarrier::Answer::kOther:
+      break;
+  }
+  Advance();
 }
 
 int64_t IiwaSim::MaxLagMicros() const { return std::max<int64_t>(100'000, 20 * period_us_); }
@@ -256,14 +358,21 @@ void IiwaSim::PublishClock(int64_t utime) {
   clock.utime = utime;
   clock.realtime_rate = options_.realtime_rate;
   clock.start_utime = start_utime_;
-  process_->Publish(options_.sim_clock_channel, clock);
+  if (options_.lockstep) {
+    clock.lockstep_round = std::max<int32_t>(1, round_);
+    barrier_.BeginRound(utime, start_utime_, clock.lockstep_round, MonotonicS());
+  }
+  process_->PublishControl(options_.sim_clock_channel, clock);
 }
 
 void IiwaSim::PublishAll(int64_t utime, const CollisionResult& r) {
   // The clock first: a process that follows it (--sim-time) runs its timers up to this tick while
   // it still holds the previous tick's state, as it would at real time.
   PublishClock(utime);
+  PublishState(utime, r);
+}
 
+void IiwaSim::PublishState(int64_t utime, const CollisionResult& r) {
   const RobotModel& model = arm_->model();
   const int n = model.num_joints();
   const std::vector<double> q = FromVectorX(arm_->q_rad());

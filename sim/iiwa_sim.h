@@ -51,16 +51,33 @@
 /// clocks, or with this sim clock when they follow it: a command near either is fresh),
 /// PLAN_CHECK_REPLY and PROCESS_STATUS.
 ///
-/// Faster than real time (realtime_rate R > 1, for studies without a person in the loop): tick k
-/// steps the arm R times by P (each step checked for collisions as at R = 1) and stamps
-///     utime_k = start_utime + k * R * P,
+/// Faster than real time (realtime_rate R > 1, for studies without a person in the loop): a tick
+/// steps the arm K times by P (steps_per_tick, default K = R; each step checked for collisions as
+/// at R = 1), ticks are K * P / R of wall time apart, and tick k is stamped
+///     utime_k = start_utime + k * K * P,
 /// so the sim clock runs R times faster than the wall clock and the arm moves R times faster in
 /// wall time while every step, and the speed read from the stamps, keeps the joint's velocity
-/// limit in sim time. The outputs still go out once per tick (200 Hz of wall time, 200/R Hz of sim
-/// time), COLLISION_STATUS with the tick's step that came closest to contact (so near misses are
-/// seen at every rate). Each tick's stamp goes out first on SIM_CLOCK (sim_clock_t), the clock the
-/// processes started with --sim-time follow (procs/common/sim_clock.h); with hold_for it stays at
-/// start_utime, and the arm does not step, until that process runs. The others keep the wall clock.
+/// limit in sim time. The outputs go out once per tick (at K = R: 200 Hz of wall time, 200/R Hz of
+/// sim time), COLLISION_STATUS with the tick's step that came closest to contact (so near misses
+/// are seen at every rate). Each tick's stamp goes out first on SIM_CLOCK (sim_clock_t), the clock
+/// the processes started with --sim-time follow (procs/common/sim_clock.h); with hold_for it stays
+/// at start_utime, and the arm does not step, until that process runs. The others keep the wall
+/// clock.
+///
+/// Lockstep (lockstep, --lockstep; for runs that must not depend on the machine's speed): the sim
+/// does not step on while a follower still works on the tick. Each tick's SIM_CLOCK alone is round
+/// 1 (the followers' timers run on the previous tick's state); once every follower has answered it
+/// on SIM_CLOCK_ACK (procs/common/sim_clock.h), the tick's IIWA_STATUS, ROBOT_STATE and
+/// COLLISION_STATUS go out and the stamp again as round 2, and while any answer (or the sim itself,
+/// a PLAN_CHECK_REPLY) says it published something, the sim repeats the stamp in the next round; the next
+/// tick comes once a round is quiet and its wall time K * P / R has come (R is then the fastest the sim runs:
+/// a slow follower slows it down, and after a wait of more than MaxLagMicros() the pace starts again from
+/// there rather than rushing to catch up; no stall jump). So every follower sees each tick's state, and every
+/// reply to what it sent, before the next tick, however loaded the machine and whatever R: with the same K, a
+/// run at R = 1 and one at R = 10 are the same run. A follower that has not answered a round within
+/// lockstep_timeout_s (killed, hung) is left out, counted as the drop "lockstep/<name>" and logged, and taken
+/// back with its next answer; a held clock waits for nobody (its rounds let the followers join). Answers are
+/// checked (CheckSimClockAck; refused as "<channel>/field"), at most kMaxLockstepFollowers names.
 ///
 /// Crash recovery (state_file, sim_state.h): the sim saves its measured q while the arm moves, at most
 /// every state_save_period_s of sim time and whenever the arm comes to rest, and a sim started on an
@@ -73,21 +90,27 @@
 
 #include <chrono>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <orbed/iiwa_command_t.hpp>
 #include <orbed/iiwa_status_t.hpp>
 #include <orbed/plan_check_request_t.hpp>
+#include <orbed/sim_clock_ack_t.hpp>
 
 #include "base/source_paths.h"
 #include "procs/common/channels.h"
 #include "procs/common/process.h"
+#include "procs/common/sim_clock.h"
 #include "sim/manual_arm.h"
 #include "sim/robot_model.h"
 #include "sim/scene.h"
 
 namespace orbed::sim {
+
+/// The most steps of P one tick may make.
+inline constexpr int kMaxStepsPerTick = 1000;
 
 struct IiwaSimOptions {
   /// URDF and scene files; "" = the files shipped in the source tree (SourceTreePath()).
@@ -96,8 +119,15 @@ struct IiwaSimOptions {
   /// Tick = status period [s]; rounded to whole microseconds, which must leave >= 1 us.
   double period_s{0.005};
   /// Sim seconds per wall second, 1..kMaxRealtimeRate (Drake's target realtime rate, whole numbers
-  /// here): each tick steps the arm this many times by P and publishes once (see Clocks).
+  /// here; in lockstep the most, see Lockstep).
   int realtime_rate{1};
+  /// K: each tick steps the arm K times by P and publishes once (see Clocks); 0 = realtime_rate.
+  /// At most kMaxStepsPerTick.
+  int steps_per_tick{0};
+  /// Lockstep (see Lockstep): before each step, wait until the followers have answered.
+  bool lockstep{false};
+  /// How long a lockstep round waits for a follower before leaving it out [s of wall time], > 0.
+  double lockstep_timeout_s{10.0};
   /// Initial joint vector [deg]; empty = all zero (the arm upright). Must be within the limits.
   std::vector<double> initial_q_deg;
   /// The state file (sim_state.h): read at start (over initial_q_deg) and written as the arm moves;
@@ -148,6 +178,11 @@ class IiwaSim {
   int64_t ticks() const { return ticks_; }
   /// Whether the clock is still held (IiwaSimOptions::hold_for).
   bool holding() const { return holding_; }
+  /// Sim time per tick K x P [us].
+  int64_t tick_us() const { return tick_us_; }
+  /// Lockstep: the followers waited for, the current tick's round (0 before the first).
+  std::vector<std::string> lockstep_followers() const { return barrier_.followers(); }
+  int32_t lockstep_round() const { return round_; }
   /// How far behind its deadline a tick may run before the sim clock skips ahead [us].
   int64_t MaxLagMicros() const;
   const Scene& scene() const { return scene_; }
@@ -157,13 +192,24 @@ class IiwaSim {
   /// COLLISION_STATUS stamped with it (the timer's callback; public so tests can drive it without
   /// waiting).
   void Tick();
+  /// Lockstep: the next round, or the next tick once the round is complete, nobody published and
+  /// the tick is due; nothing while the clock is held (the poll's callback after the hold, and
+  /// each answer's; public so tests can drive it).
+  void Advance();
 
  private:
   void OnCommand(const orbed::iiwa_command_t& msg, const std::string& channel);
   void OnPlanCheck(const orbed::plan_check_request_t& msg, const std::string& channel);
+  // SIM_CLOCK, then PublishState.
   void PublishAll(int64_t utime, const CollisionResult& r);
-  // SIM_CLOCK at `utime` (nothing without a sim_clock_channel).
+  // IIWA_STATUS, ROBOT_STATE, COLLISION_STATUS at `utime` (saving the state file).
+  void PublishState(int64_t utime, const CollisionResult& r);
+  // SIM_CLOCK at `utime` (nothing without a sim_clock_channel); in lockstep round `round_`, which
+  // the barrier then waits on.
   void PublishClock(int64_t utime);
+  void OnAck(const orbed::sim_clock_ack_t& msg, const std::string& channel);
+  // The sim time of the last tick [us since the epoch].
+  int64_t NowUtime() const { return start_utime_ + ticks_ * tick_us_; }
   void SaveState(const orbed::iiwa_status_t& status);
 
   IiwaSimOptions options_;
@@ -173,7 +219,13 @@ class IiwaSim {
   std::vector<int> reported_links_;  // links with geometry and a finite clearance
   std::vector<Eigen::Isometry3d> X_RL_;
   int64_t period_us_{0};
+  int steps_per_tick_{1};    // K
+  int64_t tick_us_{0};       // K x P
+  int64_t tick_wall_ns_{0};  // K x P / R: the wall time between ticks
   int64_t start_utime_{0};
+  LockstepBarrier barrier_;
+  int32_t round_{0};                                  // the round out (lockstep), 0 before the first
+  std::optional<CollisionResult> unpublished_state_;  // lockstep: the tick's state, for round 2
   std::chrono::steady_clock::time_point start_mono_;
   bool holding_{false};
   int64_t ticks_{0};

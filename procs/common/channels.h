@@ -32,6 +32,7 @@ inline constexpr char kLoggerStatus[] = "LOGGER_STATUS";                // logge
 inline constexpr char kIgtlTarget[] = "IGTL_TARGET";                    // target_pose_t, orbed-igtl-bridge
 inline constexpr char kFixedView[] = "FIXED_VIEW";                      // image_t (JPEG), orbed-fixed-display
 inline constexpr char kSimClock[] = "SIM_CLOCK";                        // sim_clock_t, sim, once per tick
+inline constexpr char kSimClockAck[] = "SIM_CLOCK_ACK";  // sim_clock_ack_t, each follower, per lockstep round
 
 /// Every channel above (tools that address channels by index: the fuzz targets and their corpora;
 /// new channels are appended so that the indices of the old ones stay).
@@ -41,6 +42,6 @@ inline constexpr const char* kAllChannels[] = {
     kGazeRay,         kReflectiveView, kAlignmentTrial,      kRegistration,    kSessionControl,
     kLandmarkRequest, kLandmark,       kMisalignmentRequest, kMisalignment,    kGuidance,
     kProcessStatus,   kLoggerStatus,   kSetupTask,           kSetupResult,     kIgtlTarget,
-    kFixedView,       kSimClock};
+    kFixedView,       kSimClock,       kSimClockAck};
 
 }  // namespace orbed::channels

@@ -59,7 +59,8 @@ void AddSimTimeFlag(CLI::App* app, CommonFlags* flags) {
   app->add_flag(
          "--sim-time", flags->sim_time,
          "Run timers, timeouts and stamps on the sim's clock (SIM_CLOCK from orbed-iiwa-sim, which may "
-         "run faster than real time) instead of the wall clock (default: $ORBED_SIM_TIME)")
+         "run faster than real time) instead of the wall clock, answering its lockstep rounds on "
+         "SIM_CLOCK_ACK (default: $ORBED_SIM_TIME)")
       ->envname("ORBED_SIM_TIME");
 }
 

@@ -106,12 +106,18 @@ void Process::AddWallTimer(double period_s, std::function<void()> callback, cons
   AddTimerOn(false, period_s, std::move(callback), name);
 }
 
-void Process::AddTimerOn(bool sim, double period_s, std::function<void()> callback, const std::string& name) {
+void Process::AddWallPoll(double period_s, std::function<void()> callback) {
+  AddTimerOn(false, period_s, std::move(callback), "", /*poll=*/true);
+}
+
+void Process::AddTimerOn(bool sim, double period_s, std::function<void()> callback, const std::string& name,
+                         bool poll) {
   if (!(period_s > 0) || !std::isfinite(period_s) || period_s > 1e6) {
     throw std::invalid_argument("timer period must be > 0 s (and at most 1e6 s)");
   }
   Timer timer;
   timer.sim = sim;
+  timer.poll = poll;
   timer.drop_key = "timer/" + (name.empty() ? std::to_string(timers_.size()) : name);
   timer.period_ns = std::max<int64_t>(1, std::llround(period_s * 1e9));
   timer.next_ns = (sim ? sim_clock_.elapsed_us() * 1000 : UptimeNanos()) + timer.period_ns;
@@ -166,6 +172,20 @@ void Process::OnSimClock(const orbed::sim_clock_t& msg, const std::string& chann
     case SimClock::Step::kSame:
       break;
   }
+  // A lockstep round is answered once the timers it made due have run (Run()); a late one is not.
+  if (msg.lockstep_round >= 1 && sim_clock_.utime() == msg.utime) unanswered_round_ = msg;
+}
+
+void Process::AnswerLockstepRound() {
+  if (!unanswered_round_) return;
+  orbed::sim_clock_ack_t ack{};
+  ack.utime = unanswered_round_->utime;
+  ack.start_utime = unanswered_round_->start_utime;
+  ack.lockstep_round = unanswered_round_->lockstep_round;
+  ack.process = name_;
+  ack.published = published_since_ack_.exchange(false);
+  unanswered_round_.reset();
+  PublishControl(channels::kSimClockAck, ack);
 }
 
 lcm::Subscription* Process::Add(std::unique_ptr<SubscriptionBase> subscription, const std::string& channel) {
@@ -296,7 +316,7 @@ orbed::process_status_t Process::MakeStatus() const {
 
 void Process::PublishStatus() {
   const orbed::process_status_t status = MakeStatus();
-  Publish(channels::kProcessStatus, status);
+  PublishControl(channels::kProcessStatus, status);
 }
 
 void Process::RunTimer(size_t i) {
@@ -317,7 +337,9 @@ void Process::RunTimer(size_t i) {
   // A sim timer catches up over the whole last SIM_CLOCK step too (R x P of sim time at once).
   const int64_t allowed_ns =
       kMaxCatchUpPeriods * timer.period_ns + (timer.sim ? sim_clock_.last_step_us() * 1000 : 0);
-  if (now_ns - timer.next_ns > allowed_ns) {
+  if (timer.poll && now_ns >= timer.next_ns) {
+    timer.next_ns += ((now_ns - timer.next_ns) / timer.period_ns + 1) * timer.period_ns;
+  } else if (now_ns - timer.next_ns > allowed_ns) {
     const int64_t behind = (now_ns - timer.next_ns) / timer.period_ns + 1;
     timer.next_ns += behind * timer.period_ns;
     CountDrop(timer.drop_key, behind);
@@ -355,6 +377,7 @@ int Process::Run() {
       if (!first) break;
       RunTimer(*first);
     }
+    AnswerLockstepRound();
     DeliverDueDatagrams();
     const auto now = std::chrono::steady_clock::now();
     auto next = std::min(deadline, now + max_wait);

@@ -18,7 +18,10 @@
 /// SIM_CLOCK), inside a timer's callback the clock reads that deadline (so a 60 Hz stream samples
 /// at exact multiples of 1/60 s of sim time, however many sim steps one tick of the sim makes), and
 /// elsewhere the latest SIM_CLOCK. The sim itself, the logger, the launcher and the monitor keep
-/// the wall clock.
+/// the wall clock. A SIM_CLOCK of a lockstep round (lockstep_round >= 1, sim_clock.h) is answered
+/// on SIM_CLOCK_ACK right after the timers it made due have run, before the next datagram is
+/// handled, with whether the process published since its previous answer (Publish, not
+/// PublishControl).
 ///
 /// Fault injection: with a chaos spec (CommonFlags::chaos, i.e. --chaos or $ORBED_CHAOS;
 /// procs/common/chaos.h) every datagram of a matching channel passes, before decoding, through a
@@ -89,12 +92,23 @@ class Process {
   lcm::Subscription* SubscribeRaw(const std::string& channel_regex,
                                   std::function<void(const lcm::ReceiveBuffer&, const std::string&)> handler);
 
-  /// Publishes and counts one message out.
+  /// Publishes and counts one message out (and says so on the next SIM_CLOCK_ACK: it may cause replies).
   template <class Msg>
   void Publish(const std::string& channel, const Msg& msg) {
     lcm_->publish(channel, &msg);
     ++messages_out_;
+    published_since_ack_ = true;
   }
+  /// Publishes and counts a message nobody answers (heartbeats, the sim clock and its answers): not
+  /// a publication a lockstep round waits on.
+  template <class Msg>
+  void PublishControl(const std::string& channel, const Msg& msg) {
+    lcm_->publish(channel, &msg);
+    ++messages_out_;
+  }
+  /// Whether Publish() was called since the last call (or the last SIM_CLOCK_ACK); clears it. The
+  /// sim, which answers no clock, asks this once per lockstep round.
+  bool TakePublished() { return published_since_ack_.exchange(false); }
 
   /// Calls `callback` every `period_s` seconds of the process clock on the Run() thread, first at
   /// start + period (with sim_time: the first SIM_CLOCK + period, or now + period if later).
@@ -105,6 +119,9 @@ class Process {
   void AddTimer(double period_s, std::function<void()> callback, const std::string& name = "");
   /// As AddTimer, on the monotonic clock whether or not the process follows the sim clock.
   void AddWallTimer(double period_s, std::function<void()> callback, const std::string& name = "");
+  /// A monotonic-clock poll: as AddWallTimer, but missed deadlines are neither run nor counted (the
+  /// callback checks a condition; being late for it loses no work).
+  void AddWallPoll(double period_s, std::function<void()> callback);
 
   /// Whether the process clock is the sim's (CommonFlags::sim_time).
   bool sim_time() const { return sim_time_; }
@@ -154,6 +171,7 @@ class Process {
   // exactly and run in the order they were added.
   struct Timer {
     bool sim{false};       // on the sim clock (else the monotonic one)
+    bool poll{false};      // missed deadlines skipped silently (AddWallPoll)
     int64_t period_ns{0};  // of its clock
     int64_t next_ns{0};    // deadline on its clock: since the start / the first SIM_CLOCK
     std::function<void()> callback;
@@ -179,7 +197,10 @@ class Process {
   // Registers a subscription (sets its process and index) and subscribes it to LCM.
   lcm::Subscription* Add(std::unique_ptr<SubscriptionBase> subscription, const std::string& channel);
   void PublishStatus();
-  void AddTimerOn(bool sim, double period_s, std::function<void()> callback, const std::string& name);
+  void AddTimerOn(bool sim, double period_s, std::function<void()> callback, const std::string& name,
+                  bool poll = false);
+  // Answers the lockstep round received last, if not yet answered (SIM_CLOCK_ACK).
+  void AnswerLockstepRound();
   // Now on the timer's clock [ns]; INT64_MIN for a sim timer before the first SIM_CLOCK.
   int64_t TimerNow(const Timer& timer) const;
   int64_t UptimeNanos() const;
@@ -197,7 +218,9 @@ class Process {
   std::chrono::steady_clock::time_point start_;
   bool sim_time_{false};
   SimClock sim_clock_;
-  std::optional<int64_t> sim_deadline_ns_;  // the running sim timer's deadline
+  std::optional<int64_t> sim_deadline_ns_;              // the running sim timer's deadline
+  std::optional<orbed::sim_clock_t> unanswered_round_;  // a lockstep SIM_CLOCK not yet answered
+  std::atomic<bool> published_since_ack_{false};
   std::atomic<bool> stop_requested_{false};
   std::atomic<bool> running_{false};
   std::atomic<bool> failed_{false};

@@ -14,7 +14,82 @@ std::string CheckSimClock(const orbed::sim_clock_t& msg) {
     return "realtime_rate " + std::to_string(msg.realtime_rate) + " outside 1.." +
            std::to_string(kMaxRealtimeRate);
   }
+  if (msg.lockstep_round < 0) return "lockstep_round " + std::to_string(msg.lockstep_round) + " < 0";
   return "";
+}
+
+std::string CheckSimClockAck(const orbed::sim_clock_ack_t& msg) {
+  if (msg.utime <= 0 || msg.start_utime <= 0 || msg.start_utime > msg.utime) {
+    return "utime " + std::to_string(msg.utime) + " and start_utime " + std::to_string(msg.start_utime) +
+           " are not a sim clock stamp";
+  }
+  if (msg.lockstep_round < 1) return "lockstep_round " + std::to_string(msg.lockstep_round) + " < 1";
+  if (msg.process.empty() || msg.process.size() > kMaxProcessNameLength) {
+    return "process name of " + std::to_string(msg.process.size()) + " characters (1.." +
+           std::to_string(kMaxProcessNameLength) + ")";
+  }
+  return "";
+}
+
+LockstepBarrier::LockstepBarrier(double timeout_s) : timeout_s_(timeout_s) {}
+
+void LockstepBarrier::BeginRound(int64_t utime, int64_t start_utime, int32_t round, double now_s) {
+  utime_ = utime;
+  start_utime_ = start_utime;
+  round_ = round;
+  round_start_s_ = now_s;
+  for (auto& [name, f] : followers_) {
+    f.answered = false;
+    f.published = false;
+  }
+}
+
+LockstepBarrier::Answer LockstepBarrier::OnAck(const orbed::sim_clock_ack_t& msg) {
+  const bool this_round =
+      msg.utime == utime_ && msg.start_utime == start_utime_ && msg.lockstep_round == round_;
+  auto it = followers_.find(msg.process);
+  Answer answer = Answer::kCounted;
+  if (it == followers_.end()) {
+    if (followers_.size() >= kMaxLockstepFollowers) return Answer::kRefused;
+    it = followers_.emplace(msg.process, Follower{}).first;
+    // Not waited for in a round that went out before it was known: it may never have seen it.
+    it->second.answered = true;
+    answer = Answer::kJoined;
+  } else if (!it->second.present) {
+    it->second.present = true;
+    it->second.answered = true;
+    answer = Answer::kRejoined;
+  }
+  if (!this_round) return answer == Answer::kCounted ? Answer::kOther : answer;
+  it->second.answered = true;
+  it->second.published = it->second.published || msg.published;
+  return answer;
+}
+
+LockstepBarrier::Status LockstepBarrier::Check(double now_s) {
+  Status status;
+  status.complete = true;
+  const bool timed_out = now_s - round_start_s_ > timeout_s_;
+  for (auto& [name, f] : followers_) {
+    if (!f.present) continue;
+    status.published = status.published || f.published;
+    if (f.answered) continue;
+    if (timed_out) {
+      f.present = false;
+      status.left_out.push_back(name);
+    } else {
+      status.complete = false;
+    }
+  }
+  return status;
+}
+
+std::vector<std::string> LockstepBarrier::followers() const {
+  std::vector<std::string> names;
+  for (const auto& [name, f] : followers_) {
+    if (f.present) names.push_back(name);
+  }
+  return names;
 }
 
 SimClock::Step SimClock::Advance(int64_t utime, int64_t start_utime) {

@@ -12,12 +12,26 @@
 /// behind the old sim time) re-anchors it too. So the processes that follow it never run
 /// backwards, and a single bad or late stamp neither skips every timer nor counts time twice.
 ///
+/// Lockstep (contract change 8): a sim in lockstep publishes each tick's SIM_CLOCK with
+/// lockstep_round 1, every follower answers each round on SIM_CLOCK_ACK (sim_clock_ack_t) once the
+/// timers that clock made due have run, saying whether it published anything since its previous
+/// answer; the sim repeats the tick's stamp in round 2, 3, ... until a round in which every follower
+/// answered and nobody (the sim included) published. LCM's multicast delivers one sender's
+/// datagrams in order, and a follower sends its output before its answer, so when that round is
+/// complete every message the tick caused, and every reply to one, has been handled: the next step
+/// no longer depends on how fast anyone computed. LockstepBarrier is the sim's side of it.
+///
 /// Units: utime in µs since the Unix epoch (the sim's stamps), elapsed time in µs and s since the
-/// first stamp. Threading: none (the owner's thread).
+/// first stamp; LockstepBarrier's now_s any monotonic clock [s] (the sim's wall clock). Threading:
+/// none (the owner's thread).
 
 #include <cstdint>
 #include <string>
 
+#include <map>
+#include <vector>
+
+#include <orbed/sim_clock_ack_t.hpp>
 #include <orbed/sim_clock_t.hpp>
 
 namespace orbed {
@@ -32,8 +46,15 @@ inline constexpr int64_t kMaxSimClockStepUs = 10'000'000;
 inline constexpr double kSimClockStartTimeoutS = 30.0;
 
 /// "" if `msg` is a usable clock stamp, else why not (utime or start_utime ≤ 0, utime before
-/// start_utime, realtime_rate outside 1..100).
+/// start_utime, realtime_rate outside 1..100, lockstep_round < 0).
 std::string CheckSimClock(const orbed::sim_clock_t& msg);
+/// "" if `msg` is a usable answer, else why not (the stamps as CheckSimClock, lockstep_round < 1, a
+/// process name empty or longer than kMaxProcessNameLength).
+std::string CheckSimClockAck(const orbed::sim_clock_ack_t& msg);
+/// The longest follower name a sim keeps (a process's --name is far shorter).
+inline constexpr size_t kMaxProcessNameLength = 256;
+/// The most followers a sim waits for; answers from further names are refused.
+inline constexpr size_t kMaxLockstepFollowers = 64;
 
 class SimClock {
  public:
@@ -58,6 +79,51 @@ class SimClock {
   int64_t elapsed_us_{0};
   int64_t start_utime_{0};
   int64_t last_step_us_{0};
+};
+
+/// The sim's side of lockstep: who follows, who answered the round that is out, whether anyone
+/// published. A follower joins with its first answer (during the hold, every follower that is up
+/// answers) and is waited for from the next round on; one that has not answered the round within
+/// timeout_s (killed, hung) is left out, reported once by Check(), and joins again with its next
+/// answer, so a killed follower costs one timeout and its respawn takes part again.
+class LockstepBarrier {
+ public:
+  /// `timeout_s` > 0: how long a round waits for a follower [s of the caller's clock].
+  explicit LockstepBarrier(double timeout_s);
+
+  /// A round goes out: SIM_CLOCK (utime, start_utime, round) at now_s. Nobody has answered it.
+  void BeginRound(int64_t utime, int64_t start_utime, int32_t round, double now_s);
+  enum class Answer { kCounted, kJoined, kRejoined, kOther, kRefused };
+  /// An answer (CheckSimClockAck first). kCounted: a follower's answer to the round that is out;
+  /// kJoined / kRejoined: a new / left-out follower, waited for from the next round (its answer
+  /// counts if it is to this one); kOther: an answer to an earlier round or another sim (ignored);
+  /// kRefused: a new name beyond kMaxLockstepFollowers.
+  Answer OnAck(const orbed::sim_clock_ack_t& msg);
+
+  struct Status {
+    bool complete{false};               ///< every follower answered the round or was left out
+    bool published{false};              ///< some follower that answered published since its previous answer
+    std::vector<std::string> left_out;  ///< followers left out by this call (timed out)
+  };
+  /// The round's state at now_s; followers past the timeout are left out here (once each).
+  Status Check(double now_s);
+
+  /// The followers waited for (not left out), by name.
+  std::vector<std::string> followers() const;
+  int32_t round() const { return round_; }
+
+ private:
+  struct Follower {
+    bool present{true};
+    bool answered{false};
+    bool published{false};
+  };
+  double timeout_s_;
+  int64_t utime_{0};
+  int64_t start_utime_{0};
+  int32_t round_{0};
+  double round_start_s_{0};
+  std::map<std::string, Follower> followers_;
 };
 
 }  // namespace orbed

@@ -22,6 +22,7 @@ int RunRegistration(int argc, const char* const* argv, std::ostream& out, std::o
   // Server flags.
   CommonFlags common("orbed-registration");
   AddCommonFlags(&app, &common);
+  AddSimTimeFlag(&app, &common);
   RegistrationServerOptions server;
   std::vector<double> server_centroid_m;
   app.add_option("--state-period-s", server.state_period_s, "Period of the full-state REGISTRATION (0 = off)")
