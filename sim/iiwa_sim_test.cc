@@ -19,7 +19,9 @@
 #include <orbed/collision_status_t.hpp>
 #include <orbed/iiwa_status_t.hpp>
 #include <orbed/plan_check_reply_t.hpp>
+#include <orbed/plan_check_request_t.hpp>
 #include <orbed/robot_state_t.hpp>
+#include <orbed/sim_clock_ack_t.hpp>
 #include <orbed/sim_clock_t.hpp>
 
 #include "base/test_command.h"
@@ -485,6 +487,106 @@ TEST(IiwaSim, SendsItsClockFirstAndHoldsItUntilTheNamedProcessRuns) {
   lcm.publish("IIWA_COMMAND", &ahead);
   drain();
   EXPECT_EQ(sim.process().rejections().counts().at("IIWA_COMMAND/stale"), 1);
+}
+
+// Lockstep, driven by hand over memq:// (Advance() is what the poll and each answer call): round
+// 1 is the clock alone, the tick's state opens round 2 once every follower has answered, rounds
+// repeat while anyone (the sim too: a PLAN_CHECK_REPLY) published, the next tick comes only after
+// a quiet round, and a follower that stops answering is left out after the timeout, counted.
+TEST(IiwaSim, InLockstepStepsOnlyAfterAQuietRoundOfEveryFollower) {
+  IiwaSimOptions options;
+  options.period_s = 1e-6;
+  options.realtime_rate = 100;  // ticks 20 ns of wall time apart: always due here
+  options.steps_per_tick = 2;
+  options.lockstep = true;
+  options.lockstep_timeout_s = 0.2;
+  IiwaSim sim(MemqFlags(0.1), options);
+  ASSERT_EQ(sim.tick_us(), 2);
+  lcm::LCM& lcm = sim.process().lcm();
+  std::vector<std::string> got;  // "<channel> <sim us since start> [r<round>]", as received
+  struct Recorder {
+    std::vector<std::string>* got;
+    int64_t start;
+    void OnClock(const lcm::ReceiveBuffer*, const std::string&, const orbed::sim_clock_t* m) {
+      got->push_back("SIM_CLOCK " + std::to_string(m->utime - start) + " r" +
+                     std::to_string(m->lockstep_round));
+    }
+    void OnStatus(const lcm::ReceiveBuffer*, const std::string& ch, const orbed::iiwa_status_t* m) {
+      got->push_back(ch + " " + std::to_string(m->utime - start));
+    }
+    void OnReply(const lcm::ReceiveBuffer*, const std::string& ch, const orbed::plan_check_reply_t*) {
+      got->push_back(ch);
+    }
+  } recorder{&got, sim.start_utime()};
+  lcm.subscribe("SIM_CLOCK", &Recorder::OnClock, &recorder);
+  lcm.subscribe("IIWA_STATUS", &Recorder::OnStatus, &recorder);
+  lcm.subscribe("PLAN_CHECK_REPLY", &Recorder::OnReply, &recorder);
+  auto drain = [&] {
+    while (lcm.handleTimeout(0) > 0) {
+    }
+  };
+  // Each answer is handled (OnAck, then Advance) as it is drained.
+  auto answer = [&](int64_t t_us, int32_t round, bool published) {
+    orbed::sim_clock_ack_t ack{};
+    ack.utime = sim.start_utime() + t_us;
+    ack.start_utime = sim.start_utime();
+    ack.lockstep_round = round;
+    ack.process = "follower";
+    ack.published = published;
+    lcm.publish("SIM_CLOCK_ACK", &ack);
+    drain();
+  };
+  auto take = [&] {
+    std::vector<std::string> out;
+    out.swap(got);
+    return out;
+  };
+  using Seen = std::vector<std::string>;
+
+  sim.Advance();  // tick 1: the clock alone
+  drain();
+  EXPECT_EQ(take(), (Seen{"SIM_CLOCK 2 r1"}));
+  answer(2, 1, false);  // joins: not waited for in the round it joined
+  EXPECT_EQ(take(), (Seen{"IIWA_STATUS 2", "SIM_CLOCK 2 r2"}));
+  EXPECT_EQ(sim.lockstep_followers(), std::vector<std::string>{"follower"});
+  sim.Advance();  // waits for the follower
+  drain();
+  EXPECT_TRUE(take().empty());
+  answer(2, 2, true);  // it published: another round
+  EXPECT_EQ(take(), (Seen{"SIM_CLOCK 2 r3"}));
+  // A plan check during round 3 is answered; the sim published, so round 4 follows.
+  orbed::plan_check_request_t request{};
+  request.request_id = 7;
+  request.num_joints = 7;
+  request.joint_position.assign(7, 0.0);
+  lcm.publish("PLAN_CHECK_REQUEST", &request);
+  drain();
+  answer(2, 3, false);
+  EXPECT_EQ(take(), (Seen{"PLAN_CHECK_REPLY", "SIM_CLOCK 2 r4"}));
+  answer(2, 3, false);  // a repeat of an old round: nothing
+  EXPECT_TRUE(take().empty());
+  answer(2, 4, false);  // quiet: tick 2
+  EXPECT_EQ(take(), (Seen{"SIM_CLOCK 4 r1"}));
+  EXPECT_EQ(sim.ticks(), 2);
+
+  // The follower goes silent: the round waits until the timeout, then goes on without it.
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (got.empty() && std::chrono::steady_clock::now() < give_up) {
+    sim.Advance();
+    drain();
+  }
+  EXPECT_EQ(take(), (Seen{"IIWA_STATUS 4", "SIM_CLOCK 4 r2"}));
+  EXPECT_EQ(sim.process().drop_counts().at("lockstep/follower"), 1);
+  EXPECT_TRUE(sim.lockstep_followers().empty());
+  sim.Advance();  // nobody to wait for, nobody published: tick 3
+  drain();
+  EXPECT_EQ(take(), (Seen{"SIM_CLOCK 6 r1"}));
+  answer(4, 2, false);  // back (an old round): waited for from the next round on
+  EXPECT_EQ(take(), (Seen{"IIWA_STATUS 6", "SIM_CLOCK 6 r2"}));
+  sim.Advance();
+  drain();
+  EXPECT_TRUE(take().empty());
+  EXPECT_EQ(sim.process().rejections().total(), 0);
 }
 
 TEST(IiwaSim, PublishesTrueFramesAndClearances) {

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <orbed/sim_clock_ack_t.hpp>
 #include <orbed/sim_clock_t.hpp>
 
 #include "procs/common/channels.h"
@@ -74,6 +75,172 @@ TEST(SimClock, CheckRefusesNonTimesAndRatesOutsideTheSims) {
   for (int64_t bad : {int64_t{0}, int64_t{-5}}) {
     msg.utime = bad;
     EXPECT_NE(CheckSimClock(msg), "") << bad;
+  }
+}
+
+orbed::sim_clock_ack_t Ack(const std::string& process, int64_t utime, int32_t round, bool published) {
+  orbed::sim_clock_ack_t ack{};
+  ack.utime = utime;
+  ack.start_utime = kStart;
+  ack.lockstep_round = round;
+  ack.process = process;
+  ack.published = published;
+  return ack;
+}
+
+TEST(SimClockAck, CheckRefusesNonStampsRoundsBelowOneAndBadNames) {
+  EXPECT_EQ(CheckSimClockAck(Ack("hmd", kStart + 5000, 1, false)), "");
+  EXPECT_NE(CheckSimClockAck(Ack("hmd", kStart - 1, 1, false)), "");  // before its start
+  EXPECT_NE(CheckSimClockAck(Ack("hmd", kStart, 0, false)), "");      // round 0 wants no answer
+  EXPECT_NE(CheckSimClockAck(Ack("", kStart, 1, false)), "");
+  EXPECT_NE(CheckSimClockAck(Ack(std::string(kMaxProcessNameLength + 1, 'x'), kStart, 1, false)), "");
+  orbed::sim_clock_t clock{};
+  clock.utime = clock.start_utime = kStart;
+  clock.realtime_rate = 1;
+  clock.lockstep_round = -1;
+  EXPECT_NE(CheckSimClock(clock), "");
+}
+
+// The sim's side of lockstep, round by round with a hand-made clock [s]: who is waited for, when a
+// round is complete, whether anyone published, and a follower left out after the timeout.
+TEST(LockstepBarrier, WaitsForEveryFollowerLeavesOutTheSilentAndTakesThemBack) {
+  LockstepBarrier barrier(/*timeout_s=*/2.0);
+  const int64_t t1 = kStart + 50'000;
+  barrier.BeginRound(kStart, kStart, 1, 0.0);  // a held clock's round: followers join
+  EXPECT_TRUE(barrier.Check(0.0).complete);    // nobody to wait for
+  EXPECT_EQ(barrier.OnAck(Ack("hmd", kStart, 1, false)), LockstepBarrier::Answer::kJoined);
+  EXPECT_EQ(barrier.OnAck(Ack("guidance", kStart, 1, false)), LockstepBarrier::Answer::kJoined);
+  EXPECT_EQ(barrier.followers(), (std::vector<std::string>{"guidance", "hmd"}));
+
+  // Round 1 of the next tick: both are waited for; one answer is not enough.
+  barrier.BeginRound(t1, kStart, 1, 10.0);
+  EXPECT_FALSE(barrier.Check(10.0).complete);
+  EXPECT_EQ(barrier.OnAck(Ack("hmd", t1, 1, true)), LockstepBarrier::Answer::kCounted);
+  EXPECT_EQ(barrier.OnAck(Ack("guidance", kStart, 1, false)),
+            LockstepBarrier::Answer::kOther);  // an old round
+  EXPECT_FALSE(barrier.Check(10.5).complete);
+  EXPECT_EQ(barrier.OnAck(Ack("guidance", t1, 1, false)), LockstepBarrier::Answer::kCounted);
+  LockstepBarrier::Status status = barrier.Check(10.5);
+  EXPECT_TRUE(status.complete);
+  EXPECT_TRUE(status.published);  // hmd sent something: another round
+  EXPECT_TRUE(status.left_out.empty());
+
+  // Round 2: a quiet one. A follower met only now (it started during round 1) is not waited for
+  // in this round, and an answer from another sim changes nothing.
+  barrier.BeginRound(t1, kStart, 2, 11.0);
+  EXPECT_EQ(barrier.OnAck(Ack("assistant", t1, 1, true)), LockstepBarrier::Answer::kJoined);
+  orbed::sim_clock_ack_t other = Ack("hmd", t1, 2, true);
+  other.start_utime = kStart - 1;
+  EXPECT_EQ(barrier.OnAck(other), LockstepBarrier::Answer::kOther);
+  EXPECT_EQ(barrier.OnAck(Ack("hmd", t1, 2, false)), LockstepBarrier::Answer::kCounted);
+  EXPECT_EQ(barrier.OnAck(Ack("guidance", t1, 2, false)), LockstepBarrier::Answer::kCounted);
+  status = barrier.Check(11.1);
+  EXPECT_TRUE(status.complete);
+  EXPECT_FALSE(status.published);
+
+  // The next tick: the assistant is waited for now. hmd goes silent: complete only after 2 s,
+  // when it is left out (once), not before.
+  const int64_t t2 = t1 + 50'000;
+  barrier.BeginRound(t2, kStart, 1, 20.0);
+  EXPECT_EQ(barrier.OnAck(Ack("guidance", t2, 1, false)), LockstepBarrier::Answer::kCounted);
+  EXPECT_FALSE(barrier.Check(20.1).complete);
+  EXPECT_EQ(barrier.OnAck(Ack("assistant", t2, 1, false)), LockstepBarrier::Answer::kCounted);
+  EXPECT_FALSE(barrier.Check(22.0).complete);  // exactly the timeout: still waiting
+  status = barrier.Check(22.01);
+  EXPECT_TRUE(status.complete);
+  EXPECT_EQ(status.left_out, std::vector<std::string>{"hmd"});
+  EXPECT_TRUE(barrier.Check(22.02).left_out.empty());
+  EXPECT_EQ(barrier.followers(), (std::vector<std::string>{"assistant", "guidance"}));
+  // Its next answer (to any round) takes it back; it is waited for from the next round on.
+  barrier.BeginRound(t2, kStart, 2, 23.0);
+  EXPECT_EQ(barrier.OnAck(Ack("hmd", t1, 2, false)), LockstepBarrier::Answer::kRejoined);
+  EXPECT_EQ(barrier.OnAck(Ack("guidance", t2, 2, false)), LockstepBarrier::Answer::kCounted);
+  EXPECT_EQ(barrier.OnAck(Ack("assistant", t2, 2, false)), LockstepBarrier::Answer::kCounted);
+  EXPECT_TRUE(barrier.Check(23.0).complete);
+  barrier.BeginRound(t2 + 50'000, kStart, 1, 24.0);
+  EXPECT_EQ(barrier.OnAck(Ack("guidance", t2 + 50'000, 1, false)), LockstepBarrier::Answer::kCounted);
+  EXPECT_EQ(barrier.OnAck(Ack("assistant", t2 + 50'000, 1, false)), LockstepBarrier::Answer::kCounted);
+  EXPECT_FALSE(barrier.Check(24.0).complete);  // hmd again
+}
+
+TEST(LockstepBarrier, RefusesNamesBeyondTheMost) {
+  LockstepBarrier barrier(1.0);
+  barrier.BeginRound(kStart, kStart, 1, 0.0);
+  for (size_t i = 0; i < kMaxLockstepFollowers; ++i) {
+    EXPECT_EQ(barrier.OnAck(Ack("p" + std::to_string(i), kStart, 1, false)),
+              LockstepBarrier::Answer::kJoined);
+  }
+  EXPECT_EQ(barrier.OnAck(Ack("one-too-many", kStart, 1, false)), LockstepBarrier::Answer::kRefused);
+  EXPECT_EQ(barrier.followers().size(), kMaxLockstepFollowers);
+}
+
+// A process with sim_time answers each lockstep round on SIM_CLOCK_ACK after the timers that clock
+// made due have run, saying whether it published since its previous answer (a timer's output, a
+// handler's reply), not counting its heartbeat. The "sim" is the test: it sends the next round
+// only when the answer to the last one is in (as orbed-iiwa-sim does), over memq://.
+TEST(ProcessSimTime, AnswersEachLockstepRoundAfterItsDueTimers) {
+  CommonFlags flags("orbed-follower");
+  flags.lcm_url = "memq://";
+  flags.duration_s = 20;  // a safety limit only
+  flags.sim_time = true;
+  Process process(flags);
+  int a_runs = 0;
+  process.AddTimer(0.02, [&] {
+    ++a_runs;
+    orbed::sim_clock_t out{};  // any message: the timer's output
+    process.Publish("OUTPUT", out);
+  });
+  // A reply in a handler, as the registration server answers a trial.
+  process.Subscribe<orbed::sim_clock_t>("PING", [&](const orbed::sim_clock_t& msg, const std::string&,
+                                                    int64_t) { process.Publish("PONG", msg); });
+  struct Answer {
+    int64_t t_us;
+    int32_t round;
+    bool published;
+    int a_runs;
+    std::string process;
+  };
+  std::vector<Answer> answers;
+  // The rounds the "sim" sends: (sim µs since start, round), and a PING before one.
+  const std::vector<std::pair<int64_t, int32_t>> rounds = {{0, 1},       {50'000, 1},  {50'000, 2},
+                                                           {100'000, 1}, {100'000, 2}, {100'000, 3}};
+  size_t next = 0;
+  auto send = [&] {
+    if (next == rounds.size()) return process.RequestStop();
+    if (next == 4) {
+      orbed::sim_clock_t ping{};
+      process.lcm().publish("PING", &ping);
+    }
+    orbed::sim_clock_t clock{};
+    clock.utime = kStart + rounds[next].first;
+    clock.start_utime = kStart;
+    clock.realtime_rate = 10;
+    clock.lockstep_round = rounds[next].second;
+    ++next;
+    process.lcm().publish(channels::kSimClock, &clock);
+  };
+  process.SubscribeRaw(channels::kSimClockAck, [&](const lcm::ReceiveBuffer& rbuf, const std::string&) {
+    orbed::sim_clock_ack_t ack;
+    ASSERT_EQ(ack.decode(rbuf.data, 0, rbuf.data_size), static_cast<int>(rbuf.data_size));
+    answers.push_back(
+        {ack.utime - kStart, ack.lockstep_round, static_cast<bool>(ack.published), a_runs, ack.process});
+    send();
+  });
+  send();
+  EXPECT_EQ(process.Run(), 0);
+  // 0 s: no timer due, nothing published. 0.05 s round 1: a ran at 0.02 and 0.04 and published;
+  // round 2: nothing new. 0.10 s round 1: a at 0.06, 0.08, 0.10; round 2: the PING (sent before
+  // it) was answered in its handler; round 3: quiet.
+  const std::vector<Answer> expected = {{0, 1, false, 0, ""},      {50'000, 1, true, 2, ""},
+                                        {50'000, 2, false, 2, ""}, {100'000, 1, true, 5, ""},
+                                        {100'000, 2, true, 5, ""}, {100'000, 3, false, 5, ""}};
+  ASSERT_EQ(answers.size(), expected.size());
+  for (size_t k = 0; k < expected.size(); ++k) {
+    EXPECT_EQ(answers[k].t_us, expected[k].t_us) << k;
+    EXPECT_EQ(answers[k].round, expected[k].round) << k;
+    EXPECT_EQ(answers[k].published, expected[k].published) << k;
+    EXPECT_EQ(answers[k].a_runs, expected[k].a_runs) << k;
+    EXPECT_EQ(answers[k].process, "orbed-follower") << k;
   }
 }
 

@@ -20,9 +20,16 @@
 //     conductor runs): the run ends with exit 0 and both set-ups recorded as the assistant read
 //     them; SIM_CLOCK carries rate 8 and stamps every IIWA_STATUS; and every GUIDANCE is stamped at
 //     a deadline of its 30 Hz timer on the sim clock, start + round(k x 33 333.333 us), which the
-//     wall clock would not give. (The set-ups are not compared with a run at R = 1: the sim does
-//     not wait for its followers, so under load a look moves in sim time by R times its wall
-//     latency, and in the sanitizer build joints ended 17-90 deg apart.)
+//     wall clock would not give. (Without lockstep the set-ups are not compared with a run at
+//     R = 1: the sim does not wait for its followers, so under load a look moves in sim time by R
+//     times its wall latency, and in the sanitizer build joints ended 17-90 deg apart; case 8.)
+//  8. Lockstep (the rest of issue 11 item 6): the same user, a fixed and an AR set-up (with its
+//     three alignments through the headset and the registration server), run in lockstep with 8
+//     steps per tick at real time and at 8 times real time: the two runs are the same run, every
+//     message stamped on the sim clock equal field for field at the same sim time (IIWA_STATUS,
+//     HMD_POSE, ALIGNMENT_TRIAL, SETUP_RESULT) and the recorded joints equal to the bit, although
+//     the wall time each process took differs by a factor of 8 (and more under load); every
+//     follower of the clock answered its rounds on SIM_CLOCK_ACK.
 //  3. scripts/launch/setup.yaml for one user and one target per mode through orbed-launch: the run
 //     ends with exit 0; setup_results.json has the three set-ups in the order the user seed draws,
 //     each reached_deg equal to the assistant's (the sim's measured joints, twice read), an
@@ -43,12 +50,16 @@
 #include <yaml-cpp/yaml.h>
 #include <lcm/lcm-cpp.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <orbed/alignment_trial_t.hpp>
 #include <orbed/guidance_t.hpp>
+#include <orbed/hmd_pose_t.hpp>
 #include <orbed/iiwa_status_t.hpp>
 #include <orbed/image_t.hpp>
 #include <orbed/registration_t.hpp>
 #include <orbed/robot_state_t.hpp>
+#include <orbed/setup_result_t.hpp>
 #include <orbed/setup_task_t.hpp>
+#include <orbed/sim_clock_ack_t.hpp>
 #include <orbed/sim_clock_t.hpp>
 
 #include "base/units.h"
@@ -452,5 +463,104 @@ TEST(SetupStudy, EightTimesFasterEveryProcessFollowsTheSimClock) {
     EXPECT_NEAR(static_cast<double>(g.utime - start), k * 33333.333, 1.0) << "GUIDANCE stamp " << g.utime;
   }
 }
+// One lockstep launch of setup.yaml at realtime rate `rate`; returns its run folder.
+std::string RunInLockstep(int rate) {
+  const std::string log_dir = MakeTempDir("setup_lockstep_r" + std::to_string(rate));
+  RunningProcess launcher(
+      {BinPath("orbed-launch"), SourcePath("scripts/launch/setup.yaml"), "--duration-s", "400"},
+      {{"ORBED_LOG_DIR", log_dir},
+       {"ORBED_RUN_ID", "setup-lockstep"},
+       {"ORBED_USER", "u1"},
+       {"ORBED_USER_SEED", "1"},
+       {"ORBED_SETUP_MODES", "fixed,ar"},
+       {"ORBED_SETUP_TARGETS", "1"},
+       {"ORBED_SIM_TIME", "1"},
+       {"ORBED_SIM_LOCKSTEP", "1"},
+       {"ORBED_SIM_STEPS_PER_TICK", "8"},
+       {"ORBED_SIM_HOLD_FOR", "setup"},
+       {"ORBED_SIM_RATE", std::to_string(rate)}});
+  EXPECT_TRUE(launcher.Wait(400)) << "the run at rate " << rate << " did not finish";
+  EXPECT_EQ(launcher.exit_code(), 0) << "rate " << rate;
+  return log_dir;
+}
+
+// The sim's start stamp of a run (every stamp below is compared as the time since it).
+int64_t SimStart(const std::string& log_dir) {
+  const std::vector<orbed::sim_clock_t> clock = Logged<orbed::sim_clock_t>(log_dir, "SIM_CLOCK");
+  EXPECT_FALSE(clock.empty());
+  return clock.empty() ? 0 : clock.front().start_utime;
+}
+
+TEST(SetupStudy, InLockstepARunAtEightTimesRealTimeIsTheRunAtRealTime) {
+  const std::string slow = RunInLockstep(1);
+  const std::string fast = RunInLockstep(8);
+  ASSERT_FALSE(::testing::Test::HasFailure());
+  const int64_t start_slow = SimStart(slow);
+  const int64_t start_fast = SimStart(fast);
+
+  // The records: the same joints, to the bit.
+  const YAML::Node a = YAML::LoadFile(slow + "/setup_results.json")["setups"];
+  const YAML::Node b = YAML::LoadFile(fast + "/setup_results.json")["setups"];
+  ASSERT_EQ(a.size(), 2u);
+  ASSERT_EQ(b.size(), 2u);
+  for (size_t k = 0; k < 2; ++k) {
+    EXPECT_EQ(a[k]["task_id"].as<std::string>(), b[k]["task_id"].as<std::string>());
+    for (int i = 0; i < 7; ++i) {
+      EXPECT_EQ(a[k]["reached_deg"][i].as<double>(), b[k]["reached_deg"][i].as<double>())
+          << k << " q" << i + 1;
+    }
+  }
+  // The arm, tick by tick.
+  const auto status_a = Logged<orbed::iiwa_status_t>(slow, "IIWA_STATUS");
+  const auto status_b = Logged<orbed::iiwa_status_t>(fast, "IIWA_STATUS");
+  ASSERT_GT(status_a.size(), 100u);
+  ASSERT_EQ(status_a.size(), status_b.size());
+  for (size_t k = 0; k < status_a.size(); ++k) {
+    ASSERT_EQ(status_a[k].utime - start_slow, status_b[k].utime - start_fast) << k;
+    ASSERT_EQ(status_a[k].joint_position_measured, status_b[k].joint_position_measured) << k;
+  }
+  // The person's head, on its 60 Hz sim timer, through the set-ups and the alignments.
+  const auto pose_a = Logged<orbed::hmd_pose_t>(slow, "HMD_POSE");
+  const auto pose_b = Logged<orbed::hmd_pose_t>(fast, "HMD_POSE");
+  ASSERT_GT(pose_a.size(), 100u);
+  ASSERT_EQ(pose_a.size(), pose_b.size());
+  for (size_t k = 0; k < pose_a.size(); ++k) {
+    ASSERT_EQ(pose_a[k].utime - start_slow, pose_b[k].utime - start_fast) << k;
+    for (int i = 0; i < 3; ++i) ASSERT_EQ(pose_a[k].X_WH.position_m[i], pose_b[k].X_WH.position_m[i]) << k;
+    for (int i = 0; i < 4; ++i) {
+      ASSERT_EQ(pose_a[k].X_WH.quaternion_wxyz[i], pose_b[k].X_WH.quaternion_wxyz[i]) << k;
+    }
+  }
+  // The three alignments before the AR set-up, and the assistant's answers.
+  const auto trial_a = Logged<orbed::alignment_trial_t>(slow, "ALIGNMENT_TRIAL");
+  const auto trial_b = Logged<orbed::alignment_trial_t>(fast, "ALIGNMENT_TRIAL");
+  ASSERT_GE(trial_a.size(), 3u);
+  ASSERT_EQ(trial_a.size(), trial_b.size());
+  for (size_t k = 0; k < trial_a.size(); ++k) {
+    EXPECT_EQ(trial_a[k].utime - start_slow, trial_b[k].utime - start_fast) << k;
+    EXPECT_EQ(trial_a[k].duration_s, trial_b[k].duration_s) << k;
+    for (int i = 0; i < 3; ++i) EXPECT_EQ(trial_a[k].X_WV.position_m[i], trial_b[k].X_WV.position_m[i]) << k;
+  }
+  const auto result_a = Logged<orbed::setup_result_t>(slow, "SETUP_RESULT");
+  const auto result_b = Logged<orbed::setup_result_t>(fast, "SETUP_RESULT");
+  ASSERT_EQ(result_a.size(), result_b.size());
+  for (size_t k = 0; k < result_a.size(); ++k) {
+    EXPECT_EQ(result_a[k].utime - start_slow, result_b[k].utime - start_fast) << k;
+    EXPECT_EQ(result_a[k].reached_position, result_b[k].reached_position) << k;
+  }
+  // The clock: lockstep rounds at each rate, answered by every process that follows it.
+  for (const auto& [dir, rate] : {std::make_pair(slow, 1), std::make_pair(fast, 8)}) {
+    for (const orbed::sim_clock_t& c : Logged<orbed::sim_clock_t>(dir, "SIM_CLOCK")) {
+      ASSERT_EQ(c.realtime_rate, rate);
+      ASSERT_GE(c.lockstep_round, 1);
+    }
+    std::set<std::string> answered;
+    for (const auto& ack : Logged<orbed::sim_clock_ack_t>(dir, "SIM_CLOCK_ACK")) answered.insert(ack.process);
+    EXPECT_EQ(answered, (std::set<std::string>{"assistant", "fixed_display", "guidance", "hmd",
+                                               "registration", "setup"}))
+        << "rate " << rate;
+  }
+}
+
 }  // namespace
 }  // namespace orbed::testing
