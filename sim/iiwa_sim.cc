@@ -154,10 +154,8 @@ IiwaSim::IiwaSim(const orbed::CommonFlags& flags, const IiwaSimOptions& options)
           if (!holding_ || msg.name != options_.hold_for ||
               msg.state != orbed::process_status_t::STATE_RUNNING)
             return;
-          holding_ = false;
-          ticks_ = 0;
-          start_mono_ = std::chrono::steady_clock::now();
-          ORBED_LOG(kInfo) << "the sim clock runs: " << options_.hold_for << " is running";
+          hold_for_running_ = true;
+          MaybeRelease();
         });
     process_->AddTimer(5.0, [this] {
       if (holding_) ORBED_LOG(kInfo) << "holding the sim clock until " << options_.hold_for << " runs";
@@ -328,6 +326,20 @@ void IiwaSim::Advance() {
   Tick();
 }
 
+void IiwaSim::MaybeRelease() {
+  // In lockstep the process held for must also have answered a round, so that the first tick's
+  // rounds wait for it (a follower met during a round is not waited for in that round).
+  if (!holding_ || !hold_for_running_) return;
+  if (options_.lockstep) {
+    const std::vector<std::string> followers = barrier_.followers();
+    if (std::find(followers.begin(), followers.end(), options_.hold_for) == followers.end()) return;
+  }
+  holding_ = false;
+  ticks_ = 0;
+  start_mono_ = std::chrono::steady_clock::now();
+  ORBED_LOG(kInfo) << "the sim clock runs: " << options_.hold_for << " is running";
+}
+
 void IiwaSim::OnAck(const orbed::sim_clock_ack_t& msg, const std::string& channel) {
   const std::string problem = CheckSimClockAck(msg);
   if (!problem.empty()) return process_->Reject(channel + "/field", problem);
@@ -347,6 +359,7 @@ void IiwaSim::OnAck(const orbed::sim_clock_ack_t& msg, const std::string& channe
     case LockstepBarrier::Answer::kOther:
       break;
   }
+  MaybeRelease();
   Advance();
 }
 

@@ -76,8 +76,9 @@
 /// reply to what it sent, before the next tick, however loaded the machine and whatever R: with the same K, a
 /// run at R = 1 and one at R = 10 are the same run. A follower that has not answered a round within
 /// lockstep_timeout_s (killed, hung) is left out, counted as the drop "lockstep/<name>" and logged, and taken
-/// back with its next answer; a held clock waits for nobody (its rounds let the followers join). Answers are
-/// checked (CheckSimClockAck; refused as "<channel>/field"), at most kMaxLockstepFollowers names.
+/// back with its next answer; a held clock waits for nobody (its rounds let the followers join; in lockstep
+/// it is released only once the process it holds for has answered one). Answers are checked
+/// (CheckSimClockAck; refused as "<channel>/field"), at most kMaxLockstepFollowers names.
 ///
 /// Crash recovery (state_file, sim_state.h): the sim saves its measured q while the arm moves, at most
 /// every state_save_period_s of sim time and whenever the arm comes to rest, and a sim started on an
@@ -208,6 +209,8 @@ class IiwaSim {
   // the barrier then waits on.
   void PublishClock(int64_t utime);
   void OnAck(const orbed::sim_clock_ack_t& msg, const std::string& channel);
+  // Ends the hold once hold_for runs (in lockstep: and has answered a round).
+  void MaybeRelease();
   // The sim time of the last tick [us since the epoch].
   int64_t NowUtime() const { return start_utime_ + ticks_ * tick_us_; }
   void SaveState(const orbed::iiwa_status_t& status);
@@ -228,6 +231,7 @@ class IiwaSim {
   std::optional<CollisionResult> unpublished_state_;  // lockstep: the tick's state, for round 2
   std::chrono::steady_clock::time_point start_mono_;
   bool holding_{false};
+  bool hold_for_running_{false};
   int64_t ticks_{0};
   int64_t skipped_ticks_{0};  // since the last warning
   std::chrono::steady_clock::time_point last_skip_warning_{};

@@ -62,27 +62,27 @@ ViraalScenario::ViraalScenario(const orbed::CommonFlags& flags, const ScenarioOp
   const ConductorOptions& o = options_.conductor;
   process_->Subscribe<orbed::robot_state_t>(
       o.robot_state_channel, [this](const orbed::robot_state_t& msg, const std::string&, int64_t) {
-        Apply(conductor_->OnRobotState(msg, Now()));
+        if (Started()) Apply(conductor_->OnRobotState(msg, Now()));
       });
   process_->Subscribe<orbed::plan_check_reply_t>(
       o.plan_check_reply_channel, [this](const orbed::plan_check_reply_t& msg, const std::string&, int64_t) {
-        Apply(conductor_->OnPlanCheckReply(msg, Now()));
+        if (Started()) Apply(conductor_->OnPlanCheckReply(msg, Now()));
       });
   process_->Subscribe<orbed::alignment_trial_t>(
       o.trial_channel, [this](const orbed::alignment_trial_t& msg, const std::string&, int64_t) {
-        Apply(conductor_->OnTrial(msg, Now()));
+        if (Started()) Apply(conductor_->OnTrial(msg, Now()));
       });
   process_->Subscribe<orbed::registration_t>(
       o.registration_channel, [this](const orbed::registration_t& msg, const std::string&, int64_t) {
-        Apply(conductor_->OnRegistration(msg, Now()));
+        if (Started()) Apply(conductor_->OnRegistration(msg, Now()));
       });
   process_->Subscribe<orbed::landmark_t>(o.landmark_channel,
                                          [this](const orbed::landmark_t& msg, const std::string&, int64_t) {
-                                           Apply(conductor_->OnLandmark(msg, Now()));
+                                           if (Started()) Apply(conductor_->OnLandmark(msg, Now()));
                                          });
   process_->Subscribe<orbed::misalignment_t>(
       o.misalignment_channel, [this](const orbed::misalignment_t& msg, const std::string&, int64_t) {
-        Apply(conductor_->OnMisalignment(msg, Now()));
+        if (Started()) Apply(conductor_->OnMisalignment(msg, Now()));
       });
   process_->AddTimer(options_.tick_s, [this] { Tick(); });
   ORBED_LOG(kInfo) << "run " << o.run_id << ": " << o.config.modes.size() << " modes x " << o.config.trials
@@ -92,10 +92,21 @@ ViraalScenario::ViraalScenario(const orbed::CommonFlags& flags, const ScenarioOp
 
 ViraalScenario::~ViraalScenario() = default;
 
+bool ViraalScenario::Started() {
+  if (!started_ && (!process_->sim_time() || process_->sim_clock().started())) {
+    started_ = true;
+    Apply(conductor_->Start(Now()));
+    WriteProgress();
+  }
+  return started_;
+}
+
 int ViraalScenario::Run() {
-  Apply(conductor_->Start(Now()));
-  WriteProgress();
+  // On the sim clock the conductor starts with its first input after the first SIM_CLOCK, so that
+  // its start and request ids are sim stamps, the same in every run of a lockstep study.
+  if (!process_->sim_time()) Started();
   const int code = process_->Run();
+  if (!started_) return 1;  // no sim clock came (the process says so)
   if (!finished_) {
     // Stopped from outside (signal, --duration-s) before the run completed.
     Apply(conductor_->Abort("interrupted before the run completed", Now()));
@@ -104,7 +115,9 @@ int ViraalScenario::Run() {
   return results_.ok ? code : 1;
 }
 
-void ViraalScenario::Tick() { Apply(conductor_->Tick(Now())); }
+void ViraalScenario::Tick() {
+  if (Started()) Apply(conductor_->Tick(Now()));
+}
 
 ConductorTime ViraalScenario::Now() const {
   return ConductorTime{process_->ClockSeconds(), process_->ClockUtime()};

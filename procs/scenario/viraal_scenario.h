@@ -82,6 +82,8 @@ class ViraalScenario {
 
  private:
   ConductorTime Now() const;
+  // Whether the conductor runs; starts it first if the process clock has begun (Run).
+  bool Started();
   /// Carries out the conductor's actions in order, then finishes the run once it is done.
   void Apply(const ConductorActions& actions);
   void Finish();
@@ -94,6 +96,7 @@ class ViraalScenario {
   std::unique_ptr<ViraalConductor> conductor_;
   std::unique_ptr<orbed::Process> process_;
   bool finished_{false};
+  bool started_{false};
   viraal::RunResults results_;
   std::string results_path_;
   int64_t progress_written_{-1};  // finished trials + means in the last results.json written

@@ -41,37 +41,45 @@ SetupProcess::SetupProcess(const CommonFlags& flags, const SetupOptions& options
   conductor_ = std::make_unique<SetupConductor>(options, sim::RobotModel::LoadFile(urdf_path));
   process_.Subscribe<orbed::robot_state_t>(
       options.robot_state_channel, [this](const orbed::robot_state_t& m, const std::string&, int64_t) {
-        Apply(conductor_->OnRobotState(m, Now()));
+        if (Started()) Apply(conductor_->OnRobotState(m, Now()));
       });
   process_.Subscribe<orbed::collision_status_t>(
-      options.collision_status_channel, [this](const orbed::collision_status_t& m, const std::string&,
-                                               int64_t) { Apply(conductor_->OnCollisionStatus(m, Now())); });
+      options.collision_status_channel,
+      [this](const orbed::collision_status_t& m, const std::string&, int64_t) {
+        if (Started()) Apply(conductor_->OnCollisionStatus(m, Now()));
+      });
   const scenario::ConductorOptions channels;  // the alignment's channels: the defaults
   process_.Subscribe<orbed::plan_check_reply_t>(
-      channels.plan_check_reply_channel, [this](const orbed::plan_check_reply_t& m, const std::string&,
-                                                int64_t) { Apply(conductor_->OnPlanCheckReply(m, Now())); });
+      channels.plan_check_reply_channel,
+      [this](const orbed::plan_check_reply_t& m, const std::string&, int64_t) {
+        if (Started()) Apply(conductor_->OnPlanCheckReply(m, Now()));
+      });
   process_.Subscribe<orbed::alignment_trial_t>(
       channels.trial_channel, [this](const orbed::alignment_trial_t& m, const std::string&, int64_t) {
-        Apply(conductor_->OnTrial(m, Now()));
+        if (Started()) Apply(conductor_->OnTrial(m, Now()));
       });
   process_.Subscribe<orbed::registration_t>(
       channels.registration_channel, [this](const orbed::registration_t& m, const std::string&, int64_t) {
-        Apply(conductor_->OnRegistration(m, Now()));
+        if (Started()) Apply(conductor_->OnRegistration(m, Now()));
       });
   process_.Subscribe<orbed::landmark_t>(channels.landmark_channel,
                                         [this](const orbed::landmark_t& m, const std::string&, int64_t) {
-                                          Apply(conductor_->OnLandmark(m, Now()));
+                                          if (Started()) Apply(conductor_->OnLandmark(m, Now()));
                                         });
   process_.Subscribe<orbed::misalignment_t>(
       channels.misalignment_channel, [this](const orbed::misalignment_t& m, const std::string&, int64_t) {
-        Apply(conductor_->OnMisalignment(m, Now()));
+        if (Started()) Apply(conductor_->OnMisalignment(m, Now()));
       });
   process_.Subscribe<orbed::setup_result_t>(
       options.setup_result_channel, [this](const orbed::setup_result_t& m, const std::string&, int64_t) {
-        Apply(conductor_->OnSetupResult(m, Now()));
+        if (Started()) Apply(conductor_->OnSetupResult(m, Now()));
       });
   process_.AddTimer(
-      0.01, [this] { Apply(conductor_->Tick(Now())); }, "tick");
+      0.01,
+      [this] {
+        if (Started()) Apply(conductor_->Tick(Now()));
+      },
+      "tick");
 }
 
 ConductorTime SetupProcess::Now() const {
@@ -85,9 +93,17 @@ void SetupProcess::Start() {
   Write(true);
 }
 
+bool SetupProcess::Started() {
+  if (!started_ && (!process_.sim_time() || process_.sim_clock().started())) Start();
+  return started_;
+}
+
 int SetupProcess::Run() {
-  Start();
+  // On the sim clock the conductor starts with its first input after the first SIM_CLOCK, so that
+  // its start and request ids are sim stamps, the same in every run of a lockstep study.
+  if (!process_.sim_time()) Start();
   const int code = process_.Run();
+  if (!started_) return 1;  // no sim clock came (the process says so)
   if (!finished_) {
     Apply(conductor_->Abort("interrupted before the study's set-ups were done", Now()));
     return 1;

@@ -47,6 +47,8 @@ class SetupProcess {
   Process& process() { return process_; }
 
  private:
+  // Whether the conductor runs; starts it first if the process clock has begun (Run).
+  bool Started();
   void Apply(SetupConductor::Actions actions);
   ConductorTime Now() const;
   void Write(bool partial);
