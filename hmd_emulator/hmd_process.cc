@@ -206,7 +206,7 @@ void HmdProcess::PublishPose() {
   if (pending_trial_ && !stream_->playing_faults()) {
     const TrialOutcome outcome = std::move(*pending_trial_);
     pending_trial_.reset();
-    PublishEmulatedTrial(outcome);
+    PublishEmulatedTrial(outcome, stream_->t_s() - pending_trial_walk_t_s_);
   }
 }
 
@@ -357,17 +357,21 @@ void HmdProcess::EmulateTrial(const std::string& channel) {
                    << " tracking fault(s) while aligning, played on " << options_.hmd_pose_channel
                    << " before the answer";
   pending_trial_ = outcome;
+  pending_trial_walk_t_s_ = stream_->t_s();
 }
 
-void HmdProcess::PublishEmulatedTrial(const TrialOutcome& outcome) {
+double HmdProcess::walk_t_s() const { return stream_->t_s(); }
+
+void HmdProcess::PublishEmulatedTrial(const TrialOutcome& outcome, double played_s) {
   const HmdSessionState& s = session_.state();
   const std::int32_t index = s.next_index;
   X_WV_user_ = outcome.alignment.X_WV;
   // The person spent the trial's emulated seconds aligning: the live walk goes on from there, so
   // that where the person stands after an alignment is the walk's (its end, for trials of a minute)
   // rather than where the wall time the computation took has put the live walk (on the sim clock
-  // at a rate R, R times that).
-  walk_offset_s_ += outcome.alignment.duration_s;
+  // at a rate R, R times that). A trial whose tracking faults played live has spent that part
+  // of its time on the stream already.
+  walk_offset_s_ += std::max(0.0, outcome.alignment.duration_s - played_s);
   PublishTrial(outcome.alignment.X_WV, outcome.alignment.duration_s, user_id_, outcome.faults,
                outcome.annotation);
   const TrackingFaultRecord& f = outcome.faults;

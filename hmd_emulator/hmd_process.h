@@ -166,6 +166,10 @@ class HmdProcess {
   orbed::Process& process() { return *process_; }
   const HmdOptions& options() const { return options_; }
   const HmdConfigSet& config() const { return config_; }
+  /// The live walk's time at the last HMD_POSE [s], and how far the emulated trials have moved it
+  /// on (the alignment time not already spent on the live stream) [s].
+  double walk_t_s() const;
+  double walk_offset_s() const { return walk_offset_s_; }
 
   // The timers' callbacks, public so tests can drive them without waiting (Run() thread only).
   /// Steps the head and SLAM model to t and publishes HMD_POSE + HMD_POSE_TRUTH.
@@ -221,7 +225,8 @@ class HmdProcess {
   void PublishTrial(const Eigen::Isometry3d& X_WV, double duration_s, const std::string& user_id,
                     const TrackingFaultRecord& faults = {},
                     const std::vector<AnnotationRay>& annotation = {});
-  void PublishEmulatedTrial(const TrialOutcome& outcome);
+  // `played_s`: walk time the trial already spent live (its tracking faults played on HMD_POSE).
+  void PublishEmulatedTrial(const TrialOutcome& outcome, double played_s = 0);
   void InteractiveTick();
   FrameInputs Inputs() const;
 
@@ -249,6 +254,7 @@ class HmdProcess {
   std::string user_id_;
   // An emulated trial waiting for its tracking faults to play on HMD_POSE (see the file comment).
   std::optional<TrialOutcome> pending_trial_;
+  double pending_trial_walk_t_s_{0};  // the live walk's time when pending_trial_ was requested
   // The target the person plans (interactive, key t): drawn as the hologram while planning.
   Eigen::VectorXd planned_target_q_;
   int planned_targets_sent_{0};

@@ -279,12 +279,20 @@ TEST(HmdProcess, ATrialWithATrackingFaultIsAnsweredAfterItPlaysOnHmdPose) {
 
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
   size_t poses_at_answer = 0;
+  const double walk_at_request_s = hmd.walk_t_s();  // no pose yet: 0
+  double walk_at_answer_s = 0;
   while (got.trials.empty() && std::chrono::steady_clock::now() < deadline) {
     hmd.PublishPose();
+    walk_at_answer_s = hmd.walk_t_s();
     Drain(lcm);
     poses_at_answer = got.est.size();
   }
   ASSERT_EQ(got.trials.size(), 1u);
+  // The person walked on for the trial's emulated time in all: the part the faults took on the
+  // live stream, then the rest at once.
+  EXPECT_EQ(walk_at_request_s, 0.0);
+  EXPECT_GT(walk_at_answer_s, 0.5);
+  EXPECT_NEAR(hmd.walk_offset_s(), got.trials[0].duration_s - (walk_at_answer_s - walk_at_request_s), 1e-9);
   std::vector<int> states;
   for (const auto& p : got.est) states.push_back(p.tracking_state);
   ASSERT_GE(states.size(), 7u);
