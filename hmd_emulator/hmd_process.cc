@@ -120,12 +120,17 @@ HmdProcess::HmdProcess(const orbed::CommonFlags& flags, const HmdOptions& option
   images.threaded = options_.threaded;
   ImagePipelineOutputs out;  // called on the worker thread when threaded
   orbed::Process* process = process_.get();
-  out.camera = [process, ch = options_.camera_channel](const orbed::image_t& m) { process->Publish(ch, m); };
+  // The rendered streams run on the wall clock and no process acts on them within a sim tick: they
+  // are not publications a lockstep round waits on (else at ~65 frames/s every round would ask
+  // for another).
+  out.camera = [process, ch = options_.camera_channel](const orbed::image_t& m) {
+    process->PublishControl(ch, m);
+  };
   out.reflective = [process, ch = options_.reflective_channel](const orbed::reflective_view_t& m) {
-    process->Publish(ch, m);
+    process->PublishControl(ch, m);
   };
   out.ar_view = [process, ch = options_.ar_view_channel](const orbed::image_t& m) {
-    process->Publish(ch, m);
+    process->PublishControl(ch, m);
   };
   out.error = [process](const std::string& error, int64_t count) {
     // Shown as last_error on the heartbeat; an engine error must not take the process down.

@@ -65,6 +65,18 @@ IiwaSimOptions Resolved(IiwaSimOptions options) {
                                 std::to_string(kMaxStepsPerTick) + "] (or 0: the realtime rate), not " +
                                 std::to_string(options.steps_per_tick));
   }
+  if (static_cast<int64_t>(options.steps_per_tick) * std::llround(options.period_s * 1e6) >
+      kMaxSimClockStepUs) {
+    throw std::invalid_argument("--steps-per-tick x --period-s must be at most " +
+                                std::to_string(kMaxSimClockStepUs / 1'000'000) +
+                                " s of sim time per tick (the largest step a follower's clock takes)");
+  }
+  if (options.lockstep && options.sim_clock_channel.empty()) {
+    throw std::invalid_argument("--lockstep needs the sim clock channel (--sim-clock-channel)");
+  }
+  if (!(options.lockstep_resend_s > 0) || !std::isfinite(options.lockstep_resend_s)) {
+    throw std::invalid_argument("the lockstep resend period must be a finite number > 0");
+  }
   if (!(options.lockstep_timeout_s > 0) || !std::isfinite(options.lockstep_timeout_s)) {
     throw std::invalid_argument("--lockstep-timeout-s must be a finite number > 0");
   }
@@ -167,7 +179,13 @@ IiwaSim::IiwaSim(const orbed::CommonFlags& flags, const IiwaSimOptions& options)
         channels::kSimClockAck, [this](const orbed::sim_clock_ack_t& msg, const std::string& channel,
                                        int64_t) { OnAck(msg, channel); });
     // The ticks come from Advance(): from this poll and from each answer.
-    process_->AddWallPoll(tick_wall_s, [this] { holding_ ? Tick() : Advance(); });
+    process_->AddWallPoll(tick_wall_s, [this] {
+      if (!holding_) return Advance();
+      // The held clock's rounds only let the followers join: at most kHeldRoundsHz.
+      const double now_s = MonotonicS();
+      if (now_s - round_sent_s_ < 1.0 / kHeldRoundsHz) return;
+      Tick();
+    });
   } else {
     // Deadlines the loop skips (more than a few periods behind) are counted as "timer/tick" drops:
     // no IIWA_STATUS, ROBOT_STATE or COLLISION_STATUS went out for them.
@@ -291,39 +309,68 @@ void IiwaSim::Tick() {
 
 void IiwaSim::Advance() {
   if (holding_) return;  // the held clock's rounds (the poll's) wait for nobody
-  const double now_s = MonotonicS();
-  if (round_ > 0) {
-    const LockstepBarrier::Status status = barrier_.Check(now_s);
-    for (const std::string& name : status.left_out) {
-      process_->CountDrop("lockstep/" + name);
-      ORBED_LOG(kWarn) << "lockstep: " << name << " did not answer round " << round_ << " of tick " << ticks_
-                       << " within " << options_.lockstep_timeout_s
-                       << " s; going on without it until it answers again";
+  // Each pass either waits (returns) or sends something; with nobody to wait for, a round is
+  // complete at once and the loop goes on to the next, up to the end of one tick per call (the
+  // poll's pace).
+  bool ticked = false;
+  for (;;) {
+    const double now_s = MonotonicS();
+    if (round_ > 0) {
+      const LockstepBarrier::Status status = barrier_.Check(now_s);
+      for (const std::string& name : status.left_out) {
+        process_->CountDrop("lockstep/" + name);
+        ORBED_LOG(kWarn) << "lockstep: " << name << " did not answer round " << round_ << " of tick "
+                         << ticks_ << " within " << options_.lockstep_timeout_s
+                         << " s; going on without it until it answers again";
+      }
+      if (!status.complete) {
+        // A lost SIM_CLOCK or answer: the round again (a follower answers a repeat as before).
+        if (now_s - round_sent_s_ >= options_.lockstep_resend_s) {
+          round_sent_s_ = now_s;
+          ResendClock();
+        }
+        return;
+      }
+      // What the sim published during the round counts too (PLAN_CHECK_REPLY; the tick's state in
+      // round 1): someone may still be handling it.
+      bool published = process_->TakePublished();
+      if (unpublished_state_) {
+        PublishState(NowUtime(), *unpublished_state_);
+        unpublished_state_.reset();
+        process_->TakePublished();  // the state is round 2's cause, the followers' answers its effects
+        published = true;
+      }
+      if ((status.published || published) && round_ < kMaxLockstepRounds) {
+        ++round_;
+        PublishClock(NowUtime());
+        continue;
+      }
+      if (round_ >= kMaxLockstepRounds) {
+        // Followers that keep answering each other would hold the arm for ever.
+        process_->CountDrop("lockstep/rounds");
+        ORBED_LOG(kWarn) << "lockstep: tick " << ticks_ << " still busy after " << round_
+                         << " rounds; stepping on";
+      }
     }
-    if (!status.complete) return;
-    // What the sim published during the round counts too (PLAN_CHECK_REPLY; the tick's state in
-    // round 1): someone may still be handling it.
-    bool published = process_->TakePublished();
-    if (unpublished_state_) {
-      PublishState(NowUtime(), *unpublished_state_);
-      unpublished_state_.reset();
-      process_->TakePublished();  // the state is round 2's cause, the followers' answers its effects
-      published = true;
-    }
-    if (status.published || published) {
-      ++round_;
-      PublishClock(NowUtime());
-      return;
-    }
+    // A quiet round: the next tick once its wall time has come (half a poll early: the poll's grid
+    // and the ticks' are the same period, in some phase).
+    const int64_t elapsed_ns =
+        std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start_mono_)
+            .count();
+    if (ticked || elapsed_ns < (ticks_ + 1) * tick_wall_ns_ - tick_wall_ns_ / 2) return;
+    ticked = true;
+    round_ = 1;
+    Tick();
   }
-  // A quiet round: the next tick once its wall time has come (half a poll early: the poll's grid
-  // and the ticks' are the same period, in some phase).
-  const int64_t elapsed_ns =
-      std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start_mono_)
-          .count();
-  if (elapsed_ns < (ticks_ + 1) * tick_wall_ns_ - tick_wall_ns_ / 2) return;
-  round_ = 1;
-  Tick();
+}
+
+void IiwaSim::ResendClock() {
+  orbed::sim_clock_t clock{};
+  clock.utime = NowUtime();
+  clock.realtime_rate = options_.realtime_rate;
+  clock.start_utime = start_utime_;
+  clock.lockstep_round = round_;
+  process_->PublishControl(options_.sim_clock_channel, clock);
 }
 
 void IiwaSim::MaybeRelease() {
@@ -348,9 +395,10 @@ void IiwaSim::OnAck(const orbed::sim_clock_ack_t& msg, const std::string& channe
     case LockstepBarrier::Answer::kJoined:
       ORBED_LOG(kInfo) << "lockstep: " << msg.process << " follows the clock";
       break;
-    case LockstepBarrier::Answer::kRejoined:
-      ORBED_LOG(kInfo) << "lockstep: " << msg.process << " answers again";
-      break;
+    case LockstepBarrier::Answer::kUnsent:
+      return process_->Reject(channel + "/unsent", "'" + msg.process + "' answers round " +
+                                                       std::to_string(msg.lockstep_round) + " at " +
+                                                       std::to_string(msg.utime) + ", which was not sent");
     case LockstepBarrier::Answer::kRefused:
       return process_->Reject(channel + "/followers", "more than " + std::to_string(kMaxLockstepFollowers) +
                                                           " followers; '" + msg.process +
@@ -373,7 +421,8 @@ void IiwaSim::PublishClock(int64_t utime) {
   clock.start_utime = start_utime_;
   if (options_.lockstep) {
     clock.lockstep_round = std::max<int32_t>(1, round_);
-    barrier_.BeginRound(utime, start_utime_, clock.lockstep_round, MonotonicS());
+    round_sent_s_ = MonotonicS();
+    barrier_.BeginRound(utime, start_utime_, clock.lockstep_round, round_sent_s_);
   }
   process_->PublishControl(options_.sim_clock_channel, clock);
 }

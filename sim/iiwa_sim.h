@@ -110,8 +110,14 @@
 
 namespace orbed::sim {
 
-/// The most steps of P one tick may make.
+/// The most steps of P one tick may make (and K x P at most kMaxSimClockStepUs).
 inline constexpr int kMaxStepsPerTick = 1000;
+/// Lockstep: a round still missing answers after this long [s of wall time] is sent again (a lost
+/// datagram; the default of IiwaSimOptions::lockstep_resend_s); a tick steps on after this many rounds
+/// (counted as the drop "lockstep/rounds"); a held clock's rounds go out at most this often [Hz].
+inline constexpr double kLockstepResendS = 0.1;
+inline constexpr int32_t kMaxLockstepRounds = 1000;
+inline constexpr double kHeldRoundsHz = 20.0;
 
 struct IiwaSimOptions {
   /// URDF and scene files; "" = the files shipped in the source tree (SourceTreePath()).
@@ -129,6 +135,8 @@ struct IiwaSimOptions {
   bool lockstep{false};
   /// How long a lockstep round waits for a follower before leaving it out [s of wall time], > 0.
   double lockstep_timeout_s{10.0};
+  /// A lockstep round still missing answers after this long is sent again [s of wall time], > 0.
+  double lockstep_resend_s{kLockstepResendS};
   /// Initial joint vector [deg]; empty = all zero (the arm upright). Must be within the limits.
   std::vector<double> initial_q_deg;
   /// The state file (sim_state.h): read at start (over initial_q_deg) and written as the arm moves;
@@ -211,6 +219,8 @@ class IiwaSim {
   void OnAck(const orbed::sim_clock_ack_t& msg, const std::string& channel);
   // Ends the hold once hold_for runs (in lockstep: and has answered a round).
   void MaybeRelease();
+  // The round that is out, again (SIM_CLOCK; the barrier keeps the answers it has).
+  void ResendClock();
   // The sim time of the last tick [us since the epoch].
   int64_t NowUtime() const { return start_utime_ + ticks_ * tick_us_; }
   void SaveState(const orbed::iiwa_status_t& status);
@@ -227,7 +237,8 @@ class IiwaSim {
   int64_t tick_wall_ns_{0};  // K x P / R: the wall time between ticks
   int64_t start_utime_{0};
   LockstepBarrier barrier_;
-  int32_t round_{0};                                  // the round out (lockstep), 0 before the first
+  int32_t round_{0};           // the round out (lockstep), 0 before the first
+  double round_sent_s_{-1e9};  // when it (or the held clock's last round) went out [monotonic s]
   std::optional<CollisionResult> unpublished_state_;  // lockstep: the tick's state, for round 2
   std::chrono::steady_clock::time_point start_mono_;
   bool holding_{false};

@@ -499,7 +499,8 @@ TEST(IiwaSim, InLockstepStepsOnlyAfterAQuietRoundOfEveryFollower) {
   options.realtime_rate = 100;  // ticks 20 ns of wall time apart: always due here
   options.steps_per_tick = 2;
   options.lockstep = true;
-  options.lockstep_timeout_s = 0.2;
+  options.lockstep_timeout_s = 2.0;
+  options.lockstep_resend_s = 1e6;  // no re-sent rounds here (the next test has them)
   IiwaSim sim(MemqFlags(0.1), options);
   ASSERT_EQ(sim.tick_us(), 2);
   lcm::LCM& lcm = sim.process().lcm();
@@ -543,17 +544,21 @@ TEST(IiwaSim, InLockstepStepsOnlyAfterAQuietRoundOfEveryFollower) {
   };
   using Seen = std::vector<std::string>;
 
-  sim.Advance();  // tick 1: the clock alone
+  // Nobody to wait for yet: tick 1's rounds are complete at once (round 1 the clock alone, the
+  // state with round 2), all in one call; one tick per call.
+  sim.Advance();
   drain();
-  EXPECT_EQ(take(), (Seen{"SIM_CLOCK 2 r1"}));
-  answer(2, 1, false);  // joins: not waited for in the round it joined
-  EXPECT_EQ(take(), (Seen{"IIWA_STATUS 2", "SIM_CLOCK 2 r2"}));
+  EXPECT_EQ(take(), (Seen{"SIM_CLOCK 2 r1", "IIWA_STATUS 2", "SIM_CLOCK 2 r2"}));
+  answer(2, 2, false);  // joins, answering the round that is out: quiet, tick 2
+  EXPECT_EQ(take(), (Seen{"SIM_CLOCK 4 r1"}));
   EXPECT_EQ(sim.lockstep_followers(), std::vector<std::string>{"follower"});
   sim.Advance();  // waits for the follower
   drain();
   EXPECT_TRUE(take().empty());
-  answer(2, 2, true);  // it published: another round
-  EXPECT_EQ(take(), (Seen{"SIM_CLOCK 2 r3"}));
+  answer(4, 1, false);
+  EXPECT_EQ(take(), (Seen{"IIWA_STATUS 4", "SIM_CLOCK 4 r2"}));
+  answer(4, 2, true);  // it published: another round
+  EXPECT_EQ(take(), (Seen{"SIM_CLOCK 4 r3"}));
   // A plan check during round 3 is answered; the sim published, so round 4 follows.
   orbed::plan_check_request_t request{};
   request.request_id = 7;
@@ -561,32 +566,88 @@ TEST(IiwaSim, InLockstepStepsOnlyAfterAQuietRoundOfEveryFollower) {
   request.joint_position.assign(7, 0.0);
   lcm.publish("PLAN_CHECK_REQUEST", &request);
   drain();
-  answer(2, 3, false);
-  EXPECT_EQ(take(), (Seen{"PLAN_CHECK_REPLY", "SIM_CLOCK 2 r4"}));
-  answer(2, 3, false);  // a repeat of an old round: nothing
+  answer(4, 3, false);
+  EXPECT_EQ(take(), (Seen{"PLAN_CHECK_REPLY", "SIM_CLOCK 4 r4"}));
+  answer(4, 3, false);  // a repeat of an old round: nothing
   EXPECT_TRUE(take().empty());
-  answer(2, 4, false);  // quiet: tick 2
-  EXPECT_EQ(take(), (Seen{"SIM_CLOCK 4 r1"}));
-  EXPECT_EQ(sim.ticks(), 2);
+  answer(4, 4, false);  // quiet: tick 3
+  EXPECT_EQ(take(), (Seen{"SIM_CLOCK 6 r1"}));
+  EXPECT_EQ(sim.ticks(), 3);
 
-  // The follower goes silent: the round waits until the timeout, then goes on without it.
-  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  // The follower goes silent: the round waits until the timeout, then goes on without it (and
+  // through tick 4, with nobody to wait for).
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(60);
   while (got.empty() && std::chrono::steady_clock::now() < give_up) {
     sim.Advance();
     drain();
   }
-  EXPECT_EQ(take(), (Seen{"IIWA_STATUS 4", "SIM_CLOCK 4 r2"}));
+  EXPECT_EQ(take(),
+            (Seen{"IIWA_STATUS 6", "SIM_CLOCK 6 r2", "SIM_CLOCK 8 r1", "IIWA_STATUS 8", "SIM_CLOCK 8 r2"}));
   EXPECT_EQ(sim.process().drop_counts().at("lockstep/follower"), 1);
   EXPECT_TRUE(sim.lockstep_followers().empty());
-  sim.Advance();  // nobody to wait for, nobody published: tick 3
-  drain();
-  EXPECT_EQ(take(), (Seen{"SIM_CLOCK 6 r1"}));
-  answer(4, 2, false);  // back (an old round): waited for from the next round on
-  EXPECT_EQ(take(), (Seen{"IIWA_STATUS 6", "SIM_CLOCK 6 r2"}));
+  // An answer to a round never sent is refused; one to an old round brings the follower back,
+  // waited for from the next round on.
+  answer(10, 1, false);
+  EXPECT_EQ(sim.process().rejections().counts().at("SIM_CLOCK_ACK/unsent"), 1);
+  answer(6, 2, false);
+  EXPECT_EQ(take(), (Seen{"SIM_CLOCK 10 r1"}));
+  EXPECT_EQ(sim.lockstep_followers(), std::vector<std::string>{"follower"});
   sim.Advance();
   drain();
   EXPECT_TRUE(take().empty());
-  EXPECT_EQ(sim.process().rejections().total(), 0);
+  EXPECT_EQ(sim.process().rejections().total(), 1);
+}
+
+// A round whose answer was lost is sent again, the same stamp and round, until the answer comes.
+TEST(IiwaSim, InLockstepResendsARoundWhoseAnswerIsMissing) {
+  IiwaSimOptions options;
+  options.period_s = 1e-6;
+  options.realtime_rate = 100;
+  options.steps_per_tick = 2;
+  options.lockstep = true;
+  options.lockstep_timeout_s = 1e6;
+  options.lockstep_resend_s = 0.01;
+  IiwaSim sim(MemqFlags(0.1), options);
+  lcm::LCM& lcm = sim.process().lcm();
+  std::vector<std::pair<int64_t, int32_t>> clocks;
+  struct Recorder {
+    std::vector<std::pair<int64_t, int32_t>>* clocks;
+    int64_t start;
+    void OnClock(const lcm::ReceiveBuffer*, const std::string&, const orbed::sim_clock_t* m) {
+      clocks->emplace_back(m->utime - start, m->lockstep_round);
+    }
+  } recorder{&clocks, sim.start_utime()};
+  lcm.subscribe("SIM_CLOCK", &Recorder::OnClock, &recorder);
+  auto drain = [&] {
+    while (lcm.handleTimeout(0) > 0) {
+    }
+  };
+  auto answer = [&](int64_t t_us, int32_t round) {
+    orbed::sim_clock_ack_t ack{};
+    ack.utime = sim.start_utime() + t_us;
+    ack.start_utime = sim.start_utime();
+    ack.lockstep_round = round;
+    ack.process = "follower";
+    lcm.publish("SIM_CLOCK_ACK", &ack);
+    drain();
+  };
+  sim.Advance();
+  drain();
+  answer(2, 2);  // joins, answering tick 1's last round: tick 2 goes out and waits for it
+  ASSERT_EQ(clocks.back(), std::make_pair(int64_t{4}, 1));
+  const size_t sent = clocks.size();
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (clocks.size() < sent + 2 && std::chrono::steady_clock::now() < give_up) {
+    sim.Advance();
+    drain();
+  }
+  ASSERT_EQ(clocks.size(), sent + 2);
+  EXPECT_EQ(clocks[sent], std::make_pair(int64_t{4}, 1));
+  EXPECT_EQ(clocks[sent + 1], std::make_pair(int64_t{4}, 1));
+  EXPECT_EQ(sim.ticks(), 2);
+  answer(4, 1);  // the answer at last: the state and round 2
+  EXPECT_EQ(clocks.back(), std::make_pair(int64_t{4}, 2));
+  EXPECT_EQ(sim.process().dropped(), 0);
 }
 
 TEST(IiwaSim, PublishesTrueFramesAndClearances) {

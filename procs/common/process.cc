@@ -184,7 +184,14 @@ void Process::AnswerLockstepRound() {
   ack.lockstep_round = unanswered_round_->lockstep_round;
   ack.process = name_;
   ack.published = published_since_ack_.exchange(false);
+  // The sim re-sends a round whose answers are missing: the repeat of a round already answered
+  // says "published" if the first answer did (it may be the one that was lost).
+  if (ack.utime == last_answer_.utime && ack.start_utime == last_answer_.start_utime &&
+      ack.lockstep_round == last_answer_.lockstep_round) {
+    ack.published = ack.published || last_answer_.published;
+  }
   unanswered_round_.reset();
+  last_answer_ = ack;
   PublishControl(channels::kSimClockAck, ack);
 }
 

@@ -48,6 +48,7 @@
 
 #include <lcm/lcm-cpp.hpp>
 #include <orbed/process_status_t.hpp>
+#include <orbed/sim_clock_ack_t.hpp>
 
 #include "lcmtypes/bounded_decode.h"
 #include "procs/common/chaos.h"
@@ -99,8 +100,9 @@ class Process {
     ++messages_out_;
     published_since_ack_ = true;
   }
-  /// Publishes and counts a message nobody answers (heartbeats, the sim clock and its answers): not
-  /// a publication a lockstep round waits on.
+  /// Publishes and counts a message no process acts on within a sim tick (heartbeats, the sim clock
+  /// and its answers, the headset's wall-clock image streams): not a publication a lockstep round
+  /// waits on. Thread-safe as Publish.
   template <class Msg>
   void PublishControl(const std::string& channel, const Msg& msg) {
     lcm_->publish(channel, &msg);
@@ -220,6 +222,7 @@ class Process {
   SimClock sim_clock_;
   std::optional<int64_t> sim_deadline_ns_;              // the running sim timer's deadline
   std::optional<orbed::sim_clock_t> unanswered_round_;  // a lockstep SIM_CLOCK not yet answered
+  orbed::sim_clock_ack_t last_answer_{};                // the last answer sent (a repeat says as much)
   std::atomic<bool> published_since_ack_{false};
   std::atomic<bool> stop_requested_{false};
   std::atomic<bool> running_{false};

@@ -45,20 +45,16 @@ void LockstepBarrier::BeginRound(int64_t utime, int64_t start_utime, int32_t rou
 }
 
 LockstepBarrier::Answer LockstepBarrier::OnAck(const orbed::sim_clock_ack_t& msg) {
-  const bool this_round =
-      msg.utime == utime_ && msg.start_utime == start_utime_ && msg.lockstep_round == round_;
+  if (msg.start_utime != start_utime_) return Answer::kOther;
+  if (msg.utime > utime_ || (msg.utime == utime_ && msg.lockstep_round > round_)) return Answer::kUnsent;
+  const bool this_round = msg.utime == utime_ && msg.lockstep_round == round_;
   auto it = followers_.find(msg.process);
   Answer answer = Answer::kCounted;
   if (it == followers_.end()) {
     if (followers_.size() >= kMaxLockstepFollowers) return Answer::kRefused;
-    it = followers_.emplace(msg.process, Follower{}).first;
     // Not waited for in a round that went out before it was known: it may never have seen it.
-    it->second.answered = true;
+    it = followers_.emplace(msg.process, Follower{true, false}).first;
     answer = Answer::kJoined;
-  } else if (!it->second.present) {
-    it->second.present = true;
-    it->second.answered = true;
-    answer = Answer::kRejoined;
   }
   if (!this_round) return answer == Answer::kCounted ? Answer::kOther : answer;
   it->second.answered = true;
@@ -70,15 +66,17 @@ LockstepBarrier::Status LockstepBarrier::Check(double now_s) {
   Status status;
   status.complete = true;
   const bool timed_out = now_s - round_start_s_ > timeout_s_;
-  for (auto& [name, f] : followers_) {
-    if (!f.present) continue;
+  for (auto it = followers_.begin(); it != followers_.end();) {
+    const Follower& f = it->second;
     status.published = status.published || f.published;
-    if (f.answered) continue;
-    if (timed_out) {
-      f.present = false;
-      status.left_out.push_back(name);
+    if (f.answered) {
+      ++it;
+    } else if (timed_out) {
+      status.left_out.push_back(it->first);
+      it = followers_.erase(it);
     } else {
       status.complete = false;
+      ++it;
     }
   }
   return status;
@@ -86,9 +84,7 @@ LockstepBarrier::Status LockstepBarrier::Check(double now_s) {
 
 std::vector<std::string> LockstepBarrier::followers() const {
   std::vector<std::string> names;
-  for (const auto& [name, f] : followers_) {
-    if (f.present) names.push_back(name);
-  }
+  for (const auto& [name, f] : followers_) names.push_back(name);
   return names;
 }
 

@@ -82,10 +82,11 @@ class SimClock {
 };
 
 /// The sim's side of lockstep: who follows, who answered the round that is out, whether anyone
-/// published. A follower joins with its first answer (during the hold, every follower that is up
-/// answers) and is waited for from the next round on; one that has not answered the round within
-/// timeout_s (killed, hung) is left out, reported once by Check(), and joins again with its next
-/// answer, so a killed follower costs one timeout and its respawn takes part again.
+/// published. A follower joins with its first answer to a round that was sent (during the hold,
+/// every follower that is up answers) and is waited for from the next round on; one that has not
+/// answered the round within timeout_s (killed, hung) is left out, reported once by Check() and
+/// forgotten, and joins again with its next answer, so a killed follower costs one timeout and its
+/// respawn takes part again.
 class LockstepBarrier {
  public:
   /// `timeout_s` > 0: how long a round waits for a follower [s of the caller's clock].
@@ -93,11 +94,12 @@ class LockstepBarrier {
 
   /// A round goes out: SIM_CLOCK (utime, start_utime, round) at now_s. Nobody has answered it.
   void BeginRound(int64_t utime, int64_t start_utime, int32_t round, double now_s);
-  enum class Answer { kCounted, kJoined, kRejoined, kOther, kRefused };
+  enum class Answer { kCounted, kJoined, kOther, kUnsent, kRefused };
   /// An answer (CheckSimClockAck first). kCounted: a follower's answer to the round that is out;
-  /// kJoined / kRejoined: a new / left-out follower, waited for from the next round (its answer
-  /// counts if it is to this one); kOther: an answer to an earlier round or another sim (ignored);
-  /// kRefused: a new name beyond kMaxLockstepFollowers.
+  /// kJoined: a new (or left-out) follower, waited for from the next round (its answer counts if
+  /// it is to this one); kOther: an answer to an earlier round or another sim (ignored); kUnsent:
+  /// an answer to a round this sim has not sent (refused); kRefused: a new name beyond
+  /// kMaxLockstepFollowers.
   Answer OnAck(const orbed::sim_clock_ack_t& msg);
 
   struct Status {
@@ -108,13 +110,12 @@ class LockstepBarrier {
   /// The round's state at now_s; followers past the timeout are left out here (once each).
   Status Check(double now_s);
 
-  /// The followers waited for (not left out), by name.
+  /// The followers waited for, by name.
   std::vector<std::string> followers() const;
   int32_t round() const { return round_; }
 
  private:
   struct Follower {
-    bool present{true};
     bool answered{false};
     bool published{false};
   };

@@ -151,9 +151,12 @@ TEST(LockstepBarrier, WaitsForEveryFollowerLeavesOutTheSilentAndTakesThemBack) {
   EXPECT_EQ(status.left_out, std::vector<std::string>{"hmd"});
   EXPECT_TRUE(barrier.Check(22.02).left_out.empty());
   EXPECT_EQ(barrier.followers(), (std::vector<std::string>{"assistant", "guidance"}));
-  // Its next answer (to any round) takes it back; it is waited for from the next round on.
+  // Its next answer (to any round sent) takes it back; it is waited for from the next round on.
+  // An answer to a round not sent yet is refused.
   barrier.BeginRound(t2, kStart, 2, 23.0);
-  EXPECT_EQ(barrier.OnAck(Ack("hmd", t1, 2, false)), LockstepBarrier::Answer::kRejoined);
+  EXPECT_EQ(barrier.OnAck(Ack("hmd", t2, 3, false)), LockstepBarrier::Answer::kUnsent);
+  EXPECT_EQ(barrier.OnAck(Ack("hmd", t2 + 50'000, 1, false)), LockstepBarrier::Answer::kUnsent);
+  EXPECT_EQ(barrier.OnAck(Ack("hmd", t1, 2, false)), LockstepBarrier::Answer::kJoined);
   EXPECT_EQ(barrier.OnAck(Ack("guidance", t2, 2, false)), LockstepBarrier::Answer::kCounted);
   EXPECT_EQ(barrier.OnAck(Ack("assistant", t2, 2, false)), LockstepBarrier::Answer::kCounted);
   EXPECT_TRUE(barrier.Check(23.0).complete);
@@ -202,12 +205,13 @@ TEST(ProcessSimTime, AnswersEachLockstepRoundAfterItsDueTimers) {
   };
   std::vector<Answer> answers;
   // The rounds the "sim" sends: (sim µs since start, round), and a PING before one.
-  const std::vector<std::pair<int64_t, int32_t>> rounds = {{0, 1},       {50'000, 1},  {50'000, 2},
-                                                           {100'000, 1}, {100'000, 2}, {100'000, 3}};
+  // (0.05, 1) twice: the sim's repeat of a round whose answer it lost.
+  const std::vector<std::pair<int64_t, int32_t>> rounds = {
+      {0, 1}, {50'000, 1}, {50'000, 1}, {50'000, 2}, {100'000, 1}, {100'000, 2}, {100'000, 3}};
   size_t next = 0;
   auto send = [&] {
     if (next == rounds.size()) return process.RequestStop();
-    if (next == 4) {
+    if (next == 5) {
       orbed::sim_clock_t ping{};
       process.lcm().publish("PING", &ping);
     }
@@ -229,11 +233,13 @@ TEST(ProcessSimTime, AnswersEachLockstepRoundAfterItsDueTimers) {
   send();
   EXPECT_EQ(process.Run(), 0);
   // 0 s: no timer due, nothing published. 0.05 s round 1: a ran at 0.02 and 0.04 and published;
-  // round 2: nothing new. 0.10 s round 1: a at 0.06, 0.08, 0.10; round 2: the PING (sent before
-  // it) was answered in its handler; round 3: quiet.
+  // its repeat says so again (the first answer may be the one that was lost); round 2: nothing new. 0.10 s
+  // round 1: a at 0.06, 0.08, 0.10; round 2: the PING (sent before it) was answered in its handler; round 3:
+  // quiet.
   const std::vector<Answer> expected = {{0, 1, false, 0, ""},      {50'000, 1, true, 2, ""},
-                                        {50'000, 2, false, 2, ""}, {100'000, 1, true, 5, ""},
-                                        {100'000, 2, true, 5, ""}, {100'000, 3, false, 5, ""}};
+                                        {50'000, 1, true, 2, ""},  {50'000, 2, false, 2, ""},
+                                        {100'000, 1, true, 5, ""}, {100'000, 2, true, 5, ""},
+                                        {100'000, 3, false, 5, ""}};
   ASSERT_EQ(answers.size(), expected.size());
   for (size_t k = 0; k < expected.size(); ++k) {
     EXPECT_EQ(answers[k].t_us, expected[k].t_us) << k;

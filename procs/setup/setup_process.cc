@@ -103,7 +103,10 @@ int SetupProcess::Run() {
   // its start and request ids are sim stamps, the same in every run of a lockstep study.
   if (!process_.sim_time()) Start();
   const int code = process_.Run();
-  if (!started_) return 1;  // no sim clock came (the process says so)
+  if (!started_) {
+    ORBED_LOG(kWarn) << "stopped before the sim clock started: the conductor did not run";
+    return 1;
+  }
   if (!finished_) {
     Apply(conductor_->Abort("interrupted before the study's set-ups were done", Now()));
     return 1;
