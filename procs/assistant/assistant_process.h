@@ -55,6 +55,7 @@
 #include <orbed/setup_task_t.hpp>
 
 #include "procs/assistant/assistant.h"
+#include "procs/common/channels.h"
 #include "procs/common/process.h"
 #include "sim/robot_model.h"
 
@@ -71,16 +72,16 @@ struct AssistantOptions {
   double move_timeout_s{30.0};
   /// A joint within this of where the person put it, with the arm at rest, has arrived [deg].
   double arrived_deg{0.05};
-  std::string guidance_channel{"GUIDANCE"};
-  std::string iiwa_status_channel{"IIWA_STATUS"};
-  std::string robot_state_channel{"ROBOT_STATE"};
-  std::string registration_channel{"REGISTRATION"};
-  std::string hmd_pose_channel{"HMD_POSE"};
-  std::string hmd_pose_truth_channel{"HMD_POSE_TRUTH"};
-  std::string iiwa_command_channel{"IIWA_COMMAND"};
-  std::string setup_task_channel{"SETUP_TASK"};
-  std::string setup_result_channel{"SETUP_RESULT"};
-  std::string fixed_view_channel{"FIXED_VIEW"};
+  std::string guidance_channel{channels::kGuidance};
+  std::string iiwa_status_channel{channels::kIiwaStatus};
+  std::string robot_state_channel{channels::kRobotState};
+  std::string registration_channel{channels::kRegistration};
+  std::string hmd_pose_channel{channels::kHmdPose};
+  std::string hmd_pose_truth_channel{channels::kHmdPoseTruth};
+  std::string iiwa_command_channel{channels::kIiwaCommand};
+  std::string setup_task_channel{channels::kSetupTask};
+  std::string setup_result_channel{channels::kSetupResult};
+  std::string fixed_view_channel{channels::kFixedView};
   double fixed_view_stale_s{2.0};
 };
 

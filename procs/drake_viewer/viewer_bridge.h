@@ -20,6 +20,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "procs/common/channels.h"
 #include "procs/common/process.h"
 #include "sim/robot_model.h"
 #include "sim/scene.h"
@@ -32,9 +33,9 @@ struct ViewerOptions {
   std::string scene_path;  ///< "" = the shipped scene; "none" = no scene objects
   double rate_hz{30.0};
   double load_period_s{2.0};
-  std::string robot_state_channel{"ROBOT_STATE"};
-  std::string registration_channel{"REGISTRATION"};
-  std::string guidance_channel{"GUIDANCE"};
+  std::string robot_state_channel{channels::kRobotState};
+  std::string registration_channel{channels::kRegistration};
+  std::string guidance_channel{channels::kGuidance};
   std::string load_channel{"DRAKE_VIEWER_LOAD_ROBOT"};
   std::string draw_channel{"DRAKE_VIEWER_DRAW"};
 };

@@ -25,6 +25,7 @@
 #include <Eigen/Geometry>
 #include <orbed/image_t.hpp>
 
+#include "procs/common/channels.h"
 #include "procs/common/process.h"
 #include "procs/fixed_display/fixed_view.h"
 #include "sim/robot_model.h"
@@ -43,9 +44,9 @@ struct FixedDisplayOptions {
   bool all_modes{false};
   bool window{false};
   std::string png_path;
-  std::string robot_state_channel{"ROBOT_STATE"};
-  std::string guidance_channel{"GUIDANCE"};
-  std::string fixed_view_channel{"FIXED_VIEW"};
+  std::string robot_state_channel{channels::kRobotState};
+  std::string guidance_channel{channels::kGuidance};
+  std::string fixed_view_channel{channels::kFixedView};
 };
 
 class FixedDisplay {

@@ -24,6 +24,7 @@
 
 #include <Eigen/Core>
 
+#include "procs/common/channels.h"
 #include "procs/common/process.h"
 #include "procs/guidance/guidance.h"
 #include "sim/robot_model.h"
@@ -39,10 +40,10 @@ struct GuidanceOptions {
   double rate_hz{30.0};
   /// No GUIDANCE from an IIWA_STATUS received longer ago than this [s] (the sim sends 200 Hz).
   double stale_after_s{0.5};
-  std::string iiwa_status_channel{"IIWA_STATUS"};
-  std::string guidance_channel{"GUIDANCE"};
-  std::string setup_task_channel{"SETUP_TASK"};
-  std::string igtl_target_channel{"IGTL_TARGET"};
+  std::string iiwa_status_channel{channels::kIiwaStatus};
+  std::string guidance_channel{channels::kGuidance};
+  std::string setup_task_channel{channels::kSetupTask};
+  std::string igtl_target_channel{channels::kIgtlTarget};
   std::string igtl_target_name{"Trocar"};  ///< "" = IGTL_TARGET ignored
   std::string scene_path;                  ///< for IGTL_TARGET's IK; "" = the shipped scene
 };

@@ -53,6 +53,7 @@
 #include <orbed/setup_result_t.hpp>
 #include <orbed/setup_task_t.hpp>
 
+#include "procs/common/channels.h"
 #include "procs/scenario/viraal_conductor.h"
 #include "sim/robot_model.h"
 #include "viraal/protocol.h"
@@ -84,12 +85,12 @@ struct SetupOptions {
   double task_timeout_s{600.0};
   double command_resend_s{0.25};
   double task_resend_s{1.0};
-  std::string robot_state_channel{"ROBOT_STATE"};
-  std::string collision_status_channel{"COLLISION_STATUS"};
-  std::string iiwa_command_channel{"IIWA_COMMAND"};
-  std::string setup_task_channel{"SETUP_TASK"};
-  std::string setup_result_channel{"SETUP_RESULT"};
-  std::string registration_channel{"REGISTRATION"};
+  std::string robot_state_channel{channels::kRobotState};
+  std::string collision_status_channel{channels::kCollisionStatus};
+  std::string iiwa_command_channel{channels::kIiwaCommand};
+  std::string setup_task_channel{channels::kSetupTask};
+  std::string setup_result_channel{channels::kSetupResult};
+  std::string registration_channel{channels::kRegistration};
   /// Resuming (KeptSetups): the set-ups an earlier run of this user finished, in order; the run
   /// starts with the next one. Empty = a new run.
   std::vector<SetupRecord> kept;
