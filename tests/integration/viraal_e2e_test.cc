@@ -109,7 +109,9 @@ TEST(ViraalRun, FasterThanRealTimeTheRunIsTheSame) {
   // The sim clock ran 8 times faster: IIWA_STATUS stamps 8 x 5 ms apart (a whole multiple of that
   // after a stall of the loop), where at the wall clock's pace they would be 5 ms apart.
   const std::vector<orbed::iiwa_status_t> status = Logged<orbed::iiwa_status_t>(log_dir, "IIWA_STATUS");
-  ASSERT_GT(status.size(), 100u);
+  // The run lasts about 100 of those steps (~4 s of sim time; how many depends on when the logger
+  // and the sim start): enough that "most steps are exactly 40 ms" is a real check.
+  ASSERT_GE(status.size(), 50u);
   size_t exact = 0;
   for (size_t k = 1; k < status.size(); ++k) {
     const int64_t step_us = status[k].utime - status[k - 1].utime;
