@@ -33,6 +33,8 @@ inline constexpr char kIgtlTarget[] = "IGTL_TARGET";                    // targe
 inline constexpr char kFixedView[] = "FIXED_VIEW";                      // image_t (JPEG), orbed-fixed-display
 inline constexpr char kSimClock[] = "SIM_CLOCK";                        // sim_clock_t, sim, once per tick
 inline constexpr char kSimClockAck[] = "SIM_CLOCK_ACK";  // sim_clock_ack_t, each follower, per lockstep round
+inline constexpr char kDeputyCommand[] = "DEPUTY_COMMAND";  // deputy_command_t, launcher, 5 Hz per deputy
+inline constexpr char kDeputyStatus[] = "DEPUTY_STATUS";    // deputy_status_t, each deputy, 5 Hz
 
 /// Every channel above (tools that address channels by index: the fuzz targets and their corpora;
 /// new channels are appended so that the indices of the old ones stay).
@@ -42,6 +44,6 @@ inline constexpr const char* kAllChannels[] = {
     kGazeRay,         kReflectiveView, kAlignmentTrial,      kRegistration,    kSessionControl,
     kLandmarkRequest, kLandmark,       kMisalignmentRequest, kMisalignment,    kGuidance,
     kProcessStatus,   kLoggerStatus,   kSetupTask,           kSetupResult,     kIgtlTarget,
-    kFixedView,       kSimClock,       kSimClockAck};
+    kFixedView,       kSimClock,       kSimClockAck,         kDeputyCommand,   kDeputyStatus};
 
 }  // namespace orbed::channels

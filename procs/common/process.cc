@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <csignal>
+#include <cstdlib>
 #include <limits>
 #include <regex>
 #include <stdexcept>
@@ -38,6 +39,14 @@ void InstallStopSignalHandlers() {
 
 bool StopSignalled() { return g_stop_signalled.load(); }
 void RequestGlobalStop() { g_stop_signalled = true; }
+
+std::string ThisHostName() {
+  const char* host = std::getenv("ORBED_HOST");
+  if (host != nullptr && host[0] != '\0') return host;
+  char buffer[256] = {};
+  if (gethostname(buffer, sizeof(buffer) - 1) != 0) return "unknown";
+  return buffer;
+}
 
 namespace {
 
@@ -289,6 +298,7 @@ orbed::process_status_t Process::MakeStatus() const {
   status.utime = NowMicros();
   status.name = name_;
   status.pid = static_cast<int32_t>(getpid());
+  status.host = host_;
   if (failed_) {
     status.state = orbed::process_status_t::STATE_FAILED;
   } else if (stop_requested_ || StopSignalled()) {

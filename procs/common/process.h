@@ -64,6 +64,10 @@ void InstallStopSignalHandlers();
 bool StopSignalled();
 void RequestGlobalStop();
 
+/// The host this process runs on, as its PROCESS_STATUS says: $ORBED_HOST when set and not empty
+/// (orbed-launch sets it: its --host, or a deputy's name), else the machine's hostname.
+std::string ThisHostName();
+
 class Process {
  public:
   /// Connects to flags.lcm_url (adding recv_buf_size=8 MB unless the URL sets it); throws
@@ -212,6 +216,7 @@ class Process {
   void OnSimClock(const orbed::sim_clock_t& msg, const std::string& channel);
 
   std::string name_;
+  std::string host_ = ThisHostName();
   uint64_t seed_;
   double duration_sec_;
   std::unique_ptr<lcm::LCM> lcm_;

@@ -1,5 +1,6 @@
 #include "procs/launcher/child.h"
 
+#include "procs/launcher/deputy_protocol.h"
 #include "procs/launcher/launch_file.h"
 
 #include <fcntl.h>
@@ -65,7 +66,14 @@ bool Child::Start(const std::vector<std::string>& argv, const std::map<std::stri
   c_argv.push_back(nullptr);
   const pid_t parent = getpid();
 
+  // Signals are blocked across fork: one sent to the new child before it has reset its
+  // dispositions would otherwise reach the launcher's handlers in the child and be lost (a stop
+  // right after a start). The child unblocks them once they are back at their defaults.
+  sigset_t all, previous;
+  sigfillset(&all);
+  sigprocmask(SIG_SETMASK, &all, &previous);
   const pid_t pid = fork();
+  if (pid != 0) sigprocmask(SIG_SETMASK, &previous, nullptr);
   if (pid < 0) {
     close(fds[0]);
     close(fds[1]);
@@ -80,12 +88,14 @@ bool Child::Start(const std::vector<std::string>& argv, const std::map<std::stri
     dup2(fds[1], STDERR_FILENO);
     int devnull = open("/dev/null", O_RDONLY);
     if (devnull >= 0) dup2(devnull, STDIN_FILENO);
-    // Default signal dispositions and an empty mask for the new program.
+    // Default signal dispositions, then an empty mask for the new program (a signal sent meanwhile
+    // is delivered now, with its default action).
+    for (int s = 1; s < NSIG; ++s) {
+      if (s != SIGKILL && s != SIGSTOP) signal(s, SIG_DFL);
+    }
     sigset_t none;
     sigemptyset(&none);
     sigprocmask(SIG_SETMASK, &none, nullptr);
-    signal(SIGINT, SIG_DFL);
-    signal(SIGTERM, SIG_DFL);
     execve(executable.c_str(), c_argv.data(), c_envp.data());
     const char* message = "orbed-launch: exec failed\n";
     (void)!write(STDERR_FILENO, message, std::strlen(message));
@@ -120,10 +130,7 @@ bool Child::Poll() {
   return exited_;
 }
 
-std::string Child::DescribeExit() const {
-  if (term_signal_ != 0) return std::string("killed by signal ") + strsignal(term_signal_);
-  return "exited with code " + std::to_string(exit_code_);
-}
+std::string Child::DescribeExit() const { return launcher::DescribeExit(exit_code_, term_signal_); }
 
 void Child::Signal(int signal) {
   if (running()) kill(-pid_, signal);
@@ -149,10 +156,12 @@ void Child::Drain(const std::string& prefix, bool final) {
        start = newline + 1) {
     std::fprintf(stdout, "%s%.*s\n", prefix.c_str(), static_cast<int>(newline - start),
                  partial_line_.data() + start);
+    if (copy_ != nullptr) copy_->push_back(partial_line_.substr(start, newline - start));
   }
   partial_line_.erase(0, start);
   if ((final || output_fd_ < 0) && !partial_line_.empty()) {
     std::fprintf(stdout, "%s%s\n", prefix.c_str(), partial_line_.c_str());
+    if (copy_ != nullptr) copy_->push_back(partial_line_);
     partial_line_.clear();
   }
   std::fflush(stdout);

@@ -15,10 +15,27 @@
 
 namespace orbed::launcher {
 
-class Child {
+/// What the launcher needs of a child, whether it runs here (Child) or on another host, started by
+/// a deputy (RemoteChild, deputy_link.h).
+class ChildHandle {
+ public:
+  virtual ~ChildHandle() = default;
+  virtual bool Start(const std::vector<std::string>& argv, const std::map<std::string, std::string>& env,
+                     const std::string& search_dir, std::string* error) = 0;
+  virtual bool Poll() = 0;
+  virtual bool running() const = 0;
+  virtual pid_t pid() const = 0;
+  virtual int exit_code() const = 0;
+  virtual int term_signal() const = 0;
+  virtual std::string DescribeExit() const = 0;
+  virtual void Signal(int signal) = 0;
+  virtual void Drain(const std::string& prefix, bool final = false) = 0;
+};
+
+class Child : public ChildHandle {
  public:
   Child() = default;
-  ~Child();
+  ~Child() override;
   Child(const Child&) = delete;
   Child& operator=(const Child&) = delete;
 
@@ -26,23 +43,26 @@ class Child {
   /// PATH) with the launcher's environment plus `env`. Returns false with *error set when it
   /// cannot start (fork failure or a missing executable, detected before fork).
   bool Start(const std::vector<std::string>& argv, const std::map<std::string, std::string>& env,
-             const std::string& search_dir, std::string* error);
+             const std::string& search_dir, std::string* error) override;
 
   /// Non-blocking: reaps the child if it exited. Returns true once it has exited.
-  bool Poll();
-  bool running() const { return pid_ > 0 && !exited_; }
-  pid_t pid() const { return pid_; }
+  bool Poll() override;
+  bool running() const override { return pid_ > 0 && !exited_; }
+  pid_t pid() const override { return pid_; }
   /// Valid after Poll() returned true.
-  int exit_code() const { return exit_code_; }      // -1 when killed by a signal
-  int term_signal() const { return term_signal_; }  // 0 unless killed by a signal
-  std::string DescribeExit() const;
+  int exit_code() const override { return exit_code_; }      // -1 when killed by a signal
+  int term_signal() const override { return term_signal_; }  // 0 unless killed by a signal
+  std::string DescribeExit() const override;
 
   /// Sends `signal` to the child's process group.
-  void Signal(int signal);
+  void Signal(int signal) override;
 
   /// Reads what the child printed (non-blocking) and writes complete lines to stdout as
-  /// "<prefix><line>". At exit the rest is flushed with Drain(true).
-  void Drain(const std::string& prefix, bool final = false);
+  /// "<prefix><line>" (and, after CopyLinesTo, appends each line without the prefix there). At
+  /// exit the rest is flushed with Drain(true).
+  void Drain(const std::string& prefix, bool final = false) override;
+  /// Also keep every line the child prints in `*lines` (tests read a child's output).
+  void CopyLinesTo(std::vector<std::string>* lines) { copy_ = lines; }
 
  private:
   pid_t pid_ = -1;
@@ -51,6 +71,7 @@ class Child {
   int exit_code_ = 0;
   int term_signal_ = 0;
   std::string partial_line_;
+  std::vector<std::string>* copy_ = nullptr;
 };
 
 /// Resolves an executable name as Child::Start does; "" if not found.

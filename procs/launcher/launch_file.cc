@@ -19,13 +19,17 @@ namespace {
 const std::vector<std::string> kSignalNames = {"SIGINT",  "SIGTERM", "SIGHUP", "SIGQUIT",
                                                "SIGUSR1", "SIGUSR2", "SIGKILL"};
 
+bool IsHostName(const std::string& host) {
+  return !host.empty() && host.size() <= 64 && host.find_first_of(" \t/") == std::string::npos;
+}
+
 // `key` is the process's dotted path, e.g. "groups[0].processes[1]".
 ProcessSpec ParseProcess(const YamlFields& f, const YAML::Node& node, const std::string& key,
                          const std::map<std::string, std::string>& environment) {
   if (!node.IsMap()) f.Fail(node, key, "expected a mapping with at least name and command");
   f.CheckKeys(node, key,
-              {"name", "command", "args", "env", "required", "respawn", "stop_signal", "stop_timeout_s",
-               "ready", "ready_timeout_s", "exit_stops_all"});
+              {"name", "command", "host", "args", "env", "required", "respawn", "stop_signal",
+               "stop_timeout_s", "ready", "ready_timeout_s", "exit_stops_all"});
   ProcessSpec spec;
   spec.name = f.String(f.Required(node, "name", key + ".name", "a string"), key + ".name");
   if (spec.name.empty() || spec.name.find_first_of(" \t/") != std::string::npos) {
@@ -41,6 +45,12 @@ ProcessSpec ParseProcess(const YamlFields& f, const YAML::Node& node, const std:
   };
   const YAML::Node command = f.Required(node, "command", key + ".command", "a string");
   spec.command = expand(f.String(command, key + ".command"), command, key + ".command");
+  if (const YAML::Node host = node["host"]) {
+    spec.host = expand(f.String(host, key + ".host"), host, key + ".host");
+    if (!IsHostName(spec.host)) {
+      f.Fail(host, key + ".host", "expected a host name without spaces or '/', got '" + spec.host + "'");
+    }
+  }
   if (const YAML::Node args = node["args"]) {
     if (!args.IsSequence()) f.Fail(args, key + ".args", "expected a list of strings");
     for (std::size_t i = 0; i < args.size(); ++i) {
@@ -85,7 +95,7 @@ void ParseLaunch(const YAML::Node& root, const std::string& path,
                  const std::map<std::string, std::string>& environment, ReadState* state, LaunchSpec* spec) {
   const YamlFields f(path);
   if (!root.IsMap()) f.Fail(root, "(top level)", "expected a mapping with a 'groups' list");
-  f.CheckKeys(root, "", {"name", "include", "groups"});
+  f.CheckKeys(root, "", {"name", "include", "groups", "placement"});
   if (state->chain.empty()) spec->name = f.StringOr(root, "name", "", "orbed");  // the top file's
   state->chain.push_back(path);
   // Included files first, in order, relative to this file's folder.
@@ -145,6 +155,33 @@ void ParseLaunch(const YAML::Node& root, const std::string& path,
       group.processes.push_back(std::move(process));
     }
     spec->groups.push_back(std::move(group));
+  }
+  // Placement last: it may move processes of the included files and of this one.
+  if (const YAML::Node placement = root["placement"]) {
+    if (!placement.IsMap()) f.Fail(placement, "placement", "expected a mapping {process: host}");
+    for (const auto& item : placement) {
+      const std::string name = item.first.IsScalar() ? item.first.Scalar() : "";
+      const std::string key = "placement." + name;
+      std::string host = f.String(item.second, key);
+      try {
+        host = ExpandVariables(host, environment);
+      } catch (const std::invalid_argument& e) {
+        f.Fail(item.second, key, e.what());
+      }
+      if (!IsHostName(host)) {
+        f.Fail(item.second, key, "expected a host name without spaces or '/', got '" + host + "'");
+      }
+      ProcessSpec* placed = nullptr;
+      for (GroupSpec& group : spec->groups) {
+        for (ProcessSpec& process : group.processes) {
+          if (process.name == name) placed = &process;
+        }
+      }
+      if (placed == nullptr) {
+        f.Fail(item.first, key, "expected the name of a process of this launch, got '" + name + "'");
+      }
+      placed->host = host;
+    }
   }
   state->chain.pop_back();
 }

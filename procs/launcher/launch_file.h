@@ -7,11 +7,16 @@
 ///   include: [base.yaml]               # optional: launch files read first, their groups before
 ///                                      # this file's (paths relative to this file; ${VAR} expands;
 ///                                      # nested up to 8 deep, no cycles)
+///   placement: {registration: hostB}   # optional: moves processes (this file's or included ones)
+///                                      # to hosts, as their `host:` would
 ///   groups:                            # may be left out when an include has groups
 ///     - name: recording
 ///       processes:
 ///         - name: logger               # unique; passed to the child as --name for heartbeats
 ///           command: orbed-logger      # no '/': looked up in the launcher's folder, then PATH
+///           host: hostB                # optional: run by the deputy of that name (`orbed-launch
+///                                      # --deputy hostB` on that machine); left out, or equal to
+///                                      # the launcher's --host: started by the launcher itself
 ///           args: [--log-dir, "${ORBED_LOG_DIR}"]
 ///           env: {KEY: value}          # added to the launcher's environment
 ///           required: true             # its failure stops the testbed, exit != 0 (default true)
@@ -46,6 +51,8 @@ enum class ReadyCheck { kHeartbeat, kNone };
 struct ProcessSpec {
   std::string name;
   std::string command;
+  /// "" = the launcher's own host; else the name of the deputy that runs it.
+  std::string host;
   std::vector<std::string> args;
   std::map<std::string, std::string> env;
   bool required = true;

@@ -14,14 +14,22 @@
 namespace orbed::launcher {
 namespace {
 
+// How long past a remote process's SIGKILL the launcher waits for its deputy to confirm the exit.
+constexpr double kRemoteStopGraceS = 5.0;
+
 double SecondsSince(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
 
 }  // namespace
 
-Launcher::Launcher(const CommonFlags& flags, LaunchSpec spec, std::string bin_dir)
-    : flags_(flags), spec_(std::move(spec)), bin_dir_(std::move(bin_dir)), process_(flags) {
+Launcher::Launcher(const CommonFlags& flags, LaunchSpec spec, std::string bin_dir, std::string host)
+    : flags_(flags),
+      spec_(std::move(spec)),
+      bin_dir_(std::move(bin_dir)),
+      host_(std::move(host)),
+      process_(flags),
+      deputies_(&process_, spec_.name + "@" + host_ + "/" + std::to_string(getpid())) {
   name_width_ = 7;  // "process", the summary's header
   for (size_t g = 0; g < spec_.groups.size(); ++g) {
     for (const ProcessSpec& p : spec_.groups[g].processes) {
@@ -33,7 +41,8 @@ Launcher::Launcher(const CommonFlags& flags, LaunchSpec spec, std::string bin_di
       Managed managed;
       managed.spec = p;
       managed.group = g;
-      managed.child = std::make_unique<Child>();
+      managed.remote = !p.host.empty() && p.host != host_;
+      managed.child = MakeChild(managed);
       managed.prefix = p.name + std::string(name_width_ - p.name.size(), ' ') + " | ";
       managed_.push_back(std::move(managed));
     }
@@ -42,6 +51,11 @@ Launcher::Launcher(const CommonFlags& flags, LaunchSpec spec, std::string bin_di
       channels::kProcessStatus, [this](const orbed::process_status_t& status, const std::string&,
                                        int64_t recv_utime) { OnHeartbeat(status, recv_utime); });
   process_.AddTimer(0.02, [this] { Tick(); });
+}
+
+std::unique_ptr<ChildHandle> Launcher::MakeChild(const Managed& m) {
+  if (m.remote) return deputies_.MakeChild(m.spec.host, m.spec.name, m.spec.stop_timeout_s);
+  return std::make_unique<Child>();
 }
 
 Launcher::~Launcher() = default;
@@ -56,9 +70,10 @@ bool Launcher::StartProcess(Managed* m) {
   }
   std::map<std::string, std::string> env = m->spec.env;
   env.emplace("ORBED_LCM_URL", flags_.lcm_url);
+  env.emplace("ORBED_HOST", host_);
   env["ORBED_LOG_PREFIXED"] = "1";
   std::string error;
-  m->child = std::make_unique<Child>();
+  m->child = MakeChild(*m);
   if (!m->child->Start(argv, env, bin_dir_, &error)) {
     m->last_exit = error;
     ORBED_LOG(kError) << m->spec.name << ": " << error;
@@ -69,7 +84,11 @@ bool Launcher::StartProcess(Managed* m) {
   m->finished = false;
   m->respawn_pending = false;
   m->started_at = Clock::now();
-  ORBED_LOG(kInfo) << "started " << m->spec.name << " (pid " << m->child->pid() << ")";
+  if (m->remote) {
+    ORBED_LOG(kInfo) << "asked deputy " << m->spec.host << " to start " << m->spec.name;
+  } else {
+    ORBED_LOG(kInfo) << "started " << m->spec.name << " (pid " << m->child->pid() << ")";
+  }
   return true;
 }
 
@@ -100,6 +119,7 @@ void Launcher::OnHeartbeat(const orbed::process_status_t& status, int64_t) {
     if (m.spec.name != status.name || !m.child->running() || m.ready) continue;
     // A heartbeat still on its way from an instance that died is not the new instance's.
     if (status.pid > 0 && status.pid != m.child->pid()) continue;
+    if (m.remote && status.host != m.spec.host) continue;
     m.ready = true;
     if (m.restarts == 0) {
       ORBED_LOG(kInfo) << m.spec.name << " is ready (first heartbeat after " << SecondsSince(m.started_at)
@@ -162,6 +182,7 @@ void Launcher::FailTestbed(const std::string& reason) {
 }
 
 void Launcher::Tick() {
+  deputies_.Tick();
   for (Managed& m : managed_) {
     if (!m.started) continue;
     m.child->Drain(m.prefix);
@@ -196,6 +217,13 @@ void Launcher::Tick() {
     // Measured from the group's start, not the last respawn: a child that keeps dying before
     // its first heartbeat must still time out.
     if (SecondsSince(group_started_at_) > m.spec.ready_timeout_s) {
+      if (m.remote && !deputies_.Heard(m.spec.host)) {
+        FailTestbed("process '" + m.spec.name + "' is placed on host '" + m.spec.host +
+                    "', whose deputy was not heard on DEPUTY_STATUS within " +
+                    std::to_string(m.spec.ready_timeout_s) + " s: start `orbed-launch --deputy " +
+                    m.spec.host + "` on that host, on this LCM URL (" + flags_.lcm_url + ")");
+        return;
+      }
       FailTestbed("process '" + m.spec.name + "' sent no heartbeat on PROCESS_STATUS within " +
                   std::to_string(m.spec.ready_timeout_s) +
                   " s (if it is not an orbed process, set `ready: none` in " + spec_.path + ")");
@@ -228,6 +256,19 @@ void Launcher::StopEverything() {
       m->child->Signal(m->spec.stop_signal);
       timeout = std::max(timeout, m->spec.stop_timeout_s);
     }
+    deputies_.Tick();  // the remote stops go out now
+    // A deputy not heard lately cannot confirm a stop: its processes are left to its orphan timeout.
+    for (auto it = group.begin(); it != group.end();) {
+      Managed* m = *it;
+      if (m->remote && !deputies_.Reachable(m->spec.host)) {
+        ORBED_LOG(kWarn) << "deputy " << m->spec.host << " is not reachable: cannot confirm that "
+                         << m->spec.name << " stops (its deputy stops it after its orphan timeout)";
+        m->last_exit = "not confirmed stopped: deputy " + m->spec.host + " not reachable";
+        it = group.erase(it);
+      } else {
+        ++it;
+      }
+    }
     const auto begin = Clock::now();
     bool killed = false;
     for (;;) {
@@ -238,6 +279,16 @@ void Launcher::StopEverything() {
         if (!m->child->running()) m->last_exit = m->child->DescribeExit();
       }
       if (!any_running) break;
+      if (killed && SecondsSince(begin) > timeout + kRemoteStopGraceS) {
+        for (Managed* m : group) {
+          if (m->child->running()) {
+            ORBED_LOG(kWarn) << "deputy " << m->spec.host << " did not confirm that " << m->spec.name
+                             << " stopped; leaving it to the deputy's orphan timeout";
+            m->last_exit = "not confirmed stopped by deputy " + m->spec.host;
+          }
+        }
+        break;
+      }
       if (!killed && SecondsSince(begin) > timeout) {
         for (Managed* m : group) {
           if (m->child->running()) {
@@ -248,7 +299,9 @@ void Launcher::StopEverything() {
         }
         killed = true;
       }
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      // Waits up to 10 ms for the deputies' statuses (and sends them the stops).
+      deputies_.Tick();
+      process_.lcm().handleTimeout(10);
     }
     for (Managed* m : group) {
       m->child->Drain(m->prefix, true);

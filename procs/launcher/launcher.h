@@ -13,8 +13,15 @@
 /// reverse order: each child gets its stop_signal, then SIGKILL after stop_timeout_s.
 ///
 /// Children get: --name <name> appended (heartbeat-ready processes, unless args have --name),
-/// ORBED_LCM_URL = the launcher's LCM URL, ORBED_LOG_PREFIXED=1 (their log lines then omit the
-/// name), plus the env of their spec.
+/// ORBED_LCM_URL = the launcher's LCM URL, ORBED_HOST = the launcher's host name,
+/// ORBED_LOG_PREFIXED=1 (their log lines then omit the name), plus the env of their spec.
+///
+/// Across hosts: a process whose `host:` is not the launcher's own host name is started, watched,
+/// restarted and stopped the same way through the deputy of that name (`orbed-launch --deputy
+/// NAME` on that host; deputy_link.h, deputy.h), which prints its output there. A deputy never
+/// heard makes the process's readiness time out with an error naming the deputy; a deputy that
+/// falls silent (a partition) is logged, and its processes keep their last known state until it
+/// is heard again.
 ///
 /// Exit code: 0, or 1 when a required process failed or was not ready in time, or the exit code of
 /// an `exit_stops_all` process.
@@ -30,14 +37,16 @@
 
 #include "procs/common/process.h"
 #include "procs/launcher/child.h"
+#include "procs/launcher/deputy_link.h"
 #include "procs/launcher/launch_file.h"
 
 namespace orbed::launcher {
 
 class Launcher {
  public:
-  /// `bin_dir` is searched first for commands without '/'.
-  Launcher(const CommonFlags& flags, LaunchSpec spec, std::string bin_dir);
+  /// `bin_dir` is searched first for commands without '/'. `host` is this host's name: processes
+  /// without `host:` or with this one run here.
+  Launcher(const CommonFlags& flags, LaunchSpec spec, std::string bin_dir, std::string host);
   ~Launcher();
 
   int Run();
@@ -49,7 +58,8 @@ class Launcher {
   struct Managed {
     ProcessSpec spec;
     size_t group = 0;
-    std::unique_ptr<Child> child;
+    std::unique_ptr<ChildHandle> child;
+    bool remote = false;
     std::string prefix;
     bool started = false;
     bool ready = false;
@@ -63,6 +73,7 @@ class Launcher {
     std::string last_exit;
   };
 
+  std::unique_ptr<ChildHandle> MakeChild(const Managed& managed);
   void Tick();
   void OnHeartbeat(const orbed::process_status_t& status, int64_t recv_utime);
   bool StartProcess(Managed* managed);
@@ -75,7 +86,9 @@ class Launcher {
   CommonFlags flags_;
   LaunchSpec spec_;
   std::string bin_dir_;
+  std::string host_;
   Process process_;
+  DeputyLink deputies_;
   std::vector<Managed> managed_;
   size_t starting_group_ = 0;
   bool all_started_ = false;

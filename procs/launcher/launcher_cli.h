@@ -3,7 +3,13 @@
 /// The `orbed-launch` command line (thin main in launcher_main.cc), as a library function so that
 /// tests can run it in-process.
 ///
-///   orbed-launch [common process flags] [--dry-run] LAUNCH_FILE
+///   orbed-launch [common process flags] [--host NAME] [--dry-run] LAUNCH_FILE
+///   orbed-launch [common process flags] --deputy NAME [--orphan-timeout-s S]
+///
+/// The first starts a launch; processes whose `host:` is neither left out nor --host (default
+/// $ORBED_HOST, else the machine's hostname) are started through the deputy of that name. The
+/// second is that deputy (deputy.h): run it on each other host, on the same LCM URL (e.g. with
+/// --lan); its heartbeat is named "deputy-NAME" unless --name is given.
 ///
 /// Commands without '/' in the launch file are looked up beside the running executable first
 /// (its folder is also given to children as $ORBED_BIN_DIR). --dry-run parses the file and prints
@@ -11,7 +17,8 @@
 ///
 /// Exit codes: 0 after --help or --dry-run, else the launcher's (launcher.h: 0, 1 when a required
 /// process failed or was not ready, or an `exit_stops_all` process's code); CLI11's code (non-zero)
-/// for an unknown flag, a bad flag value or a missing LAUNCH_FILE (the message names it); 2 for a
+/// for an unknown flag, a bad flag value or a missing LAUNCH_FILE (the message names it; a
+/// LAUNCH_FILE given with --deputy is such an error too); 2 for a
 /// launch file that does not parse (the message names the file and the problem); 1 when the
 /// launcher cannot start. Help and the plan go to `out`, errors to `err`.
 

@@ -39,6 +39,10 @@ Monitor::Monitor(const CommonFlags& flags, MonitorOptions options) : options_(op
                         msg.name.empty() || msg.name.size() > kMaxNameLength
                             ? "name of " + std::to_string(msg.name.size()) + " characters, expected 1.." +
                                   std::to_string(kMaxNameLength)
+                            : "",
+                        msg.host.size() > kMaxNameLength
+                            ? "host of " + std::to_string(msg.host.size()) +
+                                  " characters, expected at most " + std::to_string(kMaxNameLength)
                             : ""});
         if (!error.empty()) {
           process_.Reject(channel + "/field", error);
@@ -49,7 +53,13 @@ Monitor::Monitor(const CommonFlags& flags, MonitorOptions options) : options_(op
                                                      " process names; ignoring '" + msg.name + "'");
           return;
         }
-        processes_[msg.name] = Seen{msg, recv_utime};
+        Seen& seen = processes_[msg.name];
+        if (seen.silent && options_.out != nullptr) {
+          *options_.out << EscapeText(msg.name) << " on " << EscapeText(msg.host) << ": heard again after "
+                        << Fixed((recv_utime - seen.recv_utime) * 1e-6, 1) << " s\n"
+                        << std::flush;
+        }
+        seen = Seen{msg, recv_utime, false};
       });
   process_.Subscribe<orbed::logger_status_t>(
       channels::kLoggerStatus, [this](const orbed::logger_status_t& msg, const std::string&, int64_t) {
@@ -59,21 +69,39 @@ Monitor::Monitor(const CommonFlags& flags, MonitorOptions options) : options_(op
   process_.AddTimer(options_.print_period_s, [this] {
     if (options_.out != nullptr) *options_.out << Table(NowMicros()) << std::flush;
   });
+  process_.AddWallPoll(0.1, [this] {
+    const std::string lines = NewlySilent(NowMicros());
+    if (!lines.empty() && options_.out != nullptr) *options_.out << lines << std::flush;
+  });
+}
+
+std::string Monitor::NewlySilent(int64_t now_utime) {
+  std::string out;
+  for (auto& [name, seen] : processes_) {
+    const double age_s = (now_utime - seen.recv_utime) * 1e-6;
+    if (seen.silent || age_s <= options_.silent_after_s) continue;
+    seen.silent = true;
+    out += EscapeText(name) + " on " + EscapeText(seen.status.host) + ": SILENT (no heartbeat for " +
+           Fixed(age_s, 1) + " s)\n";
+  }
+  return out;
 }
 
 std::string Monitor::Table(int64_t now_utime) const {
   std::string out =
-      "process               state     uptime_s      in       out  rejected   dropped  last error\n";
+      "process               host          state     uptime_s      in       out  rejected   dropped  last "
+      "error\n";
   char line[512];
   for (const auto& [name, seen] : processes_) {
     const orbed::process_status_t& s = seen.status;
     const double age_s = (now_utime - seen.recv_utime) * 1e-6;
     const std::string state = age_s > options_.silent_after_s ? "SILENT" : StateName(s.state);
     // Names and errors come from the bus: escaped before they reach a terminal.
-    std::snprintf(line, sizeof(line), "%-20s  %-8s  %8.1f  %7lld  %8lld  %8lld  %8lld  %s\n",
-                  EscapeText(name).c_str(), state.c_str(), s.uptime_s, static_cast<long long>(s.messages_in),
-                  static_cast<long long>(s.messages_out), static_cast<long long>(s.rejected_inputs),
-                  static_cast<long long>(s.dropped), EscapeText(s.last_error.substr(0, 60)).c_str());
+    std::snprintf(line, sizeof(line), "%-20s  %-12s  %-8s  %8.1f  %7lld  %8lld  %8lld  %8lld  %s\n",
+                  EscapeText(name).c_str(), EscapeText(s.host.substr(0, 12)).c_str(), state.c_str(),
+                  s.uptime_s, static_cast<long long>(s.messages_in), static_cast<long long>(s.messages_out),
+                  static_cast<long long>(s.rejected_inputs), static_cast<long long>(s.dropped),
+                  EscapeText(s.last_error.substr(0, 60)).c_str());
     out += line;
   }
   if (have_logger_) {

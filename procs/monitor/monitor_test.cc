@@ -20,6 +20,7 @@ TEST(Monitor, TabulatesHeartbeatsAndFlagsSilentProcesses) {
   Monitor monitor(flags, options);
   orbed::process_status_t status{};
   status.name = "sim";
+  status.host = "hostB";  // contract change 9
   status.state = orbed::process_status_t::STATE_RUNNING;
   status.uptime_s = 42.25;
   status.messages_in = 12;
@@ -44,10 +45,10 @@ TEST(Monitor, TabulatesHeartbeatsAndFlagsSilentProcesses) {
   monitor.Run();
   const int64_t now = NowMicros();
   const std::string table = monitor.Table(now);
-  // The sim's row, field by field: name, state, uptime [s] to 0.1, messages in and out, rejected
-  // inputs, dropped work, the last error (cut at 60 characters).
+  // The sim's row, field by field: name, host, state, uptime [s] to 0.1, messages in and out,
+  // rejected inputs, dropped work, the last error (cut at 60 characters).
   const std::string sim_row =
-      "sim                   running       42.2       12       345         2         7  "
+      "sim                   hostB         running       42.2       12       345         2         7  "
       "IIWA_COMMAND/num_joints: num_joints is 6, expected 7\n";
   EXPECT_NE(table.find(sim_row), std::string::npos) << table;
   EXPECT_EQ(table.find("liar"), std::string::npos);  // rejected: state out of range
@@ -56,9 +57,14 @@ TEST(Monitor, TabulatesHeartbeatsAndFlagsSilentProcesses) {
   EXPECT_EQ(monitor.process().rejections().counts().at("PROCESS_STATUS/field"), 1);
   EXPECT_EQ(monitor.process().rejections().counts().at("PROCESS_STATUS/too_many"), 46);
   // 10 s later, past silent_after_s = 3 s, the same row says SILENT.
-  EXPECT_NE(
-      monitor.Table(now + 10'000'000).find("sim                   SILENT        42.2       12       345"),
-      std::string::npos);
+  EXPECT_NE(monitor.Table(now + 10'000'000)
+                .find("sim                   hostB         SILENT        42.2       12       345"),
+            std::string::npos);
+  // ... and the moment it fell silent is said once, naming its host.
+  EXPECT_EQ(monitor.NewlySilent(now + 1'000'000).find("sim on"), std::string::npos);  // 1 s: not yet
+  const std::string said = monitor.NewlySilent(now + 10'000'000);
+  EXPECT_NE(said.find("sim on hostB: SILENT (no heartbeat for 10."), std::string::npos) << said;
+  EXPECT_EQ(monitor.NewlySilent(now + 11'000'000), "");
 }
 
 // The command line, in-process.
@@ -85,7 +91,7 @@ TEST(MonitorCli, RunsForTheDurationAndPrintsTheTableOnOut) {
   const test::CommandRun r = test::RunCommand(
       RunMonitor, "orbed-monitor", {"--lcm-url", "memq://", "--duration-s", "1", "--print-period-s", "0.01"});
   EXPECT_EQ(r.code, 0) << r.err;
-  EXPECT_NE(r.out.find("process               state     uptime_s"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("process               host          state     uptime_s"), std::string::npos) << r.out;
 }
 
 }  // namespace

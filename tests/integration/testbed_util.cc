@@ -63,6 +63,7 @@ RunningProcess::RunningProcess(const std::vector<std::string>& argv,
                                const std::map<std::string, std::string>& env)
     : prefix_(std::filesystem::path(argv.at(0)).filename().string() + " | ") {
   std::string error;
+  child_.CopyLinesTo(&lines_);
   if (!child_.Start(argv, env, "", &error)) throw std::runtime_error(error);
 }
 

@@ -51,10 +51,13 @@ class RunningProcess {
   bool running();
   int exit_code() const { return child_.exit_code(); }
   int term_signal() const { return child_.term_signal(); }
+  /// Every line it printed so far (read while Wait() or running() drains its output).
+  const std::vector<std::string>& lines() const { return lines_; }
 
  private:
   launcher::Child child_;
   std::string prefix_;
+  std::vector<std::string> lines_;
 };
 
 /// Listens to PROCESS_STATUS (and anything else subscribed) on the default bus; heartbeats that are

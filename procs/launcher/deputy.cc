@@ -1,0 +1,228 @@
+#include "procs/launcher/deputy.h"
+
+#include <csignal>
+#include <thread>
+
+#include "procs/common/channels.h"
+#include "procs/common/conversions.h"
+#include "procs/common/log.h"
+#include "procs/launcher/deputy_protocol.h"
+
+namespace orbed::launcher {
+namespace {
+
+constexpr double kUnlistedStopTimeoutS = 5.0;
+
+double SecondsSince(Deputy::Clock::time_point t) {
+  return std::chrono::duration<double>(Deputy::Clock::now() - t).count();
+}
+
+}  // namespace
+
+Deputy::Deputy(const CommonFlags& flags, DeputyOptions options)
+    : options_(std::move(options)), flags_(flags), process_(flags) {
+  process_.Subscribe<orbed::deputy_command_t>(
+      channels::kDeputyCommand,
+      [this](const orbed::deputy_command_t& command, const std::string&, int64_t) { OnCommand(command); });
+  process_.AddWallPoll(0.02, [this] { Tick(); });
+  last_status_ = Clock::now();
+}
+
+Deputy::~Deputy() = default;
+
+void Deputy::Start(Managed* m, const orbed::deputy_process_t& wanted) {
+  std::map<std::string, std::string> env;
+  for (size_t i = 0; i < wanted.env_key.size(); ++i) env[wanted.env_key[i]] = wanted.env_value[i];
+  env["ORBED_LCM_URL"] = flags_.lcm_url;
+  env["ORBED_HOST"] = options_.name;
+  env["ORBED_LOG_PREFIXED"] = "1";
+  m->name = wanted.name;
+  m->instance = wanted.instance;
+  m->stop_signal = wanted.stop_signal;
+  m->stop_timeout_s = wanted.stop_timeout_s;
+  m->signal_sent = 0;
+  m->prefix = wanted.name + " | ";
+  m->child = std::make_unique<Child>();
+  std::string error;
+  m->failed_to_start = !m->child->Start(wanted.argv, env, options_.bin_dir, &error);
+  m->detail = m->failed_to_start ? error : "running";
+  if (m->failed_to_start) {
+    ORBED_LOG(kError) << wanted.name << " (instance " << wanted.instance << "): " << error;
+  } else {
+    ORBED_LOG(kInfo) << "started " << wanted.name << " (instance " << wanted.instance << ", pid "
+                     << m->child->pid() << ") for " << launcher_;
+  }
+  changed_ = true;
+}
+
+void Deputy::Stop(Managed* m, int signal, double timeout_s) {
+  if (!m->child || !m->child->running() || m->signal_sent == signal) return;
+  if (m->signal_sent == 0) {
+    m->kill_at =
+        Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout_s));
+  }
+  m->child->Signal(signal);
+  m->signal_sent = signal;
+  m->detail = "stopping";
+  changed_ = true;
+}
+
+void Deputy::StopAll(std::vector<Managed>* list, const char* why) {
+  for (Managed& m : *list) {
+    if (m.child && m.child->running() && m.signal_sent == 0) {
+      ORBED_LOG(kInfo) << "stopping " << m.name << ": " << why;
+      Stop(&m, m.stop_signal, m.stop_timeout_s);
+    }
+  }
+}
+
+void Deputy::OnCommand(const orbed::deputy_command_t& command) {
+  const std::string problem = CheckDeputyCommand(command);
+  if (!problem.empty()) {
+    process_.Reject(std::string(channels::kDeputyCommand) + "/invalid", problem);
+    return;
+  }
+  if (command.deputy != options_.name) return;  // another deputy's
+  if (command.launcher != launcher_) {
+    if (!launcher_.empty()) {
+      ORBED_LOG(kWarn) << "now following " << command.launcher << " (was " << launcher_ << ")";
+      StopAll(&children_, "its launcher was replaced");
+      for (Managed& m : children_) leaving_.push_back(std::move(m));
+      children_.clear();
+    } else {
+      ORBED_LOG(kInfo) << "following " << command.launcher;
+    }
+    launcher_ = command.launcher;
+    changed_ = true;
+  }
+  last_command_ = Clock::now();
+  for (const orbed::deputy_process_t& wanted : command.processes) {
+    Managed* current = nullptr;
+    for (Managed& m : children_) {
+      if (m.name == wanted.name) current = &m;
+    }
+    if (wanted.run) {
+      if (current != nullptr && current->instance >= wanted.instance) continue;
+      if (current != nullptr) {
+        // A newer instance while the old one runs (the launcher missed its exit): the old one goes.
+        Stop(current, SIGKILL, 0);
+        leaving_.push_back(std::move(*current));
+        *current = Managed{};
+      } else {
+        children_.emplace_back();
+        current = &children_.back();
+      }
+      Start(current, wanted);
+    } else if (current != nullptr && current->instance <= wanted.instance) {
+      Stop(current, wanted.stop_signal, wanted.stop_timeout_s);
+    }
+  }
+  // Processes the launcher no longer lists.
+  for (auto it = children_.begin(); it != children_.end();) {
+    bool listed = false;
+    for (const orbed::deputy_process_t& wanted : command.processes)
+      listed = listed || wanted.name == it->name;
+    if (listed) {
+      ++it;
+      continue;
+    }
+    Stop(&*it, SIGTERM, kUnlistedStopTimeoutS);
+    leaving_.push_back(std::move(*it));
+    it = children_.erase(it);
+    changed_ = true;
+  }
+}
+
+bool Deputy::AnyRunning() const {
+  for (const auto* list : {&children_, &leaving_}) {
+    for (const Managed& m : *list) {
+      if (m.child && m.child->running()) return true;
+    }
+  }
+  return false;
+}
+
+void Deputy::Tick() {
+  for (auto* list : {&children_, &leaving_}) {
+    for (Managed& m : *list) {
+      if (!m.child) continue;
+      m.child->Drain(m.prefix);
+      if (m.child->running() && m.child->Poll()) {
+        m.child->Drain(m.prefix, true);
+        m.detail = m.child->DescribeExit();
+        if (m.signal_sent != 0 || m.child->exit_code() == 0) {
+          ORBED_LOG(kInfo) << m.name << " (instance " << m.instance << ") " << m.detail;
+        } else {
+          ORBED_LOG(kWarn) << m.name << " (instance " << m.instance << ") " << m.detail;
+        }
+        changed_ = true;
+      }
+      if (m.child->running() && m.signal_sent != 0 && m.signal_sent != SIGKILL && Clock::now() >= m.kill_at) {
+        ORBED_LOG(kWarn) << m.name << " did not stop within " << m.stop_timeout_s << " s: SIGKILL";
+        m.child->Signal(SIGKILL);
+        m.signal_sent = SIGKILL;
+      }
+    }
+  }
+  // Forget what has left.
+  for (auto it = leaving_.begin(); it != leaving_.end();) {
+    it = (it->child && it->child->running()) ? it + 1 : leaving_.erase(it);
+  }
+  if (!launcher_.empty() && SecondsSince(last_command_) > options_.orphan_timeout_s) {
+    bool any = false;
+    for (const Managed& m : children_) any = any || (m.child && m.child->running() && m.signal_sent == 0);
+    if (any) {
+      ORBED_LOG(kWarn) << "no command from " << launcher_ << " for " << SecondsSince(last_command_)
+                       << " s: stopping what it started";
+      StopAll(&children_, "its launcher is gone");
+    }
+  }
+  if (changed_ || SecondsSince(last_status_) >= kDeputyPeriodS) {
+    process_.PublishControl(channels::kDeputyStatus, Status());
+    last_status_ = Clock::now();
+    changed_ = false;
+  }
+}
+
+orbed::deputy_status_t Deputy::Status() const {
+  orbed::deputy_status_t status{};
+  status.utime = NowMicros();
+  status.deputy = options_.name;
+  status.launcher = launcher_;
+  for (const Managed& m : children_) {
+    orbed::deputy_child_t c{};
+    c.name = m.name;
+    c.instance = m.instance;
+    c.pid = m.child && !m.failed_to_start ? static_cast<int32_t>(m.child->pid()) : 0;
+    if (m.failed_to_start) {
+      c.state = orbed::deputy_child_t::STATE_FAILED_TO_START;
+      c.exit_code = 127;
+    } else if (m.child->running()) {
+      c.state =
+          m.signal_sent != 0 ? orbed::deputy_child_t::STATE_STOPPING : orbed::deputy_child_t::STATE_RUNNING;
+    } else {
+      c.state = orbed::deputy_child_t::STATE_EXITED;
+      c.exit_code = m.child->exit_code();
+      c.term_signal = m.child->term_signal();
+    }
+    c.detail = m.detail;
+    status.children.push_back(std::move(c));
+  }
+  status.num_children = static_cast<int32_t>(status.children.size());
+  return status;
+}
+
+int Deputy::Run() {
+  ORBED_LOG(kInfo) << "deputy " << options_.name << " on " << flags_.lcm_url << " (orphan timeout "
+                   << options_.orphan_timeout_s << " s)";
+  process_.Run();
+  // Stop what runs, as the launcher would: stop signal, then SIGKILL.
+  StopAll(&children_, "the deputy is stopping");
+  while (AnyRunning()) {
+    Tick();
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return 0;
+}
+
+}  // namespace orbed::launcher

@@ -1,0 +1,176 @@
+#include "procs/launcher/deputy_link.h"
+
+#include <csignal>
+
+#include <orbed/deputy_command_t.hpp>
+
+#include "procs/common/channels.h"
+#include "procs/common/conversions.h"
+#include "procs/common/log.h"
+#include "procs/launcher/deputy_protocol.h"
+
+namespace orbed::launcher {
+namespace {
+
+double SecondsBetween(DeputyLink::Clock::time_point a, DeputyLink::Clock::time_point b) {
+  return std::chrono::duration<double>(b - a).count();
+}
+
+// A child on another host, as its deputy reports it.
+class RemoteChild : public ChildHandle {
+ public:
+  RemoteChild(DeputyLink* link, DeputyLink::Slot* slot) : link_(link), slot_(slot) {}
+
+  bool Start(const std::vector<std::string>& argv, const std::map<std::string, std::string>& env,
+             const std::string&, std::string*) override {
+    ++slot_->instance;
+    slot_->run = true;
+    slot_->argv = argv;
+    slot_->env = env;
+    slot_->stop_signal = SIGINT;
+    link_->Changed(slot_->deputy);
+    return true;
+  }
+  bool Poll() override { return !running(); }
+  bool running() const override {
+    if (slot_->instance == 0) return false;
+    if (slot_->reported_instance != slot_->instance) return true;  // not reported yet: starting
+    return slot_->state == orbed::deputy_child_t::STATE_RUNNING ||
+           slot_->state == orbed::deputy_child_t::STATE_STOPPING;
+  }
+  pid_t pid() const override { return Reported() ? slot_->pid : 0; }
+  int exit_code() const override { return Reported() ? slot_->exit_code : 0; }
+  int term_signal() const override { return Reported() ? slot_->term_signal : 0; }
+  std::string DescribeExit() const override {
+    const std::string where = " on " + slot_->deputy;
+    if (Reported() && slot_->state == orbed::deputy_child_t::STATE_FAILED_TO_START) {
+      return "could not start" + where + ": " + slot_->detail;
+    }
+    return launcher::DescribeExit(exit_code(), term_signal()) + where;
+  }
+  void Signal(int signal) override {
+    if (!slot_->run && slot_->stop_signal == signal) return;
+    slot_->run = false;
+    slot_->stop_signal = signal;
+    link_->Changed(slot_->deputy);
+  }
+  void Drain(const std::string&, bool) override {}  // the deputy prints it on its host
+
+ private:
+  bool Reported() const { return slot_->reported_instance == slot_->instance; }
+  DeputyLink* link_;
+  DeputyLink::Slot* slot_;
+};
+
+}  // namespace
+
+DeputyLink::DeputyLink(Process* process, std::string launcher_id)
+    : process_(process), launcher_id_(std::move(launcher_id)) {
+  process_->Subscribe<orbed::deputy_status_t>(channels::kDeputyStatus,
+                                              [this](const orbed::deputy_status_t& status, const std::string&,
+                                                     int64_t recv_utime) { OnStatus(status, recv_utime); });
+}
+
+std::unique_ptr<ChildHandle> DeputyLink::MakeChild(const std::string& deputy, const std::string& name,
+                                                   double stop_timeout_s) {
+  std::unique_ptr<Slot>& slot = slots_[name];
+  if (!slot) {
+    slot = std::make_unique<Slot>();
+    slot->deputy = deputy;
+    slot->name = name;
+  }
+  slot->stop_timeout_s = stop_timeout_s;
+  return std::make_unique<RemoteChild>(this, slot.get());
+}
+
+bool DeputyLink::Heard(const std::string& deputy) const { return last_heard_.count(deputy) > 0; }
+
+bool DeputyLink::Reachable(const std::string& deputy) const {
+  const auto heard = last_heard_.find(deputy);
+  return heard != last_heard_.end() && SecondsBetween(heard->second, Clock::now()) <= kDeputySilentAfterS;
+}
+
+void DeputyLink::OnStatus(const orbed::deputy_status_t& status, int64_t) {
+  const std::string problem = CheckDeputyStatus(status);
+  if (!problem.empty()) {
+    process_->Reject(std::string(channels::kDeputyStatus) + "/invalid", problem);
+    return;
+  }
+  bool ours = false;
+  for (const auto& [name, slot] : slots_) ours = ours || slot->deputy == status.deputy;
+  if (!ours) return;  // another launch's deputy
+  const auto now = Clock::now();
+  if (silent_[status.deputy]) {
+    ORBED_LOG(kInfo) << "deputy " << status.deputy << " heard again after "
+                     << SecondsBetween(last_heard_[status.deputy], now) << " s";
+    silent_[status.deputy] = false;
+  } else if (!Heard(status.deputy)) {
+    ORBED_LOG(kInfo) << "deputy " << status.deputy << " is there";
+  }
+  last_heard_[status.deputy] = now;
+  // A status for another launcher (an earlier one, or before it heard us) says nothing of ours.
+  if (status.launcher != launcher_id_) return;
+  for (const orbed::deputy_child_t& child : status.children) {
+    const auto it = slots_.find(child.name);
+    if (it == slots_.end() || it->second->deputy != status.deputy) continue;
+    Slot& slot = *it->second;
+    if (child.instance > slot.instance) continue;  // cannot be: we never asked for it
+    slot.reported_instance = child.instance;
+    slot.pid = child.pid;
+    slot.state = child.state;
+    slot.exit_code = child.exit_code;
+    slot.term_signal = child.term_signal;
+    slot.detail = child.detail;
+  }
+}
+
+void DeputyLink::Send(const std::string& deputy) {
+  orbed::deputy_command_t command{};
+  command.utime = NowMicros();
+  command.launcher = launcher_id_;
+  command.deputy = deputy;
+  for (const auto& [name, slot] : slots_) {
+    if (slot->deputy != deputy || slot->instance == 0) continue;
+    orbed::deputy_process_t p{};
+    p.name = slot->name;
+    p.instance = slot->instance;
+    p.run = slot->run;
+    p.argv = slot->argv;
+    p.argc = static_cast<int32_t>(p.argv.size());
+    for (const auto& [key, value] : slot->env) {
+      p.env_key.push_back(key);
+      p.env_value.push_back(value);
+    }
+    p.num_env = static_cast<int32_t>(p.env_key.size());
+    p.stop_signal = slot->stop_signal;
+    p.stop_timeout_s = slot->stop_timeout_s;
+    command.processes.push_back(std::move(p));
+  }
+  command.num_processes = static_cast<int32_t>(command.processes.size());
+  process_->PublishControl(channels::kDeputyCommand, command);
+  last_sent_[deputy] = Clock::now();
+  due_[deputy] = false;
+}
+
+void DeputyLink::Tick() {
+  const auto now = Clock::now();
+  std::map<std::string, bool> deputies;
+  for (const auto& [name, slot] : slots_) {
+    if (slot->instance > 0) deputies[slot->deputy] = true;
+  }
+  for (const auto& [deputy, unused] : deputies) {
+    const auto sent = last_sent_.find(deputy);
+    if (due_[deputy] || sent == last_sent_.end() || SecondsBetween(sent->second, now) >= kDeputyPeriodS) {
+      Send(deputy);
+    }
+    const auto heard = last_heard_.find(deputy);
+    if (heard != last_heard_.end() && !silent_[deputy] &&
+        SecondsBetween(heard->second, now) > kDeputySilentAfterS) {
+      silent_[deputy] = true;
+      ORBED_LOG(kWarn) << "deputy " << deputy << " silent for " << SecondsBetween(heard->second, now)
+                       << " s (its processes keep their last known state)";
+    }
+  }
+}
+
+}  // namespace orbed::launcher

@@ -1,0 +1,199 @@
+// Launch across hosts (issue 12): three network namespaces as hosts A, B and C, each joined by a
+// veth pair to one bridge in this test's own private namespace (addresses 10.77.0.0/24, which
+// exist only in here), LCM's multicast with ttl=1 between them and nothing else reachable. On A
+// orbed-launch runs scripts/launch/viraal.yaml with the registration server placed on B and the
+// headset on C (`placement:`), through `orbed-launch --deputy` on B and C. The ViRAAl run
+// completes with the pinned results; every process's heartbeat names its host; C's link, cut for
+// 5 s in the middle of the run, shows as SILENT in the monitor and in the launcher, and the run
+// resumes when it returns.
+#include <sys/types.h>
+#include <unistd.h>
+
+#include <csignal>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+#include <lcm/lcm-cpp.hpp>
+#include <orbed/process_status_t.hpp>
+
+#include "tests/integration/logged.h"
+#include "tests/integration/testbed_util.h"
+#include "tests/same_tree.h"
+
+namespace orbed::testing {
+namespace {
+
+// LCM between the hosts: the bus's group and port, packets allowed one hop (the bridge).
+constexpr char kLanUrl[] = "udpm://239.255.76.67:7667?ttl=1";
+
+bool Shell(const std::string& command) {
+  const int status = std::system(command.c_str());
+  EXPECT_EQ(status, 0) << command;
+  return status == 0;
+}
+
+// Hosts as network namespaces on one bridge. Each host is a namespace held open by a sleeping
+// process; commands run in it through nsenter. Everything lives inside the test's own namespace
+// and goes with it.
+class VirtualLan {
+ public:
+  VirtualLan() {
+    ok_ = Shell("ip link add orbedbr0 type bridge mcast_snooping 0 && ip link set orbedbr0 up");
+    // The test itself listens on the bridge (an observer, not a host).
+    ok_ =
+        ok_ && Shell("ip addr add 10.77.0.254/24 dev orbedbr0 && ip route replace 224.0.0.0/4 dev orbedbr0");
+  }
+  ~VirtualLan() {
+    // The hosts' ends of the veth pairs go with their namespaces (the holders, stopped after this).
+    std::system("ip link del orbedbr0 2>/dev/null; ip route replace 224.0.0.0/4 dev lo");
+  }
+  bool ok() const { return ok_; }
+
+  // Adds host `name` as 10.77.0.<index>.
+  void AddHost(const std::string& name, int index) {
+    auto holder =
+        std::make_unique<RunningProcess>(std::vector<std::string>{"/usr/bin/unshare", "-n", "sleep", "3600"});
+    const std::string pid = std::to_string(holder->pid());
+    // The holder is in its namespace once its /proc entry points at another one than ours.
+    ASSERT_TRUE(WaitFor([&] { return NetNamespace("/proc/" + pid) != NetNamespace("/proc/self"); }, 10));
+    const std::string outside = "ve" + std::to_string(index), inside = "eth" + std::to_string(index);
+    const std::string in_host = "nsenter --target " + pid + " --net ";
+    ok_ = ok_ && Shell("ip link add " + outside + " type veth peer name " + inside + " && ip link set " +
+                       inside + " netns " + pid + " && ip link set " + outside + " master orbedbr0 up");
+    ok_ = ok_ && Shell(in_host + "ip link set lo up && " + in_host + "ip addr add 10.77.0." +
+                       std::to_string(index) + "/24 dev " + inside + " && " + in_host + "ip link set " +
+                       inside + " up && " + in_host + "ip route add 224.0.0.0/4 dev " + inside);
+    hosts_[name] = Host{pid, outside, std::move(holder)};
+  }
+
+  // argv run on `host`, with the LAN's LCM URL.
+  std::unique_ptr<RunningProcess> Run(const std::string& host, std::vector<std::string> argv,
+                                      std::map<std::string, std::string> env = {}) {
+    argv.insert(argv.begin(), {"/usr/bin/nsenter", "--target", hosts_.at(host).pid, "--net", "--"});
+    env["ORBED_LCM_URL"] = kLanUrl;
+    return std::make_unique<RunningProcess>(argv, env);
+  }
+
+  // Takes `host`'s link down or up (at the bridge).
+  void SetLink(const std::string& host, bool up) {
+    Shell("ip link set " + hosts_.at(host).link + (up ? " up" : " down"));
+  }
+
+ private:
+  static std::string NetNamespace(const std::string& proc) {
+    std::error_code ec;
+    return std::filesystem::read_symlink(proc + "/ns/net", ec).string();
+  }
+  struct Host {
+    std::string pid, link;
+    std::unique_ptr<RunningProcess> holder;
+  };
+  bool ok_ = false;
+  std::map<std::string, Host> hosts_;
+};
+
+bool AnyLineHas(const std::vector<std::string>& lines, const std::string& a, const std::string& b = "") {
+  for (const std::string& line : lines) {
+    if (line.find(a) != std::string::npos && line.find(b) != std::string::npos) return true;
+  }
+  return false;
+}
+
+TEST(Hosts, TheViraalRunOnThreeHostsCompletesAndSurvivesAPartition) {
+  if (std::getenv("ORBED_IN_NETNS") == nullptr || geteuid() != 0) {
+    GTEST_SKIP() << "needs root in a private network namespace (scripts/netns-exec as root)";
+  }
+  VirtualLan lan;
+  ASSERT_TRUE(lan.ok());
+  lan.AddHost("hostA", 1);
+  lan.AddHost("hostB", 2);
+  lan.AddHost("hostC", 3);
+  ASSERT_TRUE(lan.ok());
+  if (::testing::Test::HasFatalFailure()) return;
+
+  const std::string dir = MakeTempDir("hosts");
+  std::ofstream(dir + "/three_hosts.yaml")
+      << "name: three_hosts\n"
+      << "include: [" << SourcePath("scripts/launch/viraal.yaml") << "]\n"
+      << "placement: {registration: hostB, hmd: hostC}\n";
+  const auto deputy_b = lan.Run("hostB", {BinPath("orbed-launch"), "--deputy", "hostB"});
+  const auto deputy_c = lan.Run("hostC", {BinPath("orbed-launch"), "--deputy", "hostC"});
+
+  lcm::LCM observer(kLanUrl);
+  ASSERT_TRUE(observer.good());
+  int trials = 0;
+  observer.subscribeFunction(
+      "ALIGNMENT_TRIAL", +[](const lcm::ReceiveBuffer*, const std::string&, int* n) { ++*n; }, &trials);
+
+  const std::string log_dir = dir + "/log";
+  const auto launcher = lan.Run(
+      "hostA", {BinPath("orbed-launch"), dir + "/three_hosts.yaml", "--host", "hostA", "--duration-s", "240"},
+      {{"ORBED_LOG_DIR", log_dir}, {"ORBED_RUN_ID", "pinned"}});
+  // The partition starts with the first trial heard from C.
+  ASSERT_TRUE(WaitFor(
+      [&] {
+        observer.handleTimeout(10);
+        return trials > 0 || !launcher->running();
+      },
+      120));
+  ASSERT_TRUE(launcher->running()) << "the run ended before its first trial";
+  lan.SetLink("hostC", false);
+  // Cut for 5 s of wall time (the partition's length, not a wait for anything).
+  std::this_thread::sleep_for(std::chrono::seconds(5));
+  lan.SetLink("hostC", true);
+  ASSERT_TRUE(launcher->Wait(180)) << "the run did not finish after the partition";
+  EXPECT_EQ(launcher->exit_code(), 0);
+
+  // The run: the pinned numbers of the single-host run.
+  ExpectSameTree(YAML::LoadFile(SourcePath("tests/integration/testdata/viraal_pinned_results.json")),
+                 YAML::LoadFile(log_dir + "/results.json"), "results", {"started_utime", "duration_s"});
+  EXPECT_TRUE(YAML::LoadFile(log_dir + "/manifest.json")["complete"].as<bool>());
+
+  // Every process says where it ran.
+  std::map<std::string, std::string> host_of;
+  for (const orbed::process_status_t& status : Logged<orbed::process_status_t>(log_dir, "PROCESS_STATUS")) {
+    host_of[status.name] = status.host;
+  }
+  EXPECT_EQ(host_of["sim"], "hostA");
+  EXPECT_EQ(host_of["logger"], "hostA");
+  EXPECT_EQ(host_of["scenario"], "hostA");
+  EXPECT_EQ(host_of["registration"], "hostB");
+  EXPECT_EQ(host_of["hmd"], "hostC");
+  EXPECT_EQ(host_of["deputy-hostC"], "hostC");
+
+  // The partition, as the monitor (on A) and the launcher saw it.
+  const std::vector<std::string>& said = launcher->lines();
+  EXPECT_TRUE(AnyLineHas(said, "hmd on hostC: SILENT")) << "the monitor did not flag the headset";
+  EXPECT_TRUE(AnyLineHas(said, "hmd on hostC: heard again after"));
+  EXPECT_TRUE(AnyLineHas(said, "deputy hostC silent for"));
+  EXPECT_TRUE(AnyLineHas(said, "deputy hostC heard again after"));
+  // B was never cut off.
+  EXPECT_FALSE(AnyLineHas(said, "registration on hostB: SILENT"));
+}
+
+// A process placed on a host whose deputy never answers: the launch stops with an error naming the
+// host and what to start there.
+TEST(Hosts, AHostWithoutADeputyIsNamedInTheError) {
+  const std::string dir = MakeTempDir("no_deputy");
+  std::ofstream(dir + "/lonely.yaml") << "name: lonely\n"
+                                      << "groups:\n"
+                                      << "  - name: far\n"
+                                      << "    processes:\n"
+                                      << "      - {name: monitor, command: orbed-monitor, host: nowhere,\n"
+                                      << "         ready_timeout_s: 2}\n";
+  RunningProcess launcher({BinPath("orbed-launch"), dir + "/lonely.yaml", "--host", "here"});
+  ASSERT_TRUE(launcher.Wait(60));
+  EXPECT_EQ(launcher.exit_code(), 1);
+  EXPECT_TRUE(AnyLineHas(launcher.lines(), "placed on host 'nowhere'", "orbed-launch --deputy nowhere"));
+}
+
+}  // namespace
+}  // namespace orbed::testing
