@@ -24,6 +24,7 @@ class RemoteChild : public ChildHandle {
   bool Start(const std::vector<std::string>& argv, const std::map<std::string, std::string>& env,
              const std::string&, std::string*) override {
     ++slot_->instance;
+    exited_ = false;
     slot_->run = true;
     slot_->argv = argv;
     slot_->env = env;
@@ -31,13 +32,15 @@ class RemoteChild : public ChildHandle {
     link_->Changed(slot_->deputy);
     return true;
   }
-  bool Poll() override { return !running(); }
-  bool running() const override {
-    if (slot_->instance == 0) return false;
-    if (slot_->reported_instance != slot_->instance) return true;  // not reported yet: starting
-    return slot_->state == orbed::deputy_child_t::STATE_RUNNING ||
-           slot_->state == orbed::deputy_child_t::STATE_STOPPING;
+  // As Child: running() holds until Poll() has seen the exit (the deputy's report of it).
+  bool Poll() override {
+    if (!exited_ && Reported()) {
+      exited_ = slot_->state == orbed::deputy_child_t::STATE_EXITED ||
+                slot_->state == orbed::deputy_child_t::STATE_FAILED_TO_START;
+    }
+    return !running();
   }
+  bool running() const override { return slot_->instance > 0 && !exited_; }
   pid_t pid() const override { return Reported() ? slot_->pid : 0; }
   int exit_code() const override { return Reported() ? slot_->exit_code : 0; }
   int term_signal() const override { return Reported() ? slot_->term_signal : 0; }
@@ -60,6 +63,7 @@ class RemoteChild : public ChildHandle {
   bool Reported() const { return slot_->reported_instance == slot_->instance; }
   DeputyLink* link_;
   DeputyLink::Slot* slot_;
+  bool exited_ = false;
 };
 
 }  // namespace

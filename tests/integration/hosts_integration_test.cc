@@ -15,6 +15,7 @@
 #include <fstream>
 #include <map>
 #include <memory>
+#include <set>
 #include <string>
 #include <thread>
 #include <vector>
@@ -177,6 +178,72 @@ TEST(Hosts, TheViraalRunOnThreeHostsCompletesAndSurvivesAPartition) {
   EXPECT_TRUE(AnyLineHas(said, "deputy hostC heard again after"));
   // B was never cut off.
   EXPECT_FALSE(AnyLineHas(said, "registration on hostB: SILENT"));
+}
+
+// A process on another host that dies is respawned there, through its deputy, as a local one
+// would be: the headset on B, SIGKILLed after the first trial, comes back as a new instance (a new
+// pid, ready again at its heartbeat) and the run completes.
+TEST(Hosts, AProcessKilledOnAnotherHostIsRespawnedThroughItsDeputy) {
+  if (std::getenv("ORBED_IN_NETNS") == nullptr || geteuid() != 0) {
+    GTEST_SKIP() << "needs root in a private network namespace (scripts/netns-exec as root)";
+  }
+  VirtualLan lan;
+  ASSERT_TRUE(lan.ok());
+  lan.AddHost("hostA", 1);
+  lan.AddHost("hostB", 2);
+  ASSERT_TRUE(lan.ok());
+  if (::testing::Test::HasFatalFailure()) return;
+  const std::string dir = MakeTempDir("hosts_respawn");
+  std::ofstream(dir + "/two_hosts.yaml") << "name: two_hosts\n"
+                                         << "include: [" << SourcePath("scripts/launch/viraal.yaml") << "]\n"
+                                         << "placement: {hmd: hostB}\n";
+  const auto deputy_b = lan.Run("hostB", {BinPath("orbed-launch"), "--deputy", "hostB"});
+
+  struct Seen {
+    int trials = 0;
+    std::set<int> hmd_pids;
+  } seen;
+  lcm::LCM observer(kLanUrl);
+  ASSERT_TRUE(observer.good());
+  observer.subscribeFunction(
+      "ALIGNMENT_TRIAL", +[](const lcm::ReceiveBuffer*, const std::string&, Seen* s) { ++s->trials; }, &seen);
+  observer.subscribeFunction(
+      "PROCESS_STATUS",
+      +[](const lcm::ReceiveBuffer* rbuf, const std::string&, Seen* s) {
+        orbed::process_status_t status;
+        if (status.decode(rbuf->data, 0, static_cast<int>(rbuf->data_size)) > 0 && status.name == "hmd") {
+          s->hmd_pids.insert(status.pid);
+        }
+      },
+      &seen);
+  const std::string log_dir = dir + "/log";
+  const auto launcher = lan.Run(
+      "hostA", {BinPath("orbed-launch"), dir + "/two_hosts.yaml", "--host", "hostA", "--duration-s", "240"},
+      {{"ORBED_LOG_DIR", log_dir}, {"ORBED_RUN_ID", "respawn"}});
+  ASSERT_TRUE(WaitFor(
+      [&] {
+        observer.handleTimeout(10);
+        return (seen.trials > 0 && !seen.hmd_pids.empty()) || !launcher->running();
+      },
+      120));
+  ASSERT_TRUE(launcher->running()) << "the run ended before its first trial";
+  ASSERT_EQ(seen.hmd_pids.size(), 1u);
+  ASSERT_EQ(kill(*seen.hmd_pids.begin(), SIGKILL), 0);
+  ASSERT_TRUE(WaitFor(
+      [&] {
+        observer.handleTimeout(10);
+        return !launcher->running();
+      },
+      180))
+      << "the run did not finish after the headset was killed";
+  EXPECT_EQ(launcher->exit_code(), 0);
+  EXPECT_EQ(seen.hmd_pids.size(), 2u) << "no second instance of the headset was heard";
+  EXPECT_TRUE(AnyLineHas(launcher->lines(), "hmd killed by signal", "on hostB; respawning"));
+  EXPECT_TRUE(AnyLineHas(launcher->lines(), "hmd is ready again"));
+  const YAML::Node results = YAML::LoadFile(log_dir + "/results.json");
+  EXPECT_EQ(results["status"].as<std::string>(), "ok");
+  ASSERT_EQ(results["sessions"].size(), 2u);
+  for (const auto& session : results["sessions"]) EXPECT_EQ(session["trials"].size(), 3u);
 }
 
 // A process placed on a host whose deputy never answers: the launch stops with an error naming the
