@@ -113,9 +113,11 @@ TEST(LcmTypes, EveryTypeRoundTripsAndHasAUniqueFingerprint) {
 // another fingerprint ("<channel>/decode/fingerprint"): any change of a type is a breaking change
 // on the wire. docs/design.md §3 "Changing the contract" says how one is made: fields appended at the
 // end, the change listed there with the old and new fingerprints, and this table updated in the same
-// commit. Last change: contract change 5 (the landmark annotation appended to alignment_trial_t);
-// before it, contract change 4 (types added: setup_task_t and setup_result_t for the robot
-// set-up study, the four viewer_*_t types that are Drake's lcmt_viewer_*); before it, contract change 3
+// commit. Last change: contract change 9 (host appended to process_status_t; the four deputy_*_t
+// types of launch across hosts); before it, contract change 8 (lockstep_round appended to
+// sim_clock_t, sim_clock_ack_t added); contract change 5 (the landmark annotation appended to
+// alignment_trial_t); before it, contract change 4 (types added: setup_task_t and setup_result_t for the
+// robot set-up study, the four viewer_*_t types that are Drake's lcmt_viewer_*); before it, contract change 3
 // (dropped, drop_reason and drop_count appended to process_status_t); before it, contract change 2 (the
 // tracking fault record appended to alignment_trial_t) and contract change 1 (request_id appended to
 // session_control_t, alignment_trial_t and registration_t).
@@ -123,6 +125,10 @@ TEST(LcmTypes, FingerprintsArePinned) {
   const std::map<std::string, uint64_t> pinned = {{"alignment_trial_t", 0x271026afe7973c6dULL},
                                                   {"collision_status_t", 0x9f78934234cce93fULL},
                                                   {"contact_t", 0x2d8c8a472f48e7e9ULL},
+                                                  {"deputy_child_t", 0xf936d88118a99250ULL},
+                                                  {"deputy_command_t", 0x9c83752069eba4e2ULL},
+                                                  {"deputy_process_t", 0xea93be0d0e14b1f6ULL},
+                                                  {"deputy_status_t", 0xc89ea34a54f2bd1aULL},
                                                   {"gaze_ray_t", 0x65a37e31d5a2eea1ULL},
                                                   {"guidance_t", 0x00fc655bb50b4853ULL},
                                                   {"hmd_pose_t", 0xdafcd85796f0e809ULL},
@@ -137,7 +143,7 @@ TEST(LcmTypes, FingerprintsArePinned) {
                                                   {"plan_check_reply_t", 0x08220670e46ad680ULL},
                                                   {"plan_check_request_t", 0xf954868fc0afdd74ULL},
                                                   {"pose_t", 0xcefe2d89aeb7c79fULL},
-                                                  {"process_status_t", 0xaf74744443776f9eULL},
+                                                  {"process_status_t", 0xfc07aa15bec7ef20ULL},
                                                   {"reflective_view_t", 0xba9d743e2da58034ULL},
                                                   {"registration_t", 0xa59c0b3d053d0d83ULL},
                                                   {"robot_state_t", 0x3af0ecdeab2a6837ULL},
