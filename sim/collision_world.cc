@@ -131,6 +131,8 @@ struct Body {
   std::string name;
   int link{-1};
   int object{-1};
+  int arm{-1};       // another arm's index (AddOtherArm), -1 for this arm's links and the scene
+  int arm_link{-1};  // that arm's link index
   std::vector<Child> children;
   std::unique_ptr<btCompoundShape> compound;
   std::unique_ptr<btCollisionObject> object_bt;
@@ -140,10 +142,15 @@ struct Body {
   long epoch{0};
 };
 
+enum class Group { kSelf = 0, kEnvironment = 1, kOtherArm = 2 };
+
 struct Pair {
   int a;  // body index (a robot link)
   int b;  // body index
-  bool self;
+  Group group;
+  bool self() const { return group == Group::kSelf; }
+  // Both bodies move (self and other-arm pairs): bounding spheres on both sides.
+  bool moving() const { return group != Group::kEnvironment; }
 };
 
 // The last exact result of a pair and the body epochs (and path) it was computed at: when neither
@@ -189,10 +196,10 @@ bool ChildDistance(const Child& a, const Child& b, bool fast_path, SignedDistanc
   return true;
 }
 
-// Lower bound on the distance of two children: bounding spheres for self pairs, the exact scene
-// shape against the robot child's bounding sphere otherwise.
-double ChildLowerBound(const Child& ca, const Child& cb, bool self) {
-  if (self)
+// Lower bound on the distance of two children: bounding spheres when both move (self and
+// other-arm pairs), the exact scene shape against the robot child's bounding sphere otherwise.
+double ChildLowerBound(const Child& ca, const Child& cb, bool moving) {
+  if (moving)
     return (ca.X_WC.translation() - cb.X_WC.translation()).norm() - ca.bound_radius_m - cb.bound_radius_m;
   return PointDistance(cb.prim, cb.X_CW * ca.X_WC.translation()) - ca.bound_radius_m;
 }
@@ -206,12 +213,18 @@ struct CollisionWorld::Impl {
   btCollisionWorld world{&dispatcher, &broadphase, &config};
   std::vector<Body> bodies;
   std::vector<int> body_of_link;  // robot link -> body index or -1
+  int num_robot_bodies{0};        // bodies [0, num_robot_bodies) are this arm's links
+  // Other arms: their names, whether their poses were set, and their link -> body index (or -1).
+  std::vector<std::string> arm_names;
+  std::vector<char> arm_posed;
+  std::vector<std::vector<int>> body_of_arm_link;
   std::vector<std::string> object_names;
   std::vector<Pair> pairs;
   // Scratch for queries (sized once, reused).
   std::vector<double> lower_bound;
   std::vector<char> done;
-  std::vector<int> seed;         // per link, then self group, then environment group: the pair of least bound
+  std::vector<int>
+      seed;  // per link, then the self, environment and other-arm groups: the pair of least bound
   std::vector<PairCache> cache;  // per pair
 
   ~Impl() {
@@ -261,6 +274,7 @@ CollisionWorld::CollisionWorld(const RobotModel& model, const Scene* scene, cons
     im.AddBody(std::move(body), X_WR_ * X_RL[i]);
   }
   const int num_robot_bodies = static_cast<int>(im.bodies.size());
+  im.num_robot_bodies = num_robot_bodies;
   if (scene) {
     for (size_t k = 0; k < scene->objects.size(); ++k) {
       const SceneObject& o = scene->objects[k];
@@ -296,7 +310,7 @@ CollisionWorld::CollisionWorld(const RobotModel& model, const Scene* scene, cons
       const int link_b = im.bodies[b].link;
       const int separation = model_.BodySeparation(model_.links()[link_a].body, model_.links()[link_b].body);
       if (separation < std::max(2, options_.min_self_separation)) continue;
-      im.pairs.push_back({a, b, true});
+      im.pairs.push_back({a, b, Group::kSelf});
     }
   }
   if (scene) {
@@ -312,7 +326,7 @@ CollisionWorld::CollisionWorld(const RobotModel& model, const Scene* scene, cons
         const std::string& link_name = im.bodies[a].name;
         if (std::find(o.ignore_links.begin(), o.ignore_links.end(), link_name) != o.ignore_links.end())
           continue;
-        im.pairs.push_back({a, b, false});
+        im.pairs.push_back({a, b, Group::kEnvironment});
       }
     }
   }
@@ -322,12 +336,76 @@ CollisionWorld::~CollisionWorld() = default;
 
 int CollisionWorld::num_self_pairs() const {
   return static_cast<int>(
-      std::count_if(impl_->pairs.begin(), impl_->pairs.end(), [](const Pair& p) { return p.self; }));
+      std::count_if(impl_->pairs.begin(), impl_->pairs.end(), [](const Pair& p) { return p.self(); }));
 }
 
 int CollisionWorld::num_environment_pairs() const {
-  return static_cast<int>(impl_->pairs.size()) - num_self_pairs();
+  return static_cast<int>(std::count_if(impl_->pairs.begin(), impl_->pairs.end(),
+                                        [](const Pair& p) { return p.group == Group::kEnvironment; }));
 }
+
+int CollisionWorld::num_other_arm_pairs() const {
+  return static_cast<int>(impl_->pairs.size()) - num_self_pairs() - num_environment_pairs();
+}
+
+int CollisionWorld::AddOtherArm(const std::string& name, const RobotModel& other) {
+  Impl& im = *impl_;
+  if (name.empty() || std::find(im.arm_names.begin(), im.arm_names.end(), name) != im.arm_names.end()) {
+    throw std::invalid_argument("CollisionWorld::AddOtherArm: expected a new non-empty arm name, got '" +
+                                name + "'");
+  }
+  const int arm = static_cast<int>(im.arm_names.size());
+  im.arm_names.push_back(name);
+  im.arm_posed.push_back(0);
+  im.body_of_arm_link.emplace_back(other.num_links(), -1);
+  for (int i = 0; i < other.num_links(); ++i) {
+    const RobotLink& link = other.links()[i];
+    if (link.collision.empty()) continue;
+    Body body;
+    body.name = name + "/" + link.name;
+    body.arm = arm;
+    body.arm_link = i;
+    for (const auto& prim : FuseCapsules(link.collision)) {
+      Child c;
+      c.prim = prim;
+      body.children.push_back(std::move(c));
+    }
+    const int b = static_cast<int>(im.bodies.size());
+    im.body_of_arm_link[arm][i] = b;
+    im.AddBody(std::move(body), Eigen::Isometry3d::Identity());
+    for (int a = 0; a < im.num_robot_bodies; ++a) im.pairs.push_back({a, b, Group::kOtherArm});
+  }
+  im.cache.clear();
+  return arm;
+}
+
+void CollisionWorld::SetOtherArmLinkPoses(int arm, const std::vector<Eigen::Isometry3d>& X_WL) {
+  Impl& im = *impl_;
+  if (arm < 0 || arm >= static_cast<int>(im.arm_names.size()) ||
+      X_WL.size() != im.body_of_arm_link[arm].size()) {
+    throw std::invalid_argument("CollisionWorld::SetOtherArmLinkPoses: no arm " + std::to_string(arm) +
+                                " with " + std::to_string(X_WL.size()) + " links");
+  }
+  for (const Eigen::Isometry3d& X : X_WL) {
+    if (!X.matrix().allFinite()) {
+      throw std::invalid_argument("CollisionWorld::SetOtherArmLinkPoses: a non-finite pose of arm '" +
+                                  im.arm_names[arm] + "'");
+    }
+  }
+  for (size_t i = 0; i < X_WL.size(); ++i) {
+    const int b = im.body_of_arm_link[arm][i];
+    if (b < 0) continue;
+    Body& body = im.bodies[b];
+    if (X_WL[i].matrix() == body.X_WL.matrix()) continue;
+    ++body.epoch;
+    body.X_WL = X_WL[i];
+    body.object_bt->setWorldTransform(ToBt(X_WL[i]));
+    for (auto& c : body.children) c.X_WC = X_WL[i] * c.prim.X_LG;
+  }
+  im.arm_posed[arm] = 1;
+}
+
+int CollisionWorld::num_other_arms() const { return static_cast<int>(impl_->arm_names.size()); }
 
 CollisionResult CollisionWorld::Check(const Eigen::VectorXd& q_rad) {
   if (q_rad.size() != model_.num_joints() || !q_rad.allFinite()) {
@@ -361,6 +439,16 @@ CollisionResult CollisionWorld::CheckPoses(const std::vector<Eigen::Isometry3d>&
   const bool prune = options_.prune, fast = options_.fast_path;
   const double report = options_.report_distance_m;
 
+  // Pairs not checked: self pairs when check_self is off, pairs with an arm whose poses are unknown.
+  auto Skipped = [&](const Pair& p) {
+    if (p.self()) return !options_.check_self;
+    return p.group == Group::kOtherArm && !im.arm_posed[im.bodies[p.b].arm];
+  };
+  auto GroupClosest = [](Group g, CollisionResult* r) -> PairDistance& {
+    return g == Group::kSelf          ? r->closest_self
+           : g == Group::kEnvironment ? r->closest_environment
+                                      : r->closest_other_arm;
+  };
   // The exact distance of pair i, folded into the result.
   auto compute = [&](int i) {
     const Pair& p = im.pairs[i];
@@ -375,7 +463,7 @@ CollisionResult CollisionWorld::CheckPoses(const std::vector<Eigen::Isometry3d>&
         for (const Child& cb : B.children) {
           // Within a pair only the least distance is kept: a child pair whose bound is not below the
           // best so far cannot replace it (ties keep the earlier one either way).
-          if (prune && !single && ChildLowerBound(ca, cb, p.self) >= best.distance_m) continue;
+          if (prune && !single && ChildLowerBound(ca, cb, p.moving()) >= best.distance_m) continue;
           SignedDistance d;
           result.primitive_pairs_gjk += ChildDistance(ca, cb, fast, &d);
           if (d.distance_m < best.distance_m) best = d;
@@ -389,18 +477,20 @@ CollisionResult CollisionWorld::CheckPoses(const std::vector<Eigen::Isometry3d>&
     const double dist = best.distance_m;
     double& clear_a = result.link_clearance_m[A.link];
     clear_a = std::min(clear_a, dist);
-    if (p.self) {
+    if (p.self()) {
       double& clear_b = result.link_clearance_m[B.link];
       clear_b = std::min(clear_b, dist);
     }
-    PairDistance& group = p.self ? result.closest_self : result.closest_environment;
+    PairDistance& group = GroupClosest(p.group, &result);
     const bool closer_in_group = dist < group.distance_m, closest = dist < result.min_distance_m;
     if (!closer_in_group && !closest && !(dist < report)) return;
     PairDistance pd;
     pd.link_a = A.link;
     pd.link_b = B.link;
     pd.object_b = B.object;
-    pd.self = p.self;
+    pd.self = p.self();
+    pd.arm_b = B.arm;
+    pd.arm_link_b = B.arm_link;
     pd.distance_m = dist;
     pd.p_WA = best.p_WA;
     pd.p_WB = best.p_WB;
@@ -416,7 +506,7 @@ CollisionResult CollisionWorld::CheckPoses(const std::vector<Eigen::Isometry3d>&
   const int n = static_cast<int>(im.pairs.size());
   if (!prune) {
     for (int i = 0; i < n; ++i) {
-      if (im.pairs[i].self && !options_.check_self) continue;
+      if (Skipped(im.pairs[i])) continue;
       compute(i);
     }
   } else {
@@ -426,14 +516,14 @@ CollisionResult CollisionWorld::CheckPoses(const std::vector<Eigen::Isometry3d>&
     const int num_links = model_.num_links();
     im.lower_bound.resize(n);
     im.done.assign(n, 0);
-    im.seed.assign(num_links + 2, -1);
+    im.seed.assign(num_links + 3, -1);
     auto offer = [&](int slot, int i, double lb) {
       int& s = im.seed[slot];
       if (s < 0 || lb < im.lower_bound[s]) s = i;
     };
     for (int i = 0; i < n; ++i) {
       const Pair& p = im.pairs[i];
-      if (p.self && !options_.check_self) {
+      if (Skipped(p)) {
         im.done[i] = 1;
         continue;
       }
@@ -441,12 +531,12 @@ CollisionResult CollisionWorld::CheckPoses(const std::vector<Eigen::Isometry3d>&
       const Body& B = im.bodies[p.b];
       double lb = kInf;
       for (const Child& ca : A.children) {
-        for (const Child& cb : B.children) lb = std::min(lb, ChildLowerBound(ca, cb, p.self));
+        for (const Child& cb : B.children) lb = std::min(lb, ChildLowerBound(ca, cb, p.moving()));
       }
       im.lower_bound[i] = lb;
       offer(A.link, i, lb);
-      if (p.self) offer(B.link, i, lb);
-      offer(num_links + (p.self ? 0 : 1), i, lb);
+      if (p.self()) offer(B.link, i, lb);
+      offer(num_links + static_cast<int>(p.group), i, lb);
     }
     for (int i : im.seed) {
       if (i < 0 || im.done[i]) continue;
@@ -459,9 +549,8 @@ CollisionResult CollisionWorld::CheckPoses(const std::vector<Eigen::Isometry3d>&
       const double lb = im.lower_bound[i];
       // Skip only what cannot lower link A's or B's clearance, its group's closest pair (and so the
       // overall minimum) or enter the report list.
-      const double clear_b = p.self ? result.link_clearance_m[im.bodies[p.b].link] : -kInf;
-      const double group_min =
-          p.self ? result.closest_self.distance_m : result.closest_environment.distance_m;
+      const double clear_b = p.self() ? result.link_clearance_m[im.bodies[p.b].link] : -kInf;
+      const double group_min = GroupClosest(p.group, &result).distance_m;
       if (lb >= result.link_clearance_m[im.bodies[p.a].link] && lb >= clear_b && lb >= group_min &&
           lb >= report) {
         continue;
@@ -475,11 +564,16 @@ CollisionResult CollisionWorld::CheckPoses(const std::vector<Eigen::Isometry3d>&
   auto name = [&](PairDistance& d) {
     if (!d.valid()) return;
     d.body_a = im.bodies[im.body_of_link[d.link_a]].name;
-    d.body_b = d.link_b >= 0 ? im.bodies[im.body_of_link[d.link_b]].name : im.object_names[d.object_b];
+    if (d.arm_b >= 0) {
+      d.body_b = im.bodies[im.body_of_arm_link[d.arm_b][d.arm_link_b]].name;
+    } else {
+      d.body_b = d.link_b >= 0 ? im.bodies[im.body_of_link[d.link_b]].name : im.object_names[d.object_b];
+    }
   };
   name(result.closest);
   name(result.closest_self);
   name(result.closest_environment);
+  name(result.closest_other_arm);
   for (auto& c : result.contacts) name(c);
   result.in_collision = result.min_distance_m <= 0.0;
   return result;
@@ -490,7 +584,7 @@ std::vector<CollisionWorld::CheckedPair> CollisionWorld::CheckedPairs() const {
   for (const Pair& p : impl_->pairs) {
     const Body& A = impl_->bodies[p.a];
     const Body& B = impl_->bodies[p.b];
-    out.push_back({A.link, B.link, B.object});
+    out.push_back({A.link, B.link, B.object, B.arm, B.arm_link});
   }
   return out;
 }

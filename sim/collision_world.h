@@ -7,7 +7,11 @@
 /// compound children:
 ///   - self pairs: robot links on non-adjacent bodies (RobotModel::BodiesAdjacent()),
 ///   - environment pairs: every robot link vs every scene object, except links the object lists in
-///     ignore_links (e.g. the base standing on its cart).
+///     ignore_links (e.g. the base standing on its cart),
+///   - other-arm pairs (several arms, AddOtherArm): every robot link vs every link of each other arm
+///     in the OR, whose link poses in W the caller sets before each query (SetOtherArmLinkPoses; an
+///     arm whose poses were never set is not checked). The other arm's own self and scene pairs are
+///     its own world's business: each arm's world checks itself, the scene and the others.
 /// No contact manifold is used or kept, so every result is computed fresh from the current poses.
 ///
 /// Geometry: a URDF cylinder with a sphere of the same radius centred on each end face is exactly a
@@ -62,6 +66,8 @@ struct PairDistance {
   int link_b{-1};      ///< robot link index of body_b, -1 for a scene object
   int object_b{-1};    ///< scene object index of body_b, -1 for a robot link
   bool self{false};
+  int arm_b{-1};       ///< other arm index of body_b (AddOtherArm), -1 otherwise
+  int arm_link_b{-1};  ///< that arm's link index, -1 otherwise
   double distance_m{std::numeric_limits<double>::infinity()};  ///< signed; < 0 penetrating
   Eigen::Vector3d p_WA{Eigen::Vector3d::Zero()};               ///< closest (deepest) point on A
   Eigen::Vector3d p_WB{Eigen::Vector3d::Zero()};               ///< closest (deepest) point on B
@@ -75,6 +81,7 @@ struct CollisionResult {
   PairDistance closest;              ///< the pair with min_distance_m
   PairDistance closest_self;         ///< closest self pair (invalid if none checked)
   PairDistance closest_environment;  ///< closest robot-scene pair (invalid if none checked)
+  PairDistance closest_other_arm;    ///< closest pair with another arm (invalid if none checked)
   /// Per robot link (indexed as RobotModel::links()): the smallest distance to anything it is
   /// checked against; +infinity for links without geometry or without checked pairs.
   std::vector<double> link_clearance_m;
@@ -124,16 +131,29 @@ class CollisionWorld {
   /// The full check with link poses X_RL from RobotModel::CalcLinkPoses().
   CollisionResult CheckPoses(const std::vector<Eigen::Isometry3d>& X_RL);
 
-  /// Number of self and environment pairs that are checked (fixed at construction).
+  /// Number of self, environment and other-arm pairs that are checked.
   int num_self_pairs() const;
   int num_environment_pairs() const;
+  int num_other_arm_pairs() const;
 
-  /// One checked pair: a robot link against a robot link (object_b = -1) or a scene object
-  /// (link_b = -1).
+  /// Adds another arm of the OR (several arms): `other`'s links with collision geometry, named
+  /// "<name>/<link>" in results, checked against every link of this arm once their poses are set.
+  /// Returns the arm's index. Throws std::invalid_argument on an empty or repeated name.
+  int AddOtherArm(const std::string& name, const RobotModel& other);
+  /// The other arm's link poses X_WL in W (one per link of its model, as its
+  /// RobotModel::CalcLinkPoses gives X_RL, times its X_WR). Throws std::invalid_argument on a
+  /// wrong arm, count or a non-finite pose.
+  void SetOtherArmLinkPoses(int arm, const std::vector<Eigen::Isometry3d>& X_WL);
+  int num_other_arms() const;
+
+  /// One checked pair: a robot link against a robot link (object_b = -1), a scene object
+  /// (link_b = -1) or another arm's link (arm_b >= 0).
   struct CheckedPair {
     int link_a{-1};
     int link_b{-1};
     int object_b{-1};
+    int arm_b{-1};       ///< another arm (then link_b = object_b = -1)
+    int arm_link_b{-1};  ///< its link
   };
   /// Every pair a query considers (for baselines such as the FCL benchmark).
   std::vector<CheckedPair> CheckedPairs() const;

@@ -557,6 +557,82 @@ TEST(CollisionWorldTest, FastPathMatchesGjkOverRandomConfigurations) {
             << gjk_gjk_prims / 3000.0 << " (GJK only)\n";
 }
 
+// Several arms: a second iiwa B at X_WB, 0.45 m from A and turned 160 deg, both at random joint
+// vectors. Every pair of capsule links of A and B has the hand-computed segment distance minus both
+// radii; the closest other-arm pair is the least of them (and of the non-capsule links), pruning
+// changes nothing, and an arm whose poses were never set is not checked.
+TEST(CollisionWorldTest, OtherArmDistancesMatchSegmentDistances) {
+  const RobotModel m = LoadIiwa();
+  CollisionWorld::Options all;
+  all.report_distance_m = 1e9;
+  CollisionWorld world(m, nullptr, all);
+  CollisionWorld pruned(m, nullptr);  // default options: report nothing, prune
+  EXPECT_EQ(world.num_other_arm_pairs(), 0);
+  ASSERT_EQ(world.AddOtherArm("B", m), 0);
+  ASSERT_EQ(pruned.AddOtherArm("B", m), 0);
+  EXPECT_THROW(world.AddOtherArm("B", m), std::invalid_argument);
+  int bodies = 0;
+  for (const RobotLink& link : m.links()) bodies += link.collision.empty() ? 0 : 1;
+  EXPECT_EQ(world.num_other_arm_pairs(), bodies * bodies);
+  // Not posed yet: not checked.
+  EXPECT_FALSE(world.Check(Eigen::VectorXd::Zero(7)).closest_other_arm.valid());
+
+  const Eigen::Isometry3d X_WB =
+      Eigen::Translation3d(0.45, 0.05, 0) * Eigen::AngleAxisd(160 * kDegToRad, Eigen::Vector3d::UnitZ());
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(0, 1);
+  auto random_q = [&] {
+    Eigen::VectorXd q(7);
+    for (int i = 0; i < 7; ++i)
+      q[i] = m.joints()[i].lower_rad + u(rng) * (m.joints()[i].upper_rad - m.joints()[i].lower_rad);
+    return q;
+  };
+  int checked = 0, collisions = 0;
+  for (int n = 0; n < 500; ++n) {
+    const Eigen::VectorXd q_A = random_q(), q_B = random_q();
+    std::vector<Eigen::Isometry3d> X_WL_B = m.CalcLinkPoses(q_B);
+    for (auto& X : X_WL_B) X = X_WB * X;
+    world.SetOtherArmLinkPoses(0, X_WL_B);
+    pruned.SetOtherArmLinkPoses(0, X_WL_B);
+    const CollisionResult r = world.Check(q_A);
+    const auto caps_A = ArmCapsules(m, q_A);
+    auto caps_B = ArmCapsules(m, q_B);
+    for (auto& c : caps_B) c.a = X_WB * c.a, c.b = X_WB * c.b;
+    double least = std::numeric_limits<double>::infinity();
+    for (const PairDistance& p : r.contacts) {
+      if (p.arm_b >= 0) least = std::min(least, p.distance_m);
+    }
+    ASSERT_TRUE(r.closest_other_arm.valid());
+    EXPECT_EQ(r.closest_other_arm.distance_m, least);
+    EXPECT_EQ(r.closest_other_arm.body_b.rfind("B/", 0), 0u) << r.closest_other_arm.body_b;
+    for (int i = 1; i <= 6; ++i) {
+      for (int j = 1; j <= 6; ++j) {
+        const PairDistance* p =
+            FindPair(r, "iiwa_link_" + std::to_string(i), "B/iiwa_link_" + std::to_string(j));
+        ASSERT_NE(p, nullptr) << i << "," << j;
+        EXPECT_FALSE(p->self);
+        EXPECT_EQ(p->arm_b, 0);
+        EXPECT_LE(r.link_clearance_m[m.FindLink("iiwa_link_" + std::to_string(i))], p->distance_m);
+        const double seg = SegmentSegmentDistance(caps_A[i].a, caps_A[i].b, caps_B[j].a, caps_B[j].b);
+        if (seg < 1e-3) continue;  // crossing axes: the depth is not seg - r - r
+        EXPECT_NEAR(p->distance_m, seg - caps_A[i].r - caps_B[j].r, 1e-6) << i << "," << j;
+        ++checked;
+        if (p->distance_m < 0) ++collisions;
+      }
+    }
+    // Pruned, the answers are the same.
+    const CollisionResult rp = pruned.Check(q_A);
+    EXPECT_EQ(rp.closest_other_arm.distance_m, r.closest_other_arm.distance_m);
+    EXPECT_EQ(rp.min_distance_m, r.min_distance_m);
+    EXPECT_EQ(rp.link_clearance_m, r.link_clearance_m);
+  }
+  EXPECT_GT(checked, 15000);
+  EXPECT_GT(collisions, 0);  // 0.45 m apart, the arms do collide
+  EXPECT_THROW(world.SetOtherArmLinkPoses(1, std::vector<Eigen::Isometry3d>(m.num_links())),
+               std::invalid_argument);
+  EXPECT_THROW(world.SetOtherArmLinkPoses(0, std::vector<Eigen::Isometry3d>(2)), std::invalid_argument);
+}
+
 TEST(CollisionWorldTest, UnknownIgnoredLinkIsAnError) {
   const RobotModel m = LoadIiwa();
   Scene scene = FloorScene(0.1);
