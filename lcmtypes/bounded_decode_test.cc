@@ -186,11 +186,12 @@ TEST(BoundedDecodeTest, AHugeCountIsRefusedBeforeAnyAllocation) {
   process_status_t status{};
   status.name = "x";
   Bytes bytes = Encode(status);
-  // num_reasons sits just before last_error ("" = int32 length 1 + the NUL byte), dropped (int64)
-  // and num_drop_reasons (int32): 4 + 1 + 8 + 4 + 4 bytes from the end.
-  const size_t count_at = bytes.size() - 21;
-  // 18: one more than the 17 bytes left after the count.
-  for (const uint32_t count : {0x7fffffffu, 0x80000000u, 0xffffffffu, 18u}) {
+  // num_reasons sits just before last_error ("" = int32 length 1 + the NUL byte), dropped (int64),
+  // num_drop_reasons (int32) and host (contract change 9; "" as last_error): 4 + 5 + 8 + 4 + 5
+  // bytes from the end.
+  const size_t count_at = bytes.size() - 26;
+  // 23: one more than the 22 bytes left after the count.
+  for (const uint32_t count : {0x7fffffffu, 0x80000000u, 0xffffffffu, 23u}) {
     SCOPED_TRACE(count);
     for (int i = 0; i < 4; ++i)
       bytes[count_at + static_cast<size_t>(i)] = static_cast<uint8_t>(count >> (24 - 8 * i));

@@ -103,11 +103,20 @@ class Watcher {
   std::thread thread_;
 };
 
-// The launch file of the ViRAAl run with `--config config` added to orbed-hmd's arguments.
+// The launch file of the ViRAAl run with `--config config` added to orbed-hmd's arguments: orbed-hmd
+// is in testbed.yaml, which viraal.yaml includes; both are written to `dir` (the copy of viraal.yaml
+// including the changed testbed.yaml), their other includes pointing back at scripts/launch.
 std::string LaunchWithHeadsetConfig(const std::string& dir, const std::string& config) {
-  YAML::Node launch = YAML::LoadFile(SourcePath("scripts/launch/viraal.yaml"));
+  auto absolute_includes = [](YAML::Node launch) {
+    YAML::Node includes(YAML::NodeType::Sequence);
+    for (const YAML::Node& include : launch["include"]) {
+      includes.push_back(SourcePath("scripts/launch/" + include.as<std::string>()));
+    }
+    launch["include"] = includes;
+  };
+  YAML::Node testbed = YAML::LoadFile(SourcePath("scripts/launch/testbed.yaml"));
   bool found = false;
-  for (YAML::Node group : launch["groups"]) {
+  for (YAML::Node group : testbed["groups"]) {
     for (YAML::Node process : group["processes"]) {
       if (process["name"].as<std::string>() != "hmd") continue;
       process["args"].push_back("--config");
@@ -115,12 +124,15 @@ std::string LaunchWithHeadsetConfig(const std::string& dir, const std::string& c
       found = true;
     }
   }
-  EXPECT_TRUE(found) << "no process 'hmd' in scripts/launch/viraal.yaml";
-  // Written elsewhere, the file includes what viraal.yaml includes from scripts/launch.
+  EXPECT_TRUE(found) << "no process 'hmd' in scripts/launch/testbed.yaml";
+  absolute_includes(testbed);
+  std::ofstream(dir + "/testbed_faults.yaml") << YAML::Dump(testbed) << "\n";
+
+  YAML::Node launch = YAML::LoadFile(SourcePath("scripts/launch/viraal.yaml"));
+  EXPECT_EQ(launch["include"].size(), 1u);
+  EXPECT_EQ(launch["include"][0].as<std::string>(), "testbed.yaml");
   YAML::Node includes(YAML::NodeType::Sequence);
-  for (const YAML::Node& include : launch["include"]) {
-    includes.push_back(SourcePath("scripts/launch/" + include.as<std::string>()));
-  }
+  includes.push_back(dir + "/testbed_faults.yaml");
   launch["include"] = includes;
   const std::string path = dir + "/viraal_faults.yaml";
   std::ofstream(path) << YAML::Dump(launch) << "\n";
