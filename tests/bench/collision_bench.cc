@@ -6,7 +6,9 @@
 /// boxes), the minimum signed distance, the closest pair and per-link clearance — every checked pair
 /// one after the other (FclChecker), and through FCL's own broadphase (a dynamic AABB tree over every
 /// primitive, its distance query pruning by the best distance so far, the same pairs filtered in the
-/// callback: FclBroadphaseChecker, the minimum distance only). The joint vectors are a fixed pool of
+/// callback: FclBroadphaseChecker, the minimum distance only). Then four arms around the table
+/// (FourArms, issue 12): each arm's Bullet world checking itself, the scene and the three others,
+/// against one FCL broadphase over the four arms and the scene. The joint vectors are a fixed pool of
 /// 1024 seeded random vectors within the limits.
 ///
 /// Counters: `pairs` = exact pair distances computed per query; `gjk_prims` = primitive pairs of
@@ -163,44 +165,63 @@ class FclChecker {
   std::vector<Eigen::Isometry3d> X_RL_;
 };
 
-// The same minimum distance through FCL's broadphase manager: every primitive of every link and
-// object in one dynamic AABB tree; the distance callback skips primitive pairs whose links are not
-// a checked pair (adjacent links, links of one body, scene objects among themselves) and hands the
-// best distance back (at least 0: overlapping boxes are always visited, for the deepest penetration)
-// so the tree prunes every pair of boxes farther apart.
+// The same minimum distance through FCL's broadphase manager: every primitive of every arm's links
+// and of the scene in one dynamic AABB tree; the distance callback skips primitive pairs whose
+// bodies are not a checked pair (adjacent links, links of one body, scene objects among
+// themselves) and hands the best distance back (at least 0: overlapping boxes are always visited,
+// for the deepest penetration) so the tree prunes every pair of boxes farther apart. Several arms:
+// arm k's world has the others added in index order (AddOtherArm), so its other-arm pairs name them
+// by that order; every pair any world checks is checked once here.
 class FclBroadphaseChecker {
  public:
-  explicit FclBroadphaseChecker(const CollisionWorld& world, const Scene& scene)
-      : model_(world.model()), X_WR_(scene.X_WR) {
-    const int num_links = model_.num_links();
+  FclBroadphaseChecker(const std::vector<CollisionWorld*>& worlds, const Scene& scene) : worlds_(worlds) {
+    const int num_arms = static_cast<int>(worlds.size());
+    num_links_ = worlds[0]->model().num_links();
     const int num_objects = static_cast<int>(scene.objects.size());
-    // Owner ids: links 0..num_links-1, scene objects num_links + k.
-    owners_ = num_links + num_objects;
+    // Owner ids: arm k's link l is k * num_links + l; scene object o is num_arms * num_links + o.
+    owners_ = num_arms * num_links_ + num_objects;
     checked_.assign(static_cast<size_t>(owners_ * owners_), false);
-    for (const auto& pair : world.CheckedPairs()) {
-      const int a = pair.link_a, b = pair.link_b >= 0 ? pair.link_b : num_links + pair.object_b;
-      checked_[Index(a, b)] = checked_[Index(b, a)] = true;
+    for (int k = 0; k < num_arms; ++k) {
+      for (const auto& pair : worlds[k]->CheckedPairs()) {
+        const int a = k * num_links_ + pair.link_a;
+        int b = 0;
+        if (pair.link_b >= 0) {
+          b = k * num_links_ + pair.link_b;
+        } else if (pair.object_b >= 0) {
+          b = num_arms * num_links_ + pair.object_b;
+        } else {
+          const int other = pair.arm_b < k ? pair.arm_b : pair.arm_b + 1;
+          b = other * num_links_ + pair.arm_link_b;
+        }
+        checked_[Index(a, b)] = checked_[Index(b, a)] = true;
+      }
+      for (int l = 0; l < num_links_; ++l) {
+        for (const auto& g : worlds[k]->LinkPrimitives(l)) {
+          Add(ToFcl(g), k * num_links_ + l, g.X_LG, Eigen::Isometry3d::Identity());
+        }
+      }
     }
-    for (int l = 0; l < num_links; ++l) {
-      for (const auto& g : world.LinkPrimitives(l)) Add(ToFcl(g), l, g.X_LG, Eigen::Isometry3d::Identity());
-    }
-    for (int k = 0; k < num_objects; ++k) {
-      const SceneObject& o = scene.objects[k];
-      Add(ToFcl(ObjectPrimitive(o)), num_links + k, Eigen::Isometry3d::Identity(), o.X_WO);
+    for (int o = 0; o < num_objects; ++o) {
+      const SceneObject& object = scene.objects[o];
+      Add(ToFcl(ObjectPrimitive(object)), num_arms * num_links_ + o, Eigen::Isometry3d::Identity(),
+          object.X_WO);
     }
     for (auto& c : children_) manager_.registerObject(c.object.get());
     manager_.setup();
     request_.enable_signed_distance = true;
     request_.gjk_solver_type = fcl::GST_LIBCCD;
+    X_RL_.resize(worlds.size());
   }
 
-  double MinDistance(const Eigen::VectorXd& q) {
-    model_.CalcLinkPoses(q, &X_RL_);
+  // The minimum over every checked pair; `q[k]` is arm k's joint vector.
+  double MinDistance(const std::vector<const Eigen::VectorXd*>& q) {
+    for (size_t k = 0; k < worlds_.size(); ++k) worlds_[k]->model().CalcLinkPoses(*q[k], &X_RL_[k]);
+    const int arm_owners = static_cast<int>(worlds_.size()) * num_links_;
     for (auto& c : children_) {
-      if (c.owner < model_.num_links()) {
-        c.object->setTransform(X_WR_ * X_RL_[c.owner] * c.X_LG);
-        c.object->computeAABB();
-      }
+      if (c.owner >= arm_owners) continue;
+      const int k = c.owner / num_links_, l = c.owner % num_links_;
+      c.object->setTransform(worlds_[k]->X_WR() * X_RL_[k][l] * c.X_LG);
+      c.object->computeAABB();
     }
     manager_.update();
     Query query{this, std::numeric_limits<double>::infinity()};
@@ -240,14 +261,76 @@ class FclBroadphaseChecker {
     return false;
   }
 
-  const RobotModel& model_;
-  Eigen::Isometry3d X_WR_;
+  std::vector<CollisionWorld*> worlds_;
+  int num_links_ = 0;
   int owners_ = 0;
   std::vector<bool> checked_;
   std::deque<Child> children_;  // stable addresses: each object's user data points at its owner
   fcl::DynamicAABBTreeCollisionManagerd manager_;
   fcl::DistanceRequestd request_;
-  std::vector<Eigen::Isometry3d> X_RL_;
+  std::vector<std::vector<Eigen::Isometry3d>> X_RL_;
+};
+
+// Four arms around the table (issue 12): arm 0 where the scene puts it, arms 1 and 2 beside it on
+// the same side of the table (0.7 m to either side along it), arm 3 across the table facing it
+// (their carts are not in the scene: the scene's one cart is arm 0's).
+// Each arm's world checks its own links, the scene and the three others, as each arm's sim would
+// (so a pair of arms is checked from both sides); each arm sits at its own joint vector from the
+// pool.
+struct FourArms {
+  static constexpr int kArms = 4;
+  std::vector<Scene> scenes;
+  std::vector<std::unique_ptr<CollisionWorld>> worlds;
+  explicit FourArms(const CollisionWorld::Options& options = {}) {
+    const auto& f = F();
+    const Eigen::Isometry3d X_WR0 = f.scene.X_WR;
+    for (int k = 0; k < kArms; ++k) {
+      Scene scene = f.scene;
+      if (k == 1) scene.X_WR = Eigen::Translation3d(-0.7, 0, 0) * X_WR0;
+      if (k == 2) scene.X_WR = Eigen::Translation3d(0.7, 0, 0) * X_WR0;
+      if (k == 3) {
+        // Mirrored across the table's long axis (y = 0): base at (0.25, 0.55), facing -y.
+        scene.X_WR = X_WR0;
+        scene.X_WR.translation().y() = -X_WR0.translation().y();
+        scene.X_WR.linear() = Eigen::AngleAxisd(-M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+      }
+      scenes.push_back(scene);
+    }
+    for (int k = 0; k < kArms; ++k) {
+      worlds.push_back(std::make_unique<CollisionWorld>(f.model, &scenes[k], options));
+    }
+    for (int k = 0; k < kArms; ++k) {
+      for (int j = 0; j < kArms; ++j) {
+        if (j != k) worlds[k]->AddOtherArm("arm" + std::to_string(j), f.model);
+      }
+    }
+  }
+  // Poses every arm at pool[first + k] and checks every world; returns the least distance.
+  double Check(size_t first, int* pairs = nullptr) {
+    const auto& f = F();
+    for (int k = 0; k < kArms; ++k) {
+      f.model.CalcLinkPoses(f.pool[(first + k) & 1023], &X_RL[k]);
+      X_WL[k].resize(X_RL[k].size());
+      for (size_t l = 0; l < X_RL[k].size(); ++l) X_WL[k][l] = scenes[k].X_WR * X_RL[k][l];
+    }
+    double least = std::numeric_limits<double>::infinity();
+    for (int k = 0; k < kArms; ++k) {
+      int other = 0;
+      for (int j = 0; j < kArms; ++j) {
+        if (j != k) worlds[k]->SetOtherArmLinkPoses(other++, X_WL[j]);
+      }
+      const CollisionResult r = worlds[k]->CheckPoses(X_RL[k]);
+      least = std::min(least, r.min_distance_m);
+      if (pairs) *pairs += r.pairs_computed;
+    }
+    return least;
+  }
+  std::vector<CollisionWorld*> Raw() const {
+    std::vector<CollisionWorld*> raw;
+    for (const auto& w : worlds) raw.push_back(w.get());
+    return raw;
+  }
+  std::vector<Eigen::Isometry3d> X_RL[kArms], X_WL[kArms];
 };
 
 void BM_Fk(benchmark::State& state) {
@@ -313,16 +396,61 @@ BENCHMARK(BM_FclFkAndCheck);
 void BM_FclBroadphaseFkAndCheck(benchmark::State& state) {
   auto& f = F();
   CollisionWorld world(f.model, &f.scene);
-  FclBroadphaseChecker checker(world, f.scene);
+  FclBroadphaseChecker checker({&world}, f.scene);
   double max_diff = 0;
   for (const auto& q : f.pool) {
-    max_diff = std::max(max_diff, std::abs(checker.MinDistance(q) - world.Check(q).min_distance_m));
+    max_diff = std::max(max_diff, std::abs(checker.MinDistance({&q}) - world.Check(q).min_distance_m));
   }
   size_t i = 0;
-  for (auto _ : state) benchmark::DoNotOptimize(checker.MinDistance(f.pool[i++ & 1023]));
+  for (auto _ : state) benchmark::DoNotOptimize(checker.MinDistance({&f.pool[i++ & 1023]}));
   state.counters["max_diff_vs_bullet_m"] = max_diff;
 }
 BENCHMARK(BM_FclBroadphaseFkAndCheck);
+
+// Four arms: FK of the four and each arm's check (itself, the scene, the three others).
+void BM_Bullet4ArmsFkAndCheck(benchmark::State& state) {
+  FourArms arms;
+  size_t i = 0;
+  double pairs = 0;
+  for (auto _ : state) {
+    int n = 0;
+    benchmark::DoNotOptimize(arms.Check(4 * i++, &n));
+    pairs += n;
+  }
+  int checked = 0;
+  for (const auto& w : arms.worlds) {
+    checked += w->num_self_pairs() + w->num_environment_pairs() + w->num_other_arm_pairs();
+  }
+  state.counters["pairs"] = pairs / static_cast<double>(state.iterations());
+  state.counters["checked_pairs"] = checked;
+  state.counters["inter_arm_pairs"] = arms.worlds[0]->num_other_arm_pairs();
+}
+BENCHMARK(BM_Bullet4ArmsFkAndCheck);
+
+// The same four arms through one FCL broadphase over all their primitives and the scene (every
+// checked pair once: the minimum distance only).
+void BM_FclBroadphase4ArmsFkAndCheck(benchmark::State& state) {
+  const auto& f = F();
+  FourArms arms;
+  FclBroadphaseChecker checker(arms.Raw(), f.scene);
+  auto q_of = [&](size_t first) {
+    std::vector<const Eigen::VectorXd*> q;
+    for (int k = 0; k < FourArms::kArms; ++k) q.push_back(&f.pool[(first + k) & 1023]);
+    return q;
+  };
+  double max_diff = 0;
+  int colliding = 0;
+  for (size_t i = 0; i < 256; ++i) {
+    const double bullet = arms.Check(4 * i);
+    max_diff = std::max(max_diff, std::abs(checker.MinDistance(q_of(4 * i)) - bullet));
+    colliding += bullet <= 0;
+  }
+  size_t i = 0;
+  for (auto _ : state) benchmark::DoNotOptimize(checker.MinDistance(q_of(4 * i++)));
+  state.counters["max_diff_vs_bullet_m"] = max_diff;
+  state.counters["colliding_of_256"] = colliding;
+}
+BENCHMARK(BM_FclBroadphase4ArmsFkAndCheck);
 
 }  // namespace
 }  // namespace orbed::sim
