@@ -32,6 +32,16 @@ static_assert(static_cast<int>(MotionState::kIdle) == orbed::robot_state_t::MOTI
 
 // Resolves default paths and checks every number before anything is loaded.
 IiwaSimOptions Resolved(IiwaSimOptions options) {
+  if (!options.arm.empty()) {
+    // One of several arms: every channel of its own gets the arm's suffix.
+    for (std::string* channel :
+         {&options.iiwa_status_channel, &options.iiwa_command_channel, &options.robot_state_channel,
+          &options.collision_status_channel, &options.plan_check_request_channel,
+          &options.plan_check_reply_channel, &options.sim_clock_channel}) {
+      if (!channel->empty()) *channel = channels::ForArm(*channel, options.arm);
+    }
+    if (options.robot_name == IiwaSimOptions{}.robot_name) options.robot_name = options.arm;
+  }
   if (options.urdf_path.empty()) options.urdf_path = SourceTreePath(RobotModel::kDefaultUrdfRelativePath);
   if (options.scene_path.empty()) options.scene_path = SourceTreePath(kDefaultSceneRelativePath);
   // The sim clock counts whole microseconds (utime): the tick is P = period_s rounded to them, and
@@ -122,6 +132,16 @@ IiwaSim::IiwaSim(const orbed::CommonFlags& flags, const IiwaSimOptions& options)
       tick_us_(steps_per_tick_ * period_us_),
       tick_wall_ns_(std::max<int64_t>(1, tick_us_ * 1000 / options_.realtime_rate)),
       barrier_(options_.lockstep_timeout_s) {
+  if (!options_.arm.empty()) {
+    const ArmPlacement* placement = scene_.FindArm(options_.arm);
+    if (placement == nullptr) {
+      std::string names;
+      for (const ArmPlacement& a : scene_.arms) names += (names.empty() ? "" : ", ") + a.name;
+      throw std::invalid_argument("--arm " + options_.arm + ": the scene " + scene_.source + " has " +
+                                  (names.empty() ? "no arms: list" : "the arms " + names));
+    }
+    scene_.X_WR = placement->X_WR;
+  }
   const RobotModel model = LoadRobotForScene(options_.urdf_path, scene_);
   ManualArmOptions arm_options;
   arm_options.stop_margin_m = options_.stop_margin_m;
@@ -147,6 +167,18 @@ IiwaSim::IiwaSim(const orbed::CommonFlags& flags, const IiwaSimOptions& options)
   }
 
   process_ = std::make_unique<orbed::Process>(flags);
+  if (!options_.arm.empty()) {
+    // The other arms of the scene, wherever their ROBOT_STATE says they are.
+    for (const ArmPlacement& other : scene_.arms) {
+      if (other.name == options_.arm) continue;
+      const int index = arm_->AddOtherArm(other.name, model);
+      process_->Subscribe<orbed::robot_state_t>(
+          channels::ForArm(channels::kRobotState, other.name),
+          [this, index](const orbed::robot_state_t& msg, const std::string& channel, int64_t) {
+            OnOtherArm(index, msg, channel);
+          });
+    }
+  }
   process_->Subscribe<orbed::iiwa_command_t>(
       options_.iiwa_command_channel, [this](const orbed::iiwa_command_t& msg, const std::string& channel,
                                             int64_t) { OnCommand(msg, channel); });
@@ -227,6 +259,26 @@ void IiwaSim::OnCommand(const orbed::iiwa_command_t& msg, const std::string& cha
     }
   }
   arm_->SetCommand(command.q_rad);
+}
+
+void IiwaSim::OnOtherArm(int index, const orbed::robot_state_t& msg, const std::string& channel) {
+  const RobotModel& model = arm_->model();
+  std::string problem = CheckRobotState(msg, model.num_joints());
+  if (problem.empty() && msg.num_links != model.num_links()) {
+    problem = "num_links " + std::to_string(msg.num_links) + ", expected " +
+              std::to_string(model.num_links()) + " (the arms share one model)";
+  }
+  for (int i = 0; problem.empty() && i < msg.num_links; ++i) {
+    problem = CheckPose(msg.X_RL[i], "X_RL[" + std::to_string(i) + "]");
+  }
+  if (!problem.empty()) {
+    process_->Reject(channel + "/field", problem);
+    return;
+  }
+  const Eigen::Isometry3d X_WR = FromPose(msg.X_WR);
+  other_X_WL_.resize(msg.X_RL.size());
+  for (size_t i = 0; i < msg.X_RL.size(); ++i) other_X_WL_[i] = X_WR * FromPose(msg.X_RL[i]);
+  arm_->SetOtherArmLinkPoses(index, other_X_WL_);
 }
 
 void IiwaSim::OnPlanCheck(const orbed::plan_check_request_t& msg, const std::string& channel) {

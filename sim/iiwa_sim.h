@@ -98,6 +98,7 @@
 #include <orbed/iiwa_command_t.hpp>
 #include <orbed/iiwa_status_t.hpp>
 #include <orbed/plan_check_request_t.hpp>
+#include <orbed/robot_state_t.hpp>
 #include <orbed/sim_clock_ack_t.hpp>
 
 #include "base/source_paths.h"
@@ -150,8 +151,15 @@ struct IiwaSimOptions {
   double stop_margin_m{0.01};
   /// COLLISION_STATUS lists pairs closer than this [m].
   double report_distance_m{0.05};
-  /// robot_state_t::robot_name.
+  /// robot_state_t::robot_name (with `arm`, unless set: the arm's name).
   std::string robot_name{"iiwa7"};
+  /// Several arms (issue 12): "" = the single arm (the scene's robot.base_pose, plain channel
+  /// names). Else the name of one of the scene's `arms:`: its base, every channel below suffixed
+  /// with channels::ForArm (IIWA_STATUS_A1, ...; SIM_CLOCK too: each arm's sim keeps its own
+  /// clock), and every other arm of the scene a moving obstacle, posed from its ROBOT_STATE_<NAME>
+  /// (checked as CheckRobotState, its link count the model's, each X_RL a pose; refused as
+  /// "<channel>/field"), not checked until its first.
+  std::string arm;
   std::string iiwa_status_channel{channels::kIiwaStatus};
   std::string iiwa_command_channel{channels::kIiwaCommand};
   std::string robot_state_channel{channels::kRobotState};
@@ -209,6 +217,7 @@ class IiwaSim {
  private:
   void OnCommand(const orbed::iiwa_command_t& msg, const std::string& channel);
   void OnPlanCheck(const orbed::plan_check_request_t& msg, const std::string& channel);
+  void OnOtherArm(int index, const orbed::robot_state_t& msg, const std::string& channel);
   // SIM_CLOCK, then PublishState.
   void PublishAll(int64_t utime, const CollisionResult& r);
   // IIWA_STATUS, ROBOT_STATE, COLLISION_STATUS at `utime` (saving the state file).
@@ -231,6 +240,7 @@ class IiwaSim {
   std::unique_ptr<orbed::Process> process_;
   std::vector<int> reported_links_;  // links with geometry and a finite clearance
   std::vector<Eigen::Isometry3d> X_RL_;
+  std::vector<Eigen::Isometry3d> other_X_WL_;  // scratch: another arm's link poses
   int64_t period_us_{0};
   int steps_per_tick_{1};    // K
   int64_t tick_us_{0};       // K x P

@@ -44,6 +44,11 @@ int RunIiwaSim(int argc, const char* const* argv, std::ostream& out, std::ostrea
                  "Wall seconds a lockstep round waits for a follower before going on without it")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  app.add_option(
+      "--arm", options.arm,
+      "Be the arm NAME of the scene's `arms:` list (several arms): its base, its channels with the "
+      "suffix _NAME (IIWA_STATUS_A1, ...), the other arms as obstacles from their ROBOT_STATE_<NAME> "
+      "(default: the single arm, plain channel names)");
   app.add_option("--hold-for", options.hold_for,
                  "Hold the sim clock (publish only SIM_CLOCK, do not step) until PROCESS_STATUS shows the "
                  "process of this name running, so that a launch's followers of the clock start together "

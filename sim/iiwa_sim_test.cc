@@ -680,6 +680,98 @@ TEST(IiwaSim, PublishesTrueFramesAndClearances) {
   for (const auto& contact : c.contacts) EXPECT_LT(contact.distance_m, 0.05);
 }
 
+// Several arms (issue 12): orbed-iiwa-sim --arm a0 in scenes/four_arms_or.yaml stands at a0's base
+// and uses a0's channels; arm a1 (0.7 m along the table, upright at q = 0) is known from the
+// ROBOT_STATE_A1 the test publishes, as a1's own sim would. Swinging a0 horizontal toward a1 stops
+// before it (its tool before a1's), naming a1's link; once a1 is elsewhere a0 goes on; a ROBOT_STATE_A1 of
+// another model's size is refused; an unknown arm is an error naming the scene's arms.
+TEST(IiwaSim, OneOfSeveralArmsStopsBeforeAnother) {
+  IiwaSimOptions options;
+  options.scene_path = SourceTreePath("sim/models/scenes/four_arms_or.yaml");
+  options.arm = "a0";
+  IiwaSim sim(MemqFlags(0), options);
+  EXPECT_EQ(sim.options().iiwa_status_channel, "IIWA_STATUS_A0");
+  EXPECT_EQ(sim.options().iiwa_command_channel, "IIWA_COMMAND_A0");
+  EXPECT_EQ(sim.options().robot_state_channel, "ROBOT_STATE_A0");
+  EXPECT_EQ(sim.options().sim_clock_channel, "SIM_CLOCK_A0");
+  EXPECT_EQ(sim.options().robot_name, "a0");
+  EXPECT_TRUE(sim.scene().X_WR.isApprox(sim.scene().FindArm("a0")->X_WR));
+  lcm::LCM& lcm = sim.process().lcm();
+  auto dispatch = [&] {
+    while (lcm.handleTimeout(0) > 0) {
+    }
+  };
+  std::vector<orbed::robot_state_t> states;
+  lcm.subscribeFunction(
+      "ROBOT_STATE_A0",
+      +[](const lcm::ReceiveBuffer*, const std::string&, const orbed::robot_state_t* m,
+          std::vector<orbed::robot_state_t>* out) { out->push_back(*m); },
+      &states);
+
+  // a1 upright at its base, as its sim would say.
+  const RobotModel& model = sim.arm().model();
+  orbed::robot_state_t a1{};
+  a1.utime = NowMicros();
+  a1.robot_name = "a1";
+  a1.X_WR = ToPose(sim.scene().FindArm("a1")->X_WR);
+  a1.X_RF = a1.X_RT = ToPose(Eigen::Isometry3d::Identity());
+  a1.num_joints = 7;
+  a1.joint_position.assign(7, 0.0);
+  a1.joint_limit_hit.assign(7, 0);
+  for (const Eigen::Isometry3d& X : model.CalcLinkPoses(Eigen::VectorXd::Zero(7))) {
+    a1.X_RL.push_back(ToPose(X));
+    a1.link_names.push_back("x");
+  }
+  a1.num_links = static_cast<int32_t>(a1.X_RL.size());
+  orbed::robot_state_t wrong = a1;
+  wrong.num_links = 3;
+  wrong.X_RL.resize(3);
+  wrong.link_names.resize(3);
+  lcm.publish("ROBOT_STATE_A1", &wrong);
+  lcm.publish("ROBOT_STATE_A1", &a1);
+  dispatch();
+  EXPECT_EQ(sim.process().rejections().counts().at("ROBOT_STATE_A1/field"), 1);
+
+  // Joint 1 to 90 deg (upright, turning in place), then joint 2 to 90 deg: horizontal, toward a1.
+  for (const std::vector<double>& q_deg :
+       {std::vector<double>{90, 0, 0, 0, 0, 0, 0}, std::vector<double>{90, 90, 0, 0, 0, 0, 0}}) {
+    const orbed::iiwa_command_t cmd = Command(q_deg);
+    lcm.publish("IIWA_COMMAND_A0", &cmd);
+    dispatch();
+    for (int k = 0; k < 400 && (k < 2 || states.back().motion_state == orbed::robot_state_t::MOTION_MOVING);
+         ++k) {
+      sim.Tick();
+      dispatch();
+    }
+  }
+  ASSERT_FALSE(states.empty());
+  const orbed::robot_state_t& last = states.back();
+  EXPECT_EQ(last.motion_state, +orbed::robot_state_t::MOTION_STOPPED_BEFORE_COLLISION) << last.stop_reason;
+  EXPECT_NE(last.stop_reason.find(" vs a1/"), std::string::npos) << last.stop_reason;
+  EXPECT_LT(last.joint_position[1], 89 * kDegToRad);  // short of its command
+  // At rest just outside the stop margin (the last step shortened by bisection).
+  EXPECT_GE(sim.arm().collision().closest_other_arm.distance_m, options.stop_margin_m);
+  EXPECT_LT(sim.arm().collision().closest_other_arm.distance_m, options.stop_margin_m + 0.01);
+
+  // a1 moves away (folded down the other way): a0's refusal is lifted and it reaches its command.
+  a1.X_WR = ToPose(Eigen::Translation3d(-3, 0, 0) * sim.scene().FindArm("a1")->X_WR);
+  lcm.publish("ROBOT_STATE_A1", &a1);
+  dispatch();
+  for (int k = 0; k < 400 && states.back().joint_position[1] < 90 * kDegToRad; ++k) {
+    sim.Tick();
+    dispatch();
+  }
+  EXPECT_NEAR(states.back().joint_position[1], 90 * kDegToRad, 1e-12) << states.back().stop_reason;
+
+  options.arm = "a9";
+  try {
+    IiwaSim unknown(MemqFlags(0), options);
+    ADD_FAILURE() << "an unknown arm was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("the arms a0, a1, a2, a3"), std::string::npos) << e.what();
+  }
+}
+
 TEST(IiwaSim, BadOptionsAndFilesAreNamed) {
   IiwaSimOptions bad_q;
   bad_q.initial_q_deg = {0, 0, 0, 0, 0, 0};

@@ -93,6 +93,12 @@ void ManualArm::SetCommand(const Eigen::VectorXd& q_command_rad) {
 void ManualArm::Step(double period_s) {
   if (!(period_s > 0) || !std::isfinite(period_s)) throw std::invalid_argument("Step: period must be > 0 s");
   const Eigen::VectorXd q_before = q_;
+  if (others_moved_) {
+    // Another arm moved: the current q's distances changed, and so may a refusal.
+    collision_ = TimedCheck(q_, &collision_check_us_);
+    blocked_ = false;
+    others_moved_ = false;
+  }
   const Eigen::VectorXd delta = target_ - q_;
   if (delta.cwiseAbs().maxCoeff() == 0.0) {
     blocked_ = false;

@@ -27,7 +27,8 @@
 ///     never touches anything.
 ///   - A blocked arm with an unchanged target re-checks nothing (same q, static scene: same answer).
 ///     Likewise collision() is the query of the current q, made when the arm moved there; an arm at
-///     rest is not re-queried every tick.
+///     rest is not re-queried every tick. Other arms (several arms) are not static: after their poses
+///     change, the next Step re-queries the current q and lifts a refusal.
 ///
 /// Frames: q and limits in the joint space of RobotModel (rad); the collision world in the scene
 /// frame W (X_WR from the scene). Units: m, rad, rad/s, s.
@@ -83,6 +84,19 @@ class ManualArm {
   /// One tick of `period_s` (> 0) seconds: moves, checks, updates state, velocity and collision.
   void Step(double period_s);
 
+  /// Several arms: another arm in the OR, checked against this one from its first
+  /// SetOtherArmLinkPoses on (CollisionWorld::AddOtherArm). Returns its index.
+  int AddOtherArm(const std::string& name, const RobotModel& other) {
+    return world_.AddOtherArm(name, other);
+  }
+  /// Where the other arm's links are now (X_WL per link of its model). The next Step() then checks
+  /// the current q afresh (collision() follows the other arm even while this one rests) and lifts a
+  /// refusal, since the obstacle moved. Throws as CollisionWorld::SetOtherArmLinkPoses.
+  void SetOtherArmLinkPoses(int arm, const std::vector<Eigen::Isometry3d>& X_WL) {
+    world_.SetOtherArmLinkPoses(arm, X_WL);
+    others_moved_ = true;
+  }
+
   /// Fresh collision check of any joint vector (for plan checks); does not move the arm.
   CollisionResult Check(const Eigen::VectorXd& q_rad) { return world_.Check(q_rad); }
 
@@ -120,6 +134,7 @@ class ManualArm {
   Eigen::VectorXd q_, v_, command_, target_;
   std::string clamp_reason_;  // non-empty when the target was clamped
   bool blocked_{false};       // the last step was refused entirely and the target is unchanged
+  bool others_moved_{false};  // another arm's poses changed since the last Step
   std::string blocked_reason_;
   MotionState state_{MotionState::kIdle};
   std::string stop_reason_;

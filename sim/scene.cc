@@ -25,7 +25,7 @@ Scene LoadScene(const YAML::Node& root, const std::string& source) {
   if (!root.IsMap()) f.Fail(root, "(top level)", "expected a mapping with keys robot, trocar, objects");
   Scene scene;
   scene.source = source;
-  f.CheckKeys(root, "", {"name", "robot", "trocar", "objects"});
+  f.CheckKeys(root, "", {"name", "robot", "arms", "trocar", "objects"});
   scene.name = f.StringOr(root, "name", "", scene.name);
 
   const YAML::Node robot = f.Required(root, "robot", "robot", "a mapping with base_pose and tool_length_m");
@@ -36,6 +36,35 @@ Scene LoadScene(const YAML::Node& root, const std::string& source) {
   scene.tool_length_m =
       f.Positive(f.Required(robot, "tool_length_m", "robot.tool_length_m", "a length > 0 [m]"),
                  "robot.tool_length_m", "m");
+
+  // Several arms: each one's name and base; the robot's base_pose stays the single arm's.
+  if (const YAML::Node arms = root["arms"]) {
+    if (!arms.IsSequence() || arms.size() == 0 || arms.size() > kMaxSceneArms) {
+      f.Fail(arms, "arms", "expected a list of 1.." + std::to_string(kMaxSceneArms) + " {name, base_pose}");
+    }
+    for (size_t i = 0; i < arms.size(); ++i) {
+      const std::string key = "arms[" + std::to_string(i) + "]";
+      f.CheckKeys(arms[i], key, {"name", "base_pose"});
+      ArmPlacement arm;
+      arm.name = f.String(f.Required(arms[i], "name", key + ".name", "a name"), key + ".name");
+      const bool plain =
+          !arm.name.empty() && arm.name.size() <= 32 &&
+          arm.name.find_first_not_of("abcdefghijklmnopqrstuvwxyz0123456789_") == std::string::npos;
+      if (!plain) {
+        f.Fail(arms[i]["name"], key + ".name",
+               "expected 1..32 characters of a-z, 0-9 and _ (it names channels), got '" + arm.name + "'");
+      }
+      if (scene.FindArm(arm.name) != nullptr) {
+        f.Fail(arms[i]["name"], key + ".name",
+               "expected a name not used by another arm, got '" + arm.name + "'");
+      }
+      arm.X_WR = Pose(
+          f,
+          f.Required(arms[i], "base_pose", key + ".base_pose", "{position_m: [x, y, z], rpy_deg: [r, p, y]}"),
+          key + ".base_pose");
+      scene.arms.push_back(arm);
+    }
+  }
 
   const YAML::Node trocar =
       f.Required(root, "trocar", "trocar", "a mapping with position_m and insertion_direction");
@@ -111,6 +140,13 @@ Eigen::Matrix3d RotationFromRpyDeg(const Eigen::Vector3d& rpy_deg) {
           Eigen::AngleAxisd(r.y(), Eigen::Vector3d::UnitY()) *
           Eigen::AngleAxisd(r.x(), Eigen::Vector3d::UnitX()))
       .toRotationMatrix();
+}
+
+const ArmPlacement* Scene::FindArm(const std::string& arm_name) const {
+  for (const ArmPlacement& arm : arms) {
+    if (arm.name == arm_name) return &arm;
+  }
+  return nullptr;
 }
 
 Scene LoadSceneFile(const std::string& path) { return LoadScene(YamlFields::LoadFile(path), path); }

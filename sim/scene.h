@@ -16,6 +16,9 @@
 /// robot:                             # required
 ///   base_pose: {position_m: [0.25, -0.55, 0.75], rpy_deg: [0, 0, 90]}   # required: X_WR
 ///   tool_length_m: 0.25              # required: flange F to tool tip T [m], > 0
+/// arms:                              # optional, several arms (scenes/four_arms_or.yaml): 1..16
+///   - name: a0                       # a-z, 0-9, _ (1..32); unique; `orbed-iiwa-sim --arm a0`
+///     base_pose: {position_m: [0.25, -0.55, 0.75], rpy_deg: [0, 0, 90]}   # that arm's X_WR
 /// trocar:                            # required
 ///   position_m: [0.11294, 0.0, 1.06830]                # p_WT*, where the tip docks onto the cannula
 ///   insertion_direction: [-0.258819, 0.0, -0.965926]   # unit vector in W (normalised if within 1 %)
@@ -62,13 +65,26 @@ struct Trocar {
   Eigen::Vector3d insertion_direction_W{-Eigen::Vector3d::UnitZ()};  ///< unit vector
 };
 
+/// One of several arms in the OR (the scene file's `arms:` list): its name (1..32 characters of
+/// a-z, 0-9, _; it suffixes the arm's channels, channels::ForArm) and its base X_WR.
+struct ArmPlacement {
+  std::string name;
+  Eigen::Isometry3d X_WR{Eigen::Isometry3d::Identity()};
+};
+inline constexpr size_t kMaxSceneArms = 16;
+
 struct Scene {
   std::string name;
   std::string source;  ///< file name or the name passed to the loader
+  /// The single arm's base (robot.base_pose); an arm of `arms` has its own.
   Eigen::Isometry3d X_WR{Eigen::Isometry3d::Identity()};
   double tool_length_m{0.25};  ///< [m]: the URDF's tool
   Trocar trocar;
   std::vector<SceneObject> objects;
+  /// Several arms (issue 12): empty for a single-arm scene.
+  std::vector<ArmPlacement> arms;
+  /// The arm of that name, or nullptr.
+  const ArmPlacement* FindArm(const std::string& arm_name) const;
 };
 
 /// Loads a scene file. Throws std::runtime_error naming the file, the line, the key and what was

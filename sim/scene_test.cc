@@ -113,6 +113,34 @@ trocar:
   insertion_direction: [0, 0, -1]
 )";
 
+// Several arms: four_arms_or.yaml's four bases, a0 where the single arm stands; names are checked
+// (they name channels), unique, and at most kMaxSceneArms.
+TEST(SceneTest, ArmsHaveNamesAndBases) {
+  const Scene four = LoadSceneFile(orbed::SourceTreePath("sim/models/scenes/four_arms_or.yaml"));
+  ASSERT_EQ(four.arms.size(), 4u);
+  EXPECT_EQ(four.arms[3].name, "a3");
+  EXPECT_TRUE(four.FindArm("a0")->X_WR.isApprox(four.X_WR, 0));
+  EXPECT_TRUE(four.FindArm("a1")->X_WR.translation().isApprox(Eigen::Vector3d(-0.45, -0.55, 0.75), 0));
+  // a3 faces -y: its x axis is W's -y.
+  EXPECT_TRUE((four.FindArm("a3")->X_WR.linear() * Eigen::Vector3d::UnitX())
+                  .isApprox(-Eigen::Vector3d::UnitY(), 1e-12));
+  EXPECT_EQ(four.FindArm("a4"), nullptr);
+  EXPECT_TRUE(LoadSceneFile(orbed::SourceTreePath(kDefaultSceneRelativePath)).arms.empty());
+  const std::string arm = "  - {name: a0, base_pose: {position_m: [0, 0, 0]}}\n";
+  std::string e = Error(std::string(kGood) + "arms:\n  - {name: Left, base_pose: {position_m: [0, 0, 0]}}\n");
+  EXPECT_NE(e.find("arms[0].name: expected 1..32 characters of a-z, 0-9 and _"), std::string::npos) << e;
+  e = Error(std::string(kGood) + "arms:\n" + arm + arm);
+  EXPECT_NE(e.find("arms[1].name: expected a name not used by another arm, got 'a0'"), std::string::npos)
+      << e;
+  std::string many = std::string(kGood) + "arms:\n";
+  for (int i = 0; i < 17; ++i)
+    many += "  - {name: a" + std::to_string(i) + ", base_pose: {position_m: [0, 0, 0]}}\n";
+  e = Error(many);
+  EXPECT_NE(e.find("arms: expected a list of 1..16"), std::string::npos) << e;
+  e = Error(std::string(kGood) + "arms:\n  - {name: a0}\n");
+  EXPECT_NE(e.find("arms[0].base_pose: missing"), std::string::npos) << e;
+}
+
 TEST(SceneTest, ErrorsNameFileLineKeyAndExpectation) {
   EXPECT_EQ(Error(kGood), "(no error)");
   std::string e = Error(std::string(kGood) +

@@ -3,6 +3,9 @@
 /// Channel names of the orbed bus, defined once. Every process takes these as defaults and lets a
 /// flag override them. Types per channel are in lcmtypes/ and README.md.
 
+#include <cctype>
+#include <string>
+
 namespace orbed::channels {
 
 inline constexpr char kIiwaStatus[] = "IIWA_STATUS";                    // iiwa_status_t, sim, 200 Hz
@@ -35,6 +38,16 @@ inline constexpr char kSimClock[] = "SIM_CLOCK";                        // sim_c
 inline constexpr char kSimClockAck[] = "SIM_CLOCK_ACK";  // sim_clock_ack_t, each follower, per lockstep round
 inline constexpr char kDeputyCommand[] = "DEPUTY_COMMAND";  // deputy_command_t, launcher, 5 Hz per deputy
 inline constexpr char kDeputyStatus[] = "DEPUTY_STATUS";    // deputy_status_t, each deputy, 5 Hz
+
+/// A channel of one of several arms (issue 12): `channel` + "_" + the arm's name in capitals
+/// (ForArm("IIWA_STATUS", "a1") == "IIWA_STATUS_A1"); a single arm ("") keeps the plain name, so
+/// Drake's tools still find IIWA_STATUS and IIWA_COMMAND.
+inline std::string ForArm(const std::string& channel, const std::string& arm) {
+  if (arm.empty()) return channel;
+  std::string suffix = arm;
+  for (char& c : suffix) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  return channel + "_" + suffix;
+}
 
 /// Every channel above (tools that address channels by index: the fuzz targets and their corpora;
 /// new channels are appended so that the indices of the old ones stay).

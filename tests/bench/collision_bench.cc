@@ -271,37 +271,26 @@ class FclBroadphaseChecker {
   std::vector<std::vector<Eigen::Isometry3d>> X_RL_;
 };
 
-// Four arms around the table (issue 12): arm 0 where the scene puts it, arms 1 and 2 beside it on
-// the same side of the table (0.7 m to either side along it), arm 3 across the table facing it
-// (their carts are not in the scene: the scene's one cart is arm 0's).
-// Each arm's world checks its own links, the scene and the three others, as each arm's sim would
-// (so a pair of arms is checked from both sides); each arm sits at its own joint vector from the
-// pool.
+// Four arms around the table (issue 12): sim/models/scenes/four_arms_or.yaml, a0 where the single
+// arm stands, a1 and a2 beside it 0.7 m along the table, a3 across it, each on its cart. Each arm's
+// world checks its own links, the scene and the three others, as each arm's sim would (so a pair of
+// arms is checked from both sides); each arm sits at its own joint vector from the pool.
 struct FourArms {
   static constexpr int kArms = 4;
+  Scene four = LoadSceneFile(orbed::SourceTreePath("sim/models/scenes/four_arms_or.yaml"));
   std::vector<Scene> scenes;
   std::vector<std::unique_ptr<CollisionWorld>> worlds;
-  explicit FourArms(const CollisionWorld::Options& options = {}) {
+  FourArms() {
     const auto& f = F();
-    const Eigen::Isometry3d X_WR0 = f.scene.X_WR;
     for (int k = 0; k < kArms; ++k) {
-      Scene scene = f.scene;
-      if (k == 1) scene.X_WR = Eigen::Translation3d(-0.7, 0, 0) * X_WR0;
-      if (k == 2) scene.X_WR = Eigen::Translation3d(0.7, 0, 0) * X_WR0;
-      if (k == 3) {
-        // Mirrored across the table's long axis (y = 0): base at (0.25, 0.55), facing -y.
-        scene.X_WR = X_WR0;
-        scene.X_WR.translation().y() = -X_WR0.translation().y();
-        scene.X_WR.linear() = Eigen::AngleAxisd(-M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-      }
+      Scene scene = four;
+      scene.X_WR = four.arms.at(k).X_WR;
       scenes.push_back(scene);
     }
-    for (int k = 0; k < kArms; ++k) {
-      worlds.push_back(std::make_unique<CollisionWorld>(f.model, &scenes[k], options));
-    }
+    for (int k = 0; k < kArms; ++k) worlds.push_back(std::make_unique<CollisionWorld>(f.model, &scenes[k]));
     for (int k = 0; k < kArms; ++k) {
       for (int j = 0; j < kArms; ++j) {
-        if (j != k) worlds[k]->AddOtherArm("arm" + std::to_string(j), f.model);
+        if (j != k) worlds[k]->AddOtherArm(four.arms[j].name, f.model);
       }
     }
   }
@@ -432,7 +421,7 @@ BENCHMARK(BM_Bullet4ArmsFkAndCheck);
 void BM_FclBroadphase4ArmsFkAndCheck(benchmark::State& state) {
   const auto& f = F();
   FourArms arms;
-  FclBroadphaseChecker checker(arms.Raw(), f.scene);
+  FclBroadphaseChecker checker(arms.Raw(), arms.four);
   auto q_of = [&](size_t first) {
     std::vector<const Eigen::VectorXd*> q;
     for (int k = 0; k < FourArms::kArms; ++k) q.push_back(&f.pool[(first + k) & 1023]);
