@@ -379,7 +379,7 @@ int CollisionWorld::AddOtherArm(const std::string& name, const RobotModel& other
   return arm;
 }
 
-void CollisionWorld::SetOtherArmLinkPoses(int arm, const std::vector<Eigen::Isometry3d>& X_WL) {
+bool CollisionWorld::SetOtherArmLinkPoses(int arm, const std::vector<Eigen::Isometry3d>& X_WL) {
   Impl& im = *impl_;
   if (arm < 0 || arm >= static_cast<int>(im.arm_names.size()) ||
       X_WL.size() != im.body_of_arm_link[arm].size()) {
@@ -392,17 +392,20 @@ void CollisionWorld::SetOtherArmLinkPoses(int arm, const std::vector<Eigen::Isom
                                   im.arm_names[arm] + "'");
     }
   }
+  bool changed = !im.arm_posed[arm];
   for (size_t i = 0; i < X_WL.size(); ++i) {
     const int b = im.body_of_arm_link[arm][i];
     if (b < 0) continue;
     Body& body = im.bodies[b];
     if (X_WL[i].matrix() == body.X_WL.matrix()) continue;
+    changed = true;
     ++body.epoch;
     body.X_WL = X_WL[i];
     body.object_bt->setWorldTransform(ToBt(X_WL[i]));
     for (auto& c : body.children) c.X_WC = X_WL[i] * c.prim.X_LG;
   }
   im.arm_posed[arm] = 1;
+  return changed;
 }
 
 int CollisionWorld::num_other_arms() const { return static_cast<int>(impl_->arm_names.size()); }

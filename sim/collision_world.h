@@ -141,9 +141,10 @@ class CollisionWorld {
   /// Returns the arm's index. Throws std::invalid_argument on an empty or repeated name.
   int AddOtherArm(const std::string& name, const RobotModel& other);
   /// The other arm's link poses X_WL in W (one per link of its model, as its
-  /// RobotModel::CalcLinkPoses gives X_RL, times its X_WR). Throws std::invalid_argument on a
-  /// wrong arm, count or a non-finite pose.
-  void SetOtherArmLinkPoses(int arm, const std::vector<Eigen::Isometry3d>& X_WL);
+  /// RobotModel::CalcLinkPoses gives X_RL, times its X_WR). Returns whether anything changed for
+  /// a query (the first poses, or a link that moved). Throws std::invalid_argument on a wrong arm,
+  /// count or a non-finite pose.
+  bool SetOtherArmLinkPoses(int arm, const std::vector<Eigen::Isometry3d>& X_WL);
   int num_other_arms() const;
 
   /// One checked pair: a robot link against a robot link (object_b = -1), a scene object

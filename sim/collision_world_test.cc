@@ -592,7 +592,8 @@ TEST(CollisionWorldTest, OtherArmDistancesMatchSegmentDistances) {
     const Eigen::VectorXd q_A = random_q(), q_B = random_q();
     std::vector<Eigen::Isometry3d> X_WL_B = m.CalcLinkPoses(q_B);
     for (auto& X : X_WL_B) X = X_WB * X;
-    world.SetOtherArmLinkPoses(0, X_WL_B);
+    EXPECT_TRUE(world.SetOtherArmLinkPoses(0, X_WL_B));   // moved
+    EXPECT_FALSE(world.SetOtherArmLinkPoses(0, X_WL_B));  // the same poses again: nothing changed
     pruned.SetOtherArmLinkPoses(0, X_WL_B);
     const CollisionResult r = world.Check(q_A);
     const auto caps_A = ArmCapsules(m, q_A);

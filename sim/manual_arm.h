@@ -89,12 +89,12 @@ class ManualArm {
   int AddOtherArm(const std::string& name, const RobotModel& other) {
     return world_.AddOtherArm(name, other);
   }
-  /// Where the other arm's links are now (X_WL per link of its model). The next Step() then checks
-  /// the current q afresh (collision() follows the other arm even while this one rests) and lifts a
-  /// refusal, since the obstacle moved. Throws as CollisionWorld::SetOtherArmLinkPoses.
+  /// Where the other arm's links are now (X_WL per link of its model). If anything moved (or these
+  /// are its first poses), the next Step() checks the current q afresh (collision() follows the other arm
+  /// even while this one rests) and lifts a refusal, since the obstacle moved. Throws as
+  /// CollisionWorld::SetOtherArmLinkPoses.
   void SetOtherArmLinkPoses(int arm, const std::vector<Eigen::Isometry3d>& X_WL) {
-    world_.SetOtherArmLinkPoses(arm, X_WL);
-    others_moved_ = true;
+    if (world_.SetOtherArmLinkPoses(arm, X_WL)) others_moved_ = true;
   }
 
   /// Fresh collision check of any joint vector (for plan checks); does not move the arm.

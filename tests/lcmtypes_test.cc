@@ -126,7 +126,7 @@ TEST(LcmTypes, FingerprintsArePinned) {
                                                   {"collision_status_t", 0x9f78934234cce93fULL},
                                                   {"contact_t", 0x2d8c8a472f48e7e9ULL},
                                                   {"deputy_child_t", 0xf936d88118a99250ULL},
-                                                  {"deputy_command_t", 0x9c83752069eba4e2ULL},
+                                                  {"deputy_command_t", 0xa90c3f5e659ec5a9ULL},
                                                   {"deputy_process_t", 0xea93be0d0e14b1f6ULL},
                                                   {"deputy_status_t", 0xc89ea34a54f2bd1aULL},
                                                   {"gaze_ray_t", 0x65a37e31d5a2eea1ULL},

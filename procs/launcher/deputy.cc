@@ -56,7 +56,8 @@ void Deputy::Start(Managed* m, const orbed::deputy_process_t& wanted) {
 }
 
 void Deputy::Stop(Managed* m, int signal, double timeout_s) {
-  if (!m->child || !m->child->running() || m->signal_sent == signal) return;
+  // Once SIGKILL went out there is nothing stronger (nor weaker) to send.
+  if (!m->child || !m->child->running() || m->signal_sent == signal || m->signal_sent == SIGKILL) return;
   if (m->signal_sent == 0) {
     m->kill_at =
         Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout_s));
@@ -76,6 +77,16 @@ void Deputy::StopAll(std::vector<Managed>* list, const char* why) {
   }
 }
 
+void Deputy::Forget(const char* why) {
+  StopAll(&children_, why);
+  for (Managed& m : children_) {
+    if (m.child && m.child->running()) leaving_.push_back(std::move(m));
+  }
+  children_.clear();
+  launcher_.clear();  // launcher_start_utime_ stays: only a later launcher is followed next
+  changed_ = true;
+}
+
 void Deputy::OnCommand(const orbed::deputy_command_t& command) {
   const std::string problem = CheckDeputyCommand(command);
   if (!problem.empty()) {
@@ -84,18 +95,35 @@ void Deputy::OnCommand(const orbed::deputy_command_t& command) {
   }
   if (command.deputy != options_.name) return;  // another deputy's
   if (command.launcher != launcher_) {
+    if (command.processes.empty()) return;  // a goodbye from a launcher not followed (any more)
+    // Only a launcher that started later replaces the one followed: an earlier one's datagrams
+    // (late, or from a launch left running) must not make the two take turns.
+    // (Also after a launcher was forgotten: its late datagrams do not bring it back.)
+    if (command.launcher_start_utime <= launcher_start_utime_) {
+      if (ignored_launchers_.size() < 16 && ignored_launchers_.insert(command.launcher).second) {
+        ORBED_LOG(kWarn) << "ignoring " << command.launcher
+                         << ", which started no later than the last launcher "
+                         << "followed" << (launcher_.empty() ? "" : " (" + launcher_ + ")");
+      }
+      return;
+    }
     if (!launcher_.empty()) {
       ORBED_LOG(kWarn) << "now following " << command.launcher << " (was " << launcher_ << ")";
-      StopAll(&children_, "its launcher was replaced");
-      for (Managed& m : children_) leaving_.push_back(std::move(m));
-      children_.clear();
+      Forget("its launcher was replaced");
     } else {
       ORBED_LOG(kInfo) << "following " << command.launcher;
     }
     launcher_ = command.launcher;
+    launcher_start_utime_ = command.launcher_start_utime;
     changed_ = true;
   }
   last_command_ = Clock::now();
+  if (command.processes.empty()) {
+    // The launcher's goodbye: whatever still runs stops, and the next launcher is welcome.
+    ORBED_LOG(kInfo) << launcher_ << " is done";
+    Forget("its launcher is done");
+    return;
+  }
   for (const orbed::deputy_process_t& wanted : command.processes) {
     Managed* current = nullptr;
     for (Managed& m : children_) {
@@ -103,6 +131,13 @@ void Deputy::OnCommand(const orbed::deputy_command_t& command) {
     }
     if (wanted.run) {
       if (current != nullptr && current->instance >= wanted.instance) continue;
+      // An earlier launcher's process of that name still stopping: start once it is gone (the
+      // command comes again in 0.2 s), never two at once.
+      bool predecessor_running = false;
+      for (const Managed& m : leaving_) {
+        predecessor_running = predecessor_running || (m.name == wanted.name && m.child && m.child->running());
+      }
+      if (predecessor_running) continue;
       if (current != nullptr) {
         // A newer instance while the old one runs (the launcher missed its exit): the old one goes.
         Stop(current, SIGKILL, 0);
@@ -113,8 +148,23 @@ void Deputy::OnCommand(const orbed::deputy_command_t& command) {
         current = &children_.back();
       }
       Start(current, wanted);
-    } else if (current != nullptr && current->instance <= wanted.instance) {
+    } else if (current != nullptr && current->instance == wanted.instance) {
       Stop(current, wanted.stop_signal, wanted.stop_timeout_s);
+    } else if (current == nullptr || current->instance < wanted.instance) {
+      // Stopped before it started here (the start was lost, or overtaken): it is reported as
+      // exited, so the launcher's stop completes; an older instance still running goes too.
+      if (current != nullptr) {
+        Stop(current, SIGKILL, 0);
+        leaving_.push_back(std::move(*current));
+        *current = Managed{};
+      } else {
+        children_.emplace_back();
+        current = &children_.back();
+      }
+      current->name = wanted.name;
+      current->instance = wanted.instance;
+      current->detail = "stopped before it started";
+      changed_ = true;
     }
   }
   // Processes the launcher no longer lists.
@@ -169,13 +219,9 @@ void Deputy::Tick() {
     it = (it->child && it->child->running()) ? it + 1 : leaving_.erase(it);
   }
   if (!launcher_.empty() && SecondsSince(last_command_) > options_.orphan_timeout_s) {
-    bool any = false;
-    for (const Managed& m : children_) any = any || (m.child && m.child->running() && m.signal_sent == 0);
-    if (any) {
-      ORBED_LOG(kWarn) << "no command from " << launcher_ << " for " << SecondsSince(last_command_)
-                       << " s: stopping what it started";
-      StopAll(&children_, "its launcher is gone");
-    }
+    ORBED_LOG(kWarn) << "no command from " << launcher_ << " for " << SecondsSince(last_command_)
+                     << " s: stopping what it started and forgetting it";
+    Forget("its launcher is gone");
   }
   if (changed_ || SecondsSince(last_status_) >= kDeputyPeriodS) {
     process_.PublishControl(channels::kDeputyStatus, Status());
@@ -194,7 +240,9 @@ orbed::deputy_status_t Deputy::Status() const {
     c.name = m.name;
     c.instance = m.instance;
     c.pid = m.child && !m.failed_to_start ? static_cast<int32_t>(m.child->pid()) : 0;
-    if (m.failed_to_start) {
+    if (!m.child) {  // stopped before it started
+      c.state = orbed::deputy_child_t::STATE_EXITED;
+    } else if (m.failed_to_start) {
       c.state = orbed::deputy_child_t::STATE_FAILED_TO_START;
       c.exit_code = 127;
     } else if (m.child->running()) {

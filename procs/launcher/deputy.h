@@ -11,11 +11,16 @@
 ///   - `run: false` sends the process group its stop_signal (again whenever the wanted signal
 ///     changes, e.g. to SIGKILL), and SIGKILL after stop_timeout_s;
 ///   - a process missing from the command is stopped (SIGTERM, SIGKILL after 5 s);
-///   - a command from another launcher than the one followed makes that one current: what the
-///     previous one started is stopped;
-///   - no command from its launcher for orphan_timeout_s stops everything it started for it (a
-///     launcher that died must not leave processes behind; a partition shorter than that
-///     changes nothing).
+///   - a `run: false` for an instance it never started (the start was lost) is reported as exited
+///     ("stopped before it started"), so the launcher's stop completes;
+///   - a command from a launcher that started later than the one followed makes that one current:
+///     what the previous one started is stopped, and a process of the same name is started only
+///     once its predecessor is gone; commands of an earlier launcher are ignored (no flapping
+///     between two launches);
+///   - a command listing no processes is the followed launcher's goodbye, and no command from it for
+///     orphan_timeout_s means it is gone (a launcher that died must not leave processes behind; a
+///     partition shorter than that changes nothing): either way everything it started is stopped
+///     and the deputy follows nobody until the next launcher.
 /// On SIGINT/SIGTERM it stops its processes (as above) and exits 0.
 ///
 /// Anyone on the LCM group can start commands through a deputy: run deputies only on a group
@@ -26,6 +31,7 @@
 #include <chrono>
 #include <map>
 #include <memory>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -78,11 +84,15 @@ class Deputy {
   void Start(Managed* managed, const orbed::deputy_process_t& wanted);
   void Stop(Managed* managed, int signal, double timeout_s);
   void StopAll(std::vector<Managed>* list, const char* why);
+  // Stops what the followed launcher started and follows nobody.
+  void Forget(const char* why);
 
   DeputyOptions options_;
   CommonFlags flags_;
   Process process_;
-  std::string launcher_;  // the launcher followed ("" before the first command)
+  std::string launcher_;                     // the launcher followed ("" before the first command)
+  int64_t launcher_start_utime_ = 0;         // the last followed one's launcher_start_utime
+  std::set<std::string> ignored_launchers_;  // earlier launchers already warned about
   Clock::time_point last_command_;
   std::vector<Managed> children_;  // the current launcher's, one per name
   std::vector<Managed> leaving_;   // stopping: an earlier launcher's, or replaced instances

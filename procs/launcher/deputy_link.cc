@@ -4,6 +4,7 @@
 
 #include <orbed/deputy_command_t.hpp>
 
+#include "base/format.h"
 #include "procs/common/channels.h"
 #include "procs/common/conversions.h"
 #include "procs/common/log.h"
@@ -28,7 +29,7 @@ class RemoteChild : public ChildHandle {
     slot_->run = true;
     slot_->argv = argv;
     slot_->env = env;
-    slot_->stop_signal = SIGINT;
+    slot_->stop_signal = slot_->spec_stop_signal;
     link_->Changed(slot_->deputy);
     return true;
   }
@@ -37,6 +38,11 @@ class RemoteChild : public ChildHandle {
     if (!exited_ && Reported()) {
       exited_ = slot_->state == orbed::deputy_child_t::STATE_EXITED ||
                 slot_->state == orbed::deputy_child_t::STATE_FAILED_TO_START;
+      // Gone is gone: a deputy that restarts must not start this instance again.
+      if (exited_ && slot_->run) {
+        slot_->run = false;
+        link_->Changed(slot_->deputy);
+      }
     }
     return !running();
   }
@@ -68,15 +74,15 @@ class RemoteChild : public ChildHandle {
 
 }  // namespace
 
-DeputyLink::DeputyLink(Process* process, std::string launcher_id)
-    : process_(process), launcher_id_(std::move(launcher_id)) {
+DeputyLink::DeputyLink(Process* process, std::string launcher_id, int64_t start_utime)
+    : process_(process), launcher_id_(std::move(launcher_id)), start_utime_(start_utime) {
   process_->Subscribe<orbed::deputy_status_t>(channels::kDeputyStatus,
                                               [this](const orbed::deputy_status_t& status, const std::string&,
                                                      int64_t recv_utime) { OnStatus(status, recv_utime); });
 }
 
 std::unique_ptr<ChildHandle> DeputyLink::MakeChild(const std::string& deputy, const std::string& name,
-                                                   double stop_timeout_s) {
+                                                   int stop_signal, double stop_timeout_s) {
   std::unique_ptr<Slot>& slot = slots_[name];
   if (!slot) {
     slot = std::make_unique<Slot>();
@@ -84,6 +90,7 @@ std::unique_ptr<ChildHandle> DeputyLink::MakeChild(const std::string& deputy, co
     slot->name = name;
   }
   slot->stop_timeout_s = stop_timeout_s;
+  slot->spec_stop_signal = stop_signal;
   return std::make_unique<RemoteChild>(this, slot.get());
 }
 
@@ -112,8 +119,17 @@ void DeputyLink::OnStatus(const orbed::deputy_status_t& status, int64_t) {
     ORBED_LOG(kInfo) << "deputy " << status.deputy << " is there";
   }
   last_heard_[status.deputy] = now;
-  // A status for another launcher (an earlier one, or before it heard us) says nothing of ours.
-  if (status.launcher != launcher_id_) return;
+  // A status for another launcher (an earlier one, or before it heard us) says nothing of ours;
+  // after it followed us, it means the deputy let us go.
+  if (status.launcher != launcher_id_) {
+    if (followed_[status.deputy] && lost_.empty()) {
+      lost_ = status.deputy;
+      ORBED_LOG(kError) << "deputy " << status.deputy << " no longer follows this launch (it now follows '"
+                        << EscapeText(status.launcher) << "')";
+    }
+    return;
+  }
+  followed_[status.deputy] = true;
   for (const orbed::deputy_child_t& child : status.children) {
     const auto it = slots_.find(child.name);
     if (it == slots_.end() || it->second->deputy != status.deputy) continue;
@@ -132,6 +148,7 @@ void DeputyLink::Send(const std::string& deputy) {
   orbed::deputy_command_t command{};
   command.utime = NowMicros();
   command.launcher = launcher_id_;
+  command.launcher_start_utime = start_utime_;
   command.deputy = deputy;
   for (const auto& [name, slot] : slots_) {
     if (slot->deputy != deputy || slot->instance == 0) continue;
@@ -154,6 +171,23 @@ void DeputyLink::Send(const std::string& deputy) {
   process_->PublishControl(channels::kDeputyCommand, command);
   last_sent_[deputy] = Clock::now();
   due_[deputy] = false;
+}
+
+std::string DeputyLink::LostDeputy() const { return lost_; }
+
+void DeputyLink::SayGoodbye() {
+  std::map<std::string, bool> deputies;
+  for (const auto& [name, slot] : slots_) {
+    if (slot->instance > 0) deputies[slot->deputy] = true;
+  }
+  for (const auto& [deputy, unused] : deputies) {
+    orbed::deputy_command_t command{};
+    command.utime = NowMicros();
+    command.launcher = launcher_id_;
+    command.launcher_start_utime = start_utime_;
+    command.deputy = deputy;
+    for (int copy = 0; copy < 3; ++copy) process_->PublishControl(channels::kDeputyCommand, command);
+  }
 }
 
 void DeputyLink::Tick() {

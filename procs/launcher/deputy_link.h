@@ -30,13 +30,21 @@ inline constexpr double kDeputySilentAfterS = 3.0;
 class DeputyLink {
  public:
   using Clock = std::chrono::steady_clock;
-  /// `launcher_id` names this launcher in every command ("<launch>@<host>/<pid>").
-  DeputyLink(Process* process, std::string launcher_id);
+  /// `launcher_id` names this launcher in every command ("<launch>@<host>/<pid>"),
+  /// `start_utime` is when it started [us since the epoch].
+  DeputyLink(Process* process, std::string launcher_id, int64_t start_utime);
 
-  /// A handle on process `name` run by `deputy`, which escalates a stop to SIGKILL after
-  /// `stop_timeout_s`; the same slot (and instance count) for every call with that name.
-  std::unique_ptr<ChildHandle> MakeChild(const std::string& deputy, const std::string& name,
+  /// A handle on process `name` run by `deputy`, which stops it with `stop_signal` (when it stops
+  /// it on its own: orphaned, replaced) and escalates a stop to SIGKILL after `stop_timeout_s`; the
+  /// same slot (and instance count) for every call with that name.
+  std::unique_ptr<ChildHandle> MakeChild(const std::string& deputy, const std::string& name, int stop_signal,
                                          double stop_timeout_s);
+  /// The launcher is done: every deputy it used gets an empty command (sent three times), which
+  /// makes it stop whatever still runs and follow the next launcher at once.
+  void SayGoodbye();
+  /// A deputy that followed this launcher and now reports following another or none (it timed
+  /// this launcher out, e.g. across a long partition): its name, else "".
+  std::string LostDeputy() const;
 
   /// Sends the commands that are due and notes deputies that fell silent.
   void Tick();
@@ -52,7 +60,8 @@ class DeputyLink {
     bool run = false;
     std::vector<std::string> argv;
     std::map<std::string, std::string> env;
-    int stop_signal = 2;
+    int stop_signal = 2;       // the signal of the stop asked for now
+    int spec_stop_signal = 2;  // the launch file's
     double stop_timeout_s = 5.0;
     // Reported (for `instance` only once reported.instance == instance).
     int reported_instance = 0;
@@ -71,6 +80,9 @@ class DeputyLink {
 
   Process* process_;
   std::string launcher_id_;
+  int64_t start_utime_;
+  std::map<std::string, bool> followed_;  // by deputy: it reported following this launcher
+  std::string lost_;
   std::map<std::string, std::unique_ptr<Slot>> slots_;  // by process name
   std::map<std::string, bool> due_;                     // by deputy
   std::map<std::string, Clock::time_point> last_sent_, last_heard_;

@@ -16,6 +16,7 @@ bool NameOk(const std::string& name) { return !name.empty() && name.size() <= kM
 std::string CheckDeputyCommand(const orbed::deputy_command_t& msg) {
   if (!NameOk(msg.launcher)) return "launcher: expected 1.." + std::to_string(kMaxDeputyName) + " bytes";
   if (!NameOk(msg.deputy)) return "deputy: expected 1.." + std::to_string(kMaxDeputyName) + " bytes";
+  if (msg.launcher_start_utime <= 0) return "launcher_start_utime: expected > 0";
   if (msg.num_processes < 0 || static_cast<size_t>(msg.num_processes) > kMaxDeputyProcesses ||
       static_cast<size_t>(msg.num_processes) != msg.processes.size()) {
     return "num_processes: expected 0.." + std::to_string(kMaxDeputyProcesses) + " and the array's length";

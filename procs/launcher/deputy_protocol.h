@@ -13,7 +13,8 @@
 ///
 /// Checks (the reason names the field; a deputy or launcher counts it under
 /// "<channel>/invalid" and keeps running):
-///   deputy_command_t: launcher and deputy names 1..kMaxDeputyName bytes; at most
+///   deputy_command_t: launcher and deputy names 1..kMaxDeputyName bytes; launcher_start_utime
+///     > 0; at most
 ///     kMaxDeputyProcesses processes with distinct names (1..kMaxDeputyName bytes, no '/' or
 ///     space); instance >= 1; argc 1..kMaxArgc equal to argv's length, argv[0] not empty, each
 ///     argument at most kMaxArgBytes; num_env at most kMaxEnv equal to both arrays' lengths, keys

@@ -30,11 +30,13 @@ orbed::deputy_process_t Wanted(const std::string& name, int instance, bool run, 
   return p;
 }
 
+// A command of launcher "bed@hostA/<n>", which started at n us.
 orbed::deputy_command_t Command(const std::string& launcher, const std::string& deputy,
                                 std::vector<orbed::deputy_process_t> processes) {
   orbed::deputy_command_t c{};
   c.utime = 1;
   c.launcher = launcher;
+  c.launcher_start_utime = std::stoll(launcher.substr(launcher.rfind('/') + 1));
   c.deputy = deputy;
   c.processes = std::move(processes);
   c.num_processes = static_cast<int32_t>(c.processes.size());
@@ -112,11 +114,44 @@ TEST_F(DeputyTest, StopsOnRunFalseOnAnotherLauncherAndWhenItsLauncherFallsSilent
   ASSERT_EQ(Child("b").state, kRunning);
   deputy.OnCommand(Command("bed@hostA/2", "hostB", {Wanted("c", 1, true, "exec sleep 30")}));
   EXPECT_EQ(Child("b").instance, 0);  // no longer reported
+  EXPECT_EQ(deputy.Status().launcher, "bed@hostA/2");
   ASSERT_TRUE(TickUntil([&] { return Child("c").state == kRunning; }));
-  // Silent launcher: after 0.5 s without a command, what it started is stopped.
+  // The earlier launcher's late command changes nothing (no taking turns).
+  deputy.OnCommand(Command("bed@hostA/1", "hostB", {Wanted("d", 1, true, "exec sleep 30")}));
+  EXPECT_EQ(deputy.Status().launcher, "bed@hostA/2");
+  EXPECT_EQ(Child("d").instance, 0);
+  // Silent launcher: after 0.5 s without a command, what it started is stopped and it is
+  // forgotten; its late datagrams do not bring it back.
   ASSERT_TRUE(TickUntil([&] { return !deputy.AnyRunning(); }));
-  EXPECT_EQ(Child("c").state, kExited);
-  EXPECT_EQ(Child("c").term_signal, SIGTERM);
+  EXPECT_EQ(deputy.Status().launcher, "");
+  EXPECT_EQ(deputy.Status().num_children, 0);
+  deputy.OnCommand(Command("bed@hostA/2", "hostB", {Wanted("c", 1, true, "exec sleep 30")}));
+  EXPECT_EQ(deputy.Status().launcher, "");
+  EXPECT_FALSE(deputy.AnyRunning());
+}
+
+TEST_F(DeputyTest, AGoodbyeStopsEverythingAndAStopBeforeTheStartIsReported) {
+  Deputy& deputy = MakeDeputy();
+  // The start of "late" was lost; its stop arrives first: reported as exited, never started.
+  deputy.OnCommand(
+      Command("bed@hostA/1", "hostB",
+              {Wanted("a", 1, true, "exec sleep 30"), Wanted("late", 1, false, "exec sleep 30")}));
+  EXPECT_EQ(Child("late").state, kExited);
+  EXPECT_EQ(Child("late").pid, 0);
+  EXPECT_EQ(Child("late").detail, "stopped before it started");
+  deputy.OnCommand(
+      Command("bed@hostA/1", "hostB",
+              {Wanted("a", 1, true, "exec sleep 30"), Wanted("late", 1, true, "exec sleep 30")}));
+  EXPECT_EQ(Child("late").state, kExited);  // that instance is over; only a next one would start
+  ASSERT_EQ(Child("a").state, kRunning);
+  // The launcher's goodbye (no processes): "a" is stopped, the deputy follows nobody, and the next
+  // launcher is followed at once.
+  deputy.OnCommand(Command("bed@hostA/1", "hostB", {}));
+  EXPECT_EQ(deputy.Status().launcher, "");
+  ASSERT_TRUE(TickUntil([&] { return !deputy.AnyRunning(); }));
+  deputy.OnCommand(Command("bed@hostA/3", "hostB", {Wanted("a", 1, true, "exec sleep 30")}));
+  EXPECT_EQ(deputy.Status().launcher, "bed@hostA/3");
+  EXPECT_EQ(Child("a").state, kRunning);
 }
 
 TEST_F(DeputyTest, IgnoresOtherDeputiesCommandsAndCountsMalformedOnes) {
@@ -147,6 +182,7 @@ TEST(DeputyProtocol, ChecksEveryField) {
     return CheckDeputyCommand(c);
   };
   EXPECT_NE(broken([](auto* c) { c->launcher = ""; }), "");
+  EXPECT_NE(broken([](auto* c) { c->launcher_start_utime = 0; }), "");
   EXPECT_NE(broken([](auto* c) { c->deputy = std::string(kMaxDeputyName + 1, 'd'); }), "");
   EXPECT_NE(broken([](auto* c) { c->num_processes = 2; }), "");
   EXPECT_NE(broken([](auto* c) { c->processes.push_back(c->processes[0]), c->num_processes = 2; }), "");

@@ -10,6 +10,7 @@
 #include "procs/common/channels.h"
 #include "procs/common/conversions.h"
 #include "procs/common/log.h"
+#include "procs/launcher/deputy_protocol.h"
 
 namespace orbed::launcher {
 namespace {
@@ -23,13 +24,38 @@ double SecondsSince(std::chrono::steady_clock::time_point t) {
 
 }  // namespace
 
+namespace {
+
+// A process placed on another host must fit DEPUTY_COMMAND's limits (deputy_protocol.h), or its
+// deputy would refuse the whole command: said here, at start, naming the process.
+void CheckRemoteProcess(const ProcessSpec& p) {
+  auto fail = [&](const std::string& why) {
+    throw std::invalid_argument("process '" + p.name + "' on host '" + p.host + "': " + why);
+  };
+  if (p.name.size() > kMaxDeputyName || p.host.size() > kMaxDeputyName) fail("a name over 256 bytes");
+  if (!(p.stop_timeout_s <= kMaxStopTimeoutS)) {
+    fail("stop_timeout_s over " + std::to_string(static_cast<int>(kMaxStopTimeoutS)) + " s");
+  }
+  if (p.args.size() + 3 > kMaxArgc) fail("more than " + std::to_string(kMaxArgc - 3) + " arguments");
+  if (p.command.size() > kMaxArgBytes) fail("a command over " + std::to_string(kMaxArgBytes) + " bytes");
+  for (const std::string& arg : p.args) {
+    if (arg.size() > kMaxArgBytes) fail("an argument over " + std::to_string(kMaxArgBytes) + " bytes");
+  }
+  if (p.env.size() + 3 > kMaxEnv) fail("more than " + std::to_string(kMaxEnv - 3) + " env variables");
+  for (const auto& [key, value] : p.env) {
+    if (key.size() > kMaxDeputyName || value.size() > kMaxArgBytes) fail("env " + key + " too long");
+  }
+}
+
+}  // namespace
+
 Launcher::Launcher(const CommonFlags& flags, LaunchSpec spec, std::string bin_dir, std::string host)
     : flags_(flags),
       spec_(std::move(spec)),
       bin_dir_(std::move(bin_dir)),
       host_(std::move(host)),
       process_(flags),
-      deputies_(&process_, spec_.name + "@" + host_ + "/" + std::to_string(getpid())) {
+      deputies_(&process_, spec_.name + "@" + host_ + "/" + std::to_string(getpid()), NowMicros()) {
   name_width_ = 7;  // "process", the summary's header
   for (size_t g = 0; g < spec_.groups.size(); ++g) {
     for (const ProcessSpec& p : spec_.groups[g].processes) {
@@ -42,9 +68,18 @@ Launcher::Launcher(const CommonFlags& flags, LaunchSpec spec, std::string bin_di
       managed.spec = p;
       managed.group = g;
       managed.remote = !p.host.empty() && p.host != host_;
+      if (managed.remote) CheckRemoteProcess(p);
       managed.child = MakeChild(managed);
       managed.prefix = p.name + std::string(name_width_ - p.name.size(), ' ') + " | ";
       managed_.push_back(std::move(managed));
+    }
+  }
+  std::map<std::string, size_t> per_host;
+  for (const Managed& m : managed_) {
+    if (m.remote && ++per_host[m.spec.host] > kMaxDeputyProcesses) {
+      throw std::invalid_argument("more than " + std::to_string(kMaxDeputyProcesses) +
+                                  " processes on host '" + m.spec.host +
+                                  "' (one deputy runs at most that many)");
     }
   }
   process_.Subscribe<orbed::process_status_t>(
@@ -54,7 +89,8 @@ Launcher::Launcher(const CommonFlags& flags, LaunchSpec spec, std::string bin_di
 }
 
 std::unique_ptr<ChildHandle> Launcher::MakeChild(const Managed& m) {
-  if (m.remote) return deputies_.MakeChild(m.spec.host, m.spec.name, m.spec.stop_timeout_s);
+  if (m.remote)
+    return deputies_.MakeChild(m.spec.host, m.spec.name, m.spec.stop_signal, m.spec.stop_timeout_s);
   return std::make_unique<Child>();
 }
 
@@ -183,6 +219,15 @@ void Launcher::FailTestbed(const std::string& reason) {
 
 void Launcher::Tick() {
   deputies_.Tick();
+  if (!stopping_ && exit_code_ == 0) {
+    const std::string lost = deputies_.LostDeputy();
+    if (!lost.empty()) {
+      FailTestbed("deputy " + lost +
+                  " stopped following this launch (it heard nothing from it for its --orphan-timeout-s, or a "
+                  "later launch took it over) and stopped its processes");
+      return;
+    }
+  }
   for (Managed& m : managed_) {
     if (!m.started) continue;
     m.child->Drain(m.prefix);
@@ -333,6 +378,7 @@ int Launcher::Run() {
   StartGroup(0);
   process_.Run();
   StopEverything();
+  deputies_.SayGoodbye();
   PrintSummary();
   if (exit_code_ != 0) ORBED_LOG(kError) << "testbed failed: exit code " << exit_code_;
   return exit_code_;

@@ -81,6 +81,11 @@ std::string Monitor::NewlySilent(int64_t now_utime) {
     const double age_s = (now_utime - seen.recv_utime) * 1e-6;
     if (seen.silent || age_s <= options_.silent_after_s) continue;
     seen.silent = true;
+    if (seen.status.state == orbed::process_status_t::STATE_STOPPING) {
+      out += EscapeText(name) + " on " + EscapeText(seen.status.host) +
+             ": stopped (its last heartbeat said so)\n";
+      continue;
+    }
     out += EscapeText(name) + " on " + EscapeText(seen.status.host) + ": SILENT (no heartbeat for " +
            Fixed(age_s, 1) + " s)\n";
   }
