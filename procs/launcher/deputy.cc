@@ -77,6 +77,17 @@ void Deputy::StopAll(std::vector<Managed>* list, const char* why) {
   }
 }
 
+Deputy::Managed* Deputy::Replace(Managed* current) {
+  if (current == nullptr) {
+    children_.emplace_back();
+    return &children_.back();
+  }
+  Stop(current, SIGKILL, 0);
+  leaving_.push_back(std::move(*current));
+  *current = Managed{};
+  return current;
+}
+
 void Deputy::Forget(const char* why) {
   StopAll(&children_, why);
   for (Managed& m : children_) {
@@ -138,29 +149,15 @@ void Deputy::OnCommand(const orbed::deputy_command_t& command) {
         predecessor_running = predecessor_running || (m.name == wanted.name && m.child && m.child->running());
       }
       if (predecessor_running) continue;
-      if (current != nullptr) {
-        // A newer instance while the old one runs (the launcher missed its exit): the old one goes.
-        Stop(current, SIGKILL, 0);
-        leaving_.push_back(std::move(*current));
-        *current = Managed{};
-      } else {
-        children_.emplace_back();
-        current = &children_.back();
-      }
+      // A newer instance while the old one runs (the launcher missed its exit): the old one goes.
+      current = Replace(current);
       Start(current, wanted);
     } else if (current != nullptr && current->instance == wanted.instance) {
       Stop(current, wanted.stop_signal, wanted.stop_timeout_s);
     } else if (current == nullptr || current->instance < wanted.instance) {
       // Stopped before it started here (the start was lost, or overtaken): it is reported as
       // exited, so the launcher's stop completes; an older instance still running goes too.
-      if (current != nullptr) {
-        Stop(current, SIGKILL, 0);
-        leaving_.push_back(std::move(*current));
-        *current = Managed{};
-      } else {
-        children_.emplace_back();
-        current = &children_.back();
-      }
+      current = Replace(current);
       current->name = wanted.name;
       current->instance = wanted.instance;
       current->detail = "stopped before it started";

@@ -86,6 +86,9 @@ class Deputy {
   void StopAll(std::vector<Managed>* list, const char* why);
   // Stops what the followed launcher started and follows nobody.
   void Forget(const char* why);
+  // A fresh entry for a process: `current` (its old instance SIGKILLed and moved to leaving_) or,
+  // for nullptr, a new one in children_.
+  Managed* Replace(Managed* current);
 
   DeputyOptions options_;
   CommonFlags flags_;

@@ -46,11 +46,13 @@ bool Shell(const std::string& command) {
 // and goes with it.
 class VirtualLan {
  public:
-  VirtualLan() {
+  // Hosts named `hosts`, as 10.77.0.1, .2, ...
+  explicit VirtualLan(const std::vector<std::string>& hosts) {
     ok_ = Shell("ip link add orbedbr0 type bridge mcast_snooping 0 && ip link set orbedbr0 up");
     // The test itself listens on the bridge (an observer, not a host).
     ok_ =
         ok_ && Shell("ip addr add 10.77.0.254/24 dev orbedbr0 && ip route replace 224.0.0.0/4 dev orbedbr0");
+    for (size_t i = 0; i < hosts.size() && ok_; ++i) AddHost(hosts[i], static_cast<int>(i) + 1);
   }
   ~VirtualLan() {
     // The hosts' ends of the veth pairs go with their namespaces (the holders, stopped after this).
@@ -64,7 +66,11 @@ class VirtualLan {
         std::make_unique<RunningProcess>(std::vector<std::string>{"/usr/bin/unshare", "-n", "sleep", "3600"});
     const std::string pid = std::to_string(holder->pid());
     // The holder is in its namespace once its /proc entry points at another one than ours.
-    ASSERT_TRUE(WaitFor([&] { return NetNamespace("/proc/" + pid) != NetNamespace("/proc/self"); }, 10));
+    if (!WaitFor([&] { return NetNamespace("/proc/" + pid) != NetNamespace("/proc/self"); }, 10)) {
+      ADD_FAILURE() << "host " << name << ": no network namespace of its own";
+      ok_ = false;
+      return;
+    }
     const std::string outside = "ve" + std::to_string(index), inside = "eth" + std::to_string(index);
     const std::string in_host = "nsenter --target " + pid + " --net ";
     ok_ = ok_ && Shell("ip link add " + outside + " type veth peer name " + inside + " && ip link set " +
@@ -101,6 +107,10 @@ class VirtualLan {
   std::map<std::string, Host> hosts_;
 };
 
+// Hosts are network namespaces made by root inside the test's own (scripts/netns-exec).
+bool CanBuildHosts() { return std::getenv("ORBED_IN_NETNS") != nullptr && geteuid() == 0; }
+constexpr char kNoHosts[] = "needs root in a private network namespace (scripts/netns-exec as root)";
+
 bool AnyLineHas(const std::vector<std::string>& lines, const std::string& a, const std::string& b = "") {
   for (const std::string& line : lines) {
     if (line.find(a) != std::string::npos && line.find(b) != std::string::npos) return true;
@@ -109,16 +119,9 @@ bool AnyLineHas(const std::vector<std::string>& lines, const std::string& a, con
 }
 
 TEST(Hosts, TheViraalRunOnThreeHostsCompletesAndSurvivesAPartition) {
-  if (std::getenv("ORBED_IN_NETNS") == nullptr || geteuid() != 0) {
-    GTEST_SKIP() << "needs root in a private network namespace (scripts/netns-exec as root)";
-  }
-  VirtualLan lan;
+  if (!CanBuildHosts()) GTEST_SKIP() << kNoHosts;
+  VirtualLan lan({"hostA", "hostB", "hostC"});
   ASSERT_TRUE(lan.ok());
-  lan.AddHost("hostA", 1);
-  lan.AddHost("hostB", 2);
-  lan.AddHost("hostC", 3);
-  ASSERT_TRUE(lan.ok());
-  if (::testing::Test::HasFatalFailure()) return;
 
   const std::string dir = MakeTempDir("hosts");
   std::ofstream(dir + "/three_hosts.yaml")
@@ -184,15 +187,9 @@ TEST(Hosts, TheViraalRunOnThreeHostsCompletesAndSurvivesAPartition) {
 // would be: the headset on B, SIGKILLed after the first trial, comes back as a new instance (a new
 // pid, ready again at its heartbeat) and the run completes.
 TEST(Hosts, AProcessKilledOnAnotherHostIsRespawnedThroughItsDeputy) {
-  if (std::getenv("ORBED_IN_NETNS") == nullptr || geteuid() != 0) {
-    GTEST_SKIP() << "needs root in a private network namespace (scripts/netns-exec as root)";
-  }
-  VirtualLan lan;
+  if (!CanBuildHosts()) GTEST_SKIP() << kNoHosts;
+  VirtualLan lan({"hostA", "hostB"});
   ASSERT_TRUE(lan.ok());
-  lan.AddHost("hostA", 1);
-  lan.AddHost("hostB", 2);
-  ASSERT_TRUE(lan.ok());
-  if (::testing::Test::HasFatalFailure()) return;
   const std::string dir = MakeTempDir("hosts_respawn");
   std::ofstream(dir + "/two_hosts.yaml") << "name: two_hosts\n"
                                          << "include: [" << SourcePath("scripts/launch/viraal.yaml") << "]\n"
