@@ -1,5 +1,7 @@
 #include "base/proc_stats.h"
 
+#include <unistd.h>
+
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -33,6 +35,33 @@ int64_t ProcStatusKb(pid_t pid, const std::string& field) {
     return value >> kb ? kb : -1;
   }
   return -1;
+}
+
+int64_t ParseStatCpuTicks(const std::string& stat) {
+  const size_t name_end = stat.rfind(')');
+  if (name_end == std::string::npos) return -1;
+  // After the name: field 3 (state) onwards; utime and stime are fields 14 and 15.
+  std::istringstream fields(stat.substr(name_end + 1));
+  std::vector<std::string> f((std::istream_iterator<std::string>(fields)),
+                             std::istream_iterator<std::string>());
+  constexpr size_t kUtime = 14 - 3, kStime = 15 - 3;
+  if (f.size() <= kStime) return -1;
+  try {
+    size_t used_u = 0, used_s = 0;
+    const int64_t utime = std::stoll(f[kUtime], &used_u);
+    const int64_t stime = std::stoll(f[kStime], &used_s);
+    if (used_u != f[kUtime].size() || used_s != f[kStime].size() || utime < 0 || stime < 0) return -1;
+    return utime + stime;
+  } catch (const std::exception&) {
+    return -1;
+  }
+}
+
+double ProcCpuSeconds(pid_t pid) {
+  const int64_t ticks = ParseStatCpuTicks(ReadAll(ProcPath(pid, "stat")));
+  const long ticks_per_s = sysconf(_SC_CLK_TCK);
+  if (ticks < 0 || ticks_per_s <= 0) return -1;
+  return static_cast<double>(ticks) / static_cast<double>(ticks_per_s);
 }
 
 std::map<std::string, pid_t> ChildrenByName(pid_t parent) {

@@ -24,6 +24,14 @@ namespace orbed {
 /// resident), or -1 when the process is gone or has no such line.
 int64_t ProcStatusKb(pid_t pid, const std::string& field);
 
+/// The CPU time `pid` has used since it started, user + system over all its threads [s], or -1
+/// when the process is gone.
+double ProcCpuSeconds(pid_t pid);
+/// User + system clock ticks (fields 14 and 15) from the text of /proc/<pid>/stat, or -1 when it
+/// is malformed. The command name (field 2) may hold spaces and parentheses: the fields are counted
+/// from its last ')'.
+int64_t ParseStatCpuTicks(const std::string& stat);
+
 /// The live children of `parent` whose command line has "--name NAME", by NAME (from
 /// /proc/<parent>/task/*/children and each child's cmdline). orbed-launch passes every child its
 /// --name, so this maps a launch file's process names to their pids.

@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <csignal>
+#include <ctime>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -63,6 +64,33 @@ TEST(ProcStats, ParsesTheDropsColumnByInode) {
   EXPECT_EQ(drops.at(148171), 17);
   EXPECT_EQ(drops.at(81235), 0);
   EXPECT_TRUE(ParseUdpDropsByInode("").empty());
+}
+
+TEST(ProcStats, CpuTicksAreCountedFromTheLastParenthesis) {
+  // Fields 3..15 after a name with a space and a ')': utime 250 and stime 40 ticks.
+  EXPECT_EQ(ParseStatCpuTicks("1234 (we ird) x) S 1 2 3 4 5 6 7 8 9 10 250 40 0 0 20 0 1 0 100\n"), 290);
+  EXPECT_EQ(ParseStatCpuTicks("1234 (short) S 1 2 3"), -1);
+  EXPECT_EQ(ParseStatCpuTicks("1234 (bad) S 1 2 3 4 5 6 7 8 9 10 2x5 40"), -1);
+  EXPECT_EQ(ParseStatCpuTicks("no parenthesis"), -1);
+  EXPECT_EQ(ProcCpuSeconds(0x3fffffff), -1);
+}
+
+TEST(ProcStats, OwnCpuTimeAgreesWithTheProcessClock) {
+  // The kernel's process CPU clock (clock_gettime) read before and after /proc: the ticks lie
+  // between, up to two ticks of truncation.
+  const auto cpu_s = [] {
+    timespec t{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+  };
+  volatile double sink = 0;
+  while (cpu_s() < 0.1) sink = sink + 1;  // some CPU time of our own
+  const double tick_s = 1.0 / static_cast<double>(sysconf(_SC_CLK_TCK));
+  const double before = cpu_s();
+  const double proc = ProcCpuSeconds(getpid());
+  const double after = cpu_s();
+  EXPECT_GE(proc, before - 2 * tick_s);
+  EXPECT_LE(proc, after + tick_s);
 }
 
 TEST(ProcStats, OwnUdpSocketIsSeenWithNoDrops) {

@@ -134,4 +134,14 @@ HmdConfigSet LoadHmdConfigs(const std::vector<std::string>& paths) {
   return set;
 }
 
+HmdConfigSet MovedBy(const Eigen::Isometry3d& X, HmdConfigSet config) {
+  config.walk.p_W_look_at = X * config.walk.p_W_look_at;
+  for (HeadWaypoint& w : config.walk.waypoints) {
+    w.p_WH = X * w.p_WH;
+    if (w.p_W_look_at) w.p_W_look_at = X * *w.p_W_look_at;
+  }
+  config.hmd.session_start_m = X * config.hmd.session_start_m;
+  return config;
+}
+
 }  // namespace orbed::hmd

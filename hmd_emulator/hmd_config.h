@@ -106,6 +106,11 @@ struct HmdConfigSet {
   std::vector<std::string> sources;  ///< files read, in order
 };
 
+/// The same person around another arm: every point of the config in W (the walk's waypoints and
+/// look-at targets, the session map's origin) carried by the rigid motion X_WW' (p -> X p), e.g.
+/// X_WR_arm X_WR_single^-1 to walk around the arm at X_WR_arm the walk written for X_WR_single.
+HmdConfigSet MovedBy(const Eigen::Isometry3d& X, HmdConfigSet config);
+
 /// Loads `paths` in order (see the file comment: merged key by key), then resolves and
 /// checks the cross references: an empty display list becomes one display at the walk's first
 /// waypoint, an empty align_waypoint the walk's last; every waypoint named must exist in the walk

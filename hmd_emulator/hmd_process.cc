@@ -40,6 +40,23 @@ HmdProcess::HmdProcess(const orbed::CommonFlags& flags, const HmdOptions& option
   if (options_.urdf_path.empty())
     options_.urdf_path = HmdSourcePath(sim::RobotModel::kDefaultUrdfRelativePath);
   if (options_.scene_path.empty()) options_.scene_path = HmdSourcePath(sim::kDefaultSceneRelativePath);
+  for (const auto& [flag, name] :
+       {std::pair{"--headset", options_.headset}, std::pair{"--arm", options_.arm}}) {
+    if (!name.empty() && !channels::IsInstanceName(name))
+      throw std::invalid_argument(std::string(flag) + " " + name + ": expected " +
+                                  channels::kInstanceNameRule);
+  }
+  for (std::string* channel :
+       {&options_.hmd_pose_channel, &options_.hmd_pose_truth_channel, &options_.camera_channel,
+        &options_.gaze_channel, &options_.reflective_channel, &options_.ar_view_channel,
+        &options_.trial_channel, &options_.session_control_channel, &options_.registration_channel}) {
+    *channel = channels::ForHeadset(*channel, options_.headset);
+  }
+  for (std::string* channel :
+       {&options_.iiwa_status_channel, &options_.robot_state_channel, &options_.iiwa_command_channel,
+        &options_.guidance_channel, &options_.setup_task_channel}) {
+    *channel = channels::ForArm(*channel, options_.arm);
+  }
   if (!(options_.camera_hz > 0 && options_.camera_hz <= 1000)) {
     throw std::invalid_argument("--camera-hz must be in (0, 1000] Hz");
   }
@@ -63,7 +80,11 @@ HmdProcess::HmdProcess(const orbed::CommonFlags& flags, const HmdOptions& option
                                 " reflective display(s) (hmd.displays)");
   }
 
-  const sim::Scene scene = sim::LoadSceneFile(options_.scene_path);
+  sim::Scene scene = sim::LoadSceneFile(options_.scene_path);
+  // Another arm than the single one: the same person walks the same way around that arm.
+  const Eigen::Isometry3d X_WR_single = scene.X_WR;
+  scene.StandAt(options_.arm);
+  if (!options_.arm.empty()) config_ = MovedBy(scene.X_WR * X_WR_single.inverse(), config_);
   // With the scene's tool length, before any geometry copies the tool's primitives.
   robot_model_ = std::make_unique<sim::RobotModel>(sim::LoadRobotForScene(options_.urdf_path, scene));
   // Names every annotation landmark the model lacks now rather than at the first trial.

@@ -131,6 +131,15 @@ struct HmdOptions {
   bool threaded{true};  ///< images on a worker thread (see the file comment)
   /// The session's state file (session_file.h): restored at start, saved on every change; "" = none.
   std::string state_file;
+  /// One of several headsets (issue 12; channels::IsInstanceName): every channel of the headset's
+  /// own (HMD_POSE, HMD_POSE_TRUTH, HMD_CAMERA, GAZE_RAY, REFLECTIVE_VIEW, AR_VIEW,
+  /// ALIGNMENT_TRIAL) and of its session (SESSION_CONTROL, REGISTRATION) gets the suffix _NAME
+  /// (channels::ForHeadset); "" = the single headset, plain names.
+  std::string headset;
+  /// The arm it looks at, one of the scene's `arms:` (sim::Scene::StandAt): the walk and the start
+  /// offset around that arm's base, the arm's channels (IIWA_STATUS, ROBOT_STATE, IIWA_COMMAND,
+  /// GUIDANCE, SETUP_TASK) with its suffix (channels::ForArm); "" = the single arm.
+  std::string arm;
   std::string iiwa_status_channel{channels::kIiwaStatus};
   std::string robot_state_channel{channels::kRobotState};
   std::string session_control_channel{channels::kSessionControl};

@@ -497,6 +497,58 @@ TEST(HmdProcess, PoseAndTruthShareSeqAndStartAtTheFirstWaypoint) {
   EXPECT_NEAR(ToVector3(got.gaze.back().direction_W).norm(), 1.0, 1e-9);
 }
 
+// Several headsets and arms (issue 12): --headset suffixes what the headset publishes, --arm what
+// it reads of its arm, and the person walks the shipped walk carried to that arm's base.
+TEST(HmdProcess, AHeadsetAtAnotherArmUsesItsChannelsAndWalksAroundThatArm) {
+  HmdOptions o = Inline();
+  o.scene_path = HmdSourcePath("sim/models/scenes/four_arms_or.yaml");
+  o.headset = "h1";
+  o.arm = "a2";
+  HmdProcess hmd(MemqFlags(0), o);
+  EXPECT_EQ(hmd.options().hmd_pose_channel, "HMD_POSE_H1");
+  EXPECT_EQ(hmd.options().camera_channel, "HMD_CAMERA_H1");
+  EXPECT_EQ(hmd.options().trial_channel, "ALIGNMENT_TRIAL_H1");
+  EXPECT_EQ(hmd.options().session_control_channel, "SESSION_CONTROL_H1");
+  EXPECT_EQ(hmd.options().registration_channel, "REGISTRATION_H1");
+  EXPECT_EQ(hmd.options().iiwa_status_channel, "IIWA_STATUS_A2");
+  EXPECT_EQ(hmd.options().robot_state_channel, "ROBOT_STATE_A2");
+  EXPECT_EQ(hmd.options().guidance_channel, "GUIDANCE_A2");
+  Collector plain;  // the single headset's channels
+  plain.Attach(hmd.process().lcm());
+  std::vector<orbed::hmd_pose_t> truth;
+  lcm::LCM& lcm = hmd.process().lcm();
+  auto* sub = lcm.subscribeFunction(
+      "HMD_POSE_TRUTH_H1",
+      +[](const lcm::ReceiveBuffer*, const std::string&, const orbed::hmd_pose_t* m,
+          std::vector<orbed::hmd_pose_t>* out) { out->push_back(*m); },
+      &truth);
+  hmd.PublishPose();
+  hmd.PublishGaze();
+  Drain(lcm);
+  lcm.unsubscribe(sub);
+  EXPECT_TRUE(plain.truth.empty() && plain.est.empty() && plain.gaze.empty());
+  ASSERT_EQ(truth.size(), 1u);
+  // foot_end (1.45, -1.20, 1.70) of viraal_walk.yaml, written for the single arm (a0's base), carried
+  // to a2's base.
+  const sim::Scene scene = sim::LoadSceneFile(o.scene_path);
+  const Eigen::Vector3d expected =
+      scene.FindArm("a2")->X_WR * scene.FindArm("a0")->X_WR.inverse() * Eigen::Vector3d(1.45, -1.20, 1.70);
+  EXPECT_LT((ToVector3(truth[0].X_WH.position_m) - expected).norm(), 1e-9);
+  EXPECT_GT((expected - Eigen::Vector3d(1.45, -1.20, 1.70)).norm(), 0.5);  // a2 stands elsewhere
+
+  HmdOptions bad = o;
+  bad.arm = "a7";
+  try {
+    HmdProcess unknown(MemqFlags(0), bad);
+    ADD_FAILURE() << "an arm the scene lacks was taken";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("the arms a0, a1, a2, a3"), std::string::npos) << e.what();
+  }
+  bad = o;
+  bad.headset = "H1";
+  EXPECT_THROW(HmdProcess(MemqFlags(0), bad), std::invalid_argument);
+}
+
 TEST(HmdProcess, CameraReflectiveAndArViewCarryTheirGeometry) {
   HmdOptions options = Inline();
   options.displays = 1;

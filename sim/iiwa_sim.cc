@@ -132,16 +132,7 @@ IiwaSim::IiwaSim(const orbed::CommonFlags& flags, const IiwaSimOptions& options)
       tick_us_(steps_per_tick_ * period_us_),
       tick_wall_ns_(std::max<int64_t>(1, tick_us_ * 1000 / options_.realtime_rate)),
       barrier_(options_.lockstep_timeout_s) {
-  if (!options_.arm.empty()) {
-    const ArmPlacement* placement = scene_.FindArm(options_.arm);
-    if (placement == nullptr) {
-      std::string names;
-      for (const ArmPlacement& a : scene_.arms) names += (names.empty() ? "" : ", ") + a.name;
-      throw std::invalid_argument("--arm " + options_.arm + ": the scene " + scene_.source + " has " +
-                                  (names.empty() ? "no arms: list" : "the arms " + names));
-    }
-    scene_.X_WR = placement->X_WR;
-  }
+  scene_.StandAt(options_.arm);
   const RobotModel model = LoadRobotForScene(options_.urdf_path, scene_);
   ManualArmOptions arm_options;
   arm_options.stop_margin_m = options_.stop_margin_m;

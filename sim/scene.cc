@@ -7,6 +7,7 @@
 #include "base/source_paths.h"
 #include "base/units.h"
 #include "base/yaml_fields.h"
+#include "procs/common/channels.h"
 
 namespace orbed::sim {
 namespace {
@@ -47,12 +48,10 @@ Scene LoadScene(const YAML::Node& root, const std::string& source) {
       f.CheckKeys(arms[i], key, {"name", "base_pose"});
       ArmPlacement arm;
       arm.name = f.String(f.Required(arms[i], "name", key + ".name", "a name"), key + ".name");
-      const bool plain =
-          !arm.name.empty() && arm.name.size() <= 32 &&
-          arm.name.find_first_not_of("abcdefghijklmnopqrstuvwxyz0123456789_") == std::string::npos;
-      if (!plain) {
+      if (!channels::IsInstanceName(arm.name)) {
         f.Fail(arms[i]["name"], key + ".name",
-               "expected 1..32 characters of a-z, 0-9 and _ (it names channels), got '" + arm.name + "'");
+               std::string("expected ") + channels::kInstanceNameRule + " (it names channels), got '" +
+                   arm.name + "'");
       }
       if (scene.FindArm(arm.name) != nullptr) {
         f.Fail(arms[i]["name"], key + ".name",
@@ -147,6 +146,18 @@ const ArmPlacement* Scene::FindArm(const std::string& arm_name) const {
     if (arm.name == arm_name) return &arm;
   }
   return nullptr;
+}
+
+void Scene::StandAt(const std::string& arm_name) {
+  if (arm_name.empty()) return;
+  const ArmPlacement* placement = FindArm(arm_name);
+  if (placement == nullptr) {
+    std::string names;
+    for (const ArmPlacement& a : arms) names += (names.empty() ? "" : ", ") + a.name;
+    throw std::invalid_argument("--arm " + arm_name + ": the scene " + source + " has " +
+                                (names.empty() ? "no arms: list" : "the arms " + names));
+  }
+  X_WR = placement->X_WR;
 }
 
 Scene LoadSceneFile(const std::string& path) { return LoadScene(YamlFields::LoadFile(path), path); }

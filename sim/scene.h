@@ -85,6 +85,10 @@ struct Scene {
   std::vector<ArmPlacement> arms;
   /// The arm of that name, or nullptr.
   const ArmPlacement* FindArm(const std::string& arm_name) const;
+  /// Makes the arm `arm_name` of `arms` the scene's arm (X_WR = its base), as a process that is
+  /// that arm or looks at it does (--arm NAME); "" keeps the single arm. std::invalid_argument
+  /// naming the scene's arms when it has no such arm.
+  void StandAt(const std::string& arm_name);
 };
 
 /// Loads a scene file. Throws std::runtime_error naming the file, the line, the key and what was

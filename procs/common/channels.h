@@ -39,14 +39,32 @@ inline constexpr char kSimClockAck[] = "SIM_CLOCK_ACK";  // sim_clock_ack_t, eac
 inline constexpr char kDeputyCommand[] = "DEPUTY_COMMAND";  // deputy_command_t, launcher, 5 Hz per deputy
 inline constexpr char kDeputyStatus[] = "DEPUTY_STATUS";    // deputy_status_t, each deputy, 5 Hz
 
-/// A channel of one of several arms (issue 12): `channel` + "_" + the arm's name in capitals
-/// (ForArm("IIWA_STATUS", "a1") == "IIWA_STATUS_A1"); a single arm ("") keeps the plain name, so
-/// Drake's tools still find IIWA_STATUS and IIWA_COMMAND.
-inline std::string ForArm(const std::string& channel, const std::string& arm) {
-  if (arm.empty()) return channel;
-  std::string suffix = arm;
+/// A name that may suffix channels: 1..32 characters of a-z, 0-9 and _ (an arm's, a headset's).
+inline bool IsInstanceName(const std::string& name) {
+  return !name.empty() && name.size() <= 32 &&
+         name.find_first_not_of("abcdefghijklmnopqrstuvwxyz0123456789_") == std::string::npos;
+}
+inline constexpr char kInstanceNameRule[] = "1..32 characters of a-z, 0-9 and _";
+
+/// `channel` + "_" + `name` in capitals, or `channel` for name "": how one of several arms or
+/// headsets names its channels.
+inline std::string Suffixed(const std::string& channel, const std::string& name) {
+  if (name.empty()) return channel;
+  std::string suffix = name;
   for (char& c : suffix) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
   return channel + "_" + suffix;
+}
+
+/// A channel of one of several arms (issue 12): ForArm("IIWA_STATUS", "a1") == "IIWA_STATUS_A1";
+/// a single arm ("") keeps the plain name, so Drake's tools still find IIWA_STATUS and IIWA_COMMAND.
+inline std::string ForArm(const std::string& channel, const std::string& arm) {
+  return Suffixed(channel, arm);
+}
+
+/// A channel of one of several headsets (issue 12): ForHeadset("HMD_CAMERA", "h1") ==
+/// "HMD_CAMERA_H1"; a single headset ("") keeps the plain name.
+inline std::string ForHeadset(const std::string& channel, const std::string& headset) {
+  return Suffixed(channel, headset);
 }
 
 /// Every channel above (tools that address channels by index: the fuzz targets and their corpora;

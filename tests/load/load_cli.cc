@@ -1,6 +1,8 @@
 #include "tests/load/load_cli.h"
 
 #include <exception>
+#include <fstream>
+#include <stdexcept>
 
 #include <CLI/CLI.hpp>
 
@@ -10,15 +12,29 @@ namespace orbed::load {
 
 int RunLoadCli(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
   CLI::App app{
-      "orbed-load: runs the testbed (scripts/launch/load.yaml) at --factor times its nominal rates and\n"
-      "measures it: resident memory of each process early and at the end, respawns, the drops each\n"
-      "process counts on its heartbeat and the kernel's socket drops, and per stream the wanted and\n"
-      "achieved rates. Run it in a private network namespace (scripts/orbed load does)."};
+      "orbed-load: runs the testbed (scripts/launch/load.yaml; with --arms and --headsets, several of\n"
+      "each) at --factor times its nominal rates and measures it: CPU and resident memory of each\n"
+      "process, respawns, the drops each process counts on its heartbeat and the kernel's socket\n"
+      "drops, per stream the wanted and achieved rates, and each camera's capture-to-receive latency.\n"
+      "Run it in a private network namespace (scripts/orbed load and scripts/orbed scale do)."};
   LoadOptions options;
   double max_growth_percent = 10;
   app.add_option("--factor", options.factor, "Times the nominal rates, in [0.1, 16]")
       ->check(CLI::Range(kMinFactor, kMaxFactor))
       ->capture_default_str();
+  app.add_option(
+         "--arms", options.arms,
+         "With --headsets: the scale launch (sim/models/scenes/four_arms_or.yaml) with this many arms, "
+         "1..4, each an orbed-iiwa-sim --arm a<i>, instead of the single testbed")
+      ->check(CLI::Range(1, kMaxScaleArms));
+  app.add_option(
+         "--headsets", options.headsets,
+         "With --arms: this many headsets, 1..8, orbed-hmd --headset h<j> looking at arm a<j mod arms>, "
+         "each a different person")
+      ->check(CLI::Range(1, kMaxScaleHeadsets));
+  std::string json_path;
+  app.add_option("--json", json_path,
+                 "Also write the report as JSON to this file (scripts/scale.py reads it)");
   app.add_option("--duration-s", options.duration_s, "Length of the run from when every process is ready [s]")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
@@ -46,10 +62,19 @@ int RunLoadCli(int argc, const char* const* argv, std::ostream& out, std::ostrea
   } catch (const CLI::ParseError& e) {
     return app.exit(e, out, err);
   }
+  if ((options.arms > 0) != (options.headsets > 0)) {
+    err << "orbed-load: --arms and --headsets go together (the scale launch has both)\n";
+    return 2;
+  }
   try {
     const LoadReport report = RunLoad(options, err);
     out << "\n";
     PrintReport(report, out);
+    if (!json_path.empty()) {
+      std::ofstream json(json_path);
+      json << ReportJson(report) << "\n";
+      if (!json) throw std::runtime_error("cannot write " + json_path);
+    }
     const auto failures = Failures(report, max_growth_percent);
     for (const auto& failure : failures) err << "orbed-load: FAILED: " << failure << "\n";
     if (failures.empty()) err << "orbed-load: passed\n";

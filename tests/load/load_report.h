@@ -20,7 +20,16 @@
 /// Image streams are requested by a timer and made by the renderer: their drops are the requests
 /// never made, and sent + drops = wanted the same way.
 ///
-/// Units: rates Hz, times s (utime µs), memory kB (/proc's), counts in messages.
+/// Scale (issue 12, "Scale benchmark"): MakeScalePlan(A, H) is the testbed with A arms (the
+/// scene sim/models/scenes/four_arms_or.yaml, one orbed-iiwa-sim --arm a<i> each, process sim_a<i>)
+/// and H headsets (orbed-hmd --headset h<j> --arm a<j mod A>, each a different person, --user-seed
+/// j + 1, process hmd_h<j>), every stream on its suffixed channel; ScaleLaunchYaml() is its launch
+/// file. Beside rates and drops it measures each camera stream's capture-to-receive latency (the
+/// watcher's receive stamp minus the image's sample stamp, both the wall clock of this host) and
+/// each process's CPU time.
+///
+/// Units: rates Hz, times s (utime µs), latency ms, memory kB (/proc's), CPU in percent of one
+/// core, counts in messages.
 
 #include <cstdint>
 #include <map>
@@ -44,7 +53,12 @@ struct StreamSpec {
   /// The publisher's drop keys (process_status_t drop_reason) that count this stream's losses.
   std::vector<std::string> drop_keys;
   bool has_seq{false};  ///< hmd_pose_t.seq: the number sent is known
+  bool latency{false};  ///< image_t: its capture-to-receive latency is measured (camera streams)
 };
+
+/// The scale launch's limits: the arms of four_arms_or.yaml, and as many headsets as it has room for.
+inline constexpr int kMaxScaleArms = 4;
+inline constexpr int kMaxScaleHeadsets = 8;
 
 struct LoadPlan {
   double factor{1};
@@ -55,6 +69,10 @@ struct LoadPlan {
   double reflective_hz{30};    ///< hmd.reflective_hz (one display)
   double ar_view_hz{5};        ///< hmd.ar_view_hz
   std::vector<StreamSpec> streams;
+  /// 0 and 0: the single testbed (scripts/launch/load.yaml, plain channel names); else the scale
+  /// launch (ScaleLaunchYaml).
+  int arms{0};
+  int headsets{0};
 
   /// The variables scripts/launch/load.yaml expands (ORBED_LOAD_SIM_PERIOD_S, ORBED_LOAD_POSE_HZ,
   /// ORBED_LOAD_CAMERA_HZ, ORBED_LOAD_HMD_CONFIG = `hmd_config_path`).
@@ -62,11 +80,18 @@ struct LoadPlan {
   /// The headset config override with the scaled gaze, reflective and AR view rates (orbed-hmd
   /// --config).
   std::string HmdConfigYaml() const;
+  /// The scale launch (arms and headsets > 0): logger, the arms' sims, the headsets, the monitor,
+  /// with the variables of load.yaml (std::logic_error for the single testbed's plan).
+  std::string ScaleLaunchYaml() const;
 };
 
 /// The plan at `factor` times the nominal rates; std::invalid_argument outside
 /// [kMinFactor, kMaxFactor].
 LoadPlan MakeLoadPlan(double factor);
+/// The testbed with `arms` arms and `headsets` headsets at `factor` times the nominal rates (see the
+/// file comment); std::invalid_argument outside 1..kMaxScaleArms, 1..kMaxScaleHeadsets or the
+/// factor's range.
+LoadPlan MakeScalePlan(int arms, int headsets, double factor = 1);
 
 /// What the watcher had counted on one channel at some moment.
 struct ChannelCount {
@@ -97,8 +122,22 @@ struct StreamRow {
 /// The stream between the heartbeats `first` and `last` of its publisher (see the file comment).
 StreamRow AccountStream(const StreamSpec& spec, const Snapshot& first, const Snapshot& last);
 
+/// A camera stream's capture-to-receive latency over the window.
+struct LatencyRow {
+  std::string channel;
+  int64_t count{0};
+  double p50_ms{0};
+  double p99_ms{0};
+  double max_ms{0};
+};
+/// The row of the latencies `latencies_ms` (count 0 and zeros for none).
+LatencyRow SummarizeLatency(const std::string& channel, const std::vector<double>& latencies_ms);
+
 struct ProcessRow {
   std::string name;
+  /// CPU time used from the early sample to the end over that wall time [% of one core]; -1 when
+  /// the process was gone.
+  double cpu_percent{-1};
   int64_t rss_early_kb{-1};  ///< VmRSS at the early sample (-1: not taken)
   int64_t rss_end_kb{-1};    ///< VmRSS at the end (-1: the process was gone)
   int respawns{0};           ///< instances after the first (distinct pids seen)
@@ -129,7 +168,11 @@ struct LoadReport {
   std::vector<ProcessRow> processes;
   std::vector<StreamRow> streams;
   LoggerAccount logger;
-  int64_t watcher_socket_drops{-1};  ///< the watcher's own kernel drops during the run
+  int arms{0};                        ///< the plan's (0: the single testbed)
+  int headsets{0};                    ///< the plan's
+  std::vector<LatencyRow> latencies;  ///< the plan's latency streams
+  int64_t watcher_socket_drops{-1};   ///< the watcher's own kernel drops during the run
+  double watcher_cpu_percent{-1};     ///< orbed-load's own CPU over the same window [% of one core]
   int launcher_exit_code{0};
   std::string launcher_exit;  ///< how orbed-launch ended ("exit code 0", "killed by signal ...")
 };
@@ -139,7 +182,13 @@ struct LoadReport {
 /// exit 0. Empty = passed.
 std::vector<std::string> Failures(const LoadReport& report, double max_rss_growth_percent);
 
-/// The two tables (processes, then streams) and the logger's account.
+/// The two tables (processes, then streams), the latencies and the logger's account.
 void PrintReport(const LoadReport& report, std::ostream& out);
+/// The report as one JSON object (scripts/scale.py reads it): arms, headsets, factor, duration_s,
+/// processes [{name, cpu_percent, rss_end_kb, respawns, alive_at_end, socket_drops, dropped}],
+/// streams [{channel, publisher, wanted_hz, achieved_hz, wanted, received, drops, lost}],
+/// latencies [{channel, count, p50_ms, p99_ms, max_ms}], logger {known, events_written, drops,
+/// unaccounted}, watcher_socket_drops, watcher_cpu_percent, launcher_exit.
+std::string ReportJson(const LoadReport& report);
 
 }  // namespace orbed::load

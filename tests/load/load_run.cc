@@ -17,6 +17,7 @@
 
 #include <lcm/lcm-cpp.hpp>
 #include <orbed/hmd_pose_t.hpp>
+#include <orbed/image_t.hpp>
 #include <orbed/process_status_t.hpp>
 
 #include "base/proc_stats.h"
@@ -46,9 +47,13 @@ constexpr int kWatcherQueueCapacity = 100000;
 // watched process. Handles LCM on its own thread.
 class BusWatcher {
  public:
-  explicit BusWatcher(std::set<std::string> watched)
+  BusWatcher(std::set<std::string> watched, const LoadPlan& plan)
       : watched_(std::move(watched)), lcm_(WithRecvBufSize(DefaultLcmUrl(), kWatcherRecvBufBytes)) {
     if (!lcm_.good()) throw std::runtime_error("orbed-load: cannot open LCM (is there a multicast route?)");
+    for (const StreamSpec& stream : plan.streams) {
+      if (stream.has_seq) seq_channels_.insert(stream.channel);
+      if (stream.latency) latencies_[stream.channel];
+    }
     lcm::Subscription* all = lcm_.subscribe(".*", &BusWatcher::OnMessage, this);
     all->setQueueCapacity(kWatcherQueueCapacity);
     thread_ = std::thread([this] {
@@ -69,6 +74,12 @@ class BusWatcher {
     const auto it = beats_.find(name);
     return it == beats_.end() ? std::vector<Beat>{} : it->second;
   }
+  /// A latency stream's (receive utime, capture-to-receive latency [ms]) per frame.
+  std::vector<std::pair<int64_t, double>> Latencies(const std::string& channel) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const auto it = latencies_.find(channel);
+    return it == latencies_.end() ? std::vector<std::pair<int64_t, double>>{} : it->second;
+  }
   int64_t self_tests() const {
     std::lock_guard<std::mutex> lock(mutex_);
     return self_tests_;
@@ -85,9 +96,15 @@ class BusWatcher {
     }
     ChannelCount& count = counts_[channel];
     ++count.received;
-    if (channel == channels::kHmdPose || channel == channels::kHmdPoseTruth) {
+    if (seq_channels_.count(channel) > 0) {
       orbed::hmd_pose_t pose;
       if (DecodeBounded(rbuf->data, rbuf->data_size, &pose).ok()) count.last_seq = pose.seq;
+    } else if (const auto latency = latencies_.find(channel); latency != latencies_.end()) {
+      orbed::image_t image;
+      if (DecodeBounded(rbuf->data, rbuf->data_size, &image).ok()) {
+        latency->second.emplace_back(rbuf->recv_utime,
+                                     static_cast<double>(rbuf->recv_utime - image.utime) / 1e3);
+      }
     } else if (channel == channels::kProcessStatus) {
       orbed::process_status_t status;
       if (!DecodeBounded(rbuf->data, rbuf->data_size, &status).ok() || watched_.count(status.name) == 0)
@@ -108,7 +125,10 @@ class BusWatcher {
   mutable std::mutex mutex_;
   std::map<std::string, ChannelCount> counts_;      // guarded by mutex_
   std::map<std::string, std::vector<Beat>> beats_;  // guarded by mutex_
-  int64_t self_tests_{0};                           // guarded by mutex_
+  std::set<std::string> seq_channels_;              // const after construction
+  // Keys const after construction; the frames guarded by mutex_.
+  std::map<std::string, std::vector<std::pair<int64_t, double>>> latencies_;
+  int64_t self_tests_{0};  // guarded by mutex_
 };
 
 Clock::time_point After(Clock::time_point t, double seconds) {
@@ -134,7 +154,12 @@ std::string DefaultBinDir() {
 }  // namespace
 
 LoadReport RunLoad(const LoadOptions& options, std::ostream& log) {
-  const LoadPlan plan = MakeLoadPlan(options.factor);
+  const bool scale = options.arms > 0 || options.headsets > 0;
+  const LoadPlan plan =
+      scale ? MakeScalePlan(options.arms, options.headsets, options.factor) : MakeLoadPlan(options.factor);
+  if (scale && !options.launch_file.empty())
+    throw std::invalid_argument(
+        "the scale launch is written by orbed-load: no --launch-file with --arms/--headsets");
   if (!(options.duration_s > 0)) throw std::invalid_argument("--duration-s must be > 0");
   if (!(options.rss_early_s > 0 && options.rss_early_s < options.duration_s))
     throw std::invalid_argument("--rss-early-s must be > 0 and less than --duration-s");
@@ -142,8 +167,14 @@ LoadReport RunLoad(const LoadOptions& options, std::ostream& log) {
     throw std::invalid_argument("--warmup-s must be >= 0 and less than --duration-s");
   if (options.log_dir.empty()) throw std::invalid_argument("a log folder is needed (--log-dir)");
   fs::create_directories(options.log_dir);
-  const std::string launch_file =
+  std::string launch_file =
       options.launch_file.empty() ? SourceTreePath("scripts/launch/load.yaml") : options.launch_file;
+  if (scale) {
+    launch_file = (fs::path(options.log_dir) / "scale.yaml").string();
+    std::ofstream out(launch_file);
+    out << plan.ScaleLaunchYaml();
+    if (!out) throw std::runtime_error("cannot write " + launch_file);
+  }
   const std::string bin_dir = options.bin_dir.empty() ? DefaultBinDir() : options.bin_dir;
 
   const std::string hmd_config = (fs::path(options.log_dir) / "load_hmd.yaml").string();
@@ -163,7 +194,7 @@ LoadReport RunLoad(const LoadOptions& options, std::ostream& log) {
     for (const auto& process : group.processes) names.push_back(process.name);
   }
 
-  BusWatcher watcher(std::set<std::string>(names.begin(), names.end()));
+  BusWatcher watcher(std::set<std::string>(names.begin(), names.end()), plan);
   const int64_t watcher_drops_before = UdpReceiveDrops(getpid());
   launcher::Child launcher;
   std::string error;
@@ -210,12 +241,20 @@ LoadReport RunLoad(const LoadOptions& options, std::ostream& log) {
   report.factor = plan.factor;
   report.duration_s = options.duration_s;
   report.rss_early_s = options.rss_early_s;
+  report.arms = plan.arms;
+  report.headsets = plan.headsets;
   std::map<std::string, ProcessRow> rows;
   for (const auto& name : names) rows[name].name = name;
   // The run: deadlines only; the early sample, then the end (or orbed-launch ending by itself).
   PollUntil(
       launcher, [&] { return !launcher.running() || launcher.Poll(); }, After(start, options.rss_early_s));
-  for (auto& [name, row] : rows) row.rss_early_kb = ProcStatusKb(children[name], "VmRSS");
+  std::map<std::string, double> cpu_early_s;
+  for (auto& [name, row] : rows) {
+    row.rss_early_kb = ProcStatusKb(children[name], "VmRSS");
+    cpu_early_s[name] = ProcCpuSeconds(children[name]);
+  }
+  const double watcher_cpu_early_s = ProcCpuSeconds(getpid());
+  const Clock::time_point early = Clock::now();
   log << "load: resident memory sampled at " << options.rss_early_s << " s\n";
   PollUntil(
       launcher, [&] { return !launcher.running() || launcher.Poll(); }, After(start, options.duration_s));
@@ -229,6 +268,14 @@ LoadReport RunLoad(const LoadOptions& options, std::ostream& log) {
     row.alive_at_end = it != children_at_end.end() && it->second == pid;
     row.rss_end_kb = row.alive_at_end ? ProcStatusKb(pid, "VmRSS") : -1;
     row.socket_drops = row.alive_at_end ? UdpReceiveDrops(pid) : -1;
+    const double cpu_end_s = row.alive_at_end ? ProcCpuSeconds(pid) : -1;
+    if (cpu_end_s >= 0 && cpu_early_s[name] >= 0 && end > early)
+      row.cpu_percent =
+          100 * (cpu_end_s - cpu_early_s[name]) / std::chrono::duration<double>(end - early).count();
+  }
+  if (end > early && watcher_cpu_early_s >= 0) {
+    report.watcher_cpu_percent = 100 * (ProcCpuSeconds(getpid()) - watcher_cpu_early_s) /
+                                 std::chrono::duration<double>(end - early).count();
   }
   report.watcher_socket_drops = UdpReceiveDrops(getpid()) - watcher_drops_before;
   log << "load: " << std::chrono::duration<double>(end - start).count() << " s done; stopping the testbed\n";
@@ -297,6 +344,14 @@ LoadReport RunLoad(const LoadOptions& options, std::ostream& log) {
     }
     if (first && last && last->utime_us > first->utime_us)
       report.streams.push_back(AccountStream(stream, *first, *last));
+  }
+  for (const StreamSpec& stream : plan.streams) {
+    if (!stream.latency) continue;
+    std::vector<double> in_window;
+    for (const auto& [recv_utime, latency_ms] : watcher.Latencies(stream.channel)) {
+      if (recv_utime >= warm_utime && recv_utime <= end_utime) in_window.push_back(latency_ms);
+    }
+    report.latencies.push_back(SummarizeLatency(stream.channel, in_window));
   }
   for (const auto& name : names) report.processes.push_back(rows[name]);
   return report;

@@ -15,6 +15,9 @@
 /// Must run inside a private network namespace (scripts/netns-exec) like every testbed run; the
 /// /proc/net/udp drop counts are those of the caller's namespace.
 /// Threading: RunLoad blocks; the LCM handling runs on a thread it owns and joins.
+/// Each camera stream's latency: the watcher's receive stamp (LCM's recv_utime) minus the image's
+/// sample stamp, over the same window as the rates; CPU from /proc between the early sample and
+/// the end.
 /// Clock: the steady clock paces the run (deadlines only; nothing waits as synchronisation).
 
 #include <ostream>
@@ -26,6 +29,10 @@ namespace orbed::load {
 
 struct LoadOptions {
   double factor{10};
+  /// > 0 both: the scale launch with that many arms and headsets (MakeScalePlan), written into
+  /// log_dir as scale.yaml; 0 both: the single testbed of launch_file.
+  int arms{0};
+  int headsets{0};
   double duration_s{60};   ///< from the moment every process is ready
   double rss_early_s{10};  ///< the early resident-memory sample, after ready
   double warmup_s{5};      ///< rates are accounted from the first heartbeat after this

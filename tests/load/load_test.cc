@@ -1,11 +1,15 @@
 // orbed-load's pure core (load_report.h): the plan at a factor, the accounting of a stream between
 // two heartbeats, the verdict and the tables. The run itself is load_integration_test.
 #include <cmath>
+#include <map>
 #include <sstream>
 #include <stdexcept>
 
 #include <gtest/gtest.h>
 
+#include <nlohmann/json.hpp>
+
+#include "procs/launcher/launch_file.h"
 #include "tests/load/load_report.h"
 
 namespace orbed::load {
@@ -54,6 +58,107 @@ TEST(LoadPlan, FactorOneIsTheTestbedAndTheRangeIsChecked) {
   EXPECT_THROW(MakeLoadPlan(0), std::invalid_argument);
   EXPECT_THROW(MakeLoadPlan(17), std::invalid_argument);
   EXPECT_THROW(MakeLoadPlan(std::nan("")), std::invalid_argument);
+}
+
+TEST(ScalePlan, EachArmAndHeadsetHasItsStreamsOnItsOwnChannels) {
+  const LoadPlan plan = MakeScalePlan(2, 3);
+  EXPECT_EQ(plan.arms, 2);
+  EXPECT_EQ(plan.headsets, 3);
+  EXPECT_EQ(plan.streams.size(), 2u * 3 + 3u * 6);
+  EXPECT_EQ(Stream(plan, "IIWA_STATUS_A1").publisher, "sim_a1");
+  EXPECT_DOUBLE_EQ(Stream(plan, "COLLISION_STATUS_A0").wanted_hz, 200);
+  EXPECT_EQ(Stream(plan, "HMD_POSE_TRUTH_H2").publisher, "hmd_h2");
+  EXPECT_TRUE(Stream(plan, "HMD_POSE_TRUTH_H2").has_seq);
+  // The headset's timers are named by its own channels.
+  EXPECT_EQ(Stream(plan, "HMD_POSE_TRUTH_H2").drop_keys, std::vector<std::string>{"timer/HMD_POSE_H2"});
+  EXPECT_EQ(Stream(plan, "REFLECTIVE_VIEW_H0").drop_keys,
+            (std::vector<std::string>{"timer/REFLECTIVE_VIEW_H0", "REFLECTIVE_VIEW_H0/busy"}));
+  int latency_streams = 0;
+  for (const StreamSpec& s : plan.streams) latency_streams += s.latency ? 1 : 0;
+  EXPECT_EQ(latency_streams, 3);
+  EXPECT_TRUE(Stream(plan, "HMD_CAMERA_H1").latency);
+  for (const StreamSpec& s : MakeLoadPlan(1).streams) EXPECT_EQ(s.latency, s.channel == "HMD_CAMERA");
+  EXPECT_THROW(MakeScalePlan(0, 1), std::invalid_argument);
+  EXPECT_THROW(MakeScalePlan(5, 1), std::invalid_argument);
+  EXPECT_THROW(MakeScalePlan(1, 9), std::invalid_argument);
+  EXPECT_THROW(MakeScalePlan(1, 1, 20), std::invalid_argument);
+  EXPECT_THROW(MakeLoadPlan(1).ScaleLaunchYaml(), std::logic_error);
+}
+
+TEST(ScalePlan, TheLaunchFileReadsBackWithEveryProcessAtItsArm) {
+  // The launcher's own reader is the oracle for the file the plan writes.
+  const LoadPlan plan = MakeScalePlan(2, 3, 2);
+  const std::map<std::string, std::string> env = {{"ORBED_LOG_DIR", "/logs"},
+                                                  {"ORBED_SOURCE_DIR", "/src"},
+                                                  {"ORBED_LOAD_SIM_PERIOD_S", "0.0025"},
+                                                  {"ORBED_LOAD_POSE_HZ", "120"},
+                                                  {"ORBED_LOAD_CAMERA_HZ", "60"},
+                                                  {"ORBED_LOAD_HMD_CONFIG", "/logs/load_hmd.yaml"}};
+  const launcher::LaunchSpec spec = launcher::ParseLaunchYaml(plan.ScaleLaunchYaml(), "scale.yaml", env);
+  EXPECT_EQ(spec.name, "scale_2x3");
+  std::map<std::string, std::vector<std::string>> args;
+  for (const auto& group : spec.groups) {
+    for (const auto& process : group.processes) args[process.name] = process.args;
+  }
+  ASSERT_EQ(args.size(), 7u);  // logger, 2 sims, 3 headsets, monitor
+  const std::string scene = "/src/sim/models/scenes/four_arms_or.yaml";
+  EXPECT_EQ(args.at("sim_a1"), (std::vector<std::string>{"--scene", scene, "--arm", "a1", "--state-file",
+                                                         "/logs/sim_a1.state", "--period-s", "0.0025"}));
+  EXPECT_EQ(args.at("hmd_h2"),
+            (std::vector<std::string>{"--scene", scene, "--headset", "h2", "--arm", "a0", "--user-seed", "3",
+                                      "--state-file", "/logs/hmd_h2.state", "--pose-hz", "120", "--camera-hz",
+                                      "60", "--config", "/logs/load_hmd.yaml"}));
+  EXPECT_EQ(args.at("hmd_h1")[5], "a1");
+  EXPECT_EQ(args.at("logger"), (std::vector<std::string>{"--log-dir", "/logs"}));
+  EXPECT_EQ(args.count("monitor"), 1u);
+}
+
+TEST(SummarizeLatency, QuantilesByHand) {
+  std::vector<double> ms;
+  for (int i = 100; i >= 1; --i) ms.push_back(i);  // 1..100 ms, unsorted
+  const LatencyRow row = SummarizeLatency("HMD_CAMERA_H0", ms);
+  EXPECT_EQ(row.count, 100);
+  EXPECT_DOUBLE_EQ(row.p50_ms, 50.5);    // between the 50th and 51st
+  EXPECT_NEAR(row.p99_ms, 99.01, 1e-9);  // (n - 1) q = 98.01: x[98] + 0.01 (x[99] - x[98])
+  EXPECT_DOUBLE_EQ(row.max_ms, 100);
+  const LatencyRow none = SummarizeLatency("HMD_CAMERA_H1", {});
+  EXPECT_EQ(none.count, 0);
+  EXPECT_EQ(none.max_ms, 0);
+}
+
+TEST(ReportJson, ReadsBackWithNlohmann) {
+  LoadReport report;
+  report.arms = 2;
+  report.headsets = 1;
+  report.factor = 1;
+  report.duration_s = 30;
+  ProcessRow sim;
+  sim.name = "sim_a0";
+  sim.cpu_percent = 7.5;
+  sim.rss_end_kb = 17000;
+  sim.alive_at_end = true;
+  ProcessRow gone;
+  gone.name = "hmd_h0";
+  report.processes = {sim, gone};
+  StreamRow row;
+  row.spec = {"HMD_POSE_H0", "hmd_h0", 60, 60, {"timer/HMD_POSE_H0"}, true};
+  row.window_s = 10;
+  row.wanted = 600;
+  row.received = 598;
+  row.sent = 599;
+  report.streams = {row};
+  report.latencies = {SummarizeLatency("HMD_CAMERA_H0", {1, 2, 3})};
+  report.watcher_cpu_percent = 3;
+  const nlohmann::json j = nlohmann::json::parse(ReportJson(report));
+  EXPECT_EQ(j.at("arms"), 2);
+  EXPECT_EQ(j.at("processes").size(), 2u);
+  EXPECT_DOUBLE_EQ(j.at("processes")[0].at("cpu_percent").get<double>(), 7.5);
+  EXPECT_TRUE(j.at("processes")[1].at("cpu_percent").is_null());  // gone: no CPU figure
+  EXPECT_FALSE(j.at("processes")[1].at("alive_at_end").get<bool>());
+  EXPECT_DOUBLE_EQ(j.at("streams")[0].at("achieved_hz").get<double>(), 59.8);
+  EXPECT_EQ(j.at("streams")[0].at("lost"), 1);
+  EXPECT_DOUBLE_EQ(j.at("latencies")[0].at("p50_ms").get<double>(), 2);
+  EXPECT_DOUBLE_EQ(j.at("watcher_cpu_percent").get<double>(), 3);
 }
 
 TEST(AccountStream, CountsBetweenTwoHeartbeats) {
