@@ -50,13 +50,13 @@ int RunHmd(int argc, const char* const* argv, std::ostream& out, std::ostream& e
   app.add_option("--state-file", o.state_file,
                  "Keep the session and its last trial in this file and continue from it when it exists "
                  "(crash recovery)");
-  app.add_option(
-      "--headset", o.headset,
+  AddInstanceFlag(
+      &app, "--headset", &o.headset,
       "One of several headsets: its own and its session's channels get the suffix _NAME "
       "(HMD_POSE_H1, HMD_CAMERA_H1, SESSION_CONTROL_H1, REGISTRATION_H1, ...; default: plain names)");
-  app.add_option("--arm", o.arm,
-                 "Look at the arm NAME of the scene's `arms:` list: walk around its base and read its "
-                 "channels (IIWA_STATUS_A1, ROBOT_STATE_A1, GUIDANCE_A1, ...; default: the single arm)");
+  AddInstanceFlag(&app, "--arm", &o.arm,
+                  "Look at the arm NAME of the scene's `arms:` list: walk around its base and read its "
+                  "channels (IIWA_STATUS_A1, ROBOT_STATE_A1, GUIDANCE_A1, ...; default: the single arm)");
   app.add_option("--iiwa-status-channel", o.iiwa_status_channel)->capture_default_str();
   app.add_option("--robot-state-channel", o.robot_state_channel)->capture_default_str();
   app.add_option("--iiwa-command-channel", o.iiwa_command_channel,

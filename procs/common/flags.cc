@@ -3,6 +3,7 @@
 #include <cstdlib>
 #include <regex>
 
+#include "procs/common/channels.h"
 #include "procs/common/chaos.h"
 #include "procs/common/log.h"
 
@@ -62,6 +63,16 @@ void AddSimTimeFlag(CLI::App* app, CommonFlags* flags) {
          "run faster than real time) instead of the wall clock, answering its lockstep rounds on "
          "SIM_CLOCK_ACK (default: $ORBED_SIM_TIME)")
       ->envname("ORBED_SIM_TIME");
+}
+
+void AddInstanceFlag(CLI::App* app, const std::string& flag, std::string* name, const std::string& help) {
+  app->add_option(flag, *name, help)
+      ->check(CLI::Validator(
+          [](std::string& value) {
+            return channels::IsInstanceName(value) ? std::string()
+                                                   : std::string("expected ") + channels::kInstanceNameRule;
+          },
+          "NAME"));
 }
 
 void ApplyCommonFlags(const CommonFlags& flags) {

@@ -56,6 +56,11 @@ void AddCommonFlags(CLI::App* app, CommonFlags* flags);
 /// (the clock's source), the logger, the launcher and the monitor do not take it.
 void AddSimTimeFlag(CLI::App* app, CommonFlags* flags);
 
+/// Adds `flag` (--headset or --arm) naming one of several headsets or arms, checked against
+/// channels::IsInstanceName; the process suffixes its channels with it (channels::ForHeadset,
+/// channels::ForArm). `help` says which.
+void AddInstanceFlag(CLI::App* app, const std::string& flag, std::string* name, const std::string& help);
+
 /// Sets the log name and level; throws CLI::ValidationError on a bad level or chaos spec.
 void ApplyCommonFlags(const CommonFlags& flags);
 

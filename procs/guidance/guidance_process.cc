@@ -27,6 +27,14 @@ namespace {
 // The sim clamps to the limits; this absorbs rounding (as orbed-hmd).
 constexpr double kJointLimitSlackRad = 0.01;
 
+GuidanceOptions WithArmChannels(GuidanceOptions o) {
+  for (std::string* channel :
+       {&o.iiwa_status_channel, &o.guidance_channel, &o.setup_task_channel, &o.igtl_target_channel}) {
+    *channel = channels::ForArm(*channel, o.arm);
+  }
+  return o;
+}
+
 }  // namespace
 
 GuidanceProcess::GuidanceProcess(const CommonFlags& flags, const GuidanceOptions& options)
@@ -35,7 +43,7 @@ GuidanceProcess::GuidanceProcess(const CommonFlags& flags, const GuidanceOptions
       core_(options.target.q_target_rad.size() > 0
                 ? std::optional<GuidanceCore>(GuidanceCore(model_, options.target))
                 : std::nullopt),
-      options_(options) {
+      options_(WithArmChannels(options)) {
   process_.Subscribe<orbed::iiwa_status_t>(
       options_.iiwa_status_channel,
       [this](const orbed::iiwa_status_t& msg, const std::string& channel, int64_t received_utime) {
@@ -113,6 +121,7 @@ void GuidanceProcess::OnIgtlTarget(const Eigen::Isometry3d& X_WT) {
     if (!scene_) {
       scene_ = sim::LoadSceneFile(options_.scene_path.empty() ? SourceTreePath(sim::kDefaultSceneRelativePath)
                                                               : options_.scene_path);
+      scene_->StandAt(options_.arm);
       ik_model_ = sim::LoadRobotForScene(options_.urdf_path.empty()
                                              ? SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath)
                                              : options_.urdf_path,
@@ -183,6 +192,10 @@ int RunGuidance(int argc, const char* const* argv, std::ostream& out, std::ostre
       ->capture_default_str();
   app.add_option("--urdf", options.urdf_path,
                  "Robot URDF (default: sim/models/iiwa7.urdf under $ORBED_SOURCE_DIR, else the source tree)");
+  AddInstanceFlag(
+      &app, "--arm", &options.arm,
+      "Guide the arm NAME (one of several): every channel below gets the suffix _NAME (IIWA_STATUS_A1, "
+      "GUIDANCE_A1, ...) and IGTL_TARGET's IK stands at its base in --scene");
   app.add_option("--iiwa-status-channel", options.iiwa_status_channel)->capture_default_str();
   app.add_option("--guidance-channel", options.guidance_channel)->capture_default_str();
   app.add_option("--setup-task-channel", options.setup_task_channel)->capture_default_str();

@@ -41,6 +41,10 @@ int RunRegistration(int argc, const char* const* argv, std::ostream& out, std::o
                  "Landmarks: rays closer than this to parallel are rejected")
       ->check(CLI::Range(0.0, 89.0))
       ->capture_default_str();
+  AddInstanceFlag(
+      &app, "--headset", &server.headset,
+      "The registration of headset NAME (one of several): every channel below gets the suffix _NAME "
+      "(SESSION_CONTROL_H1, ALIGNMENT_TRIAL_H1, REGISTRATION_H1, ...)");
   app.add_option("--trial-channel", server.trial_channel)->capture_default_str();
   app.add_option("--registration-channel", server.registration_channel)->capture_default_str();
   app.add_option("--session-control-channel", server.session_control_channel)->capture_default_str();

@@ -4,10 +4,23 @@
 
 namespace orbed::registration {
 
+namespace {
+
+RegistrationServerOptions WithHeadsetChannels(RegistrationServerOptions o) {
+  for (std::string* channel :
+       {&o.session_control_channel, &o.trial_channel, &o.registration_channel, &o.landmark_request_channel,
+        &o.landmark_channel, &o.misalignment_request_channel, &o.misalignment_channel}) {
+    *channel = channels::ForHeadset(*channel, o.headset);
+  }
+  return o;
+}
+
+}  // namespace
+
 RegistrationServer::RegistrationServer(const orbed::CommonFlags& flags,
                                        const RegistrationServerOptions& options)
     : Process(flags),
-      options_(options),
+      options_(WithHeadsetChannels(options)),
       service_(options.service,
                [this](const std::string& key, const std::string& reason) { Reject(key, reason); }) {
   if (!options_.journal_path.empty()) {

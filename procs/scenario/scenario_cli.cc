@@ -89,6 +89,15 @@ int RunScenario(int argc, const char* const* argv, std::ostream& out, std::ostre
   app.add_option("--retry-max-s", run.retry_max_s, "Longest interval between re-sends of a request [s]")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  std::string headset, arm;
+  AddInstanceFlag(
+      &app, "--headset", &headset,
+      "Conduct the ViRAAl run of headset NAME (one of several): the session's channels get the suffix "
+      "_NAME (SESSION_CONTROL_H1, ALIGNMENT_TRIAL_H1, REGISTRATION_H1, LANDMARK*_H1, MISALIGNMENT*_H1)");
+  AddInstanceFlag(
+      &app, "--arm", &arm,
+      "With the arm NAME (one of several): ROBOT_STATE, IIWA_COMMAND and PLAN_CHECK_* get the suffix "
+      "_NAME");
   app.add_option("--robot-state-channel", run.robot_state_channel)->capture_default_str();
   app.add_option("--iiwa-command-channel", run.iiwa_command_channel)->capture_default_str();
   app.add_option("--plan-check-request-channel", run.plan_check_request_channel)->capture_default_str();
@@ -106,6 +115,7 @@ int RunScenario(int argc, const char* const* argv, std::ostream& out, std::ostre
                  "1 failed, 3 stopped before the end (it can be resumed)");
   if (const auto code = ParseCommandLine(&app, common, argc, argv, out, err)) return *code;
   if (!print_path.empty()) return PrintResults(print_path, out, err);
+  UseInstanceChannels(&run, headset, arm);
   try {
     if (scenario_path.empty()) scenario_path = ScenarioSourcePath(viraal::kDefaultScenarioRelativePath);
     run.config = viraal::LoadScenarioFile(scenario_path);

@@ -51,6 +51,18 @@ void CheckConductorOptions(const ConductorOptions& options) {
   }
 }
 
+void UseInstanceChannels(ConductorOptions* o, const std::string& headset, const std::string& arm) {
+  for (std::string* channel : {&o->session_control_channel, &o->trial_channel, &o->registration_channel,
+                               &o->landmark_request_channel, &o->landmark_channel,
+                               &o->misalignment_request_channel, &o->misalignment_channel}) {
+    *channel = channels::ForHeadset(*channel, headset);
+  }
+  for (std::string* channel : {&o->robot_state_channel, &o->iiwa_command_channel,
+                               &o->plan_check_request_channel, &o->plan_check_reply_channel}) {
+    *channel = channels::ForArm(*channel, arm);
+  }
+}
+
 ViraalConductor::ViraalConductor(ConductorOptions options, orbed::sim::RobotModel model)
     : options_(std::move(options)), model_(std::make_unique<orbed::sim::RobotModel>(std::move(model))) {
   CheckConductorOptions(options_);

@@ -149,6 +149,11 @@ struct ConductorOptions {
   std::string misalignment_channel{channels::kMisalignment};
 };
 
+/// One of several headsets and arms (issue 12): the session's channels (SESSION_CONTROL,
+/// ALIGNMENT_TRIAL, REGISTRATION, LANDMARK*, MISALIGNMENT*) get the headset's suffix, the arm's
+/// (ROBOT_STATE, IIWA_COMMAND, PLAN_CHECK_*) the arm's (channels::ForHeadset, ForArm); "" keeps them.
+void UseInstanceChannels(ConductorOptions* options, const std::string& headset, const std::string& arm);
+
 /// Throws std::invalid_argument naming the flag of the first duration or tolerance in `options`
 /// that is not a finite number > 0, or when retry_max_s < retry_initial_s.
 void CheckConductorOptions(const ConductorOptions& options);

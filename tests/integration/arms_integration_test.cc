@@ -4,11 +4,15 @@
 // horizontal toward a1 (upright 0.7 m away), stops before a1, naming a1's link; a1, at rest, sees
 // a0 come close in its own COLLISION_STATUS_A1; the single arm's plain channels stay silent.
 #include <cmath>
+#include <filesystem>
 #include <functional>
+#include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 #include <lcm/lcm-cpp.hpp>
 #include <orbed/collision_status_t.hpp>
 #include <orbed/iiwa_command_t.hpp>
@@ -16,6 +20,7 @@
 
 #include "base/units.h"
 #include "procs/common/conversions.h"
+#include "sim/scene.h"
 #include "tests/integration/testbed_util.h"
 
 namespace orbed::testing {
@@ -27,6 +32,10 @@ struct Seen {
   orbed::collision_status_t collision_a0, collision_a1;
   int plain_status = 0;  // anything on the single arm's IIWA_STATUS
 };
+
+Eigen::Vector3d ReadVector(const YAML::Node& node) {
+  return Eigen::Vector3d(node[0].as<double>(), node[1].as<double>(), node[2].as<double>());
+}
 
 bool Names(const orbed::collision_status_t& status, const std::string& prefix) {
   for (const auto& contact : status.contacts) {
@@ -102,6 +111,52 @@ TEST(Arms, OneArmStopsBeforeAnotherRunningInItsOwnProcess) {
   ASSERT_TRUE(until([&] { return Names(seen.collision_a0, "a1/") && Names(seen.collision_a1, "a0/"); }, 10));
   EXPECT_GT(seen.collision_a0.min_distance_m, 0.0);
   EXPECT_EQ(seen.plain_status, 0) << "an arm of several published on the single arm's IIWA_STATUS";
+}
+
+// Several headsets, each registering its own map to its own arm (issue 12): two arms (a1 and a2 of
+// four_arms_or.yaml, 1.4 m apart), and per arm a headset with its own person (--user-seed), its
+// registration server and its ViRAAl conductor, all on the headset's and the arm's channels, run
+// at once on one bus. Each run ends ok; each results.json holds the truth of its own arm (the
+// scene file's base) and a mean registration near that arm, not the other.
+TEST(Arms, TwoHeadsetsRegisterTheirMapsToTwoArmsAtOnce) {
+  const std::string scene = SourcePath("sim/models/scenes/four_arms_or.yaml");
+  const std::string dir = MakeTempDir("arms_viraal");
+  const std::vector<std::pair<std::string, std::string>> pairs = {{"h1", "a1"}, {"h2", "a2"}};
+  std::vector<std::unique_ptr<RunningProcess>> processes, conductors;
+  for (const auto& [headset, arm] : pairs) {
+    processes.push_back(std::make_unique<RunningProcess>(std::vector<std::string>{
+        BinPath("orbed-iiwa-sim"), "--scene", scene, "--arm", arm, "--name", "sim_" + arm}));
+    processes.push_back(std::make_unique<RunningProcess>(std::vector<std::string>{
+        BinPath("orbed-registration"), "--headset", headset, "--name", "registration_" + headset}));
+    processes.push_back(std::make_unique<RunningProcess>(
+        std::vector<std::string>{BinPath("orbed-hmd"), "--scene", scene, "--headset", headset, "--arm", arm,
+                                 "--user-seed", headset == "h1" ? "11" : "12", "--name", "hmd_" + headset}));
+  }
+  for (const auto& [headset, arm] : pairs) {
+    std::filesystem::create_directories(dir + "/" + headset);
+    conductors.push_back(std::make_unique<RunningProcess>(std::vector<std::string>{
+        BinPath("orbed-scenario"), "--headset", headset, "--arm", arm, "--trials", "2", "--run-id",
+        "two-" + headset, "--results-dir", dir + "/" + headset, "--name", "scenario_" + headset}));
+  }
+  const sim::Scene four = sim::LoadSceneFile(scene);
+  for (size_t k = 0; k < pairs.size(); ++k) {
+    const auto& [headset, arm] = pairs[k];
+    SCOPED_TRACE(headset + " at " + arm);
+    ASSERT_TRUE(conductors[k]->Wait(240)) << "the run did not finish";
+    ASSERT_EQ(conductors[k]->exit_code(), 0);
+    const YAML::Node results = YAML::LoadFile(dir + "/" + headset + "/results.json");
+    EXPECT_EQ(results["status"].as<std::string>(), "ok");
+    const Eigen::Vector3d p_WR = ReadVector(results["X_WR"]["position_m"]);
+    EXPECT_LT((p_WR - four.FindArm(arm)->X_WR.translation()).norm(), 1e-9);
+    ASSERT_EQ(results["sessions"].size(), 2u);
+    for (const auto& session : results["sessions"]) {
+      ASSERT_EQ(session["trials"].size(), 2u);
+      EXPECT_LT(session["mean"]["translation_error_mm"].as<double>(), 200.0);
+      // The mean places the hologram at this arm: within 0.2 m of its base, 1.4 m from the other's.
+      const Eigen::Vector3d p_WV = ReadVector(session["mean"]["X_WV"]["position_m"]);
+      EXPECT_LT((p_WV - p_WR).norm(), 0.2);
+    }
+  }
 }
 
 }  // namespace
