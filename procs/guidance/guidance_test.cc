@@ -9,6 +9,7 @@
 #include <cmath>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -145,6 +146,38 @@ TEST(GuidanceProcess, PublishesForTheLastGoodStatusAndCountsBadOnes) {
   EXPECT_EQ(counts.at("IIWA_STATUS/num_joints"), 1);
   EXPECT_EQ(counts.at("IIWA_STATUS/non_finite"), 1);
   EXPECT_EQ(counts.at("IIWA_STATUS/limits"), 1);
+}
+
+// One of several arms (--arm a1): the guidance reads IIWA_STATUS_A1 and publishes GUIDANCE_A1; the
+// single arm's channels are neither read nor written.
+TEST(GuidanceProcess, AnArmOfSeveralIsGuidedOnItsOwnChannels) {
+  CommonFlags flags("orbed-guidance-test");
+  flags.lcm_url = "memq://";
+  flags.duration_s = 0.3;
+  GuidanceOptions options;
+  options.target.q_target_rad = Deg({0, 30, 0, -60, 0, 45, 0});
+  options.rate_hz = 50;
+  options.stale_after_s = 3600;
+  options.arm = "a1";
+  GuidanceProcess guidance(flags, options);
+  std::map<std::string, std::vector<orbed::guidance_t>> seen;
+  for (const char* channel : {"GUIDANCE", "GUIDANCE_A1"}) {
+    guidance.process().lcm().subscribeFunction(
+        channel,
+        +[](const lcm::ReceiveBuffer*, const std::string& ch, const orbed::guidance_t* msg,
+            std::map<std::string, std::vector<orbed::guidance_t>>* out) { (*out)[ch].push_back(*msg); },
+        &seen);
+  }
+  auto a1 = Status(Deg({0, 30, 0, -60, 0, 45, 7}));  // joint 7, 7 deg off
+  guidance.process().lcm().publish("IIWA_STATUS_A1", &a1);
+  auto single = Status(Deg({20, 30, 0, -60, 0, 45, 0}));
+  guidance.process().lcm().publish("IIWA_STATUS", &single);
+  EXPECT_EQ(guidance.Run(), 0);
+  EXPECT_EQ(seen.count("GUIDANCE"), 0u);
+  ASSERT_FALSE(seen["GUIDANCE_A1"].empty());
+  EXPECT_EQ(seen["GUIDANCE_A1"].back().next_joint, 6);
+  EXPECT_NEAR(seen["GUIDANCE_A1"].back().error_deg[6], 7.0, 1e-9);
+  EXPECT_NEAR(seen["GUIDANCE_A1"].back().error_deg[0], 0.0, 1e-9);
 }
 
 // IGTL_TARGET: an unreachable trocar (5 m away) and a non-unit quaternion are refused and the
