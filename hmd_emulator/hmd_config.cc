@@ -30,11 +30,12 @@ std::vector<std::string> DefaultHmdConfigRelativePaths() {
 HmdConfig ParseHmdConfig(const YAML::Node& node, const std::string& source, const std::string& key,
                          const HmdConfig& base) {
   const YamlFields f(source);
-  f.CheckKeys(node, key,
-              {"name", "gaze_hz", "reflective_hz", "ar_view_hz", "align_waypoint", "settle_s", "max_wait_s",
-               "max_repeats", "recapture_period_s", "gaze_fallback_distance_m", "max_gaze_distance_m",
-               "displays", "annotation_landmarks", "annotation_pointing_std_deg", "annotation_dwell_s",
-               "annotation_view_angle_deg", "annotation_walk_speed_m_per_s", "session_start_m"});
+  f.CheckKeys(
+      node, key,
+      {"name", "gaze_hz", "reflective_hz", "ar_view_hz", "align_waypoint", "settle_s", "max_wait_s",
+       "max_repeats", "recapture_period_s", "gaze_fallback_distance_m", "max_gaze_distance_m", "displays",
+       "annotation_landmarks", "annotation_pointing_std_deg", "annotation_dwell_s",
+       "annotation_view_angle_deg", "annotation_walk_speed_m_per_s", "session_start_m", "collaborator"});
   HmdConfig c = base;
   c.name = Text(f, node, "name", key, c.name);
   c.gaze_hz = f.NumberOr(node, "gaze_hz", key, c.gaze_hz, 0.1, 1000, "Hz");
@@ -69,6 +70,18 @@ HmdConfig ParseHmdConfig(const YAML::Node& node, const std::string& source, cons
     if (c.session_start_m.norm() > 100)
       f.Fail(node["session_start_m"], key + ".session_start_m", "more than 100 m from W");
   }
+  const YAML::Node collaborator = node["collaborator"];
+  if (collaborator.IsDefined() && !collaborator.IsNull()) {
+    const std::string k = key + ".collaborator";
+    f.CheckKeys(collaborator, k,
+                {"waypoint", "colocalization_translation_mm", "colocalization_rotation_deg"});
+    c.collaborator.waypoint = Text(f, collaborator, "waypoint", k, "");
+    if (c.collaborator.waypoint.empty()) f.Fail(collaborator, k + ".waypoint", "missing (a waypoint name)");
+    c.collaborator.colocalization_translation_mm =
+        f.NumberOr(collaborator, "colocalization_translation_mm", k, 0.0, 0, 1000, "mm");
+    c.collaborator.colocalization_rotation_deg =
+        f.NumberOr(collaborator, "colocalization_rotation_deg", k, 0.0, 0, 45, "deg");
+  }
   const YAML::Node displays = node["displays"];
   if (displays.IsDefined() && !displays.IsNull()) {
     if (!displays.IsSequence() || displays.size() == 0 || displays.size() > 16) {
@@ -90,7 +103,8 @@ HmdConfig ParseHmdConfig(const YAML::Node& node, const std::string& source, cons
 
 HmdConfigSet LoadHmdConfigs(const std::vector<std::string>& paths) {
   HmdConfigSet set;
-  std::string walk_source, align_source = "(defaults)", displays_source = "(defaults)";
+  std::string walk_source, align_source = "(defaults)", displays_source = "(defaults)",
+                           collaborator_source = "(defaults)";
   for (const std::string& path : paths) {
     const YAML::Node root = YamlFields::LoadFile(path);
     const YamlFields f(path);
@@ -107,6 +121,7 @@ HmdConfigSet LoadHmdConfigs(const std::vector<std::string>& paths) {
       set.hmd = ParseHmdConfig(root["hmd"], path, "hmd", set.hmd);
       if (root["hmd"]["align_waypoint"]) align_source = path;
       if (root["hmd"]["displays"]) displays_source = path;
+      if (root["hmd"]["collaborator"]) collaborator_source = path;
     }
     set.sources.push_back(path);
   }
@@ -131,6 +146,8 @@ HmdConfigSet LoadHmdConfigs(const std::vector<std::string>& paths) {
     check(set.hmd.displays[i].capture_waypoint, "hmd.displays[" + std::to_string(i) + "].capture_waypoint",
           displays_source);
   }
+  if (!set.hmd.collaborator.waypoint.empty())
+    check(set.hmd.collaborator.waypoint, "hmd.collaborator.waypoint", collaborator_source);
   return set;
 }
 

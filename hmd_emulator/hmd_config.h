@@ -44,6 +44,10 @@
 ///   session_start_m: [2.6, 0.3, 1.7]  # where the person puts the headset on: the map's origin [m]
 ///   # displays: a list of {capture_waypoint: NAME}, where each reflective display captures its
 ///   # frame, in order; default (absent): one display at the walk's first waypoint.
+///   # collaborator: {waypoint: NAME, colocalization_translation_mm: T, colocalization_rotation_deg: R}
+///   #   a second person's headset, standing at that waypoint of the walk, serves as the first
+///   #   reflective display with its live frames (CollaboratorDisplay, viraal_trial.h; the mapping
+///   #   is replaced as a whole); default (absent): none.
 /// @endcode
 /// Display i is placed at (captures its frame from) the camera pose at the arrival at its waypoint of
 /// the walk: live, and in every emulated trial that uses >= i + 1 displays.
@@ -58,6 +62,7 @@
 #include "hmd_emulator/head_trajectory.h"
 #include "hmd_emulator/slam_model.h"
 #include "hmd_emulator/user_model.h"
+#include "hmd_emulator/viraal_trial.h"
 
 namespace orbed::hmd {
 
@@ -87,6 +92,7 @@ struct HmdConfig {
   double annotation_walk_speed_m_per_s{0.5};
   /// Where the person puts the headset on, the session map's origin (SessionMapAtTrial) [m, W].
   Eigen::Vector3d session_start_m{2.6, 0.3, 1.7};
+  CollaboratorDisplay collaborator;  ///< waypoint "" = none
 };
 
 /// The most landmarks a person annotates per trial (ALIGNMENT_TRIAL carries 4 rays per landmark).

@@ -3,6 +3,7 @@
 // from the defaults (the walk's waypoint names) are what the defaults resolve to with the shipped walk.
 #include "hmd_emulator/hmd_config.h"
 
+#include <fstream>
 #include <set>
 #include <string>
 
@@ -68,6 +69,41 @@ TEST(HmdConfig, HeaderStructAndShippedFileAgree) {
   EXPECT_EQ(defaults.hmd.align_waypoint, expected.align_waypoint);
   ASSERT_EQ(defaults.hmd.displays.size(), 1u);
   EXPECT_EQ(defaults.hmd.displays[0].capture_waypoint, expected.displays[0].capture_waypoint);
+}
+
+// hmd.collaborator (viraal_trial.h's CollaboratorDisplay): absent by default; read and checked
+// like the other waypoint names, against the loaded walk.
+TEST(HmdConfig, TheCollaboratorNamesAWaypointOfTheWalk) {
+  std::vector<std::string> paths;
+  for (const std::string& rel : DefaultHmdConfigRelativePaths()) paths.push_back(HmdSourcePath(rel));
+  EXPECT_TRUE(LoadHmdConfigs(paths).hmd.collaborator.waypoint.empty());
+  auto with = [&](const std::string& yaml) {
+    const std::string path = ::testing::TempDir() + "collaborator.yaml";
+    std::ofstream(path) << yaml;
+    std::vector<std::string> all = paths;
+    all.push_back(path);
+    return LoadHmdConfigs(all);
+  };
+  const HmdConfigSet set = with(
+      "hmd:\n  collaborator: {waypoint: foot_end, colocalization_translation_mm: 12, "
+      "colocalization_rotation_deg: 0.4}\n");
+  EXPECT_EQ(set.hmd.collaborator.waypoint, "foot_end");
+  EXPECT_EQ(set.hmd.collaborator.colocalization_translation_mm, 12);
+  EXPECT_EQ(set.hmd.collaborator.colocalization_rotation_deg, 0.4);
+  auto error = [&](const std::string& yaml) {
+    try {
+      with(yaml);
+    } catch (const std::exception& e) {
+      return std::string(e.what());
+    }
+    return std::string("(accepted)");
+  };
+  EXPECT_NE(error("hmd:\n  collaborator: {waypoint: the_door}\n").find("hmd.collaborator.waypoint"),
+            std::string::npos);
+  EXPECT_NE(error("hmd:\n  collaborator: {waypoint: foot_end, colocalization_translation_mm: -1}\n")
+                .find("colocalization_translation_mm"),
+            std::string::npos);
+  EXPECT_NE(error("hmd:\n  collaborator: {waypoint: foot_end, wall: 1}\n").find("wall"), std::string::npos);
 }
 
 }  // namespace

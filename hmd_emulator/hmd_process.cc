@@ -108,7 +108,9 @@ HmdProcess::HmdProcess(const orbed::CommonFlags& flags, const HmdOptions& option
                        robot_model_->num_joints());
   stream_ = std::make_unique<PoseStream>(config_, scene, *robot_model_);
 
-  process_ = std::make_unique<orbed::Process>(flags);
+  orbed::CommonFlags process_flags = flags;
+  process_flags.sim_clock_arm = options_.arm;  // --sim-time follows the clock of the arm it looks at
+  process_ = std::make_unique<orbed::Process>(process_flags);
   process_->Subscribe<orbed::iiwa_status_t>(
       options_.iiwa_status_channel,
       [this](const orbed::iiwa_status_t& m, const std::string& ch, int64_t) { OnIiwaStatus(m, ch); });
@@ -569,7 +571,7 @@ void HmdProcess::SubmitInteractiveTrial() {
                                                : +orbed::alignment_trial_t::MODE_AR;
     start.num_mirrors = options_.displays;
     start.method = orbed::registration_t::METHOD_KARCHER;
-    session_.Open({start.session_id, start.display_mode, start.num_mirrors, start.method, 0});
+    session_.Open({start.session_id, start.display_mode, start.num_mirrors, start.method, 0, 0, {}});
     saved_ = SavedSession{start, std::nullopt};
     process_->Publish(options_.session_control_channel, start);
   }

@@ -58,6 +58,21 @@
 
 namespace orbed::hmd {
 
+/// A collaborator's headset as the first reflective display (the paper's Discussion: multi-view
+/// from collaborative devices; issue 12). Another person stands at `waypoint` of the walk, their
+/// head where the walk's is on arriving there (looking where the walk looks), and their camera's
+/// live frame, with the hologram drawn in it, is what the display shows while the wearer aligns.
+/// Their headset has its own map, joined to the wearer's by a shared anchor: the frame is stamped
+/// with the collaborator's camera in the wearer's map of the moment (CollaboratorView), so it
+/// carries the wearer's current map error rather than the error of an earlier capture, times the
+/// anchor's error, drawn per trial, normal with these standard deviations per axis. No literature
+/// value is assumed for them: `scripts/orbed sweep --only collaborator` sweeps the translation.
+struct CollaboratorDisplay {
+  std::string waypoint;                       ///< "" = none
+  double colocalization_translation_mm{0.0};  ///< [mm], 0 .. 1000
+  double colocalization_rotation_deg{0.0};    ///< [deg], 0 .. 45
+};
+
 struct TrialSetup {
   Eigen::Isometry3d X_WR{Eigen::Isometry3d::Identity()};  ///< real robot base (truth)
   std::vector<Eigen::Vector3d> p_RQ;                      ///< model points at the trial's q
@@ -66,6 +81,9 @@ struct TrialSetup {
   /// Waypoints where a reflective display captures its frame (at arrival, once tracking; see
   /// WalkSamples::at_capture); empty = AR only.
   std::vector<std::string> capture_waypoints;
+  /// With a waypoint and at least one capture waypoint: the first display is the collaborator's
+  /// live frame instead of the frame captured on the walk.
+  CollaboratorDisplay collaborator;
   /// Waypoint where the user aligns (at arrival, after `settle_s`, once tracking is TRACKING).
   std::string align_waypoint;
   double settle_s{0.5};
@@ -102,6 +120,15 @@ struct TrackingFaultRecord {
   /// The faults met, at their onset (the sample they started on) from the alignment start.
   std::vector<TimedFault> met;
 };
+
+/// The collaborator's display as the wearer sees it while aligning from `at`: the collaborator's
+/// camera truly at X_WC = X_WH(arrival at setup.collaborator.waypoint) · X_HC, stamped in the
+/// wearer's map as X_WC_est = C · M · X_WC, M = at.X_WH_est · at.X_WH_true⁻¹ (the wearer's map
+/// error then, E⁻¹ of slam_model.h up to jitter) and C the anchor's error (translation and rotation
+/// vector normal per axis with the configured deviations, from trial_seed's own stream: nothing
+/// else the trial draws changes). D from the collaborator's line of sight (CaptureGazeDistance).
+ReflectiveDisplayView CollaboratorView(const TrialSetup& setup, const Eigen::Isometry3d& X_HC,
+                                       const SlamSample& at, std::uint64_t trial_seed);
 
 struct TrialOutcome {
   /// The person's (last) alignment; its duration_s is the whole alignment's, waits and interrupted

@@ -446,6 +446,59 @@ TEST(SessionMap, TheCacheGivesTheReplaysMap) {
   EXPECT_THROW(SessionMapAtTrial(f.setup, f.slam, f.p_W_start, kMaxSessionTrials, &t), std::invalid_argument);
 }
 
+// A collaborator's headset as the display (TrialSetup::collaborator): its camera where the walk's
+// is on arriving at the waypoint, stamped with the wearer's map error of the moment (here a 2 cm
+// shift of the map, put into the sample by hand) and no anchor error.
+TEST(Collaborator, TheLiveFrameCarriesTheWearersMapErrorOfTheMoment) {
+  Fixture f;
+  f.setup.collaborator.waypoint = "foot_end";
+  SlamSample at;
+  at.X_WH_true = HeadTrajectory(f.setup.walk).X_WH(30.0);
+  at.X_WH_est = Translation({0.02, 0, 0}) * at.X_WH_true;
+  const ReflectiveDisplayView view = CollaboratorView(f.setup, f.slam.X_HC, at, 5);
+  const HeadTrajectory walk(f.setup.walk);
+  const Eigen::Isometry3d X_WC = walk.X_WH(walk.ArrivalTime(walk.FindWaypoint("foot_end"))) * f.slam.X_HC;
+  EXPECT_TRUE(view.X_WC_true.isApprox(X_WC, 1e-12));
+  EXPECT_TRUE(view.X_WC_est.isApprox(Translation({0.02, 0, 0}) * X_WC, 1e-12));
+  EXPECT_GT(view.D_m, 0.5);
+  f.setup.collaborator.waypoint = "nowhere";
+  EXPECT_THROW(CollaboratorView(f.setup, f.slam.X_HC, at, 5), std::invalid_argument);
+}
+
+// In an exact map with an exact anchor, the collaborator standing where the display captured shows
+// what the captured frame showed: the person aligns to the same pose.
+TEST(Collaborator, AtTheCapturePointWithAnExactMapAndAnchorItIsTheCapturedDisplay) {
+  Fixture f;
+  const TrialOutcome captured = f.Run({});
+  f.setup.collaborator.waypoint = "foot_end";
+  const TrialOutcome live = f.Run({});
+  EXPECT_TRUE(live.alignment.X_WV.isApprox(captured.alignment.X_WV, 1e-9));
+  EXPECT_EQ(live.alignment.nudges, captured.alignment.nudges);
+  // The trial does use the collaborator's frame: an anchor 5 cm off moves what the person settles on.
+  f.setup.collaborator.colocalization_translation_mm = 50;
+  EXPECT_FALSE(f.Run({}).alignment.X_WV.isApprox(captured.alignment.X_WV, 1e-6));
+}
+
+// The anchor's error: per axis normal with the configured deviations, drawn per trial seed.
+TEST(Collaborator, TheAnchorErrorHasTheConfiguredSpread) {
+  Fixture f;
+  f.setup.collaborator = {"foot_end", 10.0, 1.0};
+  SlamSample at;
+  at.X_WH_true = at.X_WH_est = HeadTrajectory(f.setup.walk).X_WH(30.0);
+  const int n = 2000;
+  Eigen::Vector3d sum_t2 = Eigen::Vector3d::Zero();
+  double sum_angle2 = 0;
+  for (int seed = 0; seed < n; ++seed) {
+    const ReflectiveDisplayView view = CollaboratorView(f.setup, f.slam.X_HC, at, seed);
+    const Eigen::Isometry3d C = view.X_WC_est * view.X_WC_true.inverse();  // M = identity here
+    sum_t2 += C.translation().cwiseAbs2();
+    sum_angle2 += std::pow(Eigen::AngleAxisd(C.linear()).angle(), 2);
+  }
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(std::sqrt(sum_t2[k] / n), 0.010, 0.0008) << k;  // 10 mm
+  // The rotation vector is normal per axis: |w|^2 has mean 3 sigma^2.
+  EXPECT_NEAR(std::sqrt(sum_angle2 / n), std::sqrt(3.0) * 1.0 * M_PI / 180, 0.0025);
+}
+
 TEST(AlignmentResult, PoseAtATime) {
   AlignmentResult r;
   r.poses = {{0.0, Translation({0, 0, 0})}, {7.5, Translation({1, 0, 0})}, {13.0, Translation({2, 0, 0})}};

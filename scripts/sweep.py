@@ -15,6 +15,10 @@ std of the trials' mean absolute landmark errors, then the norms of the two vect
                  at hmd.session_start_m, which the person walks from to the capture point first).
   displays       1, 2, 3 displays (reflective_mirrors) captured at 104.5 deg (foot_end, shipped),
                  60 deg and 150 deg; the walk visits them from the farthest to head_end.
+  collaborator   the display is a collaborator's headset standing at foot_end (hmd.collaborator,
+                 viraal_trial.h: its live frame, in the wearer's map of the moment, through a shared
+                 anchor) instead of the frame captured there on the walk; the anchor's translation
+                 error 0, 5, 10, 20, 40 mm per axis (value -1: the shipped captured display).
 
 Writes sweep.csv and one PNG per sweep into OUT and prints the table. Model inputs not swept keep
 the shipped values (docs/parameters.md). Run by `scripts/orbed sweep`; needs python3-matplotlib.
@@ -71,6 +75,7 @@ def run_point(study, tmp, trials, users, overlay_text, scenario_text, user_text=
     overlay_text: headset config (no `user:` mapping); user_text: more keys of each person's `user:`
     mapping, each line indented by two spaces. Returns {mode: (mean, std, n)} for the modes run."""
     axes = {m: [] for m in MODES}
+    truth = {m: [] for m in MODES}
     for user in range(1, users + 1):
         overlay = os.path.join(tmp, "overlay.yaml")
         with open(overlay, "w") as f:
@@ -88,6 +93,7 @@ def run_point(study, tmp, trials, users, overlay_text, scenario_text, user_text=
             results = json.load(f)
         for s in results["sessions"]:
             axes[s["mode"]] += [t["misalignment_axes_mm"] for t in s["trials"]]
+            truth[s["mode"]] += [t["truth_misalignment_mm"] for t in s["trials"]]
     row = {}
     for mode, values in axes.items():
         n = len(values)
@@ -95,8 +101,35 @@ def run_point(study, tmp, trials, users, overlay_text, scenario_text, user_text=
             continue
         means = [sum(v[k] for v in values) / n for k in range(3)]
         stds = [math.sqrt(sum((v[k] - means[k]) ** 2 for v in values) / (n - 1)) if n > 1 else 0.0 for k in range(3)]
-        row[mode] = (math.hypot(*means), math.hypot(*stds), n)
+        row[mode] = (math.hypot(*means), math.hypot(*stds), n, sum(truth[mode]) / n)
     return row
+
+
+def plot_collaborator(rows, xlabel, args, path):
+    """The collaborator sweep: the Table 1 statistic and the truth's misalignment with the
+    collaborator's display against the anchor's error, the captured display and AR only as lines."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11, 4.0), dpi=100)
+    swept = [r for r in rows if r["mode"] == "ar_reflective" and r["value"] >= 0]
+    captured = [r for r in rows if r["mode"] == "ar_reflective" and r["value"] < 0][0]
+    ar_only = [r for r in rows if r["mode"] == "ar" and r["value"] < 0][0]
+    for ax, key, title in ((ax1, "table1_mean_mm", "Table 1 statistic (measured in the headset)"),
+                           (ax2, "truth_misalignment_mean_mm", "misalignment from the truth's landmarks")):
+        ax.plot([r["value"] for r in swept], [r[key] for r in swept], "o-", color="tab:green",
+                label="collaborator's live display")
+        ax.axhline(captured[key], color="tab:blue", linestyle="--", label="display captured on the walk (shipped)")
+        ax.axhline(ar_only[key], color="tab:orange", linestyle="--", label="AR only")
+        ax.set_xlabel(xlabel)
+        ax.set_ylabel("[mm]")
+        ax.set_ylim(bottom=0)
+        ax.set_title(title, fontsize=9)
+        ax.legend(fontsize=8)
+    fig.suptitle(f"{args.users} persons x {args.trials} trials per mode; collaborator at foot_end", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
 
 
 def main():
@@ -106,7 +139,8 @@ def main():
     parser.add_argument("--out", required=True, help="folder for sweep.csv and the PNGs")
     parser.add_argument("--trials", type=int, default=50, help="trials per person and mode (default 50)")
     parser.add_argument("--users", type=int, default=4, help="emulated persons per point (default 4)")
-    parser.add_argument("--only", choices=["drift", "capture_angle", "displays"], help="one sweep only")
+    parser.add_argument("--only", choices=["drift", "capture_angle", "displays", "collaborator"],
+                        help="one sweep only")
     args = parser.parse_args()
     if args.trials < 2 or args.users < 1:
         sys.exit("sweep: --trials must be >= 2 and --users >= 1")
@@ -123,6 +157,9 @@ def main():
                   for f in (0.0, 0.003, 0.006, 0.01, 0.014, 0.02)],
         "capture_angle": [],
         "displays": [],
+        "collaborator": [(-1, shipped_walk, scenario, shipped_path)] + [
+            (t, shipped_walk + f"  collaborator: {{waypoint: capture_0, colocalization_translation_mm: {t}}}\n",
+             scenario, shipped_path) for t in (0, 5, 10, 20, 40)],
     }
     for angle in (0, 15, 30, 60, 90, 120, 150, 170):
         text, path = walk_yaml([on_circle(angle)])
@@ -140,12 +177,13 @@ def main():
             for value, overlay, scenario_text, path in points:
                 result = run_point(args.study, tmp, args.trials, args.users, overlay, scenario_text)
                 for mode in MODES:
-                    mean, std, n = result[mode]
+                    mean, std, n, true_mean = result[mode]
                     rows.append({"sweep": name, "value": value, "mode": mode, "trials": n,
                                  "table1_mean_mm": round(mean, 3), "table1_std_mm": round(std, 3),
-                                 "path_m": round(path, 3)})
+                                 "truth_misalignment_mean_mm": round(true_mean, 3), "path_m": round(path, 3)})
                 print(f"{name:14s} {value:>6}  with display {result['ar_reflective'][0]:5.1f} +/- "
-                      f"{result['ar_reflective'][1]:4.1f} mm   AR only {result['ar'][0]:5.1f} +/- {result['ar'][1]:4.1f} mm"
+                      f"{result['ar_reflective'][1]:4.1f} mm (truth {result['ar_reflective'][3]:5.1f})   "
+                      f"AR only {result['ar'][0]:5.1f} +/- {result['ar'][1]:4.1f} mm (truth {result['ar'][3]:5.1f})"
                       f"   (walk {path:.2f} m)", flush=True)
     with open(os.path.join(args.out, "sweep.csv"), "w", newline="") as f:
         writer = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
@@ -157,10 +195,14 @@ def main():
     import matplotlib.pyplot as plt
     labels = {"drift": "SLAM drift [fraction of the distance walked]",
               "capture_angle": "angle between capture and alignment viewpoints [deg]",
-              "displays": "number of reflective displays"}
+              "displays": "number of reflective displays",
+              "collaborator": "collaborator's shared-anchor error [mm per axis]"}
     for name in labels:
         mine = [r for r in rows if r["sweep"] == name]
         if not mine:
+            continue
+        if name == "collaborator":
+            plot_collaborator(mine, labels[name], args, os.path.join(args.out, f"{name}.png"))
             continue
         fig, ax = plt.subplots(figsize=(6.4, 4.0), dpi=100)
         span = max(r["value"] for r in mine) - min(r["value"] for r in mine)

@@ -199,8 +199,10 @@ IiwaSim::IiwaSim(const orbed::CommonFlags& flags, const IiwaSimOptions& options)
   const double tick_wall_s = 1e-9 * static_cast<double>(tick_wall_ns_);
   if (options_.lockstep) {
     process_->Subscribe<orbed::sim_clock_ack_t>(
-        channels::kSimClockAck, [this](const orbed::sim_clock_ack_t& msg, const std::string& channel,
-                                       int64_t) { OnAck(msg, channel); });
+        channels::ForArm(channels::kSimClockAck, options_.arm),
+        [this](const orbed::sim_clock_ack_t& msg, const std::string& channel, int64_t) {
+          OnAck(msg, channel);
+        });
     // The ticks come from Advance(): from this poll and from each answer.
     process_->AddWallPoll(tick_wall_s, [this] {
       if (!holding_) return Advance();

@@ -70,7 +70,8 @@ Process::Process(const CommonFlags& flags)
       duration_sec_(flags.duration_s),
       lcm_(std::make_unique<lcm::LCM>(UrlWithReceiveBuffer(flags.lcm_url))),
       start_(std::chrono::steady_clock::now()),
-      sim_time_(flags.sim_time) {
+      sim_time_(flags.sim_time),
+      sim_clock_arm_(flags.sim_clock_arm) {
   // Before any slow set-up (models, meshes, hashes), so that a stop request during it is a clean
   // stop (Run() returns at once) rather than the default action.
   InstallStopSignalHandlers();
@@ -81,7 +82,7 @@ Process::Process(const CommonFlags& flags)
   }
   AddWallTimer(1.0, [this] { PublishStatus(); });
   if (sim_time_) {
-    Subscribe<orbed::sim_clock_t>(channels::kSimClock,
+    Subscribe<orbed::sim_clock_t>(channels::ForArm(channels::kSimClock, flags.sim_clock_arm),
                                   [this](const orbed::sim_clock_t& msg, const std::string& channel, int64_t) {
                                     OnSimClock(msg, channel);
                                   });
@@ -90,11 +91,11 @@ Process::Process(const CommonFlags& flags)
     AddWallTimer(5.0, [this] {
       if (sim_clock_.started()) return;
       if (UptimeSeconds() >= kSimClockStartTimeoutS) {
-        return Fail("no " + std::string(channels::kSimClock) + " within " +
+        return Fail("no " + channels::ForArm(channels::kSimClock, sim_clock_arm_) + " within " +
                     std::to_string(static_cast<int>(kSimClockStartTimeoutS)) +
                     " s (--sim-time): is orbed-iiwa-sim running?");
       }
-      ORBED_LOG(kWarn) << "no " << channels::kSimClock
+      ORBED_LOG(kWarn) << "no " << channels::ForArm(channels::kSimClock, sim_clock_arm_)
                        << " yet (--sim-time): the timers wait for orbed-iiwa-sim's clock";
     });
   }
@@ -201,7 +202,7 @@ void Process::AnswerLockstepRound() {
   }
   unanswered_round_.reset();
   last_answer_ = ack;
-  PublishControl(channels::kSimClockAck, ack);
+  PublishControl(channels::ForArm(channels::kSimClockAck, sim_clock_arm_), ack);
 }
 
 lcm::Subscription* Process::Add(std::unique_ptr<SubscriptionBase> subscription, const std::string& channel) {

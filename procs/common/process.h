@@ -224,6 +224,7 @@ class Process {
   std::vector<Timer> timers_;
   std::chrono::steady_clock::time_point start_;
   bool sim_time_{false};
+  std::string sim_clock_arm_;  // whose SIM_CLOCK (CommonFlags::sim_clock_arm)
   SimClock sim_clock_;
   std::optional<int64_t> sim_deadline_ns_;              // the running sim timer's deadline
   std::optional<orbed::sim_clock_t> unanswered_round_;  // a lockstep SIM_CLOCK not yet answered

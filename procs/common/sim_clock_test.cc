@@ -319,6 +319,42 @@ TEST(ProcessSimTime, TimersRunAtSimDeadlinesInDeadlineOrder) {
   EXPECT_EQ(process.dropped(), 0);  // 50 ms steps are 2.5 and 1.7 periods: caught up, not skipped
 }
 
+// One of several arms (sim_clock_arm "a1"): the process follows SIM_CLOCK_A1 and answers its rounds
+// on SIM_CLOCK_ACK_A1; the single arm's SIM_CLOCK does not move its clock and gets no answer.
+TEST(ProcessSimTime, AFollowerOfOneArmOfSeveralUsesThatArmsClock) {
+  CommonFlags flags("orbed-follower");
+  flags.lcm_url = "memq://";
+  flags.duration_s = 20;  // a safety limit only
+  flags.sim_time = true;
+  flags.sim_clock_arm = "a1";
+  Process process(flags);
+  std::vector<std::pair<std::string, int64_t>> answers;  // (channel, utime - kStart)
+  for (const char* channel : {"SIM_CLOCK_ACK", "SIM_CLOCK_ACK_A1"}) {
+    process.SubscribeRaw(channel, [&](const lcm::ReceiveBuffer& rbuf, const std::string& ch) {
+      orbed::sim_clock_ack_t ack;
+      ASSERT_EQ(ack.decode(rbuf.data, 0, rbuf.data_size), static_cast<int>(rbuf.data_size));
+      answers.emplace_back(ch, ack.utime - kStart);
+      if (answers.size() == 2) process.RequestStop();
+    });
+  }
+  auto tick = [&](const char* channel, int64_t t_us) {
+    orbed::sim_clock_t clock{};
+    clock.utime = kStart + t_us;
+    clock.start_utime = kStart;
+    clock.realtime_rate = 10;
+    clock.lockstep_round = 1;
+    process.lcm().publish(channel, &clock);
+  };
+  tick("SIM_CLOCK", 900'000);  // another arm's clock, far ahead: ignored
+  tick("SIM_CLOCK_A1", 0);
+  tick("SIM_CLOCK_A1", 50'000);
+  EXPECT_EQ(process.Run(), 0);
+  const std::vector<std::pair<std::string, int64_t>> expected = {{"SIM_CLOCK_ACK_A1", 0},
+                                                                 {"SIM_CLOCK_ACK_A1", 50'000}};
+  EXPECT_EQ(answers, expected);
+  EXPECT_NEAR(process.ClockSeconds(), 0.05, 1e-9);
+}
+
 // Without sim_time the process clock is the monotonic one and SIM_CLOCK is not even subscribed.
 TEST(ProcessSimTime, WithoutItTheClockIsTheWallsAndSimClockIsIgnored) {
   CommonFlags flags("orbed-test");

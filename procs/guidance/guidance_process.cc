@@ -221,6 +221,7 @@ int RunGuidance(int argc, const char* const* argv, std::ostream& out, std::ostre
       const sim::RobotModel model = sim::RobotModel::LoadFlag(options.urdf_path);
       options.target.q_target_rad = ReadPlanTarget(plan_path, plan_target, model.num_joints());
     }
+    common.sim_clock_arm = options.arm;
     GuidanceProcess guidance(common, options);
     return guidance.Run();
   } catch (const std::exception& e) {

@@ -116,6 +116,7 @@ int RunScenario(int argc, const char* const* argv, std::ostream& out, std::ostre
   if (const auto code = ParseCommandLine(&app, common, argc, argv, out, err)) return *code;
   if (!print_path.empty()) return PrintResults(print_path, out, err);
   UseInstanceChannels(&run, headset, arm);
+  common.sim_clock_arm = arm;
   try {
     if (scenario_path.empty()) scenario_path = ScenarioSourcePath(viraal::kDefaultScenarioRelativePath);
     run.config = viraal::LoadScenarioFile(scenario_path);
