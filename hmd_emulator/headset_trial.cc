@@ -43,6 +43,7 @@ TrialSetup MakeHeadsetTrialSetup(const HmdConfigSet& config, const HeadsetTrialI
   setup.annotation.walk_speed_m_per_s = config.hmd.annotation_walk_speed_m_per_s;
   setup.annotation_view_angle_deg = config.hmd.annotation_view_angle_deg;
   setup.collaborator = config.hmd.collaborator;
+  if (inputs.collaborator_X_WC_true) setup.collaborator.X_WC_true = inputs.collaborator_X_WC_true;
   if (!inputs.capture_waypoints.empty() &&
       static_cast<int>(inputs.capture_waypoints.size()) != inputs.num_mirrors) {
     throw std::invalid_argument("headset trial: " + std::to_string(inputs.capture_waypoints.size()) +

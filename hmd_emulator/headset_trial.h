@@ -27,6 +27,7 @@
 /// Threading: pure functions of their arguments; reentrant. No LCM, no clock, no process state.
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -68,6 +69,9 @@ struct HeadsetTrialInputs {
   /// The landmarks the person annotates after the alignment, in R at q (AnnotationLandmarkPoints);
   /// empty = no annotation.
   std::vector<Eigen::Vector3d> p_RL;
+  /// A live collaborator's camera, truly (orbed-hmd --collaborator): the first display is its
+  /// frame (CollaboratorDisplay::X_WC_true, with config.hmd.collaborator's anchor error).
+  std::optional<Eigen::Isometry3d> collaborator_X_WC_true;
 };
 
 /// The origins of config.hmd.annotation_landmarks' links at q [rad], in R [m], in that order.

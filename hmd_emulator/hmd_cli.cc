@@ -57,6 +57,11 @@ int RunHmd(int argc, const char* const* argv, std::ostream& out, std::ostream& e
   AddInstanceFlag(&app, "--arm", &o.arm,
                   "Look at the arm NAME of the scene's `arms:` list: walk around its base and read its "
                   "channels (IIWA_STATUS_A1, ROBOT_STATE_A1, GUIDANCE_A1, ...; default: the single arm)");
+  AddInstanceFlag(
+      &app, "--collaborator", &o.collaborator,
+      "Another headset (its --headset NAME) as this one's first reflective display: what its camera "
+      "sees (it stands where its HMD_POSE_TRUTH_<NAME> says), the hologram drawn through a shared "
+      "anchor (error: hmd.collaborator in --config); the emulated trials align with it");
   app.add_option("--iiwa-status-channel", o.iiwa_status_channel)->capture_default_str();
   app.add_option("--robot-state-channel", o.robot_state_channel)->capture_default_str();
   app.add_option("--iiwa-command-channel", o.iiwa_command_channel,

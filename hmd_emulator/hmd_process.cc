@@ -40,12 +40,14 @@ HmdProcess::HmdProcess(const orbed::CommonFlags& flags, const HmdOptions& option
   if (options_.urdf_path.empty())
     options_.urdf_path = HmdSourcePath(sim::RobotModel::kDefaultUrdfRelativePath);
   if (options_.scene_path.empty()) options_.scene_path = HmdSourcePath(sim::kDefaultSceneRelativePath);
-  for (const auto& [flag, name] :
-       {std::pair{"--headset", options_.headset}, std::pair{"--arm", options_.arm}}) {
+  for (const auto& [flag, name] : {std::pair{"--headset", options_.headset}, std::pair{"--arm", options_.arm},
+                                   std::pair{"--collaborator", options_.collaborator}}) {
     if (!name.empty() && !channels::IsInstanceName(name))
       throw std::invalid_argument(std::string(flag) + " " + name + ": expected " +
                                   channels::kInstanceNameRule);
   }
+  if (!options_.collaborator.empty() && options_.collaborator == options_.headset)
+    throw std::invalid_argument("--collaborator " + options_.collaborator + ": that is this headset");
   for (std::string* channel :
        {&options_.hmd_pose_channel, &options_.hmd_pose_truth_channel, &options_.camera_channel,
         &options_.gaze_channel, &options_.reflective_channel, &options_.ar_view_channel,
@@ -126,6 +128,12 @@ HmdProcess::HmdProcess(const orbed::CommonFlags& flags, const HmdOptions& option
   process_->Subscribe<orbed::guidance_t>(
       options_.guidance_channel,
       [this](const orbed::guidance_t& m, const std::string& ch, int64_t) { OnGuidance(m, ch); });
+  if (!options_.collaborator.empty()) {
+    live_anchor_error_ = AnchorError(config_.hmd.collaborator, process_->seed());
+    process_->Subscribe<orbed::hmd_pose_t>(
+        channels::ForHeadset(channels::kHmdPoseTruth, options_.collaborator),
+        [this](const orbed::hmd_pose_t& m, const std::string& ch, int64_t) { OnCollaboratorPose(m, ch); });
+  }
   process_->Subscribe<orbed::alignment_trial_t>(
       options_.trial_channel,
       [this](const orbed::alignment_trial_t& m, const std::string& ch, int64_t) { OnTrial(m, ch); });
@@ -217,6 +225,12 @@ FrameInputs HmdProcess::Inputs() const {
   in.hide_reflective_hologram = hologram.reflective_hidden;
   in.q_reflective_rad = hologram.reflective_q_rad;
   in.t_s = stream_->t_s();
+  if (collaborator_X_WC_true_ && in.have_sample) {
+    // In this headset's map of the moment, through the shared anchor (CollaboratorView's relation).
+    const Eigen::Isometry3d M = in.sample.X_WH_est * in.sample.X_WH_true.inverse();
+    in.collaborator = FrameInputs::CollaboratorCamera{
+        *collaborator_X_WC_true_, live_anchor_error_ * M * *collaborator_X_WC_true_, collaborator_utime_};
+  }
   return in;
 }
 
@@ -264,6 +278,13 @@ void HmdProcess::OnIiwaStatus(const orbed::iiwa_status_t& msg, const std::string
     return process_->Reject(channel + "/" + problem.rejection_class, problem.reason);
   robot_.q_rad = q;
   robot_.have_q = true;
+}
+
+void HmdProcess::OnCollaboratorPose(const orbed::hmd_pose_t& msg, const std::string& channel) {
+  const std::string error = CheckWorldPose(msg.X_WC, "X_WC");
+  if (!error.empty()) return process_->Reject(channel + "/pose", error);
+  collaborator_X_WC_true_ = FromPose(msg.X_WC);
+  collaborator_utime_ = msg.utime;
 }
 
 void HmdProcess::OnRobotState(const orbed::robot_state_t& msg, const std::string& channel) {
@@ -371,6 +392,7 @@ void HmdProcess::EmulateTrial(const std::string& channel) {
   inputs.trial_index = s.next_index;
   inputs.num_mirrors = s.num_mirrors;
   inputs.capture_waypoints = s.capture_waypoints;
+  inputs.collaborator_X_WC_true = collaborator_X_WC_true_;
   TrialOutcome outcome;
   try {
     SetRobotAt(*robot_model_, robot_.q_rad, &inputs);

@@ -14,7 +14,9 @@
 ///               SESSION_CONTROL (session_control_t): START / RESET / STOP / REQUEST_TRIAL;
 ///               REGISTRATION (registration_t): X_WV_mean, where the hologram is drawn when valid;
 ///               ALIGNMENT_TRIAL (alignment_trial_t): another's trial of the active session moves
-///               the next trial index past it (HmdSession::ObserveTrial).
+///               the next trial index past it (HmdSession::ObserveTrial);
+///               HMD_POSE_TRUTH_<NAME> (hmd_pose_t) with --collaborator NAME: where that headset's
+///               camera truly is, display 0 and the trials' first display (CollaboratorDisplay).
 ///   Publishes:  HMD_POSE and HMD_POSE_TRUTH (hmd_pose_t) at pose_hz (pose_stream.h);
 ///               HMD_CAMERA (image_t, JPEG) at camera_hz, REFLECTIVE_VIEW (reflective_view_t) at
 ///               hmd.reflective_hz per display (--displays), AR_VIEW (image_t, JPEG) at
@@ -62,6 +64,7 @@
 /// Rejections (Process::Reject, key "<channel>/<class>"; the process keeps running):
 ///   IIWA_STATUS/num_joints, /non_finite, /limits (beyond a joint limit by > 0.01 rad);
 ///   ROBOT_STATE/pose (X_WR not finite or not a unit quaternion);
+///   HMD_POSE_TRUTH_<NAME>/pose (the collaborator's X_WC not a world pose, CheckWorldPose);
 ///   REGISTRATION/pose (a valid mean with a bad X_WV_mean);
 ///   SESSION_CONTROL/<key> with the keys of hmd_session.h, /trial_failed, and /busy (a request
 ///   while a trial waits for its tracking faults to play);
@@ -93,6 +96,7 @@
 #include <opencv2/core.hpp>
 #include <orbed/alignment_trial_t.hpp>
 #include <orbed/guidance_t.hpp>
+#include <orbed/hmd_pose_t.hpp>
 #include <orbed/iiwa_status_t.hpp>
 #include <orbed/registration_t.hpp>
 #include <orbed/robot_state_t.hpp>
@@ -140,6 +144,11 @@ struct HmdOptions {
   /// offset around that arm's base, the arm's channels (IIWA_STATUS, ROBOT_STATE, IIWA_COMMAND,
   /// GUIDANCE, SETUP_TASK) with its suffix (channels::ForArm); "" = the single arm.
   std::string arm;
+  /// Another headset (its --headset NAME) whose camera is this one's first reflective display
+  /// (viraal_trial.h's CollaboratorDisplay, the anchor's error from hmd.collaborator): where it
+  /// truly is comes from its HMD_POSE_TRUTH_<NAME>; the live display 0 shows what its camera sees,
+  /// and the emulated trials align with it. "" = none.
+  std::string collaborator;
   std::string iiwa_status_channel{channels::kIiwaStatus};
   std::string robot_state_channel{channels::kRobotState};
   std::string session_control_channel{channels::kSessionControl};
@@ -222,6 +231,7 @@ class HmdProcess {
   void OnRegistration(const orbed::registration_t& msg, const std::string& channel);
   void OnTrial(const orbed::alignment_trial_t& msg, const std::string& channel);
   void OnGuidance(const orbed::guidance_t& msg, const std::string& channel);
+  void OnCollaboratorPose(const orbed::hmd_pose_t& msg, const std::string& channel);
   void SaveState();
   void EmulateTrial(const std::string& channel);
   void SubmitInteractiveTrial();
@@ -258,6 +268,11 @@ class HmdProcess {
 
   // Latest valid inputs (Run() thread).
   RobotState robot_;
+  // The collaborator's camera, truly (its latest valid HMD_POSE_TRUTH), and the shared anchor's
+  // error of the live display, drawn once from --seed (AnchorError).
+  std::optional<Eigen::Isometry3d> collaborator_X_WC_true_;
+  int64_t collaborator_utime_{0};
+  Eigen::Isometry3d live_anchor_error_{Eigen::Isometry3d::Identity()};
   std::optional<Eigen::Isometry3d> X_WV_registration_, X_WV_user_;
   Eigen::Isometry3d X_WV_start_{Eigen::Isometry3d::Identity()};
   std::string user_id_;

@@ -186,6 +186,26 @@ void ImagePipeline::Recapture(Display* d) {
   ++d->version;
 }
 
+void ImagePipeline::FromCollaborator(Display* d, const FrameInputs::CollaboratorCamera& camera) {
+  if (d->captured && SamePose(d->X_WC_true, camera.X_WC_true) &&
+      SamePose(d->frame.X_WC_est, camera.X_WC_est) && robot_.SameAs(d->robot)) {
+    return;
+  }
+  renderer_.Render(mesh_, camera.X_WC_true, &d->frame.bgr);
+  d->frame.bgr = d->frame.bgr.clone();  // own its pixels (the renderer may reuse the buffer)
+  d->frame.intrinsics = renderer_.intrinsics();
+  d->frame.X_WC_est = camera.X_WC_est;
+  d->frame.q_rad = robot_.known() ? robot_.q_rad : Eigen::VectorXd();
+  d->frame.utime = camera.utime;
+  d->X_WC_true = camera.X_WC_true;
+  d->X_WH_true = camera.X_WC_true;  // D along the camera's own line of sight
+  d->robot = robot_;
+  d->D_m = GazeDistance(d->X_WH_true, d->X_WC_true);
+  d->captured = true;
+  d->captured_at_s = clocks_.monotonic_s();
+  ++d->version;
+}
+
 void ImagePipeline::Camera(const FrameInputs& in) {
   if (!in.have_sample) return;
   const Eigen::Isometry3d& X_WC_true = in.sample.X_WC_true;
@@ -214,6 +234,10 @@ void ImagePipeline::Camera(const FrameInputs& in) {
   }
   for (std::size_t i = 0; i < displays_.size(); ++i) {
     Display& d = displays_[i];
+    if (i == 0 && in.collaborator) {
+      FromCollaborator(&d, *in.collaborator);
+      continue;
+    }
     // Due at the arrival, once tracking: a frame taken while tracking is limited or lost has no
     // pose to place it with (as the emulated trial's display, viraal_trial.h).
     bool wanted =

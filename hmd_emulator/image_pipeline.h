@@ -39,6 +39,7 @@
 #include <cstdint>
 #include <functional>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -76,6 +77,17 @@ struct FrameInputs {
   /// no reflective display).
   bool hide_reflective_hologram{false};
   double t_s{0};  ///< walk time of the sample [s]
+  /// A live collaborator's camera as display 0 (orbed-hmd --collaborator; viraal_trial.h's
+  /// CollaboratorDisplay): truly at X_WC_true, placed in this headset's map at X_WC_est. Display 0
+  /// then shows the scene and the real robot rendered from X_WC_true (the picture that camera
+  /// takes) with the hologram composed from X_WC_est, renewed at each camera frame in which the
+  /// pose or the robot changed, instead of the frame it captured on the walk.
+  struct CollaboratorCamera {
+    Eigen::Isometry3d X_WC_true{Eigen::Isometry3d::Identity()};
+    Eigen::Isometry3d X_WC_est{Eigen::Isometry3d::Identity()};
+    int64_t utime{0};  ///< its sample's [µs]
+  };
+  std::optional<CollaboratorCamera> collaborator;
 };
 
 struct ImagePipelineOptions {
@@ -163,6 +175,8 @@ class ImagePipeline {
   double GazeDistance(const Eigen::Isometry3d& X_WH, const Eigen::Isometry3d& X_WC) const;
   void Capture(Display* d, const FrameInputs& in);
   void Recapture(Display* d);
+  // Display 0 from the collaborator's camera (FrameInputs::collaborator).
+  void FromCollaborator(Display* d, const FrameInputs::CollaboratorCamera& camera);
   void Camera(const FrameInputs& in);
   void Reflective(const FrameInputs& in);
   void ArView(const FrameInputs& in, bool publish);

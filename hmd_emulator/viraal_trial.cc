@@ -220,23 +220,33 @@ SlamModel SessionMapAtTrial(const TrialSetup& setup, const SlamConfig& session_s
   return std::move(*model);
 }
 
-ReflectiveDisplayView CollaboratorView(const TrialSetup& setup, const Eigen::Isometry3d& X_HC,
-                                       const SlamSample& at, std::uint64_t trial_seed) {
+Eigen::Isometry3d AnchorError(const CollaboratorDisplay& collaborator, std::uint64_t seed) {
   constexpr std::uint64_t kCollaboratorSalt = 0x636f6c6c61626f72ULL;  // "collabor"
-  const HeadTrajectory walk(setup.walk);
-  const int waypoint = walk.FindWaypoint(setup.collaborator.waypoint);
-  if (waypoint < 0)
-    throw std::invalid_argument("collaborator: the walk has no waypoint '" + setup.collaborator.waypoint +
-                                "'");
-  ReflectiveDisplayView view;
-  view.intrinsics = setup.intrinsics;
-  view.X_WC_true = walk.X_WH(walk.ArrivalTime(waypoint)) * X_HC;
-  Random random(SplitMix64(trial_seed ^ kCollaboratorSalt));
-  const Eigen::Vector3d t_m = 1e-3 * setup.collaborator.colocalization_translation_mm * random.Normal3();
-  const Eigen::Vector3d w_rad = kDegToRad * setup.collaborator.colocalization_rotation_deg * random.Normal3();
+  Random random(SplitMix64(seed ^ kCollaboratorSalt));
+  const Eigen::Vector3d t_m = 1e-3 * collaborator.colocalization_translation_mm * random.Normal3();
+  const Eigen::Vector3d w_rad = kDegToRad * collaborator.colocalization_rotation_deg * random.Normal3();
   Eigen::Isometry3d C = Eigen::Isometry3d::Identity();
   C.linear() = geometry::ExpSO3(w_rad);
   C.translation() = t_m;
+  return C;
+}
+
+ReflectiveDisplayView CollaboratorView(const TrialSetup& setup, const Eigen::Isometry3d& X_HC,
+                                       const SlamSample& at, std::uint64_t trial_seed) {
+  ReflectiveDisplayView view;
+  view.intrinsics = setup.intrinsics;
+  if (setup.collaborator.X_WC_true) {
+    view.X_WC_true = *setup.collaborator.X_WC_true;
+  } else {
+    const HeadTrajectory walk(setup.walk);
+    const int waypoint = walk.FindWaypoint(setup.collaborator.waypoint);
+    if (waypoint < 0) {
+      throw std::invalid_argument("collaborator: the walk has no waypoint '" + setup.collaborator.waypoint +
+                                  "'");
+    }
+    view.X_WC_true = walk.X_WH(walk.ArrivalTime(waypoint)) * X_HC;
+  }
+  const Eigen::Isometry3d C = AnchorError(setup.collaborator, trial_seed);
   const Eigen::Isometry3d M = at.X_WH_est * at.X_WH_true.inverse();
   view.X_WC_est = C * M * view.X_WC_true;
   view.D_m = CaptureGazeDistance(view.X_WC_true, setup.X_WR, setup.p_RQ);
@@ -275,7 +285,7 @@ TrialOutcome RunTrialFrom(const TrialSetup& setup, SlamModel model, double t0_s,
   out.relocalizations = walked.relocalizations;
 
   ViewingContext ctx = TrialViewingContext(setup, out.at_alignment, out.at_capture);
-  if (!setup.collaborator.waypoint.empty() && !ctx.displays.empty())
+  if (setup.collaborator.active() && !ctx.displays.empty())
     ctx.displays[0] = CollaboratorView(setup, model.config().X_HC, out.at_alignment, trial_seed);
   out.alignment = user.Align(ctx, setup.p_RQ, X_WV_start, trial_seed);
   out.at_end = out.at_alignment;

@@ -68,9 +68,13 @@ namespace orbed::hmd {
 /// anchor's error, drawn per trial, normal with these standard deviations per axis. No literature
 /// value is assumed for them: `scripts/orbed sweep --only collaborator` sweeps the translation.
 struct CollaboratorDisplay {
-  std::string waypoint;                       ///< "" = none
+  std::string waypoint;  ///< "" = none (unless X_WC_true is given)
+  /// Where the collaborator's camera truly is, instead of at the waypoint: a live second headset
+  /// (orbed-hmd --collaborator, from its HMD_POSE_TRUTH_<NAME>) [m].
+  std::optional<Eigen::Isometry3d> X_WC_true;
   double colocalization_translation_mm{0.0};  ///< [mm], 0 .. 1000
   double colocalization_rotation_deg{0.0};    ///< [deg], 0 .. 45
+  bool active() const { return !waypoint.empty() || X_WC_true.has_value(); }
 };
 
 struct TrialSetup {
@@ -122,11 +126,16 @@ struct TrackingFaultRecord {
 };
 
 /// The collaborator's display as the wearer sees it while aligning from `at`: the collaborator's
-/// camera truly at X_WC = X_WH(arrival at setup.collaborator.waypoint) · X_HC, stamped in the
+/// camera truly at X_WC = setup.collaborator.X_WC_true, else X_WH(arrival at its waypoint) · X_HC,
+/// stamped in the
 /// wearer's map as X_WC_est = C · M · X_WC, M = at.X_WH_est · at.X_WH_true⁻¹ (the wearer's map
 /// error then, E⁻¹ of slam_model.h up to jitter) and C the anchor's error (translation and rotation
 /// vector normal per axis with the configured deviations, from trial_seed's own stream: nothing
 /// else the trial draws changes). D from the collaborator's line of sight (CaptureGazeDistance).
+/// The shared anchor's error C (see CollaboratorView), drawn from `seed`'s own stream: translation
+/// and rotation vector normal per axis with the collaborator's deviations.
+Eigen::Isometry3d AnchorError(const CollaboratorDisplay& collaborator, std::uint64_t seed);
+
 ReflectiveDisplayView CollaboratorView(const TrialSetup& setup, const Eigen::Isometry3d& X_HC,
                                        const SlamSample& at, std::uint64_t trial_seed);
 

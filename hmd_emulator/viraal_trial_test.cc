@@ -482,7 +482,9 @@ TEST(Collaborator, AtTheCapturePointWithAnExactMapAndAnchorItIsTheCapturedDispla
 // The anchor's error: per axis normal with the configured deviations, drawn per trial seed.
 TEST(Collaborator, TheAnchorErrorHasTheConfiguredSpread) {
   Fixture f;
-  f.setup.collaborator = {"foot_end", 10.0, 1.0};
+  f.setup.collaborator.waypoint = "foot_end";
+  f.setup.collaborator.colocalization_translation_mm = 10;
+  f.setup.collaborator.colocalization_rotation_deg = 1;
   SlamSample at;
   at.X_WH_true = at.X_WH_est = HeadTrajectory(f.setup.walk).X_WH(30.0);
   const int n = 2000;
