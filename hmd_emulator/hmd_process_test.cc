@@ -87,6 +87,17 @@ struct Collector {
   }
 };
 
+// Every `Msg` on `channel` goes into *out (as the handlers run: Drain).
+template <typename Msg>
+void CollectInto(lcm::LCM& lcm, const std::string& channel, std::vector<Msg>* out) {
+  lcm.subscribeFunction(
+      channel,
+      +[](const lcm::ReceiveBuffer*, const std::string&, const Msg* m, std::vector<Msg>* o) {
+        o->push_back(*m);
+      },
+      out);
+}
+
 CommonFlags MemqFlags(double duration_s) {
   CommonFlags flags("orbed-hmd");
   flags.lcm_url = "memq://";
@@ -519,15 +530,10 @@ TEST(HmdProcess, AHeadsetAtAnotherArmUsesItsChannelsAndWalksAroundThatArm) {
   plain.Attach(hmd.process().lcm());
   std::vector<orbed::hmd_pose_t> truth;
   lcm::LCM& lcm = hmd.process().lcm();
-  auto* sub = lcm.subscribeFunction(
-      "HMD_POSE_TRUTH_H1",
-      +[](const lcm::ReceiveBuffer*, const std::string&, const orbed::hmd_pose_t* m,
-          std::vector<orbed::hmd_pose_t>* out) { out->push_back(*m); },
-      &truth);
+  CollectInto(lcm, "HMD_POSE_TRUTH_H1", &truth);
   hmd.PublishPose();
   hmd.PublishGaze();
   Drain(lcm);
-  lcm.unsubscribe(sub);
   EXPECT_TRUE(plain.truth.empty() && plain.est.empty() && plain.gaze.empty());
   ASSERT_EQ(truth.size(), 1u);
   // foot_end (1.45, -1.20, 1.70) of viraal_walk.yaml, written for the single arm (a0's base), carried
@@ -563,26 +569,10 @@ TEST(HmdProcess, ACollaboratorsCameraIsTheFirstDisplay) {
   std::vector<orbed::reflective_view_t> views;
   std::vector<orbed::hmd_pose_t> est, truth;
   std::vector<orbed::alignment_trial_t> trials;
-  lcm.subscribeFunction(
-      "REFLECTIVE_VIEW_H1",
-      +[](const lcm::ReceiveBuffer*, const std::string&, const orbed::reflective_view_t* m,
-          std::vector<orbed::reflective_view_t>* out) { out->push_back(*m); },
-      &views);
-  lcm.subscribeFunction(
-      "HMD_POSE_H1",
-      +[](const lcm::ReceiveBuffer*, const std::string&, const orbed::hmd_pose_t* m,
-          std::vector<orbed::hmd_pose_t>* out) { out->push_back(*m); },
-      &est);
-  lcm.subscribeFunction(
-      "HMD_POSE_TRUTH_H1",
-      +[](const lcm::ReceiveBuffer*, const std::string&, const orbed::hmd_pose_t* m,
-          std::vector<orbed::hmd_pose_t>* out) { out->push_back(*m); },
-      &truth);
-  lcm.subscribeFunction(
-      "ALIGNMENT_TRIAL_H1",
-      +[](const lcm::ReceiveBuffer*, const std::string&, const orbed::alignment_trial_t* m,
-          std::vector<orbed::alignment_trial_t>* out) { out->push_back(*m); },
-      &trials);
+  CollectInto(lcm, "REFLECTIVE_VIEW_H1", &views);
+  CollectInto(lcm, "HMD_POSE_H1", &est);
+  CollectInto(lcm, "HMD_POSE_TRUTH_H1", &truth);
+  CollectInto(lcm, "ALIGNMENT_TRIAL_H1", &trials);
   const auto status = Status(kQDeg);
   const auto state = State(SceneX_WR());
   lcm.publish("IIWA_STATUS", &status);
