@@ -34,7 +34,7 @@ orbed::session_control_t Control(const std::string& id, int8_t command, int8_t m
   return m;
 }
 
-HmdSession TwoDisplays() { return HmdSession({2, "IIWA_STATUS", "ROBOT_STATE"}); }
+HmdSession TwoDisplays() { return HmdSession({2, "IIWA_STATUS", "ROBOT_STATE", {}}); }
 
 TEST(HmdSession, StartOpensTheSessionAtIndexZero) {
   HmdSession session = TwoDisplays();
@@ -72,7 +72,8 @@ TEST(HmdSession, RepeatedStartIsANoOpAndAnotherStartReplaces) {
 
 TEST(HmdSession, LocalSessionIsRepeatedByItsEchoedStart) {
   HmdSession session = TwoDisplays();
-  session.Open({"interactive-1", +AT::MODE_AR_REFLECTIVE, 1, +orbed::registration_t::METHOD_KARCHER, 0});
+  session.Open(
+      {"interactive-1", +AT::MODE_AR_REFLECTIVE, 1, +orbed::registration_t::METHOD_KARCHER, 0, 0, {}});
   session.TakeTrialIndex();
   EXPECT_EQ(session.Handle(Control("interactive-1", +SC::START, +AT::MODE_AR_REFLECTIVE, 1), kRobot).kind,
             Kind::kRepeatedStart);
@@ -231,7 +232,7 @@ TEST(HmdSession, StartBeyondThePlacedDisplaysIsRefused) {
   EXPECT_NE(d.refusal.reason.find("2 display(s)"), std::string::npos) << d.refusal.reason;
   EXPECT_FALSE(session.state().active());
   // A headset without displays takes MODE_AR only.
-  HmdSession bare({0});
+  HmdSession bare({0, "IIWA_STATUS", "ROBOT_STATE", {}});
   EXPECT_EQ(bare.Handle(Control("s", +SC::START, +AT::MODE_AR_REFLECTIVE, 1), kRobot).refusal.key,
             "num_mirrors");
   EXPECT_EQ(bare.Handle(Control("s", +SC::START, +AT::MODE_AR, 0), kRobot).kind, Kind::kStart);

@@ -59,7 +59,7 @@ AT Trial(const std::string& id, int index, int32_t mirrors = 1) {
   return t;
 }
 
-HmdSession TwoDisplays() { return HmdSession({2, "IIWA_STATUS", "ROBOT_STATE"}); }
+HmdSession TwoDisplays() { return HmdSession({2, "IIWA_STATUS", "ROBOT_STATE", {}}); }
 
 TEST(SessionFile, SavedSessionsRestoreWithTheirNextIndex) {
   const std::string path = TempPath("session.state");
