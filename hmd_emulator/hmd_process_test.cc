@@ -368,6 +368,24 @@ TEST(HmdProcess, SameSeedSameSessionGivesTheSameTrial) {
 
 // The published trial is RunHeadsetTrial() of the same inputs (headset_trial.h), bit for bit: what
 // another program gets when it calls the function with the process's seed, session and index.
+// The inputs orbed-hmd gives RunHeadsetTrial for a REQUEST_TRIAL with the shipped scene and model.
+HeadsetTrialInputs ShippedTrialInputs(const HmdProcess& hmd, const orbed::iiwa_status_t& status,
+                                      const orbed::robot_state_t& state, std::uint64_t seed,
+                                      const std::string& session, int32_t mirrors) {
+  const sim::Scene scene = sim::LoadSceneFile(HmdSourcePath(sim::kDefaultSceneRelativePath));
+  const sim::RobotModel robot =
+      sim::LoadRobotForScene(HmdSourcePath(sim::RobotModel::kDefaultUrdfRelativePath), scene);
+  HeadsetTrialInputs in;
+  SetRobotAt(robot, ToVectorX(status.joint_position_measured), &in);
+  in.X_WR = FromPose(state.X_WR);
+  in.X_WV_start = EmulatedUser(hmd.config().user).StartPose(scene.X_WR);
+  in.process_seed = seed;
+  in.session_id = session;
+  in.num_mirrors = mirrors;
+  in.p_RL = AnnotationLandmarkPoints(robot, hmd.config().hmd, ToVectorX(status.joint_position_measured));
+  return in;
+}
+
 TEST(HmdProcess, PublishedTrialIsTheHeadsetTrialFunction) {
   CommonFlags flags = MemqFlags(0.2);
   flags.seed = 7;
@@ -387,16 +405,7 @@ TEST(HmdProcess, PublishedTrialIsTheHeadsetTrialFunction) {
   EXPECT_EQ(RunAndDrain(&hmd), 0);
   ASSERT_EQ(got.trials.size(), 2u);
 
-  const sim::Scene scene = sim::LoadSceneFile(HmdSourcePath(sim::kDefaultSceneRelativePath));
-  const sim::RobotModel robot =
-      sim::LoadRobotForScene(HmdSourcePath(sim::RobotModel::kDefaultUrdfRelativePath), scene);
-  HeadsetTrialInputs in;
-  SetRobotAt(robot, ToVectorX(status.joint_position_measured), &in);
-  in.X_WR = FromPose(state.X_WR);
-  in.X_WV_start = EmulatedUser(hmd.config().user).StartPose(scene.X_WR);
-  in.process_seed = 7;
-  in.session_id = "fn";
-  in.num_mirrors = 2;
+  HeadsetTrialInputs in = ShippedTrialInputs(hmd, status, state, 7, "fn", 2);
   for (int32_t index = 0; index < 2; ++index) {
     in.trial_index = index;
     const TrialOutcome outcome = RunHeadsetTrial(hmd.config(), in);
@@ -602,17 +611,7 @@ TEST(HmdProcess, ACollaboratorsCameraIsTheFirstDisplay) {
   lcm.publish("SESSION_CONTROL_H1", &request);
   Drain(lcm);
   ASSERT_EQ(trials.size(), 1u);
-  const sim::Scene scene = sim::LoadSceneFile(HmdSourcePath(sim::kDefaultSceneRelativePath));
-  const sim::RobotModel robot =
-      sim::LoadRobotForScene(HmdSourcePath(sim::RobotModel::kDefaultUrdfRelativePath), scene);
-  HeadsetTrialInputs in;
-  SetRobotAt(robot, ToVectorX(status.joint_position_measured), &in);
-  in.X_WR = FromPose(state.X_WR);
-  in.X_WV_start = EmulatedUser(hmd.config().user).StartPose(scene.X_WR);
-  in.process_seed = 1;
-  in.session_id = "co";
-  in.num_mirrors = 1;
-  in.p_RL = AnnotationLandmarkPoints(robot, hmd.config().hmd, ToVectorX(status.joint_position_measured));
+  HeadsetTrialInputs in = ShippedTrialInputs(hmd, status, state, 1, "co", 1);
   in.collaborator_X_WC_true = X_WC2;
   const TrialOutcome with = RunHeadsetTrial(hmd.config(), in);
   EXPECT_TRUE(FromPose(trials[0].X_WV).isApprox(with.alignment.X_WV, 1e-12));
