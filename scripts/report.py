@@ -177,6 +177,24 @@ def stats_row(name, ours, paper, as_clock=False):
     return "<tr><th>%s</th>%s</tr>" % (html.escape(name), cells)
 
 
+def provenance_footer(study_dir):
+    """Where the numbers came from: the study folder's provenance record (scripts/provenance.py)."""
+    path = os.path.join(study_dir, "provenance.json")
+    if not os.path.exists(path):
+        return "<footer><p>No provenance.json in this folder: made without scripts/orbed.</p></footer>"
+    with open(path) as f:
+        p = json.load(f)
+    git = p.get("git", {})
+    commit = (git.get("commit") or "unknown commit") + (" (uncommitted changes)" if git.get("dirty") else "")
+    settings = ", ".join("%s=%s" % (k, v) for k, v in sorted(p.get("settings", {}).items()))
+    return ("<footer><hr><p>Made by orbed %s at commit %s, run %s on %s, started %s: <code>%s</code>. "
+            "Settings: %s. Every input and output with its SHA-256: provenance.json (and each user's "
+            "run folder's); check them with <code>scripts/orbed verify</code>.</p></footer>" % (
+                html.escape(str(p.get("orbed_version"))), html.escape(commit), html.escape(p.get("run", "")),
+                html.escape(p.get("host", "")), html.escape(p.get("started_utc", "")),
+                html.escape(" ".join(p.get("command_line", []))), html.escape(settings)))
+
+
 def report(study_dir):
     tables = json.load(open(os.path.join(study_dir, "tables.json")))
     paper = tables.get("paper", {})
@@ -271,6 +289,7 @@ def report(study_dir):
                 parts.append("<tr><th>%s</th><td>%s</td><td>%s</td><td>%s</td></tr>" % (
                     LABELS[mode], mean_std(t), mean_std(a, 2), mean_std(m)))
         parts.append("</table>")
+    parts.append(provenance_footer(study_dir))
     # The page checks itself once loaded: how many of its pictures decoded, as data-images-loaded on
     # <body> (what a headless browser's DOM dump shows; tests/report_test.sh reads it).
     parts.append("<script>addEventListener('load', () => { const i = [...document.images]; "

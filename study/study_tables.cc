@@ -11,6 +11,7 @@
 
 #include "base/format.h"
 #include "base/json.h"
+#include "base/run_folder.h"
 #include "viraal/paper_reference.h"
 
 namespace orbed::study {
@@ -132,9 +133,10 @@ std::string AlignmentMeansCsv(const std::vector<UserRun>& runs) {
 
 std::string TablesJson(const std::vector<UserRun>& runs, const LandmarkValidation& validation,
                        const std::vector<SetupUserRun>& setup_runs,
-                       const std::vector<SetupUserRun>& setup_truth_runs) {
+                       const std::vector<SetupUserRun>& setup_truth_runs, const std::string& provenance) {
   JsonWriter json(2);
   json.BeginObject();
+  if (!provenance.empty()) json.Key("provenance").String(provenance);
   json.Key("users").Int(static_cast<int64_t>(runs.size()));
   json.Key("table1").BeginObject();
   for (const std::string& mode : StudyModes(runs)) {
@@ -279,7 +281,7 @@ int RunStudyTables(int argc, const char* const* argv, std::ostream& out, std::os
         {"alignment_trials.csv", AlignmentTrialsCsv(runs)},
         {"alignment_means.csv", AlignmentMeansCsv(runs)},
         {"landmark_validation.csv", LandmarkValidationCsv(v)},
-        {"tables.json", TablesJson(runs, v, setup_runs, setup_truth_runs)}};
+        {"tables.json", TablesJson(runs, v, setup_runs, setup_truth_runs, ProvenanceRecordIn(out_dir))}};
     std::vector<std::pair<std::string, std::string>> all;
     for (const auto& [name, text] : files) {
       const bool alignment = std::string(name).rfind("alignment_", 0) == 0;

@@ -43,10 +43,12 @@ viraal::Table1Row ModeMeansRow(const std::vector<UserRun>& runs, const std::stri
 
 std::string AlignmentTrialsCsv(const std::vector<UserRun>& runs);
 std::string AlignmentMeansCsv(const std::vector<UserRun>& runs);
-/// With set-up runs, tables.json also has Tables 2-4 (setup_tables.h) and the paper's.
+/// With set-up runs, tables.json also has Tables 2-4 (setup_tables.h) and the paper's; with a
+/// `provenance` record name (base/run_folder.h), a first key "provenance" naming it.
 std::string TablesJson(const std::vector<UserRun>& runs, const LandmarkValidation& validation,
                        const std::vector<SetupUserRun>& setup_runs = {},
-                       const std::vector<SetupUserRun>& setup_truth_runs = {});
+                       const std::vector<SetupUserRun>& setup_truth_runs = {},
+                       const std::string& provenance = "");
 /// Table 1 as the study measured it, beside the paper's, for the terminal.
 std::string StudySummary(const std::vector<UserRun>& runs, const LandmarkValidation& validation);
 

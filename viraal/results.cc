@@ -99,6 +99,7 @@ std::string ResultsJson(const RunResults& r) {
   json.Key("status").String(r.ok ? "ok" : r.partial ? "partial" : "failed");
   json.Key("error").String(r.error);
   if (!r.resumed_from.empty()) json.Key("resumed_from").String(r.resumed_from);
+  if (!r.provenance.empty()) json.Key("provenance").String(r.provenance);
   json.Key("seed").Int(static_cast<int64_t>(r.seed));
   json.Key("started_utime").Int(r.started_utime);
   json.Key("duration_s").Number(r.duration_s);
@@ -355,6 +356,7 @@ RunResults ParseResultsJson(const std::string& text, const std::string& source) 
   r.partial = status_text == "partial";
   r.error = f.String(f.Member(root, "error"), 1 << 16);
   if (const auto from = f.OptionalMember(root, "resumed_from")) r.resumed_from = f.String(*from, 1 << 12);
+  if (const auto record = f.OptionalMember(root, "provenance")) r.provenance = f.String(*record, 1 << 12);
   r.seed = static_cast<uint64_t>(f.Integer(f.Member(root, "seed"), std::numeric_limits<int64_t>::min(),
                                            std::numeric_limits<int64_t>::max()));
   // The run's times (absent from a pinned file, which leaves them out).

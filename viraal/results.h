@@ -9,7 +9,8 @@
 /// results.json, top level:
 ///   "run_id", "status" ("ok" | "failed" | "partial": written while the run goes on, so a conductor
 ///   that is killed leaves what it finished), "error" (one line, "" when ok or partial),
-///   "resumed_from" (only in a run resumed from an earlier one's results: that file), "seed",
+///   "resumed_from" (only in a run resumed from an earlier one's results: that file), "provenance"
+///   (only in a run folder that has a provenance record: its file name, "provenance.json"), "seed",
 ///   "started_utime" [µs since the epoch], "duration_s" (wall clock of the run),
 ///   "translation_error_point" (what "translation_error_mm" measures), "misalignment_definition",
 ///   "landmarks" (link names), "X_WR" (truth at the first trial), "configurations_deg",
@@ -134,6 +135,7 @@ struct RunResults {
   bool partial{false};  ///< not ok, not failed: the run goes on (status "partial")
   std::string error;
   std::string resumed_from;  ///< the results this run resumed ("" = none)
+  std::string provenance;    ///< the run folder's provenance record ("" = none; base/run_folder.h)
   uint64_t seed{0};
   int64_t started_utime{0};
   double duration_s{0};

@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <variant>
 
+#include "base/run_folder.h"
 #include "base/source_paths.h"
 #include "procs/common/conversions.h"
 #include "procs/common/log.h"
@@ -157,6 +158,7 @@ void ViraalScenario::WriteProgress() {
   results.partial = true;
   results.duration_s = Now().t_s;
   results.rejected_inputs = process_->rejections().total();
+  results.provenance = ProvenanceRecordIn(options_.results_dir);
   try {
     std::filesystem::create_directories(options_.results_dir);
     results_path_ = viraal::WriteResultsFile(options_.results_dir, viraal::ResultsJson(results));
@@ -169,6 +171,7 @@ void ViraalScenario::Finish() {
   finished_ = true;
   results_ = conductor_->results();
   results_.rejected_inputs = process_->rejections().total();
+  results_.provenance = ProvenanceRecordIn(options_.results_dir);
   ORBED_LOG(kInfo) << conductor_->retries() << " request(s) re-sent for lack of an answer";
   try {
     std::filesystem::create_directories(options_.results_dir);

@@ -54,6 +54,7 @@ std::string SetupRunJson(const SetupRun& run, bool partial) {
   json.BeginObject();
   json.Key("user").String(run.user);
   json.Key("run_id").String(run.run_id);
+  if (!run.provenance.empty()) json.Key("provenance").String(run.provenance);
   json.Key("status").String(partial ? "partial" : (run.ok ? "ok" : "failed"));
   json.Key("error").String(run.error);
   json.Key("order").BeginArray();
@@ -162,6 +163,7 @@ SetupRun SetupRunFromJson(const JsonFields& f, const nlohmann::json& doc, std::s
   SetupRun run;
   run.user = f.String(f.Member(root, "user"), 256);
   run.run_id = f.String(f.Member(root, "run_id"), 256);
+  if (const auto record = f.OptionalMember(root, "provenance")) run.provenance = f.String(*record, 256);
   const JsonAt status_at = f.Member(root, "status");
   *status = f.String(status_at, 16);
   if (*status != "ok" && *status != "failed" && *status != "partial")

@@ -132,12 +132,14 @@ Docking DockingError(const sim::RobotModel& model, const std::vector<double>& ta
 
 struct SetupRun {
   std::string user, run_id;
+  std::string provenance;  ///< the run folder's provenance record ("" = none; base/run_folder.h)
   bool ok{false};
   std::string error;
   std::vector<std::string> order;  ///< mode names
   std::vector<SetupRecord> setups;
 };
-/// setup_results.json's text: {"user", "run_id", "status": "ok" | "failed" | "partial", "error",
+/// setup_results.json's text: {"user", "run_id", "provenance" (only when the run folder has a
+/// record: "provenance.json"), "status": "ok" | "failed" | "partial", "error",
 /// "order", "setups": [{task_id, mode, order, target, target_deg, reached_deg,
 /// assistant_reached_deg, error_deg, twisting, ranges, execution_s, alignment_s (null for fixed),
 /// person_scale, registration ("measured" | "truth" | null for fixed), docking_tip_mm, docking_axis_deg,

@@ -16,6 +16,7 @@
 #include "base/number_list.h"
 #include "base/random.h"
 #include "base/replace_file.h"
+#include "base/run_folder.h"
 #include "base/source_paths.h"
 #include "base/units.h"
 #include "procs/common/conversions.h"
@@ -153,8 +154,10 @@ void SetupProcess::Write(bool partial) {
   std::error_code ec;
   std::filesystem::create_directories(results_dir_, ec);
   const std::string path = results_dir_ + "/setup_results.json";
+  SetupRun run = conductor_->run();
+  run.provenance = ProvenanceRecordIn(results_dir_);
   std::string error;
-  if (!ReplaceFile(path, SetupRunJson(conductor_->run(), partial), &error)) {
+  if (!ReplaceFile(path, SetupRunJson(run, partial), &error)) {
     ORBED_LOG(kWarn) << "cannot write " << path << ": " << error;
   } else if (!partial && out_) {
     *out_ << "set-up results: " << path << "\n" << std::flush;
