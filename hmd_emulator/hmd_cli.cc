@@ -2,7 +2,10 @@
 
 #include <cstdint>
 #include <exception>
+#include <string>
+#include <vector>
 
+#include "hmd_emulator/hmd_config.h"
 #include "hmd_emulator/hmd_process.h"
 
 namespace orbed::hmd {
@@ -80,7 +83,24 @@ int RunHmd(int argc, const char* const* argv, std::ostream& out, std::ostream& e
   app.add_option("--reflective-channel", o.reflective_channel)->capture_default_str();
   app.add_option("--ar-view-channel", o.ar_view_channel)->capture_default_str();
   app.add_option("--trial-channel", o.trial_channel)->capture_default_str();
+  bool check_config = false;
+  app.add_flag("--check-config", check_config,
+               "Read the shipped configuration and every --config over it as a run would, say whether "
+               "it is valid (exit code 0, else 2), and exit");
   if (const auto code = ParseCommandLine(&app, common, argc, argv, out, err)) return *code;
+  if (check_config) {
+    try {
+      std::vector<std::string> paths;
+      for (const auto& rel : DefaultHmdConfigRelativePaths()) paths.push_back(HmdSourcePath(rel));
+      paths.insert(paths.end(), o.config_paths.begin(), o.config_paths.end());
+      LoadHmdConfigs(paths);
+      out << "orbed-hmd: the configuration is valid (" << paths.size() << " files)\n";
+      return 0;
+    } catch (const std::exception& e) {
+      err << "orbed-hmd: " << e.what() << "\n";
+      return 2;
+    }
+  }
   try {
     HmdProcess hmd(common, o);
     return hmd.Run();

@@ -164,9 +164,21 @@ def cmd_start(args):
         "host": socket.gethostname(),
         "placed_on_hosts": hosts,
         "settings": dict(args.setting),
+        "arguments": {},
+        "overrides": {"settings": {}, "from": {}},
         "config_files": [{"path": relative(c), "sha256": sha256(c)} for c in unique],
         "outputs": [],
     }
+    # What scripts/orbed wrote into the folder before the start: the launch's arguments as
+    # orbed-launch resolved them, and the settings given with --config / --set (scripts/settings.py).
+    arguments = os.path.join(args.run, "launch_arguments.json")
+    if os.path.isfile(arguments):
+        with open(arguments) as f:
+            record["arguments"] = {k: v["value"] for k, v in json.load(f).items()}
+    overrides = os.path.join(args.run, "settings", "settings.json")
+    if os.path.isfile(overrides):
+        with open(overrides) as f:
+            record["overrides"] = json.load(f)
     if args.parent:
         record["part_of"] = os.path.basename(os.path.abspath(args.parent))
     write_record(args.run, record)

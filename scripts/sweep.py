@@ -69,6 +69,10 @@ def walk_yaml(captures):
     return "\n".join(lines) + "\n", path
 
 
+# The run's own settings (--base-config), given to orbed-user-study before each point's overlay.
+BASE_CONFIGS = []
+
+
 def run_point(study, tmp, trials, users, overlay_text, scenario_text, user_text=""):
     """Table 1 per mode over USERS persons for one model setting.
 
@@ -84,7 +88,8 @@ def run_point(study, tmp, trials, users, overlay_text, scenario_text, user_text=
         with open(scenario, "w") as f:
             f.write(scenario_text)
         out = os.path.join(tmp, "results.json")
-        cmd = [study, "--trials", str(trials), "--run-id", f"sweep-u{user}", "--config", overlay,
+        cmd = [study, "--trials", str(trials), "--run-id", f"sweep-u{user}",
+               *[a for c in BASE_CONFIGS for a in ("--config", c)], "--config", overlay,
                "--scenario", scenario, "--json", out, "--quiet"]
         done = subprocess.run(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
         if done.returncode != 0:
@@ -141,7 +146,10 @@ def main():
     parser.add_argument("--users", type=int, default=4, help="emulated persons per point (default 4)")
     parser.add_argument("--only", choices=["drift", "capture_angle", "displays", "collaborator"],
                         help="one sweep only")
+    parser.add_argument("--base-config", action="append", default=[],
+                        help="a headset configuration overlay under every point (the run's settings)")
     args = parser.parse_args()
+    BASE_CONFIGS.extend(args.base_config)
     if args.trials < 2 or args.users < 1:
         sys.exit("sweep: --trials must be >= 2 and --users >= 1")
     os.makedirs(args.out, exist_ok=True)

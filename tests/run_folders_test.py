@@ -5,6 +5,9 @@
                                 (hashes checked with hashlib), what `finish` adds, and that
                                 `verify` finds a changed output, a missing one and a changed
                                 configuration file, and passes an untouched folder
+                                and scripts/settings.py: --config and --set merged in order into
+                                each reader's overlay, what is not a setting refused, and the
+                                readers' --check-config naming a bad key with its file and line
   run_folders_test.py studies   three small studies (`scripts/orbed study --users 1 --trials 1
                                 --setup-users 1 --targets 1`) started together in one logs folder,
                                 then the same study alone: four distinct folders, each user's run
@@ -133,6 +136,76 @@ class Records(unittest.TestCase):
         self.assertIn("provenance.json", done.stdout)
 
 
+class Settings(unittest.TestCase):
+    """scripts/settings.py, and the readers' --check-config on what it writes."""
+
+    def setUp(self):
+        self.tmp = tempfile.mkdtemp(prefix="orbed_settings_")
+        self.addCleanup(shutil.rmtree, self.tmp)
+        self.bin = os.path.join(os.environ.get("ORBED_BUILD_DIR", os.path.join(ROOT, "build")), "bin")
+
+    def settings(self, *args):
+        return subprocess.run(["/usr/bin/python3", os.path.join(ROOT, "scripts", "settings.py"),
+                               os.path.join(self.tmp, "out"), *args], capture_output=True, text=True)
+
+    def test_files_and_sets_merge_in_order_into_each_readers_overlay(self):
+        config = os.path.join(self.tmp, "mine.yaml")
+        with open(config, "w") as f:
+            f.write("user:\n  direct_view: {depth_bias_fraction_std: 0.02}\n  seed: 4\nassistant:\n  seed: 9\n")
+        done = self.settings("--config", config, "--set", "user.direct_view.depth_bias_fraction_std=0.05",
+                             "--set", "slam.drift_m_per_m=[0.001, 0.0, 0.0]")
+        self.assertEqual(done.returncode, 0, done.stderr)
+        out = os.path.join(self.tmp, "out")
+        self.assertEqual(done.stdout.splitlines(), [f"hmd_config={out}/hmd.yaml",
+                                                    f"assistant_config={out}/assistant.yaml"])
+        with open(os.path.join(out, "settings.json")) as f:
+            merged = json.load(f)
+        self.assertEqual(merged["settings"], {"user.direct_view.depth_bias_fraction_std": 0.05, "user.seed": 4,
+                                              "assistant.seed": 9, "slam.drift_m_per_m": [0.001, 0.0, 0.0]})
+        self.assertEqual(merged["from"]["user.seed"], f"--config {config}")
+        self.assertEqual(merged["from"]["user.direct_view.depth_bias_fraction_std"],
+                         "--set user.direct_view.depth_bias_fraction_std=0.05")
+        import yaml
+        with open(os.path.join(out, "hmd.yaml")) as f:
+            self.assertEqual(yaml.safe_load(f), {"user": {"direct_view": {"depth_bias_fraction_std": 0.05}, "seed": 4},
+                                                 "slam": {"drift_m_per_m": [0.001, 0.0, 0.0]}})
+        with open(os.path.join(out, "assistant.yaml")) as f:
+            self.assertEqual(yaml.safe_load(f), {"assistant": {"seed": 9}})
+
+    def test_what_is_not_a_setting_is_refused_before_anything_is_written(self):
+        done = self.settings("--set", "robot.speed=2")
+        self.assertEqual(done.returncode, 2)
+        self.assertIn("--set robot.speed=2: robot.speed: 'robot' is not a section", done.stderr)
+        done = self.settings("--set", "user=3")
+        self.assertEqual(done.returncode, 2)
+        self.assertIn("expected a key inside the section", done.stderr)
+        self.assertEqual(self.settings("--set", "novalue").returncode, 2)
+        listed = os.path.join(self.tmp, "list.yaml")
+        with open(listed, "w") as f:
+            f.write("- 1\n")
+        self.assertIn("expected a mapping of sections", self.settings("--config", listed).stderr)
+        self.assertFalse(os.path.exists(os.path.join(self.tmp, "out")))
+
+    def test_the_readers_check_every_key(self):
+        hmd = os.path.join(self.bin, "orbed-hmd")
+        if not os.path.exists(hmd):
+            self.skipTest("orbed-hmd is not built")
+        self.assertEqual(self.settings("--set", "user.direct_view.depth_bias_fraction_std=0.05").returncode, 0)
+        overlay = os.path.join(self.tmp, "out", "hmd.yaml")
+        good = subprocess.run([hmd, "--check-config", "--config", overlay], capture_output=True, text=True)
+        self.assertEqual(good.returncode, 0, good.stderr)
+        self.assertEqual(self.settings("--set", "user.direct_view.depth_bias_fraction_sd=0.05").returncode, 0)
+        bad = subprocess.run([hmd, "--check-config", "--config", overlay], capture_output=True, text=True)
+        self.assertEqual(bad.returncode, 2)
+        self.assertIn(f"{overlay}:4", bad.stderr)
+        self.assertIn("depth_bias_fraction_sd", bad.stderr)
+        self.assertEqual(self.settings("--set", "assistant.headset.lateral_noise_arcmin=-1").returncode, 0)
+        assistant = subprocess.run([os.path.join(self.bin, "orbed-assistant"), "--check-config", "--config",
+                                    os.path.join(self.tmp, "out", "assistant.yaml")], capture_output=True, text=True)
+        self.assertEqual(assistant.returncode, 2)
+        self.assertIn("lateral_noise_arcmin", assistant.stderr)
+
+
 class Studies(unittest.TestCase):
     ARGS = ["study", "--users", "1", "--trials", "1", "--setup-users", "1", "--targets", "1"]
 
@@ -163,7 +236,9 @@ class Studies(unittest.TestCase):
                 with open(os.path.join(folder, run, "provenance.json")) as f:
                     user = json.load(f)
                 self.assertEqual(user["part_of"], study)
-                self.assertEqual(user["settings"]["ORBED_USER_SEED"], "1")
+                self.assertEqual(user["arguments"]["user_seed"], "1")
+                self.assertEqual(user["arguments"]["run_id"], f"study-s1-{run.split('-')[0]}-u1"
+                                 if run.startswith("setup") else "study-s1-u1")
                 self.assertEqual(user["exit_code"], 0)
             # Results files name the record beside them.
             with open(os.path.join(folder, "viraal-u1", "results.json")) as f:
@@ -200,6 +275,7 @@ class Studies(unittest.TestCase):
 
 if __name__ == "__main__":
     which = sys.argv.pop(1) if len(sys.argv) > 1 else "records"
-    suite = unittest.TestLoader().loadTestsFromTestCase({"records": Records, "studies": Studies}[which])
+    cases = {"records": [Records, Settings], "studies": [Studies]}[which]
+    suite = unittest.TestSuite(unittest.TestLoader().loadTestsFromTestCase(c) for c in cases)
     result = unittest.TextTestRunner(verbosity=2).run(suite)
     sys.exit(0 if result.wasSuccessful() else 1)

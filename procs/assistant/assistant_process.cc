@@ -356,8 +356,21 @@ int RunAssistant(int argc, const char* const* argv, std::ostream& out, std::ostr
   app.add_option("--setup-task-channel", options.setup_task_channel)->capture_default_str();
   app.add_option("--setup-result-channel", options.setup_result_channel)->capture_default_str();
   app.add_option("--fixed-view-channel", options.fixed_view_channel)->capture_default_str();
+  bool check_config = false;
+  app.add_flag("--check-config", check_config,
+               "Read --config as a run would, say whether it is valid (exit code 0, else 2), and exit");
   if (const auto code = ParseCommandLine(&app, common, argc, argv, out, err)) return *code;
   if (seed_flag->count() > 0) options.seed = seed;
+  if (check_config) {
+    try {
+      LoadConfig(options);
+      out << "orbed-assistant: the configuration is valid\n";
+      return 0;
+    } catch (const std::exception& e) {
+      err << "orbed-assistant: " << e.what() << "\n";
+      return 2;
+    }
+  }
   try {
     AssistantProcess assistant(common, options);
     return assistant.Run();

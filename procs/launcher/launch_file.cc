@@ -1,5 +1,6 @@
 #include "procs/launcher/launch_file.h"
 
+#include <cctype>
 #include <csignal>
 #include <filesystem>
 #include <fstream>
@@ -23,9 +24,20 @@ bool IsHostName(const std::string& host) {
   return !host.empty() && host.size() <= 64 && host.find_first_of(" \t/") == std::string::npos;
 }
 
+// What the files of one launch share while they are read: the names taken so far, the files
+// being read (an include of one of them is a cycle), and the arguments' values (declared in the
+// first pass over the files, used in the second).
+struct ReadState {
+  std::set<std::string> process_names, group_names;
+  std::vector<std::string> chain;
+  bool declaring = true;                       // the first pass: only `arguments`
+  std::map<std::string, std::string> values;   // argument name -> value (given, else default)
+  std::map<std::string, std::string> given;    // what the command line gave
+};
+
 // `key` is the process's dotted path, e.g. "groups[0].processes[1]".
 ProcessSpec ParseProcess(const YamlFields& f, const YAML::Node& node, const std::string& key,
-                         const std::map<std::string, std::string>& environment) {
+                         const std::map<std::string, std::string>& environment, const ReadState& state) {
   if (!node.IsMap()) f.Fail(node, key, "expected a mapping with at least name and command");
   f.CheckKeys(node, key,
               {"name", "command", "host", "args", "env", "required", "respawn", "stop_signal",
@@ -38,7 +50,7 @@ ProcessSpec ParseProcess(const YamlFields& f, const YAML::Node& node, const std:
   }
   auto expand = [&](const std::string& text, const YAML::Node& where, const std::string& where_key) {
     try {
-      return ExpandVariables(text, environment);
+      return ExpandArguments(ExpandVariables(text, environment), state.values);
     } catch (const std::invalid_argument& e) {
       f.Fail(where, where_key, std::string(e.what()) + " (in process '" + spec.name + "')");
     }
@@ -55,7 +67,24 @@ ProcessSpec ParseProcess(const YamlFields& f, const YAML::Node& node, const std:
     if (!args.IsSequence()) f.Fail(args, key + ".args", "expected a list of strings");
     for (std::size_t i = 0; i < args.size(); ++i) {
       const std::string k = key + ".args[" + std::to_string(i) + "]";
-      spec.args.push_back(expand(f.String(args[i], k), args[i], k));
+      if (!args[i].IsMap()) {
+        spec.args.push_back(expand(f.String(args[i], k), args[i], k));
+        continue;
+      }
+      // {if: NAME, args: [...]}: the list when argument NAME is set.
+      f.CheckKeys(args[i], k, {"if", "args"});
+      const YAML::Node name = f.Required(args[i], "if", k + ".if", "the name of an argument");
+      const auto value = state.values.find(f.String(name, k + ".if"));
+      if (value == state.values.end()) {
+        f.Fail(name, k + ".if", "expected a declared argument, got '" + name.Scalar() + "'");
+      }
+      const YAML::Node list = f.Required(args[i], "args", k + ".args", "a list of strings");
+      if (!list.IsSequence()) f.Fail(list, k + ".args", "expected a list of strings");
+      for (std::size_t j = 0; j < list.size(); ++j) {
+        const std::string kj = k + ".args[" + std::to_string(j) + "]";
+        const std::string text = expand(f.String(list[j], kj), list[j], kj);
+        if (!value->second.empty()) spec.args.push_back(text);
+      }
     }
   }
   if (const YAML::Node env = node["env"]) {
@@ -78,24 +107,47 @@ ProcessSpec ParseProcess(const YamlFields& f, const YAML::Node& node, const std:
   return spec;
 }
 
-// What the files of one launch share while they are read: the names taken so far and the files
-// being read (an include of one of them is a cycle).
-struct ReadState {
-  std::set<std::string> process_names, group_names;
-  std::vector<std::string> chain;
-};
-
 constexpr int kMaxIncludeDepth = 8;
 constexpr std::uintmax_t kMaxLaunchFileBytes = 1 << 20;  // a device or a huge file is no launch file
 
 void ReadLaunchFile(const std::string& path, const std::map<std::string, std::string>& environment,
                     ReadState* state, LaunchSpec* spec);
 
+// The file's `arguments:` into spec->arguments and state->values (the given value, else the default).
+void DeclareArguments(const YamlFields& f, const YAML::Node& root, ReadState* state, LaunchSpec* spec) {
+  const YAML::Node arguments = root["arguments"];
+  if (!arguments) return;
+  if (!arguments.IsMap()) f.Fail(arguments, "arguments", "expected a mapping {name: {default, help}}");
+  for (const auto& item : arguments) {
+    const std::string name = item.first.IsScalar() ? item.first.Scalar() : "";
+    const std::string key = "arguments." + name;
+    try {
+      ParseArgumentAssignment(name + "=");
+    } catch (const std::invalid_argument&) {
+      f.Fail(item.first, key, "expected a name of letters, digits and '_'");
+    }
+    if (state->values.count(name) != 0) {
+      f.Fail(item.first, key, "expected an argument declared once, got '" + name + "' again");
+    }
+    if (!item.second.IsMap()) f.Fail(item.second, key, "expected a mapping {default, help}");
+    f.CheckKeys(item.second, key, {"default", "help"});
+    ArgumentSpec argument;
+    argument.name = name;
+    argument.default_value = f.StringOr(item.second, "default", key, "");
+    argument.help = f.StringOr(item.second, "help", key, "");
+    const auto given = state->given.find(name);
+    argument.given = given != state->given.end();
+    argument.value = argument.given ? given->second : argument.default_value;
+    state->values[name] = argument.value;
+    spec->arguments.push_back(argument);
+  }
+}
+
 void ParseLaunch(const YAML::Node& root, const std::string& path,
                  const std::map<std::string, std::string>& environment, ReadState* state, LaunchSpec* spec) {
   const YamlFields f(path);
   if (!root.IsMap()) f.Fail(root, "(top level)", "expected a mapping with a 'groups' list");
-  f.CheckKeys(root, "", {"name", "include", "groups", "placement"});
+  f.CheckKeys(root, "", {"name", "include", "groups", "placement", "arguments"});
   if (state->chain.empty()) spec->name = f.StringOr(root, "name", "", "orbed");  // the top file's
   state->chain.push_back(path);
   // Included files first, in order, relative to this file's folder.
@@ -123,6 +175,11 @@ void ParseLaunch(const YAML::Node& root, const std::string& path,
       ReadLaunchFile(included, environment, state, spec);
     }
   }
+  if (state->declaring) {
+    DeclareArguments(f, root, state, spec);  // after the included files', as groups are
+    state->chain.pop_back();
+    return;
+  }
   const YAML::Node groups = root["groups"];
   if (groups && !groups.IsSequence()) f.Fail(groups, "groups", "expected a list of {name, processes}");
   const std::size_t num_groups = groups ? groups.size() : 0;
@@ -147,7 +204,7 @@ void ParseLaunch(const YAML::Node& root, const std::string& path,
     }
     for (std::size_t p = 0; p < processes.size(); ++p) {
       const std::string process_key = key + ".processes[" + std::to_string(p) + "]";
-      ProcessSpec process = ParseProcess(f, processes[p], process_key, environment);
+      ProcessSpec process = ParseProcess(f, processes[p], process_key, environment, *state);
       if (!state->process_names.insert(process.name).second) {
         f.Fail(processes[p]["name"], process_key + ".name",
                "expected a name not used by another process, got '" + process.name + "' (used twice)");
@@ -164,7 +221,7 @@ void ParseLaunch(const YAML::Node& root, const std::string& path,
       const std::string key = "placement." + name;
       std::string host = f.String(item.second, key);
       try {
-        host = ExpandVariables(host, environment);
+        host = ExpandArguments(ExpandVariables(host, environment), state->values);
       } catch (const std::invalid_argument& e) {
         f.Fail(item.second, key, e.what());
       }
@@ -241,6 +298,36 @@ std::string ExpandVariables(const std::string& text, const std::map<std::string,
   return out;
 }
 
+std::string ExpandArguments(const std::string& text, const std::map<std::string, std::string>& values) {
+  static const std::string kOpen = "$(arg ";
+  std::string out;
+  size_t i = 0;
+  while (i < text.size()) {
+    if (text.compare(i, kOpen.size(), kOpen) == 0) {
+      const size_t end = text.find(')', i + kOpen.size());
+      if (end == std::string::npos) throw std::invalid_argument("unterminated $(arg in '" + text + "'");
+      const std::string name = text.substr(i + kOpen.size(), end - i - kOpen.size());
+      const auto it = values.find(name);
+      if (it == values.end()) throw std::invalid_argument("argument '" + name + "' is not declared");
+      out += it->second;
+      i = end + 1;
+    } else {
+      out += text[i++];
+    }
+  }
+  return out;
+}
+
+std::pair<std::string, std::string> ParseArgumentAssignment(const std::string& text) {
+  const size_t eq = text.find('=');
+  if (eq == std::string::npos) throw std::invalid_argument("expected NAME=VALUE, got '" + text + "'");
+  const std::string name = text.substr(0, eq);
+  bool word = !name.empty() && name.size() <= 64;
+  for (const char c : name) word = word && (std::isalnum(static_cast<unsigned char>(c)) || c == '_');
+  if (!word) throw std::invalid_argument("expected NAME=VALUE with NAME of letters, digits and '_', got '" + text + "'");
+  return {name, text.substr(eq + 1)};
+}
+
 int SignalFromName(const std::string& name) {
   static const std::map<std::string, int> kSignals = {
       {"SIGINT", SIGINT},   {"SIGTERM", SIGTERM}, {"SIGHUP", SIGHUP},  {"SIGQUIT", SIGQUIT},
@@ -259,22 +346,51 @@ std::map<std::string, std::string> CurrentEnvironment() {
   return env;
 }
 
-LaunchSpec ParseLaunchYaml(const std::string& yaml, const std::string& path,
-                           const std::map<std::string, std::string>& environment) {
+namespace {
+
+// Two passes over the files: the first declares every argument, the second reads the rest with
+// their values known. `read` reads the top file into the state and spec given.
+template <typename Read>
+LaunchSpec ReadTwice(const std::string& path, const std::map<std::string, std::string>& arguments, Read read) {
+  ReadState declared;
+  declared.given = arguments;
   LaunchSpec spec;
   spec.path = path;
+  read(&declared, &spec);
+  for (const auto& [name, value] : arguments) {
+    if (declared.values.count(name) == 0) {
+      std::string names;
+      for (const ArgumentSpec& a : spec.arguments) names += (names.empty() ? "" : ", ") + a.name;
+      throw LaunchFileError(path + ": --arg " + name + ": the launch declares no argument '" + name +
+                            "' (it has: " + (names.empty() ? "none" : names) + ")");
+    }
+  }
   ReadState state;
-  state.chain.reserve(kMaxIncludeDepth + 2);
-  ParseLaunchText(yaml, path, environment, &state, &spec);
-  return spec;
+  state.declaring = false;
+  state.values = declared.values;
+  LaunchSpec full;
+  full.path = path;
+  read(&state, &full);
+  full.arguments = spec.arguments;
+  return full;
 }
 
-LaunchSpec LoadLaunchFile(const std::string& path, const std::map<std::string, std::string>& environment) {
-  LaunchSpec spec;
-  spec.path = path;
-  ReadState state;
-  ReadLaunchFile(path, environment, &state, &spec);
-  return spec;
+}  // namespace
+
+LaunchSpec ParseLaunchYaml(const std::string& yaml, const std::string& path,
+                           const std::map<std::string, std::string>& environment,
+                           const std::map<std::string, std::string>& arguments) {
+  return ReadTwice(path, arguments, [&](ReadState* state, LaunchSpec* spec) {
+    state->chain.reserve(kMaxIncludeDepth + 2);
+    ParseLaunchText(yaml, path, environment, state, spec);
+  });
+}
+
+LaunchSpec LoadLaunchFile(const std::string& path, const std::map<std::string, std::string>& environment,
+                          const std::map<std::string, std::string>& arguments) {
+  return ReadTwice(path, arguments, [&](ReadState* state, LaunchSpec* spec) {
+    ReadLaunchFile(path, environment, state, spec);
+  });
 }
 
 }  // namespace orbed::launcher

@@ -9,6 +9,10 @@
 ///                                      # nested up to 8 deep, no cycles)
 ///   placement: {registration: hostB}   # optional: moves processes (this file's or included ones)
 ///                                      # to hosts, as their `host:` would
+///   arguments:                         # optional: the launch's settings, given as
+///     user_seed:                       # `orbed-launch FILE --arg user_seed=3`
+///       default: ""                    # (a string; "" = not set)
+///       help: "the emulated person"    # shown by `orbed-launch FILE --show-args`
 ///   groups:                            # may be left out when an include has groups
 ///     - name: recording
 ///       processes:
@@ -17,7 +21,8 @@
 ///           host: hostB                # optional: run by the deputy of that name (`orbed-launch
 ///                                      # --deputy hostB` on that machine); left out, or equal to
 ///                                      # the launcher's --host: started by the launcher itself
-///           args: [--log-dir, "${ORBED_LOG_DIR}"]
+///           args: [--log-dir, "${ORBED_LOG_DIR}",
+///                  {if: user_seed, args: [--user-seed, "$(arg user_seed)"]}]
 ///           env: {KEY: value}          # added to the launcher's environment
 ///           required: true             # its failure stops the testbed, exit != 0 (default true)
 ///           respawn: false             # restart when it dies (default false)
@@ -27,9 +32,14 @@
 ///           ready_timeout_s: 10      # (default 10)
 ///           exit_stops_all: false      # when it exits, stop the testbed with its exit status
 ///
-/// ${VAR} in command, args and env values expands from the environment (orbed-launch adds
+/// ${VAR} in command, host, args and env values expands from the environment (orbed-launch adds
 /// ORBED_BIN_DIR, its own folder, and ORBED_LAUNCH_FILE, the file it was given); an unset variable is an
-/// error. Group and process names are unique across a file and everything it includes. The file is read with
+/// error. The environment says where things are (folders, the bus); what a run is (the person, the
+/// trials, the clock, configuration overlays) is an argument: $(arg NAME) expands to its value
+/// (given, else its default) in the same places, and an args element {if: NAME, args: [...]} stands
+/// for its list when NAME's value is not empty and for nothing when it is. An argument is declared
+/// once in the file or the files it includes, before or after its use; using an undeclared one, or
+/// giving one the launch does not declare, is an error. Group and process names are unique across a file and everything it includes. The file is read with
 /// the project's checked YAML reader (base/yaml_fields.h): errors throw LaunchFileError with "file:line:
 /// dotted.key: expected ..., got ...", e.g.
 ///   "testbed.yaml:12: groups[1].processes[0].stop_signal: expected SIGINT, ... or SIGKILL, got 'SIGFOO'".
@@ -69,20 +79,38 @@ struct GroupSpec {
   std::vector<ProcessSpec> processes;
 };
 
+struct ArgumentSpec {
+  std::string name;
+  std::string default_value;
+  std::string help;
+  std::string value;  ///< the given value, else the default
+  bool given = false;
+};
+
 struct LaunchSpec {
   std::string name;
   std::string path;
   std::vector<GroupSpec> groups;
+  std::vector<ArgumentSpec> arguments;  ///< in the order declared (included files' first)
 };
 
-/// Parses a launch file. `environment` supplies ${VAR} values.
-LaunchSpec LoadLaunchFile(const std::string& path, const std::map<std::string, std::string>& environment);
+/// Parses a launch file. `environment` supplies ${VAR} values, `arguments` the $(arg NAME) values
+/// given (each must be declared).
+LaunchSpec LoadLaunchFile(const std::string& path, const std::map<std::string, std::string>& environment,
+                          const std::map<std::string, std::string>& arguments = {});
 /// The same from YAML text; `path` only names the source in errors.
 LaunchSpec ParseLaunchYaml(const std::string& yaml, const std::string& path,
-                           const std::map<std::string, std::string>& environment);
+                           const std::map<std::string, std::string>& environment,
+                           const std::map<std::string, std::string>& arguments = {});
 
 /// Expands ${VAR}; throws std::invalid_argument naming an unset variable.
 std::string ExpandVariables(const std::string& text, const std::map<std::string, std::string>& environment);
+/// Expands $(arg NAME) from `values`; throws std::invalid_argument naming an undeclared argument.
+std::string ExpandArguments(const std::string& text, const std::map<std::string, std::string>& values);
+
+/// "NAME=VALUE" → {NAME, VALUE}; throws std::invalid_argument when there is no '=' or NAME is not
+/// a word of letters, digits and '_'.
+std::pair<std::string, std::string> ParseArgumentAssignment(const std::string& text);
 
 /// "SIGINT" → 2 etc.; returns -1 for an unknown name.
 int SignalFromName(const std::string& name);

@@ -4,11 +4,14 @@
 #include <exception>
 #include <filesystem>
 #include <string>
+#include <map>
 #include <system_error>
 #include <utility>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
+#include "base/json.h"
 #include "procs/common/flags.h"
 #include "procs/common/log.h"
 #include "procs/launcher/deputy.h"
@@ -29,6 +32,35 @@ void PrintPlan(const LaunchSpec& spec, std::ostream& out) {
   }
 }
 
+// The launch's arguments: a table for people, or JSON for scripts (scripts/provenance.py records
+// it as the run's effective settings).
+void PrintArguments(const LaunchSpec& spec, bool json, std::ostream& out) {
+  if (json) {
+    JsonWriter w(2);
+    w.BeginObject();
+    for (const ArgumentSpec& a : spec.arguments) {
+      w.Key(a.name).BeginObject();
+      w.Key("value").String(a.value);
+      w.Key("default").String(a.default_value);
+      w.Key("given").Bool(a.given);
+      w.Key("help").String(a.help);
+      w.EndObject();
+    }
+    w.EndObject();
+    out << w.str() << "\n";
+    return;
+  }
+  if (spec.arguments.empty()) {
+    out << spec.path << " declares no arguments\n";
+    return;
+  }
+  out << "arguments of " << spec.path << " (give them as --arg NAME=VALUE):\n";
+  for (const ArgumentSpec& a : spec.arguments) {
+    out << "  " << a.name << " = \"" << a.value << "\"" << (a.given ? "" : " (default)") << "\n";
+    if (!a.help.empty()) out << "      " << a.help << "\n";
+  }
+}
+
 }  // namespace
 
 int RunLauncher(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
@@ -43,6 +75,12 @@ int RunLauncher(int argc, const char* const* argv, std::ostream& out, std::ostre
                           ->check(CLI::ExistingFile);
   bool dry_run = false;
   app.add_flag("--dry-run", dry_run, "Parse the file, print the plan and exit");
+  std::vector<std::string> assignments;
+  app.add_option("--arg", assignments,
+                 "NAME=VALUE: the launch file's argument NAME (repeatable; --show-args lists them)");
+  bool show_args = false, json = false;
+  app.add_flag("--show-args", show_args, "Print the launch's arguments with their values and help, then exit");
+  app.add_flag("--json", json, "With --show-args: as JSON {name: {value, default, given, help}}");
   std::string host = ThisHostName();
   app.add_option("--host", host,
                  "This host's name: processes with this `host:` (or none) start here, the others through "
@@ -52,7 +90,7 @@ int RunLauncher(int argc, const char* const* argv, std::ostream& out, std::ostre
   auto* deputy_option = app.add_option("--deputy", deputy.name,
                                        "Be the deputy NAME: run what launchers place on host NAME (no launch "
                                        "file)");
-  deputy_option->excludes(file_option)->excludes("--dry-run");
+  deputy_option->excludes(file_option)->excludes("--dry-run")->excludes("--arg")->excludes("--show-args");
   app.add_option("--orphan-timeout-s", deputy.orphan_timeout_s,
                  "Deputy: stop what a launcher started when it has been silent this long")
       ->needs(deputy_option)
@@ -86,12 +124,29 @@ int RunLauncher(int argc, const char* const* argv, std::ostream& out, std::ostre
   auto environment = CurrentEnvironment();
   environment.emplace("ORBED_BIN_DIR", bin_dir);
   environment["ORBED_LAUNCH_FILE"] = std::filesystem::absolute(launch_file, ec).lexically_normal().string();
+  std::map<std::string, std::string> arguments;
+  for (const std::string& assignment : assignments) {
+    try {
+      const auto [name, value] = ParseArgumentAssignment(assignment);
+      if (!arguments.emplace(name, value).second) {
+        err << "orbed-launch: --arg " << name << " given twice\n";
+        return 2;
+      }
+    } catch (const std::invalid_argument& e) {
+      err << "orbed-launch: --arg: " << e.what() << "\n";
+      return 2;
+    }
+  }
   LaunchSpec spec;
   try {
-    spec = LoadLaunchFile(launch_file, environment);
+    spec = LoadLaunchFile(launch_file, environment, arguments);
   } catch (const LaunchFileError& e) {
     err << "orbed-launch: " << e.what() << "\n";
     return 2;
+  }
+  if (show_args) {
+    PrintArguments(spec, json, out);
+    return 0;
   }
   if (dry_run) {
     PrintPlan(spec, out);

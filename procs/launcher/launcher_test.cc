@@ -28,6 +28,15 @@ std::string ErrorOf(const std::string& yaml) {
   return "";
 }
 
+std::string ErrorOfFile(const std::string& path) {
+  try {
+    LoadLaunchFile(path, kEnv);
+  } catch (const LaunchFileError& e) {
+    return e.what();
+  }
+  return "(accepted)";
+}
+
 TEST(LaunchFile, ParsesGroupsProcessesDefaultsAndVariables) {
   const LaunchSpec spec = ParseLaunchYaml(R"(
 name: bed
@@ -182,6 +191,81 @@ TEST(LaunchFile, IncludesReadTheirGroupsFirst) {
   EXPECT_NE(error("deep0.yaml").find("nested includes"), std::string::npos) << error("deep0.yaml");
 }
 
+// Arguments: declared in any file of the chain (here after their use, in an included file),
+// given or defaulted, $(arg NAME) expanded and {if: NAME, args: [...]} kept only when NAME is set.
+TEST(LaunchFile, ArgumentsAreDeclaredGivenDefaultedAndConditional) {
+  const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / "launch_arguments";
+  std::filesystem::create_directories(dir);
+  auto write = [&](const std::string& name, const std::string& text) { std::ofstream(dir / name) << text; };
+  write("base.yaml",
+        "arguments:\n"
+        "  seed: {default: '', help: the person}\n"
+        "  rate: {default: '1'}\n"
+        "groups:\n  - name: robot\n    processes:\n"
+        "      - {name: sim, command: s, args: [--rate, '$(arg rate)', {if: seed, args: [--seed, '$(arg seed)']}]}\n");
+  write("top.yaml",
+        "include: [base.yaml]\n"
+        "arguments:\n  trials: {default: '10'}\n"
+        "groups:\n  - name: run\n    processes:\n"
+        "      - {name: c, command: c, args: ['${LOGS}/$(arg trials)', {if: seed, args: [--s, x$(arg seed)y]}]}\n");
+  const std::string top = (dir / "top.yaml").string();
+  LaunchSpec spec = LoadLaunchFile(top, kEnv);
+  EXPECT_EQ(spec.groups[0].processes[0].args, (std::vector<std::string>{"--rate", "1"}));
+  EXPECT_EQ(spec.groups[1].processes[0].args, (std::vector<std::string>{"/tmp/logs/10"}));
+  ASSERT_EQ(spec.arguments.size(), 3u);
+  EXPECT_EQ(spec.arguments[0].name, "seed");  // the included file's first
+  EXPECT_EQ(spec.arguments[0].help, "the person");
+  EXPECT_FALSE(spec.arguments[0].given);
+  EXPECT_EQ(spec.arguments[2].name, "trials");
+
+  spec = LoadLaunchFile(top, kEnv, {{"seed", "7"}, {"trials", "3"}});
+  EXPECT_EQ(spec.groups[0].processes[0].args, (std::vector<std::string>{"--rate", "1", "--seed", "7"}));
+  EXPECT_EQ(spec.groups[1].processes[0].args, (std::vector<std::string>{"/tmp/logs/3", "--s", "x7y"}));
+  EXPECT_TRUE(spec.arguments[0].given);
+  EXPECT_EQ(spec.arguments[0].value, "7");
+  EXPECT_EQ(spec.arguments[1].value, "1");
+
+  auto error = [&](const std::map<std::string, std::string>& given) -> std::string {
+    try {
+      LoadLaunchFile(top, kEnv, given);
+    } catch (const LaunchFileError& e) {
+      return e.what();
+    }
+    return "(accepted)";
+  };
+  EXPECT_EQ(error({{"sed", "1"}}), top + ": --arg sed: the launch declares no argument 'sed' (it has: seed, rate, trials)");
+  write("undeclared.yaml",
+        "groups:\n  - name: g\n    processes:\n      - {name: a, command: a, args: ['$(arg nope)']}\n");
+  const std::string undeclared = ErrorOfFile((dir / "undeclared.yaml").string());
+  EXPECT_NE(undeclared.find("undeclared.yaml:4: groups[0].processes[0].args[0]: argument 'nope' is not declared"),
+            std::string::npos)
+      << undeclared;
+  write("twice.yaml", "include: [base.yaml]\narguments:\n  seed: {default: '2'}\n");
+  EXPECT_NE(ErrorOfFile((dir / "twice.yaml").string()).find("twice.yaml:3: arguments.seed: expected an argument declared once"),
+            std::string::npos)
+      << ErrorOfFile((dir / "twice.yaml").string());
+  write("bad_if.yaml",
+        "groups:\n  - name: g\n    processes:\n      - {name: a, command: a, args: [{if: x, args: [-v]}]}\n");
+  EXPECT_NE(ErrorOfFile((dir / "bad_if.yaml").string()).find("args[0].if: expected a declared argument, got 'x'"),
+            std::string::npos);
+  write("bad_key.yaml", "arguments:\n  a: {default: '', typo: 1}\ngroups:\n  - name: g\n    processes:\n"
+                        "      - {name: a, command: a}\n");
+  EXPECT_NE(ErrorOfFile((dir / "bad_key.yaml").string()).find("bad_key.yaml:2: arguments.a"), std::string::npos)
+      << ErrorOfFile((dir / "bad_key.yaml").string());
+}
+
+TEST(LaunchFile, ArgumentAssignments) {
+  EXPECT_EQ(ParseArgumentAssignment("user_seed=3"), (std::pair<std::string, std::string>{"user_seed", "3"}));
+  EXPECT_EQ(ParseArgumentAssignment("a=b=c"), (std::pair<std::string, std::string>{"a", "b=c"}));
+  EXPECT_EQ(ParseArgumentAssignment("empty="), (std::pair<std::string, std::string>{"empty", ""}));
+  EXPECT_THROW(ParseArgumentAssignment("novalue"), std::invalid_argument);
+  EXPECT_THROW(ParseArgumentAssignment("=3"), std::invalid_argument);
+  EXPECT_THROW(ParseArgumentAssignment("a-b=3"), std::invalid_argument);
+  EXPECT_EQ(ExpandArguments("x$(arg a)y$(arg b)", {{"a", "1"}, {"b", ""}}), "x1y");
+  EXPECT_THROW(ExpandArguments("$(arg a", {{"a", "1"}}), std::invalid_argument);
+  EXPECT_THROW(ExpandArguments("$(arg c)", {{"a", "1"}}), std::invalid_argument);
+}
+
 TEST(LaunchFile, ExpandVariables) {
   EXPECT_EQ(ExpandVariables("a${LOGS}b${BIN}", kEnv), "a/tmp/logsb/opt/b");
   EXPECT_EQ(ExpandVariables("plain $LOGS", kEnv), "plain $LOGS");
@@ -266,6 +350,27 @@ TEST(LauncherCli, DryRunPrintsThePlan) {
   EXPECT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(r.out, "group g:\n  a: x -v  [respawn]  [required]\n");
   std::filesystem::remove(good);
+}
+
+TEST(LauncherCli, ShowArgsListsTheArgumentsAndRefusesAnUndeclaredOne) {
+  const std::string file = WriteTempFile(
+      "_args.yaml",
+      "arguments:\n  seed: {default: '1', help: the person}\n"
+      "groups:\n  - name: g\n    processes:\n      - {name: a, command: x, args: ['$(arg seed)']}\n");
+  test::CommandRun r = test::RunCommand(RunLauncher, "orbed-launch", {file, "--show-args", "--json", "--arg", "seed=4"});
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.out,
+            "{\n  \"seed\": {\n    \"value\": \"4\",\n    \"default\": \"1\",\n    \"given\": true,\n"
+            "    \"help\": \"the person\"\n  }\n}\n");
+  r = test::RunCommand(RunLauncher, "orbed-launch", {file, "--dry-run", "--arg", "seed=9"});
+  EXPECT_EQ(r.out, "group g:\n  a: x 9  [required]\n");
+  r = test::RunCommand(RunLauncher, "orbed-launch", {file, "--dry-run", "--arg", "sead=9"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--arg sead: the launch declares no argument 'sead' (it has: seed)"), std::string::npos) << r.err;
+  r = test::RunCommand(RunLauncher, "orbed-launch", {file, "--dry-run", "--arg", "seed=1", "--arg", "seed=2"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--arg seed given twice"), std::string::npos) << r.err;
+  std::filesystem::remove(file);
 }
 
 }  // namespace

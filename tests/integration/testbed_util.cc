@@ -48,7 +48,14 @@ std::string MakeTempDir(const std::string& tag) {
   return dir.string();
 }
 
+double TestTimeFactor() {
+  const char* text = std::getenv("ORBED_TEST_TIME_FACTOR");
+  const double factor = text == nullptr ? 1.0 : std::atof(text);
+  return factor >= 1.0 && factor <= 100.0 ? factor : 1.0;
+}
+
 bool WaitFor(const std::function<bool()>& condition, double timeout_s) {
+  timeout_s *= TestTimeFactor();
   const auto deadline =
       std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                                              std::chrono::duration<double>(timeout_s));

@@ -31,7 +31,13 @@ std::string SourcePath(const std::string& relative);
 /// A fresh empty temporary folder; removed at exit when every test passed.
 std::string MakeTempDir(const std::string& tag);
 
-/// Polls `condition` every 10 ms until true or `timeout_s` passes; returns its last value.
+/// How much slower than the release build this build runs, declared by the build
+/// ($ORBED_TEST_TIME_FACTOR, set by tests/integration/CMakeLists.txt: 4 for the sanitizer build,
+/// else 1). Every wall-clock wait below is multiplied by it; waits on the sim clock need none.
+double TestTimeFactor();
+
+/// Polls `condition` every 10 ms until true or TestTimeFactor() x `timeout_s` passes; returns its
+/// last value.
 bool WaitFor(const std::function<bool()>& condition, double timeout_s);
 
 /// Runs a command as a child (own process group); its output goes to this test's stdout with a
