@@ -193,13 +193,15 @@ void Process::AnswerLockstepRound() {
   ack.start_utime = unanswered_round_->start_utime;
   ack.lockstep_round = unanswered_round_->lockstep_round;
   ack.process = name_;
-  ack.published = published_since_ack_.exchange(false);
-  // The sim re-sends a round whose answers are missing: the repeat of a round already answered
-  // says "published" if the first answer did (it may be the one that was lost).
-  if (ack.utime == last_answer_.utime && ack.start_utime == last_answer_.start_utime &&
-      ack.lockstep_round == last_answer_.lockstep_round) {
-    ack.published = ack.published || last_answer_.published;
-  }
+  // The sim re-sends a round whose answers are missing: a repeat of the round answered last gets
+  // that answer again ("published" included: the first may be the one that was lost). What was
+  // published since stays for the next round's answer: the sim may have closed this round already
+  // (another follower's answer was the missing one) and then ignores answers to it, so a flag
+  // spent here would be lost and the round that follows would look quiet while the publication is
+  // still being handled.
+  const bool repeat = ack.utime == last_answer_.utime && ack.start_utime == last_answer_.start_utime &&
+                      ack.lockstep_round == last_answer_.lockstep_round;
+  ack.published = repeat ? last_answer_.published : published_since_ack_.exchange(false);
   unanswered_round_.reset();
   last_answer_ = ack;
   PublishControl(channels::ForArm(channels::kSimClockAck, sim_clock_arm_), ack);

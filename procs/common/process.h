@@ -21,7 +21,8 @@
 /// the wall clock. A SIM_CLOCK of a lockstep round (lockstep_round >= 1, sim_clock.h) is answered
 /// on SIM_CLOCK_ACK right after the timers it made due have run, before the next datagram is
 /// handled, with whether the process published since its previous answer (Publish, not
-/// PublishControl).
+/// PublishControl); the sim's repeat of a round already answered gets the same answer again, and
+/// what was published meanwhile is said in the answer to the next round.
 ///
 /// Fault injection: with a chaos spec (CommonFlags::chaos, i.e. --chaos or $ORBED_CHAOS;
 /// procs/common/chaos.h) every datagram of a matching channel passes, before decoding, through a

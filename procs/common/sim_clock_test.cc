@@ -250,6 +250,102 @@ TEST(ProcessSimTime, AnswersEachLockstepRoundAfterItsDueTimers) {
   }
 }
 
+// The sim re-sends a round it still waits on; a follower that answered it already, and has
+// published since (a reply to another follower's request), answers the repeat as the first time and
+// says "published" in its answer to the next round. The order is one a loaded machine gives, played
+// here against the sim's LockstepBarrier: "hmd" (this process, over memq://) answers round 2 of a
+// tick; "setup" (the test) sends it a REQUEST and is slow to answer; the sim re-sends round 2;
+// setup's answer (it published) closes round 2 and round 3 goes out; only then does hmd's answer to
+// the repeat reach the sim, which ignores it (an earlier round). Round 3 must not look quiet: hmd's
+// REPLY is still to be handled, and the arm would step on without it, at a moment the load decides.
+TEST(ProcessSimTime, APublicationAfterAnAnswerIsSaidInTheNextRoundNotInARepeat) {
+  CommonFlags flags("hmd");
+  flags.lcm_url = "memq://";
+  flags.duration_s = 20;  // a safety limit only
+  flags.sim_time = true;
+  Process process(flags);
+  process.Subscribe<orbed::sim_clock_t>("REQUEST", [&](const orbed::sim_clock_t& msg, const std::string&,
+                                                       int64_t) { process.Publish("REPLY", msg); });
+  const int64_t t1 = kStart + 50'000;
+  auto send_clock = [&](int64_t utime, int32_t round) {
+    orbed::sim_clock_t clock{};
+    clock.utime = utime;
+    clock.start_utime = kStart;
+    clock.realtime_rate = 8;
+    clock.lockstep_round = round;
+    process.lcm().publish(channels::kSimClock, &clock);
+  };
+  // The sim's side, [s] a hand-made wall clock. The held clock's round: setup joins first.
+  LockstepBarrier barrier(/*timeout_s=*/10.0);
+  barrier.BeginRound(kStart, kStart, 1, 0.0);
+  ASSERT_EQ(barrier.OnAck(Ack("setup", kStart, 1, false)), LockstepBarrier::Answer::kJoined);
+  struct Answer {
+    int64_t t_us;
+    int32_t round;
+    bool published;
+    LockstepBarrier::Answer taken;
+  };
+  std::vector<Answer> answers;
+  LockstepBarrier::Status last{};
+  process.SubscribeRaw(channels::kSimClockAck, [&](const lcm::ReceiveBuffer& rbuf, const std::string&) {
+    orbed::sim_clock_ack_t ack;
+    ASSERT_EQ(ack.decode(rbuf.data, 0, rbuf.data_size), static_cast<int>(rbuf.data_size));
+    answers.push_back({ack.utime - kStart, ack.lockstep_round, static_cast<bool>(ack.published),
+                       barrier.OnAck(ack)});
+    switch (answers.size()) {
+      case 1:  // hmd joined during the hold. Tick 1, round 1: the clock alone.
+        barrier.BeginRound(t1, kStart, 1, 1.0);
+        return send_clock(t1, 1);
+      case 2:  // setup answers too, nobody published: the sim's state and round 2.
+        ASSERT_EQ(barrier.OnAck(Ack("setup", t1, 1, false)), LockstepBarrier::Answer::kCounted);
+        ASSERT_TRUE(barrier.Check(1.1).complete);
+        barrier.BeginRound(t1, kStart, 2, 2.0);
+        return send_clock(t1, 2);
+      case 3: {
+        // hmd has answered round 2. setup, handling the state, sends its REQUEST and is descheduled;
+        // the sim re-sends round 2; setup's answer then closes it, and round 3 goes out.
+        orbed::sim_clock_t request{};
+        process.lcm().publish("REQUEST", &request);
+        send_clock(t1, 2);
+        EXPECT_FALSE(barrier.Check(2.1).complete);
+        EXPECT_EQ(barrier.OnAck(Ack("setup", t1, 2, true)), LockstepBarrier::Answer::kCounted);
+        const LockstepBarrier::Status closed = barrier.Check(2.15);
+        EXPECT_TRUE(closed.complete);
+        EXPECT_TRUE(closed.published);
+        barrier.BeginRound(t1, kStart, 3, 2.2);
+        return send_clock(t1, 3);
+      }
+      case 4:  // hmd's answer to the repeat: too late for round 2.
+        return;
+      case 5:  // hmd's answer to round 3; setup published nothing since.
+        EXPECT_EQ(barrier.OnAck(Ack("setup", t1, 3, false)), LockstepBarrier::Answer::kCounted);
+        last = barrier.Check(2.3);
+        return process.RequestStop();
+      default:
+        return process.RequestStop();
+    }
+  });
+  send_clock(kStart, 1);
+  EXPECT_EQ(process.Run(), 0);
+  // The repeat says what the first answer to round 2 said (nothing), and the REPLY, published
+  // between them, is said in round 3: complete, but not quiet, so the sim sends round 4 instead of
+  // stepping the arm.
+  const std::vector<Answer> expected = {{0, 1, false, LockstepBarrier::Answer::kJoined},
+                                        {50'000, 1, false, LockstepBarrier::Answer::kCounted},
+                                        {50'000, 2, false, LockstepBarrier::Answer::kCounted},
+                                        {50'000, 2, false, LockstepBarrier::Answer::kOther},
+                                        {50'000, 3, true, LockstepBarrier::Answer::kCounted}};
+  ASSERT_EQ(answers.size(), expected.size());
+  for (size_t k = 0; k < expected.size(); ++k) {
+    EXPECT_EQ(answers[k].t_us, expected[k].t_us) << k;
+    EXPECT_EQ(answers[k].round, expected[k].round) << k;
+    EXPECT_EQ(answers[k].published, expected[k].published) << k;
+    EXPECT_EQ(answers[k].taken, expected[k].taken) << k;
+  }
+  EXPECT_TRUE(last.complete);
+  EXPECT_TRUE(last.published);
+}
+
 // A process with sim_time: its "sim" (a wall timer of its own) publishes SIM_CLOCK 50 ms of sim
 // time apart, as orbed-iiwa-sim does at R = 10, first one bad message and a restart 1 s behind,
 // later one late datagram.
