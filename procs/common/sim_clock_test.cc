@@ -290,8 +290,8 @@ TEST(ProcessSimTime, APublicationAfterAnAnswerIsSaidInTheNextRoundNotInARepeat) 
   process.SubscribeRaw(channels::kSimClockAck, [&](const lcm::ReceiveBuffer& rbuf, const std::string&) {
     orbed::sim_clock_ack_t ack;
     ASSERT_EQ(ack.decode(rbuf.data, 0, rbuf.data_size), static_cast<int>(rbuf.data_size));
-    answers.push_back({ack.utime - kStart, ack.lockstep_round, static_cast<bool>(ack.published),
-                       barrier.OnAck(ack)});
+    answers.push_back(
+        {ack.utime - kStart, ack.lockstep_round, static_cast<bool>(ack.published), barrier.OnAck(ack)});
     switch (answers.size()) {
       case 1:  // hmd joined during the hold. Tick 1, round 1: the clock alone.
         barrier.BeginRound(t1, kStart, 1, 1.0);
