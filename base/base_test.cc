@@ -1,5 +1,6 @@
 // base/: formatting, units, the seed hashes, SHA-256 (FIPS 180-4 vectors), number lists, the JSON
 // writer, the checked YAML reader.
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -42,7 +43,13 @@ TEST(ReplaceFile, ReplacesWholeAndNamesTheFileWhenItCannot) {
   EXPECT_FALSE(std::ifstream(path + ".tmp").good());  // the temporary is gone
   std::remove(path.c_str());
   EXPECT_FALSE(ReplaceFile("/nonexistent-dir/x.json", "{}", &error));
-  EXPECT_NE(error.find("/nonexistent-dir/x.json.tmp"), std::string::npos) << error;
+  EXPECT_NE(error.find("/nonexistent-dir/x.json.tmp: No such file or directory (ENOENT)"), std::string::npos)
+      << error;
+}
+
+TEST(Format, DescribeErrnoGivesTheTextAndTheName) {
+  EXPECT_EQ(DescribeErrno(ENOSPC), "No space left on device (ENOSPC)");
+  EXPECT_EQ(DescribeErrno(EIO), "Input/output error (EIO)");
 }
 
 TEST(Format, FixedRoundsToTheGivenDecimals) {

@@ -3,6 +3,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <ctime>
 
 namespace orbed {
@@ -51,6 +52,11 @@ std::string FormatUtc(int64_t utime, const char* format) {
   gmtime_r(&seconds, &tm);
   char buffer[64];
   return std::string(buffer, std::strftime(buffer, sizeof(buffer), format, &tm));
+}
+
+std::string DescribeErrno(int error_number) {
+  const char* name = strerrorname_np(error_number);  // glibc 2.32
+  return std::string(std::strerror(error_number)) + " (" + (name ? name : std::to_string(error_number)) + ")";
 }
 
 }  // namespace orbed

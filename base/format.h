@@ -22,6 +22,10 @@ std::string ShortestDecimal(float value);
 /// that came from the bus or a file.
 std::string EscapeText(const std::string& text);
 
+/// An errno value as its text and its name: ENOSPC → "No space left on device (ENOSPC)" (the
+/// number when the C library has no name for it).
+std::string DescribeErrno(int error_number);
+
 /// A utime [µs since the Unix epoch] as UTC text by strftime's `format`, e.g. "%Y-%m-%dT%H:%M:%SZ".
 std::string FormatUtc(int64_t utime, const char* format);
 
