@@ -59,6 +59,12 @@
 
 namespace orbed {
 
+/// Exit code of a process that stopped because it cannot write its output (a full disk, a
+/// read-only or vanished folder): the fault is outside the process and a new instance would meet
+/// it again, so orbed-launch does not respawn it, whatever its `respawn:` says, and a required one
+/// fails the launch with its last output line as the reason. (EX_IOERR of sysexits.h.)
+inline constexpr int kExitCannotWrite = 74;
+
 /// Installs SIGINT/SIGTERM handlers that make every Process::Run() return. Idempotent.
 void InstallStopSignalHandlers();
 /// True once SIGINT or SIGTERM arrived (or RequestGlobalStop() was called).

@@ -110,6 +110,7 @@ bool Child::Start(const std::vector<std::string>& argv, const std::map<std::stri
   exit_code_ = 0;
   term_signal_ = 0;
   partial_line_.clear();
+  last_line_.clear();
   return true;
 }
 
@@ -154,14 +155,15 @@ void Child::Drain(const std::string& prefix, bool final) {
   size_t start = 0;
   for (size_t newline; (newline = partial_line_.find('\n', start)) != std::string::npos;
        start = newline + 1) {
-    std::fprintf(stdout, "%s%.*s\n", prefix.c_str(), static_cast<int>(newline - start),
-                 partial_line_.data() + start);
-    if (copy_ != nullptr) copy_->push_back(partial_line_.substr(start, newline - start));
+    last_line_ = partial_line_.substr(start, newline - start);
+    std::fprintf(stdout, "%s%s\n", prefix.c_str(), last_line_.c_str());
+    if (copy_ != nullptr) copy_->push_back(last_line_);
   }
   partial_line_.erase(0, start);
   if ((final || output_fd_ < 0) && !partial_line_.empty()) {
-    std::fprintf(stdout, "%s%s\n", prefix.c_str(), partial_line_.c_str());
-    if (copy_ != nullptr) copy_->push_back(partial_line_);
+    last_line_ = partial_line_;
+    std::fprintf(stdout, "%s%s\n", prefix.c_str(), last_line_.c_str());
+    if (copy_ != nullptr) copy_->push_back(last_line_);
     partial_line_.clear();
   }
   std::fflush(stdout);

@@ -34,6 +34,8 @@ class ChildHandle {
 
 class Child : public ChildHandle {
  public:
+  /// The last line it printed ("" when its output is not seen here, as on another host).
+  virtual std::string last_line() const { return ""; }
   Child() = default;
   ~Child() override;
   Child(const Child&) = delete;
@@ -67,6 +69,7 @@ class Child : public ChildHandle {
  private:
   pid_t pid_ = -1;
   int output_fd_ = -1;
+  std::string last_line() const override { return last_line_; }
   bool exited_ = false;
   int exit_code_ = 0;
   int term_signal_ = 0;
@@ -75,6 +78,7 @@ class Child : public ChildHandle {
 };
 
 /// Resolves an executable name as Child::Start does; "" if not found.
+  std::string last_line_;
 std::string ResolveExecutable(const std::string& command, const std::string& search_dir);
 
 }  // namespace orbed::launcher

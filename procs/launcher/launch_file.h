@@ -25,7 +25,8 @@
 ///                  {if: user_seed, args: [--user-seed, "$(arg user_seed)"]}]
 ///           env: {KEY: value}          # added to the launcher's environment
 ///           required: true             # its failure stops the testbed, exit != 0 (default true)
-///           respawn: false             # restart when it dies (default false)
+///           respawn: false             # restart when it dies (default false); never after exit
+///                                      # code 74, "cannot write its output" (process.h)
 ///           stop_signal: SIGINT        # SIGINT | SIGTERM | SIGHUP | SIGQUIT | SIGUSR1 | SIGUSR2 | SIGKILL
 ///           stop_timeout_s: 5        # then SIGKILL (default 5)
 ///           ready: heartbeat           # heartbeat (first PROCESS_STATUS) | none (default heartbeat)

@@ -183,6 +183,21 @@ void Launcher::HandleExit(Managed* m) {
     process_.RequestStop();
     return;
   }
+  if (m->child->exit_code() == kExitCannotWrite) {
+    // It cannot write its output (a full disk): not a crash, and a new instance would fail the
+    // same way, so it is not respawned.
+    m->finished = true;
+    const std::string said = m->child->last_line();
+    const std::string reason = "process '" + m->spec.name + "' " + m->last_exit +
+                               ": it cannot write its output, not respawned" +
+                               (said.empty() ? "" : " (it said: " + said + ")");
+    if (m->spec.required) {
+      FailTestbed("required " + reason);
+    } else {
+      ORBED_LOG(kWarn) << "optional " << reason << "; continuing without it";
+    }
+    return;
+  }
   if (m->spec.respawn) {
     if (m->ready) m->unready_since = Clock::now();
     const bool fast = SecondsSince(m->started_at) < 1.0;

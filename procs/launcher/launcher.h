@@ -9,8 +9,11 @@
 /// marked `exit_stops_all` exits (one killed by a signal: an error, "before it finished"). A
 /// respawned process is ready again at its new instance's first heartbeat; a required one that is
 /// not ready again within its ready_timeout_s of dying (e.g. it keeps dying at start) stops the
-/// testbed with an error naming it. On SIGINT/SIGTERM or after --duration-s it stops the groups in
-/// reverse order: each child gets its stop_signal, then SIGKILL after stop_timeout_s.
+/// testbed with an error naming it. A process that exits with kExitCannotWrite (74, process.h: it
+/// cannot write its output, e.g. the logger on a full disk) is never respawned, and a required one
+/// stops the testbed with its last output line in the error. On SIGINT/SIGTERM or after
+/// --duration-s it stops the groups in reverse order: each child gets its stop_signal, then
+/// SIGKILL after stop_timeout_s.
 ///
 /// Children get: --name <name> appended (heartbeat-ready processes, unless args have --name),
 /// ORBED_LCM_URL = the launcher's LCM URL, ORBED_HOST = the launcher's host name,
@@ -23,8 +26,11 @@
 /// falls silent (a partition) is logged, and its processes keep their last known state until it
 /// is heard again.
 ///
-/// Exit code: 0, or 1 when a required process failed or was not ready in time, or the exit code of
-/// an `exit_stops_all` process.
+/// Exit code: 0, or 1 when a required process failed (kExitCannotWrite included) or was not ready
+/// in time, or the exit code of an `exit_stops_all` process.
+///
+/// Killed outright (SIGKILL), the launcher takes its local children with it (PR_SET_PDEATHSIG,
+/// child.h); its deputies stop theirs once they have heard nothing from it for their orphan timeout.
 ///
 /// Threading: one thread (Process::Run); children are polled every 20 ms.
 
