@@ -40,7 +40,7 @@ fs::path LogFolder(const LoggerOptions& options) {
 // are not a whole event (a torn tail). Throws when the file cannot be read.
 void Recount(const fs::path& path, ManifestPart* part) {
   const MappedLog log(path.string());
-  if (!log.ok()) throw std::runtime_error("cannot continue the recording: " + log.error());
+  if (!log.ok()) throw std::runtime_error(log.error());
   EventLogScanner scanner = log.Scanner();
   ManifestPart recounted;
   recounted.file = part->file;
@@ -97,7 +97,11 @@ Logger::Logger(const CommonFlags& flags, LoggerOptions options)
   if (std::optional<Manifest> previous = RecordingToContinue(manifest_path(), options_)) {
     manifest_ = *previous;
     ManifestPart& last = manifest_.parts.back();
-    Recount(folder / last.file, &last);
+    try {
+      Recount(folder / last.file, &last);
+    } catch (const std::runtime_error& e) {
+      throw std::runtime_error(std::string("cannot continue the recording: ") + e.what());
+    }
     int number = static_cast<int>(manifest_.parts.size()) + 1;
     while (fs::exists(folder / PartFileName(manifest_.parts.front().file, number))) ++number;
     log_path_ = (folder / PartFileName(manifest_.parts.front().file, number)).string();
@@ -134,7 +138,10 @@ Logger::Logger(const CommonFlags& flags, LoggerOptions options)
     manifest_.files.push_back({path, hash, hash.empty() ? error : ""});
   }
   process_.AddTimer(1.0, [this] { process_.Publish(options_.status_channel, MakeStatus()); });
-  process_.AddTimer(5.0, [this] { WriteManifest(false); });
+  process_.AddTimer(5.0, [this] {
+    std::string error;
+    if (!WriteManifest(false, &error)) StopOnWriteError(error, false);
+  });
 }
 
 Logger::~Logger() {
@@ -194,34 +201,41 @@ void Logger::WriterLoop() {
     WriteBatch(batch);
     batch.clear();
     if (stop || Clock::now() >= next_flush) {
-      const bool flushed = file_->Flush();
-      std::lock_guard<std::mutex> lock(stats_mutex_);
-      if (!flushed && write_error_.empty()) {
-        write_error_ = file_->error();
-        process_.Fail("log flush failed: " + write_error_);
+      if (file_->Flush()) {
+        std::lock_guard<std::mutex> lock(stats_mutex_);
+        last_flush_utime_ = NowMicros();
+      } else {
+        StopOnWriteError(file_->error(), true);
       }
-      last_flush_utime_ = NowMicros();
       next_flush = Clock::now() + flush_period;
     }
     if (stop) break;
   }
-  file_->Close();
+  if (!file_->Close()) StopOnWriteError(file_->error(), true);
+}
+
+void Logger::StopOnWriteError(const std::string& error, bool in_log) {
+  {
+    std::lock_guard<std::mutex> lock(stats_mutex_);
+    if (!write_error_.empty()) return;
+    write_error_ = error;
+    log_write_failed_ = in_log;
+  }
+  process_.Fail(error);
 }
 
 void Logger::WriteBatch(const std::deque<Event>& batch) {
   for (const Event& event : batch) {
     const size_t written = file_->Write(event.utime, event.channel, event.data.data(), event.data.size());
-    std::lock_guard<std::mutex> lock(stats_mutex_);
     if (written == 0) {
       // Disk full or gone: every later event is lost too. Say so once, count the losses as
       // drops, and stop the logger (its exit code and heartbeat say FAILED).
-      if (write_error_.empty()) {
-        write_error_ = file_->error();
-        process_.Fail("log write failed: " + write_error_);
-      }
+      StopOnWriteError(file_->error(), true);
+      std::lock_guard<std::mutex> lock(stats_mutex_);
       ++lost_events_;
       continue;
     }
+    std::lock_guard<std::mutex> lock(stats_mutex_);
     ++events_written_;
     bytes_written_ += static_cast<int64_t>(written);
     ChannelStats& stats = stats_[event.channel];
@@ -244,7 +258,8 @@ void Logger::WriteQueued() {
 
 int Logger::Run() {
   ORBED_LOG(kInfo) << "recording channels /" << options_.channels << "/ to " << log_path_;
-  WriteManifest(false);
+  std::string error;
+  if (!WriteManifest(false, &error)) StopOnWriteError(error, false);
   writer_ = std::thread([this] { WriterLoop(); });
   const int code = process_.Run();
   {
@@ -252,18 +267,52 @@ int Logger::Run() {
     writer_stop_ = true;
   }
   queue_cv_.notify_all();
-  writer_.join();
+  writer_.join();  // the log is closed
   stop_utime_ = NowMicros();
-  WriteManifest(true);
+  {
+    std::lock_guard<std::mutex> lock(stats_mutex_);
+    error = write_error_;
+  }
+  if (error.empty() && !WriteManifest(true, &error)) StopOnWriteError(error, false);
+  if (!error.empty()) return EndFailedRecording();
   const orbed::logger_status_t status = MakeStatus();
   ORBED_LOG(kInfo) << "closed " << log_path_ << ": " << status.events_written << " events, "
                    << status.bytes_written << " bytes, " << status.drops << " dropped";
-  std::lock_guard<std::mutex> lock(stats_mutex_);
-  if (!write_error_.empty()) {
-    ORBED_LOG(kError) << write_error_;
-    return 1;
-  }
   return code;
+}
+
+int Logger::EndFailedRecording() {
+  std::string error;
+  bool in_log = false;
+  int64_t handed_to_writer = 0;
+  {
+    std::lock_guard<std::mutex> lock(stats_mutex_);
+    error = write_error_;
+    in_log = log_write_failed_;
+    handed_to_writer = events_written_;
+  }
+  // What the file really holds, whatever was handed to the writer before the failure.
+  Manifest manifest = MakeManifest(false);
+  ManifestPart& part = manifest.parts.back();
+  std::string line;
+  try {
+    Recount(log_path_, &part);
+    const int64_t size = part.bytes + part.damaged_bytes;  // the file's size: every byte is one or the other
+    line = error + (in_log ? " after " : "; the log " + log_path_ + " holds ") + std::to_string(size) +
+           " bytes, " + std::to_string(part.events) + " events";
+  } catch (const std::exception& e) {
+    line = error + "; the log cannot be read back: " + e.what();
+  }
+  part.drops += handed_to_writer - part.events;  // buffered when the write failed: not in the file
+  part.error = line;
+  std::string manifest_error;
+  if (WriteManifestFile(manifest_path(), manifest, &manifest_error)) {
+    line += "; recorded in " + manifest_path();
+  } else {
+    line += "; " + manifest_path() + " not updated: " + manifest_error;
+  }
+  ORBED_LOG(kError) << line;  // the last line: orbed-launch names it as the reason
+  return kExitCannotWrite;
 }
 
 orbed::logger_status_t Logger::MakeStatus() const {
@@ -311,9 +360,8 @@ Manifest Logger::MakeManifest(bool complete) const {
   return m;
 }
 
-void Logger::WriteManifest(bool complete) const {
-  std::string error;
-  if (!WriteManifestFile(manifest_path(), MakeManifest(complete), &error)) ORBED_LOG(kWarn) << error;
+bool Logger::WriteManifest(bool complete, std::string* error) const {
+  return WriteManifestFile(manifest_path(), MakeManifest(complete), error);
 }
 
 }  // namespace orbed::logger

@@ -16,6 +16,16 @@
 /// and bytes; rewritten at start, every 5 s and at the end), LOGGER_STATUS at 1 Hz (this part's
 /// counts) and the PROCESS_STATUS heartbeat.
 ///
+/// Write errors: a failed fwrite, fflush or fclose of the log (e.g. ENOSPC: a full disk) or a failed
+/// write of the manifest stops the logger. Nothing is written to the log after the failure
+/// (event_log_writer.h), the part is re-counted from its file as it is, and the logger says, as its
+/// last line, e.g. "cannot write <log>: No space left on device (ENOSPC) after 262144 bytes, 251
+/// events" (the file's size, its whole events; a torn last event is damaged bytes), puts the same
+/// text in its manifest part's "error" when the manifest can still be written (the recording stays
+/// unfinished), or says that it could not, and exits with kExitCannotWrite (74, process.h), which
+/// orbed-launch does not respawn: a full disk is not a crash, and a new logger would fail the same
+/// way.
+///
 /// Crash recovery: a logger whose manifest already exists and says the recording is not complete
 /// (its logger died: SIGKILL, power) continues that recording in a new part, <stem>.part<N>.lcmlog
 /// beside the first (with --file only if the recording's first part is that file; otherwise, and
@@ -75,7 +85,7 @@ class Logger {
   Logger(const CommonFlags& flags, LoggerOptions options);
   ~Logger();
 
-  /// Records until stopped; returns the exit code.
+  /// Records until stopped; returns the exit code: 0, 1 (Process::Fail), or kExitCannotWrite.
   int Run();
 
   /// This logger's part.
@@ -101,7 +111,13 @@ class Logger {
   void WriterLoop();
   // Writes `batch` to the file and counts it (the writer thread, or WriteQueued()).
   void WriteBatch(const std::deque<Event>& batch);
-  void WriteManifest(bool complete) const;
+  // Writes the manifest; false with *error set when it cannot.
+  bool WriteManifest(bool complete, std::string* error) const;
+  // Keeps the first write error (`in_log`: of the log, else of the manifest) and stops the logger.
+  void StopOnWriteError(const std::string& error, bool in_log);
+  // After a write error: re-counts this part from its file, marks the manifest if it can, says
+  // so and returns kExitCannotWrite.
+  int EndFailedRecording();
 
   LoggerOptions options_;
   CommonFlags flags_;
@@ -124,6 +140,7 @@ class Logger {
   int64_t bytes_written_ = 0;                  // guarded by stats_mutex_
   int64_t last_flush_utime_ = 0;               // guarded by stats_mutex_
   std::string write_error_;                    // guarded by stats_mutex_
+  bool log_write_failed_ = false;              // guarded by stats_mutex_ (else the manifest's)
   int64_t lost_events_ = 0;                    // guarded by stats_mutex_ (after a write error)
 
   std::unique_ptr<EventLogWriter> file_;  // used by the writer thread only, after Run() starts

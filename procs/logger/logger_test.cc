@@ -170,7 +170,8 @@ TEST(Logger, RecordsEveryChannelWritesManifestAndCountsDrops) {
   EXPECT_NE(text.find("\"lcm\": \"1.3.1\""), std::string::npos);
 }
 
-// A full disk (/dev/full: every write fails with ENOSPC) fails the logger: exit 1, not silence.
+// A full disk (/dev/full: every write fails with ENOSPC) stops the logger with kExitCannotWrite,
+// which orbed-launch does not respawn, and its manifest part says why.
 TEST(Logger, WriteErrorsFailTheLogger) {
   CommonFlags flags("orbed-logger");
   flags.lcm_url = "memq://";
@@ -182,8 +183,13 @@ TEST(Logger, WriteErrorsFailTheLogger) {
   Logger logger(flags, options);
   const std::string payload(100000, 'x');
   for (int i = 0; i < 20; ++i) logger.process().lcm().publish("BLOB", payload.data(), payload.size());
-  EXPECT_EQ(logger.Run(), 1);
+  EXPECT_EQ(logger.Run(), kExitCannotWrite);
   EXPECT_EQ(logger.process().MakeStatus().state, +orbed::process_status_t::STATE_FAILED);
+  const Manifest manifest = ReadManifestFile(options.manifest);
+  EXPECT_FALSE(manifest.complete);
+  EXPECT_NE(manifest.parts.back().error.find("cannot write /dev/full: No space left on device (ENOSPC)"),
+            std::string::npos)
+      << manifest.parts.back().error;
 }
 
 TEST(Logger, MalformedChannelRegexThrowsBeforeCreatingAFile) {

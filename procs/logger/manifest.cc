@@ -134,6 +134,7 @@ std::string ManifestJson(const Manifest& m) {
     json.Key("damaged_bytes").Int(part.damaged_bytes);
     json.Key("channels");
     WriteChannels(&json, part.channels);
+    if (!part.error.empty()) json.Key("error").String(part.error);
     json.EndObject();
   }
   json.EndArray();
@@ -206,6 +207,7 @@ Manifest ParseManifest(const std::string& text, const std::string& source) {
     part.drops = f.Integer(f.Member(at, "drops"), 0, kMaxCount);
     part.damaged_bytes = f.Integer(f.Member(at, "damaged_bytes"), 0, kMaxCount);
     part.channels = ReadChannels(f, f.Member(at, "channels"));
+    if (const auto error = f.OptionalMember(at, "error")) part.error = f.String(*error, kMaxText);
     // The part's totals are its channels' (bytes: each event's header and channel name too).
     int64_t events = 0, bytes = 0;
     for (const auto& [name, stats] : part.channels) {

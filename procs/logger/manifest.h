@@ -20,7 +20,9 @@
 ///              "events", "bytes" (whole events: header + channel + data), "drops" (queue
 ///              overflows counted by its logger, as last written), "damaged_bytes" (bytes that are
 ///              not a whole event: a torn tail after a crash), "channels" {name: {"events",
-///              "bytes" (payload), "first_utime", "last_utime"}}}]
+///              "bytes" (payload), "first_utime", "last_utime"}}, and "error" (optional: why its
+///              logger could not go on writing, e.g. "cannot write …: No space left on device
+///              (ENOSPC) after 262144 bytes, 251 events"; its counts are then those of the file)}]
 ///   "events_written", "bytes_written", "drops", "channels"   the sums over the parts
 ///
 /// Reading (ParseManifest) checks the document like any input from outside: at most
@@ -66,6 +68,7 @@ struct ManifestPart {
   int64_t drops = 0;
   int64_t damaged_bytes = 0;
   std::map<std::string, ChannelStats> channels;
+  std::string error;  ///< "" unless its logger stopped on a write error
 };
 
 struct HashedFile {

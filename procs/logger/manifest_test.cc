@@ -92,6 +92,22 @@ TEST(Manifest, ReadsBackWhatItWrites) {
   EXPECT_EQ(doc["start_time_utc"], "2023-11-14T22:13:20Z");
 }
 
+// A part whose logger stopped on a write error says why; a part without one has no "error" key.
+TEST(Manifest, APartsWriteErrorReadsBack) {
+  Manifest m = TwoParts();
+  m.complete = false;
+  m.stop_utime.reset();
+  m.parts[1].complete = false;
+  m.parts[1].error =
+      "cannot write /d/orbed-X.part2.lcmlog: No space left on device (ENOSPC) after 13 bytes, 0 events";
+  const std::string text = ManifestJson(m);
+  const Manifest back = ParseManifest(text, "m.json");
+  EXPECT_EQ(back.parts[1].error, m.parts[1].error);
+  EXPECT_EQ(back.parts[0].error, "");
+  EXPECT_EQ(nlohmann::json::parse(text)["parts"][0].count("error"), 0u);
+  EXPECT_EQ(ManifestJson(back), text);
+}
+
 std::string RefusalOf(const std::function<void(nlohmann::json&)>& damage) {
   nlohmann::json doc = nlohmann::json::parse(ManifestJson(TwoParts()));
   damage(doc);
