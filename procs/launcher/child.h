@@ -1,9 +1,13 @@
 #pragma once
 /// @file
 /// One child process of orbed-launch: fork/exec in its own process group (so a terminal's Ctrl-C
-/// reaches only the launcher, which then stops children in order) with PR_SET_PDEATHSIG so it dies
-/// if the launcher is killed; stdout and stderr merged into a pipe that the launcher reads and
-/// re-emits line by line with the child's name in front.
+/// reaches only the launcher, which then stops children in order) with PR_SET_PDEATHSIG = SIGKILL,
+/// so it dies with the launcher (or deputy) that started it when that one is killed outright:
+/// nobody is left to stop it in order or to escalate a stop that hangs, and what the processes
+/// keep (logs, state files, journals) is written to survive a SIGKILL. Only the child itself:
+/// processes it starts in turn are not covered (the testbed's processes start none). stdout and
+/// stderr merged into a pipe that the launcher reads and re-emits line by line with the child's
+/// name in front.
 ///
 /// Threading: not thread-safe; used from the launcher's loop thread only.
 
@@ -30,12 +34,12 @@ class ChildHandle {
   virtual std::string DescribeExit() const = 0;
   virtual void Signal(int signal) = 0;
   virtual void Drain(const std::string& prefix, bool final = false) = 0;
+  /// The last line it printed ("" when its output is not seen here, as on another host).
+  virtual std::string last_line() const { return ""; }
 };
 
 class Child : public ChildHandle {
  public:
-  /// The last line it printed ("" when its output is not seen here, as on another host).
-  virtual std::string last_line() const { return ""; }
   Child() = default;
   ~Child() override;
   Child(const Child&) = delete;
@@ -65,20 +69,20 @@ class Child : public ChildHandle {
   void Drain(const std::string& prefix, bool final = false) override;
   /// Also keep every line the child prints in `*lines` (tests read a child's output).
   void CopyLinesTo(std::vector<std::string>* lines) { copy_ = lines; }
+  std::string last_line() const override { return last_line_; }
 
  private:
   pid_t pid_ = -1;
   int output_fd_ = -1;
-  std::string last_line() const override { return last_line_; }
   bool exited_ = false;
   int exit_code_ = 0;
   int term_signal_ = 0;
   std::string partial_line_;
+  std::string last_line_;
   std::vector<std::string>* copy_ = nullptr;
 };
 
 /// Resolves an executable name as Child::Start does; "" if not found.
-  std::string last_line_;
 std::string ResolveExecutable(const std::string& command, const std::string& search_dir);
 
 }  // namespace orbed::launcher
