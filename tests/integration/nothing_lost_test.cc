@@ -9,7 +9,7 @@
 //     ENOSPC, the file's size on disk and its whole events; under orbed-launch it is not respawned
 //     and the launch fails with that line;
 //   - orbed-launch SIGKILLed: none of its processes is left (read from /proc), not even one that
-//     ignores SIGTERM. (The same across hosts, through a deputy's orphan timeout:
+//     ignores SIGINT and SIGTERM. (The same across hosts, through a deputy's orphan timeout:
 //     hosts_integration_test.)
 #include <sched.h>
 #include <signal.h>
@@ -320,7 +320,7 @@ TEST(NothingLost, ALaunchWhoseLoggerFillsTheDiskFailsWithItsLineAndDoesNotRespaw
 TEST(NothingLost, ASigkilledLauncherTakesItsProcessesWithIt) {
   const std::string dir = MakeTempDir("launcher_sigkill");
   const std::string mark = "ORBED_RUN_MARK=" + dir;
-  // The monitor, and a shell that ignores SIGTERM (as a hung process would) sleeping.
+  // The monitor, and a shell that ignores SIGINT and SIGTERM (as a hung process would) sleeping.
   std::ofstream(dir + "/launch.yaml")
       << "name: launcher_sigkill\n"
          "groups:\n"
@@ -329,7 +329,7 @@ TEST(NothingLost, ASigkilledLauncherTakesItsProcessesWithIt) {
          "      - {name: monitor, command: orbed-monitor, env: {ORBED_RUN_MARK: \""
       << dir
       << "\"}}\n"
-         "      - {name: deaf, command: sh, args: [-c, 'trap \"\" TERM; exec sleep 600'], ready: none,\n"
+         "      - {name: deaf, command: sh, args: [-c, 'trap \"\" INT TERM; exec sleep 600'], ready: none,\n"
          "         env: {ORBED_RUN_MARK: \""
       << dir << "\"}}\n";
   BusWatcher bus;
