@@ -9,6 +9,7 @@
 #include <sys/types.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <csignal>
 #include <cstdlib>
 #include <filesystem>
@@ -241,6 +242,79 @@ TEST(Hosts, AProcessKilledOnAnotherHostIsRespawnedThroughItsDeputy) {
   EXPECT_EQ(results["status"].as<std::string>(), "ok");
   ASSERT_EQ(results["sessions"].size(), 2u);
   for (const auto& session : results["sessions"]) EXPECT_EQ(session["trials"].size(), 3u);
+}
+
+// The live processes (not zombies) whose environment holds every one of `entries` ("KEY=value").
+std::vector<int> PidsWithEnv(const std::vector<std::string>& entries) {
+  std::vector<int> pids;
+  for (const auto& dir : std::filesystem::directory_iterator("/proc")) {
+    const std::string name = dir.path().filename().string();
+    if (name.find_first_not_of("0123456789") != std::string::npos) continue;
+    std::ifstream environ(dir.path() / "environ", std::ios::binary);  // empty for a zombie
+    std::set<std::string> variables;
+    for (std::string variable; std::getline(environ, variable, '\0');) variables.insert(variable);
+    if (std::all_of(entries.begin(), entries.end(), [&](const std::string& e) { return variables.count(e); }))
+      pids.push_back(std::stoi(name));
+  }
+  return pids;
+}
+
+// orbed-launch on A SIGKILLed: nothing of its run is left on A at once (PR_SET_PDEATHSIG), nor on
+// B once B's deputy has heard nothing for its orphan timeout (3 s here) and stopped what it
+// started, SIGKILL included for a process that ignores its stop signal (after its
+// stop_timeout_s, 1 s).
+TEST(Hosts, ASigkilledLauncherLeavesNoProcessOnAnyHost) {
+  if (!CanBuildHosts()) GTEST_SKIP() << kNoHosts;
+  VirtualLan lan({"hostA", "hostB"});
+  ASSERT_TRUE(lan.ok());
+  const std::string dir = MakeTempDir("hosts_launcher_killed");
+  const std::string mark = "ORBED_RUN_MARK=" + dir;
+  const std::string env = "env: {ORBED_RUN_MARK: \"" + dir + "\"}";
+  const std::string deaf =
+      "command: sh, args: [-c, 'trap \"\" INT TERM; exec sleep 600'], ready: none, stop_timeout_s: 1";
+  std::ofstream(dir + "/killed.yaml")
+      << "name: killed\n"
+      << "groups:\n"
+      << "  - name: g\n"
+      << "    processes:\n"
+      << "      - {name: deaf_a, " << deaf << ", " << env << "}\n"
+      << "      - {name: deaf_b, host: hostB, " << deaf << ", " << env << "}\n"
+      << "      - {name: monitor_b, command: orbed-monitor, host: hostB, " << env << "}\n";
+  constexpr double kOrphanTimeoutS = 3, kStopTimeoutS = 1;
+  const auto deputy_b = lan.Run("hostB", {BinPath("orbed-launch"), "--deputy", "hostB", "--orphan-timeout-s",
+                                          std::to_string(kOrphanTimeoutS)});
+  const auto launcher = lan.Run("hostA", {BinPath("orbed-launch"), dir + "/killed.yaml", "--host", "hostA"});
+  ASSERT_TRUE(WaitFor(
+      [&] {
+        launcher->running();  // prints its output
+        return PidsWithEnv({mark}).size() == 3 && AnyLineHas(launcher->lines(), "monitor_b is ready");
+      },
+      60))
+      << "the run did not start on both hosts";
+  ASSERT_EQ(PidsWithEnv({mark, "ORBED_HOST=hostA"}).size(), 1u);
+  ASSERT_EQ(PidsWithEnv({mark, "ORBED_HOST=hostB"}).size(), 2u);
+
+  launcher->Signal(SIGKILL);
+  ASSERT_TRUE(launcher->Wait(10));
+  ASSERT_EQ(launcher->term_signal(), SIGKILL);
+  // On A: at once (the deadline only bounds the kernel's delivery of the parent-death signal).
+  EXPECT_TRUE(WaitFor(
+      [&] {
+        return PidsWithEnv({mark, "ORBED_HOST=hostA"}).empty();
+      },
+      5))
+      << "a process on A outlived its launcher";
+  // On B: within the orphan timeout and the stop's SIGKILL, plus slack for the deputy's 20 ms
+  // ticks on a busy machine.
+  EXPECT_TRUE(WaitFor([&] { return PidsWithEnv({mark}).empty(); }, kOrphanTimeoutS + kStopTimeoutS + 5))
+      << "a process on B outlived its launcher's orphan timeout";
+  EXPECT_TRUE(WaitFor(
+      [&] {
+        deputy_b->running();
+        return AnyLineHas(deputy_b->lines(), "no command from", "stopping what it started") &&
+               AnyLineHas(deputy_b->lines(), "deaf_b did not stop within 1 s: SIGKILL");
+      },
+      5));
 }
 
 // A process placed on a host whose deputy never answers: the launch stops with an error naming the
