@@ -28,10 +28,8 @@ int RunHmd(int argc, const char* const* argv, std::ostream& out, std::ostream& e
       "YAML file(s) with slam:, user:, head_trajectory: and/or hmd: mappings, applied in order after "
       "the shipped hmd_emulator/config/{slam,user,viraal_walk,hmd}.yaml (repeatable)");
   app.add_option_function<std::uint64_t>(
-         "--user-seed", [&o](const std::uint64_t& seed) { o.user_seed = seed; },
-         "The emulated person (overrides user.seed; default $ORBED_USER_SEED if set): a different seed is "
-         "a different person")
-      ->envname("ORBED_USER_SEED");
+      "--user-seed", [&o](const std::uint64_t& seed) { o.user_seed = seed; },
+      "The emulated person (overrides user.seed): a different seed is a different person");
   app.add_option("--camera-hz", o.camera_hz,
                  "HMD_CAMERA rate [Hz], (0, 1000]; faster than the renderer keeps up with, a request that "
                  "finds the previous one still waiting replaces it, counted as the drop HMD_CAMERA/busy")

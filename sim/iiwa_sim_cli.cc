@@ -27,19 +27,15 @@ int RunIiwaSim(int argc, const char* const* argv, std::ostream& out, std::ostrea
       ->capture_default_str();
   app.add_option("--realtime-rate", options.realtime_rate,
                  "Sim seconds per wall second (1-100; for studies without a person in the loop; in "
-                 "--lockstep the fastest; default $ORBED_SIM_RATE if set)")
-      ->envname("ORBED_SIM_RATE")
+                 "--lockstep the fastest)")
       ->capture_default_str();
   app.add_option("--steps-per-tick", options.steps_per_tick,
-                 "Steps of --period-s per tick, which publishes once (1-1000; 0 = the realtime rate; "
-                 "default $ORBED_SIM_STEPS_PER_TICK if set)")
-      ->envname("ORBED_SIM_STEPS_PER_TICK")
+                 "Steps of --period-s per tick, which publishes once (1-1000; 0 = the realtime rate)")
       ->capture_default_str();
   app.add_flag("--lockstep", options.lockstep,
                "Before each step, wait until every process that follows the clock (--sim-time) has "
                "answered on SIM_CLOCK_ACK and nothing is in flight: runs do not depend on the machine's "
-               "speed or the rate (default $ORBED_SIM_LOCKSTEP if set)")
-      ->envname("ORBED_SIM_LOCKSTEP");
+               "speed or the rate");
   app.add_option("--lockstep-timeout-s", options.lockstep_timeout_s,
                  "Wall seconds a lockstep round waits for a follower before going on without it")
       ->check(CLI::PositiveNumber)
@@ -52,8 +48,7 @@ int RunIiwaSim(int argc, const char* const* argv, std::ostream& out, std::ostrea
   app.add_option("--hold-for", options.hold_for,
                  "Hold the sim clock (publish only SIM_CLOCK, do not step) until PROCESS_STATUS shows the "
                  "process of this name running, so that a launch's followers of the clock start together "
-                 "(default $ORBED_SIM_HOLD_FOR; empty: run from the start)")
-      ->envname("ORBED_SIM_HOLD_FOR");
+                 "(empty: run from the start)");
   app.add_option("--initial-q-deg", options.initial_q_deg,
                  "Initial joint angles q1,...,q7 [deg] (default: all 0)")
       ->delimiter(',');

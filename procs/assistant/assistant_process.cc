@@ -333,10 +333,7 @@ int RunAssistant(int argc, const char* const* argv, std::ostream& out, std::ostr
   uint64_t seed = 0;
   app.add_option("--config", options.config_path,
                  "Assistant parameters (default: procs/assistant/assistant.yaml in the source tree)");
-  auto* seed_flag =
-      app.add_option("--person-seed", seed,
-                     "The person (overrides the config's seed; default $ORBED_USER_SEED if set)")
-          ->envname("ORBED_USER_SEED");
+  auto* seed_flag = app.add_option("--person-seed", seed, "The person (overrides the config's seed)");
   app.add_option("--result", options.result_path, "Write the set-up's result (JSON) to this file when done");
   app.add_flag("--once", options.once,
                "Carry out the first GUIDANCE's target without a SETUP_TASK, then stop (exit 0)");

@@ -58,11 +58,10 @@ void AddCommonFlags(CLI::App* app, CommonFlags* flags) {
 
 void AddSimTimeFlag(CLI::App* app, CommonFlags* flags) {
   app->add_flag(
-         "--sim-time", flags->sim_time,
-         "Run timers, timeouts and stamps on the sim's clock (SIM_CLOCK from orbed-iiwa-sim, which may "
-         "run faster than real time) instead of the wall clock, answering its lockstep rounds on "
-         "SIM_CLOCK_ACK (default: $ORBED_SIM_TIME)")
-      ->envname("ORBED_SIM_TIME");
+      "--sim-time", flags->sim_time,
+      "Run timers, timeouts and stamps on the sim's clock (SIM_CLOCK from orbed-iiwa-sim, which may "
+      "run faster than real time) instead of the wall clock, answering its lockstep rounds on "
+      "SIM_CLOCK_ACK");
 }
 
 void AddInstanceFlag(CLI::App* app, const std::string& flag, std::string* name, const std::string& help) {

@@ -8,7 +8,7 @@
 ///   --log-level L      debug | info | warn | error
 ///   --chaos SPEC       fault injection on received datagrams (default: $ORBED_CHAOS; chaos.h)
 /// and, for the processes that can follow the sim clock (AddSimTimeFlag):
-///   --sim-time         timers, timeouts and stamps on SIM_CLOCK (default: $ORBED_SIM_TIME)
+///   --sim-time         timers, timeouts and stamps on SIM_CLOCK
 /// Usage in a thin main:
 ///   CLI::App app{"what it does"};
 ///   orbed::CommonFlags common("orbed-foo");
@@ -56,7 +56,7 @@ std::string DefaultLcmUrl();
 std::string WithRecvBufSize(const std::string& url, int64_t bytes);
 
 void AddCommonFlags(CLI::App* app, CommonFlags* flags);
-/// Adds --sim-time ($ORBED_SIM_TIME) for a process whose timers may follow the sim clock. The sim
+/// Adds --sim-time for a process whose timers may follow the sim clock. The sim
 /// (the clock's source), the logger, the launcher and the monitor do not take it.
 void AddSimTimeFlag(CLI::App* app, CommonFlags* flags);
 

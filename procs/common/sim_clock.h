@@ -2,7 +2,7 @@
 /// @file
 /// The simulation clock a process can follow (as ROS's /clock with use_sim_time): orbed-iiwa-sim
 /// publishes sim_clock_t on SIM_CLOCK once per tick, and a process started with --sim-time
-/// ($ORBED_SIM_TIME) runs its timers, timeouts and message stamps on it (Process, process.h).
+/// runs its timers, timeouts and message stamps on it (Process, process.h).
 ///
 /// SimClock is the pure core: it turns the stream of SIM_CLOCK stamps into a monotonic elapsed sim
 /// time. Within one sim (the same start_utime), a step forward of at most kMaxSimClockStepUs

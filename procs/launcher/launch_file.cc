@@ -30,9 +30,9 @@ bool IsHostName(const std::string& host) {
 struct ReadState {
   std::set<std::string> process_names, group_names;
   std::vector<std::string> chain;
-  bool declaring = true;                       // the first pass: only `arguments`
-  std::map<std::string, std::string> values;   // argument name -> value (given, else default)
-  std::map<std::string, std::string> given;    // what the command line gave
+  bool declaring = true;                      // the first pass: only `arguments`
+  std::map<std::string, std::string> values;  // argument name -> value (given, else default)
+  std::map<std::string, std::string> given;   // what the command line gave
 };
 
 // `key` is the process's dotted path, e.g. "groups[0].processes[1]".
@@ -324,7 +324,9 @@ std::pair<std::string, std::string> ParseArgumentAssignment(const std::string& t
   const std::string name = text.substr(0, eq);
   bool word = !name.empty() && name.size() <= 64;
   for (const char c : name) word = word && (std::isalnum(static_cast<unsigned char>(c)) || c == '_');
-  if (!word) throw std::invalid_argument("expected NAME=VALUE with NAME of letters, digits and '_', got '" + text + "'");
+  if (!word)
+    throw std::invalid_argument("expected NAME=VALUE with NAME of letters, digits and '_', got '" + text +
+                                "'");
   return {name, text.substr(eq + 1)};
 }
 
@@ -351,7 +353,8 @@ namespace {
 // Two passes over the files: the first declares every argument, the second reads the rest with
 // their values known. `read` reads the top file into the state and spec given.
 template <typename Read>
-LaunchSpec ReadTwice(const std::string& path, const std::map<std::string, std::string>& arguments, Read read) {
+LaunchSpec ReadTwice(const std::string& path, const std::map<std::string, std::string>& arguments,
+                     Read read) {
   ReadState declared;
   declared.given = arguments;
   LaunchSpec spec;

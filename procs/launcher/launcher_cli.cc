@@ -3,8 +3,8 @@
 #include <cstdlib>
 #include <exception>
 #include <filesystem>
-#include <string>
 #include <map>
+#include <string>
 #include <system_error>
 #include <utility>
 #include <vector>
@@ -79,7 +79,8 @@ int RunLauncher(int argc, const char* const* argv, std::ostream& out, std::ostre
   app.add_option("--arg", assignments,
                  "NAME=VALUE: the launch file's argument NAME (repeatable; --show-args lists them)");
   bool show_args = false, json = false;
-  app.add_flag("--show-args", show_args, "Print the launch's arguments with their values and help, then exit");
+  app.add_flag("--show-args", show_args,
+               "Print the launch's arguments with their values and help, then exit");
   app.add_flag("--json", json, "With --show-args: as JSON {name: {value, default, given, help}}");
   std::string host = ThisHostName();
   app.add_option("--host", host,

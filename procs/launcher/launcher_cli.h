@@ -19,8 +19,8 @@
 /// A bad --arg (no '=', a name the launch does not declare, given twice) is refused with code 2
 /// before anything starts.
 ///
-/// Exit codes: 0 after --help, --dry-run or --show-args, else the launcher's (launcher.h: 0, 1 when a required
-/// process failed or was not ready, or an `exit_stops_all` process's code); CLI11's code (non-zero)
+/// Exit codes: 0 after --help, --dry-run or --show-args, else the launcher's (launcher.h: 0, 1 when a
+/// required process failed or was not ready, or an `exit_stops_all` process's code); CLI11's code (non-zero)
 /// for an unknown flag, a bad flag value or a missing LAUNCH_FILE (the message names it; a
 /// LAUNCH_FILE given with --deputy is such an error too); 2 for a
 /// launch file that does not parse (the message names the file and the problem); 1 when the

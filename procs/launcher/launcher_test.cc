@@ -202,12 +202,14 @@ TEST(LaunchFile, ArgumentsAreDeclaredGivenDefaultedAndConditional) {
         "  seed: {default: '', help: the person}\n"
         "  rate: {default: '1'}\n"
         "groups:\n  - name: robot\n    processes:\n"
-        "      - {name: sim, command: s, args: [--rate, '$(arg rate)', {if: seed, args: [--seed, '$(arg seed)']}]}\n");
+        "      - {name: sim, command: s, args: [--rate, '$(arg rate)', {if: seed, args: [--seed, '$(arg "
+        "seed)']}]}\n");
   write("top.yaml",
         "include: [base.yaml]\n"
         "arguments:\n  trials: {default: '10'}\n"
         "groups:\n  - name: run\n    processes:\n"
-        "      - {name: c, command: c, args: ['${LOGS}/$(arg trials)', {if: seed, args: [--s, x$(arg seed)y]}]}\n");
+        "      - {name: c, command: c, args: ['${LOGS}/$(arg trials)', {if: seed, args: [--s, x$(arg "
+        "seed)y]}]}\n");
   const std::string top = (dir / "top.yaml").string();
   LaunchSpec spec = LoadLaunchFile(top, kEnv);
   EXPECT_EQ(spec.groups[0].processes[0].args, (std::vector<std::string>{"--rate", "1"}));
@@ -233,24 +235,30 @@ TEST(LaunchFile, ArgumentsAreDeclaredGivenDefaultedAndConditional) {
     }
     return "(accepted)";
   };
-  EXPECT_EQ(error({{"sed", "1"}}), top + ": --arg sed: the launch declares no argument 'sed' (it has: seed, rate, trials)");
+  EXPECT_EQ(error({{"sed", "1"}}),
+            top + ": --arg sed: the launch declares no argument 'sed' (it has: seed, rate, trials)");
   write("undeclared.yaml",
         "groups:\n  - name: g\n    processes:\n      - {name: a, command: a, args: ['$(arg nope)']}\n");
   const std::string undeclared = ErrorOfFile((dir / "undeclared.yaml").string());
-  EXPECT_NE(undeclared.find("undeclared.yaml:4: groups[0].processes[0].args[0]: argument 'nope' is not declared"),
-            std::string::npos)
+  EXPECT_NE(
+      undeclared.find("undeclared.yaml:4: groups[0].processes[0].args[0]: argument 'nope' is not declared"),
+      std::string::npos)
       << undeclared;
   write("twice.yaml", "include: [base.yaml]\narguments:\n  seed: {default: '2'}\n");
-  EXPECT_NE(ErrorOfFile((dir / "twice.yaml").string()).find("twice.yaml:3: arguments.seed: expected an argument declared once"),
+  EXPECT_NE(ErrorOfFile((dir / "twice.yaml").string())
+                .find("twice.yaml:3: arguments.seed: expected an argument declared once"),
             std::string::npos)
       << ErrorOfFile((dir / "twice.yaml").string());
   write("bad_if.yaml",
         "groups:\n  - name: g\n    processes:\n      - {name: a, command: a, args: [{if: x, args: [-v]}]}\n");
-  EXPECT_NE(ErrorOfFile((dir / "bad_if.yaml").string()).find("args[0].if: expected a declared argument, got 'x'"),
-            std::string::npos);
-  write("bad_key.yaml", "arguments:\n  a: {default: '', typo: 1}\ngroups:\n  - name: g\n    processes:\n"
-                        "      - {name: a, command: a}\n");
-  EXPECT_NE(ErrorOfFile((dir / "bad_key.yaml").string()).find("bad_key.yaml:2: arguments.a"), std::string::npos)
+  EXPECT_NE(
+      ErrorOfFile((dir / "bad_if.yaml").string()).find("args[0].if: expected a declared argument, got 'x'"),
+      std::string::npos);
+  write("bad_key.yaml",
+        "arguments:\n  a: {default: '', typo: 1}\ngroups:\n  - name: g\n    processes:\n"
+        "      - {name: a, command: a}\n");
+  EXPECT_NE(ErrorOfFile((dir / "bad_key.yaml").string()).find("bad_key.yaml:2: arguments.a"),
+            std::string::npos)
       << ErrorOfFile((dir / "bad_key.yaml").string());
 }
 
@@ -357,7 +365,8 @@ TEST(LauncherCli, ShowArgsListsTheArgumentsAndRefusesAnUndeclaredOne) {
       "_args.yaml",
       "arguments:\n  seed: {default: '1', help: the person}\n"
       "groups:\n  - name: g\n    processes:\n      - {name: a, command: x, args: ['$(arg seed)']}\n");
-  test::CommandRun r = test::RunCommand(RunLauncher, "orbed-launch", {file, "--show-args", "--json", "--arg", "seed=4"});
+  test::CommandRun r =
+      test::RunCommand(RunLauncher, "orbed-launch", {file, "--show-args", "--json", "--arg", "seed=4"});
   EXPECT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(r.out,
             "{\n  \"seed\": {\n    \"value\": \"4\",\n    \"default\": \"1\",\n    \"given\": true,\n"
@@ -366,8 +375,11 @@ TEST(LauncherCli, ShowArgsListsTheArgumentsAndRefusesAnUndeclaredOne) {
   EXPECT_EQ(r.out, "group g:\n  a: x 9  [required]\n");
   r = test::RunCommand(RunLauncher, "orbed-launch", {file, "--dry-run", "--arg", "sead=9"});
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find("--arg sead: the launch declares no argument 'sead' (it has: seed)"), std::string::npos) << r.err;
-  r = test::RunCommand(RunLauncher, "orbed-launch", {file, "--dry-run", "--arg", "seed=1", "--arg", "seed=2"});
+  EXPECT_NE(r.err.find("--arg sead: the launch declares no argument 'sead' (it has: seed)"),
+            std::string::npos)
+      << r.err;
+  r = test::RunCommand(RunLauncher, "orbed-launch",
+                       {file, "--dry-run", "--arg", "seed=1", "--arg", "seed=2"});
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("--arg seed given twice"), std::string::npos) << r.err;
   std::filesystem::remove(file);

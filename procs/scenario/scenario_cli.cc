@@ -47,21 +47,16 @@ int RunScenario(int argc, const char* const* argv, std::ostream& out, std::ostre
   app.add_option("--scenario", scenario_path,
                  "Scenario YAML (default: viraal/viraal.yaml under $ORBED_SOURCE_DIR, else under "
                  "the source tree it was built from)");
-  app.add_option("--trials", trials,
-                 "Trials per mode (overrides the file's trials; default $ORBED_TRIALS if set)")
-      ->check(CLI::Range(1, 1000))
-      ->envname("ORBED_TRIALS");
+  app.add_option("--trials", trials, "Trials per mode (overrides the file's trials)")
+      ->check(CLI::Range(1, 1000));
   app.add_option("--modes", modes, "Comma-separated run order of ar_reflective, ar (overrides the file)");
   app.add_option("--q-deg", q_deg,
                  "A trial configuration q1,...,q7 [deg]; repeat for each (replaces the file's list)");
   app.add_option("--run-id", run.run_id,
-                 "Run id; sessions are <run-id>-<mode> (default: $ORBED_RUN_ID if set and not empty, "
-                 "else viraal-<UTC time>)")
-      ->envname("ORBED_RUN_ID");
+                 "Run id; sessions are <run-id>-<mode> (default, or empty: viraal-<UTC time>)");
   app.add_option("--resume", options.resume_path,
                  "Continue the run whose results.json (or run folder) this is: its finished trials and means "
-                 "are kept, the rest is run (default: $ORBED_RESUME if set and not empty)")
-      ->envname("ORBED_RESUME");
+                 "are kept, the rest is run (empty: none)");
   app.add_option("--results-dir", options.results_dir,
                  "Folder of results.json (default: $ORBED_LOG_DIR, else the working directory)");
   app.add_option("--urdf", options.urdf_path,

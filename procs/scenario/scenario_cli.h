@@ -7,8 +7,7 @@
 /// Flags: the common ones (flags.h: --lcm-url, --name, --seed, --duration-s, --log-level), and
 ///   --scenario FILE            scenario YAML (default viraal/viraal.yaml of the source tree)
 ///   --trials N, --modes a,b, --q-deg q1,...,q7 (repeatable)   overrides of the file
-///   --run-id ID                sessions are <ID>-<mode>; default $ORBED_RUN_ID when it is set and not
-///                              empty, else viraal-<UTC time>
+///   --run-id ID                sessions are <ID>-<mode>; default (or empty) viraal-<UTC time>
 ///   --results-dir DIR          folder of results.json (default $ORBED_LOG_DIR, else the working dir)
 ///   --urdf FILE                robot model for the landmark FK (default sim/models/iiwa7.urdf)
 ///   --tolerance-deg, --startup-timeout-s, --reply-timeout-s, --move-timeout-s,

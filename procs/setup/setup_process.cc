@@ -177,23 +177,15 @@ int RunSetup(int argc, const char* const* argv, std::ostream& out, std::ostream&
   std::string plan_path, scenario_path, urdf_path, results_dir, modes, start_deg = "0,20,0,-60,0,40,0";
   uint64_t user_seed = 1;
   int targets = 3, trials = 3;
-  app.add_option("--user", options.user,
-                 "The user's name in task ids and results (u1, u2, ...; default $ORBED_USER if set)")
-      ->envname("ORBED_USER")
+  app.add_option("--user", options.user, "The user's name in task ids and results (u1, u2, ...)")
       ->capture_default_str();
-  app.add_option("--user-seed", user_seed,
-                 "The user's seed: the order of the modes (unless --modes; default $ORBED_USER_SEED if set)")
-      ->envname("ORBED_USER_SEED")
+  app.add_option("--user-seed", user_seed, "The user's seed: the order of the modes (unless --modes)")
       ->capture_default_str();
-  app.add_option(
-         "--modes", modes,
-         "The order of the modes, e.g. fixed,ar,ar_reflective (default $ORBED_SETUP_MODES if set, else from "
-         "--user-seed)")
-      ->envname("ORBED_SETUP_MODES");
+  app.add_option("--modes", modes,
+                 "The order of the modes, e.g. fixed,ar,ar_reflective (default: drawn from "
+                 "--user-seed)");
   app.add_option("--plan", plan_path, "Targets from `orbed-robot plan` (default: procs/setup/targets.json)");
-  app.add_option("--targets", targets,
-                 "How many of the plan's targets per mode (default $ORBED_SETUP_TARGETS if set)")
-      ->envname("ORBED_SETUP_TARGETS")
+  app.add_option("--targets", targets, "How many of the plan's targets per mode")
       ->check(CLI::Range(1, 20))
       ->capture_default_str();
   app.add_option("--start-deg", start_deg, "Where the arm is parked before each set-up [deg]")
@@ -205,14 +197,10 @@ int RunSetup(int argc, const char* const* argv, std::ostream& out, std::ostream&
   std::string registration = "measured";
   app.add_option("--registration", registration,
                  "Headset modes: 'measured' (N alignments, their mean; the paper) or 'truth' (the true base "
-                 "pose published as the registration: the registration's share of the error; default "
-                 "$ORBED_SETUP_REGISTRATION if set)")
-      ->envname("ORBED_SETUP_REGISTRATION")
+                 "pose published as the registration: the registration's share of the error)")
       ->check(CLI::IsMember({"measured", "truth"}))
       ->capture_default_str();
-  app.add_option("--run-id", options.run_id,
-                 "Run id (sessions are <run-id>-<task id>-<mode>; default $ORBED_RUN_ID if set)")
-      ->envname("ORBED_RUN_ID")
+  app.add_option("--run-id", options.run_id, "Run id (sessions are <run-id>-<task id>-<mode>)")
       ->capture_default_str();
   app.add_option("--results-dir", results_dir,
                  "Folder of setup_results.json (default: $ORBED_LOG_DIR, else .)");
@@ -226,8 +214,7 @@ int RunSetup(int argc, const char* const* argv, std::ostream& out, std::ostream&
   std::string resume;
   app.add_option("--resume", resume,
                  "Continue a run that stopped before its end: its setup_results.json (or the folder). Its "
-                 "finished set-ups are kept, the rest are run (default $ORBED_SETUP_RESUME if set)")
-      ->envname("ORBED_SETUP_RESUME");
+                 "finished set-ups are kept, the rest are run");
   if (const auto code = ParseCommandLine(&app, common, argc, argv, out, err)) return *code;
   try {
     if (modes.empty()) {

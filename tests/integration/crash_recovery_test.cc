@@ -19,7 +19,7 @@
 // the parts together must hold every protocol message of the run exactly once, in order.
 //
 // Then the conductor: SIGKILLed after the first trial of session 1, the launch ends with exit
-// code 1 and a results.json marked "partial"; a second launch with ORBED_RESUME set to the first
+// code 1 and a results.json marked "partial"; a second launch with --arg resume= the first
 // run's folder completes it, and its results.json equals the pinned run's.
 #include <signal.h>
 
@@ -278,9 +278,9 @@ TEST(CrashRecovery, KilledProcessesComeBackAndTheRunEndsWithTheUninterruptedResu
     if (requests == 5 && !hmd_killed) hmd_killed = kill(LatestPid(bus, "hmd"), SIGKILL) == 0;
   };
 
-  RunningProcess launcher(
-      {BinPath("orbed-launch"), SourcePath("scripts/launch/viraal.yaml"), "--duration-s", "240"},
-      {{"ORBED_LOG_DIR", dir}, {"ORBED_RUN_ID", "pinned"}});
+  RunningProcess launcher({BinPath("orbed-launch"), SourcePath("scripts/launch/viraal.yaml"), "--duration-s",
+                           "240", "--arg", "run_id=pinned"},
+                          {{"ORBED_LOG_DIR", dir}});
 
   // 1. The registration server, after trial 0 of session 0 is registered (MISALIGNMENT 1).
   ASSERT_TRUE(WaitFor([&] { return hold.held() && bus.Count("MISALIGNMENT") >= 1; }, 120)) << "no trial 0";
@@ -398,9 +398,9 @@ TEST(CrashRecovery, AKilledConductorLeavesPartialResultsAndResumeCompletesTheRun
       if (trial.session_id == "pinned-ar" && trial.trial_index == 0)
         killed = kill(LatestPid(bus, "scenario"), SIGKILL) == 0;
     };
-    RunningProcess launcher(
-        {BinPath("orbed-launch"), SourcePath("scripts/launch/viraal.yaml"), "--duration-s", "240"},
-        {{"ORBED_LOG_DIR", first}, {"ORBED_RUN_ID", "pinned"}});
+    RunningProcess launcher({BinPath("orbed-launch"), SourcePath("scripts/launch/viraal.yaml"),
+                             "--duration-s", "240", "--arg", "run_id=pinned"},
+                            {{"ORBED_LOG_DIR", first}});
     ASSERT_TRUE(launcher.Wait(180)) << "the launch did not end";
     ASSERT_TRUE(killed.load());
     EXPECT_EQ(launcher.exit_code(), 1);
@@ -414,9 +414,9 @@ TEST(CrashRecovery, AKilledConductorLeavesPartialResultsAndResumeCompletesTheRun
   EXPECT_LE(partial["sessions"][1]["trials"].size(), 1u);
 
   const std::string second = MakeTempDir("conductor_resumed");
-  RunningProcess launcher(
-      {BinPath("orbed-launch"), SourcePath("scripts/launch/viraal.yaml"), "--duration-s", "240"},
-      {{"ORBED_LOG_DIR", second}, {"ORBED_RESUME", first}});
+  RunningProcess launcher({BinPath("orbed-launch"), SourcePath("scripts/launch/viraal.yaml"), "--duration-s",
+                           "240", "--arg", "resume=" + first},
+                          {{"ORBED_LOG_DIR", second}});
   ASSERT_TRUE(launcher.Wait(180)) << "the resumed run did not finish";
   ASSERT_EQ(launcher.exit_code(), 0);
   const YAML::Node results = YAML::LoadFile(second + "/results.json");

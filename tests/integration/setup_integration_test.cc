@@ -9,10 +9,10 @@
 //  4. A set-up whose assistant and guidance are SIGKILLed while the assistant moves the arm: the
 //     launcher brings both back, the conductor's re-sent SETUP_TASK reaches them, the set-up is done
 //     from where the arm was, and the run ends with exit 0 and a consistent record.
-//  5. The registration's share over the bus: setup.yaml with ORBED_SETUP_REGISTRATION=truth, one AR
+//  5. The registration's share over the bus: setup.yaml with --arg setup_registration=truth, one AR
 //     set-up: no alignment, REGISTRATION carries exactly ROBOT_STATE's true base pose, the assistant
 //     finishes with it, and the record has the clearance the sim's COLLISION_STATUS gave.
-//  6. A resumed run (ORBED_SETUP_RESUME): a finished run's file cut back to its first set-up and
+//  6. A resumed run (--arg setup_resume=...): a finished run's file cut back to its first set-up and
 //     marked partial; the launch keeps that set-up as it was, sends SETUP_TASK for the second only,
 //     and ends with both, the first exactly as the file had it.
 //  7. The sim clock (issue 11 item 6): setup.yaml for one user, two fixed-monitor set-ups, on the
@@ -165,13 +165,10 @@ TEST(Assistant, TheOtherElbowSendsJointOneHalfATurnAway) {
 TEST(SetupStudy, OneUserThroughTheLaunchFile) {
   const std::string log_dir = MakeTempDir("setup_e2e");
   constexpr uint64_t kSeed = 4;
-  RunningProcess launcher(
-      {BinPath("orbed-launch"), SourcePath("scripts/launch/setup.yaml"), "--duration-s", "400"},
-      {{"ORBED_LOG_DIR", log_dir},
-       {"ORBED_RUN_ID", "setup-e2e"},
-       {"ORBED_USER", "u7"},
-       {"ORBED_USER_SEED", std::to_string(kSeed)},
-       {"ORBED_SETUP_TARGETS", "1"}});
+  RunningProcess launcher({BinPath("orbed-launch"), SourcePath("scripts/launch/setup.yaml"), "--duration-s",
+                           "400", "--arg", "run_id=setup-e2e", "--arg", "user=u7", "--arg",
+                           "user_seed=" + std::to_string(kSeed), "--arg", "setup_targets=1"},
+                          {{"ORBED_LOG_DIR", log_dir}});
   ASSERT_TRUE(launcher.Wait(400)) << "the run did not finish";
   ASSERT_EQ(launcher.exit_code(), 0);
   const YAML::Node results = YAML::LoadFile(log_dir + "/setup_results.json");
@@ -242,14 +239,10 @@ TEST(SetupStudy, AKilledAssistantAndGuidanceComeBackAndTheSetUpFinishes) {
   BusWatcher bus;
   CommandCounter tasks(&bus);
   bus.Start();
-  RunningProcess launcher(
-      {BinPath("orbed-launch"), SourcePath("scripts/launch/setup.yaml"), "--duration-s", "400"},
-      {{"ORBED_LOG_DIR", log_dir},
-       {"ORBED_RUN_ID", "setup-crash"},
-       {"ORBED_USER", "u2"},
-       {"ORBED_USER_SEED", "2"},
-       {"ORBED_SETUP_MODES", "fixed"},
-       {"ORBED_SETUP_TARGETS", "1"}});
+  RunningProcess launcher({BinPath("orbed-launch"), SourcePath("scripts/launch/setup.yaml"), "--duration-s",
+                           "400", "--arg", "run_id=setup-crash", "--arg", "user=u2", "--arg", "user_seed=2",
+                           "--arg", "setup_modes=fixed", "--arg", "setup_targets=1"},
+                          {{"ORBED_LOG_DIR", log_dir}});
   // The task is out and the assistant has started moving (its IIWA_COMMANDs on its heartbeat).
   ASSERT_TRUE(WaitFor(
       [&] {
@@ -323,14 +316,10 @@ TEST(SetupStudy, TheTrueRegistrationGoesOverTheBusInsteadOfAlignments) {
   PoseWatcher poses(&bus);
   bus.Start();
   RunningProcess launcher(
-      {BinPath("orbed-launch"), SourcePath("scripts/launch/setup.yaml"), "--duration-s", "400"},
-      {{"ORBED_LOG_DIR", log_dir},
-       {"ORBED_RUN_ID", "setup-truth"},
-       {"ORBED_USER", "u3"},
-       {"ORBED_USER_SEED", "3"},
-       {"ORBED_SETUP_MODES", "ar"},
-       {"ORBED_SETUP_REGISTRATION", "truth"},
-       {"ORBED_SETUP_TARGETS", "1"}});
+      {BinPath("orbed-launch"), SourcePath("scripts/launch/setup.yaml"), "--duration-s", "400", "--arg",
+       "run_id=setup-truth", "--arg", "user=u3", "--arg", "user_seed=3", "--arg", "setup_modes=ar", "--arg",
+       "setup_registration=truth", "--arg", "setup_targets=1"},
+      {{"ORBED_LOG_DIR", log_dir}});
   ASSERT_TRUE(launcher.Wait(400)) << "the run did not finish";
   ASSERT_EQ(launcher.exit_code(), 0);
   const YAML::Node results = YAML::LoadFile(log_dir + "/setup_results.json");
@@ -367,17 +356,23 @@ std::vector<std::string> LoggedTaskIds(const std::string& log_dir) {
 }
 
 TEST(SetupStudy, AResumedRunKeepsTheFinishedSetUpAndRunsTheRest) {
-  const std::map<std::string, std::string> env = {{"ORBED_RUN_ID", "setup-resume"},
-                                                  {"ORBED_USER", "u3"},
-                                                  {"ORBED_USER_SEED", "5"},
-                                                  {"ORBED_SETUP_MODES", "fixed"},
-                                                  {"ORBED_SETUP_TARGETS", "2"}};
-  auto launch = [&env](const std::string& log_dir, const std::string& resume) {
-    std::map<std::string, std::string> vars = env;
-    vars["ORBED_LOG_DIR"] = log_dir;
-    if (!resume.empty()) vars["ORBED_SETUP_RESUME"] = resume;
-    RunningProcess launcher(
-        {BinPath("orbed-launch"), SourcePath("scripts/launch/setup.yaml"), "--duration-s", "400"}, vars);
+  auto launch = [](const std::string& log_dir, const std::string& resume) {
+    std::vector<std::string> argv = {BinPath("orbed-launch"),
+                                     SourcePath("scripts/launch/setup.yaml"),
+                                     "--duration-s",
+                                     "400",
+                                     "--arg",
+                                     "run_id=setup-resume",
+                                     "--arg",
+                                     "user=u3",
+                                     "--arg",
+                                     "user_seed=5",
+                                     "--arg",
+                                     "setup_modes=fixed",
+                                     "--arg",
+                                     "setup_targets=2"};
+    if (!resume.empty()) argv.insert(argv.end(), {"--arg", "setup_resume=" + resume});
+    RunningProcess launcher(argv, {{"ORBED_LOG_DIR", log_dir}});
     EXPECT_TRUE(launcher.Wait(400)) << "the run did not finish";
     return launcher.exit_code();
   };
@@ -416,17 +411,27 @@ TEST(SetupStudy, AResumedRunKeepsTheFinishedSetUpAndRunsTheRest) {
 
 TEST(SetupStudy, EightTimesFasterEveryProcessFollowsTheSimClock) {
   const std::string log_dir = MakeTempDir("setup_sim_clock");
-  RunningProcess launcher(
-      {BinPath("orbed-launch"), SourcePath("scripts/launch/setup.yaml"), "--duration-s", "300"},
-      {{"ORBED_LOG_DIR", log_dir},
-       {"ORBED_RUN_ID", "setup-sim-clock"},
-       {"ORBED_USER", "u1"},
-       {"ORBED_USER_SEED", "1"},
-       {"ORBED_SETUP_MODES", "fixed"},
-       {"ORBED_SETUP_TARGETS", "2"},
-       {"ORBED_SIM_TIME", "1"},
-       {"ORBED_SIM_HOLD_FOR", "setup"},
-       {"ORBED_SIM_RATE", "8"}});
+  RunningProcess launcher({BinPath("orbed-launch"),
+                           SourcePath("scripts/launch/setup.yaml"),
+                           "--duration-s",
+                           "300",
+                           "--arg",
+                           "run_id=setup-sim-clock",
+                           "--arg",
+                           "user=u1",
+                           "--arg",
+                           "user_seed=1",
+                           "--arg",
+                           "setup_modes=fixed",
+                           "--arg",
+                           "setup_targets=2",
+                           "--arg",
+                           "sim_time=1",
+                           "--arg",
+                           "hold_for=setup",
+                           "--arg",
+                           "sim_rate=8"},
+                          {{"ORBED_LOG_DIR", log_dir}});
   ASSERT_TRUE(launcher.Wait(300)) << "the run did not finish";
   ASSERT_EQ(launcher.exit_code(), 0);
   const YAML::Node setups = YAML::LoadFile(log_dir + "/setup_results.json")["setups"];
@@ -466,19 +471,31 @@ TEST(SetupStudy, EightTimesFasterEveryProcessFollowsTheSimClock) {
 // One lockstep launch of setup.yaml at realtime rate `rate`; returns its run folder.
 std::string RunInLockstep(int rate) {
   const std::string log_dir = MakeTempDir("setup_lockstep_r" + std::to_string(rate));
-  RunningProcess launcher(
-      {BinPath("orbed-launch"), SourcePath("scripts/launch/setup.yaml"), "--duration-s", "400"},
-      {{"ORBED_LOG_DIR", log_dir},
-       {"ORBED_RUN_ID", "setup-lockstep"},
-       {"ORBED_USER", "u1"},
-       {"ORBED_USER_SEED", "1"},
-       {"ORBED_SETUP_MODES", "fixed,ar"},
-       {"ORBED_SETUP_TARGETS", "1"},
-       {"ORBED_SIM_TIME", "1"},
-       {"ORBED_SIM_LOCKSTEP", "1"},
-       {"ORBED_SIM_STEPS_PER_TICK", "8"},
-       {"ORBED_SIM_HOLD_FOR", "setup"},
-       {"ORBED_SIM_RATE", std::to_string(rate)}});
+  RunningProcess launcher({BinPath("orbed-launch"),
+                           SourcePath("scripts/launch/setup.yaml"),
+                           "--duration-s",
+                           "400",
+                           "--arg",
+                           "run_id=setup-lockstep",
+                           "--arg",
+                           "user=u1",
+                           "--arg",
+                           "user_seed=1",
+                           "--arg",
+                           "setup_modes=fixed,ar",
+                           "--arg",
+                           "setup_targets=1",
+                           "--arg",
+                           "sim_time=1",
+                           "--arg",
+                           "lockstep=1",
+                           "--arg",
+                           "steps_per_tick=8",
+                           "--arg",
+                           "hold_for=setup",
+                           "--arg",
+                           "sim_rate=" + std::to_string(rate)},
+                          {{"ORBED_LOG_DIR", log_dir}});
   EXPECT_TRUE(launcher.Wait(400)) << "the run at rate " << rate << " did not finish";
   EXPECT_EQ(launcher.exit_code(), 0) << "rate " << rate;
   return log_dir;

@@ -94,9 +94,9 @@ class Watcher {
 TEST(ViraalChaos, ALossyBusGivesTheCleanRunsResults) {
   Watcher watcher;
   const std::string log_dir = MakeTempDir("viraal_chaos");
-  RunningProcess launcher(
-      {BinPath("orbed-launch"), SourcePath("scripts/launch/viraal.yaml"), "--duration-s", "240"},
-      {{"ORBED_LOG_DIR", log_dir}, {"ORBED_RUN_ID", "pinned"}, {"ORBED_CHAOS", kChaos}});
+  RunningProcess launcher({BinPath("orbed-launch"), SourcePath("scripts/launch/viraal.yaml"), "--duration-s",
+                           "240", "--arg", "run_id=pinned"},
+                          {{"ORBED_LOG_DIR", log_dir}, {"ORBED_CHAOS", kChaos}});
   ASSERT_TRUE(launcher.Wait(240)) << "the run did not finish";
   EXPECT_EQ(launcher.term_signal(), 0);
   ASSERT_EQ(launcher.exit_code(), 0);

@@ -42,9 +42,9 @@ void ExpectErrors(const YAML::Node& node, const std::string& where) {
 
 TEST(ViraalRun, LaunchFileRunsTheStudyAndWritesResults) {
   const std::string log_dir = MakeTempDir("viraal_e2e");
-  RunningProcess launcher(
-      {BinPath("orbed-launch"), SourcePath("scripts/launch/viraal.yaml"), "--duration-s", "240"},
-      {{"ORBED_LOG_DIR", log_dir}, {"ORBED_RUN_ID", "pinned"}});
+  RunningProcess launcher({BinPath("orbed-launch"), SourcePath("scripts/launch/viraal.yaml"), "--duration-s",
+                           "240", "--arg", "run_id=pinned"},
+                          {{"ORBED_LOG_DIR", log_dir}});
   ASSERT_TRUE(launcher.Wait(240)) << "the run did not finish";
   EXPECT_EQ(launcher.term_signal(), 0);
   ASSERT_EQ(launcher.exit_code(), 0);
@@ -84,19 +84,16 @@ TEST(ViraalRun, LaunchFileRunsTheStudyAndWritesResults) {
   EXPECT_EQ(manifest["channels"]["ALIGNMENT_TRIAL"]["events"].as<int>(), 6);
 }
 
-// Faster than real time ($ORBED_SIM_RATE = 8: the sim steps the arm 8 times per tick; every other
-// process on its clock, $ORBED_SIM_TIME, which it holds until the conductor runs): the arm reaches
+// Faster than real time (--arg sim_rate=8: the sim steps the arm 8 times per tick; every other
+// process on its clock, --arg sim_time=1, which it holds until the conductor runs): the arm reaches
 // the same configurations, so the run equals the pinned results number for number, and its log is
 // whole.
 TEST(ViraalRun, FasterThanRealTimeTheRunIsTheSame) {
   const std::string log_dir = MakeTempDir("viraal_fast");
   RunningProcess launcher(
-      {BinPath("orbed-launch"), SourcePath("scripts/launch/viraal.yaml"), "--duration-s", "240"},
-      {{"ORBED_LOG_DIR", log_dir},
-       {"ORBED_RUN_ID", "pinned"},
-       {"ORBED_SIM_RATE", "8"},
-       {"ORBED_SIM_TIME", "1"},
-       {"ORBED_SIM_HOLD_FOR", "scenario"}});
+      {BinPath("orbed-launch"), SourcePath("scripts/launch/viraal.yaml"), "--duration-s", "240", "--arg",
+       "run_id=pinned", "--arg", "sim_rate=8", "--arg", "sim_time=1", "--arg", "hold_for=scenario"},
+      {{"ORBED_LOG_DIR", log_dir}});
   ASSERT_TRUE(launcher.Wait(240)) << "the run did not finish";
   ASSERT_EQ(launcher.exit_code(), 0);
   const YAML::Node pinned =
