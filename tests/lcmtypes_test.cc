@@ -113,8 +113,9 @@ TEST(LcmTypes, EveryTypeRoundTripsAndHasAUniqueFingerprint) {
 // another fingerprint ("<channel>/decode/fingerprint"): any change of a type is a breaking change
 // on the wire. docs/design.md §3 "Changing the contract" says how one is made: fields appended at the
 // end, the change listed there with the old and new fingerprints, and this table updated in the same
-// commit. Last change: contract change 9 (host appended to process_status_t; the four deputy_*_t
-// types of launch across hosts); before it, contract change 8 (lockstep_round appended to
+// commit. Last change: contract change 10 (run_dir appended to deputy_command_t, the last lines of
+// output to deputy_child_t and so deputy_status_t); before it, contract change 9 (host appended to
+// process_status_t; the four deputy_*_t types of launch across hosts); before it, contract change 8 (lockstep_round appended to
 // sim_clock_t, sim_clock_ack_t added); contract change 5 (the landmark annotation appended to
 // alignment_trial_t); before it, contract change 4 (types added: setup_task_t and setup_result_t for the
 // robot set-up study, the four viewer_*_t types that are Drake's lcmt_viewer_*); before it, contract change 3
@@ -125,10 +126,10 @@ TEST(LcmTypes, FingerprintsArePinned) {
   const std::map<std::string, uint64_t> pinned = {{"alignment_trial_t", 0x271026afe7973c6dULL},
                                                   {"collision_status_t", 0x9f78934234cce93fULL},
                                                   {"contact_t", 0x2d8c8a472f48e7e9ULL},
-                                                  {"deputy_child_t", 0xf936d88118a99250ULL},
-                                                  {"deputy_command_t", 0xa90c3f5e659ec5a9ULL},
+                                                  {"deputy_child_t", 0x650aa07106b4aaadULL},
+                                                  {"deputy_command_t", 0x4dd7cfc5439ab4c1ULL},
                                                   {"deputy_process_t", 0xea93be0d0e14b1f6ULL},
-                                                  {"deputy_status_t", 0xc89ea34a54f2bd1aULL},
+                                                  {"deputy_status_t", 0xa046332a3108edd5ULL},
                                                   {"gaze_ray_t", 0x65a37e31d5a2eea1ULL},
                                                   {"guidance_t", 0x00fc655bb50b4853ULL},
                                                   {"hmd_pose_t", 0xdafcd85796f0e809ULL},

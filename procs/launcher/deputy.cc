@@ -1,6 +1,7 @@
 #include "procs/launcher/deputy.h"
 
 #include <csignal>
+#include <filesystem>
 #include <thread>
 
 #include "procs/common/channels.h"
@@ -17,6 +18,14 @@ double SecondsSince(Deputy::Clock::time_point t) {
   return std::chrono::duration<double>(Deputy::Clock::now() - t).count();
 }
 
+// Keeps the last kMaxLastLines lines, each cut to kMaxLastLineBytes.
+void KeepLastLines(std::vector<std::string>* lines) {
+  if (lines->size() > kMaxLastLines) lines->erase(lines->begin(), lines->end() - kMaxLastLines);
+  for (std::string& line : *lines) {
+    if (line.size() > kMaxLastLineBytes) line.resize(kMaxLastLineBytes);
+  }
+}
+
 }  // namespace
 
 Deputy::Deputy(const CommonFlags& flags, DeputyOptions options)
@@ -31,8 +40,20 @@ Deputy::Deputy(const CommonFlags& flags, DeputyOptions options)
 Deputy::~Deputy() = default;
 
 void Deputy::Start(Managed* m, const orbed::deputy_process_t& wanted) {
+  std::vector<std::string> argv = wanted.argv;
   std::map<std::string, std::string> env;
   for (size_t i = 0; i < wanted.env_key.size(); ++i) env[wanted.env_key[i]] = wanted.env_value[i];
+  std::string error;
+  if (!run_dir_.empty()) {
+    // This host's folder of the run, wherever the launcher keeps its own.
+    const std::filesystem::path dir = std::filesystem::absolute(options_.log_root) / run_dir_;
+    std::error_code ec;
+    std::filesystem::create_directories(dir, ec);
+    if (ec) error = "cannot make its run folder " + dir.string() + ": " + ec.message();
+    for (std::string& arg : argv) arg = ExpandLogDir(arg, dir.string());
+    for (auto& [key, value] : env) value = ExpandLogDir(value, dir.string());
+    env["ORBED_LOG_DIR"] = dir.string();
+  }
   env["ORBED_LCM_URL"] = flags_.lcm_url;
   env["ORBED_HOST"] = options_.name;
   env["ORBED_LOG_PREFIXED"] = "1";
@@ -43,8 +64,9 @@ void Deputy::Start(Managed* m, const orbed::deputy_process_t& wanted) {
   m->signal_sent = 0;
   m->prefix = wanted.name + " | ";
   m->child = std::make_unique<Child>();
-  std::string error;
-  m->failed_to_start = !m->child->Start(wanted.argv, env, options_.bin_dir, &error);
+  m->last_lines = std::make_unique<std::vector<std::string>>();
+  m->child->CopyLinesTo(m->last_lines.get());
+  m->failed_to_start = !error.empty() || !m->child->Start(argv, env, options_.bin_dir, &error);
   m->detail = m->failed_to_start ? error : "running";
   if (m->failed_to_start) {
     ORBED_LOG(kError) << wanted.name << " (instance " << wanted.instance << "): " << error;
@@ -129,6 +151,7 @@ void Deputy::OnCommand(const orbed::deputy_command_t& command) {
     changed_ = true;
   }
   last_command_ = Clock::now();
+  run_dir_ = command.run_dir;
   if (command.processes.empty()) {
     // The launcher's goodbye: whatever still runs stops, and the next launcher is welcome.
     ORBED_LOG(kInfo) << launcher_ << " is done";
@@ -196,6 +219,7 @@ void Deputy::Tick() {
       m.child->Drain(m.prefix);
       if (m.child->running() && m.child->Poll()) {
         m.child->Drain(m.prefix, true);
+        KeepLastLines(m.last_lines.get());
         m.detail = m.child->DescribeExit();
         if (m.signal_sent != 0 || m.child->exit_code() == 0) {
           ORBED_LOG(kInfo) << m.name << " (instance " << m.instance << ") " << m.detail;
@@ -204,6 +228,7 @@ void Deputy::Tick() {
         }
         changed_ = true;
       }
+      KeepLastLines(m.last_lines.get());
       if (m.child->running() && m.signal_sent != 0 && m.signal_sent != SIGKILL && Clock::now() >= m.kill_at) {
         ORBED_LOG(kWarn) << m.name << " did not stop within " << m.stop_timeout_s << " s: SIGKILL";
         m.child->Signal(SIGKILL);
@@ -249,7 +274,10 @@ orbed::deputy_status_t Deputy::Status() const {
       c.state = orbed::deputy_child_t::STATE_EXITED;
       c.exit_code = m.child->exit_code();
       c.term_signal = m.child->term_signal();
+      // Why it ended, in its own words (only exited children's: the status stays small).
+      c.last_lines = *m.last_lines;
     }
+    c.num_last_lines = static_cast<int32_t>(c.last_lines.size());
     c.detail = m.detail;
     status.children.push_back(std::move(c));
   }

@@ -8,6 +8,12 @@
 ///     ORBED_LCM_URL = the deputy's, ORBED_HOST = NAME, ORBED_LOG_PREFIXED = 1; the same instance
 ///     is never started twice, and a process that exits stays exited until the launcher asks for
 ///     the next instance (respawning is the launcher's decision);
+///   - the command's run_dir names the run's folder: the deputy makes <log_root>/<run_dir> on its
+///     own host and expands ${ORBED_LOG_DIR} in argv and env values (and sets ORBED_LOG_DIR) to
+///     it, so a process keeps its state (journal, state file) on this host's disk, not on a path
+///     that exists only on the launcher's host; a folder it cannot make is a failure to start;
+///   - an exited child's report carries the last kMaxLastLines lines it printed (each cut to
+///     kMaxLastLineBytes), so that the launcher's terminal says why it failed;
 ///   - `run: false` sends the process group its stop_signal (again whenever the wanted signal
 ///     changes, e.g. to SIGKILL), and SIGKILL after stop_timeout_s;
 ///   - a process missing from the command is stopped (SIGTERM, SIGKILL after 5 s);
@@ -48,7 +54,11 @@ struct DeputyOptions {
   std::string name;
   /// Searched first for commands without '/'.
   std::string bin_dir;
-  double orphan_timeout_s = 30.0;
+  /// This host's logs folder: run folders are made in it (relative: to the working folder).
+  std::string log_root = "logs";
+  /// Longer than the launch files' request deadline (60 s): a partition the run rides out must not
+  /// make the deputy give up first.
+  double orphan_timeout_s = 90.0;
 };
 
 class Deputy {
@@ -73,6 +83,9 @@ class Deputy {
     std::string name;
     int instance = 0;
     std::unique_ptr<Child> child;
+    // Its last lines of output (at most kMaxLastLines after each Tick); on the heap, as the child
+    // appends to it and a Managed moves between lists.
+    std::unique_ptr<std::vector<std::string>> last_lines;
     bool failed_to_start = false;
     std::string detail;
     std::string prefix;
@@ -94,6 +107,7 @@ class Deputy {
   CommonFlags flags_;
   Process process_;
   std::string launcher_;                     // the launcher followed ("" before the first command)
+  std::string run_dir_;                      // its latest command's run_dir
   int64_t launcher_start_utime_ = 0;         // the last followed one's launcher_start_utime
   std::set<std::string> ignored_launchers_;  // earlier launchers already warned about
   Clock::time_point last_command_;

@@ -1,6 +1,7 @@
 #include "procs/launcher/deputy_link.h"
 
 #include <csignal>
+#include <cstdio>
 
 #include <orbed/deputy_command_t.hpp>
 
@@ -63,7 +64,15 @@ class RemoteChild : public ChildHandle {
     slot_->stop_signal = signal;
     link_->Changed(slot_->deputy);
   }
-  void Drain(const std::string&, bool) override {}  // the deputy prints it on its host
+  // The deputy prints the output on its host; at an exit other than code 0, its last lines are
+  // printed here too.
+  void Drain(const std::string& prefix, bool final) override {
+    if (!final || !Reported() || (exit_code() == 0 && term_signal() == 0)) return;
+    for (const std::string& line : slot_->last_lines) {
+      std::printf("%s[%s] %s\n", prefix.c_str(), slot_->deputy.c_str(), EscapeText(line).c_str());
+    }
+    std::fflush(stdout);
+  }
 
  private:
   bool Reported() const { return slot_->reported_instance == slot_->instance; }
@@ -74,8 +83,11 @@ class RemoteChild : public ChildHandle {
 
 }  // namespace
 
-DeputyLink::DeputyLink(Process* process, std::string launcher_id, int64_t start_utime)
-    : process_(process), launcher_id_(std::move(launcher_id)), start_utime_(start_utime) {
+DeputyLink::DeputyLink(Process* process, std::string launcher_id, int64_t start_utime, std::string run_dir)
+    : process_(process),
+      launcher_id_(std::move(launcher_id)),
+      start_utime_(start_utime),
+      run_dir_(std::move(run_dir)) {
   process_->Subscribe<orbed::deputy_status_t>(channels::kDeputyStatus,
                                               [this](const orbed::deputy_status_t& status, const std::string&,
                                                      int64_t recv_utime) { OnStatus(status, recv_utime); });
@@ -141,6 +153,7 @@ void DeputyLink::OnStatus(const orbed::deputy_status_t& status, int64_t) {
     slot.exit_code = child.exit_code;
     slot.term_signal = child.term_signal;
     slot.detail = child.detail;
+    slot.last_lines = child.last_lines;
   }
 }
 
@@ -168,6 +181,7 @@ void DeputyLink::Send(const std::string& deputy) {
     command.processes.push_back(std::move(p));
   }
   command.num_processes = static_cast<int32_t>(command.processes.size());
+  command.run_dir = run_dir_;
   process_->PublishControl(channels::kDeputyCommand, command);
   last_sent_[deputy] = Clock::now();
   due_[deputy] = false;

@@ -8,7 +8,9 @@
 /// A remote child is running from Start() until its deputy reports that instance exited (or could
 /// not start); until the deputy is heard it is "starting" (pid 0). A deputy not heard for
 /// kDeputySilentAfterS is reported silent once in the log, and back once it is heard again; its
-/// children keep their last known state meanwhile (a partition is not an exit).
+/// children keep their last known state meanwhile (a partition is not an exit). Every command names
+/// the run's folder (run_dir), which each deputy makes under its own logs folder; a remote child's
+/// exit is printed here with the last lines it printed on its host (Drain at its exit).
 ///
 /// Threading: the launcher's Run thread only (Tick from its timer, statuses from its handlers).
 
@@ -31,8 +33,9 @@ class DeputyLink {
  public:
   using Clock = std::chrono::steady_clock;
   /// `launcher_id` names this launcher in every command ("<launch>@<host>/<pid>"),
-  /// `start_utime` is when it started [us since the epoch].
-  DeputyLink(Process* process, std::string launcher_id, int64_t start_utime);
+  /// `start_utime` is when it started [us since the epoch], `run_dir` the run folder's name (one
+  /// path component, or "" for none).
+  DeputyLink(Process* process, std::string launcher_id, int64_t start_utime, std::string run_dir);
 
   /// A handle on process `name` run by `deputy`, which stops it with `stop_signal` (when it stops
   /// it on its own: orphaned, replaced) and escalates a stop to SIGKILL after `stop_timeout_s`; the
@@ -70,7 +73,10 @@ class DeputyLink {
     int exit_code = 0;
     int term_signal = 0;
     std::string detail;
+    std::vector<std::string> last_lines;
   };
+  /// The run folder's name sent to the deputies ("" = none).
+  const std::string& run_dir() const { return run_dir_; }
   /// Marks `deputy`'s command as due at the next Tick.
   void Changed(const std::string& deputy) { due_[deputy] = true; }
 
@@ -81,6 +87,7 @@ class DeputyLink {
   Process* process_;
   std::string launcher_id_;
   int64_t start_utime_;
+  std::string run_dir_;
   std::map<std::string, bool> followed_;  // by deputy: it reported following this launcher
   std::string lost_;
   std::map<std::string, std::unique_ptr<Slot>> slots_;  // by process name

@@ -60,6 +60,10 @@ std::string CheckDeputyCommand(const orbed::deputy_command_t& msg) {
              std::to_string(static_cast<int>(kMaxStopTimeoutS)) + "]";
     }
   }
+  if (!msg.run_dir.empty() && !RunDirOk(msg.run_dir)) {
+    return "run_dir: expected one path component of 1.." + std::to_string(kMaxDeputyName) +
+           " bytes (no '/', not '.' or '..')";
+  }
   return "";
 }
 
@@ -79,8 +83,32 @@ std::string CheckDeputyStatus(const orbed::deputy_status_t& msg) {
         c.state > orbed::deputy_child_t::STATE_FAILED_TO_START) {
       return "children[" + c.name + "].state: expected 0..3";
     }
+    if (c.num_last_lines < 0 || static_cast<size_t>(c.num_last_lines) > kMaxLastLines ||
+        static_cast<size_t>(c.num_last_lines) != c.last_lines.size()) {
+      return "children[" + c.name + "].num_last_lines: expected 0.." + std::to_string(kMaxLastLines) +
+             " and the array's length";
+    }
+    for (const std::string& line : c.last_lines) {
+      if (line.size() > kMaxLastLineBytes) {
+        return "children[" + c.name + "].last_lines: a line over " + std::to_string(kMaxLastLineBytes) +
+               " bytes";
+      }
+    }
   }
   return "";
+}
+
+std::string ExpandLogDir(const std::string& text, const std::string& dir) {
+  const std::string variable = kLogDirVariable;
+  std::string out = text;
+  for (size_t at = out.find(variable); at != std::string::npos; at = out.find(variable, at + dir.size())) {
+    out.replace(at, variable.size(), dir);
+  }
+  return out;
+}
+
+bool RunDirOk(const std::string& run_dir) {
+  return NameOk(run_dir) && run_dir.find('/') == std::string::npos && run_dir != "." && run_dir != "..";
 }
 
 std::string DescribeExit(int exit_code, int term_signal) {

@@ -2,7 +2,11 @@
 // handed in directly (LCM in memory), and the protocol's message checks (deputy_protocol.h).
 #include "procs/launcher/deputy.h"
 
+#include <unistd.h>
+
 #include <csignal>
+#include <filesystem>
+#include <fstream>
 #include <functional>
 #include <thread>
 
@@ -97,6 +101,45 @@ TEST_F(DeputyTest, StartsEachInstanceOnceAndReportsItsExit) {
   ASSERT_TRUE(TickUntil([&] { return Child("tool").instance == 2 && Child("tool").state == kExited; }));
   EXPECT_NE(Child("tool").pid, first_pid);
   EXPECT_EQ(Child("tool").exit_code, 3);
+}
+
+// The run's folder is made on the deputy's own disk (under its log root, by the name the command
+// gives) and ${ORBED_LOG_DIR} in argv and env values is that folder; an exited child's report
+// carries its last lines, at most kMaxLastLines, each cut to kMaxLastLineBytes.
+TEST_F(DeputyTest, MakesTheRunFolderOnItsOwnDiskAndReportsTheLastLines) {
+  const std::string root = ::testing::TempDir() + "deputy_log_root_" + std::to_string(getpid());
+  DeputyOptions options;
+  options.name = "hostB";
+  options.log_root = root;
+  deputy_ = std::make_unique<Deputy>(flags_, options);
+  // Writes its state where ${ORBED_LOG_DIR} says, prints 8 lines (the last one long) and fails.
+  orbed::deputy_process_t wanted = Wanted(
+      "tool", 1, true,
+      "echo kept > \"$1/tool.state\" && test \"$ORBED_LOG_DIR\" = \"$1\" && test \"$WHERE\" = \"$1/x\" && "
+      "for i in 1 2 3 4 5 6 7; do echo line $i; done && printf '%0600d\\n' 0 && exit 4; exit 9");
+  wanted.argv.push_back("sh");
+  wanted.argv.push_back("${ORBED_LOG_DIR}");
+  wanted.argc = static_cast<int32_t>(wanted.argv.size());
+  wanted.env_key = {"WHERE"};
+  wanted.env_value = {"${ORBED_LOG_DIR}/x"};
+  wanted.num_env = 1;
+  orbed::deputy_command_t command = Command("bed@hostA/1", "hostB", {wanted});
+  command.run_dir = "run1";
+  deputy_->OnCommand(command);
+  ASSERT_TRUE(TickUntil([&] { return Child("tool").state == kExited; }));
+  EXPECT_EQ(Child("tool").exit_code, 4);
+  std::ifstream state(root + "/run1/tool.state");
+  std::string kept;
+  EXPECT_TRUE(std::getline(state, kept));
+  EXPECT_EQ(kept, "kept");
+  const orbed::deputy_child_t child = Child("tool");
+  ASSERT_EQ(child.num_last_lines, static_cast<int32_t>(kMaxLastLines));
+  ASSERT_EQ(child.last_lines.size(), kMaxLastLines);
+  EXPECT_EQ(child.last_lines[0], "line 4");
+  EXPECT_EQ(child.last_lines[3], "line 7");
+  EXPECT_EQ(child.last_lines[4], std::string(kMaxLastLineBytes, '0'));
+  EXPECT_EQ(CheckDeputyStatus(deputy_->Status()), "");
+  std::filesystem::remove_all(root);
 }
 
 TEST_F(DeputyTest, StopsOnRunFalseOnAnotherLauncherAndWhenItsLauncherFallsSilent) {
@@ -199,6 +242,10 @@ TEST(DeputyProtocol, ChecksEveryField) {
   EXPECT_NE(broken([](auto* c) { c->processes[0].stop_signal = 11; }), "");  // SIGSEGV is no stop signal
   EXPECT_NE(broken([](auto* c) { c->processes[0].stop_timeout_s = std::nan(""); }), "");
   EXPECT_NE(broken([](auto* c) { c->processes[0].stop_timeout_s = -1; }), "");
+  EXPECT_EQ(broken([](auto* c) { c->run_dir = "20261204T182632Z-a1b2c3"; }), "");
+  EXPECT_NE(broken([](auto* c) { c->run_dir = "../up"; }), "");
+  EXPECT_NE(broken([](auto* c) { c->run_dir = ".."; }), "");
+  EXPECT_NE(broken([](auto* c) { c->run_dir = std::string(kMaxDeputyName + 1, 'r'); }), "");
 
   orbed::deputy_status_t status{};
   status.deputy = "hostB";
@@ -214,6 +261,17 @@ TEST(DeputyProtocol, ChecksEveryField) {
   status.children[0].instance = 0;
   EXPECT_NE(CheckDeputyStatus(status), "");
   status.children[0].instance = 1;
+  status.children[0].last_lines = {"error: something"};
+  EXPECT_NE(CheckDeputyStatus(status), "");  // num_last_lines says 0
+  status.children[0].num_last_lines = 1;
+  EXPECT_EQ(CheckDeputyStatus(status), "");
+  status.children[0].last_lines = {std::string(kMaxLastLineBytes + 1, 'e')};
+  EXPECT_NE(CheckDeputyStatus(status), "");
+  status.children[0].last_lines = std::vector<std::string>(kMaxLastLines + 1, "e");
+  status.children[0].num_last_lines = kMaxLastLines + 1;
+  EXPECT_NE(CheckDeputyStatus(status), "");
+  status.children[0].last_lines = {};
+  status.children[0].num_last_lines = 0;
   status.num_children = 3;
   EXPECT_NE(CheckDeputyStatus(status), "");
 }

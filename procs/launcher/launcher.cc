@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <csignal>
 #include <cstdio>
+#include <filesystem>
 #include <thread>
 
 #include "procs/common/channels.h"
@@ -25,6 +26,14 @@ double SecondsSince(std::chrono::steady_clock::time_point t) {
 }  // namespace
 
 namespace {
+
+// The run folder's name, as deputies make it under their logs folders; "" when it has none.
+std::string RunDirName(const std::string& log_dir) {
+  std::filesystem::path path = std::filesystem::path(log_dir).lexically_normal();
+  if (!path.has_filename()) path = path.parent_path();  // "logs/run/"
+  const std::string name = path.filename().string();
+  return RunDirOk(name) ? name : "";
+}
 
 // A process placed on another host must fit DEPUTY_COMMAND's limits (deputy_protocol.h), or its
 // deputy would refuse the whole command: said here, at start, naming the process.
@@ -49,13 +58,16 @@ void CheckRemoteProcess(const ProcessSpec& p) {
 
 }  // namespace
 
-Launcher::Launcher(const CommonFlags& flags, LaunchSpec spec, std::string bin_dir, std::string host)
+Launcher::Launcher(const CommonFlags& flags, LaunchSpec spec, std::string bin_dir, std::string host,
+                   std::string log_dir)
     : flags_(flags),
       spec_(std::move(spec)),
       bin_dir_(std::move(bin_dir)),
       host_(std::move(host)),
+      log_dir_(std::move(log_dir)),
       process_(flags),
-      deputies_(&process_, spec_.name + "@" + host_ + "/" + std::to_string(getpid()), NowMicros()) {
+      deputies_(&process_, spec_.name + "@" + host_ + "/" + std::to_string(getpid()), NowMicros(),
+                RunDirName(log_dir_)) {
   name_width_ = 7;  // "process", the summary's header
   for (size_t g = 0; g < spec_.groups.size(); ++g) {
     for (const ProcessSpec& p : spec_.groups[g].processes) {
@@ -105,6 +117,11 @@ bool Launcher::StartProcess(Managed* m) {
     argv.push_back(m->spec.name);
   }
   std::map<std::string, std::string> env = m->spec.env;
+  // Remote: the deputy expands ${ORBED_LOG_DIR} to its own run folder (else to this host's path).
+  if (!m->remote || deputies_.run_dir().empty()) {
+    for (std::string& arg : argv) arg = ExpandLogDir(arg, log_dir_);
+    for (auto& [key, value] : env) value = ExpandLogDir(value, log_dir_);
+  }
   env.emplace("ORBED_LCM_URL", flags_.lcm_url);
   env.emplace("ORBED_HOST", host_);
   env["ORBED_LOG_PREFIXED"] = "1";

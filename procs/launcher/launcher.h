@@ -15,6 +15,11 @@
 /// --duration-s it stops the groups in reverse order: each child gets its stop_signal, then
 /// SIGKILL after stop_timeout_s.
 ///
+/// Run folders: the launch file's ${ORBED_LOG_DIR} is expanded where a process runs (the CLI
+/// parses the file with it deferred): to `log_dir` for the launcher's own children, and by each
+/// deputy to <its --log-root>/<the name of log_dir> on its host (deputy_command_t.run_dir), so
+/// every process keeps its state on its own host's disk; a shared disk gives the same folder.
+///
 /// Children get: --name <name> appended (heartbeat-ready processes, unless args have --name),
 /// ORBED_LCM_URL = the launcher's LCM URL, ORBED_HOST = the launcher's host name,
 /// ORBED_LOG_PREFIXED=1 (their log lines then omit the name), plus the env of their spec.
@@ -51,8 +56,10 @@ namespace orbed::launcher {
 class Launcher {
  public:
   /// `bin_dir` is searched first for commands without '/'. `host` is this host's name: processes
-  /// without `host:` or with this one run here.
-  Launcher(const CommonFlags& flags, LaunchSpec spec, std::string bin_dir, std::string host);
+  /// without `host:` or with this one run here. `log_dir` is the run's folder here ($ORBED_LOG_DIR;
+  /// "" = none): what ${ORBED_LOG_DIR} left in `spec` expands to (see the file comment).
+  Launcher(const CommonFlags& flags, LaunchSpec spec, std::string bin_dir, std::string host,
+           std::string log_dir = "");
   ~Launcher();
 
   int Run();
@@ -93,6 +100,7 @@ class Launcher {
   LaunchSpec spec_;
   std::string bin_dir_;
   std::string host_;
+  std::string log_dir_;
   Process process_;
   DeputyLink deputies_;
   std::vector<Managed> managed_;

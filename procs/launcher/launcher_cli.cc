@@ -15,6 +15,7 @@
 #include "procs/common/flags.h"
 #include "procs/common/log.h"
 #include "procs/launcher/deputy.h"
+#include "procs/launcher/deputy_protocol.h"
 #include "procs/launcher/launch_file.h"
 #include "procs/launcher/launcher.h"
 
@@ -92,6 +93,11 @@ int RunLauncher(int argc, const char* const* argv, std::ostream& out, std::ostre
                                        "Be the deputy NAME: run what launchers place on host NAME (no launch "
                                        "file)");
   deputy_option->excludes(file_option)->excludes("--dry-run")->excludes("--arg")->excludes("--show-args");
+  app.add_option("--log-root", deputy.log_root,
+                 "Deputy: this host's logs folder, where it makes each run's folder (the launcher's run folder "
+                 "name) for the processes' ${ORBED_LOG_DIR}")
+      ->needs(deputy_option)
+      ->capture_default_str();
   app.add_option("--orphan-timeout-s", deputy.orphan_timeout_s,
                  "Deputy: stop what a launcher started when it has been silent this long")
       ->needs(deputy_option)
@@ -138,6 +144,12 @@ int RunLauncher(int argc, const char* const* argv, std::ostream& out, std::ostre
       return 2;
     }
   }
+  // ${ORBED_LOG_DIR} is expanded where each process runs (launcher.h): left in the spec here.
+  std::string log_dir;
+  if (const auto it = environment.find("ORBED_LOG_DIR"); it != environment.end()) {
+    log_dir = it->second;
+    it->second = kLogDirVariable;
+  }
   LaunchSpec spec;
   try {
     spec = LoadLaunchFile(launch_file, environment, arguments);
@@ -154,7 +166,7 @@ int RunLauncher(int argc, const char* const* argv, std::ostream& out, std::ostre
     return 0;
   }
   try {
-    Launcher launcher(common, std::move(spec), bin_dir, host);
+    Launcher launcher(common, std::move(spec), bin_dir, host, log_dir);
     return launcher.Run();
   } catch (const std::exception& e) {
     err << "orbed-launch: " << e.what() << "\n";

@@ -5,7 +5,7 @@
 ///
 ///   orbed-launch [common process flags] [--host NAME] [--arg NAME=VALUE]... [--dry-run]
 ///                [--show-args [--json]] LAUNCH_FILE
-///   orbed-launch [common process flags] --deputy NAME [--orphan-timeout-s S]
+///   orbed-launch [common process flags] --deputy NAME [--log-root DIR] [--orphan-timeout-s S]
 ///
 /// The first starts a launch; processes whose `host:` is neither left out nor --host (default
 /// $ORBED_HOST, else the machine's hostname) are started through the deputy of that name. The
