@@ -67,14 +67,12 @@ int RunScenario(int argc, const char* const* argv, std::ostream& out, std::ostre
   app.add_option("--startup-timeout-s", run.startup_timeout_s, "Wait for the first ROBOT_STATE [s]")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  app.add_option("--reply-timeout-s", run.reply_timeout_s,
-                 "Wait for PLAN_CHECK_REPLY / REGISTRATION / MISALIGNMENT [s]")
+  app.add_option("--request-deadline-s", run.request_deadline_s,
+                 "Wait this long for the answer to any request (PLAN_CHECK_REPLY, ALIGNMENT_TRIAL, "
+                 "REGISTRATION, LANDMARK, MISALIGNMENT), re-sending it meanwhile [s]")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   app.add_option("--move-timeout-s", run.move_timeout_s, "Wait for the arm to reach a configuration [s]")
-      ->check(CLI::PositiveNumber)
-      ->capture_default_str();
-  app.add_option("--trial-timeout-s", run.trial_timeout_s, "Wait for the user's ALIGNMENT_TRIAL [s]")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   app.add_option("--retry-initial-s", run.retry_initial_s,

@@ -10,8 +10,8 @@
 ///   --run-id ID                sessions are <ID>-<mode>; default (or empty) viraal-<UTC time>
 ///   --results-dir DIR          folder of results.json (default $ORBED_LOG_DIR, else the working dir)
 ///   --urdf FILE                robot model for the landmark FK (default sim/models/iiwa7.urdf)
-///   --tolerance-deg, --startup-timeout-s, --reply-timeout-s, --move-timeout-s,
-///   --trial-timeout-s        see ConductorOptions (viraal_conductor.h)
+///   --tolerance-deg, --startup-timeout-s, --request-deadline-s,
+///   --move-timeout-s         see ConductorOptions (viraal_conductor.h)
 ///   --<name>-channel           the nine channels, defaults from channels.h
 ///   --print RESULTS            no run: print the table of a run's results.json (or its folder)
 ///                              and exit 0 ok, 1 failed or unreadable, 3 stopped before the end

@@ -55,9 +55,8 @@ TEST(ScenarioCli, HelpPrintsTheUsageOnOut) {
                            "--urdf",
                            "--tolerance-deg",
                            "--startup-timeout-s",
-                           "--reply-timeout-s",
+                           "--request-deadline-s",
                            "--move-timeout-s",
-                           "--trial-timeout-s",
                            "--retry-initial-s",
                            "--retry-max-s",
                            "--robot-state-channel",
@@ -80,9 +79,9 @@ TEST(ScenarioCli, BadFlagsExitNonZeroWithTheMessageOnErr) {
   r = Cli({"--trials", "0"});
   EXPECT_NE(r.code, 0);
   EXPECT_TRUE(Contains(r.err, "--trials")) << r.err;
-  r = Cli({"--reply-timeout-s", "-1"});
+  r = Cli({"--request-deadline-s", "-1"});
   EXPECT_NE(r.code, 0);
-  EXPECT_TRUE(Contains(r.err, "--reply-timeout-s")) << r.err;
+  EXPECT_TRUE(Contains(r.err, "--request-deadline-s")) << r.err;
   r = Cli({"--retry-initial-s", "1", "--retry-max-s", "0.5", "--lcm-url", "memq://"});
   EXPECT_NE(r.code, 0);
   EXPECT_TRUE(Contains(r.err, "--retry-max-s must be >= --retry-initial-s")) << r.err;

@@ -206,8 +206,7 @@ ScenarioOptions MemqOptions(const std::string& dir) {
   options.conductor.config = viraal::LoadScenarioFile(Source(viraal::kDefaultScenarioRelativePath));
   options.conductor.run_id = "memq";
   options.results_dir = dir;
-  options.conductor.trial_timeout_s = 1.0;
-  options.conductor.reply_timeout_s = 1.0;
+  options.conductor.request_deadline_s = 1.0;
   return options;
 }
 

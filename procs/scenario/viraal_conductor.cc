@@ -34,9 +34,8 @@ std::string JointList(const std::vector<double>& q_deg, int digits) {
 void CheckConductorOptions(const ConductorOptions& options) {
   const std::pair<const char*, double> positive[] = {{"--tolerance-deg", options.tolerance_deg},
                                                      {"--startup-timeout-s", options.startup_timeout_s},
-                                                     {"--reply-timeout-s", options.reply_timeout_s},
+                                                     {"--request-deadline-s", options.request_deadline_s},
                                                      {"--move-timeout-s", options.move_timeout_s},
-                                                     {"--trial-timeout-s", options.trial_timeout_s},
                                                      {"--stopped-grace-s", options.stopped_grace_s},
                                                      {"command resend period", options.command_resend_s},
                                                      {"--retry-initial-s", options.retry_initial_s},
@@ -429,10 +428,10 @@ void ViraalConductor::Step() {
         Say("[plan] " + std::to_string(answered) +
             " configurations checked with orbed-iiwa-sim: within limits and collision-free");
         StartSession();
-      } else if (waited > options_.reply_timeout_s) {
+      } else if (waited > options_.request_deadline_s) {
         FailRun("orbed-iiwa-sim answered " + std::to_string(answered) + " of " +
                 std::to_string(plan_answered_.size()) + " PLAN_CHECK_REQUESTs within " +
-                Fixed(options_.reply_timeout_s, 1) + " s" + Attempts() + refusal);
+                Fixed(options_.request_deadline_s, 1) + " s" + Attempts() + refusal);
       } else {
         RetryIfDue();
       }
@@ -478,9 +477,9 @@ void ViraalConductor::Step() {
       return;
     }
     case Phase::kAwaitTrial:
-      if (waited > options_.trial_timeout_s) {
+      if (waited > options_.request_deadline_s) {
         FailRun("no ALIGNMENT_TRIAL for session '" + results_.sessions.back().session_id + "' trial " +
-                std::to_string(trial_index_) + " within " + Fixed(options_.trial_timeout_s, 1) +
+                std::to_string(trial_index_) + " within " + Fixed(options_.request_deadline_s, 1) +
                 " s of SESSION_CONTROL REQUEST_TRIAL" + Attempts() +
                 ": is orbed-hmd running (its emulated user answers REQUEST_TRIAL on " +
                 options_.trial_channel + ")?" + refusal);
@@ -492,7 +491,7 @@ void ViraalConductor::Step() {
       const bool registered = TrialRegistered();
       if (registered && misalignment_) {
         FinishTrial();
-      } else if (waited > options_.reply_timeout_s) {
+      } else if (waited > options_.request_deadline_s) {
         const size_t answered = std::count_if(landmark_answers_.begin(), landmark_answers_.end(),
                                               [](const auto& a) { return a.has_value(); });
         const std::string missing = !registered ? "no REGISTRATION (reason TRIAL)"
@@ -501,7 +500,7 @@ void ViraalConductor::Step() {
                                               std::to_string(landmark_requests_.size()) + " LANDMARK_REQUESTs"
                                         : "no MISALIGNMENT answer";
         FailRun(missing + " from orbed-registration for session '" + results_.sessions.back().session_id +
-                "' trial " + std::to_string(trial_index_) + " within " + Fixed(options_.reply_timeout_s, 1) +
+                "' trial " + std::to_string(trial_index_) + " within " + Fixed(options_.request_deadline_s, 1) +
                 " s" + Attempts() +
                 " (is it running? did it refuse the trial? see its PROCESS_STATUS rejections)" + refusal);
       } else {
@@ -527,9 +526,9 @@ void ViraalConductor::Step() {
         }
         Enter(Phase::kAwaitMeanMisalignment);
         SendMisalignment(pending_error_);
-      } else if (waited > options_.reply_timeout_s) {
+      } else if (waited > options_.request_deadline_s) {
         FailRun("no REGISTRATION (reason COMPUTE) from orbed-registration for session '" +
-                results_.sessions.back().session_id + "' within " + Fixed(options_.reply_timeout_s, 1) +
+                results_.sessions.back().session_id + "' within " + Fixed(options_.request_deadline_s, 1) +
                 " s" + Attempts() + refusal);
       } else {
         RetryIfDue();
@@ -538,9 +537,9 @@ void ViraalConductor::Step() {
     case Phase::kAwaitMeanMisalignment:
       if (misalignment_) {
         FinishSession();
-      } else if (waited > options_.reply_timeout_s) {
+      } else if (waited > options_.request_deadline_s) {
         FailRun("no MISALIGNMENT answer from orbed-registration for the mean of session '" +
-                results_.sessions.back().session_id + "' within " + Fixed(options_.reply_timeout_s, 1) +
+                results_.sessions.back().session_id + "' within " + Fixed(options_.request_deadline_s, 1) +
                 " s" + Attempts() + refusal);
       } else {
         RetryIfDue();

@@ -205,7 +205,7 @@ TEST(ViraalConductor, InputsBeforeStartAreALogicError) {
 
 TEST(ViraalConductor, BadOptionsAreRefusedAtConstruction) {
   ConductorOptions options = Bench::Options();
-  options.reply_timeout_s = 0;
+  options.request_deadline_s = 0;
   EXPECT_THROW(Bench{options}, std::invalid_argument);
   options = Bench::Options();
   options.run_id = "";
@@ -258,7 +258,7 @@ std::vector<uint8_t> Bytes(const Publication& p) {
       p.message);
 }
 
-TEST(ViraalConductor, MissingPlanCheckRepliesFailAfterTheReplyTimeout) {
+TEST(ViraalConductor, MissingPlanCheckRepliesFailAfterTheRequestDeadline) {
   Bench bench;
   bench.Start();
   const int64_t start_utime = bench.clock().Now().utime;
@@ -283,21 +283,24 @@ TEST(ViraalConductor, MissingPlanCheckRepliesFailAfterTheReplyTimeout) {
   bench.Send(PlanReply(base + 2));
   bench.Send(PlanReply(base + 7));
   EXPECT_TRUE(bench.refusals().empty());
-  bench.TickAt(sent_s + 4.99);  // one retry, of the unanswered request only
+  bench.TickAt(sent_s + 59.99);  // one retry, of the unanswered request only
   EXPECT_EQ(bench.conductor().phase(), Phase::kCheckPlans);
   ASSERT_EQ(bench.last().size(), 1u);
   EXPECT_EQ(Bytes(bench.last()[0]), Bytes(requests[1]));
-  bench.TickAt(sent_s + 5.01);
+  bench.TickAt(sent_s + 60.01);
   EXPECT_EQ(bench.conductor().status(), Status::kFailed);
   EXPECT_EQ(bench.conductor().results().error,
-            "orbed-iiwa-sim answered 2 of 3 PLAN_CHECK_REQUESTs within 5.0 s, sent 2 times");
+            "orbed-iiwa-sim answered 2 of 3 PLAN_CHECK_REQUESTs within 60.0 s, sent 2 times");
   EXPECT_EQ(bench.Labels(), std::vector<std::string>(4, "PLAN_CHECK_REQUEST"));  // nothing moved
 }
 
 // Unanswered requests go out again 0.2 s after the first send, then after intervals doubling up to
-// 0.5 s (0.2, 0.4, 0.5, 0.5, ...), byte for byte, only those still unanswered, until the timeout.
-TEST(ViraalConductor, UnansweredRequestsAreRetriedWithBackOffUntilTheTimeout) {
-  Bench bench;
+// 0.5 s (0.2, 0.4, 0.5, 0.5, ...), byte for byte, only those still unanswered, until the deadline
+// (here 5 s).
+TEST(ViraalConductor, UnansweredRequestsAreRetriedWithBackOffUntilTheDeadline) {
+  ConductorOptions options = Bench::Options();
+  options.request_deadline_s = 5.0;
+  Bench bench(options);
   bench.Start();
   bench.Send(RobotState(std::vector<double>(7, 0.0)));
   const std::vector<Publication> requests = bench.Sent("PLAN_CHECK_REQUEST");
@@ -510,7 +513,7 @@ int64_t LastControlId(const Bench& bench, int8_t command) {
   return id;
 }
 
-TEST(ViraalConductor, NoRegistrationOfTheTrialFailsAfterTheReplyTimeout) {
+TEST(ViraalConductor, NoRegistrationOfTheTrialFailsAfterTheRequestDeadline) {
   Bench bench;
   bench.StartAndCheckPlans();
   const auto& q0 = bench.conductor().options().config.configurations_deg[0];
@@ -523,13 +526,13 @@ TEST(ViraalConductor, NoRegistrationOfTheTrialFailsAfterTheReplyTimeout) {
   bench.Send(trial);
   ASSERT_EQ(bench.Labels().back(), "MISALIGNMENT_REQUEST");
   const double trial_s = bench.clock().t_s();
-  bench.TickAt(trial_s + 4.99);
+  bench.TickAt(trial_s + 59.99);
   EXPECT_EQ(bench.conductor().phase(), Phase::kAwaitTrialResults);
-  bench.TickAt(trial_s + 5.01);
+  bench.TickAt(trial_s + 60.01);
   EXPECT_EQ(bench.conductor().status(), Status::kFailed);
   EXPECT_EQ(bench.conductor().results().error,
             "no REGISTRATION (reason TRIAL) from orbed-registration for session 'emu-ar_reflective' trial 0 "
-            "within 5.0 s, sent 2 times (is it running? did it refuse the trial? see its PROCESS_STATUS "
+            "within 60.0 s, sent 2 times (is it running? did it refuse the trial? see its PROCESS_STATUS "
             "rejections)");
 }
 

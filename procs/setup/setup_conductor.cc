@@ -338,6 +338,7 @@ void SetupConductor::StartTask() {
   o.run_id = options_.run_id + "-" + TaskId();
   o.startup_timeout_s = options_.startup_timeout_s;
   o.move_timeout_s = options_.move_timeout_s;
+  o.request_deadline_s = options_.request_deadline_s;
   alignment_ = std::make_unique<scenario::ViraalConductor>(o, *model_);
   phase_ = Phase::kAlign;
   phase_start_s_ = now_.t_s;

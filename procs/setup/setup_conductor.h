@@ -83,6 +83,9 @@ struct SetupOptions {
   double startup_timeout_s{10.0};
   double move_timeout_s{30.0};
   double task_timeout_s{600.0};
+  /// The deadline of the alignment's requests to the headset and the registration server [s]
+  /// (ConductorOptions::request_deadline_s), stated by the launch file.
+  double request_deadline_s{60.0};
   double command_resend_s{0.25};
   double task_resend_s{1.0};
   std::string robot_state_channel{channels::kRobotState};

@@ -211,6 +211,11 @@ int RunSetup(int argc, const char* const* argv, std::ostream& out, std::ostream&
   app.add_option("--move-timeout-s", options.move_timeout_s, "Wait for the arm to reach a configuration [s]")
       ->check(CLI::Range(1.0, 3600.0))
       ->capture_default_str();
+  app.add_option("--request-deadline-s", options.request_deadline_s,
+                 "Wait this long for the headset's and the registration server's answers while aligning, "
+                 "re-sending the requests meanwhile [s]")
+      ->check(CLI::Range(1.0, 3600.0))
+      ->capture_default_str();
   std::string resume;
   app.add_option("--resume", resume,
                  "Continue a run that stopped before its end: its setup_results.json (or the folder). Its "

@@ -184,9 +184,7 @@ std::vector<std::string> ScenarioArgs(const std::string& dir) {
           "it",
           "--results-dir",
           dir,
-          "--trial-timeout-s",
-          "5",
-          "--reply-timeout-s",
+          "--request-deadline-s",
           "5",
           "--move-timeout-s",
           "20",
@@ -264,7 +262,7 @@ TEST(Scenario, WithoutAUserItFailsNamingOrbedHmd) {
   std::vector<std::string> args = ScenarioArgs(dir);
   args.push_back("--trials");
   args.push_back("1");
-  args[std::find(args.begin(), args.end(), "--trial-timeout-s") - args.begin() + 1] = "2";
+  args[std::find(args.begin(), args.end(), "--request-deadline-s") - args.begin() + 1] = "2";
   RunningProcess scenario(args);
   ASSERT_TRUE(scenario.Wait(60));
   EXPECT_EQ(scenario.exit_code(), 1);
