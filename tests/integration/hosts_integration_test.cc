@@ -5,7 +5,8 @@
 // headset on C (`placement:`), through `orbed-launch --deputy` on B and C. The ViRAAl run
 // completes with the pinned results; every process's heartbeat names its host; C's link, cut for
 // 5 s in the middle of the run, shows as SILENT in the monitor and in the launcher, and the run
-// resumes when it returns.
+// resumes when it returns. Hosts may have disks of their own: each a tmpfs in a private mount
+// namespace, empty at the start, where every process keeps its state (its deputy's run folder).
 #include <sys/types.h>
 #include <unistd.h>
 
@@ -44,11 +45,12 @@ bool Shell(const std::string& command) {
 
 // Hosts as network namespaces on one bridge. Each host is a namespace held open by a sleeping
 // process; commands run in it through nsenter. Everything lives inside the test's own namespace
-// and goes with it.
+// and goes with it. With a `disk` (a folder), each host also has a mount namespace of its own with
+// an empty tmpfs mounted there: the same path, a different disk on every host (gone with it).
 class VirtualLan {
  public:
   // Hosts named `hosts`, as 10.77.0.1, .2, ...
-  explicit VirtualLan(const std::vector<std::string>& hosts) {
+  explicit VirtualLan(const std::vector<std::string>& hosts, std::string disk = "") : disk_(std::move(disk)) {
     ok_ = Shell("ip link add orbedbr0 type bridge mcast_snooping 0 && ip link set orbedbr0 up");
     // The test itself listens on the bridge (an observer, not a host).
     ok_ =
@@ -63,12 +65,21 @@ class VirtualLan {
 
   // Adds host `name` as 10.77.0.<index>.
   void AddHost(const std::string& name, int index) {
-    auto holder =
-        std::make_unique<RunningProcess>(std::vector<std::string>{"/usr/bin/unshare", "-n", "sleep", "3600"});
+    auto holder = std::make_unique<RunningProcess>(
+        disk_.empty() ? std::vector<std::string>{"/usr/bin/unshare", "-n", "sleep", "3600"}
+                      : std::vector<std::string>{"/usr/bin/unshare", "-n", "-m", "--propagation", "private",
+                                                 "/bin/sh", "-c",
+                                                 "mount -t tmpfs orbed-disk '" + disk_ + "' && exec sleep 3600"});
     const std::string pid = std::to_string(holder->pid());
-    // The holder is in its namespace once its /proc entry points at another one than ours.
-    if (!WaitFor([&] { return NetNamespace("/proc/" + pid) != NetNamespace("/proc/self"); }, 10)) {
-      ADD_FAILURE() << "host " << name << ": no network namespace of its own";
+    // The holder is in its namespace once its /proc entry points at another one than ours (and
+    // has its disk once its mounts list it).
+    if (!WaitFor(
+            [&] {
+              return NetNamespace("/proc/" + pid) != NetNamespace("/proc/self") &&
+                     (disk_.empty() || HasMount("/proc/" + pid, disk_));
+            },
+            10)) {
+      ADD_FAILURE() << "host " << name << ": no network namespace (or disk) of its own";
       ok_ = false;
       return;
     }
@@ -86,8 +97,14 @@ class VirtualLan {
   std::unique_ptr<RunningProcess> Run(const std::string& host, std::vector<std::string> argv,
                                       std::map<std::string, std::string> env = {}) {
     argv.insert(argv.begin(), {"/usr/bin/nsenter", "--target", hosts_.at(host).pid, "--net", "--"});
+    if (!disk_.empty()) argv.insert(argv.begin() + 4, "--mount");
     env["ORBED_LCM_URL"] = kLanUrl;
     return std::make_unique<RunningProcess>(argv, env);
+  }
+
+  // `path` as seen from this test, on `host`'s disk.
+  std::string OnHost(const std::string& host, const std::string& path) const {
+    return "/proc/" + hosts_.at(host).pid + "/root" + path;
   }
 
   // Takes `host`'s link down or up (at the bridge).
@@ -100,10 +117,21 @@ class VirtualLan {
     std::error_code ec;
     return std::filesystem::read_symlink(proc + "/ns/net", ec).string();
   }
+  // Whether `proc`'s mount namespace has a tmpfs mounted on `path`.
+  static bool HasMount(const std::string& proc, const std::string& path) {
+    std::ifstream mounts(proc + "/mountinfo");
+    for (std::string line; std::getline(mounts, line);) {
+      if (line.find(" " + path + " ") != std::string::npos && line.find(" tmpfs ") != std::string::npos) {
+        return true;
+      }
+    }
+    return false;
+  }
   struct Host {
     std::string pid, link;
     std::unique_ptr<RunningProcess> holder;
   };
+  std::string disk_;
   bool ok_ = false;
   std::map<std::string, Host> hosts_;
 };
@@ -129,8 +157,9 @@ TEST(Hosts, TheViraalRunOnThreeHostsCompletesAndSurvivesAPartition) {
       << "name: three_hosts\n"
       << "include: [" << SourcePath("scripts/launch/viraal.yaml") << "]\n"
       << "placement: {registration: hostB, hmd: hostC}\n";
-  const auto deputy_b = lan.Run("hostB", {BinPath("orbed-launch"), "--deputy", "hostB"});
-  const auto deputy_c = lan.Run("hostC", {BinPath("orbed-launch"), "--deputy", "hostC"});
+  // One disk shared by all: the deputies' run folder is the launcher's.
+  const auto deputy_b = lan.Run("hostB", {BinPath("orbed-launch"), "--deputy", "hostB", "--log-root", dir});
+  const auto deputy_c = lan.Run("hostC", {BinPath("orbed-launch"), "--deputy", "hostC", "--log-root", dir});
 
   lcm::LCM observer(kLanUrl);
   ASSERT_TRUE(observer.good());
@@ -195,7 +224,7 @@ TEST(Hosts, AProcessKilledOnAnotherHostIsRespawnedThroughItsDeputy) {
   std::ofstream(dir + "/two_hosts.yaml") << "name: two_hosts\n"
                                          << "include: [" << SourcePath("scripts/launch/viraal.yaml") << "]\n"
                                          << "placement: {hmd: hostB}\n";
-  const auto deputy_b = lan.Run("hostB", {BinPath("orbed-launch"), "--deputy", "hostB"});
+  const auto deputy_b = lan.Run("hostB", {BinPath("orbed-launch"), "--deputy", "hostB", "--log-root", dir});
 
   struct Seen {
     int trials = 0;
@@ -315,6 +344,120 @@ TEST(Hosts, ASigkilledLauncherLeavesNoProcessOnAnyHost) {
                AnyLineHas(deputy_b->lines(), "deaf_b did not stop within 1 s: SIGKILL");
       },
       5));
+}
+
+// Hosts with disks of their own, each empty at the start: the headset on B and the registration
+// server on C keep their state (hmd.state, registration.journal) in their own host's folder of the
+// run, which their deputies make; the run survives a 30 s partition of C (the conductor's requests
+// wait out their 60 s deadline, re-sent meanwhile) and a SIGKILL of the headset on B, which comes
+// back in its session from B's own hmd.state.
+TEST(Hosts, HostsWithTheirOwnDisksRideOutAPartitionAndAKilledHeadset) {
+  if (!CanBuildHosts()) GTEST_SKIP() << kNoHosts;
+  const std::string dir = MakeTempDir("hosts_disks");
+  const std::string disk = dir + "/logs";  // every host's logs folder: its own tmpfs
+  std::filesystem::create_directories(disk);
+  VirtualLan lan({"hostA", "hostB", "hostC"}, disk);
+  ASSERT_TRUE(lan.ok());
+  std::ofstream(dir + "/own_disks.yaml") << "name: own_disks\n"
+                                         << "include: [" << SourcePath("scripts/launch/viraal.yaml") << "]\n"
+                                         << "placement: {hmd: hostB, registration: hostC}\n";
+  const auto deputy_b = lan.Run("hostB", {BinPath("orbed-launch"), "--deputy", "hostB", "--log-root", disk});
+  const auto deputy_c = lan.Run("hostC", {BinPath("orbed-launch"), "--deputy", "hostC", "--log-root", disk});
+
+  struct Seen {
+    int trials = 0;
+    std::set<int> hmd_pids;
+  } seen;
+  lcm::LCM observer(kLanUrl);
+  ASSERT_TRUE(observer.good());
+  observer.subscribeFunction(
+      "ALIGNMENT_TRIAL", +[](const lcm::ReceiveBuffer*, const std::string&, Seen* s) { ++s->trials; }, &seen);
+  observer.subscribeFunction(
+      "PROCESS_STATUS",
+      +[](const lcm::ReceiveBuffer* rbuf, const std::string&, Seen* s) {
+        orbed::process_status_t status;
+        if (status.decode(rbuf->data, 0, static_cast<int>(rbuf->data_size)) > 0 && status.name == "hmd") {
+          s->hmd_pids.insert(status.pid);
+        }
+      },
+      &seen);
+  // A's run folder, on A's disk (as scripts/orbed makes it there).
+  const std::string run = disk + "/own-disks-run";
+  ASSERT_TRUE(std::filesystem::create_directory(lan.OnHost("hostA", run)));
+  const auto launcher = lan.Run(
+      "hostA",
+      {BinPath("orbed-launch"), dir + "/own_disks.yaml", "--host", "hostA", "--arg", "run_id=own-disks",
+       "--duration-s", "400"},
+      {{"ORBED_LOG_DIR", run}});
+  // Everyone's output is read while waiting (a full pipe would stall the writer).
+  auto watch = [&] {
+    observer.handleTimeout(10);
+    deputy_b->running();
+    deputy_c->running();
+    return launcher->running();
+  };
+  ASSERT_TRUE(WaitFor([&] { return !watch() || (seen.trials > 0 && !seen.hmd_pids.empty()); }, 120));
+  ASSERT_TRUE(launcher->running()) << "the run ended before its first trial";
+
+  // C cut off for 30 s of wall time (the partition's length, not a wait for anything).
+  lan.SetLink("hostC", false);
+  const auto cut_until = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (std::chrono::steady_clock::now() < cut_until) watch();
+  lan.SetLink("hostC", true);
+  ASSERT_TRUE(launcher->running()) << "the run ended during the partition";
+
+  // The next trial after it, then the headset on B killed.
+  const int trials_before = seen.trials;
+  ASSERT_TRUE(WaitFor([&] { return !watch() || seen.trials > trials_before; }, 120));
+  ASSERT_TRUE(launcher->running()) << "the run ended before the headset could be killed";
+  ASSERT_EQ(seen.hmd_pids.size(), 1u);
+  ASSERT_EQ(kill(*seen.hmd_pids.begin(), SIGKILL), 0);
+  ASSERT_TRUE(WaitFor([&] { return !watch(); }, 300)) << "the run did not finish";
+  EXPECT_EQ(launcher->exit_code(), 0);
+  EXPECT_EQ(seen.hmd_pids.size(), 2u) << "no second instance of the headset was heard";
+
+  const std::vector<std::string>& said = launcher->lines();
+  EXPECT_TRUE(AnyLineHas(said, "deputy hostC silent for"));
+  EXPECT_TRUE(AnyLineHas(said, "deputy hostC heard again after"));
+  EXPECT_TRUE(AnyLineHas(said, "hmd killed by signal", "on hostB; respawning"));
+  EXPECT_TRUE(AnyLineHas(said, "hmd is ready again"));
+  EXPECT_FALSE(AnyLineHas(said, "registration exited")) << "the registration server failed on C";
+  const YAML::Node results = YAML::LoadFile(lan.OnHost("hostA", run + "/results.json"));
+  EXPECT_EQ(results["status"].as<std::string>(), "ok");
+  ASSERT_EQ(results["sessions"].size(), 2u);
+  for (const auto& session : results["sessions"]) EXPECT_EQ(session["trials"].size(), 3u);
+  // Each kept its state on its own host's disk, in the run's folder there.
+  EXPECT_TRUE(std::filesystem::exists(lan.OnHost("hostB", run + "/hmd.state")));
+  EXPECT_TRUE(std::filesystem::exists(lan.OnHost("hostC", run + "/registration.journal")));
+  EXPECT_TRUE(std::filesystem::exists(lan.OnHost("hostA", run + "/sim.state")));
+  EXPECT_FALSE(std::filesystem::exists(lan.OnHost("hostA", run + "/hmd.state")));
+  EXPECT_FALSE(std::filesystem::exists(lan.OnHost("hostA", run + "/registration.journal")));
+}
+
+// A process that fails on another host says why on the launcher's terminal: its last lines of
+// output come back in its deputy's status and are printed with its exit.
+TEST(Hosts, AProcessFailingOnAnotherHostSaysWhyOnTheLaunchersTerminal) {
+  if (!CanBuildHosts()) GTEST_SKIP() << kNoHosts;
+  VirtualLan lan({"hostA", "hostB"});
+  ASSERT_TRUE(lan.ok());
+  const std::string dir = MakeTempDir("hosts_why");
+  std::ofstream(dir + "/why.yaml") << "name: why\n"
+                                   << "groups:\n"
+                                   << "  - name: far\n"
+                                   << "    processes:\n"
+                                   << "      - {name: registration, command: orbed-registration, host: hostB,\n"
+                                   << "         args: [--journal, /nonexistent-folder/registration.journal]}\n";
+  const auto deputy_b = lan.Run("hostB", {BinPath("orbed-launch"), "--deputy", "hostB"});
+  const auto launcher = lan.Run("hostA", {BinPath("orbed-launch"), dir + "/why.yaml", "--host", "hostA"});
+  ASSERT_TRUE(WaitFor(
+      [&] {
+        deputy_b->running();
+        return !launcher->running();
+      },
+      60));
+  EXPECT_EQ(launcher->exit_code(), 1);
+  EXPECT_TRUE(AnyLineHas(launcher->lines(), "exited with code 1 on hostB"));
+  EXPECT_TRUE(AnyLineHas(launcher->lines(), "registration | [hostB]", "cannot open the journal"));
 }
 
 // A process placed on a host whose deputy never answers: the launch stops with an error naming the
