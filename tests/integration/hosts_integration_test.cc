@@ -58,7 +58,10 @@ class VirtualLan {
     for (size_t i = 0; i < hosts.size() && ok_; ++i) AddHost(hosts[i], static_cast<int>(i) + 1);
   }
   ~VirtualLan() {
-    // The hosts' ends of the veth pairs go with their namespaces (the holders, stopped after this).
+    // The veth pairs are deleted here, both ends at once: left to go with their hosts' namespaces
+    // (the holders, stopped after this), they may outlive this LAN (the kernel tears a namespace
+    // down later) and collide with the next LAN's links of the same names.
+    for (const auto& [name, host] : hosts_) std::system(("ip link del " + host.link + " 2>/dev/null").c_str());
     std::system("ip link del orbedbr0 2>/dev/null; ip route replace 224.0.0.0/4 dev lo");
   }
   bool ok() const { return ok_; }
