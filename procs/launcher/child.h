@@ -34,7 +34,8 @@ class ChildHandle {
   virtual std::string DescribeExit() const = 0;
   virtual void Signal(int signal) = 0;
   virtual void Drain(const std::string& prefix, bool final = false) = 0;
-  /// The last line it printed ("" when its output is not seen here, as on another host).
+  /// The last line it printed ("" when none; on another host, the last line its deputy reported with
+  /// its exit).
   virtual std::string last_line() const { return ""; }
 };
 

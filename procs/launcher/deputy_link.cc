@@ -58,6 +58,10 @@ class RemoteChild : public ChildHandle {
     }
     return launcher::DescribeExit(exit_code(), term_signal()) + where;
   }
+  // The last of the lines its deputy reported with its exit.
+  std::string last_line() const override {
+    return Reported() && !slot_->last_lines.empty() ? slot_->last_lines.back() : "";
+  }
   void Signal(int signal) override {
     if (!slot_->run && slot_->stop_signal == signal) return;
     slot_->run = false;
