@@ -172,8 +172,10 @@ TEST(Hosts, TheViraalRunOnThreeHostsCompletesAndSurvivesAPartition) {
 
   const std::string log_dir = dir + "/log";
   const auto launcher = lan.Run(
-      "hostA", {BinPath("orbed-launch"), dir + "/three_hosts.yaml", "--host", "hostA", "--duration-s", "240"},
-      {{"ORBED_LOG_DIR", log_dir}, {"ORBED_RUN_ID", "pinned"}});
+      "hostA",
+      {BinPath("orbed-launch"), dir + "/three_hosts.yaml", "--host", "hostA", "--arg", "run_id=pinned",
+       "--duration-s", "240"},
+      {{"ORBED_LOG_DIR", log_dir}});
   // The partition starts with the first trial heard from C.
   ASSERT_TRUE(WaitFor(
       [&] {
@@ -248,8 +250,10 @@ TEST(Hosts, AProcessKilledOnAnotherHostIsRespawnedThroughItsDeputy) {
       &seen);
   const std::string log_dir = dir + "/log";
   const auto launcher = lan.Run(
-      "hostA", {BinPath("orbed-launch"), dir + "/two_hosts.yaml", "--host", "hostA", "--duration-s", "240"},
-      {{"ORBED_LOG_DIR", log_dir}, {"ORBED_RUN_ID", "respawn"}});
+      "hostA",
+      {BinPath("orbed-launch"), dir + "/two_hosts.yaml", "--host", "hostA", "--arg", "run_id=respawn",
+       "--duration-s", "240"},
+      {{"ORBED_LOG_DIR", log_dir}});
   ASSERT_TRUE(WaitFor(
       [&] {
         observer.handleTimeout(10);
