@@ -43,7 +43,8 @@
 /// giving one the launch does not declare, is an error. orbed-launch leaves ${ORBED_LOG_DIR} (when
 /// set) to be expanded where the process runs: on another host, to that host's own folder of the
 /// run (launcher.h). Group and process names are unique across a file and everything it includes.
-/// The file is read with the project's checked YAML reader (base/yaml_fields.h): errors throw LaunchFileError with "file:line: dotted.key: expected ..., got ...", e.g.
+/// The file is read with the project's checked YAML reader (base/yaml_fields.h): errors throw
+/// LaunchFileError with "file:line: dotted.key: expected ..., got ...", e.g.
 ///   "testbed.yaml:12: groups[1].processes[0].stop_signal: expected SIGINT, ... or SIGKILL, got 'SIGFOO'".
 
 #include <map>

@@ -94,8 +94,8 @@ int RunLauncher(int argc, const char* const* argv, std::ostream& out, std::ostre
                                        "file)");
   deputy_option->excludes(file_option)->excludes("--dry-run")->excludes("--arg")->excludes("--show-args");
   app.add_option("--log-root", deputy.log_root,
-                 "Deputy: this host's logs folder, where it makes each run's folder (the launcher's run folder "
-                 "name) for the processes' ${ORBED_LOG_DIR}")
+                 "Deputy: this host's logs folder, where it makes each run's folder for the processes' "
+                 "${ORBED_LOG_DIR}")
       ->needs(deputy_option)
       ->capture_default_str();
   app.add_option("--orphan-timeout-s", deputy.orphan_timeout_s,

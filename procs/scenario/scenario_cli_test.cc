@@ -46,25 +46,10 @@ TEST(ScenarioCli, HelpPrintsTheUsageOnOut) {
   const CliRun r = Cli({"--help"});
   EXPECT_EQ(r.code, 0);
   EXPECT_TRUE(Contains(r.out, "orbed-scenario: conducts the ViRAAl experiment")) << r.out;
-  for (const char* flag : {"--scenario",
-                           "--trials",
-                           "--modes",
-                           "--q-deg",
-                           "--run-id",
-                           "--results-dir",
-                           "--urdf",
-                           "--tolerance-deg",
-                           "--startup-timeout-s",
-                           "--request-deadline-s",
-                           "--move-timeout-s",
-                           "--retry-initial-s",
-                           "--retry-max-s",
-                           "--robot-state-channel",
-                           "--misalignment-channel",
-                           "--lcm-url",
-                           "--seed",
-                           "--duration-s",
-                           "--chaos"}) {
+  for (const char* flag : {"--scenario", "--trials", "--modes", "--q-deg", "--run-id", "--results-dir",
+                           "--urdf", "--tolerance-deg", "--startup-timeout-s", "--request-deadline-s",
+                           "--move-timeout-s", "--retry-initial-s", "--retry-max-s", "--robot-state-channel",
+                           "--misalignment-channel", "--lcm-url", "--seed", "--duration-s", "--chaos"}) {
     EXPECT_TRUE(Contains(r.out, flag)) << flag;
   }
   EXPECT_FALSE(Contains(r.out, "ORBED_RUN_ID"));

@@ -500,8 +500,8 @@ void ViraalConductor::Step() {
                                               std::to_string(landmark_requests_.size()) + " LANDMARK_REQUESTs"
                                         : "no MISALIGNMENT answer";
         FailRun(missing + " from orbed-registration for session '" + results_.sessions.back().session_id +
-                "' trial " + std::to_string(trial_index_) + " within " + Fixed(options_.request_deadline_s, 1) +
-                " s" + Attempts() +
+                "' trial " + std::to_string(trial_index_) + " within " +
+                Fixed(options_.request_deadline_s, 1) + " s" + Attempts() +
                 " (is it running? did it refuse the trial? see its PROCESS_STATUS rejections)" + refusal);
       } else {
         RetryIfDue();

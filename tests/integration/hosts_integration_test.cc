@@ -61,7 +61,8 @@ class VirtualLan {
     // The veth pairs are deleted here, both ends at once: left to go with their hosts' namespaces
     // (the holders, stopped after this), they may outlive this LAN (the kernel tears a namespace
     // down later) and collide with the next LAN's links of the same names.
-    for (const auto& [name, host] : hosts_) std::system(("ip link del " + host.link + " 2>/dev/null").c_str());
+    for (const auto& [name, host] : hosts_)
+      std::system(("ip link del " + host.link + " 2>/dev/null").c_str());
     std::system("ip link del orbedbr0 2>/dev/null; ip route replace 224.0.0.0/4 dev lo");
   }
   bool ok() const { return ok_; }
@@ -69,10 +70,10 @@ class VirtualLan {
   // Adds host `name` as 10.77.0.<index>.
   void AddHost(const std::string& name, int index) {
     auto holder = std::make_unique<RunningProcess>(
-        disk_.empty() ? std::vector<std::string>{"/usr/bin/unshare", "-n", "sleep", "3600"}
-                      : std::vector<std::string>{"/usr/bin/unshare", "-n", "-m", "--propagation", "private",
-                                                 "/bin/sh", "-c",
-                                                 "mount -t tmpfs orbed-disk '" + disk_ + "' && exec sleep 3600"});
+        disk_.empty()
+            ? std::vector<std::string>{"/usr/bin/unshare", "-n", "sleep", "3600"}
+            : std::vector<std::string>{"/usr/bin/unshare", "-n", "-m", "--propagation", "private", "/bin/sh",
+                                       "-c", "mount -t tmpfs orbed-disk '" + disk_ + "' && exec sleep 3600"});
     const std::string pid = std::to_string(holder->pid());
     // The holder is in its namespace once its /proc entry points at another one than ours (and
     // has its disk once its mounts list it).
@@ -171,11 +172,10 @@ TEST(Hosts, TheViraalRunOnThreeHostsCompletesAndSurvivesAPartition) {
       "ALIGNMENT_TRIAL", +[](const lcm::ReceiveBuffer*, const std::string&, int* n) { ++*n; }, &trials);
 
   const std::string log_dir = dir + "/log";
-  const auto launcher = lan.Run(
-      "hostA",
-      {BinPath("orbed-launch"), dir + "/three_hosts.yaml", "--host", "hostA", "--arg", "run_id=pinned",
-       "--duration-s", "240"},
-      {{"ORBED_LOG_DIR", log_dir}});
+  const auto launcher = lan.Run("hostA",
+                                {BinPath("orbed-launch"), dir + "/three_hosts.yaml", "--host", "hostA",
+                                 "--arg", "run_id=pinned", "--duration-s", "240"},
+                                {{"ORBED_LOG_DIR", log_dir}});
   // The partition starts with the first trial heard from C.
   ASSERT_TRUE(WaitFor(
       [&] {
@@ -249,11 +249,10 @@ TEST(Hosts, AProcessKilledOnAnotherHostIsRespawnedThroughItsDeputy) {
       },
       &seen);
   const std::string log_dir = dir + "/log";
-  const auto launcher = lan.Run(
-      "hostA",
-      {BinPath("orbed-launch"), dir + "/two_hosts.yaml", "--host", "hostA", "--arg", "run_id=respawn",
-       "--duration-s", "240"},
-      {{"ORBED_LOG_DIR", log_dir}});
+  const auto launcher = lan.Run("hostA",
+                                {BinPath("orbed-launch"), dir + "/two_hosts.yaml", "--host", "hostA", "--arg",
+                                 "run_id=respawn", "--duration-s", "240"},
+                                {{"ORBED_LOG_DIR", log_dir}});
   ASSERT_TRUE(WaitFor(
       [&] {
         observer.handleTimeout(10);
@@ -391,11 +390,10 @@ TEST(Hosts, HostsWithTheirOwnDisksRideOutAPartitionAndAKilledHeadset) {
   // A's run folder, on A's disk (as scripts/orbed makes it there).
   const std::string run = disk + "/own-disks-run";
   ASSERT_TRUE(std::filesystem::create_directory(lan.OnHost("hostA", run)));
-  const auto launcher = lan.Run(
-      "hostA",
-      {BinPath("orbed-launch"), dir + "/own_disks.yaml", "--host", "hostA", "--arg", "run_id=own-disks",
-       "--duration-s", "400"},
-      {{"ORBED_LOG_DIR", run}});
+  const auto launcher = lan.Run("hostA",
+                                {BinPath("orbed-launch"), dir + "/own_disks.yaml", "--host", "hostA", "--arg",
+                                 "run_id=own-disks", "--duration-s", "400"},
+                                {{"ORBED_LOG_DIR", run}});
   // Everyone's output is read while waiting (a full pipe would stall the writer).
   auto watch = [&] {
     observer.handleTimeout(10);
@@ -448,12 +446,13 @@ TEST(Hosts, AProcessFailingOnAnotherHostSaysWhyOnTheLaunchersTerminal) {
   VirtualLan lan({"hostA", "hostB"});
   ASSERT_TRUE(lan.ok());
   const std::string dir = MakeTempDir("hosts_why");
-  std::ofstream(dir + "/why.yaml") << "name: why\n"
-                                   << "groups:\n"
-                                   << "  - name: far\n"
-                                   << "    processes:\n"
-                                   << "      - {name: registration, command: orbed-registration, host: hostB,\n"
-                                   << "         args: [--journal, /nonexistent-folder/registration.journal]}\n";
+  std::ofstream(dir + "/why.yaml")
+      << "name: why\n"
+      << "groups:\n"
+      << "  - name: far\n"
+      << "    processes:\n"
+      << "      - {name: registration, command: orbed-registration, host: hostB,\n"
+      << "         args: [--journal, /nonexistent-folder/registration.journal]}\n";
   const auto deputy_b = lan.Run("hostB", {BinPath("orbed-launch"), "--deputy", "hostB"});
   const auto launcher = lan.Run("hostA", {BinPath("orbed-launch"), dir + "/why.yaml", "--host", "hostA"});
   ASSERT_TRUE(WaitFor(
