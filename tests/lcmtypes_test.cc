@@ -116,11 +116,11 @@ TEST(LcmTypes, EveryTypeRoundTripsAndHasAUniqueFingerprint) {
 // commit. Last change: contract change 10 (run_dir appended to deputy_command_t, the last lines of
 // output to deputy_child_t and so deputy_status_t); before it, contract change 9 (host appended to
 // process_status_t; the four deputy_*_t types of launch across hosts); before it, contract change 8
-// (lockstep_round appended to sim_clock_t, sim_clock_ack_t added); contract change 5 (the landmark annotation appended to
-// alignment_trial_t); before it, contract change 4 (types added: setup_task_t and setup_result_t for the
-// robot set-up study, the four viewer_*_t types that are Drake's lcmt_viewer_*); before it, contract change 3
-// (dropped, drop_reason and drop_count appended to process_status_t); before it, contract change 2 (the
-// tracking fault record appended to alignment_trial_t) and contract change 1 (request_id appended to
+// (lockstep_round appended to sim_clock_t, sim_clock_ack_t added); contract change 5 (the landmark annotation
+// appended to alignment_trial_t); before it, contract change 4 (types added: setup_task_t and setup_result_t
+// for the robot set-up study, the four viewer_*_t types that are Drake's lcmt_viewer_*); before it, contract
+// change 3 (dropped, drop_reason and drop_count appended to process_status_t); before it, contract change 2
+// (the tracking fault record appended to alignment_trial_t) and contract change 1 (request_id appended to
 // session_control_t, alignment_trial_t and registration_t).
 TEST(LcmTypes, FingerprintsArePinned) {
   const std::map<std::string, uint64_t> pinned = {{"alignment_trial_t", 0x271026afe7973c6dULL},
