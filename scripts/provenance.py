@@ -129,12 +129,40 @@ def write_record(run, record):
     os.replace(tmp, os.path.join(run, RECORD))
 
 
+def inside(name, folder_only=False):
+    """Whether `name` stays inside the folder it is relative to (a run's record names no other)."""
+    if not isinstance(name, str) or not name or os.path.isabs(name):
+        return False
+    parts = name.split("/")
+    if folder_only and len(parts) != 1:
+        return False
+    return all(p not in ("", ".", "..") for p in parts)
+
+
 def read_record(run):
+    """The record of RUN; ValueError naming what is wrong when it is not one this script wrote."""
     path = os.path.join(run, RECORD)
-    with open(path) as f:
-        record = json.load(f)
+    try:
+        with open(path) as f:
+            record = json.load(f)
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
+        raise ValueError(f"{path}: cannot be read as JSON ({e})")
     if not isinstance(record, dict) or record.get("format") != FORMAT:
         raise ValueError(f"{path}: not an orbed provenance record ({FORMAT})")
+    expected = {"run": str, "kind": str, "git": dict, "started_utc": str, "config_files": list,
+                "outputs": list}
+    for key, kind in expected.items():
+        if not isinstance(record.get(key), kind):
+            raise ValueError(f"{path}: {key}: expected a {kind.__name__}")
+    for out in record["outputs"]:
+        if not isinstance(out, dict) or not inside(out.get("path")) or not isinstance(out.get("sha256"), str):
+            raise ValueError(f"{path}: outputs: expected {{path inside the run folder, sha256}}, got {out!r}")
+    for cfg in record["config_files"]:
+        if not isinstance(cfg, dict) or not isinstance(cfg.get("path"), str) or not isinstance(cfg.get("sha256"), str):
+            raise ValueError(f"{path}: config_files: expected {{path, sha256}}, got {cfg!r}")
+    runs = record.get("runs", [])
+    if not isinstance(runs, list) or not all(inside(r, folder_only=True) for r in runs):
+        raise ValueError(f"{path}: runs: expected names of folders inside the run, got {runs!r}")
     return record
 
 
@@ -175,6 +203,12 @@ def cmd_start(args):
     if os.path.isfile(arguments):
         with open(arguments) as f:
             record["arguments"] = {k: v["value"] for k, v in json.load(f).items()}
+        # A file an argument names (an overlay, a run to resume) is an input too.
+        hashed = {c["path"] for c in record["config_files"]}
+        for value in record["arguments"].values():
+            if value and os.path.isfile(value) and relative(value) not in hashed:
+                record["config_files"].append({"path": relative(value), "sha256": sha256(value)})
+                hashed.add(relative(value))
     overrides = os.path.join(args.run, "settings", "settings.json")
     if os.path.isfile(overrides):
         with open(overrides) as f:
@@ -222,10 +256,10 @@ def verify(run, bin_dir, depth=0):
         print(f"{pad}{run}: {e}")
         return 1
     differ = 0
-    print(f"{pad}{record['run']} ({record['kind']}; commit {(record['git']['commit'] or '?')[:12]}"
-          f"{' dirty' if record['git']['dirty'] else ''}; started {record['started_utc']};"
-          f" exit code {record['exit_code']})")
-    if record["ended_utc"] is None:
+    print(f"{pad}{record['run']} ({record['kind']}; commit {str(record['git'].get('commit') or '?')[:12]}"
+          f"{' dirty' if record['git'].get('dirty') else ''}; started {record['started_utc']};"
+          f" exit code {record.get('exit_code')})")
+    if record.get("ended_utc") is None:
         print(f"{pad}  not finished: the run was stopped, or is still going")
         differ += 1
     for out in record.get("outputs", []):
@@ -246,7 +280,7 @@ def verify(run, bin_dir, depth=0):
         # Not a fault of the run: the tree moved on. Said, not counted.
         print(f"{pad}  configuration changed in the source tree since the run: {', '.join(drifted)}")
     head = git("rev-parse", "HEAD")
-    if head and record["git"]["commit"] and head.strip() != record["git"]["commit"]:
+    if head and record["git"].get("commit") and head.strip() != record["git"]["commit"]:
         print(f"{pad}  the source tree is now at {head.strip()[:12]}, not the run's commit")
     if record["kind"] == "study" and os.path.isfile(os.path.join(run, "tables_args.json")):
         differ += verify_tables(run, bin_dir, pad)

@@ -18,6 +18,7 @@ the processes' own checked readers then check every key and value (scripts/orbed
 """
 import argparse
 import json
+import math
 import os
 import sys
 
@@ -37,6 +38,19 @@ class SettingsError(Exception):
     pass
 
 
+def plain(value):
+    """Whether `value` is what a configuration key can hold: a string, a finite number, a bool, or a
+    list of those or of mappings of those (a walk's waypoints); not a date, binary, a null or a NaN,
+    which YAML can also spell."""
+    if isinstance(value, list):
+        return all(plain(v) for v in value)
+    if isinstance(value, dict):
+        return all(isinstance(k, str) and plain(v) for k, v in value.items())
+    if isinstance(value, float):
+        return math.isfinite(value)
+    return isinstance(value, (str, int, bool))
+
+
 def merge(into, origin_into, key, value, origin):
     """Puts `value` at the dotted `key` of `into`; mappings merge key by key, anything else replaces."""
     if isinstance(value, dict):
@@ -50,6 +64,9 @@ def merge(into, origin_into, key, value, origin):
             f"{', '.join(s + '.*' for s in SECTIONS)} (hmd_emulator/config/*.yaml, procs/assistant/assistant.yaml)")
     if len(parts) < 2 or any(not p for p in parts):
         raise SettingsError(f"{origin}: {key}: expected a key inside the section, e.g. {parts[0]}.seed")
+    if not plain(value):
+        raise SettingsError(f"{origin}: {key}: expected a string, a finite number, true/false or a list "
+                            f"of those (or of mappings of those), got {value!r}")
     node = into
     for p in parts[:-1]:
         if not isinstance(node.get(p), dict):
@@ -65,7 +82,7 @@ def read_config(path):
             doc = yaml.safe_load(f)
     except OSError as e:
         raise SettingsError(f"--config {path}: {e.strerror}")
-    except yaml.YAMLError as e:
+    except (yaml.YAMLError, UnicodeDecodeError) as e:
         raise SettingsError(f"--config {path}: not YAML: {e}")
     if doc is None:
         return {}
@@ -77,7 +94,7 @@ def read_config(path):
 def parse_set(text):
     key, sep, value = text.partition("=")
     if not sep or not key.strip():
-        raise SettingsError(f"--set {text}: expected KEY=VALUE, e.g. user.depth_bias_fraction_std=0.03")
+        raise SettingsError(f"--set {text}: expected KEY=VALUE, e.g. user.direct_view.depth_bias_fraction_std=0.03")
     try:
         return key.strip(), yaml.safe_load(value) if value.strip() else ""
     except yaml.YAMLError as e:
@@ -134,17 +151,17 @@ def main(argv):
     except SettingsError as e:
         print(f"settings: {e}", file=sys.stderr)
         return 2
-    os.makedirs(args.out, exist_ok=True)
     files = {}
     for section, value in merged.items():
         name, _ = SECTIONS[section]
         files.setdefault(name, {})[section] = value
-    for name, sections in files.items():
+    # Every text first, then the files: nothing is written for settings that are refused.
+    texts = {name: overlay_text(sections, origins) for name, sections in files.items()}
+    texts["settings.json"] = json.dumps({"settings": dict(leaves(merged)), "from": origins}, indent=2) + "\n"
+    os.makedirs(args.out, exist_ok=True)
+    for name, text in texts.items():
         with open(os.path.join(args.out, name), "w") as f:
-            f.write(overlay_text(sections, origins))
-    with open(os.path.join(args.out, "settings.json"), "w") as f:
-        json.dump({"settings": dict(leaves(merged)), "from": origins}, f, indent=2)
-        f.write("\n")
+            f.write(text)
     for name in files:
         argument = next(a for n, a in SECTIONS.values() if n == name)
         print(f"{argument}={os.path.abspath(os.path.join(args.out, name))}")

@@ -130,6 +130,27 @@ class Records(unittest.TestCase):
         self.assertEqual(done.returncode, 1)
         self.assertIn("not finished", done.stdout)
 
+    def test_a_record_that_leads_elsewhere_or_lacks_keys_is_a_difference_not_a_crash(self):
+        record = self.start()
+        for change, said in ((lambda r: r.update(runs=[".."]), "runs: expected names of folders inside"),
+                             (lambda r: r.update(outputs=[{"path": "/etc/passwd", "sha256": "0"}]),
+                              "outputs: expected {path inside the run folder"),
+                             (lambda r: r.pop("run"), "run: expected a str"),
+                             (lambda r: r.update(config_files="x"), "config_files: expected a list")):
+            broken = dict(record)
+            change(broken)
+            with open(os.path.join(self.run_dir, "provenance.json"), "w") as f:
+                json.dump(broken, f)
+            done = provenance("verify", self.run_dir)
+            self.assertEqual(done.returncode, 1, done.stderr)
+            self.assertIn(said, done.stdout)
+            self.assertEqual(done.stderr, "")
+        with open(os.path.join(self.run_dir, "provenance.json"), "wb") as f:
+            f.write(b"\xff\xfe{")
+        done = provenance("verify", self.run_dir)
+        self.assertEqual((done.returncode, done.stderr), (1, ""))
+        self.assertIn("cannot be read as JSON", done.stdout)
+
     def test_a_folder_without_a_record_is_refused(self):
         done = provenance("verify", self.run_dir)
         self.assertEqual(done.returncode, 1)
@@ -207,7 +228,10 @@ class Settings(unittest.TestCase):
 
 
 class Studies(unittest.TestCase):
-    ARGS = ["study", "--users", "1", "--trials", "1", "--setup-users", "1", "--targets", "1"]
+    # The assistant's shipped value set again: the setting reaches the set-up runs (and not the
+    # ViRAAl runs, whose launch has no assistant) without changing a number.
+    ARGS = ["study", "--users", "1", "--trials", "1", "--setup-users", "1", "--targets", "1",
+            "--set", "assistant.headset.lateral_noise_arcmin=4.0"]
 
     def test_studies_started_together_are_each_their_own(self):
         logs = tempfile.mkdtemp(prefix="orbed_studies_")
@@ -240,6 +264,11 @@ class Studies(unittest.TestCase):
                 self.assertEqual(user["arguments"]["run_id"], f"study-s1-{run.split('-')[0]}-u1"
                                  if run.startswith("setup") else "study-s1-u1")
                 self.assertEqual(user["exit_code"], 0)
+            with open(os.path.join(folder, "setup-u1", "provenance.json")) as f:
+                self.assertEqual(json.load(f)["arguments"]["assistant_config"],
+                                 os.path.join(folder, "setup-u1", "settings", "assistant.yaml"))
+            with open(os.path.join(folder, "viraal-u1", "provenance.json")) as f:
+                self.assertNotIn("assistant_config", json.load(f)["arguments"])
             # Results files name the record beside them.
             with open(os.path.join(folder, "viraal-u1", "results.json")) as f:
                 self.assertEqual(json.load(f)["provenance"], "provenance.json")

@@ -1,5 +1,7 @@
 #include "procs/common/flags.h"
 
+#include <cmath>
+
 #include <cstdlib>
 #include <regex>
 
@@ -72,6 +74,17 @@ void AddInstanceFlag(CLI::App* app, const std::string& flag, std::string* name, 
                                                    : std::string("expected ") + channels::kInstanceNameRule;
           },
           "NAME"));
+}
+
+CLI::Validator FiniteNumber() {
+  return CLI::Validator(
+      [](std::string& value) {
+        double number = 0;
+        return CLI::detail::lexical_cast(value, number) && std::isfinite(number)
+                   ? std::string()
+                   : std::string("expected a finite number, got '") + value + "'";
+      },
+      "FINITE");
 }
 
 void ApplyCommonFlags(const CommonFlags& flags) {

@@ -65,6 +65,10 @@ void AddSimTimeFlag(CLI::App* app, CommonFlags* flags);
 /// channels::ForArm). `help` says which.
 void AddInstanceFlag(CLI::App* app, const std::string& flag, std::string* name, const std::string& help);
 
+/// A validator that refuses NaN and the infinities, which CLI::PositiveNumber and CLI::Range let
+/// through (every comparison with NaN is false): `->check(FiniteNumber())`.
+CLI::Validator FiniteNumber();
+
 /// Sets the log name and level; throws CLI::ValidationError on a bad level or chaos spec.
 void ApplyCommonFlags(const CommonFlags& flags);
 

@@ -8,6 +8,8 @@
 #include <filesystem>
 #include <thread>
 
+#include "base/format.h"
+#include "base/run_folder.h"
 #include "procs/common/channels.h"
 #include "procs/common/conversions.h"
 #include "procs/common/log.h"
@@ -26,14 +28,6 @@ double SecondsSince(std::chrono::steady_clock::time_point t) {
 }  // namespace
 
 namespace {
-
-// The run folder's name, as deputies make it under their logs folders; "" when it has none.
-std::string RunDirName(const std::string& log_dir) {
-  std::filesystem::path path = std::filesystem::path(log_dir).lexically_normal();
-  if (!path.has_filename()) path = path.parent_path();  // "logs/run/"
-  const std::string name = path.filename().string();
-  return RunDirOk(name) ? name : "";
-}
 
 // A process placed on another host must fit DEPUTY_COMMAND's limits (deputy_protocol.h), or its
 // deputy would refuse the whole command: said here, at start, naming the process.
@@ -58,6 +52,19 @@ void CheckRemoteProcess(const ProcessSpec& p) {
 
 }  // namespace
 
+std::string RunFolderName(const std::string& log_dir) {
+  if (log_dir.empty()) return "";
+  std::error_code ec;
+  std::filesystem::path path = std::filesystem::absolute(log_dir, ec).lexically_normal();
+  if (!path.has_filename()) path = path.parent_path();  // "logs/run/"
+  std::string name = path.filename().string();
+  for (path = path.parent_path(); path.has_filename() && !ProvenanceRecordIn(path.string()).empty();
+       path = path.parent_path()) {
+    name = path.filename().string() + "." + name;
+  }
+  return RunDirOk(name) ? name : "";
+}
+
 Launcher::Launcher(const CommonFlags& flags, LaunchSpec spec, std::string bin_dir, std::string host,
                    std::string log_dir)
     : flags_(flags),
@@ -67,7 +74,7 @@ Launcher::Launcher(const CommonFlags& flags, LaunchSpec spec, std::string bin_di
       log_dir_(std::move(log_dir)),
       process_(flags),
       deputies_(&process_, spec_.name + "@" + host_ + "/" + std::to_string(getpid()), NowMicros(),
-                RunDirName(log_dir_)) {
+                RunFolderName(log_dir_)) {
   name_width_ = 7;  // "process", the summary's header
   for (size_t g = 0; g < spec_.groups.size(); ++g) {
     for (const ProcessSpec& p : spec_.groups[g].processes) {
@@ -207,7 +214,7 @@ void Launcher::HandleExit(Managed* m) {
     const std::string said = m->child->last_line();
     const std::string reason = "process '" + m->spec.name + "' " + m->last_exit +
                                ": it cannot write its output, not respawned" +
-                               (said.empty() ? "" : " (it said: " + said + ")");
+                               (said.empty() ? "" : " (it said: " + EscapeText(said) + ")");
     if (m->spec.required) {
       FailTestbed("required " + reason);
     } else {

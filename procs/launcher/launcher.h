@@ -17,8 +17,10 @@
 ///
 /// Run folders: the launch file's ${ORBED_LOG_DIR} is expanded where a process runs (the CLI
 /// parses the file with it deferred): to `log_dir` for the launcher's own children, and by each
-/// deputy to <its --log-root>/<the name of log_dir> on its host (deputy_command_t.run_dir), so
-/// every process keeps its state on its own host's disk; a shared disk gives the same folder.
+/// deputy to <its --log-root>/<the run's name> on its host (deputy_command_t.run_dir: log_dir's
+/// name after those of the run folders it is in, joined by '.', e.g. "study-<time>-<random>.setup-u1"),
+/// so every process keeps its state on its own host's disk, in a folder no other run uses; with a
+/// shared disk and the logs folder as log root, a top-level run's is the launcher's folder itself.
 ///
 /// Children get: --name <name> appended (heartbeat-ready processes, unless args have --name),
 /// ORBED_LCM_URL = the launcher's LCM URL, ORBED_HOST = the launcher's host name,
@@ -52,6 +54,13 @@
 #include "procs/launcher/launch_file.h"
 
 namespace orbed::launcher {
+
+/// The run folder's name, as deputies make it under their logs folders (deputy_command_t.run_dir):
+/// `log_dir`'s own name after those of the run folders it is in (folders holding a provenance
+/// record, base/run_folder.h), joined by '.': "study-<time>-<random>.setup-u1" for a study's user,
+/// whose own name repeats in every study, so that it is as unique on every host as on this one;
+/// "" when it has none that RunDirOk accepts.
+std::string RunFolderName(const std::string& log_dir);
 
 class Launcher {
  public:

@@ -12,6 +12,7 @@
 #include "base/test_command.h"
 #include "procs/launcher/child.h"
 #include "procs/launcher/launch_file.h"
+#include "procs/launcher/launcher.h"
 #include "procs/launcher/launcher_cli.h"
 
 namespace orbed::launcher {
@@ -260,6 +261,20 @@ TEST(LaunchFile, ArgumentsAreDeclaredGivenDefaultedAndConditional) {
   EXPECT_NE(ErrorOfFile((dir / "bad_key.yaml").string()).find("bad_key.yaml:2: arguments.a"),
             std::string::npos)
       << ErrorOfFile((dir / "bad_key.yaml").string());
+}
+
+// A study's user's run folder is named after the study too, so that deputies, which make it under
+// their own logs folder, never give two studies' users one folder.
+TEST(Launcher, RunFolderNamesAreAsUniqueOnADeputyAsHere) {
+  const std::filesystem::path logs = std::filesystem::path(::testing::TempDir()) / "run_folder_names";
+  std::filesystem::create_directories(logs / "study-A" / "setup-u1");
+  std::filesystem::create_directories(logs / "20261204T000000Z-abc");
+  std::ofstream(logs / "study-A" / "provenance.json") << "{}";
+  EXPECT_EQ(RunFolderName((logs / "20261204T000000Z-abc").string()), "20261204T000000Z-abc");
+  EXPECT_EQ(RunFolderName((logs / "20261204T000000Z-abc").string() + "/"), "20261204T000000Z-abc");
+  EXPECT_EQ(RunFolderName((logs / "study-A" / "setup-u1").string()), "study-A.setup-u1");
+  EXPECT_EQ(RunFolderName((logs / "study-A").string()), "study-A");
+  EXPECT_EQ(RunFolderName(""), "");
 }
 
 TEST(LaunchFile, ArgumentAssignments) {

@@ -70,6 +70,7 @@ int RunScenario(int argc, const char* const* argv, std::ostream& out, std::ostre
   app.add_option("--request-deadline-s", run.request_deadline_s,
                  "Wait this long for the answer to any request (PLAN_CHECK_REPLY, ALIGNMENT_TRIAL, "
                  "REGISTRATION, LANDMARK, MISALIGNMENT), re-sending it meanwhile [s]")
+      ->check(FiniteNumber())
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   app.add_option("--move-timeout-s", run.move_timeout_s, "Wait for the arm to reach a configuration [s]")

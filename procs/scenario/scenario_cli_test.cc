@@ -1,5 +1,5 @@
 // The orbed-scenario command line, run in-process: --help, bad flags, and the run id's sources
-// (--run-id > $ORBED_RUN_ID > viraal-<UTC time>) seen in results.json of a run on memq:// that
+// (--run-id, else viraal-<UTC time>; never the environment) seen in results.json of a run on memq:// that
 // fails fast for want of a robot.
 #include "procs/scenario/scenario_cli.h"
 
@@ -67,6 +67,11 @@ TEST(ScenarioCli, BadFlagsExitNonZeroWithTheMessageOnErr) {
   r = Cli({"--request-deadline-s", "-1"});
   EXPECT_NE(r.code, 0);
   EXPECT_TRUE(Contains(r.err, "--request-deadline-s")) << r.err;
+  for (const char* not_finite : {"nan", "inf", "-nan"}) {  // no comparison stops a NaN deadline
+    r = Cli({"--request-deadline-s", not_finite});
+    EXPECT_NE(r.code, 0) << not_finite;
+    EXPECT_TRUE(Contains(r.err, "expected a finite number")) << r.err;
+  }
   r = Cli({"--retry-initial-s", "1", "--retry-max-s", "0.5", "--lcm-url", "memq://"});
   EXPECT_NE(r.code, 0);
   EXPECT_TRUE(Contains(r.err, "--retry-max-s must be >= --retry-initial-s")) << r.err;

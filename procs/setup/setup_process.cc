@@ -214,6 +214,7 @@ int RunSetup(int argc, const char* const* argv, std::ostream& out, std::ostream&
   app.add_option("--request-deadline-s", options.request_deadline_s,
                  "Wait this long for the headset's and the registration server's answers while aligning, "
                  "re-sending the requests meanwhile [s]")
+      ->check(FiniteNumber())
       ->check(CLI::Range(1.0, 3600.0))
       ->capture_default_str();
   std::string resume;
