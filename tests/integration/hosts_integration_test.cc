@@ -221,6 +221,28 @@ TEST(Hosts, TheViraalRunOnThreeHostsCompletesAndSurvivesAPartition) {
 // A process on another host that dies is respawned there, through its deputy, as a local one
 // would be: the headset on B, SIGKILLed after the first trial, comes back as a new instance (a new
 // pid, ready again at its heartbeat) and the run completes.
+// What a test of a killed headset hears on the LAN: the alignment trials answered, and every pid
+// that sent a PROCESS_STATUS as "hmd" (a respawned headset is a second one).
+struct HeadsetWatch {
+  int trials = 0;
+  std::set<int> hmd_pids;
+
+  void Subscribe(lcm::LCM* observer) {
+    observer->subscribeFunction(
+        "ALIGNMENT_TRIAL",
+        +[](const lcm::ReceiveBuffer*, const std::string&, HeadsetWatch* s) { ++s->trials; }, this);
+    observer->subscribeFunction(
+        "PROCESS_STATUS",
+        +[](const lcm::ReceiveBuffer* rbuf, const std::string&, HeadsetWatch* s) {
+          orbed::process_status_t status;
+          if (status.decode(rbuf->data, 0, static_cast<int>(rbuf->data_size)) > 0 && status.name == "hmd") {
+            s->hmd_pids.insert(status.pid);
+          }
+        },
+        this);
+  }
+};
+
 TEST(Hosts, AProcessKilledOnAnotherHostIsRespawnedThroughItsDeputy) {
   if (!CanBuildHosts()) GTEST_SKIP() << kNoHosts;
   VirtualLan lan({"hostA", "hostB"});
@@ -231,23 +253,10 @@ TEST(Hosts, AProcessKilledOnAnotherHostIsRespawnedThroughItsDeputy) {
                                          << "placement: {hmd: hostB}\n";
   const auto deputy_b = lan.Run("hostB", {BinPath("orbed-launch"), "--deputy", "hostB", "--log-root", dir});
 
-  struct Seen {
-    int trials = 0;
-    std::set<int> hmd_pids;
-  } seen;
+  HeadsetWatch seen;
   lcm::LCM observer(kLanUrl);
   ASSERT_TRUE(observer.good());
-  observer.subscribeFunction(
-      "ALIGNMENT_TRIAL", +[](const lcm::ReceiveBuffer*, const std::string&, Seen* s) { ++s->trials; }, &seen);
-  observer.subscribeFunction(
-      "PROCESS_STATUS",
-      +[](const lcm::ReceiveBuffer* rbuf, const std::string&, Seen* s) {
-        orbed::process_status_t status;
-        if (status.decode(rbuf->data, 0, static_cast<int>(rbuf->data_size)) > 0 && status.name == "hmd") {
-          s->hmd_pids.insert(status.pid);
-        }
-      },
-      &seen);
+  seen.Subscribe(&observer);
   const std::string log_dir = dir + "/log";
   const auto launcher = lan.Run("hostA",
                                 {BinPath("orbed-launch"), dir + "/two_hosts.yaml", "--host", "hostA", "--arg",
@@ -370,23 +379,10 @@ TEST(Hosts, HostsWithTheirOwnDisksRideOutAPartitionAndAKilledHeadset) {
   const auto deputy_b = lan.Run("hostB", {BinPath("orbed-launch"), "--deputy", "hostB", "--log-root", disk});
   const auto deputy_c = lan.Run("hostC", {BinPath("orbed-launch"), "--deputy", "hostC", "--log-root", disk});
 
-  struct Seen {
-    int trials = 0;
-    std::set<int> hmd_pids;
-  } seen;
+  HeadsetWatch seen;
   lcm::LCM observer(kLanUrl);
   ASSERT_TRUE(observer.good());
-  observer.subscribeFunction(
-      "ALIGNMENT_TRIAL", +[](const lcm::ReceiveBuffer*, const std::string&, Seen* s) { ++s->trials; }, &seen);
-  observer.subscribeFunction(
-      "PROCESS_STATUS",
-      +[](const lcm::ReceiveBuffer* rbuf, const std::string&, Seen* s) {
-        orbed::process_status_t status;
-        if (status.decode(rbuf->data, 0, static_cast<int>(rbuf->data_size)) > 0 && status.name == "hmd") {
-          s->hmd_pids.insert(status.pid);
-        }
-      },
-      &seen);
+  seen.Subscribe(&observer);
   // A's run folder, on A's disk (as scripts/orbed makes it there).
   const std::string run = disk + "/own-disks-run";
   ASSERT_TRUE(std::filesystem::create_directory(lan.OnHost("hostA", run)));
