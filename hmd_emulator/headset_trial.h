@@ -42,7 +42,7 @@ namespace orbed::hmd {
 
 /// TrialSeed() purposes.
 inline constexpr std::uint64_t kTrialSeedPurpose = 2;
-inline constexpr std::uint64_t kSessionMapPurpose = 3;  ///< 1 was a map per trial (until issue 10 item 4)
+inline constexpr std::uint64_t kSessionMapPurpose = 3;  ///< 1 was a map per trial, before one per session
 
 /// The seed for one purpose of trial `index` of `session_id` in a process seeded with `seed`:
 /// SplitMix64 over the seed, the FNV-1a hash of the session id, the index and the purpose

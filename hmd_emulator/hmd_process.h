@@ -135,7 +135,7 @@ struct HmdOptions {
   bool threaded{true};  ///< images on a worker thread (see the file comment)
   /// The session's state file (session_file.h): restored at start, saved on every change; "" = none.
   std::string state_file;
-  /// One of several headsets (issue 12; channels::IsInstanceName): every channel of the headset's
+  /// One of several headsets (channels::IsInstanceName): every channel of the headset's
   /// own (HMD_POSE, HMD_POSE_TRUTH, HMD_CAMERA, GAZE_RAY, REFLECTIVE_VIEW, AR_VIEW,
   /// ALIGNMENT_TRIAL) and of its session (SESSION_CONTROL, REGISTRATION) gets the suffix _NAME
   /// (channels::ForHeadset); "" = the single headset, plain names.

@@ -519,7 +519,7 @@ TEST(HmdProcess, PoseAndTruthShareSeqAndStartAtTheFirstWaypoint) {
   EXPECT_NEAR(ToVector3(got.gaze.back().direction_W).norm(), 1.0, 1e-9);
 }
 
-// Several headsets and arms (issue 12): --headset suffixes what the headset publishes, --arm what
+// Several headsets and arms: --headset suffixes what the headset publishes, --arm what
 // it reads of its arm, and the person walks the shipped walk carried to that arm's base.
 TEST(HmdProcess, AHeadsetAtAnotherArmUsesItsChannelsAndWalksAroundThatArm) {
   HmdOptions o = Inline();

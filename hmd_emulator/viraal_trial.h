@@ -59,7 +59,7 @@
 namespace orbed::hmd {
 
 /// A collaborator's headset as the first reflective display (the paper's Discussion: multi-view
-/// from collaborative devices; issue 12). Another person stands at `waypoint` of the walk, their
+/// from collaborative devices). Another person stands at `waypoint` of the walk, their
 /// head where the walk's is on arriving there (looking where the walk looks), and their camera's
 /// live frame, with the hologram drawn in it, is what the display shows while the wearer aligns.
 /// Their headset has its own map, joined to the wearer's by a shared anchor: the frame is stamped
@@ -190,7 +190,7 @@ WalkSamples WalkToAlignment(const TrialSetup& setup, double t0_s, SlamModel* mod
 double WalkStraight(const Eigen::Vector3d& p_W_from, const Eigen::Vector3d& p_W_to,
                     const HeadTrajectoryConfig& walk, double t0_s, SlamModel* model);
 
-/// The session's one continuous map (issue 10 item 4) as it is when trial `trial_index` begins:
+/// The session's one continuous map as it is when trial `trial_index` begins:
 /// the person puts the headset on at p_W_session_start (the map's origin, stored as the first
 /// place), walks straight to the walk's first waypoint, and for each earlier trial walks the trial's
 /// walk to its alignment sample and straight back to the first waypoint. Only the walks are

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""orbed fit: the one calibration of the ViRAAl user, made again (issue 10 item 6).
+"""orbed fit: the one calibration of the ViRAAl user, made again.
 
 Only the AR-only row of the paper's Table 1 (30.2 +/- 23.9 mm) is fitted, with the two parameters of
 the depth judgement that set its size and its person-to-person spread:

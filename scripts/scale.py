@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""orbed scale: the testbed as arms x headsets grow (issue 12, "Scale benchmark").
+"""orbed scale: the testbed as arms x headsets grow (docs/benchmarks.md, "Arms x headsets").
 
 Each point of the grid runs orbed-load --arms A --headsets H (tests/load: A orbed-iiwa-sim --arm
 a<i> in sim/models/scenes/four_arms_or.yaml, H orbed-hmd --headset h<j> looking at arm a<j mod A>,
@@ -28,7 +28,7 @@ import os
 import subprocess
 import sys
 
-LATENCY_GOAL_P99_MS = 15.0  # issue 12, item 4
+LATENCY_GOAL_P99_MS = 15.0  # the goal: every camera's p99 at most 15 ms at 4 x 4
 RATE_HELD = 0.98            # achieved / wanted for a stream to count as at its rate
 
 

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""orbed sweep: the ViRAAl alignment error as one model input varies (issue 10 item 7).
+"""orbed sweep: the ViRAAl alignment error as one model input varies.
 
 Each point runs orbed-user-study (the live run's protocol without the bus) for USERS emulated
 persons (user.seed 1..USERS) with TRIALS trials per display mode, and reports the paper's Table 1

@@ -153,7 +153,7 @@ struct IiwaSimOptions {
   double report_distance_m{0.05};
   /// robot_state_t::robot_name (with `arm`, unless set: the arm's name).
   std::string robot_name{"iiwa7"};
-  /// Several arms (issue 12): "" = the single arm (the scene's robot.base_pose, plain channel
+  /// Several arms: "" = the single arm (the scene's robot.base_pose, plain channel
   /// names). Else the name of one of the scene's `arms:`: its base, every channel below suffixed
   /// with channels::ForArm (IIWA_STATUS_A1, ...; SIM_CLOCK too: each arm's sim keeps its own
   /// clock), and every other arm of the scene a moving obstacle, posed from its ROBOT_STATE_<NAME>

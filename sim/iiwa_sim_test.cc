@@ -680,7 +680,7 @@ TEST(IiwaSim, PublishesTrueFramesAndClearances) {
   for (const auto& contact : c.contacts) EXPECT_LT(contact.distance_m, 0.05);
 }
 
-// Several arms (issue 12): orbed-iiwa-sim --arm a0 in scenes/four_arms_or.yaml stands at a0's base
+// Several arms: orbed-iiwa-sim --arm a0 in scenes/four_arms_or.yaml stands at a0's base
 // and uses a0's channels; arm a1 (0.7 m along the table, upright at q = 0) is known from the
 // ROBOT_STATE_A1 the test publishes, as a1's own sim would. Swinging a0 horizontal toward a1 stops
 // before it (its tool before a1's), naming a1's link; once a1 is elsewhere a0 goes on; a ROBOT_STATE_A1 of

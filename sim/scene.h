@@ -81,7 +81,7 @@ struct Scene {
   double tool_length_m{0.25};  ///< [m]: the URDF's tool
   Trocar trocar;
   std::vector<SceneObject> objects;
-  /// Several arms (issue 12): empty for a single-arm scene.
+  /// Several arms (`arms:`): empty for a single-arm scene.
   std::vector<ArmPlacement> arms;
   /// The arm of that name, or nullptr.
   const ArmPlacement* FindArm(const std::string& arm_name) const;

@@ -55,13 +55,13 @@ inline std::string Suffixed(const std::string& channel, const std::string& name)
   return channel + "_" + suffix;
 }
 
-/// A channel of one of several arms (issue 12): ForArm("IIWA_STATUS", "a1") == "IIWA_STATUS_A1";
+/// A channel of one of several arms: ForArm("IIWA_STATUS", "a1") == "IIWA_STATUS_A1";
 /// a single arm ("") keeps the plain name, so Drake's tools still find IIWA_STATUS and IIWA_COMMAND.
 inline std::string ForArm(const std::string& channel, const std::string& arm) {
   return Suffixed(channel, arm);
 }
 
-/// A channel of one of several headsets (issue 12): ForHeadset("HMD_CAMERA", "h1") ==
+/// A channel of one of several headsets: ForHeadset("HMD_CAMERA", "h1") ==
 /// "HMD_CAMERA_H1"; a single headset ("") keeps the plain name.
 inline std::string ForHeadset(const std::string& channel, const std::string& headset) {
   return Suffixed(channel, headset);

@@ -41,7 +41,7 @@ struct CommonFlags {
   /// Follow the sim clock (SIM_CLOCK, procs/common/sim_clock.h) instead of the monotonic and wall
   /// clocks (Process, process.h).
   bool sim_time = false;
-  /// With sim_time, the arm whose clock to follow (one of several, issue 12): SIM_CLOCK_<ARM> in,
+  /// With sim_time, the arm whose clock to follow (one of several): SIM_CLOCK_<ARM> in,
   /// lockstep answers on SIM_CLOCK_ACK_<ARM> (channels::ForArm); "" = the single arm's SIM_CLOCK.
   /// Set by the processes that take --arm.
   std::string sim_clock_arm;

@@ -40,7 +40,7 @@ struct GuidanceOptions {
   double rate_hz{30.0};
   /// No GUIDANCE from an IIWA_STATUS received longer ago than this [s] (the sim sends 200 Hz).
   double stale_after_s{0.5};
-  /// One of several arms (issue 12; the scene's `arms:`): the guidance of that arm; every channel
+  /// One of several arms (the scene's `arms:`): the guidance of that arm; every channel
   /// below gets the suffix _NAME (channels::ForArm) and IGTL_TARGET's IK stands at its base.
   std::string arm;
   std::string iiwa_status_channel{channels::kIiwaStatus};

@@ -35,7 +35,7 @@ struct RegistrationServerOptions {
   double state_period_s = 1.0;
   /// The session journal (session_journal.h); "" = none.
   std::string journal_path;
-  /// One of several headsets (issue 12): the registration of that headset's map to the arm it
+  /// One of several headsets: the registration of that headset's map to the arm it
   /// looks at; every channel below gets the suffix _NAME (channels::ForHeadset). "" = plain names.
   std::string headset;
   std::string session_control_channel = channels::kSessionControl;

@@ -151,7 +151,7 @@ struct ConductorOptions {
   std::string misalignment_channel{channels::kMisalignment};
 };
 
-/// One of several headsets and arms (issue 12): the session's channels (SESSION_CONTROL,
+/// One of several headsets and arms: the session's channels (SESSION_CONTROL,
 /// ALIGNMENT_TRIAL, REGISTRATION, LANDMARK*, MISALIGNMENT*) get the headset's suffix, the arm's
 /// (ROBOT_STATE, IIWA_COMMAND, PLAN_CHECK_*) the arm's (channels::ForHeadset, ForArm); "" keeps them.
 void UseInstanceChannels(ConductorOptions* options, const std::string& headset, const std::string& arm);

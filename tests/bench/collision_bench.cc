@@ -7,7 +7,7 @@
 /// one after the other (FclChecker), and through FCL's own broadphase (a dynamic AABB tree over every
 /// primitive, its distance query pruning by the best distance so far, the same pairs filtered in the
 /// callback: FclBroadphaseChecker, the minimum distance only). Then four arms around the table
-/// (FourArms, issue 12): each arm's Bullet world checking itself, the scene and the three others,
+/// (FourArms): each arm's Bullet world checking itself, the scene and the three others,
 /// against one FCL broadphase over the four arms and the scene. The joint vectors are a fixed pool of
 /// 1024 seeded random vectors within the limits.
 ///
@@ -271,7 +271,7 @@ class FclBroadphaseChecker {
   std::vector<std::vector<Eigen::Isometry3d>> X_RL_;
 };
 
-// Four arms around the table (issue 12): sim/models/scenes/four_arms_or.yaml, a0 where the single
+// Four arms around the table: sim/models/scenes/four_arms_or.yaml, a0 where the single
 // arm stands, a1 and a2 beside it 0.7 m along the table, a3 across it, each on its cart. Each arm's
 // world checks its own links, the scene and the three others, as each arm's sim would (so a pair of
 // arms is checked from both sides); each arm sits at its own joint vector from the pool.

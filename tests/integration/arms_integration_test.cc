@@ -1,4 +1,4 @@
-// Several arms (issue 12) over real LCM in a private network namespace: two orbed-iiwa-sim
+// Several arms over real LCM in a private network namespace: two orbed-iiwa-sim
 // processes, `--arm a0` and `--arm a1` of sim/models/scenes/four_arms_or.yaml, each on its own
 // suffixed channels and each knowing the other from its ROBOT_STATE_<NAME>. a0, turned and laid
 // horizontal toward a1 (upright 0.7 m away), stops before a1, naming a1's link; a1, at rest, sees
@@ -113,7 +113,7 @@ TEST(Arms, OneArmStopsBeforeAnotherRunningInItsOwnProcess) {
   EXPECT_EQ(seen.plain_status, 0) << "an arm of several published on the single arm's IIWA_STATUS";
 }
 
-// Several headsets, each registering its own map to its own arm (issue 12): two arms (a1 and a2 of
+// Several headsets, each registering its own map to its own arm: two arms (a1 and a2 of
 // four_arms_or.yaml, 1.4 m apart), and per arm a headset with its own person (--user-seed), its
 // registration server and its ViRAAl conductor, all on the headset's and the arm's channels, run
 // at once on one bus. Each run ends ok; each results.json holds the truth of its own arm (the

@@ -1,6 +1,6 @@
-// Crash recovery end to end (issue 9 item 4): scripts/launch/viraal.yaml through orbed-launch with
-// run id "pinned", in a private network namespace, while the test SIGKILLs processes at moments
-// it picks from what it sees on the bus (no sleeps):
+// Crash recovery end to end (state files, journal, respawn): scripts/launch/viraal.yaml through
+// orbed-launch with run id "pinned", in a private network namespace, while the test SIGKILLs
+// processes at moments it picks from what it sees on the bus (no sleeps):
 //   - the registration server after trial 0 of session 0 (its journal holds the session), and the
 //     logger after trial 1 of session 1 (the recording goes on in a second part), each while the
 //     test holds the arm (SIGSTOP of the sim from the moment the trial arrives, SIGCONT once the
@@ -9,8 +9,8 @@
 //     while nobody records;
 //   - the headset the moment the REQUEST_TRIAL for trial 1 of session 1 arrives, with no hold: the
 //     request is in flight to a process that is dying (or has just answered it). The conductor
-//     re-sends it (issue 9 item 5) until the respawned headset, restored from its state file,
-//     answers; the trial is the one the first headset would have made;
+//     re-sends it (every request is retried, every answer idempotent) until the respawned
+//     headset, restored from its state file, answers; the trial is the one the first headset would have made;
 //   - the sim while the arm moves from configuration 1 to 2 in session 0: it comes back at the
 //     last configuration it saved, and the conductor's re-sent IIWA_COMMAND takes it on.
 // The run must complete with results.json equal, number for number, to the pinned uninterrupted

@@ -1,4 +1,4 @@
-// Launch across hosts (issue 12): three network namespaces as hosts A, B and C, each joined by a
+// Launch across hosts (launcher and deputies): three network namespaces as hosts A, B and C, each joined by a
 // veth pair to one bridge in this test's own private namespace (addresses 10.77.0.0/24, which
 // exist only in here), LCM's multicast with ttl=1 between them and nothing else reachable. On A
 // orbed-launch runs scripts/launch/viraal.yaml with the registration server placed on B and the

@@ -1,4 +1,4 @@
-// The short form of `scripts/orbed load` (issue 9, "Load"): the testbed (scripts/launch/load.yaml
+// The short form of `scripts/orbed load`: the testbed (scripts/launch/load.yaml
 // through orbed-launch, in this test's private network namespace) at 10 x its nominal rates for
 // 18 s, measured by orbed-load's RunLoad (tests/load/load_run.h). What it holds, as mechanisms
 // rather than rates (the machine may be busy):

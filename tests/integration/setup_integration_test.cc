@@ -15,7 +15,7 @@
 //  6. A resumed run (--arg setup_resume=...): a finished run's file cut back to its first set-up and
 //     marked partial; the launch keeps that set-up as it was, sends SETUP_TASK for the second only,
 //     and ends with both, the first exactly as the file had it.
-//  7. The sim clock (issue 11 item 6): setup.yaml for one user, two fixed-monitor set-ups, on the
+//  7. The sim clock (SIM_CLOCK, --sim-time): setup.yaml for one user, two fixed-monitor set-ups, on the
 //     sim's clock at 8 times real time (every process following it, the sim held until the
 //     conductor runs): the run ends with exit 0 and both set-ups recorded as the assistant read
 //     them; SIM_CLOCK carries rate 8 and stamps every IIWA_STATUS; and every GUIDANCE is stamped at
@@ -23,7 +23,7 @@
 //     wall clock would not give. (Without lockstep the set-ups are not compared with a run at
 //     R = 1: the sim does not wait for its followers, so under load a look moves in sim time by R
 //     times its wall latency, and in the sanitizer build joints ended 17-90 deg apart; case 8.)
-//  8. Lockstep (the rest of issue 11 item 6): the same user, a fixed and an AR set-up (with its
+//  8. Lockstep (SIM_CLOCK_ACK rounds): the same user, a fixed and an AR set-up (with its
 //     three alignments through the headset and the registration server), run in lockstep with 8
 //     steps per tick at real time and at 8 times real time: the two runs are the same run, every
 //     message stamped on the sim clock equal field for field at the same sim time (IIWA_STATUS,

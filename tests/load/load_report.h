@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// The pure core of orbed-load (issue 9, "Load"): what the testbed is asked to do at F times its
+/// The pure core of orbed-load (the load test): what the testbed is asked to do at F times its
 /// nominal rates (LoadPlan), how the messages counted on the bus and the heartbeats' drop counters
 /// account for what was wanted (StreamRow), the per-process memory and restart figures
 /// (ProcessRow), the verdict and the printed table. No bus, no clock, no /proc: load_run.h feeds it.
@@ -20,7 +20,7 @@
 /// Image streams are requested by a timer and made by the renderer: their drops are the requests
 /// never made, and sent + drops = wanted the same way.
 ///
-/// Scale (issue 12, "Scale benchmark"): MakeScalePlan(A, H) is the testbed with A arms (the
+/// Scale (the arms x headsets benchmark): MakeScalePlan(A, H) is the testbed with A arms (the
 /// scene sim/models/scenes/four_arms_or.yaml, one orbed-iiwa-sim --arm a<i> each, process sim_a<i>)
 /// and H headsets (orbed-hmd --headset h<j> --arm a<j mod A>, each a different person, --user-seed
 /// j + 1, process hmd_h<j>), every stream on its suffixed channel; ScaleLaunchYaml() is its launch
