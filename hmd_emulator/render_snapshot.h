@@ -2,7 +2,7 @@
 /// @file
 /// The `orbed-render-snapshot` tool (thin main in render_snapshot_main.cc), as a library function so
 /// that tests can run it in-process. It writes the pictures of what the testbed's headset shows, for
-/// the README:
+/// docs/processes.md:
 ///   DIR/camera_frame.png     an HMD_CAMERA frame: the shipped OR scene and the real iiwa, rendered
 ///                            from a bedside head pose (HoloLens PV intrinsics)
 ///   DIR/reflective_view.png  a REFLECTIVE_VIEW: a frame captured from the foot of the table (the

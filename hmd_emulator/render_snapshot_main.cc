@@ -1,5 +1,5 @@
 /// @file
-/// orbed-render-snapshot: writes the README's pictures of what the testbed's headset shows,
+/// orbed-render-snapshot: writes the docs' pictures of what the testbed's headset shows,
 /// camera_frame.png and reflective_view.png (what, flags and exit codes:
 /// hmd_emulator/render_snapshot.h). Publishes and subscribes nothing.
 #include <iostream>

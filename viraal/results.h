@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// The results of a ViRAAl run and their two renderings: results.json (documented in README.md)
+/// The results of a ViRAAl run and their two renderings: results.json (documented in docs/studies.md)
 /// and the text table orbed-scenario prints at the end.
 ///
 /// Units: as named (mm, deg, s); poses X_WR (truth) and X_WV (chosen / mean) as

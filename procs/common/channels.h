@@ -1,7 +1,7 @@
 #pragma once
 /// @file
 /// Channel names of the orbed bus, defined once. Every process takes these as defaults and lets a
-/// flag override them. Types per channel are in lcmtypes/ and README.md.
+/// flag override them. Types per channel are in lcmtypes/ and docs/channels.md.
 
 #include <cctype>
 #include <string>

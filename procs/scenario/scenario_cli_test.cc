@@ -121,7 +121,7 @@ TEST(ScenarioCli, TheRunIdComesFromTheFlagThenTheClock) {
   EXPECT_EQ(id.size(), std::string("viraal-20250101T000000Z").size()) << id;
 }
 
-// --print: the pinned run's table (its Table 1 rows as the README's pinned block shows them), exit
+// --print: the pinned run's table (its Table 1 rows as docs/studies.md's pinned block shows them), exit
 // 0; the same run marked partial, exit 3 with the trials done; a missing file, exit 1 naming it.
 TEST(ScenarioCli, PrintsAFinishedRunsTable) {
   const std::string pinned = SourceTreePath("tests/integration/testdata/viraal_pinned_results.json");
