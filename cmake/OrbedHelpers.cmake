@@ -1,6 +1,8 @@
 # orbed_add_gtest(NAME name SRCS a.cc b.cc LIBS lib1 lib2 [LABELS l1 l2] [TIMEOUT sec])
 #   One gtest executable, registered with ctest as one test (names are per executable, so ctest
-#   output stays short and each library's test is one line).
+#   output stays short and each library's test is one line). A unit test: labelled `quick`
+#   (`scripts/orbed test --quick` runs the quick ones), besides any LABELS given; the integration,
+#   Xvfb, Chromium and multi-process tests are registered elsewhere and are not quick.
 function(orbed_add_gtest)
   cmake_parse_arguments(T "" "NAME;TIMEOUT" "SRCS;LIBS;LABELS" ${ARGN})
   add_executable(${T_NAME} ${T_SRCS})
@@ -12,9 +14,7 @@ function(orbed_add_gtest)
   endif()
   set_tests_properties(${T_NAME} PROPERTIES TIMEOUT ${T_TIMEOUT}
     ENVIRONMENT "ORBED_SOURCE_DIR=${CMAKE_SOURCE_DIR};ORBED_BIN_DIR=${CMAKE_BINARY_DIR}/bin")
-  if(T_LABELS)
-    set_tests_properties(${T_NAME} PROPERTIES LABELS "${T_LABELS}")
-  endif()
+  set_tests_properties(${T_NAME} PROPERTIES LABELS "quick;${T_LABELS}")
   orbed_sanitizer_test_properties(${T_NAME})
 endfunction()
 

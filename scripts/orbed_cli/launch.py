@@ -71,6 +71,8 @@ def launch(ctx, file, duration=None, lan=False, host=None, args=(), settings=(),
             run_dir = new_run_dir(ctx, "")
         os.makedirs(ctx.netns_dir, exist_ok=True)
         launch_args = list(args)
+        env = dict(os.environ, ORBED_LOG_DIR=run_dir, ORBED_SOURCE_DIR=ctx.root,
+                   ORBED_LAUNCH_FILE=os.path.realpath(file))
         orbed_launch = os.path.join(ctx.bin, "orbed-launch")
 
         def refuse(message):
@@ -86,7 +88,7 @@ def launch(ctx, file, duration=None, lan=False, host=None, args=(), settings=(),
             except Failure:
                 refuse("the settings were refused (above)")
             shown = subprocess.run([orbed_launch, file, "--show-args", "--json"], stdout=subprocess.PIPE, text=True,
-                                   stderr=out)
+                                   stderr=out, env=env)
             if shown.returncode != 0:
                 refuse(f"orbed-launch cannot read {file} (above)")
             declared = json.loads(shown.stdout)
@@ -99,11 +101,9 @@ def launch(ctx, file, duration=None, lan=False, host=None, args=(), settings=(),
         # The launch's arguments as they will be, checked (a name it does not declare is refused).
         arg_flags = [x for a in launch_args for x in ("--arg", a)]
         with open(os.path.join(run_dir, "launch_arguments.json"), "w") as f:
-            shown = subprocess.run([orbed_launch, file, "--show-args", "--json", *arg_flags], stdout=f, stderr=out)
+            shown = subprocess.run([orbed_launch, file, "--show-args", "--json", *arg_flags], stdout=f, stderr=out, env=env)
         if shown.returncode != 0:
             refuse("orbed-launch refused the launch (above)")
-        env = dict(os.environ, ORBED_LOG_DIR=run_dir, ORBED_SOURCE_DIR=ctx.root,
-                   ORBED_LAUNCH_FILE=os.path.realpath(file))
         provenance(ctx, "start", run_dir, "--kind", "launch", "--launch", file, *launch_settings(env),
                    *(["--parent", into] if into else []))
         argv = [orbed_launch, file, *arg_flags]
