@@ -106,6 +106,7 @@ class Progress:
         self.console, self.what, self.n, self.k = console, what, n, 0
         self.started = time.monotonic()
         self.detail = ""
+        self.last = None  # the line shown last
 
     def elapsed(self):
         return time.monotonic() - self.started
@@ -114,15 +115,22 @@ class Progress:
         if detail is not None:
             self.detail = detail
         line = format_progress(self.what, self.k, self.n, self.elapsed())
-        self.console.progress(line + (f" ({self.detail})" if self.detail else ""), final=final)
+        line += f" ({self.detail})" if self.detail else ""
+        if line != self.last or final:
+            self.console.progress(line, final=final)
+            self.last = line
 
     def step(self, detail=None):
         self.k = min(self.n, self.k + 1)
         self.show(detail)
 
     def done(self, detail=None):
+        """The last line: on a terminal it ends the rewritten line; otherwise shown if new."""
         self.k = self.n
-        self.show(detail, final=True)
+        if self.console.tty:
+            self.show(detail, final=True)
+        else:
+            self.show(detail)
 
 
 def tail(path, lines=40):

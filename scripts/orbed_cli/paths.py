@@ -109,7 +109,7 @@ def cmake_build(ctx, build_dir, configure_argv, targets=(), log=None, env=None, 
     the compiler's output goes there and one progress line follows cmake's [ NN%]; a failure shows
     the log's tail. Returns the seconds it took."""
     os.makedirs(build_dir, exist_ok=True)
-    started = Progress(ctx.console, what, 100)
+    started = Progress(ctx.console, f"{what}: percent", 100)
     with open(os.path.join(build_dir, ".orbed-build.lock"), "w") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX)
         if not os.path.isfile(os.path.join(build_dir, "CMakeCache.txt")):
@@ -129,7 +129,8 @@ def cmake_build(ctx, build_dir, configure_argv, targets=(), log=None, env=None, 
 
             def on_line(line):
                 m = re.match(r"\[\s*(\d+)%\]", line)
-                if m and int(m.group(1)) != started.k:
+                # On a terminal every percent; otherwise every tenth.
+                if m and (int(m.group(1)) // (1 if ctx.console.tty else 10)) != started.k // (1 if ctx.console.tty else 10):
                     started.k = int(m.group(1))
                     started.show()
             code = run_logged(argv, log, ctx.console, on_line=on_line)
