@@ -1,13 +1,14 @@
 """load: the testbed at F x its nominal rates for N s, measured by orbed-load (tests/load) in a
 private namespace; logs in logs/load-<time>-<random>/. orbed-load's chatter (stderr) goes to
-RUN/load.log, its report (stdout) to RUN/report.txt, printed once at the end; one progress line
+RUN/load.log (and the testbed's), its report is printed once at the end; one progress line
 counts the seconds."""
 import os
+import re
 import subprocess
 import threading
 
 from . import checks
-from .output import Progress, show_failure
+from .output import Progress, run_logged, show_failure
 from .paths import quiet_build
 from .runs import new_run_dir, provenance
 
@@ -23,6 +24,16 @@ def configure(p):
     p.add_argument("--factor", type=checks.positive, default="10", metavar="F", help="times the nominal rates (default 10)")
 
 
+def report(log):
+    """orbed-load's report from its log: from the process table's header on, without the lines
+    the testbed's processes and orbed-launch print while they stop."""
+    with open(log, errors="replace") as f:
+        lines = f.read().splitlines()
+    first = max([i for i, line in enumerate(lines) if re.match(r"process\s+CPU %", line)], default=len(lines))
+    return "\n".join(line for line in lines[first:]
+                     if not line.startswith("[orbed-launch]") and not re.match(r"^[\w-]+\s*\| ", line))
+
+
 def run(args, ctx):
     quiet_build(ctx, ["testbed", "orbed-load"])
     run_dir = new_run_dir(ctx, "load-")
@@ -32,7 +43,7 @@ def run(args, ctx):
                "--setting", f"duration_s={args.duration_s}", "--setting", f"factor={args.factor}")
     ctx.say(f"load: {args.factor} x nominal rates for {args.duration_s} s, logs in {ctx.rel(run_dir)}")
     env = dict(os.environ, ORBED_SOURCE_DIR=ctx.root, ORBED_NETNS_PIDFILE=pidfile)
-    log, report = os.path.join(run_dir, "load.log"), os.path.join(run_dir, "report.txt")
+    log = os.path.join(run_dir, "load.log")
     progress = Progress(ctx.console, "load: second", max(1, round(float(args.duration_s))))
     stop = threading.Event()
 
@@ -41,28 +52,19 @@ def run(args, ctx):
             progress.k = min(progress.n - 1, round(progress.elapsed()))
             progress.show()
     ticker = threading.Thread(target=tick, daemon=True)
-    with open(report, "w") as out, open(log, "w") as err:
-        child = subprocess.Popen([ctx.script("netns-exec"), os.path.join(ctx.bin, "orbed-load"), "--duration-s",
-                                  str(args.duration_s), "--factor", str(args.factor), "--log-dir", run_dir],
-                                 env=env, stdout=out, stderr=subprocess.PIPE, text=True, errors="replace")
-        ticker.start()
-        verdict = []
-        for line in child.stderr:
-            err.write(line)
-            err.flush()
-            if ctx.console.verbose:
-                ctx.console.echo(line)
-            if line.startswith("orbed-load: FAILED") or line.startswith("orbed-load: passed"):
-                verdict.append(line.rstrip("\n"))
-        code = child.wait()
-    stop.set()
-    ticker.join()
-    if os.path.exists(pidfile):
-        os.remove(pidfile)
+    ticker.start()
+    try:
+        code = run_logged([ctx.script("netns-exec"), os.path.join(ctx.bin, "orbed-load"), "--duration-s",
+                           str(args.duration_s), "--factor", str(args.factor), "--log-dir", run_dir], log, ctx.console,
+                          env=env)
+    finally:
+        stop.set()
+        ticker.join()
+        if os.path.exists(pidfile):
+            os.remove(pidfile)
     progress.done()
-    with open(report) as f:
-        ctx.console.results(f.read() + "\n".join(verdict))
-    if code and not verdict:
+    ctx.console.results(report(log))
+    if code:
         show_failure(ctx.console, log)
     provenance(ctx, "finish", run_dir, "--exit-code", str(code))
     ctx.say(f"load: exit code {code}; log folder {ctx.rel(run_dir)}")

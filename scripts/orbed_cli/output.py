@@ -126,10 +126,11 @@ class Progress:
 
     def done(self, detail=None):
         """The last line: on a terminal it ends the rewritten line; otherwise shown if new."""
+        shown_all = self.last is not None and self.last.startswith(f"{self.what} {self.n}/{self.n},")
         self.k = self.n
         if self.console.tty:
             self.show(detail, final=True)
-        else:
+        elif not shown_all:
             self.show(detail)
 
 
