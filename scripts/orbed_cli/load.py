@@ -4,7 +4,6 @@ RUN/load.log (and the testbed's), its report is printed once at the end; one pro
 counts the seconds."""
 import os
 import re
-import subprocess
 import threading
 
 from . import checks

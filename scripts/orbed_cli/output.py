@@ -3,7 +3,6 @@ work, and child processes whose output goes to a log file.
 
 Threading: Progress may be ticked from a timer thread (load) while the main thread waits for a
 child; its writes take a lock. Everything else runs on the main thread."""
-import os
 import subprocess
 import sys
 import threading

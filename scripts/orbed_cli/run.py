@@ -5,7 +5,7 @@ import json
 import os
 import subprocess
 
-from . import checks, launch as launch_verb
+from . import launch as launch_verb
 from .paths import build
 
 HELP = "set up, build and run the paper's ViRAAl experiment; print its results table"
