@@ -19,18 +19,22 @@ function(orbed_add_gtest)
 endfunction()
 
 # orbed_add_process(NAME orbed-foo MAIN main.cc LIBS foo_lib)
-#   A thin main; also registered as two smoke tests: `--help` exits 0, an unknown flag exits with an
-#   error code (1-125; 126-127: the shell could not run it, above: a signal). Checked by the shell,
-#   not by WILL_FAIL, which would also turn a sanitizer report in the output (a failure) into a pass.
+#   A thin main; also registered as three smoke tests: `--help` exits 0; an unknown flag exits 2,
+#   every orbed program's usage error (base/command_line.h); `--version` prints "orbed <version>
+#   (commit <hex>...)". Checked by the shell, not by WILL_FAIL, which would also turn a sanitizer
+#   report in the output (a failure) into a pass.
 function(orbed_add_process)
   cmake_parse_arguments(P "" "NAME;MAIN" "LIBS" ${ARGN})
   add_executable(${P_NAME} ${P_MAIN})
   target_link_libraries(${P_NAME} PRIVATE ${P_LIBS})
   add_test(NAME ${P_NAME}.help COMMAND ${P_NAME} --help)
   add_test(NAME ${P_NAME}.unknown_flag
-    COMMAND sh -c "\"$0\" --no-such-flag-xyz; c=$?; test $c -ge 1 -a $c -le 125" $<TARGET_FILE:${P_NAME}>)
-  set_tests_properties(${P_NAME}.help ${P_NAME}.unknown_flag PROPERTIES TIMEOUT 20 LABELS smoke)
-  orbed_sanitizer_test_properties(${P_NAME}.help ${P_NAME}.unknown_flag)
+    COMMAND sh -c "\"$0\" --no-such-flag-xyz; test $? -eq 2" $<TARGET_FILE:${P_NAME}>)
+  add_test(NAME ${P_NAME}.version COMMAND ${P_NAME} --version)
+  set_tests_properties(${P_NAME}.version PROPERTIES
+    PASS_REGULAR_EXPRESSION "^orbed ${PROJECT_VERSION} \\(commit ([0-9a-f]+|unknown)(, modified)?\\)")
+  set_tests_properties(${P_NAME}.help ${P_NAME}.unknown_flag ${P_NAME}.version PROPERTIES TIMEOUT 20 LABELS smoke)
+  orbed_sanitizer_test_properties(${P_NAME}.help ${P_NAME}.unknown_flag ${P_NAME}.version)
 endfunction()
 
 # orbed_sanitizer_test_properties(TEST...)

@@ -6,8 +6,10 @@
 #include <string>
 
 #include <CLI/CLI.hpp>
+
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include "base/command_line.h"
 
 #include "base/source_paths.h"
 #include "base/units.h"
@@ -87,17 +89,13 @@ int RunRenderSnapshot(int argc, const char* const* argv, std::ostream& out, std:
   CLI::App app{
       "orbed-render-snapshot: write camera_frame.png (an HMD_CAMERA frame) and reflective_view.png (a\n"
       "REFLECTIVE_VIEW with a hologram 3 cm / 2 deg off), the README's pictures. Deterministic."};
+  AddVersionFlag(&app);
   std::string dir = SourceTreePath("docs/images");
   app.add_option("--out", dir,
                  "Existing folder for the pictures (default: docs/images under $ORBED_SOURCE_DIR, else "
                  "under the source tree it was built from)")
       ->check(CLI::ExistingDirectory);
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e, out, err);
-    return code == 0 ? 0 : 2;
-  }
+  if (const auto code = ParseArguments(&app, argc, argv, out, err)) return *code;
   try {
     WriteSnapshots(dir);
   } catch (const std::exception& e) {

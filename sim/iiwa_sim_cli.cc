@@ -23,7 +23,7 @@ int RunIiwaSim(int argc, const char* const* argv, std::ostream& out, std::ostrea
   app.add_option("--scene", options.scene_path,
                  "Scene YAML (default: sim/models/scenes/trocar_or.yaml, found like --urdf)");
   app.add_option("--period-s", options.period_s, "Tick and status period [s] (0.005 = 200 Hz)")
-      ->check(CLI::PositiveNumber)
+      ->check(orbed::PositiveNumber())
       ->capture_default_str();
   app.add_option("--realtime-rate", options.realtime_rate,
                  "Sim seconds per wall second (1-100; for studies without a person in the loop; in "
@@ -38,7 +38,7 @@ int RunIiwaSim(int argc, const char* const* argv, std::ostream& out, std::ostrea
                "speed or the rate");
   app.add_option("--lockstep-timeout-s", options.lockstep_timeout_s,
                  "Wall seconds a lockstep round waits for a follower before going on without it")
-      ->check(CLI::PositiveNumber)
+      ->check(orbed::PositiveNumber())
       ->capture_default_str();
   app.add_option(
       "--arm", options.arm,
@@ -57,18 +57,18 @@ int RunIiwaSim(int argc, const char* const* argv, std::ostream& out, std::ostrea
                  "(crash recovery)");
   app.add_option("--state-save-period-s", options.state_save_period_s,
                  "Longest time between two saves of the state file while the arm moves [s]")
-      ->check(CLI::PositiveNumber)
+      ->check(orbed::PositiveNumber())
       ->capture_default_str();
   app.add_option("--stale-command-s", options.stale_command_s,
                  "Reject IIWA_COMMAND whose utime is further than this from the wall clock [s]; 0 = off")
-      ->check(CLI::NonNegativeNumber)
+      ->check(orbed::NonNegativeNumber())
       ->capture_default_str();
   app.add_option("--stop-margin-m", options.stop_margin_m, "Stop this far before contact [m]")
-      ->check(CLI::NonNegativeNumber)
+      ->check(orbed::NonNegativeNumber())
       ->capture_default_str();
   app.add_option("--report-distance-m", options.report_distance_m,
                  "COLLISION_STATUS lists pairs closer than this [m]")
-      ->check(CLI::NonNegativeNumber)
+      ->check(orbed::NonNegativeNumber())
       ->capture_default_str();
   app.add_option("--robot-name", options.robot_name, "robot_name on ROBOT_STATE")->capture_default_str();
   app.add_option("--iiwa-status-channel", options.iiwa_status_channel)->capture_default_str();

@@ -8,6 +8,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "base/command_line.h"
 #include "base/json.h"
 #include "base/number_list.h"
 #include "base/source_paths.h"
@@ -251,6 +252,7 @@ int RunPlan(const std::string& scene_path, const std::string& urdf, const Trocar
 int RunRobotTool(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
   CLI::App app{
       "orbed-robot: forward kinematics, collision check and trocar IK of the iiwa 7 model (JSON out)"};
+  AddVersionFlag(&app);
   app.require_subcommand(1);
   std::string q_text, urdf, scene_path;
   uint64_t seed = 1;
@@ -266,7 +268,7 @@ int RunRobotTool(int argc, const char* const* argv, std::ostream& out, std::ostr
   ik->add_option("--scene", scene_path, "scene YAML")->required();
   ik->add_option("--urdf", urdf, "robot URDF");
   ik->add_option("--seed", seed, "random seed of the IK starts");
-  ik->add_option("--starts", starts, "number of random IK starts")->check(CLI::Range(1, 100000));
+  ik->add_option("--starts", starts, "number of random IK starts")->check(orbed::NumberIn(1, 100000));
   TrocarPlanOptions plan_options;
   auto* plan = app.add_subcommand(
       "plan",
@@ -274,35 +276,20 @@ int RunRobotTool(int argc, const char* const* argv, std::ostream& out, std::ostr
   plan->add_option("--scene", scene_path, "scene YAML")->required();
   plan->add_option("--urdf", urdf, "robot URDF");
   plan->add_option("--targets", plan_options.num_targets, "number of targets")
-      ->check(CLI::Range(1, 20))
+      ->check(orbed::NumberIn(1, 20))
       ->capture_default_str();
   plan->add_option("--min-separation-deg", plan_options.min_separation_deg,
                    "every two targets differ by at least this in some joint [deg]")
-      ->check(CLI::Range(0.0, 180.0))
+      ->check(orbed::NumberIn(0.0, 180.0))
       ->capture_default_str();
   plan->add_option("--min-clearance-m", plan_options.min_clearance_m, "arm clearance of every target [m]")
-      ->check(CLI::NonNegativeNumber)
+      ->check(orbed::NonNegativeNumber())
       ->capture_default_str();
   plan->add_option("--seed", plan_options.seed, "random seed of the IK starts")->capture_default_str();
   plan->add_option("--starts", plan_options.starts, "IK starts per target")
-      ->check(CLI::Range(1, 1000))
+      ->check(orbed::NumberIn(1, 1000))
       ->capture_default_str();
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::CallForHelp&) {
-    out << app.help();
-    return 0;
-  } catch (const CLI::CallForAllHelp&) {
-    out << app.help("", CLI::AppFormatMode::All);
-    return 0;
-  } catch (const CLI::ParseError& e) {
-    std::string msg = e.what();
-    for (auto& c : msg) {
-      if (c == '\n') c = ' ';
-    }
-    err << "orbed-robot: " << msg << " (see --help)\n";
-    return 2;
-  }
+  if (const auto code = ParseArguments(&app, argc, argv, out, err)) return *code;
   try {
     if (*fk) return RunFk(q_text, urdf, out);
     if (*check) return RunCheck(q_text, scene_path, urdf, out);

@@ -12,6 +12,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "base/command_line.h"
 #include "base/format.h"
 #include "base/source_paths.h"
 #include "base/stats.h"
@@ -146,6 +147,7 @@ int RunUserStudy(int argc, const char* const* argv, std::ostream& out, std::ostr
       "orbed-user-study: the ViRAAl experiment of `scripts/orbed run` without the bus: the same\n"
       "headset trials, registration and errors, for as many trials as wanted. Prints the table\n"
       "(or, past 10 trials per mode, a summary and a rank test) beside the paper's Table 1."};
+  AddVersionFlag(&app);
   StudyOptions o;
   std::string scenario_path = SourceTreePath(viraal::kDefaultScenarioRelativePath);
   int trials = 0;
@@ -153,7 +155,7 @@ int RunUserStudy(int argc, const char* const* argv, std::ostream& out, std::ostr
   bool quiet = false;
   app.add_option("--trials", trials, "Trials per display mode, at most 1000 (default: the scenario file's)")
       ->transform(PositiveDecimalInt())
-      ->check(CLI::Range(1, static_cast<int>(kMaxTrialsPerSession)));
+      ->check(orbed::NumberIn(1, static_cast<int>(kMaxTrialsPerSession)));
   app.add_option("--modes", modes, "Comma-separated run order of ar_reflective, ar (default: the file's)");
   app.add_option("--seed", o.seed, "orbed-hmd's --seed: every trial's seeds derive from it")
       ->capture_default_str();
@@ -181,17 +183,12 @@ int RunUserStudy(int argc, const char* const* argv, std::ostream& out, std::ostr
       ->needs(validation_flag);
   app.add_option("--pointing-std-deg", validation.pointing_std_deg,
                  "--landmark-validation: head-gaze pointing error per axis [deg]")
-      ->check(CLI::NonNegativeNumber)
+      ->check(orbed::NonNegativeNumber())
       ->capture_default_str()
       ->needs(validation_flag);
   app.add_option("--csv", csv_path, "--landmark-validation: write landmark_validation.csv to this file")
       ->needs(validation_flag);
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e, out, err);
-    return code == 0 ? 0 : 2;  // this tool's bad-argument code, not CLI11's
-  }
+  if (const auto code = ParseArguments(&app, argc, argv, out, err)) return *code;
   if (landmark_validation) {
     try {
       validation.seed = o.seed;

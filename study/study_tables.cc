@@ -9,6 +9,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "base/command_line.h"
 #include "base/format.h"
 #include "base/json.h"
 #include "base/run_folder.h"
@@ -195,6 +196,7 @@ int RunStudyTables(int argc, const char* const* argv, std::ostream& out, std::os
       "user, named u1, u2, ... in the order given): alignment_trials.csv, alignment_means.csv,\n"
       "landmark_validation.csv and tables.json in --out, and Table 1 beside the paper's.\n"
       "`scripts/orbed study` runs the users and then this."};
+  AddVersionFlag(&app);
   std::string out_dir;
   std::vector<std::string> run_paths;
   LandmarkValidationOptions validation;
@@ -214,12 +216,7 @@ int RunStudyTables(int argc, const char* const* argv, std::ostream& out, std::os
                  "of the error); one per --setup-truth")
       ->allow_extra_args(false);
   app.add_option("runs", run_paths, "Each ViRAAl user's results.json or its run folder");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e, out, err);
-    return code == 0 ? 0 : 2;
-  }
+  if (const auto code = ParseArguments(&app, argc, argv, out, err)) return *code;
   if (run_paths.empty() && setup_paths.empty()) {
     err << "orbed-study-tables: no runs: give ViRAAl runs and/or --setup runs\n";
     return 2;

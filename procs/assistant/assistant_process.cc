@@ -339,7 +339,7 @@ int RunAssistant(int argc, const char* const* argv, std::ostream& out, std::ostr
                "Carry out the first GUIDANCE's target without a SETUP_TASK, then stop (exit 0)");
   app.add_option("--move-timeout-s", options.move_timeout_s,
                  "A move not finished after this fails the run [s]")
-      ->check(CLI::Range(0.1, 3600.0))
+      ->check(orbed::NumberIn(0.1, 3600.0))
       ->capture_default_str();
   app.add_option("--urdf", options.urdf_path,
                  "Robot URDF (default: sim/models/iiwa7.urdf under $ORBED_SOURCE_DIR, else the source tree)");

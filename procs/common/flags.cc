@@ -1,7 +1,5 @@
 #include "procs/common/flags.h"
 
-#include <cmath>
-
 #include <cstdlib>
 #include <regex>
 
@@ -39,6 +37,7 @@ std::string WithRecvBufSize(const std::string& url, int64_t bytes) {
 }
 
 void AddCommonFlags(CLI::App* app, CommonFlags* flags) {
+  AddVersionFlag(app);
   app->add_option("--lcm-url", flags->lcm_url,
                   "LCM provider URL (default: $ORBED_LCM_URL, else " + std::string(kDefaultLcmUrl) + ")")
       ->capture_default_str();
@@ -48,7 +47,7 @@ void AddCommonFlags(CLI::App* app, CommonFlags* flags) {
       ->capture_default_str();
   app->add_option("--duration-s", flags->duration_s,
                   "Stop cleanly after this many seconds (0: run until SIGINT/SIGTERM)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(NonNegativeNumber())
       ->capture_default_str();
   app->add_option("--log-level", flags->log_level, "debug | info | warn | error")
       ->check(CLI::IsMember({"debug", "info", "warn", "error"}))
@@ -76,17 +75,6 @@ void AddInstanceFlag(CLI::App* app, const std::string& flag, std::string* name, 
           "NAME"));
 }
 
-CLI::Validator FiniteNumber() {
-  return CLI::Validator(
-      [](std::string& value) {
-        double number = 0;
-        return CLI::detail::lexical_cast(value, number) && std::isfinite(number)
-                   ? std::string()
-                   : std::string("expected a finite number, got '") + value + "'";
-      },
-      "FINITE");
-}
-
 void ApplyCommonFlags(const CommonFlags& flags) {
   LogLevel level;
   if (!ParseLogLevel(flags.log_level, &level)) {
@@ -103,11 +91,12 @@ void ApplyCommonFlags(const CommonFlags& flags) {
 
 std::optional<int> ParseCommandLine(CLI::App* app, const CommonFlags& flags, int argc,
                                     const char* const* argv, std::ostream& out, std::ostream& err) {
+  if (const auto code = ParseArguments(app, argc, argv, out, err)) return code;
   try {
-    app->parse(argc, argv);
     ApplyCommonFlags(flags);
   } catch (const CLI::ParseError& e) {
-    return app->exit(e, out, err);
+    app->exit(e, out, err);
+    return kExitUsage;
   }
   return std::nullopt;
 }

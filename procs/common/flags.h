@@ -24,6 +24,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "base/command_line.h"
+
 namespace orbed {
 
 /// Multicast group and port of the testbed (LCM's own default group, ttl=0: never leaves the host).
@@ -55,6 +57,7 @@ std::string DefaultLcmUrl();
 /// messages outright. Other providers (memq://, file://) are returned unchanged.
 std::string WithRecvBufSize(const std::string& url, int64_t bytes);
 
+/// Adds the flags above and --version (base/command_line.h).
 void AddCommonFlags(CLI::App* app, CommonFlags* flags);
 /// Adds --sim-time for a process whose timers may follow the sim clock. The sim
 /// (the clock's source), the logger, the launcher and the monitor do not take it.
@@ -65,17 +68,13 @@ void AddSimTimeFlag(CLI::App* app, CommonFlags* flags);
 /// channels::ForArm). `help` says which.
 void AddInstanceFlag(CLI::App* app, const std::string& flag, std::string* name, const std::string& help);
 
-/// A validator that refuses NaN and the infinities, which CLI::PositiveNumber and CLI::Range let
-/// through (every comparison with NaN is false): `->check(FiniteNumber())`.
-CLI::Validator FiniteNumber();
-
 /// Sets the log name and level; throws CLI::ValidationError on a bad level or chaos spec.
 void ApplyCommonFlags(const CommonFlags& flags);
 
 /// The start of every command line's Run…(): parses `argv` into `app` (AddCommonFlags called on
 /// it) and applies the common flags. Returns std::nullopt to go on, else the exit code to return
-/// now: 0 after --help (the usage on `out`), CLI11's code after a bad flag or value (the message on
-/// `err`).
+/// now: 0 after --help or --version (on `out`), kExitUsage (2) after a bad flag or value (the
+/// message on `err`; base/command_line.h).
 std::optional<int> ParseCommandLine(CLI::App* app, const CommonFlags& flags, int argc,
                                     const char* const* argv, std::ostream& out, std::ostream& err);
 

@@ -53,10 +53,10 @@ int RunViewerBridge(int argc, const char* const* argv, std::ostream& out, std::o
   app.add_option("--urdf", options.urdf_path, "Robot URDF (default: the shipped iiwa 7)");
   app.add_option("--scene", options.scene_path, "Scene YAML (default: the shipped OR; none: no scene)");
   app.add_option("--rate-hz", options.rate_hz, "DRAKE_VIEWER_DRAW rate [Hz]")
-      ->check(CLI::Range(0.1, 1000.0))
+      ->check(orbed::NumberIn(0.1, 1000.0))
       ->capture_default_str();
   app.add_option("--load-period-s", options.load_period_s, "Period of DRAKE_VIEWER_LOAD_ROBOT [s]")
-      ->check(CLI::Range(0.1, 3600.0))
+      ->check(orbed::NumberIn(0.1, 3600.0))
       ->capture_default_str();
   app.add_option("--robot-state-channel", options.robot_state_channel)->capture_default_str();
   app.add_option("--registration-channel", options.registration_channel)->capture_default_str();

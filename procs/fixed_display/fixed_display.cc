@@ -125,19 +125,19 @@ int RunFixedDisplay(int argc, const char* const* argv, std::ostream& out, std::o
   app.add_option("--camera-m", camera_m, "The monitor camera's home position x,y,z [m, W]")
       ->capture_default_str();
   app.add_option("--rate-hz", options.rate_hz, "FIXED_VIEW rate [Hz]")
-      ->check(CLI::Range(0.1, 60.0))
+      ->check(orbed::NumberIn(0.1, 60.0))
       ->capture_default_str();
   app.add_option("--stale-after-s", options.stale_after_s, "A GUIDANCE older than this shows nothing [s]")
-      ->check(CLI::Range(0.05, 3600.0))
+      ->check(orbed::NumberIn(0.05, 3600.0))
       ->capture_default_str();
   app.add_option("--width-px", options.picture.width_px, "Picture width [px]")
-      ->check(CLI::Range(64, 3840))
+      ->check(orbed::NumberIn(64, 3840))
       ->capture_default_str();
   app.add_option("--height-px", options.picture.height_px, "Picture height [px]")
-      ->check(CLI::Range(48, 2160))
+      ->check(orbed::NumberIn(48, 2160))
       ->capture_default_str();
   app.add_option("--fov-deg", options.picture.horizontal_fov_deg, "Horizontal field of view [deg]")
-      ->check(CLI::Range(10.0, 120.0))
+      ->check(orbed::NumberIn(10.0, 120.0))
       ->capture_default_str();
   app.add_flag("--all-modes", options.all_modes, "Show the target in every guidance mode, not only `fixed`");
   app.add_flag("--window", options.window, "Show the picture in a window whose keys move the view");

@@ -143,21 +143,21 @@ int RunFoxgloveBridge(int argc, const char* const* argv, std::ostream& out, std:
   AddCommonFlags(&app, &common);
   BridgeOptions options;
   app.add_option("--port", options.server.port, "WebSocket port (0: any free port, printed at start)")
-      ->check(CLI::Range(0, 65535))
+      ->check(orbed::NumberIn(0, 65535))
       ->capture_default_str();
   app.add_option("--bind", options.server.bind_address, "Address to listen on (0.0.0.0: every interface)")
       ->capture_default_str();
   app.add_option("--max-clients", options.server.max_clients, "Connections served at once")
-      ->check(CLI::Range(1, 64))
+      ->check(orbed::NumberIn(1, 64))
       ->capture_default_str();
   app.add_option("--rate-hz", options.rate_hz, "/tf rate [Hz]")
-      ->check(CLI::Range(0.1, 1000.0))
+      ->check(orbed::NumberIn(0.1, 1000.0))
       ->capture_default_str();
   app.add_option("--image-hz", options.image_hz, "Image rate per camera or display [Hz]")
-      ->check(CLI::Range(0.01, 60.0))
+      ->check(orbed::NumberIn(0.01, 60.0))
       ->capture_default_str();
   app.add_option("--scene-period-s", options.scene_period_s, "Period of /scene [s]")
-      ->check(CLI::Range(0.1, 3600.0))
+      ->check(orbed::NumberIn(0.1, 3600.0))
       ->capture_default_str();
   app.add_option("--urdf", options.urdf_path, "Robot URDF (default: the shipped iiwa 7)");
   app.add_option("--scene", options.scene_path, "Scene YAML (default: the shipped OR; none: no scene)");

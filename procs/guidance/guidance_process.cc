@@ -174,21 +174,21 @@ int RunGuidance(int argc, const char* const* argv, std::ostream& out, std::ostre
       app.add_option("--plan", plan_path, "A plan from `orbed-robot plan`: its --target is the target")
           ->excludes(target_flag);
   app.add_option("--target", plan_target, "Which target of --plan (1-based)")
-      ->check(CLI::Range(1, 20))
+      ->check(orbed::NumberIn(1, 20))
       ->capture_default_str()
       ->needs(plan_flag);
   app.add_option("--mode", mode, "Guidance mode on GUIDANCE: ar, ar_reflective or fixed")
       ->capture_default_str();
   app.add_option("--tolerance-deg", options.target.tolerance_deg,
                  "A joint within this of its target is done [deg]")
-      ->check(CLI::Range(0.001, 90.0))
+      ->check(orbed::NumberIn(0.001, 90.0))
       ->capture_default_str();
   app.add_option("--rate-hz", options.rate_hz, "GUIDANCE rate [Hz]")
-      ->check(CLI::Range(0.1, 1000.0))
+      ->check(orbed::NumberIn(0.1, 1000.0))
       ->capture_default_str();
   app.add_option("--stale-after-s", options.stale_after_s,
                  "No GUIDANCE while the latest IIWA_STATUS is older than this [s]")
-      ->check(CLI::Range(0.01, 60.0))
+      ->check(orbed::NumberIn(0.01, 60.0))
       ->capture_default_str();
   app.add_option("--urdf", options.urdf_path,
                  "Robot URDF (default: sim/models/iiwa7.urdf under $ORBED_SOURCE_DIR, else the source tree)");

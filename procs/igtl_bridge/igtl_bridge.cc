@@ -221,19 +221,19 @@ int RunIgtlBridge(int argc, const char* const* argv, std::ostream& out, std::ost
   AddCommonFlags(&app, &common);
   BridgeOptions options;
   app.add_option("--port", options.server.port, "TCP port (0: any free port, printed at start)")
-      ->check(CLI::Range(0, 65535))
+      ->check(orbed::NumberIn(0, 65535))
       ->capture_default_str();
   app.add_option("--bind", options.server.bind_address,
                  "IPv4 address to listen on (0.0.0.0: every interface, for Slicer on another host)")
       ->capture_default_str();
   app.add_option("--max-clients", options.server.max_clients, "Connections served at once")
-      ->check(CLI::Range(1, 64))
+      ->check(orbed::NumberIn(1, 64))
       ->capture_default_str();
   app.add_option("--transform-hz", options.transform_hz, "TRANSFORM rate [Hz]")
-      ->check(CLI::Range(0.1, 1000.0))
+      ->check(orbed::NumberIn(0.1, 1000.0))
       ->capture_default_str();
   app.add_option("--image-hz", options.image_hz, "IMAGE rate per camera or display [Hz]")
-      ->check(CLI::Range(0.01, 60.0))
+      ->check(orbed::NumberIn(0.01, 60.0))
       ->capture_default_str();
   app.add_option("--urdf", options.urdf_path, "Robot URDF (default: the shipped iiwa 7)");
   if (const auto code = ParseCommandLine(&app, common, argc, argv, out, err)) return *code;

@@ -101,7 +101,7 @@ int RunLauncher(int argc, const char* const* argv, std::ostream& out, std::ostre
   app.add_option("--orphan-timeout-s", deputy.orphan_timeout_s,
                  "Deputy: stop what a launcher started when it has been silent this long")
       ->needs(deputy_option)
-      ->check(CLI::PositiveNumber)
+      ->check(orbed::PositiveNumber())
       ->capture_default_str();
   if (const auto code = ParseCommandLine(&app, common, argc, argv, out, err)) return *code;
 

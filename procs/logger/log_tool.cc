@@ -9,6 +9,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "base/command_line.h"
 #include "base/format.h"
 #include "procs/logger/csv_export.h"
 #include "procs/logger/event_log_reader.h"
@@ -158,6 +159,7 @@ int RunLogTool(int argc, const char* const* argv, std::ostream& out, std::ostrea
   CLI::App app{
       "orbed-log: what is in an LCM event log (orbed-logger's or lcm-logger's), whether it is damaged,\n"
       "a cut of it by time and channel, and its messages as CSV tables."};
+  AddVersionFlag(&app);
   app.require_subcommand(1);
   std::string log_path, out_path, channels = ".*";
   double from_s = 0, to_s = 1e18;
@@ -169,9 +171,9 @@ int RunLogTool(int argc, const char* const* argv, std::ostream& out, std::ostrea
   cut->add_option("log", log_path, "the log")->required();
   cut->add_option("out", out_path, "the new log (overwritten)")->required();
   cut->add_option("--from-s", from_s, "from this many seconds after the first event")
-      ->check(CLI::NonNegativeNumber);
+      ->check(orbed::NonNegativeNumber());
   cut->add_option("--to-s", to_s, "to this many seconds after the first event")
-      ->check(CLI::NonNegativeNumber);
+      ->check(orbed::NonNegativeNumber());
   cut->add_option("--channels", channels, "keep channels whose whole name matches this regex")
       ->capture_default_str();
   auto* export_cmd = app.add_subcommand(
@@ -181,17 +183,12 @@ int RunLogTool(int argc, const char* const* argv, std::ostream& out, std::ostrea
       ->required();
   export_cmd->add_flag("--csv", "CSV (the only format, and the default)");
   export_cmd->add_option("--from-s", from_s, "from this many seconds after the first event")
-      ->check(CLI::NonNegativeNumber);
+      ->check(orbed::NonNegativeNumber());
   export_cmd->add_option("--to-s", to_s, "to this many seconds after the first event")
-      ->check(CLI::NonNegativeNumber);
+      ->check(orbed::NonNegativeNumber());
   export_cmd->add_option("--channels", channels, "export channels whose whole name matches this regex")
       ->capture_default_str();
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e, out, err);
-    return code == 0 ? 0 : 2;
-  }
+  if (const auto code = ParseArguments(&app, argc, argv, out, err)) return *code;
   std::regex channel_regex;
   try {
     channel_regex = std::regex(channels, std::regex::extended);

@@ -28,15 +28,15 @@ int RunLogger(int argc, const char* const* argv, std::ostream& out, std::ostream
       ->capture_default_str();
   app.add_option("--queue-events", options.queue_capacity_events,
                  "Queue bound in events; overflow is dropped and counted")
-      ->check(CLI::PositiveNumber)
+      ->check(orbed::PositiveNumber())
       ->capture_default_str();
   int64_t queue_mb = options.queue_capacity_bytes >> 20;
   app.add_option("--queue-mb", queue_mb, "Queue bound in MiB")
-      ->check(CLI::PositiveNumber)
+      ->check(orbed::PositiveNumber())
       ->capture_default_str();
   app.add_option("--flush-interval-s", options.flush_interval_s,
                  "Flush period: after a SIGKILL the log is valid up to the last flush")
-      ->check(CLI::PositiveNumber)
+      ->check(orbed::PositiveNumber())
       ->capture_default_str();
   app.add_option("--hash-file", options.hash_files,
                  "File whose SHA-256 goes into the manifest (repeatable: URDF, scene, ...)");

@@ -18,11 +18,11 @@ int RunMonitor(int argc, const char* const* argv, std::ostream& out, std::ostrea
   MonitorOptions options;
   options.out = &out;
   app.add_option("--print-period-s", options.print_period_s, "Table period")
-      ->check(CLI::PositiveNumber)
+      ->check(orbed::PositiveNumber())
       ->capture_default_str();
   app.add_option("--silent-after-s", options.silent_after_s,
                  "Heartbeat age after which a process is shown as SILENT")
-      ->check(CLI::PositiveNumber)
+      ->check(orbed::PositiveNumber())
       ->capture_default_str();
   if (const auto code = ParseCommandLine(&app, common, argc, argv, out, err)) return *code;
   try {

@@ -26,7 +26,7 @@ int RunRegistration(int argc, const char* const* argv, std::ostream& out, std::o
   RegistrationServerOptions server;
   std::vector<double> server_centroid_m;
   app.add_option("--state-period-s", server.state_period_s, "Period of the full-state REGISTRATION (0 = off)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(orbed::NonNegativeNumber())
       ->capture_default_str();
   app.add_option("--journal", server.journal_path,
                  "Session journal: replayed at start, so a restarted server continues its session "
@@ -35,11 +35,11 @@ int RunRegistration(int argc, const char* const* argv, std::ostream& out, std::o
                  "Average translations about this model centroid p_VC (3 numbers, metres, in V)")
       ->expected(3);
   app.add_option("--k-mad", server.service.outlier.k_mad, "Robust mode: reject beyond median + k*MAD")
-      ->check(CLI::PositiveNumber)
+      ->check(orbed::PositiveNumber())
       ->capture_default_str();
   app.add_option("--min-ray-angle-deg", server.service.triangulation.min_ray_angle_deg,
                  "Landmarks: rays closer than this to parallel are rejected")
-      ->check(CLI::Range(0.0, 89.0))
+      ->check(orbed::NumberIn(0.0, 89.0))
       ->capture_default_str();
   AddInstanceFlag(
       &app, "--headset", &server.headset,
@@ -79,7 +79,7 @@ int RunRegistration(int argc, const char* const* argv, std::ostream& out, std::o
   send->add_option("--session-id", send_options.session_id, "Session id to use")->capture_default_str();
   send->add_flag("--robust", send_options.robust, "Ask for the robust mean");
   send->add_option("--timeout-s", send_options.timeout_s, "How long to wait for the answer")
-      ->check(CLI::PositiveNumber)
+      ->check(orbed::PositiveNumber())
       ->capture_default_str();
 
   if (const auto code = ParseCommandLine(&app, common, argc, argv, out, err)) return *code;

@@ -48,7 +48,7 @@ int RunScenario(int argc, const char* const* argv, std::ostream& out, std::ostre
                  "Scenario YAML (default: viraal/viraal.yaml under $ORBED_SOURCE_DIR, else under "
                  "the source tree it was built from)");
   app.add_option("--trials", trials, "Trials per mode (overrides the file's trials)")
-      ->check(CLI::Range(1, 1000));
+      ->check(orbed::NumberIn(1, 1000));
   app.add_option("--modes", modes, "Comma-separated run order of ar_reflective, ar (overrides the file)");
   app.add_option("--q-deg", q_deg,
                  "A trial configuration q1,...,q7 [deg]; repeat for each (replaces the file's list)");
@@ -62,26 +62,26 @@ int RunScenario(int argc, const char* const* argv, std::ostream& out, std::ostre
   app.add_option("--urdf", options.urdf_path,
                  "Robot URDF for the landmark FK (default: sim/models/iiwa7.urdf)");
   app.add_option("--tolerance-deg", run.tolerance_deg, "Arrival tolerance per joint [deg]")
-      ->check(CLI::PositiveNumber)
+      ->check(orbed::PositiveNumber())
       ->capture_default_str();
   app.add_option("--startup-timeout-s", run.startup_timeout_s, "Wait for the first ROBOT_STATE [s]")
-      ->check(CLI::PositiveNumber)
+      ->check(orbed::PositiveNumber())
       ->capture_default_str();
   app.add_option("--request-deadline-s", run.request_deadline_s,
                  "Wait this long for the answer to any request (PLAN_CHECK_REPLY, ALIGNMENT_TRIAL, "
                  "REGISTRATION, LANDMARK, MISALIGNMENT), re-sending it meanwhile [s]")
       ->check(FiniteNumber())
-      ->check(CLI::PositiveNumber)
+      ->check(orbed::PositiveNumber())
       ->capture_default_str();
   app.add_option("--move-timeout-s", run.move_timeout_s, "Wait for the arm to reach a configuration [s]")
-      ->check(CLI::PositiveNumber)
+      ->check(orbed::PositiveNumber())
       ->capture_default_str();
   app.add_option("--retry-initial-s", run.retry_initial_s,
                  "Re-send an unanswered request after this long, then after doubling intervals [s]")
-      ->check(CLI::PositiveNumber)
+      ->check(orbed::PositiveNumber())
       ->capture_default_str();
   app.add_option("--retry-max-s", run.retry_max_s, "Longest interval between re-sends of a request [s]")
-      ->check(CLI::PositiveNumber)
+      ->check(orbed::PositiveNumber())
       ->capture_default_str();
   std::string headset, arm;
   AddInstanceFlag(

@@ -186,13 +186,13 @@ int RunSetup(int argc, const char* const* argv, std::ostream& out, std::ostream&
                  "--user-seed)");
   app.add_option("--plan", plan_path, "Targets from `orbed-robot plan` (default: procs/setup/targets.json)");
   app.add_option("--targets", targets, "How many of the plan's targets per mode")
-      ->check(CLI::Range(1, 20))
+      ->check(orbed::NumberIn(1, 20))
       ->capture_default_str();
   app.add_option("--start-deg", start_deg, "Where the arm is parked before each set-up [deg]")
       ->capture_default_str();
   app.add_option("--scenario", scenario_path, "The alignment protocol (default: viraal/viraal.yaml)");
   app.add_option("--trials", trials, "Alignments before each headset set-up (the paper: N = 3)")
-      ->check(CLI::Range(1, 100))
+      ->check(orbed::NumberIn(1, 100))
       ->capture_default_str();
   std::string registration = "measured";
   app.add_option("--registration", registration,
@@ -206,16 +206,16 @@ int RunSetup(int argc, const char* const* argv, std::ostream& out, std::ostream&
                  "Folder of setup_results.json (default: $ORBED_LOG_DIR, else .)");
   app.add_option("--urdf", urdf_path, "Robot URDF (default: the shipped iiwa 7)");
   app.add_option("--task-timeout-s", options.task_timeout_s, "Wait for a SETUP_RESULT [s]")
-      ->check(CLI::Range(1.0, 36000.0))
+      ->check(orbed::NumberIn(1.0, 36000.0))
       ->capture_default_str();
   app.add_option("--move-timeout-s", options.move_timeout_s, "Wait for the arm to reach a configuration [s]")
-      ->check(CLI::Range(1.0, 3600.0))
+      ->check(orbed::NumberIn(1.0, 3600.0))
       ->capture_default_str();
   app.add_option("--request-deadline-s", options.request_deadline_s,
                  "Wait this long for the headset's and the registration server's answers while aligning, "
                  "re-sending the requests meanwhile [s]")
       ->check(FiniteNumber())
-      ->check(CLI::Range(1.0, 3600.0))
+      ->check(orbed::NumberIn(1.0, 3600.0))
       ->capture_default_str();
   std::string resume;
   app.add_option("--resume", resume,

@@ -6,6 +6,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "base/command_line.h"
 #include "tests/load/load_run.h"
 
 namespace orbed::load {
@@ -17,51 +18,48 @@ int RunLoadCli(int argc, const char* const* argv, std::ostream& out, std::ostrea
       "process, respawns, the drops each process counts on its heartbeat and the kernel's socket\n"
       "drops, per stream the wanted and achieved rates, and each camera's capture-to-receive latency.\n"
       "Run it in a private network namespace (scripts/orbed load and scripts/orbed scale do)."};
+  AddVersionFlag(&app);
   LoadOptions options;
   double max_growth_percent = 10;
   app.add_option("--factor", options.factor, "Times the nominal rates, in [0.1, 16]")
-      ->check(CLI::Range(kMinFactor, kMaxFactor))
+      ->check(orbed::NumberIn(kMinFactor, kMaxFactor))
       ->capture_default_str();
   app.add_option(
          "--arms", options.arms,
          "With --headsets: the scale launch (sim/models/scenes/four_arms_or.yaml) with this many arms, "
          "1..4, each an orbed-iiwa-sim --arm a<i>, instead of the single testbed")
-      ->check(CLI::Range(1, kMaxScaleArms));
+      ->check(orbed::NumberIn(1, kMaxScaleArms));
   app.add_option(
          "--headsets", options.headsets,
          "With --arms: this many headsets, 1..8, orbed-hmd --headset h<j> looking at arm a<j mod arms>, "
          "each a different person")
-      ->check(CLI::Range(1, kMaxScaleHeadsets));
+      ->check(orbed::NumberIn(1, kMaxScaleHeadsets));
   std::string json_path;
   app.add_option("--json", json_path,
                  "Also write the report as JSON to this file (scripts/scale.py reads it)");
   app.add_option("--duration-s", options.duration_s, "Length of the run from when every process is ready [s]")
-      ->check(CLI::PositiveNumber)
+      ->check(orbed::PositiveNumber())
       ->capture_default_str();
   app.add_option("--rss-early-s", options.rss_early_s, "When the early resident-memory sample is taken [s]")
-      ->check(CLI::PositiveNumber)
+      ->check(orbed::PositiveNumber())
       ->capture_default_str();
   app.add_option("--warmup-s", options.warmup_s,
                  "Rates are accounted from the first heartbeat after this [s]")
-      ->check(CLI::NonNegativeNumber)
+      ->check(orbed::NonNegativeNumber())
       ->capture_default_str();
   app.add_option(
          "--max-rss-growth-percent", max_growth_percent,
          "Fail when a process's resident memory grows more than this from the early sample to the end [%]")
-      ->check(CLI::NonNegativeNumber)
+      ->check(orbed::NonNegativeNumber())
       ->capture_default_str();
   app.add_option("--ready-timeout-s", options.ready_timeout_s, "Longest wait for the testbed to come up [s]")
-      ->check(CLI::PositiveNumber)
+      ->check(orbed::PositiveNumber())
       ->capture_default_str();
   app.add_option("--launch-file", options.launch_file, "Launch file (default: scripts/launch/load.yaml)")
       ->check(CLI::ExistingFile);
   app.add_option("--log-dir", options.log_dir, "The testbed's log folder (ORBED_LOG_DIR)")->required();
   app.add_option("--bin-dir", options.bin_dir, "Where orbed-launch is (default: beside orbed-load)");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e, out, err);
-  }
+  if (const auto code = ParseArguments(&app, argc, argv, out, err)) return *code;
   if ((options.arms > 0) != (options.headsets > 0)) {
     err << "orbed-load: --arms and --headsets go together (the scale launch has both)\n";
     return 2;

@@ -1,0 +1,92 @@
+#include "base/command_line.h"
+
+#include <cmath>
+#include <cstdio>
+#include <functional>
+
+#include "orbed_build_commit.h"  // generated at build time: ORBED_BUILD_COMMIT, ORBED_BUILD_MODIFIED
+
+namespace orbed {
+
+namespace {
+
+/// A bound as people write it: 60, 0.1, 1e+06.
+std::string BoundText(double x) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", x);
+  return text;
+}
+
+/// A validator of a number passing `ok`; `expected` completes "expected a number ...".
+CLI::Validator NumberCheck(std::function<bool(double)> ok, const std::string& expected,
+                           const std::string& name) {
+  return CLI::Validator(
+      [ok, expected](std::string& value) {
+        double number = 0;
+        if (CLI::detail::lexical_cast(value, number) && std::isfinite(number) && ok(number)) {
+          return std::string();
+        }
+        return "expected a finite number" + expected + ", got '" + value + "'";
+      },
+      name);
+}
+
+/// "orbed-foo": the app's name, else argv[0], without its folder.
+std::string ProgramName(const CLI::App& app, int argc, const char* const* argv) {
+  std::string name = app.get_name();
+  if (name.empty() && argc > 0 && argv[0] != nullptr) name = argv[0];
+  const size_t slash = name.rfind('/');
+  return slash == std::string::npos ? name : name.substr(slash + 1);
+}
+
+/// CLI11's message on one line.
+std::string OneLine(std::string text) {
+  while (!text.empty() && text.back() == '\n') text.pop_back();
+  for (char& c : text) {
+    if (c == '\n') c = ' ';
+  }
+  return text;
+}
+
+}  // namespace
+
+std::string VersionText() {
+  std::string text = std::string("orbed ") + ORBED_VERSION + " (commit " + ORBED_BUILD_COMMIT;
+  if (ORBED_BUILD_MODIFIED) text += ", modified";
+  return text + ")";
+}
+
+void AddVersionFlag(CLI::App* app) {
+  app->set_version_flag("--version", VersionText(), "Print the version and the git commit it was built from");
+}
+
+CLI::Validator FiniteNumber() {
+  return NumberCheck([](double) { return true; }, "", "FINITE");
+}
+
+CLI::Validator PositiveNumber() {
+  return NumberCheck([](double x) { return x > 0; }, " > 0", "POSITIVE");
+}
+
+CLI::Validator NonNegativeNumber() {
+  return NumberCheck([](double x) { return x >= 0; }, " >= 0", "NONNEGATIVE");
+}
+
+CLI::Validator NumberIn(double lo, double hi) {
+  const std::string range = "[" + BoundText(lo) + ", " + BoundText(hi) + "]";
+  return NumberCheck([lo, hi](double x) { return x >= lo && x <= hi; }, " in " + range, "in " + range);
+}
+
+std::optional<int> ParseArguments(CLI::App* app, int argc, const char* const* argv, std::ostream& out,
+                                  std::ostream& err) {
+  try {
+    app->parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app->exit(e, out, err);  // --help, --version: printed on out
+    err << ProgramName(*app, argc, argv) << ": " << OneLine(e.what()) << " (see --help)\n";
+    return kExitUsage;
+  }
+  return std::nullopt;
+}
+
+}  // namespace orbed

@@ -1,0 +1,48 @@
+#pragma once
+/// @file
+/// What every orbed command line shares, processes and tools alike, on CLI11:
+///   - one exit code for a usage error (kExitUsage = 2: unknown flag, missing or bad value), 0 after
+///     --help or --version;
+///   - --version: "orbed <project version> (commit <12 hex>[, modified])", the commit the binary was
+///     built from (read from git at build time; "unknown" outside a git checkout);
+///   - number checks that refuse NaN and the infinities (which CLI::PositiveNumber and CLI::Range let
+///     through: every comparison with NaN is false) and print their bounds as people write them
+///     ("expected a finite number in [0.1, 60], got 'nan'"), not as 309-digit doubles;
+///   - a usage error is one line on err: "orbed-foo: <what is wrong> (see --help)".
+/// Usage in a Run…(): add the options, `if (auto code = ParseArguments(&app, argc, argv, out, err))
+/// return *code;`. Processes use ParseCommandLine (runtime/flags.h), which calls this.
+/// Threading: pure functions.
+
+#include <optional>
+#include <ostream>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+namespace orbed {
+
+/// Exit code of every usage error, in every orbed program (as Python's argparse and getopt tools).
+inline constexpr int kExitUsage = 2;
+
+/// "orbed 0.1.0 (commit 0123456789ab)", with ", modified" when the tree had uncommitted changes.
+std::string VersionText();
+
+/// Adds --version (prints VersionText(), exits 0).
+void AddVersionFlag(CLI::App* app);
+
+/// A finite number (refuses NaN, ±inf and text).
+CLI::Validator FiniteNumber();
+/// A finite number > 0.
+CLI::Validator PositiveNumber();
+/// A finite number >= 0.
+CLI::Validator NonNegativeNumber();
+/// A finite number in [lo, hi].
+CLI::Validator NumberIn(double lo, double hi);
+
+/// Parses `argv` into `app`. Returns std::nullopt to go on, else the exit code to return now:
+/// 0 after --help (usage on `out`) or --version (on `out`), kExitUsage after a usage error (one
+/// line on `err`, above).
+std::optional<int> ParseArguments(CLI::App* app, int argc, const char* const* argv, std::ostream& out,
+                                  std::ostream& err);
+
+}  // namespace orbed
