@@ -3,7 +3,9 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <stdexcept>
 
+#include "base/number_list.h"
 #include "orbed_build_commit.h"  // generated at build time: ORBED_BUILD_COMMIT, ORBED_BUILD_MODIFIED
 
 namespace orbed {
@@ -75,6 +77,29 @@ CLI::Validator NonNegativeNumber() {
 CLI::Validator NumberIn(double lo, double hi) {
   const std::string range = "[" + BoundText(lo) + ", " + BoundText(hi) + "]";
   return NumberCheck([lo, hi](double x) { return x >= lo && x <= hi; }, " in " + range, "in " + range);
+}
+
+CLI::Option* AddNumberListOption(CLI::App* app, const std::string& name, std::vector<double>* values,
+                                 size_t count, const std::string& help) {
+  const std::string shape =
+      count == 0 ? "a,b,..." : "a comma-separated list of " + std::to_string(count) + " numbers";
+  CLI::Option* option = app->add_option_function<std::string>(
+      name, [name, values](const std::string& text) { *values = ParseNumberList(text, name); }, help);
+  option->type_name(count == 0 ? "LIST" : "LIST" + std::to_string(count));
+  option->check(CLI::Validator(
+      [name, count, shape](std::string& text) {
+        try {
+          const size_t n = ParseNumberList(text, name).size();
+          if (count != 0 && n != count) {
+            return "expected " + shape + ", got " + std::to_string(n) + " in '" + text + "'";
+          }
+        } catch (const std::invalid_argument& e) {
+          return std::string(e.what());
+        }
+        return std::string();
+      },
+      ""));
+  return option;
 }
 
 std::optional<int> ParseArguments(CLI::App* app, int argc, const char* const* argv, std::ostream& out,

@@ -8,14 +8,18 @@
 ///   - number checks that refuse NaN and the infinities (which CLI::PositiveNumber and CLI::Range let
 ///     through: every comparison with NaN is false) and print their bounds as people write them
 ///     ("expected a finite number in [0.1, 60], got 'nan'"), not as 309-digit doubles;
-///   - a usage error is one line on err: "orbed-foo: <what is wrong> (see --help)".
+///   - a usage error is one line on err: "orbed-foo: <what is wrong> (see --help)";
+///   - one way to give a point or a joint vector: ONE argument of comma-separated numbers,
+///     `--q-deg 0,20,0,-60,0,40,0`, `--camera-m 1.5,0.3,1.8` (AddNumberListOption).
 /// Usage in a Run…(): add the options, `if (auto code = ParseArguments(&app, argc, argv, out, err))
 /// return *code;`. Processes use ParseCommandLine (runtime/flags.h), which calls this.
 /// Threading: pure functions.
 
+#include <cstddef>
 #include <optional>
 #include <ostream>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
@@ -38,6 +42,11 @@ CLI::Validator PositiveNumber();
 CLI::Validator NonNegativeNumber();
 /// A finite number in [lo, hi].
 CLI::Validator NumberIn(double lo, double hi);
+
+/// Adds `name` taking one argument "a,b,c" of finite numbers (base/number_list.h), `count` of them
+/// (0: one or more), stored in `values`; anything else is a usage error naming the option.
+CLI::Option* AddNumberListOption(CLI::App* app, const std::string& name, std::vector<double>* values,
+                                 size_t count, const std::string& help);
 
 /// Parses `argv` into `app`. Returns std::nullopt to go on, else the exit code to return now:
 /// 0 after --help (usage on `out`) or --version (on `out`), kExitUsage after a usage error (one

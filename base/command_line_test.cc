@@ -32,9 +32,9 @@ Outcome Parse(const CLI::Validator& check, std::vector<std::string> args) {
 
 TEST(CommandLine, UsageErrorsExitTwoHelpAndVersionZero) {
   EXPECT_EQ(Parse(FiniteNumber(), {"--bogus"}).code, kExitUsage);
-  EXPECT_EQ(Parse(FiniteNumber(), {"--x"}).code, kExitUsage);          // value missing
-  EXPECT_EQ(Parse(FiniteNumber(), {"--x", "abc"}).code, kExitUsage);   // not a number
-  EXPECT_EQ(Parse(FiniteNumber(), {"extra"}).code, kExitUsage);        // positional not taken
+  EXPECT_EQ(Parse(FiniteNumber(), {"--x"}).code, kExitUsage);         // value missing
+  EXPECT_EQ(Parse(FiniteNumber(), {"--x", "abc"}).code, kExitUsage);  // not a number
+  EXPECT_EQ(Parse(FiniteNumber(), {"extra"}).code, kExitUsage);       // positional not taken
   const Outcome bogus = Parse(FiniteNumber(), {"--bogus"});
   EXPECT_EQ(bogus.err, "prog: The following argument was not expected: --bogus (see --help)\n");
   EXPECT_EQ(bogus.out, "");
@@ -48,8 +48,9 @@ TEST(CommandLine, UsageErrorsExitTwoHelpAndVersionZero) {
 }
 
 TEST(CommandLine, VersionNamesTheProjectVersionAndACommit) {
-  EXPECT_TRUE(std::regex_match(VersionText(),
-                               std::regex(R"(orbed [0-9]+\.[0-9]+\.[0-9]+ \(commit ([0-9a-f]{12}|unknown)(, modified)?\))")))
+  EXPECT_TRUE(std::regex_match(
+      VersionText(),
+      std::regex(R"(orbed [0-9]+\.[0-9]+\.[0-9]+ \(commit ([0-9a-f]{12}|unknown)(, modified)?\))")))
       << VersionText();
 }
 
@@ -75,11 +76,46 @@ TEST(CommandLine, NumberChecksKeepTheirBoundsIncludingTheEnds) {
 
 TEST(CommandLine, BoundsArePrintedAsWritten) {
   const Outcome range = Parse(NumberIn(0.1, 60), {"--x", "nan"});
-  EXPECT_NE(range.err.find("expected a finite number in [0.1, 60], got 'nan'"), std::string::npos) << range.err;
+  EXPECT_NE(range.err.find("expected a finite number in [0.1, 60], got 'nan'"), std::string::npos)
+      << range.err;
   const Outcome positive = Parse(PositiveNumber(), {"--x", "-1"});
   EXPECT_NE(positive.err.find("expected a finite number > 0, got '-1'"), std::string::npos) << positive.err;
   // No 309-digit double anywhere (CLI11's own PositiveNumber prints DBL_MAX in full).
   EXPECT_LT(positive.err.size(), 200u) << positive.err;
+}
+
+/// Runs an app with --p (a list of 3) on `args`; the exit code (-1 to go on), the values, err.
+struct ListOutcome {
+  int code;
+  std::vector<double> values;
+  std::string err;
+};
+
+ListOutcome ParseList(std::vector<std::string> args, size_t count = 3) {
+  CLI::App app{"test"};
+  std::vector<double> values;
+  AddNumberListOption(&app, "--p", &values, count, "a point");
+  std::vector<const char*> argv{"prog"};
+  for (const auto& a : args) argv.push_back(a.c_str());
+  std::ostringstream out, err;
+  const auto code = ParseArguments(&app, static_cast<int>(argv.size()), argv.data(), out, err);
+  return {code ? *code : -1, values, err.str()};
+}
+
+TEST(CommandLine, APointIsOneCommaSeparatedArgument) {
+  EXPECT_EQ(ParseList({"--p", "1.5,-0.25, 2e-3"}).values, (std::vector<double>{1.5, -0.25, 0.002}));
+  EXPECT_EQ(ParseList({"--p", "1,2,3"}).code, -1);
+  EXPECT_EQ(ParseList({}).values, std::vector<double>{});  // not given: untouched
+  const ListOutcome two = ParseList({"--p", "1,2"});
+  EXPECT_EQ(two.code, kExitUsage);
+  EXPECT_NE(two.err.find("expected a comma-separated list of 3 numbers, got 2 in '1,2'"), std::string::npos)
+      << two.err;
+  EXPECT_EQ(ParseList({"--p", "1", "2", "3"}).code, kExitUsage);  // the space-separated form is refused
+  EXPECT_EQ(ParseList({"--p", "1 2 3"}).code, kExitUsage);
+  EXPECT_EQ(ParseList({"--p", "1,nan,3"}).code, kExitUsage);
+  EXPECT_EQ(ParseList({"--p", "1,2,3,"}).code, kExitUsage);
+  EXPECT_EQ(ParseList({"--p", "0,20,0,-60,0,40,0"}, 0).values,
+            (std::vector<double>{0, 20, 0, -60, 0, 40, 0}));
 }
 
 }  // namespace

@@ -49,9 +49,8 @@ int RunIiwaSim(int argc, const char* const* argv, std::ostream& out, std::ostrea
                  "Hold the sim clock (publish only SIM_CLOCK, do not step) until PROCESS_STATUS shows the "
                  "process of this name running, so that a launch's followers of the clock start together "
                  "(empty: run from the start)");
-  app.add_option("--initial-q-deg", options.initial_q_deg,
-                 "Initial joint angles q1,...,q7 [deg] (default: all 0)")
-      ->delimiter(',');
+  AddNumberListOption(&app, "--initial-q-deg", &options.initial_q_deg, 0,
+                      "Initial joint angles q1,...,q7 [deg] (default: all 0)");
   app.add_option("--state-file", options.state_file,
                  "Keep the arm's measured configuration in this file and start from it when it exists "
                  "(crash recovery)");

@@ -205,6 +205,12 @@ int RunLogTool(int argc, const char* const* argv, std::ostream& out, std::ostrea
     err << "orbed-log: " << log.error() << "\n";
     return 1;
   }
+  LogEvent first;
+  if (log.size() > 0 && !log.Scanner().Next(&first)) {  // empty is a log nothing was written to yet
+    err << "orbed-log: " << EscapeText(log_path)
+        << " is not an LCM event log (not one event in it; an event starts with the sync word 0xEDA1DA01)\n";
+    return 1;
+  }
   try {
     if (*info) return Info(log, log_path, out);
     if (*check) return Check(log, log_path, out);

@@ -114,6 +114,15 @@ TEST(LogTool, BadArgumentsAndMissingFiles) {
       test::RunCommand(RunLogTool, "orbed-log", {"info", "/nonexistent/x.lcmlog"});
   EXPECT_EQ(missing.code, 1);
   EXPECT_NE(missing.err.find("nonexistent"), std::string::npos) << missing.err;
+  // A file of another kind (text without one event) is refused by every verb, not read as damage.
+  const std::string text = testing::TempDir() + "/not_a_log.md";
+  std::ofstream(text) << "# a Markdown file\n\nNot an LCM log.\n";
+  for (const char* verb : {"info", "check"}) {
+    const test::CommandRun r = test::RunCommand(RunLogTool, "orbed-log", {verb, text});
+    EXPECT_EQ(r.code, 1) << verb;
+    EXPECT_NE(r.err.find("is not an LCM event log"), std::string::npos) << r.err;
+    EXPECT_EQ(r.out, "") << verb;
+  }
 }
 
 }  // namespace

@@ -2,7 +2,7 @@
 /// orbed-registration: the registration server and its offline command line (commands, flags and
 /// exit codes: procs/registration_server/registration_cli.h).
 ///
-///   orbed-registration [--lcm-url URL] [--state-period-s S] [--model-centroid-m X Y Z] ...
+///   orbed-registration [--lcm-url URL] [--state-period-s S] [--model-centroid-m X,Y,Z] ...
 ///     The LCM server (registration_server.h).
 ///     Subscribes: SESSION_CONTROL, ALIGNMENT_TRIAL, LANDMARK_REQUEST, MISALIGNMENT_REQUEST.
 ///     Publishes:  REGISTRATION (per accepted trial, on COMPUTE, and the full state every

@@ -31,9 +31,8 @@ int RunRegistration(int argc, const char* const* argv, std::ostream& out, std::o
   app.add_option("--journal", server.journal_path,
                  "Session journal: replayed at start, so a restarted server continues its session "
                  "(created if missing)");
-  app.add_option("--model-centroid-m", server_centroid_m,
-                 "Average translations about this model centroid p_VC (3 numbers, metres, in V)")
-      ->expected(3);
+  AddNumberListOption(&app, "--model-centroid-m", &server_centroid_m, 3,
+                      "Average translations about this model centroid p_VC: x,y,z [m, in V]");
   app.add_option("--k-mad", server.service.outlier.k_mad, "Robust mode: reject beyond median + k*MAD")
       ->check(orbed::PositiveNumber())
       ->capture_default_str();
@@ -65,9 +64,8 @@ int RunRegistration(int argc, const char* const* argv, std::ostream& out, std::o
   mean->add_flag("--robust", mean_options.robust,
                  "Reject outlying trials (L1 median + k*MAD) before the Karcher mean");
   mean->add_flag("--json", mean_options.json, "Print one JSON object instead of a text report");
-  mean->add_option("--model-centroid-m", mean_centroid_m,
-                   "Average translations about this model centroid p_VC (3 numbers, metres, in V)")
-      ->expected(3);
+  AddNumberListOption(mean, "--model-centroid-m", &mean_centroid_m, 3,
+                      "Average translations about this model centroid p_VC: x,y,z [m, in V]");
 
   // Feed a trial file to a running server.
   SendCommandOptions send_options;
