@@ -1,5 +1,7 @@
 #include "base/command_line.h"
 
+#include <CLI/CLI.hpp>
+
 #include <cmath>
 #include <cstdio>
 #include <functional>

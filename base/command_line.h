@@ -21,7 +21,13 @@
 #include <string>
 #include <vector>
 
-#include <CLI/CLI.hpp>
+// CLI11's types, declared only: a file that adds options includes <CLI/CLI.hpp> itself, so the
+// ~30 k lines of CLI11 do not reach every process's translation units through process.h.
+namespace CLI {
+class App;
+class Option;
+class Validator;
+}  // namespace CLI
 
 namespace orbed {
 

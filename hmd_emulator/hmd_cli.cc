@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include <CLI/CLI.hpp>
+
 #include "hmd_emulator/hmd_config.h"
 #include "hmd_emulator/hmd_process.h"
 

@@ -11,6 +11,7 @@
 #include <thread>
 
 #include <gtest/gtest.h>
+#include <CLI/CLI.hpp>
 #include <orbed/iiwa_command_t.hpp>
 
 #include "procs/common/channels.h"

@@ -1,5 +1,7 @@
 #include "procs/common/flags.h"
 
+#include <CLI/CLI.hpp>
+
 #include <cstdlib>
 #include <regex>
 

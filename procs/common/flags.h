@@ -22,9 +22,7 @@
 #include <ostream>
 #include <string>
 
-#include <CLI/CLI.hpp>
-
-#include "base/command_line.h"
+#include "base/command_line.h"  // CLI::App, declared only
 
 namespace orbed {
 

@@ -11,6 +11,7 @@
 #include <thread>
 
 #include <gtest/gtest.h>
+#include <CLI/CLI.hpp>
 
 #include "procs/launcher/deputy_protocol.h"
 
