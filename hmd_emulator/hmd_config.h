@@ -57,12 +57,14 @@
 #include <string>
 #include <vector>
 
-#include <yaml-cpp/yaml.h>
-
 #include "hmd_emulator/head_trajectory.h"
 #include "hmd_emulator/slam_model.h"
 #include "hmd_emulator/user_model.h"
 #include "hmd_emulator/viraal_trial.h"
+
+namespace YAML {
+class Node;  // yaml-cpp, declared only: the .cc files that read YAML include it
+}  // namespace YAML
 
 namespace orbed::hmd {
 

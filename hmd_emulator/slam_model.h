@@ -108,11 +108,14 @@
 #include <string>
 #include <vector>
 
-#include <yaml-cpp/yaml.h>
 #include <Eigen/Geometry>
 
 #include "base/random.h"
 #include "hmd_emulator/head_trajectory.h"
+
+namespace YAML {
+class Node;  // yaml-cpp, declared only: the .cc files that read YAML include it
+}  // namespace YAML
 
 namespace orbed::hmd {
 

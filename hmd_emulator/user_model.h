@@ -106,11 +106,14 @@
 #include <string>
 #include <vector>
 
-#include <yaml-cpp/yaml.h>
 #include <Eigen/Geometry>
 
 #include "geometry/camera_model.h"
 #include "sim/robot_model.h"
+
+namespace YAML {
+class Node;  // yaml-cpp, declared only: the .cc files that read YAML include it
+}  // namespace YAML
 
 namespace orbed::hmd {
 
