@@ -3,7 +3,7 @@
 /// The two hashes orbed derives seeds with, defined once: Sebastiano Vigna's SplitMix64 finaliser
 /// and the 64-bit FNV-1a hash of a string. Used by the headset's per-trial seeds
 /// (hmd_emulator/headset_trial.h) and the fault injection's per-datagram draws
-/// (procs/common/chaos.h). Changing either moves every seeded number.
+/// (runtime/chaos.h). Changing either moves every seeded number.
 ///
 /// Threading: pure functions.
 

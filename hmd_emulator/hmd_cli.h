@@ -11,7 +11,7 @@
 ///               --interactive), PROCESS_STATUS at 1 Hz. Channel names can be overridden by flags.
 /// Exit codes: 0 after a clean stop or --help; CLI11's code (non-zero) for a bad flag, with the
 /// message on `err`; 1 when the process cannot start (one line on `err`) or fails.
-/// Output: --help prints the usage on `out`; the process logs through procs/common/log.h.
+/// Output: --help prints the usage on `out`; the process logs through base/log.h.
 
 #include <ostream>
 

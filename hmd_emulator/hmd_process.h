@@ -110,8 +110,8 @@
 #include "hmd_emulator/robot_state.h"
 #include "hmd_emulator/session_file.h"
 #include "hmd_emulator/viraal_trial.h"
-#include "procs/common/channels.h"
-#include "procs/common/process.h"
+#include "lcmtypes/contract/channels.h"
+#include "runtime/process.h"
 #include "sim/robot_model.h"
 
 namespace orbed::hmd {

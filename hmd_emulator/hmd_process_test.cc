@@ -31,7 +31,7 @@
 #include "base/units.h"
 #include "hmd_emulator/gaze.h"
 #include "hmd_emulator/headset_trial.h"
-#include "procs/common/conversions.h"
+#include "lcmtypes/contract/conversions.h"
 #include "render/renderer.h"
 #include "sim/guidance_messages.h"
 

@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-#include "procs/common/alignment_trial.h"
+#include "lcmtypes/contract/alignment_trial.h"
 
 #include <utility>
 #include <variant>

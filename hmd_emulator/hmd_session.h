@@ -5,7 +5,7 @@
 /// arrives and acts on the decision (refuse, forget the hologram pose, run or announce a trial).
 ///
 /// Every message is first checked by the common validator (orbed::CheckSessionControl,
-/// procs/common/session_control.h: refusal keys session_id, command, display_mode, num_mirrors,
+/// lcmtypes/contract/session_control.h: refusal keys session_id, command, display_mode, num_mirrors,
 /// method, capture_waypoint); the headset then adds its own checks:
 ///   - START: num_mirrors <= the displays placed in hmd.yaml (key "num_mirrors"); every capture
 ///     waypoint a waypoint of the walk, and a START repeating the active session (same id, mode
@@ -15,7 +15,7 @@
 ///   - REQUEST_TRIAL before a valid joint vector q and base pose X_WR are known (key
 ///     "no_robot_state": the person cannot align without the robot);
 ///   - REQUEST_TRIAL once the session has had kMaxTrialsPerSession trials (key "session_full":
-///     procs/common/alignment_trial.h; each trial replays the session's earlier walks).
+///     lcmtypes/contract/alignment_trial.h; each trial replays the session's earlier walks).
 /// The emulated trial itself may still fail; the shell refuses that under "trial_failed".
 ///
 /// Transitions: START opens session s (mode, mirrors, method), trial index 0, replacing any other;
@@ -29,7 +29,7 @@
 /// someone else (a resumed conductor re-sending the trials it kept), moves next_index past it
 /// (ObserveTrial), so the next trial gets the next index.
 ///
-/// Repeats (procs/common/recent_answers.h): a command whose nonzero request_id was acted on is a
+/// Repeats (runtime/recent_answers.h): a command whose nonzero request_id was acted on is a
 /// kRepeatedRequest and changes nothing: for a REQUEST_TRIAL its answer is the very ALIGNMENT_TRIAL
 /// published for it (the caller publishes it again: a retried request never makes a second,
 /// different trial); for START / RESET / STOP there is nothing to answer. A REQUEST_TRIAL whose id
@@ -47,8 +47,8 @@
 #include <orbed/alignment_trial_t.hpp>
 #include <orbed/session_control_t.hpp>
 
-#include "procs/common/recent_answers.h"
-#include "procs/common/session_control.h"
+#include "runtime/recent_answers.h"
+#include "lcmtypes/contract/session_control.h"
 
 namespace orbed::hmd {
 

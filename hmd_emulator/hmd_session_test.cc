@@ -9,7 +9,7 @@
 #include <orbed/alignment_trial_t.hpp>
 #include <orbed/registration_t.hpp>
 
-#include "procs/common/alignment_trial.h"
+#include "lcmtypes/contract/alignment_trial.h"
 
 namespace orbed::hmd {
 namespace {

@@ -6,7 +6,7 @@
 #include <utility>
 
 #include "hmd_emulator/gaze.h"
-#include "procs/common/conversions.h"
+#include "lcmtypes/contract/conversions.h"
 
 namespace orbed::hmd {
 namespace {

@@ -18,7 +18,7 @@
 #include "base/units.h"
 #include "hmd_emulator/hmd_config.h"
 #include "hmd_emulator/pose_stream.h"
-#include "procs/common/conversions.h"
+#include "lcmtypes/contract/conversions.h"
 
 namespace orbed::hmd {
 namespace {

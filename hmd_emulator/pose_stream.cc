@@ -1,7 +1,7 @@
 #include "hmd_emulator/pose_stream.h"
 
 #include "hmd_emulator/gaze.h"
-#include "procs/common/conversions.h"
+#include "lcmtypes/contract/conversions.h"
 
 namespace orbed::hmd {
 

@@ -4,8 +4,8 @@
 #include <variant>
 
 #include "lcmtypes/bounded_decode.h"
-#include "procs/common/alignment_trial.h"
-#include "procs/common/journal.h"
+#include "lcmtypes/contract/alignment_trial.h"
+#include "runtime/journal.h"
 
 namespace orbed::hmd {
 namespace {

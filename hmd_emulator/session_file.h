@@ -4,7 +4,7 @@
 /// with the right next trial index (its trials are functions of the session and the index, so the
 /// respawned headset's trials are those the original would have made).
 ///
-/// The file is a journal (procs/common/journal.h) replaced whole on every change (temporary file +
+/// The file is a journal (runtime/journal.h) replaced whole on every change (temporary file +
 /// rename): no records when no session is active; otherwise "SESSION_CONTROL", the START that
 /// opened the session, and, once the session has a trial, "ALIGNMENT_TRIAL", its last trial (as
 /// the headset published it, or as it observed it on the bus). RestoreSession replays the records

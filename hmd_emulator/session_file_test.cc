@@ -15,8 +15,8 @@
 
 #include "base/units.h"
 #include "hmd_emulator/hmd_process.h"
-#include "procs/common/conversions.h"
-#include "procs/common/journal.h"
+#include "lcmtypes/contract/conversions.h"
+#include "runtime/journal.h"
 
 namespace orbed::hmd {
 namespace {

@@ -214,7 +214,7 @@ SlamModel SessionMapAtTrial(const TrialSetup& setup, const SlamConfig& session_s
                             const Eigen::Vector3d& p_W_session_start, int trial_index, double* t_s,
                             SessionMapCache* cache = nullptr);
 /// The most trials a session's map is rebuilt for (= kMaxTrialsPerSession of
-/// procs/common/alignment_trial.h, which the headset's session enforces on the bus).
+/// lcmtypes/contract/alignment_trial.h, which the headset's session enforces on the bus).
 inline constexpr int kMaxSessionTrials = 1000;
 
 }  // namespace orbed::hmd

@@ -12,10 +12,10 @@
 #include <orbed/robot_state_t.hpp>
 
 #include "base/format.h"
-#include "procs/common/conversions.h"
-#include "procs/common/log.h"
-#include "procs/common/requests.h"
-#include "procs/common/validation.h"
+#include "lcmtypes/contract/conversions.h"
+#include "base/log.h"
+#include "lcmtypes/contract/requests.h"
+#include "lcmtypes/contract/validation.h"
 #include "sim/sim_state.h"
 
 namespace orbed::sim {

@@ -60,14 +60,14 @@
 /// limit in sim time. The outputs go out once per tick (at K = R: 200 Hz of wall time, 200/R Hz of
 /// sim time), COLLISION_STATUS with the tick's step that came closest to contact (so near misses
 /// are seen at every rate). Each tick's stamp goes out first on SIM_CLOCK (sim_clock_t), the clock
-/// the processes started with --sim-time follow (procs/common/sim_clock.h); with hold_for it stays
+/// the processes started with --sim-time follow (runtime/sim_clock.h); with hold_for it stays
 /// at start_utime, and the arm does not step, until that process runs. The others keep the wall
 /// clock.
 ///
 /// Lockstep (lockstep, --lockstep; for runs that must not depend on the machine's speed): the sim
 /// does not step on while a follower still works on the tick. Each tick's SIM_CLOCK alone is round
 /// 1 (the followers' timers run on the previous tick's state); once every follower has answered it
-/// on SIM_CLOCK_ACK (procs/common/sim_clock.h), the tick's IIWA_STATUS, ROBOT_STATE and
+/// on SIM_CLOCK_ACK (runtime/sim_clock.h), the tick's IIWA_STATUS, ROBOT_STATE and
 /// COLLISION_STATUS go out and the stamp again as round 2, and while any answer (or the sim itself,
 /// a PLAN_CHECK_REPLY) says it published something, the sim repeats the stamp in the next round; the next
 /// tick comes once a round is quiet and its wall time K * P / R has come (R is then the fastest the sim runs:
@@ -102,9 +102,9 @@
 #include <orbed/sim_clock_ack_t.hpp>
 
 #include "base/source_paths.h"
-#include "procs/common/channels.h"
-#include "procs/common/process.h"
-#include "procs/common/sim_clock.h"
+#include "lcmtypes/contract/channels.h"
+#include "runtime/process.h"
+#include "runtime/sim_clock.h"
 #include "sim/manual_arm.h"
 #include "sim/robot_model.h"
 #include "sim/scene.h"

@@ -3,7 +3,7 @@
 /// The `orbed-iiwa-sim` command line (thin main in iiwa_sim_main.cc), as a library function so that
 /// tests can run it in-process.
 ///
-/// Flags: the common process flags (procs/common/flags.h); --urdf, --scene (default: the shipped
+/// Flags: the common process flags (runtime/flags.h); --urdf, --scene (default: the shipped
 /// model and OR scene, under $ORBED_SOURCE_DIR, else the source tree it was built from);
 /// --period-s (> 0, default 0.005 = 200 Hz); --initial-q-deg q1,...,q7; --stale-command-s,
 /// --stop-margin-m, --report-distance-m (>= 0); --robot-name; one flag per channel name. See

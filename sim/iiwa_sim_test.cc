@@ -26,7 +26,7 @@
 
 #include "base/test_command.h"
 #include "base/units.h"
-#include "procs/common/conversions.h"
+#include "lcmtypes/contract/conversions.h"
 
 namespace orbed::sim {
 namespace {

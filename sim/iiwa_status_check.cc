@@ -1,6 +1,6 @@
 #include "sim/iiwa_status_check.h"
 
-#include "procs/common/validation.h"
+#include "lcmtypes/contract/validation.h"
 
 namespace orbed::sim {
 

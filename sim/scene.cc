@@ -7,7 +7,7 @@
 #include "base/source_paths.h"
 #include "base/units.h"
 #include "base/yaml_fields.h"
-#include "procs/common/channels.h"
+#include "lcmtypes/contract/channels.h"
 
 namespace orbed::sim {
 namespace {

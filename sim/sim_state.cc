@@ -4,9 +4,9 @@
 #include <stdexcept>
 
 #include "lcmtypes/bounded_decode.h"
-#include "procs/common/conversions.h"
-#include "procs/common/journal.h"
-#include "procs/common/validation.h"
+#include "lcmtypes/contract/conversions.h"
+#include "runtime/journal.h"
+#include "lcmtypes/contract/validation.h"
 
 namespace orbed::sim {
 

@@ -3,7 +3,7 @@
 /// orbed-iiwa-sim's state file: the arm's last measured configuration, so that a respawned sim
 /// starts where the arm was (a real arm does not teleport) instead of at --initial-q-deg.
 ///
-/// The file is a journal (procs/common/journal.h) of exactly one record, "IIWA_STATUS": the
+/// The file is a journal (runtime/journal.h) of exactly one record, "IIWA_STATUS": the
 /// iiwa_status_t the sim published for that tick, whose joint_position_measured is q [rad].
 /// WriteSimState replaces the file whole (temporary file + rename), so a reader finds the previous
 /// state or the new one, never a mix. ReadSimState checks it like input from the bus: one whole

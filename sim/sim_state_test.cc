@@ -15,8 +15,8 @@
 #include <gtest/gtest.h>
 
 #include "base/units.h"
-#include "procs/common/conversions.h"
-#include "procs/common/journal.h"
+#include "lcmtypes/contract/conversions.h"
+#include "runtime/journal.h"
 #include "sim/iiwa_sim.h"
 
 namespace orbed::sim {

@@ -3,9 +3,9 @@
 #include <orbed/hmd_pose_t.hpp>
 #include <orbed/robot_state_t.hpp>
 
-#include "procs/common/conversions.h"
-#include "procs/common/requests.h"
-#include "procs/common/validation.h"
+#include "lcmtypes/contract/conversions.h"
+#include "lcmtypes/contract/requests.h"
+#include "lcmtypes/contract/validation.h"
 #include "sim/guidance_messages.h"
 
 namespace orbed::sim {

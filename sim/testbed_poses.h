@@ -21,14 +21,14 @@
 #include <orbed/guidance_t.hpp>
 #include <orbed/registration_t.hpp>
 
-#include "procs/common/process.h"
+#include "runtime/process.h"
 #include "sim/robot_model.h"
 
 namespace orbed::sim {
 
 class TestbedPoses {
  public:
-  /// The channels (defaults: procs/common/channels.h); one named "" is not subscribed.
+  /// The channels (defaults: lcmtypes/contract/channels.h); one named "" is not subscribed.
   struct Channels {
     std::string robot_state{"ROBOT_STATE"};
     std::string registration{"REGISTRATION"};

@@ -10,7 +10,7 @@
 #include <orbed/robot_state_t.hpp>
 
 #include "base/source_paths.h"
-#include "procs/common/conversions.h"
+#include "lcmtypes/contract/conversions.h"
 #include "sim/guidance_messages.h"
 
 namespace orbed::sim {

@@ -1,5 +1,5 @@
 #include "study/study_cli.h"
-#include "procs/common/alignment_trial.h"
+#include "lcmtypes/contract/alignment_trial.h"
 
 #include <cerrno>
 #include <climits>

@@ -128,7 +128,7 @@ TEST(UserStudyCli, BadArgumentsExitTwo) {
   EXPECT_NE(r.err.find("--no-such-flag"), std::string::npos) << r.err;
   // --trials: a positive decimal integer that fits an int, nothing else (010 would be octal 8 and
   // 0x10 hex 16 for CLI11's own integer parser).
-  // At most 1000: a headset session holds no more (procs/common/alignment_trial.h).
+  // At most 1000: a headset session holds no more (lcmtypes/contract/alignment_trial.h).
   for (const char* bad : {"0", "-3", "abc", "12x", "1e3", "99999999999", "0x10", "+5", "", "1001"}) {
     r = test::RunCommand(RunUserStudy, "orbed-user-study", {"--trials", bad});
     EXPECT_EQ(r.code, 2) << bad;

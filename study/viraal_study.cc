@@ -10,7 +10,7 @@
 #include "hmd_emulator/headset_trial.h"
 #include "hmd_emulator/hmd_config.h"
 #include "hmd_emulator/user_model.h"
-#include "procs/common/conversions.h"
+#include "lcmtypes/contract/conversions.h"
 #include "procs/registration_server/registration_service.h"
 #include "sim/robot_model.h"
 #include "sim/scene.h"

@@ -4,7 +4,7 @@
 
 #include "base/units.h"
 #include "geometry/misalignment.h"
-#include "procs/common/conversions.h"
+#include "lcmtypes/contract/conversions.h"
 
 namespace orbed::viraal {
 

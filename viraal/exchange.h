@@ -30,7 +30,7 @@
 #include <orbed/pose_t.hpp>
 #include <orbed/registration_t.hpp>
 
-#include "procs/common/alignment_trial.h"
+#include "lcmtypes/contract/alignment_trial.h"
 #include "viraal/metrics.h"
 #include "viraal/results.h"
 
@@ -54,7 +54,7 @@ AlignmentError MeanError(const orbed::pose_t& X_WR, const orbed::registration_t&
                          const std::vector<RobotPoints>& session_points,
                          const std::vector<std::vector<Eigen::Vector3d>>& session_real_annotated = {});
 
-/// The annotation of a checked trial (procs/common/alignment_trial.h) as LANDMARK_REQUESTs: for each
+/// The annotation of a checked trial (lcmtypes/contract/alignment_trial.h) as LANDMARK_REQUESTs: for each
 /// landmark l, the real robot's rays then the virtual one's, named "<session>/<index>/real/<l>" and
 /// ".../virtual/<l>", request ids first_request_id, +1, ... Empty for a trial without annotation.
 std::vector<orbed::landmark_request_t> LandmarkRequests(const orbed::AlignmentTrial& trial, int64_t utime,

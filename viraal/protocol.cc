@@ -1,7 +1,7 @@
 #include "viraal/protocol.h"
 
-#include "procs/common/alignment_trial.h"
-#include "procs/common/session_control.h"
+#include "lcmtypes/contract/alignment_trial.h"
+#include "lcmtypes/contract/session_control.h"
 
 #include <cmath>
 #include <fstream>

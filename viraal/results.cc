@@ -14,7 +14,7 @@
 #include "base/json_fields.h"
 #include "base/replace_file.h"
 #include "base/stats.h"
-#include "procs/common/session_control.h"
+#include "lcmtypes/contract/session_control.h"
 #include "viraal/paper_reference.h"
 
 namespace orbed::viraal {

@@ -55,8 +55,8 @@
 #include <orbed/setup_task_t.hpp>
 
 #include "procs/assistant/assistant.h"
-#include "procs/common/channels.h"
-#include "procs/common/process.h"
+#include "lcmtypes/contract/channels.h"
+#include "runtime/process.h"
 #include "sim/robot_model.h"
 
 namespace orbed::assistant {

@@ -4,9 +4,9 @@
 
 #include <CLI/CLI.hpp>
 
-#include "procs/common/conversions.h"
-#include "procs/common/flags.h"
-#include "procs/common/log.h"
+#include "lcmtypes/contract/conversions.h"
+#include "runtime/flags.h"
+#include "base/log.h"
 #include "procs/drake_viewer/viewer_messages.h"
 
 namespace orbed::viewer {

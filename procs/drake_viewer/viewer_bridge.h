@@ -20,8 +20,8 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
-#include "procs/common/channels.h"
-#include "procs/common/process.h"
+#include "lcmtypes/contract/channels.h"
+#include "runtime/process.h"
 #include "sim/robot_model.h"
 #include "sim/scene.h"
 #include "sim/testbed_poses.h"

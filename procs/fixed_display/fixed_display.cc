@@ -13,9 +13,9 @@
 #include "base/number_list.h"
 #include "base/replace_file.h"
 #include "base/units.h"
-#include "procs/common/conversions.h"
-#include "procs/common/flags.h"
-#include "procs/common/log.h"
+#include "lcmtypes/contract/conversions.h"
+#include "runtime/flags.h"
+#include "base/log.h"
 #include "sim/guidance_messages.h"
 
 namespace orbed::fixed_display {

@@ -25,8 +25,8 @@
 #include <Eigen/Geometry>
 #include <orbed/image_t.hpp>
 
-#include "procs/common/channels.h"
-#include "procs/common/process.h"
+#include "lcmtypes/contract/channels.h"
+#include "runtime/process.h"
 #include "procs/fixed_display/fixed_view.h"
 #include "sim/robot_model.h"
 #include "sim/scene.h"

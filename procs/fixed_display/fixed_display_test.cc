@@ -18,7 +18,7 @@
 #include "base/source_paths.h"
 #include "base/test_command.h"
 #include "base/units.h"
-#include "procs/common/conversions.h"
+#include "lcmtypes/contract/conversions.h"
 #include "procs/fixed_display/fixed_display.h"
 #include "procs/fixed_display/fixed_view.h"
 #include "sim/guidance_messages.h"

@@ -9,12 +9,12 @@
 #include <orbed/registration_t.hpp>
 
 #include "base/format.h"
-#include "procs/common/channels.h"
-#include "procs/common/conversions.h"
-#include "procs/common/flags.h"
-#include "procs/common/log.h"
-#include "procs/common/requests.h"
-#include "procs/common/validation.h"
+#include "lcmtypes/contract/channels.h"
+#include "lcmtypes/contract/conversions.h"
+#include "runtime/flags.h"
+#include "base/log.h"
+#include "lcmtypes/contract/requests.h"
+#include "lcmtypes/contract/validation.h"
 #include "procs/foxglove_bridge/foxglove_messages.h"
 #include "sim/guidance_messages.h"
 

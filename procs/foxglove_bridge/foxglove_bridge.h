@@ -26,7 +26,7 @@
 
 #include <Eigen/Geometry>
 
-#include "procs/common/process.h"
+#include "runtime/process.h"
 #include "procs/foxglove_bridge/foxglove_server.h"
 #include "sim/robot_model.h"
 #include "sim/scene.h"

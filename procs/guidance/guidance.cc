@@ -6,7 +6,7 @@
 
 #include "base/format.h"
 #include "base/units.h"
-#include "procs/common/validation.h"
+#include "lcmtypes/contract/validation.h"
 
 namespace orbed::guidance {
 

@@ -24,8 +24,8 @@
 
 #include <Eigen/Core>
 
-#include "procs/common/channels.h"
-#include "procs/common/process.h"
+#include "lcmtypes/contract/channels.h"
+#include "runtime/process.h"
 #include "procs/guidance/guidance.h"
 #include "sim/robot_model.h"
 #include "sim/scene.h"

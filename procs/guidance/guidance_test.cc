@@ -19,7 +19,7 @@
 #include "base/source_paths.h"
 #include "base/test_command.h"
 #include "base/units.h"
-#include "procs/common/conversions.h"
+#include "lcmtypes/contract/conversions.h"
 #include "procs/guidance/guidance_process.h"
 
 namespace orbed::guidance {

@@ -22,7 +22,7 @@
 ///             name = the device name, X_WT in metres): a target planned in Slicer, for the tools
 ///             on the bus. Other types are skipped; refusals as igtl_codec.h says.
 ///
-/// Every LCM input is checked (procs/common) before use and refused with a counted reason. A
+/// Every LCM input is checked (lcmtypes/contract) before use and refused with a counted reason. A
 /// client that reads slower than the bridge sends misses packets (counted as drops
 /// "igtl/backlog"), never slows the bus. Connections and the first target of each client and device
 /// are logged; refusals are counted as "igtl/refused", skipped types as drops "igtl/skipped".
@@ -39,7 +39,7 @@
 
 #include <Eigen/Geometry>
 
-#include "procs/common/process.h"
+#include "runtime/process.h"
 #include "procs/igtl_bridge/igtl_server.h"
 #include "sim/robot_model.h"
 #include "sim/testbed_poses.h"

@@ -44,7 +44,7 @@
 #include <orbed/deputy_command_t.hpp>
 #include <orbed/deputy_status_t.hpp>
 
-#include "procs/common/process.h"
+#include "runtime/process.h"
 #include "procs/launcher/child.h"
 
 namespace orbed::launcher {

@@ -22,7 +22,7 @@
 
 #include <orbed/deputy_status_t.hpp>
 
-#include "procs/common/process.h"
+#include "runtime/process.h"
 #include "procs/launcher/child.h"
 
 namespace orbed::launcher {

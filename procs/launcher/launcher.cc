@@ -10,9 +10,9 @@
 
 #include "base/format.h"
 #include "base/run_folder.h"
-#include "procs/common/channels.h"
-#include "procs/common/conversions.h"
-#include "procs/common/log.h"
+#include "lcmtypes/contract/channels.h"
+#include "lcmtypes/contract/conversions.h"
+#include "base/log.h"
 #include "procs/launcher/deputy_protocol.h"
 
 namespace orbed::launcher {

@@ -48,7 +48,7 @@
 
 #include <orbed/process_status_t.hpp>
 
-#include "procs/common/process.h"
+#include "runtime/process.h"
 #include "procs/launcher/child.h"
 #include "procs/launcher/deputy_link.h"
 #include "procs/launcher/launch_file.h"

@@ -12,8 +12,8 @@
 #include <CLI/CLI.hpp>
 
 #include "base/json.h"
-#include "procs/common/flags.h"
-#include "procs/common/log.h"
+#include "runtime/flags.h"
+#include "base/log.h"
 #include "procs/launcher/deputy.h"
 #include "procs/launcher/deputy_protocol.h"
 #include "procs/launcher/launch_file.h"

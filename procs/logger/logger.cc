@@ -10,8 +10,8 @@
 
 #include "base/format.h"
 #include "base/sha256.h"
-#include "procs/common/conversions.h"
-#include "procs/common/log.h"
+#include "lcmtypes/contract/conversions.h"
+#include "base/log.h"
 #include "procs/logger/event_log_reader.h"
 
 namespace orbed::logger {

@@ -46,7 +46,7 @@
 
 #include <orbed/logger_status_t.hpp>
 
-#include "procs/common/process.h"
+#include "runtime/process.h"
 #include "procs/logger/event_log_writer.h"
 #include "procs/logger/manifest.h"
 

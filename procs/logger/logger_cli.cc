@@ -7,7 +7,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "procs/common/flags.h"
+#include "runtime/flags.h"
 #include "procs/logger/logger.h"
 
 namespace orbed::logger {

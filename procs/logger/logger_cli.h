@@ -3,7 +3,7 @@
 /// The `orbed-logger` command line (thin main in logger_main.cc), as a library function so that
 /// tests can run it in-process.
 ///
-/// Flags: the common process flags (procs/common/flags.h) and --log-dir, --file, --manifest,
+/// Flags: the common process flags (runtime/flags.h) and --log-dir, --file, --manifest,
 /// --channels (a regular expression), --queue-events, --queue-mb, --flush-interval-s,
 /// --hash-file (repeatable); see --help for their defaults and logger.h for what they do.
 ///

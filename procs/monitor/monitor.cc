@@ -4,8 +4,8 @@
 #include <iostream>
 
 #include "base/format.h"
-#include "procs/common/channels.h"
-#include "procs/common/conversions.h"
+#include "lcmtypes/contract/channels.h"
+#include "lcmtypes/contract/conversions.h"
 
 namespace orbed::monitor {
 namespace {

@@ -16,7 +16,7 @@
 #include <orbed/logger_status_t.hpp>
 #include <orbed/process_status_t.hpp>
 
-#include "procs/common/process.h"
+#include "runtime/process.h"
 
 namespace orbed::monitor {
 

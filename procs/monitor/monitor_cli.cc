@@ -4,7 +4,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "procs/common/flags.h"
+#include "runtime/flags.h"
 #include "procs/monitor/monitor.h"
 
 namespace orbed::monitor {

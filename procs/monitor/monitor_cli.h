@@ -3,7 +3,7 @@
 /// The `orbed-monitor` command line (thin main in monitor_main.cc), as a library function so that
 /// tests can run it in-process.
 ///
-/// Flags: the common process flags (procs/common/flags.h), --print-period-s (table period) and
+/// Flags: the common process flags (runtime/flags.h), --print-period-s (table period) and
 /// --silent-after-s (heartbeat age shown as SILENT), both > 0; see monitor.h.
 ///
 /// Exit codes: 0 after --help or a clean stop (SIGINT/SIGTERM, --duration-s); CLI11's code

@@ -2,8 +2,8 @@
 #include <gtest/gtest.h>
 
 #include "base/test_command.h"
-#include "procs/common/channels.h"
-#include "procs/common/conversions.h"
+#include "lcmtypes/contract/channels.h"
+#include "lcmtypes/contract/conversions.h"
 #include "procs/monitor/monitor.h"
 #include "procs/monitor/monitor_cli.h"
 

@@ -6,7 +6,7 @@
 #include <CLI/CLI.hpp>
 #include <Eigen/Core>
 
-#include "procs/common/flags.h"
+#include "runtime/flags.h"
 #include "procs/registration_server/mean_command.h"
 #include "procs/registration_server/registration_server.h"
 #include "procs/registration_server/send_command.h"

@@ -1,6 +1,6 @@
 #include "procs/registration_server/registration_server.h"
 
-#include "procs/common/log.h"
+#include "base/log.h"
 
 namespace orbed::registration {
 

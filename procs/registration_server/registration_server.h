@@ -22,8 +22,8 @@
 #include <optional>
 #include <string>
 
-#include "procs/common/channels.h"
-#include "procs/common/process.h"
+#include "lcmtypes/contract/channels.h"
+#include "runtime/process.h"
 #include "procs/registration_server/registration_service.h"
 #include "procs/registration_server/session_journal.h"
 

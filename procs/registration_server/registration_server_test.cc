@@ -14,7 +14,7 @@
 #include "base/test_command.h"
 #include "base/units.h"
 #include "geometry/test_rotations.h"
-#include "procs/common/conversions.h"
+#include "lcmtypes/contract/conversions.h"
 
 namespace orbed::registration {
 namespace {
@@ -200,7 +200,7 @@ TEST(RegistrationServiceTest, BadTrialsAndCommandsAreRejectedCountedAndChangeNot
   EXPECT_EQ(f.service.session_id(), "s1");
   EXPECT_EQ(f.rejections["ALIGNMENT_TRIAL/session"], 2);
   EXPECT_EQ(f.rejections["ALIGNMENT_TRIAL/trial_index"], 1);
-  // The message's contract (procs/common/alignment_trial.h), by field; then the session's rules.
+  // The message's contract (lcmtypes/contract/alignment_trial.h), by field; then the session's rules.
   EXPECT_EQ(f.rejections["ALIGNMENT_TRIAL/X_WV"], 3);
   EXPECT_EQ(f.rejections["ALIGNMENT_TRIAL/joint_position"], 1);
   EXPECT_EQ(f.rejections["ALIGNMENT_TRIAL/session_mode"], 1);
@@ -241,7 +241,7 @@ TEST(RegistrationServiceTest, ResetStopAndRestart) {
   EXPECT_TRUE(f.service.session_active());
 }
 
-// The contract shared with the headset (procs/common/session_control.h): a repeated START of the
+// The contract shared with the headset (lcmtypes/contract/session_control.h): a repeated START of the
 // active session keeps its trials; a START with mirrors in AR mode is refused by the same rule.
 TEST(RegistrationServiceTest, RepeatedStartKeepsTrialsAndMirrorsFollowTheMode) {
   Fixture f;

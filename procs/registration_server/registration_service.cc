@@ -6,11 +6,11 @@
 
 #include "geometry/misalignment.h"
 #include "geometry/se3_mean.h"
-#include "procs/common/alignment_trial.h"
-#include "procs/common/conversions.h"
-#include "procs/common/requests.h"
-#include "procs/common/session_control.h"
-#include "procs/common/validation.h"
+#include "lcmtypes/contract/alignment_trial.h"
+#include "lcmtypes/contract/conversions.h"
+#include "lcmtypes/contract/requests.h"
+#include "lcmtypes/contract/session_control.h"
+#include "lcmtypes/contract/validation.h"
 
 namespace orbed::registration {
 

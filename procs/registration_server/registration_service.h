@@ -10,7 +10,7 @@
 /// input that changed the session; LANDMARK / MISALIGNMENT the request's utime. Replaying a log
 /// therefore reproduces the same bytes.
 ///
-/// Sessions (commands checked by procs/common/session_control.h): START(session_id, display_mode,
+/// Sessions (commands checked by lcmtypes/contract/session_control.h): START(session_id, display_mode,
 /// num_mirrors, method) opens a session (replacing any other; a repeated START of the active session
 /// with the same mode and mirrors changes nothing); trials for it are collected until STOP; RESET drops its
 /// trials; COMPUTE asks for the full state now. The last session's state stays available (periodic state,
@@ -21,7 +21,7 @@
 /// Frames and units: trials carry X_WV (virtual robot base V in the OR world W) [m]; the mean is
 /// X_WV_mean; rays and landmarks are in W [m]; angles in messages are [deg] where named.
 ///
-/// Repeats (procs/common/recent_answers.h): a SESSION_CONTROL command whose nonzero request_id was
+/// Repeats (runtime/recent_answers.h): a SESSION_CONTROL command whose nonzero request_id was
 /// already acted on changes nothing and returns its first answer (a COMPUTE its REGISTRATION, the
 /// others nothing); the answers to the last 64 ids are kept. A trial identical to one the session
 /// holds (same index, utime, request_id and X_WV: a re-sent or duplicated datagram) changes nothing:
@@ -55,7 +55,7 @@
 
 #include "geometry/robust.h"
 #include "geometry/triangulation.h"
-#include "procs/common/recent_answers.h"
+#include "runtime/recent_answers.h"
 
 namespace orbed::registration {
 

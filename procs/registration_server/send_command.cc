@@ -10,7 +10,7 @@
 #include <orbed/session_control_t.hpp>
 
 #include "base/json.h"
-#include "procs/common/conversions.h"
+#include "lcmtypes/contract/conversions.h"
 #include "procs/registration_server/trial_file.h"
 
 namespace orbed::registration {

@@ -1,7 +1,7 @@
 #pragma once
 /// @file
 /// The registration server's crash recovery: a RegistrationService whose session inputs are
-/// journaled (procs/common/journal.h), so that a respawned orbed-registration continues the
+/// journaled (runtime/journal.h), so that a respawned orbed-registration continues the
 /// session it had, and its REGISTRATIONs from then on are byte for byte those of a server that
 /// never stopped.
 ///
@@ -37,7 +37,7 @@
 #include <orbed/registration_t.hpp>
 #include <orbed/session_control_t.hpp>
 
-#include "procs/common/journal.h"
+#include "runtime/journal.h"
 #include "procs/registration_server/registration_service.h"
 
 namespace orbed::registration {

@@ -15,7 +15,7 @@
 #include <gtest/gtest.h>
 
 #include "base/units.h"
-#include "procs/common/conversions.h"
+#include "lcmtypes/contract/conversions.h"
 
 namespace orbed::registration {
 namespace {

@@ -6,7 +6,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "procs/common/flags.h"
+#include "runtime/flags.h"
 #include "procs/scenario/viraal_scenario.h"
 #include "viraal/protocol.h"
 #include "viraal/results.h"

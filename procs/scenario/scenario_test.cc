@@ -23,7 +23,7 @@
 #include <orbed/session_control_t.hpp>
 
 #include "base/units.h"
-#include "procs/common/conversions.h"
+#include "lcmtypes/contract/conversions.h"
 #include "procs/scenario/viraal_scenario.h"
 #include "sim/scene.h"
 #include "viraal/metrics.h"

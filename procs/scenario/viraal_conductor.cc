@@ -9,10 +9,10 @@
 
 #include "base/format.h"
 #include "base/units.h"
-#include "procs/common/alignment_trial.h"
-#include "procs/common/conversions.h"
-#include "procs/common/requests.h"
-#include "procs/common/validation.h"
+#include "lcmtypes/contract/alignment_trial.h"
+#include "lcmtypes/contract/conversions.h"
+#include "lcmtypes/contract/requests.h"
+#include "lcmtypes/contract/validation.h"
 #include "viraal/exchange.h"
 
 namespace orbed::scenario {

@@ -89,8 +89,8 @@
 #include <orbed/robot_state_t.hpp>
 #include <orbed/session_control_t.hpp>
 
-#include "procs/common/channels.h"
-#include "procs/common/log.h"
+#include "lcmtypes/contract/channels.h"
+#include "base/log.h"
 #include "sim/robot_model.h"
 #include "viraal/metrics.h"
 #include "viraal/protocol.h"

@@ -16,7 +16,7 @@
 
 #include "base/source_paths.h"
 #include "base/units.h"
-#include "procs/common/conversions.h"
+#include "lcmtypes/contract/conversions.h"
 #include "procs/scenario/resume.h"
 
 namespace orbed::scenario {

@@ -11,8 +11,8 @@
 
 #include "base/run_folder.h"
 #include "base/source_paths.h"
-#include "procs/common/conversions.h"
-#include "procs/common/log.h"
+#include "lcmtypes/contract/conversions.h"
+#include "base/log.h"
 #include "procs/scenario/resume.h"
 
 namespace orbed::scenario {

@@ -34,7 +34,7 @@
 #include <memory>
 #include <string>
 
-#include "procs/common/process.h"
+#include "runtime/process.h"
 #include "procs/scenario/viraal_conductor.h"
 #include "viraal/results.h"
 

@@ -12,8 +12,8 @@
 #include "base/json.h"
 #include "base/json_fields.h"
 #include "base/units.h"
-#include "procs/common/requests.h"
-#include "procs/common/validation.h"
+#include "lcmtypes/contract/requests.h"
+#include "lcmtypes/contract/validation.h"
 #include "sim/guidance_messages.h"
 
 namespace orbed::setup {

@@ -53,7 +53,7 @@
 #include <orbed/setup_result_t.hpp>
 #include <orbed/setup_task_t.hpp>
 
-#include "procs/common/channels.h"
+#include "lcmtypes/contract/channels.h"
 #include "procs/scenario/viraal_conductor.h"
 #include "sim/robot_model.h"
 #include "viraal/protocol.h"

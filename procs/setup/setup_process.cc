@@ -19,9 +19,9 @@
 #include "base/run_folder.h"
 #include "base/source_paths.h"
 #include "base/units.h"
-#include "procs/common/conversions.h"
-#include "procs/common/flags.h"
-#include "procs/common/log.h"
+#include "lcmtypes/contract/conversions.h"
+#include "runtime/flags.h"
+#include "base/log.h"
 #include "sim/guidance_messages.h"
 
 namespace orbed::setup {

@@ -27,7 +27,7 @@
 #include <memory>
 #include <string>
 
-#include "procs/common/process.h"
+#include "runtime/process.h"
 #include "procs/setup/setup_conductor.h"
 
 namespace orbed::setup {

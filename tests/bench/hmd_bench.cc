@@ -25,7 +25,7 @@
 #include <orbed/iiwa_command_t.hpp>
 
 #include "base/units.h"
-#include "procs/common/flags.h"
+#include "runtime/flags.h"
 #include "tests/bench/bench_util.h"
 
 namespace {

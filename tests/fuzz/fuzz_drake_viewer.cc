@@ -1,6 +1,6 @@
 // libFuzzer: orbed-drake-viewer's handlers (ROBOT_STATE, REGISTRATION, GUIDANCE) and the draw it
 // would publish after each input.
-#include "procs/common/conversions.h"
+#include "lcmtypes/contract/conversions.h"
 #include "procs/drake_viewer/viewer_bridge.h"
 #include "tests/fuzz/fuzz_util.h"
 

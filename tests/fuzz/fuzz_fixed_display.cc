@@ -1,6 +1,6 @@
 // libFuzzer: orbed-fixed-display's handlers (ROBOT_STATE, GUIDANCE) and the picture it would
 // publish after each input (every mode, a small picture: each accepted target is rendered).
-#include "procs/common/conversions.h"
+#include "lcmtypes/contract/conversions.h"
 #include "procs/fixed_display/fixed_display.h"
 #include "tests/fuzz/fuzz_util.h"
 

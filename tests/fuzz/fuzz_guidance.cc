@@ -1,5 +1,5 @@
 // libFuzzer: orbed-guidance's handler (IIWA_STATUS) and the GUIDANCE it would publish.
-#include "procs/common/conversions.h"
+#include "lcmtypes/contract/conversions.h"
 #include "procs/guidance/guidance_process.h"
 #include "tests/fuzz/fuzz_util.h"
 

@@ -1,5 +1,5 @@
 // libFuzzer: orbed-monitor's handlers (PROCESS_STATUS, LOGGER_STATUS) and its table.
-#include "procs/common/conversions.h"
+#include "lcmtypes/contract/conversions.h"
 #include "procs/monitor/monitor.h"
 #include "tests/fuzz/fuzz_util.h"
 

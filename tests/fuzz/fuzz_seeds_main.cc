@@ -28,7 +28,7 @@
 #include <orbed/session_control_t.hpp>
 
 #include "lcmtypes/bounded_decode.h"
-#include "procs/common/channels.h"
+#include "lcmtypes/contract/channels.h"
 #include "procs/logger/event_log_reader.h"
 #include "procs/logger/event_log_writer.h"
 #include "procs/logger/manifest.h"

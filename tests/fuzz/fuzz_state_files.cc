@@ -1,4 +1,4 @@
-// libFuzzer: the crash-recovery files a respawned process reads (procs/common/journal.h): the
+// libFuzzer: the crash-recovery files a respawned process reads (runtime/journal.h): the
 // registration server's session journal, the headset's state file and the sim's state file.
 //
 // The first byte picks the reader (state_records.h). Mode 0 hands the rest to ParseJournal as raw
@@ -15,7 +15,7 @@
 
 #include "base/source_paths.h"
 #include "hmd_emulator/session_file.h"
-#include "procs/common/journal.h"
+#include "runtime/journal.h"
 #include "procs/registration_server/registration_service.h"
 #include "procs/registration_server/session_journal.h"
 #include "sim/robot_model.h"

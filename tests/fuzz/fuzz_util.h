@@ -15,9 +15,9 @@
 #include <iterator>
 #include <string>
 
-#include "procs/common/channels.h"
-#include "procs/common/flags.h"
-#include "procs/common/process.h"
+#include "lcmtypes/contract/channels.h"
+#include "runtime/flags.h"
+#include "runtime/process.h"
 
 namespace orbed::fuzz {
 

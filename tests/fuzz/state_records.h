@@ -2,7 +2,7 @@
 /// @file
 /// The input form of fuzz_state_files (and of the seeds orbed-fuzz-seeds writes for it): after the
 /// mode byte, a list of records [channel byte][uint16 little-endian length][data], made into a
-/// well-formed journal (procs/common/journal.h) before a reader replays it, so that fuzzing reaches
+/// well-formed journal (runtime/journal.h) before a reader replays it, so that fuzzing reaches
 /// what the records say rather than stopping at their checksums. The channel byte picks among
 /// kStateRecordChannels (modulo their number); a length running past the end takes what is left.
 ///
@@ -13,7 +13,7 @@
 #include <iterator>
 #include <string>
 
-#include "procs/common/journal.h"
+#include "runtime/journal.h"
 
 namespace orbed::fuzz {
 

@@ -19,7 +19,7 @@
 #include <orbed/robot_state_t.hpp>
 
 #include "base/units.h"
-#include "procs/common/conversions.h"
+#include "lcmtypes/contract/conversions.h"
 #include "sim/scene.h"
 #include "tests/integration/testbed_util.h"
 

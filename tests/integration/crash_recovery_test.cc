@@ -49,7 +49,7 @@
 
 #include "base/units.h"
 #include "lcmtypes/bounded_decode.h"
-#include "procs/common/flags.h"
+#include "runtime/flags.h"
 #include "procs/logger/event_log_reader.h"
 #include "procs/logger/manifest.h"
 #include "tests/integration/testbed_util.h"

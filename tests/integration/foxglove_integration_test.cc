@@ -18,7 +18,7 @@
 #include <orbed/image_t.hpp>
 #include <orbed/robot_state_t.hpp>
 
-#include "procs/common/conversions.h"
+#include "lcmtypes/contract/conversions.h"
 #include "procs/logger/event_log_writer.h"
 #include "sim/robot_model.h"
 #include "sim/scene.h"

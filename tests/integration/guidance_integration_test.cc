@@ -17,7 +17,7 @@
 #include <orbed/iiwa_status_t.hpp>
 
 #include "base/units.h"
-#include "procs/common/conversions.h"
+#include "lcmtypes/contract/conversions.h"
 #include "tests/integration/testbed_util.h"
 
 namespace orbed::testing {

@@ -28,8 +28,8 @@
 #include <orbed/session_control_t.hpp>
 
 #include "base/units.h"
-#include "procs/common/conversions.h"
-#include "procs/common/flags.h"
+#include "lcmtypes/contract/conversions.h"
+#include "runtime/flags.h"
 #include "tests/integration/testbed_util.h"
 
 namespace orbed::testing {

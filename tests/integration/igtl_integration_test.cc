@@ -32,7 +32,7 @@
 #include <orbed/robot_state_t.hpp>
 #include <orbed/target_pose_t.hpp>
 
-#include "procs/common/conversions.h"
+#include "lcmtypes/contract/conversions.h"
 #include "sim/robot_model.h"
 #include "sim/scene.h"
 #include "tests/integration/testbed_util.h"

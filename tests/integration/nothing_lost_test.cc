@@ -31,7 +31,7 @@
 #include <lcm/eventlog.h>
 #include <lcm/lcm-cpp.hpp>
 
-#include "procs/common/process.h"
+#include "runtime/process.h"
 #include "procs/logger/manifest.h"
 #include "tests/integration/testbed_util.h"
 

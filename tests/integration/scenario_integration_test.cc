@@ -21,7 +21,7 @@
 #include <orbed/session_control_t.hpp>
 
 #include "base/units.h"
-#include "procs/common/conversions.h"
+#include "lcmtypes/contract/conversions.h"
 #include "tests/integration/testbed_util.h"
 
 namespace orbed::testing {

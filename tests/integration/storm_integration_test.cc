@@ -23,8 +23,8 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "base/proc_stats.h"
-#include "procs/common/channels.h"
-#include "procs/common/conversions.h"
+#include "lcmtypes/contract/channels.h"
+#include "lcmtypes/contract/conversions.h"
 #include "tests/integration/testbed_util.h"
 
 namespace orbed::testing {

@@ -15,7 +15,7 @@
 #include <orbed/registration_t.hpp>
 #include <orbed/robot_state_t.hpp>
 
-#include "procs/common/conversions.h"
+#include "lcmtypes/contract/conversions.h"
 #include "tests/integration/testbed_util.h"
 
 namespace orbed::testing {

@@ -1,7 +1,7 @@
 // The ViRAAl run of scripts/launch/viraal.yaml over a lossy bus. The launch runs with ORBED_CHAOS
 // set, so every participant (sim, registration server, headset, conductor; the logger records the
 // bus unharmed) loses 10 % of the datagrams it receives on every control channel, receives 5 %
-// twice, 5 % after the next one, and every one up to 30 ms late (procs/common/chaos.h). The
+// twice, 5 % after the next one, and every one up to 30 ms late (runtime/chaos.h). The
 // conductor's retries and the receivers' idempotent answers must carry the run to exactly the
 // results of a clean run with the same run id: testdata/viraal_pinned_results.json, number for
 // number, including rejected_inputs = 0 (no duplicate was refused).

@@ -9,7 +9,7 @@
 #include "base/format.h"
 #include "base/json.h"
 #include "base/stats.h"
-#include "procs/common/channels.h"
+#include "lcmtypes/contract/channels.h"
 
 namespace orbed::load {
 namespace {

@@ -1,4 +1,4 @@
-#include "procs/common/sim_clock.h"
+#include "runtime/sim_clock.h"
 
 #include <cmath>
 

@@ -1,4 +1,4 @@
-#include "procs/common/conversions.h"
+#include "lcmtypes/contract/conversions.h"
 
 #include <chrono>
 

@@ -1,4 +1,4 @@
-#include "procs/common/journal.h"
+#include "runtime/journal.h"
 
 #include <algorithm>
 

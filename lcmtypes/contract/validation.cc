@@ -1,9 +1,9 @@
-#include "procs/common/validation.h"
+#include "lcmtypes/contract/validation.h"
 
 #include <cmath>
 #include <sstream>
 
-#include "procs/common/log.h"
+#include "base/log.h"
 
 namespace orbed {
 

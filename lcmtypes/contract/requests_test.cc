@@ -1,6 +1,6 @@
 // The one check of each single-reader request and command: valid messages decode, each rule
 // refuses by its key.
-#include "procs/common/requests.h"
+#include "lcmtypes/contract/requests.h"
 
 #include <cmath>
 #include <limits>

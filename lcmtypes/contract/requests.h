@@ -50,7 +50,7 @@
 #include <orbed/plan_check_request_t.hpp>
 #include <orbed/robot_state_t.hpp>
 
-#include "procs/common/session_control.h"
+#include "lcmtypes/contract/session_control.h"
 
 namespace orbed {
 

@@ -1,7 +1,7 @@
 // The fault injection's pure core: the spec's syntax and errors, seeded draws (a pure function of
 // seed, receiver, channel and index), rates within binomial bounds, and the queue's delivery
 // order for drops, duplicates, delays and reorders on an emulated clock.
-#include "procs/common/chaos.h"
+#include "runtime/chaos.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "procs/common/chaos.h"
+#include "runtime/chaos.h"
 
 #include <algorithm>
 #include <limits>

@@ -22,7 +22,7 @@
 /// count them as "<channel>/<field>" on PROCESS_STATUS.
 ///
 /// request_id is not checked (any value): a reader acts on a nonzero id once and answers a repeat
-/// with its first answer, changing nothing (procs/common/recent_answers.h); 0 is acted on every time.
+/// with its first answer, changing nothing (runtime/recent_answers.h); 0 is acted on every time.
 ///
 /// Threading: pure functions.
 

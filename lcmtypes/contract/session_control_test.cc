@@ -1,5 +1,5 @@
 // The one SESSION_CONTROL check: each field's rule, by hand-built messages.
-#include "procs/common/session_control.h"
+#include "lcmtypes/contract/session_control.h"
 
 #include <gtest/gtest.h>
 #include <orbed/alignment_trial_t.hpp>

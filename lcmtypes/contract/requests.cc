@@ -1,10 +1,10 @@
-#include "procs/common/requests.h"
+#include "lcmtypes/contract/requests.h"
 
 #include <cmath>
 #include <limits>
 
-#include "procs/common/conversions.h"
-#include "procs/common/validation.h"
+#include "lcmtypes/contract/conversions.h"
+#include "lcmtypes/contract/validation.h"
 
 namespace orbed {
 namespace {

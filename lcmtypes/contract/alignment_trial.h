@@ -34,7 +34,7 @@
 #include <Eigen/Geometry>
 #include <orbed/alignment_trial_t.hpp>
 
-#include "procs/common/session_control.h"
+#include "lcmtypes/contract/session_control.h"
 
 namespace orbed {
 

@@ -1,4 +1,4 @@
-// procs/common/journal.h: records written are read back byte for byte; a torn last record (what a
+// runtime/journal.h: records written are read back byte for byte; a torn last record (what a
 // SIGKILL leaves) ends the readable part and is cut off before appending; damaged, oversized and
 // hostile bytes are refused without reading past them.
 #include <unistd.h>
@@ -13,7 +13,7 @@
 #include <orbed/session_control_t.hpp>
 
 #include "lcmtypes/bounded_decode.h"
-#include "procs/common/journal.h"
+#include "runtime/journal.h"
 
 namespace orbed {
 namespace {

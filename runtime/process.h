@@ -25,7 +25,7 @@
 /// what was published meanwhile is said in the answer to the next round.
 ///
 /// Fault injection: with a chaos spec (CommonFlags::chaos, i.e. --chaos or $ORBED_CHAOS;
-/// procs/common/chaos.h) every datagram of a matching channel passes, before decoding, through a
+/// runtime/chaos.h) every datagram of a matching channel passes, before decoding, through a
 /// ChaosQueue seeded with the spec and the process name: it may be dropped, duplicated, delayed or
 /// reordered. Delayed and held datagrams are delivered later from the Run() loop, on the same
 /// thread, with their original receive utime. What was done is logged at start and at exit
@@ -52,10 +52,10 @@
 #include <orbed/sim_clock_ack_t.hpp>
 
 #include "lcmtypes/bounded_decode.h"
-#include "procs/common/chaos.h"
-#include "procs/common/flags.h"
-#include "procs/common/sim_clock.h"
-#include "procs/common/validation.h"
+#include "runtime/chaos.h"
+#include "runtime/flags.h"
+#include "runtime/sim_clock.h"
+#include "lcmtypes/contract/validation.h"
 
 namespace orbed {
 

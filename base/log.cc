@@ -1,4 +1,4 @@
-#include "procs/common/log.h"
+#include "base/log.h"
 
 #include <atomic>
 #include <cstdio>

@@ -1,5 +1,5 @@
 // The one ALIGNMENT_TRIAL check: each rule of the contract by a hand-built message.
-#include "procs/common/alignment_trial.h"
+#include "lcmtypes/contract/alignment_trial.h"
 
 #include <cmath>
 #include <limits>

@@ -36,9 +36,9 @@ struct CommonFlags {
   uint64_t seed = 1;
   double duration_s = 0.0;
   std::string log_level = "info";
-  /// Fault injection spec (procs/common/chaos.h); "" = none.
+  /// Fault injection spec (runtime/chaos.h); "" = none.
   std::string chaos;
-  /// Follow the sim clock (SIM_CLOCK, procs/common/sim_clock.h) instead of the monotonic and wall
+  /// Follow the sim clock (SIM_CLOCK, runtime/sim_clock.h) instead of the monotonic and wall
   /// clocks (Process, process.h).
   bool sim_time = false;
   /// With sim_time, the arm whose clock to follow (one of several): SIM_CLOCK_<ARM> in,

@@ -1,9 +1,9 @@
-#include "procs/common/alignment_trial.h"
+#include "lcmtypes/contract/alignment_trial.h"
 
 #include <cmath>
 
-#include "procs/common/conversions.h"
-#include "procs/common/validation.h"
+#include "lcmtypes/contract/conversions.h"
+#include "lcmtypes/contract/validation.h"
 
 namespace orbed {
 namespace {

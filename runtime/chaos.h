@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// Fault injection on the receive side: what the Process scaffold (procs/common/process.h) does to
+/// Fault injection on the receive side: what the Process scaffold (runtime/process.h) does to
 /// the datagrams of the channels it is told to hurt, before decoding, so that retries, idempotent
 /// answers and duplicate handling are exercised over a real bus. Multicast hands every datagram to
 /// every subscriber directly, so losses are made where a datagram is received, not in a proxy.

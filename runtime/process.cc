@@ -1,4 +1,4 @@
-#include "procs/common/process.h"
+#include "runtime/process.h"
 
 #include <poll.h>
 #include <unistd.h>
@@ -11,9 +11,9 @@
 #include <stdexcept>
 #include <thread>
 
-#include "procs/common/channels.h"
-#include "procs/common/conversions.h"
-#include "procs/common/log.h"
+#include "lcmtypes/contract/channels.h"
+#include "lcmtypes/contract/conversions.h"
+#include "base/log.h"
 
 namespace orbed {
 namespace {

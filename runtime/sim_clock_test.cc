@@ -10,10 +10,10 @@
 #include <orbed/sim_clock_ack_t.hpp>
 #include <orbed/sim_clock_t.hpp>
 
-#include "procs/common/channels.h"
-#include "procs/common/flags.h"
-#include "procs/common/process.h"
-#include "procs/common/sim_clock.h"
+#include "lcmtypes/contract/channels.h"
+#include "runtime/flags.h"
+#include "runtime/process.h"
+#include "runtime/sim_clock.h"
 
 namespace orbed {
 namespace {

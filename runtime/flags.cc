@@ -1,13 +1,13 @@
-#include "procs/common/flags.h"
+#include "runtime/flags.h"
 
 #include <CLI/CLI.hpp>
 
 #include <cstdlib>
 #include <regex>
 
-#include "procs/common/channels.h"
-#include "procs/common/chaos.h"
-#include "procs/common/log.h"
+#include "lcmtypes/contract/channels.h"
+#include "runtime/chaos.h"
+#include "base/log.h"
 
 namespace orbed {
 

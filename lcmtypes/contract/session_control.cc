@@ -1,11 +1,11 @@
-#include "procs/common/session_control.h"
+#include "lcmtypes/contract/session_control.h"
 
 #include <algorithm>
 
 #include <orbed/alignment_trial_t.hpp>
 #include <orbed/registration_t.hpp>
 
-#include "procs/common/validation.h"
+#include "lcmtypes/contract/validation.h"
 
 namespace orbed {
 
