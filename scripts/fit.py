@@ -52,7 +52,7 @@ def main():
     with open(os.path.join(args.source, "viraal", "viraal.yaml")) as f:
         scenario = f.read()
     if "modes: [ar_reflective, ar]" not in scenario:
-        sys.exit("fit: viraal/viraal.yaml no longer says 'modes: [ar_reflective, ar]'")
+        sys.exit("fit: experiments/viraal/viraal.yaml no longer says 'modes: [ar_reflective, ar]'")
     ar_only = scenario.replace("modes: [ar_reflective, ar]", "modes: [ar]")
 
     rows = []

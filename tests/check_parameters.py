@@ -29,7 +29,7 @@ FILES = [
     "hmd_emulator/config/hmd.yaml",
     "hmd_emulator/config/viraal_walk.yaml",
     "hmd_emulator/config/walk_loop.yaml",
-    "viraal/viraal.yaml",
+    "experiments/viraal/viraal.yaml",
     "procs/assistant/assistant.yaml",
 ]
 DOC = "docs/parameters.md"

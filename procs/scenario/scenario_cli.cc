@@ -8,8 +8,8 @@
 
 #include "runtime/flags.h"
 #include "procs/scenario/viraal_scenario.h"
-#include "viraal/protocol.h"
-#include "viraal/results.h"
+#include "experiments/viraal/protocol.h"
+#include "experiments/viraal/results.h"
 
 namespace orbed::scenario {
 
@@ -45,7 +45,7 @@ int RunScenario(int argc, const char* const* argv, std::ostream& out, std::ostre
   std::string modes;
   std::vector<std::string> q_deg;
   app.add_option("--scenario", scenario_path,
-                 "Scenario YAML (default: viraal/viraal.yaml under $ORBED_SOURCE_DIR, else under "
+                 "Scenario YAML (default: experiments/viraal/viraal.yaml under $ORBED_SOURCE_DIR, else under "
                  "the source tree it was built from)");
   app.add_option("--trials", trials, "Trials per mode (overrides the file's trials)")
       ->check(orbed::NumberIn(1, 1000));

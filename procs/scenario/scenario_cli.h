@@ -5,7 +5,7 @@
 /// exits: 0 when every session finished, 1 with a one-line reason otherwise.
 ///
 /// Flags: the common ones (flags.h: --lcm-url, --name, --seed, --duration-s, --log-level), and
-///   --scenario FILE            scenario YAML (default viraal/viraal.yaml of the source tree)
+///   --scenario FILE            scenario YAML (default experiments/viraal/viraal.yaml of the source tree)
 ///   --trials N, --modes a,b, --q-deg q1,...,q7 (repeatable)   overrides of the file
 ///   --run-id ID                sessions are <ID>-<mode>; default (or empty) viraal-<UTC time>
 ///   --results-dir DIR          folder of results.json (default $ORBED_LOG_DIR, else the working dir)

@@ -26,9 +26,9 @@
 #include "lcmtypes/contract/conversions.h"
 #include "procs/scenario/viraal_scenario.h"
 #include "sim/scene.h"
-#include "viraal/metrics.h"
-#include "viraal/protocol.h"
-#include "viraal/results.h"
+#include "experiments/viraal/metrics.h"
+#include "experiments/viraal/protocol.h"
+#include "experiments/viraal/results.h"
 
 namespace orbed::scenario {
 namespace {

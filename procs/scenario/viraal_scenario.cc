@@ -13,7 +13,7 @@
 #include "base/source_paths.h"
 #include "lcmtypes/contract/conversions.h"
 #include "base/log.h"
-#include "procs/scenario/resume.h"
+#include "experiments/viraal/resume.h"
 
 namespace orbed::scenario {
 namespace {

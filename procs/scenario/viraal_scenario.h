@@ -13,7 +13,7 @@
 ///
 /// Each decoded message goes to the conductor with the time it was handled, and a timer calls its
 /// Tick() every tick_s; the actions it returns are carried out at once, in order. While the run
-/// goes on, results.json (viraal/results.h) in results_dir is rewritten with status "partial" at
+/// goes on, results.json (experiments/viraal/results.h) in results_dir is rewritten with status "partial" at
 /// the start and whenever a trial or a mean is finished, so a conductor killed mid-run (SIGKILL)
 /// leaves what it finished. When the conductor is done, results.json is written once more: on
 /// success the table is printed and the process stops with exit code 0; on a failure "FAILED:
@@ -22,7 +22,7 @@
 /// end fails the run as "interrupted".
 ///
 /// Resuming (resume_path, a results.json or the folder holding it): the earlier run's results are
-/// read (viraal/results.h) and checked against this run (resume.h); the run id is the earlier
+/// read (experiments/viraal/results.h) and checked against this run (resume.h); the run id is the earlier
 /// run's unless one is given (it must then be the same); the conductor keeps what they hold.
 ///
 /// Clocks: the conductor's t_s and utime are the process clock (Process::ClockSeconds / ClockUtime:
@@ -35,8 +35,8 @@
 #include <string>
 
 #include "runtime/process.h"
-#include "procs/scenario/viraal_conductor.h"
-#include "viraal/results.h"
+#include "experiments/viraal/viraal_conductor.h"
+#include "experiments/viraal/results.h"
 
 namespace orbed::scenario {
 

@@ -184,13 +184,13 @@ int RunSetup(int argc, const char* const* argv, std::ostream& out, std::ostream&
   app.add_option("--modes", modes,
                  "The order of the modes, e.g. fixed,ar,ar_reflective (default: drawn from "
                  "--user-seed)");
-  app.add_option("--plan", plan_path, "Targets from `orbed-robot plan` (default: procs/setup/targets.json)");
+  app.add_option("--plan", plan_path, "Targets from `orbed-robot plan` (default: experiments/setup/targets.json)");
   app.add_option("--targets", targets, "How many of the plan's targets per mode")
       ->check(orbed::NumberIn(1, 20))
       ->capture_default_str();
   app.add_option("--start-deg", start_deg, "Where the arm is parked before each set-up [deg]")
       ->capture_default_str();
-  app.add_option("--scenario", scenario_path, "The alignment protocol (default: viraal/viraal.yaml)");
+  app.add_option("--scenario", scenario_path, "The alignment protocol (default: experiments/viraal/viraal.yaml)");
   app.add_option("--trials", trials, "Alignments before each headset set-up (the paper: N = 3)")
       ->check(orbed::NumberIn(1, 100))
       ->capture_default_str();
@@ -241,7 +241,7 @@ int RunSetup(int argc, const char* const* argv, std::ostream& out, std::ostream&
   }
   try {
     if (urdf_path.empty()) urdf_path = SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath);
-    if (plan_path.empty()) plan_path = SourceTreePath("procs/setup/targets.json");
+    if (plan_path.empty()) plan_path = SourceTreePath("experiments/setup/targets.json");
     if (scenario_path.empty()) scenario_path = SourceTreePath(viraal::kDefaultScenarioRelativePath);
     if (results_dir.empty()) {
       const char* env = std::getenv("ORBED_LOG_DIR");

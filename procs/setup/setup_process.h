@@ -28,7 +28,7 @@
 #include <string>
 
 #include "runtime/process.h"
-#include "procs/setup/setup_conductor.h"
+#include "experiments/setup/setup_conductor.h"
 
 namespace orbed::setup {
 

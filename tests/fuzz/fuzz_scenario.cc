@@ -2,7 +2,7 @@
 // REGISTRATION, MISALIGNMENT, ...) on a conductor that has started its run.
 #include "procs/scenario/viraal_scenario.h"
 #include "tests/fuzz/fuzz_util.h"
-#include "viraal/protocol.h"
+#include "experiments/viraal/protocol.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   static auto* scenario = [] {

@@ -7,7 +7,7 @@
 #include "procs/setup/setup_process.h"
 #include "sim/guidance_messages.h"
 #include "tests/fuzz/fuzz_util.h"
-#include "viraal/protocol.h"
+#include "experiments/viraal/protocol.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   static auto* setup = [] {

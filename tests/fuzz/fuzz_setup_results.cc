@@ -3,7 +3,7 @@
 #include <cstdlib>
 #include <string>
 
-#include "procs/setup/setup_conductor.h"
+#include "experiments/setup/setup_conductor.h"
 #include "tests/fuzz/fuzz_files.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

@@ -67,7 +67,7 @@ const std::set<std::string> kProtocolChannels = {
     "PLAN_CHECK_REQUEST",   "PLAN_CHECK_REPLY", "SESSION_CONTROL", "ALIGNMENT_TRIAL",
     "MISALIGNMENT_REQUEST", "MISALIGNMENT",     "REGISTRATION"};
 
-// The pinned scenario's configurations [deg] (viraal/viraal.yaml).
+// The pinned scenario's configurations [deg] (experiments/viraal/viraal.yaml).
 const std::vector<std::vector<double>> kConfigurationsDeg = {
     {0, 30, 0, -60, 0, 45, 0}, {40, 20, -30, -80, 20, 50, 30}, {-35, 30, 20, -65, -15, 50, -40}};
 

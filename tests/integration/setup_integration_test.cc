@@ -63,7 +63,7 @@
 #include <orbed/sim_clock_t.hpp>
 
 #include "base/units.h"
-#include "procs/setup/setup_conductor.h"
+#include "experiments/setup/setup_conductor.h"
 #include "procs/setup/setup_process.h"
 #include "sim/guidance_messages.h"
 #include "tests/integration/logged.h"

@@ -125,7 +125,7 @@ TEST(ViraalRun, TheScenariosCaptureWaypointReachesTheHeadset) {
   const std::string dir = MakeTempDir("viraal_capture");
   std::string text;
   {
-    std::ifstream in(SourcePath("viraal/viraal.yaml"));
+    std::ifstream in(SourcePath("experiments/viraal/viraal.yaml"));
     text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
   }
   auto replaced = [](std::string s, const std::string& from, const std::string& to) {

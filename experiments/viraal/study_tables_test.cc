@@ -1,0 +1,183 @@
+// The study's files from its runs (study_tables.h), against independent figures:
+//   - one user: Table 1 per mode equals the pinned run's `table1`, which Python's statistics module
+//     computed from the file's trials;
+//   - the same user twice: the means stay, each per-axis std becomes std·sqrt(4/5) (each value twice:
+//     2·Σ(x − m)² over 6 − 1 instead of Σ(x − m)² over 3 − 1);
+//   - the CSVs have STUDY's columns, a row per trial (per user and mode for the means), values from
+//     the files; tables.json has the documented shape, the paper's rows consistent with their norms;
+//   - the command writes the four files, refuses a run that did not finish.
+#include "experiments/viraal/study_tables.h"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "base/source_paths.h"
+#include "base/test_command.h"
+
+namespace orbed::study {
+namespace {
+
+const char* kPinned = "tests/integration/testdata/viraal_pinned_results.json";
+
+nlohmann::json PinnedJson() {
+  std::ifstream in(SourceTreePath(kPinned));
+  return nlohmann::json::parse(in);
+}
+
+std::vector<UserRun> Users(int n) {
+  std::vector<UserRun> runs;
+  for (int i = 0; i < n; ++i)
+    runs.push_back({"u" + std::to_string(i + 1), viraal::ReadResultsFile(SourceTreePath(kPinned))});
+  return runs;
+}
+
+std::vector<std::string> Lines(const std::string& text) {
+  std::vector<std::string> lines;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+TEST(StudyTables, OneUserGivesThePinnedRunsTable1) {
+  const nlohmann::json pinned = PinnedJson();
+  const std::vector<UserRun> runs = Users(1);
+  ASSERT_EQ(StudyModes(runs), (std::vector<std::string>{"ar_reflective", "ar"}));
+  for (const nlohmann::json& session : pinned["sessions"]) {
+    const viraal::Table1Row row = ModeTrialsRow(runs, session["mode"]);
+    const nlohmann::json& expected = session["table1"];
+    EXPECT_EQ(row.num_trials, expected["num_trials"].get<int>());
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_NEAR(row.axes_mean_mm[k], expected["axes_mean_mm"][k].get<double>(), 1e-12);
+      EXPECT_NEAR(row.axes_std_mm[k], expected["axes_std_mm"][k].get<double>(), 1e-12);
+    }
+    EXPECT_NEAR(row.mean_mm, expected["mean_mm"].get<double>(), 1e-12);
+    EXPECT_NEAR(row.std_mm, expected["std_mm"].get<double>(), 1e-12);
+  }
+}
+
+TEST(StudyTables, TheSameUserTwiceKeepsTheMeansAndShrinksTheStds) {
+  const std::vector<UserRun> one = Users(1), two = Users(2);
+  for (const char* mode : {"ar_reflective", "ar"}) {
+    const viraal::Table1Row a = ModeTrialsRow(one, mode), b = ModeTrialsRow(two, mode);
+    EXPECT_EQ(b.num_trials, 2 * a.num_trials);
+    EXPECT_NEAR((b.axes_mean_mm - a.axes_mean_mm).norm(), 0.0, 1e-12);
+    EXPECT_NEAR((b.axes_std_mm - a.axes_std_mm * std::sqrt(4.0 / 5.0)).norm(), 0.0, 1e-12);
+    // The users' SE(3) means: two equal values, no spread.
+    const viraal::Table1Row means = ModeMeansRow(two, mode);
+    EXPECT_EQ(means.num_trials, 2);
+    EXPECT_NEAR(means.std_mm, 0.0, 1e-12);
+  }
+}
+
+TEST(StudyTables, CsvsHaveTheStudyColumnsAndTheFilesValues) {
+  const nlohmann::json pinned = PinnedJson();
+  const std::vector<UserRun> runs = Users(2);
+  const std::string header =
+      "user,mode,trial,t_x_mm,t_y_mm,t_z_mm,misalignment_mm,true_translation_mm,true_rotation_deg,duration_s,"
+      "landmarks,true_misalignment_mm";
+  const std::vector<std::string> trials = Lines(AlignmentTrialsCsv(runs));
+  ASSERT_EQ(trials.size(), 1u + 2 * 2 * 3);
+  EXPECT_EQ(trials[0], header);
+  // u2's second ar trial: row 1 + 6 (u1) + 3 (u2's ar_reflective) + 1.
+  char user[8], mode[32];
+  int trial = 0;
+  char landmarks[8];
+  double t[3], mis, translation, rotation, duration, true_mis;
+  ASSERT_EQ(std::sscanf(trials[11].c_str(), "%7[^,],%31[^,],%d,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%7[^,],%lf", user,
+                        mode, &trial, &t[0], &t[1], &t[2], &mis, &translation, &rotation, &duration,
+                        landmarks, &true_mis),
+            12)
+      << trials[11];
+  const nlohmann::json& expected = pinned["sessions"][1]["trials"][1];
+  EXPECT_STREQ(user, "u2");
+  EXPECT_STREQ(mode, "ar");
+  EXPECT_EQ(trial, 2);
+  for (int k = 0; k < 3; ++k) EXPECT_DOUBLE_EQ(t[k], expected["misalignment_axes_mm"][k].get<double>());
+  EXPECT_NEAR(mis, expected["misalignment_mm"].get<double>(), 1e-9);  // the norm of the axes
+  EXPECT_DOUBLE_EQ(translation, expected["translation_error_mm"].get<double>());
+  EXPECT_DOUBLE_EQ(rotation, expected["rotation_error_deg"].get<double>());
+  EXPECT_DOUBLE_EQ(duration, expected["user_duration_s"].get<double>());
+  EXPECT_STREQ(landmarks, "gaze");
+  EXPECT_DOUBLE_EQ(true_mis, expected["truth_misalignment_mm"].get<double>());
+
+  const std::vector<std::string> means = Lines(AlignmentMeansCsv(runs));
+  ASSERT_EQ(means.size(), 1u + 2 * 2);
+  EXPECT_EQ(means[0], header);
+  EXPECT_EQ(means[1].rfind("u1,ar_reflective,mean,", 0), 0u) << means[1];
+}
+
+TEST(StudyTables, TablesJsonHasTheDocumentedShape) {
+  LandmarkValidation validation;
+  validation.mean_error_mm = 4.25;
+  const nlohmann::json tables = nlohmann::json::parse(TablesJson(Users(1), validation));
+  EXPECT_EQ(tables["users"], 1);
+  for (const char* mode : {"ar_reflective", "ar"}) {
+    for (const char* key : {"t_x", "t_y", "t_z", "norm"}) {
+      EXPECT_EQ(tables["table1"][mode][key].size(), 2u) << mode << key;
+      EXPECT_EQ(tables["table1"]["se3_mean"][mode][key].size(), 2u) << mode << key;
+    }
+    // The paper's rows: their norms are the norms of their per-axis figures (to the print's rounding).
+    const nlohmann::json& paper = tables["paper"]["table1"][mode];
+    double mean2 = 0, std2 = 0;
+    for (const char* key : {"t_x", "t_y", "t_z"}) {
+      mean2 += std::pow(paper[key][0].get<double>(), 2);
+      std2 += std::pow(paper[key][1].get<double>(), 2);
+    }
+    EXPECT_NEAR(std::sqrt(mean2), paper["norm"][0].get<double>(), 0.05) << mode;
+    EXPECT_NEAR(std::sqrt(std2), paper["norm"][1].get<double>(), 0.05) << mode;
+  }
+  EXPECT_EQ(tables["paper"]["table1"]["ar"]["norm"], nlohmann::json({30.2, 23.9}));
+  EXPECT_EQ(tables["paper"]["table1"]["se3_mean"]["ar_reflective"]["norm"], nlohmann::json({11.3, 1.01}));
+  EXPECT_EQ(tables["landmark_validation_mm"], 4.25);
+  EXPECT_EQ(tables["paper"]["landmark_validation_mm"], 3.6);
+}
+
+TEST(StudyTables, TheCommandWritesTheFilesAndRefusesAnUnfinishedRun) {
+  const std::string dir = ::testing::TempDir() + "study_tables_out";
+  std::filesystem::remove_all(dir);
+  const std::string pinned = SourceTreePath(kPinned);
+  nlohmann::json other_person = PinnedJson();
+  for (auto& session : other_person["sessions"]) {
+    for (auto& trial : session["trials"]) trial["user_id"] = "emulated-seed-2";
+  }
+  const std::string other_path = ::testing::TempDir() + "other_person_results.json";
+  std::ofstream(other_path) << other_person.dump();
+  // The same run twice is one person twice: refused.
+  test::CommandRun r = test::RunCommand(RunStudyTables, "orbed-study-tables", {"--out", dir, pinned, pinned});
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("user u2 is the same person as u1 ('emulated-seed-1')"), std::string::npos) << r.err;
+  r = test::RunCommand(RunStudyTables, "orbed-study-tables", {"--out", dir, pinned, other_path});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("ViRAAl study: 2 users"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("paper 30.2 +/- 23.9 mm"), std::string::npos) << r.out;
+  for (const char* name :
+       {"alignment_trials.csv", "alignment_means.csv", "landmark_validation.csv", "tables.json"}) {
+    EXPECT_TRUE(std::filesystem::exists(dir + "/" + name)) << name;
+  }
+
+  nlohmann::json partial = PinnedJson();
+  partial["status"] = "partial";
+  const std::string partial_path = ::testing::TempDir() + "partial_results.json";
+  std::ofstream(partial_path) << partial.dump();
+  r = test::RunCommand(RunStudyTables, "orbed-study-tables", {"--out", dir, pinned, partial_path});
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("did not finish"), std::string::npos) << r.err;
+  nlohmann::json odd_mode = other_person;
+  odd_mode["sessions"][0]["mode"] = "se3_mean";
+  const std::string odd_path = ::testing::TempDir() + "odd_mode_results.json";
+  std::ofstream(odd_path) << odd_mode.dump();
+  r = test::RunCommand(RunStudyTables, "orbed-study-tables", {"--out", dir, pinned, odd_path});
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("mode 'se3_mean' is not one of the study's"), std::string::npos) << r.err;
+  EXPECT_EQ(test::RunCommand(RunStudyTables, "orbed-study-tables", {pinned}).code, 2);  // no --out
+}
+
+}  // namespace
+}  // namespace orbed::study

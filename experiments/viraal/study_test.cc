@@ -1,0 +1,172 @@
+// The offline study against the live testbed and the paper's claims:
+//   - for the pinned seed and run id its results equal, number for number, the results.json that
+//     `scripts/orbed run` wrote (tests/integration/testdata/viraal_pinned_results.json): one
+//     protocol, one set of numbers;
+//   - the mechanism: with a display captured from another viewpoint the misalignment is smaller
+//     (rank test over many trials), with a display from the alignment viewpoint it is not (the
+//     negative control);
+//   - the command line: help, bad arguments, a small run and its results.json.
+#include "experiments/viraal/viraal_study.h"
+
+#include <cstdio>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+
+#include "base/source_paths.h"
+#include "base/stats.h"
+#include "base/test_command.h"
+#include "experiments/viraal/study_cli.h"
+#include "tests/same_tree.h"
+#include "experiments/viraal/results.h"
+
+namespace orbed::study {
+namespace {
+
+StudyOptions Shipped(int trials, const std::string& run_id) {
+  StudyOptions o;
+  o.scenario = viraal::LoadScenarioFile(SourceTreePath(viraal::kDefaultScenarioRelativePath));
+  o.scenario.trials = trials;
+  o.run_id = run_id;
+  return o;
+}
+
+// The landmark misalignment against the truth (the registration's error at the landmarks; the
+// user's gaze measurement cannot see the SLAM map's error, see GazeMeasurementSeesTheViewNotTheMap).
+std::vector<double> Misalignment(const viraal::SessionResult& session) {
+  std::vector<double> out;
+  for (const auto& t : session.trials) out.push_back(t.errors.truth_misalignment_mm);
+  return out;
+}
+
+TEST(ViraalStudy, EqualsThePinnedLiveRun) {
+  const viraal::RunResults results = RunViraalStudy(Shipped(3, "pinned"));
+  const YAML::Node pinned =
+      YAML::LoadFile(SourceTreePath("tests/integration/testdata/viraal_pinned_results.json"));
+  // The live run's timing is its own; everything else is the protocol's.
+  orbed::testing::ExpectSameTree(pinned, YAML::Load(viraal::ResultsJson(results)), "results",
+                                 {"started_utime", "duration_s"});
+}
+
+// One group of three is the session itself: its mean is the session mean the conductor scored, with
+// the truth's pairs (the group means have no annotated landmarks to be measured against).
+TEST(ViraalStudy, AGroupOfAllTheTrialsIsTheSessionMean) {
+  const StudyOptions o = Shipped(3, "pinned");
+  const viraal::RunResults results = RunViraalStudy(o);
+  for (const viraal::SessionResult& s : results.sessions) {
+    const std::vector<double> groups = GroupMeanMisalignment_mm(o, s, 3);
+    ASSERT_EQ(groups.size(), 1u);
+    ASSERT_TRUE(s.mean.has_value());
+    EXPECT_EQ(s.mean->errors.landmarks, "gaze_real");
+    EXPECT_NEAR(groups[0], s.mean->errors.truth_misalignment_mm, 1e-9) << s.mode;
+  }
+  EXPECT_EQ(GroupMeanMisalignment_mm(o, results.sessions[0], 2).size(), 1u);  // the third trial left out
+}
+
+TEST(ViraalStudy, SeedAndRunIdChooseTheTrials) {
+  const viraal::RunResults a = RunViraalStudy(Shipped(2, "a"));
+  const viraal::RunResults a_again = RunViraalStudy(Shipped(2, "a"));
+  const viraal::RunResults b = RunViraalStudy(Shipped(2, "b"));
+  EXPECT_EQ(viraal::ResultsJson(a), viraal::ResultsJson(a_again));
+  EXPECT_NE(a.sessions[0].trials[0].errors.misalignment_mm, b.sessions[0].trials[0].errors.misalignment_mm);
+}
+
+// Writes a headset config that places the one display at `waypoint`, on a map without drift or
+// tracking losses (jitter only): the display's viewpoint alone, apart from the map's error, which a
+// session shares between its trials (slam_model.h) and which the display's frame carries.
+std::string DisplayAt(const std::string& waypoint) {
+  const std::string path = ::testing::TempDir() + "display_at_" + waypoint + ".yaml";
+  std::ofstream(path) << "hmd:\n  displays:\n    - {capture_waypoint: " << waypoint << "}\n"
+                      << "slam:\n  drift: {fraction_of_distance: 0, yaw_deg_per_m: 0}\n"
+                      << "  tracking_loss: {rate_per_min: 0}\n";
+  return path;
+}
+
+// The mechanism of the paper's display: a frame captured from the foot end of the table (another
+// viewpoint than the alignment's, at the head end) shows the depth along the person's line of
+// sight, and lowers the misalignment against the truth.
+TEST(ViraalStudy, DisplayFromAnotherViewpointLowersTheMisalignment) {
+  StudyOptions o = Shipped(60, "mechanism");
+  o.headset_config_paths = {DisplayAt("foot_end")};
+  const viraal::RunResults r = RunViraalStudy(o);
+  ASSERT_EQ(r.sessions.size(), 2u);
+  ASSERT_EQ(r.sessions[0].mode, "ar_reflective");
+  const std::vector<double> with = Misalignment(r.sessions[0]), without = Misalignment(r.sessions[1]);
+  const stats::MannWhitneyResult mw = stats::MannWhitneyU(with, without);
+  ASSERT_TRUE(mw.valid);
+  EXPECT_LT(mw.p_x_less, 0.01) << stats::Mean(with) << " vs " << stats::Mean(without) << " mm";
+  EXPECT_LT(stats::Mean(with), 0.8 * stats::Mean(without));
+}
+
+// The negative control: a display captured where the person aligns shows the robot from their own
+// viewpoint; it adds no second view of the depth along the line of sight, so it must not lower the
+// misalignment significantly: the mechanism, not the mere presence of a display, makes the gain.
+TEST(ViraalStudy, DisplayFromTheAlignmentViewpointDoesNotHelp) {
+  StudyOptions o = Shipped(60, "mechanism");
+  o.headset_config_paths = {DisplayAt("head_end")};
+  const viraal::RunResults r = RunViraalStudy(o);
+  const std::vector<double> with = Misalignment(r.sessions[0]), without = Misalignment(r.sessions[1]);
+  const stats::MannWhitneyResult mw = stats::MannWhitneyU(with, without);
+  ASSERT_TRUE(mw.valid);
+  EXPECT_GT(mw.p_x_less, 0.05) << stats::Mean(with) << " vs " << stats::Mean(without) << " mm";
+}
+
+TEST(UserStudyCli, HelpGoesToOutAndExitsZero) {
+  const test::CommandRun r = test::RunCommand(RunUserStudy, "orbed-user-study", {"--help"});
+  EXPECT_EQ(r.code, 0);
+  EXPECT_NE(r.out.find("--trials"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("--run-id"), std::string::npos) << r.out;
+  EXPECT_TRUE(r.err.empty()) << r.err;
+}
+
+TEST(UserStudyCli, BadArgumentsExitTwo) {
+  test::CommandRun r = test::RunCommand(RunUserStudy, "orbed-user-study", {"--no-such-flag"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--no-such-flag"), std::string::npos) << r.err;
+  // --trials: a positive decimal integer that fits an int, nothing else (010 would be octal 8 and
+  // 0x10 hex 16 for CLI11's own integer parser).
+  // At most 1000: a headset session holds no more (lcmtypes/contract/alignment_trial.h).
+  for (const char* bad : {"0", "-3", "abc", "12x", "1e3", "99999999999", "0x10", "+5", "", "1001"}) {
+    r = test::RunCommand(RunUserStudy, "orbed-user-study", {"--trials", bad});
+    EXPECT_EQ(r.code, 2) << bad;
+    EXPECT_NE(r.err.find("--trials"), std::string::npos) << bad << ": " << r.err;
+    EXPECT_TRUE(r.out.empty()) << r.out;
+  }
+  r = test::RunCommand(RunUserStudy, "orbed-user-study", {"--modes", "ar,nothing"});
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("nothing"), std::string::npos) << r.err;
+}
+
+TEST(UserStudyCli, SmallRunPrintsTheTableAndWritesResultsJson) {
+  const std::string json = ::testing::TempDir() + "study_results.json";
+  std::remove(json.c_str());
+  const test::CommandRun r = test::RunCommand(
+      RunUserStudy, "orbed-user-study", {"--trials", "02", "--run-id", "pinned", "--json", json, "--quiet"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(r.err.empty()) << r.err;
+  EXPECT_NE(r.out.find("paper: 16.5 +/- 11.0 mm"), std::string::npos) << r.out;
+  const YAML::Node written = YAML::LoadFile(json);
+  ASSERT_EQ(written["sessions"].size(), 2u);
+  EXPECT_EQ(written["sessions"][0]["trials"].size(), 2u);  // "02" read as decimal 2
+  // The first trials are the pinned run's first trials: same seeds, same protocol.
+  const YAML::Node pinned =
+      YAML::LoadFile(SourceTreePath("tests/integration/testdata/viraal_pinned_results.json"));
+  orbed::testing::ExpectSameTree(pinned["sessions"][0]["trials"][1], written["sessions"][0]["trials"][1],
+                                 "trial 1", {});
+}
+
+TEST(UserStudyCli, ManyTrialsPrintASummaryWithTheRankTest) {
+  const test::CommandRun r =
+      test::RunCommand(RunUserStudy, "orbed-user-study", {"--trials", "12", "--run-id", "summary"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("ar_reflective (12 trials)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("Table 1 [mm]"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("Mann-Whitney U"), std::string::npos) << r.out;
+  EXPECT_NE(r.err.find("24/24 trials"), std::string::npos) << r.err;  // progress
+}
+
+}  // namespace
+}  // namespace orbed::study

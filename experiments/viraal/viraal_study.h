@@ -1,0 +1,62 @@
+#pragma once
+/// @file
+/// The ViRAAl experiment without a bus: what `scripts/orbed run` does with five processes, done in
+/// one program by calling the same code in the same order.
+///
+///   conductor (viraal/)         the scenario file's modes, trials and configurations; the errors
+///                               against the truth (experiments/viraal/exchange.h, experiments/viraal/metrics.h)
+///   headset (hmd_emulator/)     RunHeadsetTrial, the function orbed-hmd calls for a REQUEST_TRIAL,
+///                               with the same seeds (process seed, session id, trial index)
+///   registration server         RegistrationService, the core orbed-registration runs: trials in,
+///                               the SE(3) mean on COMPUTE, the misalignment of the landmark pairs
+///   arm (sim/)                  reaches each configuration exactly (the sim lands on its target), so
+///                               the trial's q is the configuration in radians
+///
+/// The messages that would have crossed the bus are built and passed as they are (poses through
+/// pose_t, joint vectors through the message arrays), so for the same seed, run id and files the
+/// results equal results.json of the live run number for number (study_test checks it against the
+/// pinned run in tests/integration/testdata). Sessions are "<run_id>-<mode>"; trial i of a mode is
+/// made at configuration i mod K.
+///
+/// Frames: W world, R real robot base, V virtual robot base. Units as in experiments/viraal/results.h.
+/// Threading: pure function of its inputs; reentrant.
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "experiments/viraal/protocol.h"
+#include "experiments/viraal/results.h"
+
+namespace orbed::study {
+
+struct StudyOptions {
+  /// The conductor's scenario (experiments/viraal/viraal.yaml, flags applied).
+  viraal::ScenarioConfig scenario;
+  /// Robot model and scene; "" = the files shipped in the source tree.
+  std::string urdf_path;
+  std::string scene_path;
+  /// Headset config files applied after the shipped ones (as orbed-hmd --config).
+  std::vector<std::string> headset_config_paths;
+  /// orbed-hmd's --seed (the per-trial seeds derive from it) and the conductor's (results.json).
+  std::uint64_t seed{1};
+  /// Session ids are "<run_id>-<mode>".
+  std::string run_id{"study"};
+  /// Called after each trial with (trials done, trials in all); may be empty.
+  std::function<void(int, int)> progress;
+};
+
+/// Runs every mode of the scenario; throws std::runtime_error / std::invalid_argument on unreadable
+/// files, a configuration outside the joint limits or a refused message (naming it).
+viraal::RunResults RunViraalStudy(const StudyOptions& options);
+
+/// The paper's registration statistic: the trials of `session` taken `group_size` at a time in
+/// order (the last incomplete group left out), each group averaged on SE(3) by the registration
+/// server's core with the scenario's method, and scored over the group's configurations with the
+/// truth's landmark pairs (a group is not a session the conductor measured; its mean is scored as a
+/// trial without annotation would be). Returns each group mean's misalignment [mm].
+std::vector<double> GroupMeanMisalignment_mm(const StudyOptions& options,
+                                             const viraal::SessionResult& session, int group_size);
+
+}  // namespace orbed::study
