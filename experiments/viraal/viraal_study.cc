@@ -11,7 +11,7 @@
 #include "hmd_emulator/hmd_config.h"
 #include "hmd_emulator/user_model.h"
 #include "lcmtypes/contract/conversions.h"
-#include "procs/registration_server/registration_service.h"
+#include "experiments/viraal/registration_service.h"
 #include "sim/robot_model.h"
 #include "sim/scene.h"
 #include "experiments/viraal/exchange.h"

@@ -24,7 +24,7 @@
 
 #include "lcmtypes/contract/channels.h"
 #include "runtime/process.h"
-#include "procs/registration_server/registration_service.h"
+#include "experiments/viraal/registration_service.h"
 #include "procs/registration_server/session_journal.h"
 
 namespace orbed::registration {

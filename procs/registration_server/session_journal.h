@@ -38,7 +38,7 @@
 #include <orbed/session_control_t.hpp>
 
 #include "runtime/journal.h"
-#include "procs/registration_server/registration_service.h"
+#include "experiments/viraal/registration_service.h"
 
 namespace orbed::registration {
 

@@ -16,7 +16,7 @@
 #include "base/source_paths.h"
 #include "hmd_emulator/session_file.h"
 #include "runtime/journal.h"
-#include "procs/registration_server/registration_service.h"
+#include "experiments/viraal/registration_service.h"
 #include "procs/registration_server/session_journal.h"
 #include "sim/robot_model.h"
 #include "sim/sim_state.h"

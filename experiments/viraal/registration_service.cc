@@ -1,4 +1,4 @@
-#include "procs/registration_server/registration_service.h"
+#include "experiments/viraal/registration_service.h"
 
 #include <algorithm>
 #include <cmath>
