@@ -2,7 +2,7 @@
 /// @file
 /// The registration server's message logic without a bus: sessions driven by session_control_t,
 /// alignment trials in, registration_t / landmark_t / misalignment_t out. RegistrationServer
-/// (registration_server.h) wires it to LCM channels; tests drive it directly.
+/// (registration_server_process.h) wires it to LCM channels; tests drive it directly.
 ///
 /// Purity: every output is a function of the inputs handled so far, in order, and nothing else (no
 /// clock, no randomness). Output utimes are input utimes: a REGISTRATION for a trial carries that

@@ -1,7 +1,7 @@
 #pragma once
 /// @file
 /// The conductor of the paper's ViRAAl experiment (Sec. III-B, Table 1) as a phase machine without
-/// a bus or a clock. ViraalScenario (viraal_scenario.h) feeds it the decoded messages and the time
+/// a bus or a clock. ViraalScenario (scenario_process.h) feeds it the decoded messages and the time
 /// and publishes what it asks for; tests drive it directly, in emulated time.
 ///
 /// The run, for each mode (ar_reflective with its mirrors, ar with 0; order from the scenario file):

@@ -8,7 +8,7 @@
 //   - the server on 127.0.0.1 (an ephemeral port) with the library's ClientSocket: both
 //     directions, the client limit, a departure;
 //   - RobotFrames: the flange at the KUKA data sheet's 1.266 m above the base at q = 0.
-#include "procs/igtl_bridge/igtl_bridge.h"
+#include "procs/igtl_bridge/igtl_bridge_process.h"
 
 #include <chrono>
 #include <cmath>

@@ -1,7 +1,7 @@
 #pragma once
 /// @file
 /// `orbed-registration mean`: the offline SE(3) mean of a trial file (trial_file.h), on exactly the
-/// code path the server uses (se3_mean.h). Kept out of main.cc so tests call it directly.
+/// code path the server uses (se3_mean.h). Kept out of the main so tests call it directly.
 ///
 /// Output with json: one line,
 ///   {"rotation_wxyz":[w,x,y,z],"translation_m":[x,y,z],"converged":b,"unique":b,"iterations":n,

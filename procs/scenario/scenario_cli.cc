@@ -7,7 +7,7 @@
 #include <CLI/CLI.hpp>
 
 #include "runtime/flags.h"
-#include "procs/scenario/viraal_scenario.h"
+#include "procs/scenario/scenario_process.h"
 #include "experiments/viraal/protocol.h"
 #include "experiments/viraal/results.h"
 

@@ -1,7 +1,7 @@
 #pragma once
 /// @file
 /// The `orbed-scenario` command line (thin main in scenario_main.cc), as a library so that tests
-/// can run it in-process. It conducts the ViRAAl experiment over the bus (viraal_scenario.h) and
+/// can run it in-process. It conducts the ViRAAl experiment over the bus (scenario_process.h) and
 /// exits: 0 when every session finished, 1 with a one-line reason otherwise.
 ///
 /// Flags: the common ones (flags.h: --lcm-url, --name, --seed, --duration-s, --log-level), and

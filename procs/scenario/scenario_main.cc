@@ -1,7 +1,7 @@
 /// @file
 /// orbed-scenario: runs the paper's ViRAAl experiment (Sec. III-B, Table 1) over the bus and exits:
 /// 0 when every session finished, 1 with a one-line reason otherwise (flags in scenario_cli.h, the
-/// process in viraal_scenario.h, the run's phases in viraal_conductor.h).
+/// process in scenario_process.h, the run's phases in viraal_conductor.h).
 /// Subscribes: ROBOT_STATE, PLAN_CHECK_REPLY, ALIGNMENT_TRIAL, REGISTRATION, MISALIGNMENT.
 /// Publishes:  PLAN_CHECK_REQUEST, SESSION_CONTROL (START / REQUEST_TRIAL / COMPUTE / STOP),
 ///             IIWA_COMMAND, MISALIGNMENT_REQUEST, PROCESS_STATUS (1 Hz).

@@ -1,7 +1,7 @@
 // libFuzzer: orbed-drake-viewer's handlers (ROBOT_STATE, REGISTRATION, GUIDANCE) and the draw it
 // would publish after each input.
 #include "lcmtypes/contract/conversions.h"
-#include "procs/drake_viewer/viewer_bridge.h"
+#include "procs/drake_viewer/drake_viewer_process.h"
 #include "tests/fuzz/fuzz_util.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

@@ -1,7 +1,7 @@
 // libFuzzer: orbed-fixed-display's handlers (ROBOT_STATE, GUIDANCE) and the picture it would
 // publish after each input (every mode, a small picture: each accepted target is rendered).
 #include "lcmtypes/contract/conversions.h"
-#include "procs/fixed_display/fixed_display.h"
+#include "procs/fixed_display/fixed_display_process.h"
 #include "tests/fuzz/fuzz_util.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

@@ -1,6 +1,6 @@
 // libFuzzer: orbed-registration's message handlers (SESSION_CONTROL, ALIGNMENT_TRIAL,
 // LANDMARK_REQUEST, MISALIGNMENT_REQUEST) in-process.
-#include "procs/registration_server/registration_server.h"
+#include "procs/registration_server/registration_server_process.h"
 #include "tests/fuzz/fuzz_util.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

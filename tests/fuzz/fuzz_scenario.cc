@@ -1,6 +1,6 @@
 // libFuzzer: orbed-scenario's handlers (ROBOT_STATE, PLAN_CHECK_REPLY, ALIGNMENT_TRIAL,
 // REGISTRATION, MISALIGNMENT, ...) on a conductor that has started its run.
-#include "procs/scenario/viraal_scenario.h"
+#include "procs/scenario/scenario_process.h"
 #include "tests/fuzz/fuzz_util.h"
 #include "experiments/viraal/protocol.h"
 

@@ -1,9 +1,9 @@
 /// @file
 /// orbed-registration: the registration server and its offline command line (commands, flags and
-/// exit codes: procs/registration_server/registration_cli.h).
+/// exit codes: procs/registration_server/registration_server_cli.h).
 ///
 ///   orbed-registration [--lcm-url URL] [--state-period-s S] [--model-centroid-m X,Y,Z] ...
-///     The LCM server (registration_server.h).
+///     The LCM server (registration_server_process.h).
 ///     Subscribes: SESSION_CONTROL, ALIGNMENT_TRIAL, LANDMARK_REQUEST, MISALIGNMENT_REQUEST.
 ///     Publishes:  REGISTRATION (per accepted trial, on COMPUTE, and the full state every
 ///                 --state-period-s), LANDMARK, MISALIGNMENT, PROCESS_STATUS (1 Hz).
@@ -12,7 +12,7 @@
 ///     Publishes SESSION_CONTROL, ALIGNMENT_TRIAL; subscribes REGISTRATION.
 #include <iostream>
 
-#include "procs/registration_server/registration_cli.h"
+#include "procs/registration_server/registration_server_cli.h"
 
 int main(int argc, char** argv) {
   return orbed::registration::RunRegistration(argc, argv, std::cout, std::cerr);

@@ -1,4 +1,4 @@
-#include "procs/drake_viewer/viewer_messages.h"
+#include "procs/drake_viewer/drake_viewer.h"
 
 #include <array>
 #include <vector>

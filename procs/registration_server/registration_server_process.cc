@@ -1,4 +1,4 @@
-#include "procs/registration_server/registration_server.h"
+#include "procs/registration_server/registration_server_process.h"
 
 #include "base/log.h"
 

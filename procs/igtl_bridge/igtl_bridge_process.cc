@@ -1,4 +1,4 @@
-#include "procs/igtl_bridge/igtl_bridge.h"
+#include "procs/igtl_bridge/igtl_bridge_process.h"
 
 #include <exception>
 #include <variant>

@@ -1,4 +1,4 @@
-#include "procs/scenario/viraal_scenario.h"
+#include "procs/scenario/scenario_process.h"
 
 #include <cmath>
 #include <cstdio>

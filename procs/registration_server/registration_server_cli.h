@@ -1,11 +1,11 @@
 #pragma once
 /// @file
-/// The `orbed-registration` command line (thin main in main.cc), as a library function so that tests
+/// The `orbed-registration` command line (thin main in registration_server_main.cc), as a library function so that tests
 /// can run it in-process.
 ///
 ///   orbed-registration [common process flags] [--state-period-s S] [--model-centroid-m X Y Z]
 ///                      [--k-mad K] [--min-ray-angle-deg A] [--<name>-channel CHANNEL]...
-///     The LCM server (registration_server.h) until SIGINT/SIGTERM or --duration-s.
+///     The LCM server (registration_server_process.h) until SIGINT/SIGTERM or --duration-s.
 ///   orbed-registration mean --input FILE [--robust] [--json] [--model-centroid-m X Y Z]
 ///     The offline SE(3) mean of a trial file (mean_command.h); touches no network.
 ///   orbed-registration send --input FILE [--session-id ID] [--robust] [--timeout-s S]

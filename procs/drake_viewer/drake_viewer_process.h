@@ -1,7 +1,7 @@
 #pragma once
 /// @file
 /// orbed-drake-viewer: the testbed in Drake's viewer (Meldis: `python3 -m pydrake.visualization.meldis`
-/// on the same LCM URL). viewer_messages.h says what is drawn.
+/// on the same LCM URL). drake_viewer.h says what is drawn.
 ///
 ///   Subscribes (sim/testbed_poses.h): ROBOT_STATE (X_WR and q: the real robot), REGISTRATION (the
 ///               latest valid X_WV_mean: the virtual robot), GUIDANCE (its target is the virtual

@@ -24,7 +24,7 @@
 
 #include "base/units.h"
 #include "lcmtypes/contract/conversions.h"
-#include "procs/scenario/viraal_scenario.h"
+#include "procs/scenario/scenario_process.h"
 #include "sim/scene.h"
 #include "experiments/viraal/metrics.h"
 #include "experiments/viraal/protocol.h"

@@ -1,4 +1,4 @@
-#include "procs/foxglove_bridge/foxglove_bridge.h"
+#include "procs/foxglove_bridge/foxglove_bridge_process.h"
 
 #include <exception>
 

@@ -2,7 +2,7 @@
 // (iiwa_link_2's cylinder: radius 0.07, length 0.11, at (0, -0.115, 0) turned by 90 deg about x), the
 // scene's base pose (X_WR: (0.25, -0.55, 0.75), 90 deg about z) and joint 2's origin 0.34 m above
 // the base, composed by hand.
-#include "procs/drake_viewer/viewer_messages.h"
+#include "procs/drake_viewer/drake_viewer.h"
 
 #include <cmath>
 #include <string>
@@ -11,7 +11,7 @@
 
 #include "base/source_paths.h"
 #include "base/test_command.h"
-#include "procs/drake_viewer/viewer_bridge.h"
+#include "procs/drake_viewer/drake_viewer_process.h"
 
 namespace orbed::viewer {
 namespace {

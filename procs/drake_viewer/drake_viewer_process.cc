@@ -1,4 +1,4 @@
-#include "procs/drake_viewer/viewer_bridge.h"
+#include "procs/drake_viewer/drake_viewer_process.h"
 
 #include <exception>
 
@@ -7,7 +7,7 @@
 #include "lcmtypes/contract/conversions.h"
 #include "runtime/flags.h"
 #include "base/log.h"
-#include "procs/drake_viewer/viewer_messages.h"
+#include "procs/drake_viewer/drake_viewer.h"
 
 namespace orbed::viewer {
 ViewerBridge::ViewerBridge(const CommonFlags& flags, const ViewerOptions& options)

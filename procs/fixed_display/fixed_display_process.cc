@@ -1,4 +1,4 @@
-#include "procs/fixed_display/fixed_display.h"
+#include "procs/fixed_display/fixed_display_process.h"
 
 #include <cmath>
 #include <exception>

@@ -1,4 +1,4 @@
-#include "procs/registration_server/registration_cli.h"
+#include "procs/registration_server/registration_server_cli.h"
 
 #include <exception>
 #include <vector>
@@ -8,7 +8,7 @@
 
 #include "runtime/flags.h"
 #include "procs/registration_server/mean_command.h"
-#include "procs/registration_server/registration_server.h"
+#include "procs/registration_server/registration_server_process.h"
 #include "procs/registration_server/send_command.h"
 
 namespace orbed::registration {
