@@ -12,11 +12,11 @@
 #include <orbed/setup_task_t.hpp>
 
 #include "base/format.h"
+#include "base/log.h"
 #include "base/units.h"
 #include "hmd_emulator/headset_trial.h"
 #include "lcmtypes/contract/alignment_trial.h"
 #include "lcmtypes/contract/conversions.h"
-#include "base/log.h"
 #include "lcmtypes/contract/validation.h"
 #include "sim/guidance_messages.h"
 #include "sim/iiwa_status_check.h"

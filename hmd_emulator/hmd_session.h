@@ -47,8 +47,8 @@
 #include <orbed/alignment_trial_t.hpp>
 #include <orbed/session_control_t.hpp>
 
-#include "runtime/recent_answers.h"
 #include "lcmtypes/contract/session_control.h"
+#include "runtime/recent_answers.h"
 
 namespace orbed::hmd {
 

@@ -5,9 +5,9 @@
 #include <cstdlib>
 #include <regex>
 
+#include "base/log.h"
 #include "lcmtypes/contract/channels.h"
 #include "runtime/chaos.h"
-#include "base/log.h"
 
 namespace orbed {
 

@@ -11,9 +11,9 @@
 #include <stdexcept>
 #include <thread>
 
+#include "base/log.h"
 #include "lcmtypes/contract/channels.h"
 #include "lcmtypes/contract/conversions.h"
-#include "base/log.h"
 
 namespace orbed {
 namespace {

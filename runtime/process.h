@@ -52,10 +52,10 @@
 #include <orbed/sim_clock_ack_t.hpp>
 
 #include "lcmtypes/bounded_decode.h"
+#include "lcmtypes/contract/validation.h"
 #include "runtime/chaos.h"
 #include "runtime/flags.h"
 #include "runtime/sim_clock.h"
-#include "lcmtypes/contract/validation.h"
 
 namespace orbed {
 

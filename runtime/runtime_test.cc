@@ -16,10 +16,10 @@
 
 #include "lcmtypes/contract/channels.h"
 #include "lcmtypes/contract/conversions.h"
+#include "lcmtypes/contract/validation.h"
 #include "runtime/flags.h"
 #include "runtime/process.h"
 #include "runtime/recent_answers.h"
-#include "lcmtypes/contract/validation.h"
 
 namespace orbed {
 namespace {

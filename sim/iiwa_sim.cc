@@ -12,8 +12,8 @@
 #include <orbed/robot_state_t.hpp>
 
 #include "base/format.h"
-#include "lcmtypes/contract/conversions.h"
 #include "base/log.h"
+#include "lcmtypes/contract/conversions.h"
 #include "lcmtypes/contract/requests.h"
 #include "lcmtypes/contract/validation.h"
 #include "sim/sim_state.h"

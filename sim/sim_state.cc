@@ -5,8 +5,8 @@
 
 #include "lcmtypes/bounded_decode.h"
 #include "lcmtypes/contract/conversions.h"
-#include "runtime/journal.h"
 #include "lcmtypes/contract/validation.h"
+#include "runtime/journal.h"
 
 namespace orbed::sim {
 

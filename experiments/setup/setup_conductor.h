@@ -53,11 +53,11 @@
 #include <orbed/setup_result_t.hpp>
 #include <orbed/setup_task_t.hpp>
 
-#include "lcmtypes/contract/channels.h"
-#include "experiments/viraal/viraal_conductor.h"
-#include "sim/robot_model.h"
 #include "experiments/viraal/protocol.h"
 #include "experiments/viraal/results.h"
+#include "experiments/viraal/viraal_conductor.h"
+#include "lcmtypes/contract/channels.h"
+#include "sim/robot_model.h"
 
 namespace orbed::setup {
 

@@ -30,9 +30,9 @@
 #include <orbed/pose_t.hpp>
 #include <orbed/registration_t.hpp>
 
-#include "lcmtypes/contract/alignment_trial.h"
 #include "experiments/viraal/metrics.h"
 #include "experiments/viraal/results.h"
+#include "lcmtypes/contract/alignment_trial.h"
 
 namespace orbed::viraal {
 

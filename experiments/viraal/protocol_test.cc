@@ -1,5 +1,6 @@
 // The ViRAAl scenario file: the defaults documented in protocol.h, ScenarioConfig's member
-// initializers and the shipped experiments/viraal/viraal.yaml agree, and an absent key takes the struct's default.
+// initializers and the shipped experiments/viraal/viraal.yaml agree, and an absent key takes the struct's
+// default.
 #include "experiments/viraal/protocol.h"
 
 #include <set>

@@ -14,8 +14,8 @@
 #include "base/json_fields.h"
 #include "base/replace_file.h"
 #include "base/stats.h"
-#include "lcmtypes/contract/session_control.h"
 #include "experiments/viraal/paper_reference.h"
+#include "lcmtypes/contract/session_control.h"
 
 namespace orbed::viraal {
 namespace {

@@ -17,8 +17,8 @@
 #include "base/source_paths.h"
 #include "base/stats.h"
 #include "experiments/viraal/landmark_validation.h"
-#include "experiments/viraal/viraal_study.h"
 #include "experiments/viraal/paper_reference.h"
+#include "experiments/viraal/viraal_study.h"
 
 namespace orbed::study {
 namespace {

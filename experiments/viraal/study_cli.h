@@ -9,10 +9,10 @@
 ///   orbed-user-study --landmark-validation [--repeats N] [--pointing-std-deg X] [--csv FILE]
 ///                    [--seed N] [--config FILE]...
 ///
-/// Prints the run's table (experiments/viraal/results.h) for up to 10 trials per mode, else a summary per mode
-/// (the trials' misalignment, translation and rotation errors, mean ± std, and the SE(3) mean of all
-/// the mode's trials) beside the paper's Table 1, and the one-sided Mann–Whitney test that the first
-/// mode's trial misalignment is smaller than the second's. Progress goes to `err` unless --quiet.
+/// Prints the run's table (experiments/viraal/results.h) for up to 10 trials per mode, else a summary per
+/// mode (the trials' misalignment, translation and rotation errors, mean ± std, and the SE(3) mean of all the
+/// mode's trials) beside the paper's Table 1, and the one-sided Mann–Whitney test that the first mode's trial
+/// misalignment is smaller than the second's. Progress goes to `err` unless --quiet.
 /// --json writes the results.json the conductor would write. Each mode's first line is the paper's
 /// Table 1 statistic (viraal::Table1Row: the norms of the per-axis means and standard deviations).
 /// --landmark-validation runs the paper's check of the measurement itself instead

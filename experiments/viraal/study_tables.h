@@ -24,8 +24,8 @@
 #include <string>
 #include <vector>
 
-#include "experiments/viraal/landmark_validation.h"
 #include "experiments/setup/setup_tables.h"
+#include "experiments/viraal/landmark_validation.h"
 #include "experiments/viraal/results.h"
 
 namespace orbed::study {

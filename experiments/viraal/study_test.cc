@@ -19,9 +19,9 @@
 #include "base/source_paths.h"
 #include "base/stats.h"
 #include "base/test_command.h"
+#include "experiments/viraal/results.h"
 #include "experiments/viraal/study_cli.h"
 #include "tests/same_tree.h"
-#include "experiments/viraal/results.h"
 
 namespace orbed::study {
 namespace {

@@ -9,11 +9,11 @@
 
 #include "base/format.h"
 #include "base/units.h"
+#include "experiments/viraal/exchange.h"
 #include "lcmtypes/contract/alignment_trial.h"
 #include "lcmtypes/contract/conversions.h"
 #include "lcmtypes/contract/requests.h"
 #include "lcmtypes/contract/validation.h"
-#include "experiments/viraal/exchange.h"
 
 namespace orbed::scenario {
 namespace {

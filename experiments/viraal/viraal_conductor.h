@@ -24,9 +24,9 @@
 /// averages them, the headset moves its next index past them), then its next trial; the trials it
 /// re-sent, coming back, are ignored.
 ///
-/// Errors (experiments/viraal/metrics.h, scored by experiments/viraal/exchange.h): X_WR from the latest ROBOT_STATE (the
-/// sim's truth); translation_error_mm at the robot centroid, rotation_error_deg the geodesic angle of
-/// R_WR^T R_WV; misalignment_mm = MISALIGNMENT.mean_error_norm_m (the paper's ‖t̄‖₂) of the user's
+/// Errors (experiments/viraal/metrics.h, scored by experiments/viraal/exchange.h): X_WR from the latest
+/// ROBOT_STATE (the sim's truth); translation_error_mm at the robot centroid, rotation_error_deg the geodesic
+/// angle of R_WR^T R_WV; misalignment_mm = MISALIGNMENT.mean_error_norm_m (the paper's ‖t̄‖₂) of the user's
 /// annotated landmark pairs (the paper's measurement, in the headset's map), or for a trial without
 /// annotation of the truth's pairs real = X_WR·X_RL(q)·0, virtual = X_WV·X_RL(q)·0, q = the trial's
 /// joint_position [rad]; truth_misalignment_mm always from the truth's pairs. A session mean
@@ -89,12 +89,12 @@
 #include <orbed/robot_state_t.hpp>
 #include <orbed/session_control_t.hpp>
 
-#include "lcmtypes/contract/channels.h"
 #include "base/log.h"
-#include "sim/robot_model.h"
 #include "experiments/viraal/metrics.h"
 #include "experiments/viraal/protocol.h"
 #include "experiments/viraal/results.h"
+#include "lcmtypes/contract/channels.h"
+#include "sim/robot_model.h"
 
 namespace orbed::scenario {
 

@@ -16,8 +16,8 @@
 
 #include "base/source_paths.h"
 #include "base/units.h"
-#include "lcmtypes/contract/conversions.h"
 #include "experiments/viraal/resume.h"
+#include "lcmtypes/contract/conversions.h"
 
 namespace orbed::scenario {
 namespace {

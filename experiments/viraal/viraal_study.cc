@@ -7,15 +7,15 @@
 #include <orbed/session_control_t.hpp>
 
 #include "base/source_paths.h"
+#include "experiments/viraal/exchange.h"
+#include "experiments/viraal/metrics.h"
+#include "experiments/viraal/registration_service.h"
 #include "hmd_emulator/headset_trial.h"
 #include "hmd_emulator/hmd_config.h"
 #include "hmd_emulator/user_model.h"
 #include "lcmtypes/contract/conversions.h"
-#include "experiments/viraal/registration_service.h"
 #include "sim/robot_model.h"
 #include "sim/scene.h"
-#include "experiments/viraal/exchange.h"
-#include "experiments/viraal/metrics.h"
 
 namespace orbed::study {
 namespace {

@@ -4,7 +4,8 @@
 /// one program by calling the same code in the same order.
 ///
 ///   conductor (viraal/)         the scenario file's modes, trials and configurations; the errors
-///                               against the truth (experiments/viraal/exchange.h, experiments/viraal/metrics.h)
+///                               against the truth (experiments/viraal/exchange.h,
+///                               experiments/viraal/metrics.h)
 ///   headset (hmd_emulator/)     RunHeadsetTrial, the function orbed-hmd calls for a REQUEST_TRIAL,
 ///                               with the same seeds (process seed, session id, trial index)
 ///   registration server         RegistrationService, the core orbed-registration runs: trials in,

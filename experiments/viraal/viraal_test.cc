@@ -11,11 +11,11 @@
 
 #include "base/source_paths.h"
 #include "base/units.h"
-#include "sim/robot_model.h"
 #include "experiments/viraal/exchange.h"
 #include "experiments/viraal/metrics.h"
 #include "experiments/viraal/protocol.h"
 #include "experiments/viraal/results.h"
+#include "sim/robot_model.h"
 
 namespace orbed::viraal {
 namespace {

@@ -15,14 +15,14 @@
 
 #include "base/format.h"
 #include "base/json.h"
+#include "base/log.h"
 #include "base/replace_file.h"
 #include "base/source_paths.h"
 #include "base/units.h"
 #include "lcmtypes/contract/conversions.h"
-#include "runtime/flags.h"
-#include "base/log.h"
 #include "lcmtypes/contract/requests.h"
 #include "lcmtypes/contract/validation.h"
+#include "runtime/flags.h"
 #include "sim/guidance_messages.h"
 #include "sim/iiwa_status_check.h"
 

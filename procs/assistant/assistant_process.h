@@ -54,8 +54,8 @@
 #include <orbed/setup_result_t.hpp>
 #include <orbed/setup_task_t.hpp>
 
-#include "procs/assistant/assistant.h"
 #include "lcmtypes/contract/channels.h"
+#include "procs/assistant/assistant.h"
 #include "runtime/process.h"
 #include "sim/robot_model.h"
 

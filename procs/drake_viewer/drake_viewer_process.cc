@@ -4,10 +4,10 @@
 
 #include <CLI/CLI.hpp>
 
-#include "lcmtypes/contract/conversions.h"
-#include "runtime/flags.h"
 #include "base/log.h"
+#include "lcmtypes/contract/conversions.h"
 #include "procs/drake_viewer/drake_viewer.h"
+#include "runtime/flags.h"
 
 namespace orbed::viewer {
 ViewerBridge::ViewerBridge(const CommonFlags& flags, const ViewerOptions& options)

@@ -10,12 +10,12 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "base/format.h"
+#include "base/log.h"
 #include "base/number_list.h"
 #include "base/replace_file.h"
 #include "base/units.h"
 #include "lcmtypes/contract/conversions.h"
 #include "runtime/flags.h"
-#include "base/log.h"
 #include "sim/guidance_messages.h"
 
 namespace orbed::fixed_display {

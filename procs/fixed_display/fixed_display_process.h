@@ -26,8 +26,8 @@
 #include <orbed/image_t.hpp>
 
 #include "lcmtypes/contract/channels.h"
-#include "runtime/process.h"
 #include "procs/fixed_display/fixed_view.h"
+#include "runtime/process.h"
 #include "sim/robot_model.h"
 #include "sim/scene.h"
 #include "sim/testbed_poses.h"

@@ -9,13 +9,13 @@
 #include <orbed/registration_t.hpp>
 
 #include "base/format.h"
+#include "base/log.h"
 #include "lcmtypes/contract/channels.h"
 #include "lcmtypes/contract/conversions.h"
-#include "runtime/flags.h"
-#include "base/log.h"
 #include "lcmtypes/contract/requests.h"
 #include "lcmtypes/contract/validation.h"
 #include "procs/foxglove_bridge/foxglove_messages.h"
+#include "runtime/flags.h"
 #include "sim/guidance_messages.h"
 
 namespace orbed::foxglove {

@@ -26,8 +26,8 @@
 
 #include <Eigen/Geometry>
 
-#include "runtime/process.h"
 #include "procs/foxglove_bridge/foxglove_server.h"
+#include "runtime/process.h"
 #include "sim/robot_model.h"
 #include "sim/scene.h"
 #include "sim/testbed_poses.h"

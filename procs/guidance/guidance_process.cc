@@ -10,14 +10,14 @@
 #include <orbed/target_pose_t.hpp>
 
 #include "base/format.h"
+#include "base/log.h"
 #include "base/number_list.h"
 #include "base/source_paths.h"
 #include "base/units.h"
 #include "lcmtypes/contract/channels.h"
 #include "lcmtypes/contract/conversions.h"
-#include "runtime/flags.h"
-#include "base/log.h"
 #include "lcmtypes/contract/validation.h"
+#include "runtime/flags.h"
 #include "sim/iiwa_status_check.h"
 #include "sim/trocar_clearance.h"
 

@@ -25,8 +25,8 @@
 #include <Eigen/Core>
 
 #include "lcmtypes/contract/channels.h"
-#include "runtime/process.h"
 #include "procs/guidance/guidance.h"
+#include "runtime/process.h"
 #include "sim/robot_model.h"
 #include "sim/scene.h"
 #include "sim/trocar_ik.h"

@@ -15,14 +15,14 @@
 #include <orbed/target_pose_t.hpp>
 
 #include "base/format.h"
+#include "base/log.h"
 #include "lcmtypes/contract/alignment_trial.h"
 #include "lcmtypes/contract/channels.h"
 #include "lcmtypes/contract/conversions.h"
-#include "runtime/flags.h"
-#include "base/log.h"
 #include "lcmtypes/contract/requests.h"
 #include "lcmtypes/contract/session_control.h"
 #include "lcmtypes/contract/validation.h"
+#include "runtime/flags.h"
 #include "sim/guidance_messages.h"
 
 namespace orbed::igtl_bridge {

@@ -39,8 +39,8 @@
 
 #include <Eigen/Geometry>
 
-#include "runtime/process.h"
 #include "procs/igtl_bridge/igtl_server.h"
+#include "runtime/process.h"
 #include "sim/robot_model.h"
 #include "sim/testbed_poses.h"
 

@@ -4,9 +4,9 @@
 #include <filesystem>
 #include <thread>
 
+#include "base/log.h"
 #include "lcmtypes/contract/channels.h"
 #include "lcmtypes/contract/conversions.h"
-#include "base/log.h"
 #include "procs/launcher/deputy_protocol.h"
 
 namespace orbed::launcher {

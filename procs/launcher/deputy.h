@@ -44,8 +44,8 @@
 #include <orbed/deputy_command_t.hpp>
 #include <orbed/deputy_status_t.hpp>
 
-#include "runtime/process.h"
 #include "procs/launcher/child.h"
+#include "runtime/process.h"
 
 namespace orbed::launcher {
 

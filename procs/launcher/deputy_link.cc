@@ -6,9 +6,9 @@
 #include <orbed/deputy_command_t.hpp>
 
 #include "base/format.h"
+#include "base/log.h"
 #include "lcmtypes/contract/channels.h"
 #include "lcmtypes/contract/conversions.h"
-#include "base/log.h"
 #include "procs/launcher/deputy_protocol.h"
 
 namespace orbed::launcher {

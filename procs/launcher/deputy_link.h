@@ -22,8 +22,8 @@
 
 #include <orbed/deputy_status_t.hpp>
 
-#include "runtime/process.h"
 #include "procs/launcher/child.h"
+#include "runtime/process.h"
 
 namespace orbed::launcher {
 

@@ -9,10 +9,10 @@
 #include <thread>
 
 #include "base/format.h"
+#include "base/log.h"
 #include "base/run_folder.h"
 #include "lcmtypes/contract/channels.h"
 #include "lcmtypes/contract/conversions.h"
-#include "base/log.h"
 #include "procs/launcher/deputy_protocol.h"
 
 namespace orbed::launcher {

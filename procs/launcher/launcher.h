@@ -48,10 +48,10 @@
 
 #include <orbed/process_status_t.hpp>
 
-#include "runtime/process.h"
 #include "procs/launcher/child.h"
 #include "procs/launcher/deputy_link.h"
 #include "procs/launcher/launch_file.h"
+#include "runtime/process.h"
 
 namespace orbed::launcher {
 

@@ -12,12 +12,12 @@
 #include <CLI/CLI.hpp>
 
 #include "base/json.h"
-#include "runtime/flags.h"
 #include "base/log.h"
 #include "procs/launcher/deputy.h"
 #include "procs/launcher/deputy_protocol.h"
 #include "procs/launcher/launch_file.h"
 #include "procs/launcher/launcher.h"
+#include "runtime/flags.h"
 
 namespace orbed::launcher {
 namespace {

@@ -9,9 +9,9 @@
 #include <stdexcept>
 
 #include "base/format.h"
+#include "base/log.h"
 #include "base/sha256.h"
 #include "lcmtypes/contract/conversions.h"
-#include "base/log.h"
 #include "procs/logger/event_log_reader.h"
 
 namespace orbed::logger {

@@ -46,9 +46,9 @@
 
 #include <orbed/logger_status_t.hpp>
 
-#include "runtime/process.h"
 #include "procs/logger/event_log_writer.h"
 #include "procs/logger/manifest.h"
+#include "runtime/process.h"
 
 namespace orbed::logger {
 

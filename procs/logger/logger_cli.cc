@@ -7,8 +7,8 @@
 
 #include <CLI/CLI.hpp>
 
-#include "runtime/flags.h"
 #include "procs/logger/logger.h"
+#include "runtime/flags.h"
 
 namespace orbed::logger {
 

@@ -4,8 +4,8 @@
 
 #include <CLI/CLI.hpp>
 
-#include "runtime/flags.h"
 #include "procs/monitor/monitor.h"
+#include "runtime/flags.h"
 
 namespace orbed::monitor {
 

@@ -6,10 +6,10 @@
 #include <CLI/CLI.hpp>
 #include <Eigen/Core>
 
-#include "runtime/flags.h"
 #include "procs/registration_server/mean_command.h"
 #include "procs/registration_server/registration_server_process.h"
 #include "procs/registration_server/send_command.h"
+#include "runtime/flags.h"
 
 namespace orbed::registration {
 

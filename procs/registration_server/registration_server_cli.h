@@ -1,7 +1,7 @@
 #pragma once
 /// @file
-/// The `orbed-registration` command line (thin main in registration_server_main.cc), as a library function so that tests
-/// can run it in-process.
+/// The `orbed-registration` command line (thin main in registration_server_main.cc), as a library function so
+/// that tests can run it in-process.
 ///
 ///   orbed-registration [common process flags] [--state-period-s S] [--model-centroid-m X Y Z]
 ///                      [--k-mad K] [--min-ray-angle-deg A] [--<name>-channel CHANNEL]...

@@ -22,10 +22,10 @@
 #include <optional>
 #include <string>
 
-#include "lcmtypes/contract/channels.h"
-#include "runtime/process.h"
 #include "experiments/viraal/registration_service.h"
+#include "lcmtypes/contract/channels.h"
 #include "procs/registration_server/session_journal.h"
+#include "runtime/process.h"
 
 namespace orbed::registration {
 

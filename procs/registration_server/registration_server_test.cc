@@ -1,8 +1,8 @@
 // The registration server's message logic (RegistrationService, no bus) and the process on
 // memq:// (in-process LCM). Oracles: hand-computable means of trials on one axis, hand-computed
 // landmark and misalignment values, byte equality of replayed outputs.
-#include "procs/registration_server/registration_server_process.h"
 #include "procs/registration_server/registration_server_cli.h"
+#include "procs/registration_server/registration_server_process.h"
 
 #include <cmath>
 #include <map>

@@ -37,8 +37,8 @@
 #include <orbed/registration_t.hpp>
 #include <orbed/session_control_t.hpp>
 
-#include "runtime/journal.h"
 #include "experiments/viraal/registration_service.h"
+#include "runtime/journal.h"
 
 namespace orbed::registration {
 

@@ -6,10 +6,10 @@
 
 #include <CLI/CLI.hpp>
 
-#include "runtime/flags.h"
-#include "procs/scenario/scenario_process.h"
 #include "experiments/viraal/protocol.h"
 #include "experiments/viraal/results.h"
+#include "procs/scenario/scenario_process.h"
+#include "runtime/flags.h"
 
 namespace orbed::scenario {
 

@@ -9,11 +9,11 @@
 #include <stdexcept>
 #include <variant>
 
+#include "base/log.h"
 #include "base/run_folder.h"
 #include "base/source_paths.h"
-#include "lcmtypes/contract/conversions.h"
-#include "base/log.h"
 #include "experiments/viraal/resume.h"
+#include "lcmtypes/contract/conversions.h"
 
 namespace orbed::scenario {
 namespace {

@@ -34,9 +34,9 @@
 #include <memory>
 #include <string>
 
-#include "runtime/process.h"
-#include "experiments/viraal/viraal_conductor.h"
 #include "experiments/viraal/results.h"
+#include "experiments/viraal/viraal_conductor.h"
+#include "runtime/process.h"
 
 namespace orbed::scenario {
 

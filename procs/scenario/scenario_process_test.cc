@@ -23,12 +23,12 @@
 #include <orbed/session_control_t.hpp>
 
 #include "base/units.h"
-#include "lcmtypes/contract/conversions.h"
-#include "procs/scenario/scenario_process.h"
-#include "sim/scene.h"
 #include "experiments/viraal/metrics.h"
 #include "experiments/viraal/protocol.h"
 #include "experiments/viraal/results.h"
+#include "lcmtypes/contract/conversions.h"
+#include "procs/scenario/scenario_process.h"
+#include "sim/scene.h"
 
 namespace orbed::scenario {
 namespace {

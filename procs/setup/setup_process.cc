@@ -13,6 +13,7 @@
 #include <orbed/registration_t.hpp>
 
 #include "base/json_fields.h"
+#include "base/log.h"
 #include "base/number_list.h"
 #include "base/random.h"
 #include "base/replace_file.h"
@@ -21,7 +22,6 @@
 #include "base/units.h"
 #include "lcmtypes/contract/conversions.h"
 #include "runtime/flags.h"
-#include "base/log.h"
 #include "sim/guidance_messages.h"
 
 namespace orbed::setup {
@@ -184,13 +184,15 @@ int RunSetup(int argc, const char* const* argv, std::ostream& out, std::ostream&
   app.add_option("--modes", modes,
                  "The order of the modes, e.g. fixed,ar,ar_reflective (default: drawn from "
                  "--user-seed)");
-  app.add_option("--plan", plan_path, "Targets from `orbed-robot plan` (default: experiments/setup/targets.json)");
+  app.add_option("--plan", plan_path,
+                 "Targets from `orbed-robot plan` (default: experiments/setup/targets.json)");
   app.add_option("--targets", targets, "How many of the plan's targets per mode")
       ->check(orbed::NumberIn(1, 20))
       ->capture_default_str();
   app.add_option("--start-deg", start_deg, "Where the arm is parked before each set-up [deg]")
       ->capture_default_str();
-  app.add_option("--scenario", scenario_path, "The alignment protocol (default: experiments/viraal/viraal.yaml)");
+  app.add_option("--scenario", scenario_path,
+                 "The alignment protocol (default: experiments/viraal/viraal.yaml)");
   app.add_option("--trials", trials, "Alignments before each headset set-up (the paper: N = 3)")
       ->check(orbed::NumberIn(1, 100))
       ->capture_default_str();

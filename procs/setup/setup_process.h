@@ -27,8 +27,8 @@
 #include <memory>
 #include <string>
 
-#include "runtime/process.h"
 #include "experiments/setup/setup_conductor.h"
+#include "runtime/process.h"
 
 namespace orbed::setup {
 

@@ -1,8 +1,8 @@
 // libFuzzer: orbed-scenario's handlers (ROBOT_STATE, PLAN_CHECK_REPLY, ALIGNMENT_TRIAL,
 // REGISTRATION, MISALIGNMENT, ...) on a conductor that has started its run.
+#include "experiments/viraal/protocol.h"
 #include "procs/scenario/scenario_process.h"
 #include "tests/fuzz/fuzz_util.h"
-#include "experiments/viraal/protocol.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   static auto* scenario = [] {

@@ -4,10 +4,10 @@
 #include <filesystem>
 
 #include "base/source_paths.h"
+#include "experiments/viraal/protocol.h"
 #include "procs/setup/setup_process.h"
 #include "sim/guidance_messages.h"
 #include "tests/fuzz/fuzz_util.h"
-#include "experiments/viraal/protocol.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   static auto* setup = [] {

@@ -14,10 +14,10 @@
 #include <string>
 
 #include "base/source_paths.h"
-#include "hmd_emulator/session_file.h"
-#include "runtime/journal.h"
 #include "experiments/viraal/registration_service.h"
+#include "hmd_emulator/session_file.h"
 #include "procs/registration_server/session_journal.h"
+#include "runtime/journal.h"
 #include "sim/robot_model.h"
 #include "sim/sim_state.h"
 #include "tests/fuzz/fuzz_files.h"

@@ -49,9 +49,9 @@
 
 #include "base/units.h"
 #include "lcmtypes/bounded_decode.h"
-#include "runtime/flags.h"
 #include "procs/logger/event_log_reader.h"
 #include "procs/logger/manifest.h"
+#include "runtime/flags.h"
 #include "tests/integration/testbed_util.h"
 #include "tests/same_tree.h"
 

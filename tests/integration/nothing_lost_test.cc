@@ -31,8 +31,8 @@
 #include <lcm/eventlog.h>
 #include <lcm/lcm-cpp.hpp>
 
-#include "runtime/process.h"
 #include "procs/logger/manifest.h"
+#include "runtime/process.h"
 #include "tests/integration/testbed_util.h"
 
 namespace orbed::testing {

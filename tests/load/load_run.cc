@@ -25,10 +25,10 @@
 #include "lcmtypes/bounded_decode.h"
 #include "lcmtypes/contract/channels.h"
 #include "lcmtypes/contract/conversions.h"
-#include "runtime/flags.h"
 #include "procs/launcher/child.h"
 #include "procs/launcher/launch_file.h"
 #include "procs/logger/manifest.h"
+#include "runtime/flags.h"
 
 namespace orbed::load {
 namespace {
