@@ -49,7 +49,7 @@ def main():
     if args.trials < 2 or args.users < 1:
         sys.exit("fit: --trials must be >= 2 and --users >= 1")
     os.makedirs(args.out, exist_ok=True)
-    with open(os.path.join(args.source, "viraal", "viraal.yaml")) as f:
+    with open(os.path.join(args.source, "experiments", "viraal", "viraal.yaml")) as f:
         scenario = f.read()
     if "modes: [ar_reflective, ar]" not in scenario:
         sys.exit("fit: experiments/viraal/viraal.yaml no longer says 'modes: [ar_reflective, ar]'")

@@ -153,7 +153,7 @@ def main():
     if args.trials < 2 or args.users < 1:
         sys.exit("sweep: --trials must be >= 2 and --users >= 1")
     os.makedirs(args.out, exist_ok=True)
-    with open(os.path.join(args.source, "viraal", "viraal.yaml")) as f:
+    with open(os.path.join(args.source, "experiments", "viraal", "viraal.yaml")) as f:
         scenario = f.read()
 
     def with_mirrors(n):
