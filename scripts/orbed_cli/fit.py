@@ -28,7 +28,7 @@ def run(args, ctx):
     out = new_run_dir(ctx, "fit-")
     provenance(ctx, "start", out, "--kind", "fit", "--config", os.path.join(ctx.root, "hmd_emulator/config/user.yaml"),
                "--config", os.path.join(ctx.root, "hmd_emulator/config/slam.yaml"),
-               "--config", os.path.join(ctx.root, "viraal/viraal.yaml"))
+               "--config", os.path.join(ctx.root, "experiments/viraal/viraal.yaml"))
     code = subprocess.run(["/usr/bin/python3", ctx.script("fit.py"), "--study", os.path.join(ctx.bin, "orbed-user-study"),
                            "--source", ctx.root, "--out", out, *passed]).returncode
     provenance(ctx, "finish", out, "--exit-code", str(code))

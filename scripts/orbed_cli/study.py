@@ -43,7 +43,7 @@ def configure(p):
                    help="ViRAAl trials per display mode (default 10)")
     p.add_argument("--setup-users", type=checks.whole(0, 99), default=8, metavar="N", help="set-up users (default 8)")
     p.add_argument("--targets", type=checks.whole(1, 3), default=3, metavar="K",
-                   help="set-up targets per mode, 1..3 (procs/setup/targets.json has 3; default 3)")
+                   help="set-up targets per mode, 1..3 (experiments/setup/targets.json has 3; default 3)")
     p.add_argument("--seed", type=checks.whole(0, 999999999), default=1, metavar="S", help="the first user's seed")
     p.add_argument("--run-id", type=checks.run_id, metavar="ID", help="default study-s<S>")
     p.add_argument("--registration-share", action="store_true",

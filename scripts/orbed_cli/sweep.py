@@ -53,7 +53,7 @@ def run(args, ctx):
             passed += ["--base-config", path]
     provenance(ctx, "start", out, "--kind", "sweep", "--config", os.path.join(ctx.root, "hmd_emulator/config/user.yaml"),
                "--config", os.path.join(ctx.root, "hmd_emulator/config/slam.yaml"),
-               "--config", os.path.join(ctx.root, "viraal/viraal.yaml"))
+               "--config", os.path.join(ctx.root, "experiments/viraal/viraal.yaml"))
     progress = Progress(ctx.console, "sweep: point", POINTS[args.only] if args.only else sum(POINTS.values()))
     progress.show(f"output in {ctx.rel(out)}/sweep.log")
     rows = []
