@@ -24,6 +24,10 @@
 /// set-up waits for a GUIDANCE showing that task's target and mode. With --once it carries out the
 /// first GUIDANCE's target without a task and stops.
 ///
+/// The state machine is the core's (AssistantMachine, assistant_machine.h: unit-tested in emulated
+/// time); this shell checks and converts what arrives, hands it to the machine with the process
+/// clock, and publishes, logs and writes what the machine returns.
+///
 /// A set-up: wait for GUIDANCE, IIWA_STATUS, ROBOT_STATE with the arm at rest and, in the headset
 /// modes, a REGISTRATION; then for each joint, looks_per_joint looks (the first over the whole
 /// range, the others within correction_window_deg), each followed by the move; then publish
@@ -48,14 +52,9 @@
 #include <string>
 #include <vector>
 
-#include <Eigen/Core>
-#include <Eigen/Geometry>
-#include <orbed/guidance_t.hpp>
-#include <orbed/setup_result_t.hpp>
-#include <orbed/setup_task_t.hpp>
-
-#include "lcmtypes/contract/channels.h"
 #include "procs/assistant/assistant.h"
+#include "procs/assistant/assistant_machine.h"
+#include "lcmtypes/contract/channels.h"
 #include "runtime/process.h"
 #include "sim/robot_model.h"
 
@@ -85,65 +84,23 @@ struct AssistantOptions {
   double fixed_view_stale_s{2.0};
 };
 
-/// What a finished set-up reports (also the result file's content).
-struct SetupResult {
-  int8_t mode{0};
-  uint64_t seed{0};
-  double person_scale{1};
-  Eigen::VectorXd q_start_rad, q_target_rad, q_reached_rad;
-  std::vector<int> twisting;
-  std::vector<int> ranges;
-  double execution_s{0};
-  bool headset_pose{false};
-};
-std::string SetupResultJson(const SetupResult& result);
-
 class AssistantProcess {
  public:
   /// Throws std::runtime_error / std::invalid_argument for an unreadable model or config.
   AssistantProcess(const CommonFlags& flags, const AssistantOptions& options);
   int Run() { return process_.Run(); }
   Process& process() { return process_; }
-  const std::optional<SetupResult>& result() const { return result_; }
-  /// The timer's work (public for the fuzz target, which has no timer running).
+  const std::optional<SetupResult>& result() const { return machine_.result(); }
+  const AssistantMachine& machine() const { return machine_; }
+  /// The timer's work: the machine's Step at the process clock, its output published (public for
+  /// the fuzz target, which has no timer running).
   void Step();
 
  private:
-  enum class Phase { kIdle, kWait, kLook, kMove, kDone };
-  void StartMove(double t_s);
-  void Finish();
-  Viewing CurrentView() const;
-
   Process process_;
   sim::RobotModel model_;
   AssistantOptions options_;
-  Assistant assistant_;
-
-  // Latest inputs.
-  std::optional<orbed::guidance_t> guidance_;
-  Eigen::VectorXd q_rad_;
-  bool have_q_{false};
-  std::optional<Eigen::Isometry3d> X_WR_;
-  int8_t motion_state_{0};
-  std::optional<Eigen::Isometry3d> X_WV_;
-  std::optional<std::pair<int64_t, Eigen::Isometry3d>> X_WH_est_, X_WH_true_;  // (seq, pose)
-  std::optional<Eigen::Isometry3d> A_;   // X_WH_true · X_WH_est⁻¹ of the latest matching pair
-  std::optional<Eigen::Vector3d> p_WE_;  // the true head position of that pair
-  std::optional<Eigen::Vector3d> p_WD_;  // FIXED_VIEW's camera position
-  double p_WD_received_s_{0};            // when it came [process clock s]
-
-  // The run.
-  Phase phase_{Phase::kIdle};
-  std::optional<orbed::setup_task_t> task_;           // the task being carried out or last finished
-  std::optional<orbed::setup_result_t> task_result_;  // its answer, once finished
-  int joint_{0};
-  int look_{0};
-  Eigen::VectorXd q_goal_;
-  double move_started_s_{0};
-  double last_command_s_{-1e9};
-  SetupResult partial_;
-  std::optional<SetupResult> result_;
-  bool waiting_logged_{false};
+  AssistantMachine machine_;  // the state machine (assistant_machine.h)
 };
 
 /// orbed-assistant's command line (flags: --help). Exit 0; 2 or CLI11's usage code (106-109) on bad
