@@ -147,7 +147,8 @@ void AssistantMachine::StartSetUp(StepOutput* out) {
   if (!ready) {
     if (guidance_ && headset && !X_WV_ && !waiting_noted_) {
       waiting_noted_ = true;
-      out->notes.push_back({false, "assistant: mode " + std::string(guidance::GuidanceModeName(guidance_->mode)) +
+      out->notes.push_back({false, "assistant: mode " +
+                                       std::string(guidance::GuidanceModeName(guidance_->mode)) +
                                        ": waiting for a valid REGISTRATION (where the hologram is drawn)"});
     }
     return;
@@ -158,12 +159,14 @@ void AssistantMachine::StartSetUp(StepOutput* out) {
   partial_.person_scale = assistant_.person_scale();
   partial_.q_start_rad = *q_rad_;
   partial_.q_target_rad = Eigen::Map<const Eigen::VectorXd>(guidance_->target_position.data(), n);
-  for (int8_t kind : guidance_->joint_kind) partial_.twisting.push_back(kind == orbed::guidance_t::JOINT_TWIST);
+  for (int8_t kind : guidance_->joint_kind)
+    partial_.twisting.push_back(kind == orbed::guidance_t::JOINT_TWIST);
   partial_.headset_pose = A_.has_value();
-  out->notes.push_back({false, "assistant: set-up in mode " + std::string(guidance::GuidanceModeName(guidance_->mode)) +
-                                   (headset ? (A_ ? " (eye and SLAM error from HMD_POSE)"
-                                                  : " (eye from the config, no SLAM error)")
-                                            : "")});
+  out->notes.push_back(
+      {false,
+       "assistant: set-up in mode " + std::string(guidance::GuidanceModeName(guidance_->mode)) +
+           (headset ? (A_ ? " (eye and SLAM error from HMD_POSE)" : " (eye from the config, no SLAM error)")
+                    : "")});
   joint_ = 0;
   look_ = 0;
   phase_ = Phase::kLook;
@@ -185,9 +188,9 @@ void AssistantMachine::LookAtJoint(double t_s, StepOutput* out) {
   q_goal_ = q;
   q_goal_[joint_] = look.q_rad;
   std::ostringstream note;
-  note << "assistant: joint " << joint_ + 1 << " look " << look_ + 1 << ": " << q[joint_] * kRadToDeg << " -> "
-       << look.q_rad * kRadToDeg << " deg (target " << q_target[joint_] * kRadToDeg << ", " << look.ranges
-       << " range(s) looked right)";
+  note << "assistant: joint " << joint_ + 1 << " look " << look_ + 1 << ": " << q[joint_] * kRadToDeg
+       << " -> " << look.q_rad * kRadToDeg << " deg (target " << q_target[joint_] * kRadToDeg << ", "
+       << look.ranges << " range(s) looked right)";
   out->notes.push_back({false, note.str()});
   phase_ = Phase::kMove;
   move_started_s_ = t_s;

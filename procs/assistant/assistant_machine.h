@@ -98,7 +98,8 @@ class AssistantMachine {
   enum class Phase { kIdle, kWait, kLook, kMove, kDone };
 
   /// `model` must outlive the machine. Throws std::invalid_argument for a config out of range.
-  AssistantMachine(const sim::RobotModel& model, const AssistantConfig& config, const MachineOptions& options);
+  AssistantMachine(const sim::RobotModel& model, const AssistantConfig& config,
+                   const MachineOptions& options);
 
   // Inputs, already checked by the shell (guidance::CheckGuidance, sim::CheckIiwaStatus, ...).
   void OnGuidance(const orbed::guidance_t& msg) { guidance_ = msg; }

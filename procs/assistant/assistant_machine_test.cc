@@ -62,7 +62,8 @@ orbed::guidance_t Guidance(int8_t mode, const Eigen::VectorXd& q_target) {
     g.target_position.push_back(q_target[i]);
     g.current_position.push_back(0);
     g.error_deg.push_back(0);
-    g.joint_kind.push_back(int8_t{i % 2 == 0 ? orbed::guidance_t::JOINT_TWIST : orbed::guidance_t::JOINT_REVOLVE});
+    g.joint_kind.push_back(
+        int8_t{i % 2 == 0 ? orbed::guidance_t::JOINT_TWIST : orbed::guidance_t::JOINT_REVOLVE});
   }
   g.next_joint = 0;
   return g;
@@ -88,7 +89,7 @@ struct Arm {
 
 // What a run of steps produced.
 struct Stepped {
-  std::vector<StepOutput> outputs;  // one per step
+  std::vector<StepOutput> outputs;                        // one per step
   std::vector<std::pair<int, Eigen::VectorXd>> commands;  // (step, joint_position)
   int finished_step{-1};
   int failed_step{-1};
@@ -101,8 +102,8 @@ Stepped Steps(AssistantMachine* machine, Arm* arm, int first, int steps) {
     StepOutput out = machine->Step(k * kStep_s, 1000 + k);
     if (out.command) {
       EXPECT_EQ(out.command->utime, 1000 + k);
-      const Eigen::VectorXd q = Eigen::Map<const Eigen::VectorXd>(out.command->joint_position.data(),
-                                                                  out.command->num_joints);
+      const Eigen::VectorXd q =
+          Eigen::Map<const Eigen::VectorXd>(out.command->joint_position.data(), out.command->num_joints);
       run.commands.emplace_back(k, q);
       if (arm->follows) {
         arm->q = q;
@@ -170,7 +171,8 @@ TEST_F(AssistantMachineTest, ATaskIsSetUpJointByJointInEmulatedTime) {
   std::vector<std::string> looks;
   for (int k = 0; k < 40; ++k) {
     for (const MachineNote& note : run.outputs[k].notes) {
-      if (note.text.find(" look ") != std::string::npos) looks.push_back(std::to_string(10 + k) + ": " + note.text.substr(0, note.text.find(":", 11)));
+      if (note.text.find(" look ") != std::string::npos)
+        looks.push_back(std::to_string(10 + k) + ": " + note.text.substr(0, note.text.find(":", 11)));
     }
   }
   ASSERT_EQ(looks.size(), 14u);
@@ -347,7 +349,7 @@ TEST_F(AssistantMachineTest, TheViewFollowsTheMonitorsCameraAndTheHeadset) {
   EXPECT_TRUE(m.OnMonitorCamera(Eigen::Vector3d(2, 1, 1.5), 11.0));
   ASSERT_TRUE(m.CurrentView(13.0).p_WD);
   EXPECT_TRUE(m.CurrentView(13.0).p_WD->isApprox(Eigen::Vector3d(2, 1, 1.5)));
-  EXPECT_FALSE(m.CurrentView(13.01).p_WD);  // stale
+  EXPECT_FALSE(m.CurrentView(13.01).p_WD);                // stale
   m.OnMonitorCamera(Eigen::Vector3d(0.1, 0, 0.1), 20.0);  // on the robot
   EXPECT_FALSE(m.CurrentView(20.0).p_WD);
 

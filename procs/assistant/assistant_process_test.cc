@@ -2,7 +2,8 @@
 // instance delivers what the test publishes on it). The test plays the arm on the same instance: an
 // IIWA_COMMAND is answered at once with an IIWA_STATUS at the commanded q. Checked: what the shell
 // refuses and counts, that the looks' commands reach the bus (joint by joint, each moving one joint:
-// the arm follows), the result file, and SETUP_TASK answered with SETUP_RESULT, a repeat with the same message.
+// the arm follows), the result file, and SETUP_TASK answered with SETUP_RESULT, a repeat with the same
+// message.
 #include "procs/assistant/assistant_process.h"
 
 #include <cstdio>
@@ -76,7 +77,8 @@ orbed::guidance_t Guidance(const std::vector<double>& q_target, int num_joints =
     g.target_position.push_back(q_target[i]);
     g.current_position.push_back(0);
     g.error_deg.push_back(0);
-    g.joint_kind.push_back(int8_t{i % 2 == 0 ? orbed::guidance_t::JOINT_TWIST : orbed::guidance_t::JOINT_REVOLVE});
+    g.joint_kind.push_back(
+        int8_t{i % 2 == 0 ? orbed::guidance_t::JOINT_TWIST : orbed::guidance_t::JOINT_REVOLVE});
   }
   g.next_joint = 0;
   return g;
@@ -131,7 +133,8 @@ void ExpectJointByJoint(const std::vector<orbed::iiwa_command_t>& commands) {
 }
 
 // --once: a bad GUIDANCE (6 joints) is refused and counted, the good one is carried out joint by
-// joint (a look that moves its joint commands it; 2 looks per joint in the shipped config), the arm ends where the last command put it, and the result file says so.
+// joint (a look that moves its joint commands it; 2 looks per joint in the shipped config), the arm ends
+// where the last command put it, and the result file says so.
 TEST(AssistantProcess, OnceCarriesOutTheGuidanceAndWritesTheResult) {
   const std::string result_path = ::testing::TempDir() + "assistant_process_test_result.json";
   std::remove(result_path.c_str());
