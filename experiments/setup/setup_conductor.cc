@@ -11,6 +11,7 @@
 #include "base/format.h"
 #include "base/json.h"
 #include "base/json_fields.h"
+#include "base/random.h"
 #include "base/units.h"
 #include "lcmtypes/contract/requests.h"
 #include "lcmtypes/contract/validation.h"
@@ -592,6 +593,37 @@ SetupConductor::Actions SetupConductor::Abort(const std::string& reason, const C
   Begin(now);
   if (phase_ != Phase::kDone) Fail(reason);
   return Take();
+}
+
+std::vector<int8_t> ModeOrderForSeed(uint64_t user_seed) {
+  std::vector<int8_t> order = {0, 1, 2};
+  Random rng(user_seed ^ 0x5e7a9ULL);
+  for (int i = 2; i > 0; --i) {
+    const int j = static_cast<int>(rng.Uniform() * (i + 1));
+    std::swap(order[i], order[j]);
+  }
+  return order;
+}
+
+std::vector<int8_t> ModeOrderFromNames(const std::string& names) {
+  std::vector<int8_t> modes;
+  size_t begin = 0;
+  while (begin <= names.size()) {
+    const size_t comma = std::min(names.find(',', begin), names.size());
+    modes.push_back(guidance::GuidanceModeFromName(names.substr(begin, comma - begin)));
+    begin = comma + 1;
+  }
+  return modes;
+}
+
+std::vector<std::vector<double>> PlanTargetsDeg(const std::string& plan_path, int count,
+                                                const sim::RobotModel& model) {
+  std::vector<std::vector<double>> targets;
+  for (int k = 1; k <= count; ++k) {
+    const Eigen::VectorXd q = guidance::ReadPlanTarget(plan_path, k, model.num_joints()) * kRadToDeg;
+    targets.emplace_back(q.data(), q.data() + q.size());
+  }
+  return targets;
 }
 
 }  // namespace orbed::setup

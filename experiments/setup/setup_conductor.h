@@ -172,6 +172,18 @@ SetupRun ParseSetupRunJson(const std::string& text, const std::string& source, s
 std::vector<SetupRecord> KeptSetups(const SetupRun& earlier, const std::string& status,
                                     const SetupOptions& options);
 
+/// A uniform random order of guidance modes 0, 1, 2 for a user seed (Fisher-Yates with
+/// base/random.h, seeded by user_seed ^ 0x5e7a9).
+std::vector<int8_t> ModeOrderForSeed(uint64_t user_seed);
+/// The modes of a comma-separated list of names ("fixed,ar,ar_reflective":
+/// guidance::GuidanceModeFromName, which throws std::invalid_argument naming a bad one), in order;
+/// repeats are the conductor's check.
+std::vector<int8_t> ModeOrderFromNames(const std::string& names);
+/// The plan's first `count` targets [deg] (guidance::ReadPlanTarget: throws std::runtime_error
+/// naming the file, or the number when the plan has fewer).
+std::vector<std::vector<double>> PlanTargetsDeg(const std::string& plan_path, int count,
+                                                const sim::RobotModel& model);
+
 /// A message of this conductor's own to publish.
 struct SetupPublication {
   std::string channel;

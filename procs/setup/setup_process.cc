@@ -15,26 +15,15 @@
 #include "base/json_fields.h"
 #include "base/log.h"
 #include "base/number_list.h"
-#include "base/random.h"
 #include "base/replace_file.h"
 #include "base/run_folder.h"
 #include "base/source_paths.h"
-#include "base/units.h"
 #include "lcmtypes/contract/conversions.h"
 #include "runtime/flags.h"
+#include "base/log.h"
 #include "sim/guidance_messages.h"
 
 namespace orbed::setup {
-
-std::vector<int8_t> ModeOrderForSeed(uint64_t user_seed) {
-  std::vector<int8_t> order = {0, 1, 2};
-  Random rng(user_seed ^ 0x5e7a9ULL);
-  for (int i = 2; i > 0; --i) {
-    const int j = static_cast<int>(rng.Uniform() * (i + 1));
-    std::swap(order[i], order[j]);
-  }
-  return order;
-}
 
 SetupProcess::SetupProcess(const CommonFlags& flags, const SetupOptions& options,
                            const std::string& urdf_path, const std::string& results_dir, std::ostream* out)
@@ -225,16 +214,7 @@ int RunSetup(int argc, const char* const* argv, std::ostream& out, std::ostream&
                  "finished set-ups are kept, the rest are run");
   if (const auto code = ParseCommandLine(&app, common, argc, argv, out, err)) return *code;
   try {
-    if (modes.empty()) {
-      options.modes = ModeOrderForSeed(user_seed);
-    } else {
-      size_t begin = 0;
-      while (begin <= modes.size()) {
-        const size_t comma = std::min(modes.find(',', begin), modes.size());
-        options.modes.push_back(guidance::GuidanceModeFromName(modes.substr(begin, comma - begin)));
-        begin = comma + 1;
-      }
-    }
+    options.modes = modes.empty() ? ModeOrderForSeed(user_seed) : ModeOrderFromNames(modes);
     options.start_deg = ParseNumberList(start_deg, "--start-deg");
     options.perfect_registration = registration == "truth";
   } catch (const std::invalid_argument& e) {
@@ -250,10 +230,7 @@ int RunSetup(int argc, const char* const* argv, std::ostream& out, std::ostream&
       results_dir = env && *env ? env : ".";
     }
     const sim::RobotModel model = sim::RobotModel::LoadFile(urdf_path);
-    for (int k = 1; k <= targets; ++k) {
-      const Eigen::VectorXd q = guidance::ReadPlanTarget(plan_path, k, model.num_joints()) * kRadToDeg;
-      options.targets_deg.emplace_back(q.data(), q.data() + q.size());
-    }
+    options.targets_deg = PlanTargetsDeg(plan_path, targets, model);
     options.alignment = viraal::LoadScenarioFile(scenario_path);
     options.alignment.trials = trials;
     if (!resume.empty()) {

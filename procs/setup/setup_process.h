@@ -14,9 +14,9 @@
 /// set-up and once at the end ("ok" or "failed"); then the process stops: exit 0 on success, 1 on a
 /// failure (the reason on stdout and the heartbeat) or when stopped from outside before the end.
 ///
-/// The user's order of the three modes: given, or drawn from the user seed (a uniform permutation,
-/// Fisher-Yates with base/random.h), so a study's users meet the modes in randomized orders as the
-/// paper's did, reproducibly.
+/// The user's order of the three modes: given (ModeOrderFromNames), or drawn from the user seed
+/// (ModeOrderForSeed, setup_conductor.h), so a study's users meet the modes in randomized orders as
+/// the paper's did, reproducibly.
 ///
 /// Clocks: the process clock (Process::ClockSeconds / ClockUtime: monotonic and wall, or with
 /// --sim-time the sim's) for the conductor's t_s and utimes. Threading: everything on the
@@ -31,9 +31,6 @@
 #include "runtime/process.h"
 
 namespace orbed::setup {
-
-/// A uniform random order of guidance modes 0, 1, 2 for a user seed.
-std::vector<int8_t> ModeOrderForSeed(uint64_t user_seed);
 
 class SetupProcess {
  public:
