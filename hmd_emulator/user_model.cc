@@ -246,72 +246,101 @@ EmulatedUser::EmulatedUser(const UserConfig& config) : config_(config) {
   depth_user_bias_ = config.depth_user_bias_fraction_std * person.Normal();
 }
 
-AlignmentResult EmulatedUser::Align(const ViewingContext& ctx, const std::vector<Eigen::Vector3d>& p_RQ,
-                                    const Eigen::Isometry3d& X_WV_start, std::uint64_t trial_seed) const {
-  if (p_RQ.empty()) throw std::invalid_argument("EmulatedUser::Align: no model points");
-  const UserConfig& c = config_;
-  // One draw per statement: the arguments of one call are evaluated in an unspecified order (GCC
-  // last first, clang first first), so two draws in one call would make another person with another
-  // compiler. The order is the one the pinned runs were drawn in: last component first.
-  Random rng(trial_seed);
+// EmulatedUser::Align's steps (user_model.h, "The alignment"). Each draws from the trial's stream
+// in the order the pinned runs were drawn in; one draw per statement (the arguments of one call are
+// evaluated in an unspecified order: GCC last first, clang first first, so two draws in one call
+// would make another person with another compiler).
+namespace {
 
-  // Biases held through the trial.
-  const double alpha_y = c.lateral_bias_arcmin * kArcminToRad * rng.Normal();
-  const double alpha_x = c.lateral_bias_arcmin * kArcminToRad * rng.Normal();
-  const Eigen::Vector2d alpha_rad(alpha_x, alpha_y);
-  const double beta = depth_scale_ * (depth_user_bias_ + c.depth_bias_fraction_std * rng.Normal());
+// The biases held through a trial: lateral α (x, y) and depth β in the direct view, one lateral
+// bias per display panel [rad; β a fraction of ρ]. Draws: α_y, α_x, β, then per panel y, x.
+struct TrialBiases {
+  Eigen::Vector2d alpha_rad{Eigen::Vector2d::Zero()};
+  double beta{0};
   std::vector<Eigen::Vector2d> display_bias_rad;  // the same acuity on each panel
-  for (std::size_t j = 0; j < ctx.displays.size(); ++j) {
-    const double bias_y = c.lateral_bias_arcmin * kArcminToRad * rng.Normal();
-    const double bias_x = c.lateral_bias_arcmin * kArcminToRad * rng.Normal();
-    display_bias_rad.emplace_back(bias_x, bias_y);
+};
+
+TrialBiases DrawBiases(const UserConfig& c, double depth_scale, double depth_user_bias,
+                       std::size_t num_displays, Random* rng) {
+  TrialBiases b;
+  const double alpha_y = c.lateral_bias_arcmin * kArcminToRad * rng->Normal();
+  const double alpha_x = c.lateral_bias_arcmin * kArcminToRad * rng->Normal();
+  b.alpha_rad = Eigen::Vector2d(alpha_x, alpha_y);
+  b.beta = depth_scale * (depth_user_bias + c.depth_bias_fraction_std * rng->Normal());
+  for (std::size_t j = 0; j < num_displays; ++j) {
+    const double bias_y = c.lateral_bias_arcmin * kArcminToRad * rng->Normal();
+    const double bias_x = c.lateral_bias_arcmin * kArcminToRad * rng->Normal();
+    b.display_bias_rad.emplace_back(bias_x, bias_y);
   }
+  return b;
+}
 
-  // The scene as it is: real points, the eye, the hologram's apparent-pose map A.
-  const Eigen::Isometry3d A = ctx.X_WH_true * ctx.X_WH_est.inverse();
-  const Eigen::Vector3d p_W_eye = ctx.X_WH_true.translation();
-  const std::size_t n = p_RQ.size();
-  std::vector<Eigen::Vector3d> r(n);
-  for (std::size_t k = 0; k < n; ++k) r[k] = ctx.X_WR * p_RQ[k];
-  const Eigen::Vector3d p_RC = Centroid(p_RQ);
-  const Eigen::Vector3d real_c = ctx.X_WR * p_RC;
+// The scene as it is during the trial: real points r, the eye, the hologram's apparent-pose map A,
+// what the robot does not hide of itself from the eye, and the see-through display's field of view
+// about the head's line of sight (z of H).
+struct TrueScene {
+  Eigen::Isometry3d A;
+  Eigen::Vector3d p_W_eye;
+  std::vector<Eigen::Vector3d> r;
+  Eigen::Vector3d p_RC;    // the model centroid, R
+  Eigen::Vector3d real_c;  // the real centroid, W
+  std::vector<bool> direct_unhidden;
+  Eigen::Isometry3d X_HW;
+  double tan_half_h{0}, tan_half_v{0};
 
-  // What the robot does not hide of itself, seen from p_W_viewer.
-  const Eigen::Isometry3d X_RW = ctx.X_WR.inverse();
-  auto unhidden_from = [&](const Eigen::Vector3d& p_W_viewer) {
-    std::vector<bool> seen(n, true);
-    if (!c.occlusion) return seen;
-    const Eigen::Vector3d p_R_viewer = X_RW * p_W_viewer;
-    for (std::size_t k = 0; k < n; ++k) seen[k] = SeenPast(ctx.solids_R, p_R_viewer, p_RQ[k]);
-    return seen;
-  };
-  const std::vector<bool> direct_unhidden = unhidden_from(p_W_eye);
-  // The see-through display's field of view about the head's line of sight (z of H).
-  const Eigen::Isometry3d X_HW = ctx.X_WH_true.inverse();
-  const double tan_half_h = std::tan(0.5 * c.fov_h_deg * kDegToRad);
-  const double tan_half_v = std::tan(0.5 * c.fov_v_deg * kDegToRad);
-  auto in_view = [&](const Eigen::Vector3d& p_H) {
+  bool InView(const Eigen::Vector3d& p_H) const {
     return p_H.z() > 1e-6 && std::abs(p_H.x()) <= tan_half_h * p_H.z() &&
            std::abs(p_H.y()) <= tan_half_v * p_H.z();
-  };
+  }
+};
 
-  // Each display's captured image of the real robot (true camera pose), and its overlay camera.
-  struct DisplayState {
-    Eigen::Isometry3d X_CW_est;
-    std::vector<bool> seen;
-    std::vector<Eigen::Vector2d> u_real;
-    Eigen::Vector2d u_centroid{Eigen::Vector2d::Zero()};  // the real centroid in the image
-    Eigen::Vector2d px_per_rad{Eigen::Vector2d::Ones()};  // camera px per radian at the eye (u, v)
-  };
+// What the robot does not hide of itself, seen from p_W_viewer.
+std::vector<bool> UnhiddenFrom(const ViewingContext& ctx, const std::vector<Eigen::Vector3d>& p_RQ,
+                               const UserConfig& c, const Eigen::Vector3d& p_W_viewer) {
+  std::vector<bool> seen(p_RQ.size(), true);
+  if (!c.occlusion) return seen;
+  const Eigen::Vector3d p_R_viewer = ctx.X_WR.inverse() * p_W_viewer;
+  for (std::size_t k = 0; k < p_RQ.size(); ++k) seen[k] = SeenPast(ctx.solids_R, p_R_viewer, p_RQ[k]);
+  return seen;
+}
+
+TrueScene SeeTheScene(const ViewingContext& ctx, const std::vector<Eigen::Vector3d>& p_RQ,
+                      const UserConfig& c) {
+  TrueScene s;
+  s.A = ctx.X_WH_true * ctx.X_WH_est.inverse();
+  s.p_W_eye = ctx.X_WH_true.translation();
+  s.r.resize(p_RQ.size());
+  for (std::size_t k = 0; k < p_RQ.size(); ++k) s.r[k] = ctx.X_WR * p_RQ[k];
+  s.p_RC = Centroid(p_RQ);
+  s.real_c = ctx.X_WR * s.p_RC;
+  s.direct_unhidden = UnhiddenFrom(ctx, p_RQ, c, s.p_W_eye);
+  s.X_HW = ctx.X_WH_true.inverse();
+  s.tan_half_h = std::tan(0.5 * c.fov_h_deg * kDegToRad);
+  s.tan_half_v = std::tan(0.5 * c.fov_v_deg * kDegToRad);
+  return s;
+}
+
+// A display's captured image of the real robot (true camera pose), and its overlay camera.
+struct DisplayState {
+  Eigen::Isometry3d X_CW_est;
+  std::vector<bool> seen;
+  std::vector<Eigen::Vector2d> u_real;
+  Eigen::Vector2d u_centroid{Eigen::Vector2d::Zero()};  // the real centroid in the image
+  Eigen::Vector2d px_per_rad{Eigen::Vector2d::Ones()};  // camera px per radian at the eye (u, v)
+};
+
+std::vector<DisplayState> CaptureDisplays(const ViewingContext& ctx, const std::vector<Eigen::Vector3d>& p_RQ,
+                                          const UserConfig& c, const TrueScene& scene) {
+  const std::size_t n = p_RQ.size();
   std::vector<DisplayState> displays;
   for (const auto& d : ctx.displays) {
     DisplayState s;
     s.X_CW_est = d.X_WC_est.inverse();
-    const PanelView panel = SeePanel(d, A, p_W_eye, c.fov_h_deg, c.fov_v_deg);
+    const PanelView panel = SeePanel(d, scene.A, scene.p_W_eye, c.fov_h_deg, c.fov_v_deg);
     s.px_per_rad = panel.px_per_rad;
     const Eigen::Vector2d& half_view_px = panel.half_view_px;
     const Eigen::Vector2d image_centre(d.intrinsics.cx_px, d.intrinsics.cy_px);  // the panel's centre
-    const std::vector<bool> unhidden = unhidden_from(d.X_WC_true.translation());
+    const std::vector<bool> unhidden = UnhiddenFrom(ctx, p_RQ, c, d.X_WC_true.translation());
     const geometry::CameraMatrix P_true = geometry::MakeCameraMatrix(d.intrinsics.K(), d.X_WC_true);
     s.seen.assign(n, false);
     s.u_real.assign(n, Eigen::Vector2d::Zero());
@@ -319,7 +348,7 @@ AlignmentResult EmulatedUser::Align(const ViewingContext& ctx, const std::vector
     int num_seen = 0;
     for (std::size_t k = 0; k < n; ++k) {
       Eigen::Vector2d uv;
-      if (unhidden[k] && geometry::Project(P_true, r[k], &uv) && InImage(d.intrinsics, uv) &&
+      if (unhidden[k] && geometry::Project(P_true, scene.r[k], &uv) && InImage(d.intrinsics, uv) &&
           std::abs(uv.x() - image_centre.x()) <= half_view_px.x() &&
           std::abs(uv.y() - image_centre.y()) <= half_view_px.y()) {
         s.seen[k] = true;
@@ -330,190 +359,240 @@ AlignmentResult EmulatedUser::Align(const ViewingContext& ctx, const std::vector
     }
     // The centre of the image scale the person does not see: where the real centroid is imaged
     // (the mean of the points seen if it is behind the camera).
-    if (!geometry::Project(P_true, real_c, &s.u_centroid)) {
+    if (!geometry::Project(P_true, scene.real_c, &s.u_centroid)) {
       s.u_centroid = num_seen > 0 ? Eigen::Vector2d(sum / num_seen) : sum;
     }
     displays.push_back(std::move(s));
   }
+  return displays;
+}
 
+// One look: the normal equations of the person's fit (H, g) over the unknowns — the nudge ξ (0..5)
+// about the pivot c_W and, when they are blind to small size differences, the apparent image scale
+// σ of the hologram in the direct view (6) and in each display j (7 + j), nuisances they cannot
+// act on — and what they perceive, per point, to judge it by.
+struct Look {
+  Eigen::MatrixXd H;
+  Eigen::VectorXd g;
+  double depth2{0};
+  // Direct view, per point: perceived lateral discrepancy and its size-nuisance direction, over ρ [rad].
+  std::vector<Eigen::Vector2d> lateral_rad, size_dir_rad;
+  // Displays, per point: the perceived 2D discrepancy [px], its size-nuisance direction, its display.
+  std::vector<Eigen::Vector2d> display_px, display_size_dir;
+  std::vector<int> display_of;
+};
+
+// The direct view's points (in view and unhidden): three draws per point (depth, b, a).
+void LookDirectly(const std::vector<Eigen::Vector3d>& p_RQ, const UserConfig& c, double depth_scale,
+                  const TrueScene& scene, const TrialBiases& biases, const Eigen::Isometry3d& X_WV,
+                  const Eigen::Vector3d& c_W, double w_lat, double w_depth, Random* rng, Look* look) {
+  const int num_unknowns = static_cast<int>(look->g.size());
+  for (std::size_t k = 0; k < p_RQ.size(); ++k) {
+    const Eigen::Vector3d x = X_WV * p_RQ[k];
+    const Eigen::Vector3d h = scene.A * x;
+    if (!scene.direct_unhidden[k] || !scene.InView(scene.X_HW * h)) continue;
+    const Eigen::Vector3d ray = scene.r[k] - scene.p_W_eye;
+    const double rho = ray.norm();
+    if (!(rho > 1e-3)) continue;
+    const Eigen::Vector3d nr = ray / rho;
+    Eigen::Vector3d a = nr.cross(Eigen::Vector3d::UnitZ());
+    a = a.norm() > 1e-6 ? Eigen::Vector3d(a.normalized()) : nr.unitOrthogonal();
+    const Eigen::Vector3d b = nr.cross(a);
+    const Eigen::Vector3d d = h - scene.r[k];
+    const double noise_depth = depth_scale * c.depth_noise_fraction_std * rng->Normal();
+    const double noise_b = c.lateral_noise_arcmin * kArcminToRad * rng->Normal();
+    const double noise_a = c.lateral_noise_arcmin * kArcminToRad * rng->Normal();
+    const Eigen::Vector3d perceived(a.dot(d) + rho * (biases.alpha_rad.x() + noise_a),
+                                    b.dot(d) + rho * (biases.alpha_rad.y() + noise_b),
+                                    nr.dot(d) + rho * (biases.beta + noise_depth));
+    look->depth2 += perceived.z() * perceived.z() / (rho * rho);
+    Eigen::Matrix3d B;
+    B.row(0) = a.transpose();
+    B.row(1) = b.transpose();
+    B.row(2) = nr.transpose();
+    Eigen::MatrixXd J = Eigen::MatrixXd::Zero(3, num_unknowns);
+    J.leftCols<6>() = B * scene.A.linear() * PointJacobian(x, c_W);
+    if (c.size_blind) {
+      // A uniform scale of what is seen about the centroid's line of sight moves each point
+      // across its ray by σ · (r − c) (the perspective signature of a shift along that line).
+      J(0, 6) = a.dot(scene.r[k] - scene.real_c);
+      J(1, 6) = b.dot(scene.r[k] - scene.real_c);
+    }
+    look->lateral_rad.emplace_back(perceived.x() / rho, perceived.y() / rho);
+    look->size_dir_rad.emplace_back(J(0, 6) / rho, J(1, 6) / rho);
+    const Eigen::Vector3d w = Eigen::Vector3d(w_lat, w_lat, w_depth) / (rho * rho);
+    look->H += J.transpose() * w.asDiagonal() * J;
+    look->g += J.transpose() * w.asDiagonal() * perceived;
+  }
+}
+
+// The displays' points (seen in the capture and projected by the overlay camera): two draws per
+// point (y, x).
+void LookAtDisplays(const ViewingContext& ctx, const std::vector<Eigen::Vector3d>& p_RQ, const UserConfig& c,
+                    const std::vector<DisplayState>& displays, const TrialBiases& biases,
+                    const Eigen::Isometry3d& X_WV, const Eigen::Vector3d& c_W, double w_lat, Random* rng,
+                    Look* look) {
+  const int num_unknowns = static_cast<int>(look->g.size());
+  for (std::size_t j = 0; j < displays.size(); ++j) {
+    const DisplayState& s = displays[j];
+    for (std::size_t k = 0; k < p_RQ.size(); ++k) {
+      if (!s.seen[k]) continue;
+      const Eigen::Vector3d x = X_WV * p_RQ[k];
+      Eigen::Vector2d u_virtual;
+      Eigen::Matrix<double, 2, 3> du_dx;
+      if (!ProjectWithJacobian(ctx.displays[j].intrinsics, s.X_CW_est, x, &u_virtual, &du_dx)) continue;
+      const double noise_y = rng->Normal();
+      const double noise_x = rng->Normal();
+      const Eigen::Vector2d perceived =
+          u_virtual - s.u_real[k] +
+          s.px_per_rad.cwiseProduct(biases.display_bias_rad[j] + c.lateral_noise_arcmin * kArcminToRad *
+                                                                     Eigen::Vector2d(noise_x, noise_y));
+      Eigen::MatrixXd J = Eigen::MatrixXd::Zero(2, num_unknowns);
+      J.leftCols<6>() = du_dx * PointJacobian(x, c_W);
+      // The display is a picture too: a hologram moved along the capture camera's line of sight
+      // only changes its size in it, about the real centroid's image, and a size-blind person
+      // does not see that either (the same nuisance as in the direct view, one per display).
+      const Eigen::Vector2d size_dir =
+          c.size_blind ? Eigen::Vector2d(s.u_real[k] - s.u_centroid) : Eigen::Vector2d::Zero();
+      J.col(7 + static_cast<int>(j)) = size_dir;
+      look->display_px.push_back(perceived);
+      look->display_size_dir.push_back(size_dir);
+      look->display_of.push_back(static_cast<int>(j));
+      const Eigen::Vector2d w = w_lat * s.px_per_rad.cwiseInverse().cwiseAbs2();
+      look->H += J.transpose() * w.asDiagonal() * J;
+      look->g += J.transpose() * w.asDiagonal() * perceived;
+    }
+  }
+}
+
+// Decides the nudge: one Gauss–Newton step on the perceived discrepancies (tiny damping keeps an
+// unobservable direction, if any, still). Returns the solution: ξ (0..5), then −σ per view.
+Eigen::VectorXd DecideNudge(const UserConfig& c, Look* look) {
+  Eigen::MatrixXd& H = look->H;
+  const int num_unknowns = static_cast<int>(look->g.size());
+  const double damping = 1e-12 * std::max(1.0, H.trace() / num_unknowns);
+  if (!c.size_blind) {
+    for (int i = 6; i < num_unknowns; ++i) H(i, i) = 1.0;  // every σ fixed at 0
+  }
+  for (int i = 6; i < num_unknowns; ++i) {
+    if (!(H(i, i) > 0)) H(i, i) = 1.0;  // a view that shows no point: its σ is fixed at 0
+  }
+  return -(H + damping * Eigen::MatrixXd::Identity(num_unknowns, num_unknowns)).ldlt().solve(look->g);
+}
+
+// What the person judges: discrepancies net of the size differences they do not see (σ: the image
+// scale that best explains what they see, per view); into result's perceived_* and *_points_seen.
+void Judge(const Look& look, const Eigen::VectorXd& solution, const std::vector<DisplayState>& displays,
+           AlignmentResult* result) {
+  const double sigma = -solution[6];
+  double lat2 = 0;
+  for (std::size_t k = 0; k < look.lateral_rad.size(); ++k) {
+    lat2 += (look.lateral_rad[k] - sigma * look.size_dir_rad[k]).squaredNorm();
+  }
+  double display2_rad = 0;  // as the eye sees it on the panels
+  for (std::size_t k = 0; k < look.display_px.size(); ++k) {
+    const int j = look.display_of[k];
+    const double sigma_j = -solution[7 + j];
+    display2_rad += (look.display_px[k] - sigma_j * look.display_size_dir[k])
+                        .cwiseQuotient(displays[static_cast<std::size_t>(j)].px_per_rad)
+                        .squaredNorm();
+  }
+  const int num_px = static_cast<int>(look.display_px.size());
+  const double num_direct = std::max<double>(1.0, static_cast<double>(look.lateral_rad.size()));
+  result->perceived_lateral_arcmin = std::sqrt(lat2 / num_direct) / kArcminToRad;
+  result->perceived_depth_fraction = std::sqrt(look.depth2 / num_direct);
+  result->perceived_display_arcmin = num_px > 0 ? std::sqrt(display2_rad / num_px) / kArcminToRad : 0.0;
+  result->direct_points_seen = static_cast<int>(look.lateral_rad.size());
+  result->display_points_seen = num_px;
+}
+
+// Whether the person stops after this look, and why ("" = they nudge): nothing in view, aligned,
+// no better look in patience_nudges nudges (best_unsatisfied and nudges_since_better carry the
+// person's patience from look to look), max_nudges, or a nudge too small to see.
+std::string StopReason(const UserConfig& c, const AlignmentResult& result,
+                       const Eigen::Matrix<double, 6, 1>& xi, double* best_unsatisfied,
+                       int* nudges_since_better) {
+  if (result.direct_points_seen == 0 && result.display_points_seen == 0) return "nothing_in_view";
+  const bool satisfied =
+      result.perceived_lateral_arcmin <= c.stop_lateral_arcmin &&
+      result.perceived_depth_fraction <= c.stop_depth_fraction &&
+      (result.display_points_seen == 0 || result.perceived_display_arcmin <= c.stop_lateral_arcmin);
+  if (satisfied) return "aligned";
+  // How far from satisfied the person sees it: the largest discrepancy over its threshold.
+  const auto over = [](double value, double threshold) { return threshold > 0 ? value / threshold : 0.0; };
+  const double unsatisfied = std::max({over(result.perceived_lateral_arcmin, c.stop_lateral_arcmin),
+                                       over(result.perceived_depth_fraction, c.stop_depth_fraction),
+                                       over(result.perceived_display_arcmin, c.stop_lateral_arcmin)});
+  if (unsatisfied < *best_unsatisfied) {
+    *best_unsatisfied = unsatisfied;
+    *nudges_since_better = 0;
+  } else if (c.patience_nudges > 0 && ++*nudges_since_better >= c.patience_nudges) {
+    return "gave_up";
+  }
+  if (result.nudges >= c.max_nudges) return "max_nudges";
+  const Eigen::Vector3d omega = xi.head<3>();
+  const Eigen::Vector3d v = xi.tail<3>();
+  if (v.norm() < c.min_step_m && omega.norm() < c.min_step_deg * kDegToRad) return "no_visible_improvement";
+  return "";
+}
+
+// Carries the nudge out about the pivot c_W: a fraction (gain) of it, with motor noise on each
+// component (6 draws, then 6 more with absolute motor noise). Returns the hologram's new pose.
+Eigen::Isometry3d CarryOut(const UserConfig& c, const Eigen::Matrix<double, 6, 1>& xi,
+                           const Eigen::Vector3d& c_W, const Eigen::Isometry3d& X_WV_before, Random* rng) {
+  Eigen::Matrix<double, 6, 1> applied;
+  for (int i = 0; i < 6; ++i) applied[i] = c.gain * xi[i] * (1.0 + c.motor_noise_fraction * rng->Normal());
+  if (c.motor_noise_translation_mm > 0 || c.motor_noise_rotation_deg > 0) {
+    for (int i = 0; i < 6; ++i) {
+      const double sigma =
+          i < 3 ? c.motor_noise_rotation_deg * kDegToRad : c.motor_noise_translation_mm * 1e-3;
+      applied[i] += sigma * rng->Normal();
+    }
+  }
+  const Eigen::Vector3d w_applied = applied.head<3>();
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  if (w_applied.norm() > 0)
+    T.linear() = Eigen::AngleAxisd(w_applied.norm(), w_applied.normalized()).toRotationMatrix();
+  T.translation() = c_W + applied.tail<3>() - T.linear() * c_W;
+  Eigen::Isometry3d X_WV = T * X_WV_before;
+  X_WV.linear() = Eigen::Quaterniond(X_WV.linear()).normalized().toRotationMatrix();
+  return X_WV;
+}
+
+}  // namespace
+
+AlignmentResult EmulatedUser::Align(const ViewingContext& ctx, const std::vector<Eigen::Vector3d>& p_RQ,
+                                    const Eigen::Isometry3d& X_WV_start, std::uint64_t trial_seed) const {
+  if (p_RQ.empty()) throw std::invalid_argument("EmulatedUser::Align: no model points");
+  const UserConfig& c = config_;
+  Random rng(trial_seed);
+  const TrialBiases biases = DrawBiases(c, depth_scale_, depth_user_bias_, ctx.displays.size(), &rng);
+  const TrueScene scene = SeeTheScene(ctx, p_RQ, c);
+  const std::vector<DisplayState> displays = CaptureDisplays(ctx, p_RQ, c, scene);
   const double w_lat =
       1.0 / std::pow(c.assumed_lateral_arcmin * kArcminToRad, 2);      // × 1/ρ² (× 1/px_per_rad²)
   const double w_depth = 1.0 / std::pow(c.assumed_depth_fraction, 2);  // × 1/ρ²
-
-  // Unknowns of the person's fit: the nudge ξ (0..5); when they are blind to small size
-  // differences, the apparent image scale σ of the hologram in the direct view (6) and in each
-  // display j (7 + j), nuisances they cannot act on.
   const int num_unknowns = 7 + static_cast<int>(displays.size());
+
   AlignmentResult result;
   Eigen::Isometry3d X_WV = X_WV_start;
   result.poses.push_back({0.0, X_WV});
   double best_unsatisfied = INFINITY;  // patience: the best look so far
   int nudges_since_better = 0;
   while (true) {
-    // Look.
     result.duration_s += c.look_time_s + c.display_look_time_s * static_cast<double>(displays.size());
-    const Eigen::Vector3d c_W = X_WV * p_RC;  // the nudge's pivot, map coordinates
-    Eigen::MatrixXd H = Eigen::MatrixXd::Zero(num_unknowns, num_unknowns);
-    Eigen::VectorXd g = Eigen::VectorXd::Zero(num_unknowns);
-    double depth2 = 0;
-    // Per point: perceived lateral discrepancy and its size-nuisance direction, over ρ [rad].
-    std::vector<Eigen::Vector2d> lateral_rad, size_dir_rad;
-    for (std::size_t k = 0; k < n; ++k) {
-      const Eigen::Vector3d x = X_WV * p_RQ[k];
-      const Eigen::Vector3d h = A * x;
-      if (!direct_unhidden[k] || !in_view(X_HW * h)) continue;
-      const Eigen::Vector3d ray = r[k] - p_W_eye;
-      const double rho = ray.norm();
-      if (!(rho > 1e-3)) continue;
-      const Eigen::Vector3d nr = ray / rho;
-      Eigen::Vector3d a = nr.cross(Eigen::Vector3d::UnitZ());
-      a = a.norm() > 1e-6 ? Eigen::Vector3d(a.normalized()) : nr.unitOrthogonal();
-      const Eigen::Vector3d b = nr.cross(a);
-      const Eigen::Vector3d d = h - r[k];
-      const double noise_depth = depth_scale_ * c.depth_noise_fraction_std * rng.Normal();
-      const double noise_b = c.lateral_noise_arcmin * kArcminToRad * rng.Normal();
-      const double noise_a = c.lateral_noise_arcmin * kArcminToRad * rng.Normal();
-      const Eigen::Vector3d perceived(a.dot(d) + rho * (alpha_rad.x() + noise_a),
-                                      b.dot(d) + rho * (alpha_rad.y() + noise_b),
-                                      nr.dot(d) + rho * (beta + noise_depth));
-      depth2 += perceived.z() * perceived.z() / (rho * rho);
-      Eigen::Matrix3d B;
-      B.row(0) = a.transpose();
-      B.row(1) = b.transpose();
-      B.row(2) = nr.transpose();
-      Eigen::MatrixXd J = Eigen::MatrixXd::Zero(3, num_unknowns);
-      J.leftCols<6>() = B * A.linear() * PointJacobian(x, c_W);
-      if (c.size_blind) {
-        // A uniform scale of what is seen about the centroid's line of sight moves each point
-        // across its ray by σ · (r − c) (the perspective signature of a shift along that line).
-        J(0, 6) = a.dot(r[k] - real_c);
-        J(1, 6) = b.dot(r[k] - real_c);
-      }
-      lateral_rad.emplace_back(perceived.x() / rho, perceived.y() / rho);
-      size_dir_rad.emplace_back(J(0, 6) / rho, J(1, 6) / rho);
-      const Eigen::Vector3d w = Eigen::Vector3d(w_lat, w_lat, w_depth) / (rho * rho);
-      H += J.transpose() * w.asDiagonal() * J;
-      g += J.transpose() * w.asDiagonal() * perceived;
-    }
-    // Per display point: the perceived 2D discrepancy [px] and its size-nuisance direction.
-    std::vector<Eigen::Vector2d> display_px, display_size_dir;
-    std::vector<int> display_of;
-    for (std::size_t j = 0; j < displays.size(); ++j) {
-      const DisplayState& s = displays[j];
-      for (std::size_t k = 0; k < n; ++k) {
-        if (!s.seen[k]) continue;
-        const Eigen::Vector3d x = X_WV * p_RQ[k];
-        Eigen::Vector2d u_virtual;
-        Eigen::Matrix<double, 2, 3> du_dx;
-        if (!ProjectWithJacobian(ctx.displays[j].intrinsics, s.X_CW_est, x, &u_virtual, &du_dx)) continue;
-        const double noise_y = rng.Normal();
-        const double noise_x = rng.Normal();
-        const Eigen::Vector2d perceived =
-            u_virtual - s.u_real[k] +
-            s.px_per_rad.cwiseProduct(display_bias_rad[j] + c.lateral_noise_arcmin * kArcminToRad *
-                                                                Eigen::Vector2d(noise_x, noise_y));
-        Eigen::MatrixXd J = Eigen::MatrixXd::Zero(2, num_unknowns);
-        J.leftCols<6>() = du_dx * PointJacobian(x, c_W);
-        // The display is a picture too: a hologram moved along the capture camera's line of sight
-        // only changes its size in it, about the real centroid's image, and a size-blind person
-        // does not see that either (the same nuisance as in the direct view, one per display).
-        const Eigen::Vector2d size_dir =
-            c.size_blind ? Eigen::Vector2d(s.u_real[k] - s.u_centroid) : Eigen::Vector2d::Zero();
-        J.col(7 + static_cast<int>(j)) = size_dir;
-        display_px.push_back(perceived);
-        display_size_dir.push_back(size_dir);
-        display_of.push_back(static_cast<int>(j));
-        const Eigen::Vector2d w = w_lat * s.px_per_rad.cwiseInverse().cwiseAbs2();
-        H += J.transpose() * w.asDiagonal() * J;
-        g += J.transpose() * w.asDiagonal() * perceived;
-      }
-    }
-    // Decide the nudge: one Gauss–Newton step on the perceived discrepancies (tiny damping keeps an
-    // unobservable direction, if any, still).
-    const double damping = 1e-12 * std::max(1.0, H.trace() / num_unknowns);
-    if (!c.size_blind) {
-      for (int i = 6; i < num_unknowns; ++i) H(i, i) = 1.0;  // every σ fixed at 0
-    }
-    for (int i = 6; i < num_unknowns; ++i) {
-      if (!(H(i, i) > 0)) H(i, i) = 1.0;  // a view that shows no point: its σ is fixed at 0
-    }
-    const Eigen::VectorXd solution =
-        -(H + damping * Eigen::MatrixXd::Identity(num_unknowns, num_unknowns)).ldlt().solve(g);
+    const Eigen::Vector3d c_W = X_WV * scene.p_RC;  // the nudge's pivot, map coordinates
+    Look look;
+    look.H = Eigen::MatrixXd::Zero(num_unknowns, num_unknowns);
+    look.g = Eigen::VectorXd::Zero(num_unknowns);
+    LookDirectly(p_RQ, c, depth_scale_, scene, biases, X_WV, c_W, w_lat, w_depth, &rng, &look);
+    LookAtDisplays(ctx, p_RQ, c, displays, biases, X_WV, c_W, w_lat, &rng, &look);
+    const Eigen::VectorXd solution = DecideNudge(c, &look);
     const Eigen::Matrix<double, 6, 1> xi = solution.head<6>();
-
-    // What the person judges: discrepancies net of the size differences they do not see (σ: the
-    // image scale that best explains what they see, per view).
-    const double sigma = -solution[6];
-    double lat2 = 0;
-    for (std::size_t k = 0; k < lateral_rad.size(); ++k) {
-      lat2 += (lateral_rad[k] - sigma * size_dir_rad[k]).squaredNorm();
-    }
-    double display2_rad = 0;  // as the eye sees it on the panels
-    for (std::size_t k = 0; k < display_px.size(); ++k) {
-      const int j = display_of[k];
-      const double sigma_j = -solution[7 + j];
-      display2_rad += (display_px[k] - sigma_j * display_size_dir[k])
-                          .cwiseQuotient(displays[static_cast<std::size_t>(j)].px_per_rad)
-                          .squaredNorm();
-    }
-    const int num_px = static_cast<int>(display_px.size());
-    const double num_direct = std::max<double>(1.0, static_cast<double>(lateral_rad.size()));
-    result.perceived_lateral_arcmin = std::sqrt(lat2 / num_direct) / kArcminToRad;
-    result.perceived_depth_fraction = std::sqrt(depth2 / num_direct);
-    result.perceived_display_arcmin = num_px > 0 ? std::sqrt(display2_rad / num_px) / kArcminToRad : 0.0;
-    result.direct_points_seen = static_cast<int>(lateral_rad.size());
-    result.display_points_seen = num_px;
-
-    if (lateral_rad.empty() && num_px == 0) {
-      result.stop_reason = "nothing_in_view";
-      break;
-    }
-    const bool satisfied = result.perceived_lateral_arcmin <= c.stop_lateral_arcmin &&
-                           result.perceived_depth_fraction <= c.stop_depth_fraction &&
-                           (num_px == 0 || result.perceived_display_arcmin <= c.stop_lateral_arcmin);
-    if (satisfied) {
-      result.stop_reason = "aligned";
-      break;
-    }
-    // How far from satisfied the person sees it: the largest discrepancy over its threshold.
-    const auto over = [](double value, double threshold) { return threshold > 0 ? value / threshold : 0.0; };
-    const double unsatisfied = std::max({over(result.perceived_lateral_arcmin, c.stop_lateral_arcmin),
-                                         over(result.perceived_depth_fraction, c.stop_depth_fraction),
-                                         over(result.perceived_display_arcmin, c.stop_lateral_arcmin)});
-    if (unsatisfied < best_unsatisfied) {
-      best_unsatisfied = unsatisfied;
-      nudges_since_better = 0;
-    } else if (c.patience_nudges > 0 && ++nudges_since_better >= c.patience_nudges) {
-      result.stop_reason = "gave_up";
-      break;
-    }
-    if (result.nudges >= c.max_nudges) {
-      result.stop_reason = "max_nudges";
-      break;
-    }
-    const Eigen::Vector3d omega = xi.head<3>();
-    const Eigen::Vector3d v = xi.tail<3>();
-    if (v.norm() < c.min_step_m && omega.norm() < c.min_step_deg * kDegToRad) {
-      result.stop_reason = "no_visible_improvement";
-      break;
-    }
-    // Carry it out: a fraction of it, with motor noise on each component.
-    Eigen::Matrix<double, 6, 1> applied;
-    for (int i = 0; i < 6; ++i) applied[i] = c.gain * xi[i] * (1.0 + c.motor_noise_fraction * rng.Normal());
-    if (c.motor_noise_translation_mm > 0 || c.motor_noise_rotation_deg > 0) {
-      for (int i = 0; i < 6; ++i) {
-        const double sigma =
-            i < 3 ? c.motor_noise_rotation_deg * kDegToRad : c.motor_noise_translation_mm * 1e-3;
-        applied[i] += sigma * rng.Normal();
-      }
-    }
-    const Eigen::Vector3d w_applied = applied.head<3>();
-    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-    if (w_applied.norm() > 0)
-      T.linear() = Eigen::AngleAxisd(w_applied.norm(), w_applied.normalized()).toRotationMatrix();
-    T.translation() = c_W + applied.tail<3>() - T.linear() * c_W;
-    X_WV = T * X_WV;
-    X_WV.linear() = Eigen::Quaterniond(X_WV.linear()).normalized().toRotationMatrix();
+    Judge(look, solution, displays, &result);
+    result.stop_reason = StopReason(c, result, xi, &best_unsatisfied, &nudges_since_better);
+    if (!result.stop_reason.empty()) break;
+    X_WV = CarryOut(c, xi, c_W, X_WV, &rng);
     ++result.nudges;
     result.duration_s += c.nudge_time_s;
     result.poses.push_back({result.duration_s, X_WV});
