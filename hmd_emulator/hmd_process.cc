@@ -37,6 +37,25 @@ double MonotonicSeconds() { return std::chrono::duration<double>(Clock::now().ti
 }  // namespace
 
 HmdProcess::HmdProcess(const orbed::CommonFlags& flags, const HmdOptions& options) : options_(options) {
+  ResolveOptions();
+  LoadConfigs();
+  const sim::Scene scene = LoadSceneAndRobot();
+  RestoreOrStartSession();
+  BuildHeadset(scene);
+  ConnectToTheBus(flags);
+  BuildImagePipeline();
+  AddTimers();
+  ORBED_LOG(kInfo) << "robot " << options_.urdf_path << ", scene " << options_.scene_path << "; walk of "
+                   << config_.walk.waypoints.size() << " waypoints ("
+                   << Fixed(stream_->trajectory().length_m(), 2) << " m), user seed " << config_.user.seed
+                   << ", " << options_.displays << " reflective display(s); pose " << options_.pose_hz
+                   << " Hz, camera " << options_.camera_hz << " Hz"
+                   << (options_.interactive ? ", interactive" : "");
+}
+
+// Defaults for the model and the scene, the instance names checked, the channels of this headset
+// and arm, the rates and flags checked (std::invalid_argument naming the flag).
+void HmdProcess::ResolveOptions() {
   if (options_.urdf_path.empty())
     options_.urdf_path = HmdSourcePath(sim::RobotModel::kDefaultUrdfRelativePath);
   if (options_.scene_path.empty()) options_.scene_path = HmdSourcePath(sim::kDefaultSceneRelativePath);
@@ -70,18 +89,27 @@ HmdProcess::HmdProcess(const orbed::CommonFlags& flags, const HmdOptions& option
   if (!options_.screenshot_path.empty() && !options_.interactive) {
     throw std::invalid_argument("--screenshot needs --interactive (it saves the window's image)");
   }
+}
+
+// config_: the shipped configs, then --config files over them; --user-seed; --displays checked
+// against the displays the config places.
+void HmdProcess::LoadConfigs() {
   std::vector<std::string> paths;
   for (const auto& rel : DefaultHmdConfigRelativePaths()) paths.push_back(HmdSourcePath(rel));
   paths.insert(paths.end(), options_.config_paths.begin(), options_.config_paths.end());
   config_ = LoadHmdConfigs(paths);
   if (options_.user_seed) config_.user.seed = *options_.user_seed;
-  const int placed = static_cast<int>(config_.hmd.displays.size());
+  const int placed = static_cast<int>(config_.hmd.displays.size());  // reflective displays in hmd.yaml
   if (options_.displays < 0 || options_.displays > placed) {
     throw std::invalid_argument("--displays must be in [0, " + std::to_string(placed) +
                                 "]: the config places " + std::to_string(placed) +
                                 " reflective display(s) (hmd.displays)");
   }
+}
 
+// The scene (standing at --arm's place: config_ moved with it), the robot model with the scene's
+// tool, the annotation landmarks checked, the user's id and the hologram's start pose.
+sim::Scene HmdProcess::LoadSceneAndRobot() {
   sim::Scene scene = sim::LoadSceneFile(options_.scene_path);
   // Another arm than the single one: the same person walks the same way around that arm.
   const Eigen::Isometry3d X_WR_single = scene.X_WR;
@@ -93,8 +121,13 @@ HmdProcess::HmdProcess(const orbed::CommonFlags& flags, const HmdOptions& option
   AnnotationLandmarkPoints(*robot_model_, config_.hmd, Eigen::VectorXd::Zero(robot_model_->num_joints()));
   user_id_ = "emulated-seed-" + std::to_string(config_.user.seed);
   X_WV_start_ = EmulatedUser(config_.user).StartPose(scene.X_WR);
+  return scene;
+}
+
+// session_: the SESSION_CONTROL state machine, restored from --state-file when there is one.
+void HmdProcess::RestoreOrStartSession() {
   HmdSessionOptions session_options;
-  session_options.displays_placed = placed;
+  session_options.displays_placed = static_cast<int>(config_.hmd.displays.size());
   for (const HeadWaypoint& w : config_.walk.waypoints) session_options.waypoint_names.push_back(w.name);
   session_options.iiwa_status_channel = options_.iiwa_status_channel;
   session_options.robot_state_channel = options_.robot_state_channel;
@@ -106,10 +139,17 @@ HmdProcess::HmdProcess(const orbed::CommonFlags& flags, const HmdOptions& option
                        << session_.state().next_index << " (state file " << options_.state_file << ")";
     }
   }
+}
+
+// The interactive mode's state and the walk + SLAM pose stream.
+void HmdProcess::BuildHeadset(const sim::Scene& scene) {
   interactive_.emplace(options_.displays, X_WV_start_, options_.scripted_keys, MonotonicSeconds(),
                        robot_model_->num_joints());
   stream_ = std::make_unique<PoseStream>(config_, scene, *robot_model_);
+}
 
+// process_ (on the clock of the arm it looks at) and every subscription.
+void HmdProcess::ConnectToTheBus(const orbed::CommonFlags& flags) {
   orbed::CommonFlags process_flags = flags;
   process_flags.sim_clock_arm = options_.arm;  // --sim-time follows the clock of the arm it looks at
   process_ = std::make_unique<orbed::Process>(process_flags);
@@ -137,7 +177,10 @@ HmdProcess::HmdProcess(const orbed::CommonFlags& flags, const HmdOptions& option
   process_->Subscribe<orbed::alignment_trial_t>(
       options_.trial_channel,
       [this](const orbed::alignment_trial_t& m, const std::string& ch, int64_t) { OnTrial(m, ch); });
+}
 
+// pipeline_: the camera frame, reflective views and AR view, published through process_.
+void HmdProcess::BuildImagePipeline() {
   ImagePipelineOptions images;
   images.jpeg_quality = options_.jpeg_quality;
   const HeadTrajectory& walk = stream_->trajectory();
@@ -169,7 +212,10 @@ HmdProcess::HmdProcess(const orbed::CommonFlags& flags, const HmdOptions& option
     if (count <= 5) ORBED_LOG(kError) << error;
   };
   pipeline_ = std::make_unique<ImagePipeline>(*robot_model_, stream_->scene_objects(), images, out);
+}
 
+// The pose and gaze timers on the process clock, the rendered streams' on the wall clock.
+void HmdProcess::AddTimers() {
   // Named by what they publish: a timer that falls behind counts its skipped deadlines as
   // "timer/<channel>" drops on the heartbeat.
   process_->AddTimer(
@@ -190,12 +236,6 @@ HmdProcess::HmdProcess(const orbed::CommonFlags& flags, const HmdOptions& option
   if (options_.interactive)
     process_->AddWallTimer(
         1.0 / kInteractiveHz, [this] { InteractiveTick(); }, "interactive");
-
-  ORBED_LOG(kInfo) << "robot " << options_.urdf_path << ", scene " << options_.scene_path << "; walk of "
-                   << config_.walk.waypoints.size() << " waypoints (" << Fixed(walk.length_m(), 2)
-                   << " m), user seed " << config_.user.seed << ", " << options_.displays
-                   << " reflective display(s); pose " << options_.pose_hz << " Hz, camera "
-                   << options_.camera_hz << " Hz" << (options_.interactive ? ", interactive" : "");
 }
 
 HmdProcess::~HmdProcess() {

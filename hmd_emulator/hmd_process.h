@@ -225,6 +225,16 @@ class HmdProcess {
   int64_t skipped_frames() const { return pipeline_->skipped(); }
 
  private:
+  // The constructor's steps, in its order.
+  void ResolveOptions();
+  void LoadConfigs();
+  sim::Scene LoadSceneAndRobot();
+  void RestoreOrStartSession();
+  void BuildHeadset(const sim::Scene& scene);
+  void ConnectToTheBus(const orbed::CommonFlags& flags);
+  void BuildImagePipeline();
+  void AddTimers();
+
   void OnIiwaStatus(const orbed::iiwa_status_t& msg, const std::string& channel);
   void OnRobotState(const orbed::robot_state_t& msg, const std::string& channel);
   void OnSessionControl(const orbed::session_control_t& msg, const std::string& channel);
