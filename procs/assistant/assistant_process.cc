@@ -10,13 +10,13 @@
 #include <orbed/robot_state_t.hpp>
 
 #include "base/format.h"
+#include "base/log.h"
 #include "base/replace_file.h"
 #include "base/source_paths.h"
 #include "lcmtypes/contract/conversions.h"
-#include "runtime/flags.h"
-#include "base/log.h"
 #include "lcmtypes/contract/requests.h"
 #include "lcmtypes/contract/validation.h"
+#include "runtime/flags.h"
 #include "sim/guidance_messages.h"
 #include "sim/iiwa_status_check.h"
 

@@ -52,9 +52,9 @@
 #include <string>
 #include <vector>
 
+#include "lcmtypes/contract/channels.h"
 #include "procs/assistant/assistant.h"
 #include "procs/assistant/assistant_machine.h"
-#include "lcmtypes/contract/channels.h"
 #include "runtime/process.h"
 #include "sim/robot_model.h"
 

@@ -20,7 +20,6 @@
 #include "base/source_paths.h"
 #include "lcmtypes/contract/conversions.h"
 #include "runtime/flags.h"
-#include "base/log.h"
 #include "sim/guidance_messages.h"
 
 namespace orbed::setup {

@@ -8,8 +8,8 @@
 #include "procs/setup/setup_process.h"
 
 #include <algorithm>
-#include <filesystem>
 #include <cstdint>
+#include <filesystem>
 #include <set>
 #include <string>
 #include <vector>
