@@ -74,8 +74,7 @@ def split_globals(argv):
             flags.append(arg)
         elif arg == "--version":
             from .paths import version
-            number, commit = version()
-            sys.stdout.write(f"orbed {number}, commit {commit}\n")
+            sys.stdout.write(version() + "\n")
             sys.exit(0)
         elif arg in ("help", "-h", "--help"):
             if i + 1 < len(argv) and argv[i + 1] in VERBS:

@@ -24,18 +24,18 @@ RMEM_WANTED = 16777216  # LCM image traffic wants a large UDP receive buffer
 
 
 def version():
-    """project(orbed VERSION x.y.z) of CMakeLists.txt, and the checkout's git commit (+ dirty)."""
+    """The version line every orbed program prints (base/command_line.h): "orbed X.Y.Z (commit
+    <12 hex>)", with ", modified" when tracked files differ from the commit; "unknown" outside git."""
     with open(os.path.join(ROOT, "CMakeLists.txt")) as f:
         found = re.search(r"project\(\s*orbed\s+VERSION\s+([0-9.]+)", f.read())
-    commit = "unknown commit"
-    head = subprocess.run(["git", "-C", ROOT, "rev-parse", "HEAD"], capture_output=True, text=True)
-    if head.returncode == 0:
+    commit = "unknown"
+    head = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short=12", "HEAD"], capture_output=True, text=True)
+    if head.returncode == 0 and head.stdout.strip():
         commit = head.stdout.strip()
-        dirty = subprocess.run(["git", "-C", ROOT, "status", "--porcelain", "--untracked-files=no"],
-                               capture_output=True, text=True)
-        if dirty.returncode == 0 and dirty.stdout.strip():
-            commit += " (dirty)"
-    return found.group(1) if found else "unknown", commit
+        diff = subprocess.run(["git", "-C", ROOT, "diff", "--quiet", "HEAD", "--"], capture_output=True)
+        if diff.returncode != 0:
+            commit += ", modified"
+    return f"orbed {found.group(1) if found else 'unknown'} (commit {commit})"
 
 
 class Context:

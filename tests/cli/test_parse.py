@@ -104,9 +104,11 @@ def test_version_names_the_project_version_and_the_commit(orbed):
     assert done.returncode == 0
     with open(os.path.join(ROOT, "CMakeLists.txt")) as f:
         version = re.search(r"project\(orbed VERSION ([0-9.]+)", f.read()).group(1)
-    head = subprocess.run(["git", "-C", ROOT, "rev-parse", "HEAD"], capture_output=True, text=True)
-    commit = head.stdout.strip() if head.returncode == 0 else "unknown commit"
-    assert done.stdout.startswith(f"orbed {version}, commit {commit}")
+    head = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short=12", "HEAD"], capture_output=True, text=True)
+    commit = head.stdout.strip() if head.returncode == 0 else "unknown"
+    # The same line as every orbed executable's --version (base/command_line.h).
+    assert re.fullmatch(r"orbed %s \(commit %s(, modified)?\)\n" % (re.escape(version), re.escape(commit)),
+                        done.stdout), done.stdout
 
 
 def test_global_flags_go_before_or_after_the_verb():
