@@ -85,12 +85,9 @@
 /// map for estimates), H head, C camera, M reversed frustum, R real robot base, V virtual robot base. Units:
 /// m, rad, px, Hz; utime µs.
 
-#include <chrono>
 #include <cstdint>
 #include <memory>
-#include <optional>
 #include <string>
-#include <vector>
 
 #include <Eigen/Geometry>
 #include <opencv2/core.hpp>
@@ -102,77 +99,18 @@
 #include <orbed/robot_state_t.hpp>
 #include <orbed/session_control_t.hpp>
 
-#include "hmd_emulator/hmd_config.h"
-#include "hmd_emulator/hmd_session.h"
+#include "hmd_emulator/hmd.h"
 #include "hmd_emulator/image_pipeline.h"
-#include "hmd_emulator/interactive.h"
-#include "hmd_emulator/pose_stream.h"
-#include "hmd_emulator/robot_state.h"
-#include "hmd_emulator/session_file.h"
-#include "hmd_emulator/viraal_trial.h"
-#include "lcmtypes/contract/channels.h"
 #include "runtime/process.h"
-#include "sim/robot_model.h"
 
 namespace orbed::hmd {
 
-struct HmdOptions {
-  /// URDF and scene; "" = the files shipped in the source tree (HmdSourcePath()).
-  std::string urdf_path;
-  std::string scene_path;
-  /// YAML files applied after the shipped config/{slam,user,viraal_walk,hmd}.yaml (hmd_config.h).
-  std::vector<std::string> config_paths;
-  /// A different person: overrides user.seed when set.
-  std::optional<std::uint64_t> user_seed;
-  double camera_hz{30.0};
-  double pose_hz{60.0};
-  int jpeg_quality{85};         ///< 1..100
-  int displays{1};              ///< live reflective displays, 0..hmd.displays.size()
-  bool interactive{false};      ///< a person in an OpenCV window instead of the emulated user
-  std::string screenshot_path;  ///< interactive: the window's last image is written here at exit
-  /// Interactive: key codes fed as if typed, one per window refresh, before real keys (tests, demos).
-  std::string scripted_keys;
-  bool threaded{true};  ///< images on a worker thread (see the file comment)
-  /// The session's state file (session_file.h): restored at start, saved on every change; "" = none.
-  std::string state_file;
-  /// One of several headsets (channels::IsInstanceName): every channel of the headset's
-  /// own (HMD_POSE, HMD_POSE_TRUTH, HMD_CAMERA, GAZE_RAY, REFLECTIVE_VIEW, AR_VIEW,
-  /// ALIGNMENT_TRIAL) and of its session (SESSION_CONTROL, REGISTRATION) gets the suffix _NAME
-  /// (channels::ForHeadset); "" = the single headset, plain names.
-  std::string headset;
-  /// The arm it looks at, one of the scene's `arms:` (sim::Scene::StandAt): the walk and the start
-  /// offset around that arm's base, the arm's channels (IIWA_STATUS, ROBOT_STATE, IIWA_COMMAND,
-  /// GUIDANCE, SETUP_TASK) with its suffix (channels::ForArm); "" = the single arm.
-  std::string arm;
-  /// Another headset (its --headset NAME) whose camera is this one's first reflective display
-  /// (viraal_trial.h's CollaboratorDisplay, the anchor's error from hmd.collaborator): where it
-  /// truly is comes from its HMD_POSE_TRUTH_<NAME>; the live display 0 shows what its camera sees,
-  /// and the emulated trials align with it. "" = none.
-  std::string collaborator;
-  std::string iiwa_status_channel{channels::kIiwaStatus};
-  std::string robot_state_channel{channels::kRobotState};
-  std::string session_control_channel{channels::kSessionControl};
-  std::string registration_channel{channels::kRegistration};
-  /// The set-up guidance (orbed-guidance): while a GUIDANCE is fresh, the hologram shows its target
-  /// configuration (modes ar, ar_reflective), or nothing (fixed: the guidance is on a monitor).
-  std::string guidance_channel{channels::kGuidance};
-  std::string hmd_pose_channel{channels::kHmdPose};
-  std::string hmd_pose_truth_channel{channels::kHmdPoseTruth};
-  std::string camera_channel{channels::kHmdCamera};
-  std::string gaze_channel{channels::kGazeRay};
-  std::string reflective_channel{channels::kReflectiveView};
-  std::string ar_view_channel{channels::kArView};
-  std::string trial_channel{channels::kAlignmentTrial};
-  /// Interactive: the person turns a joint of the real arm (keys 1-7 and , .) through the sim.
-  std::string iiwa_command_channel{channels::kIiwaCommand};
-  std::string setup_task_channel{channels::kSetupTask};  ///< interactive: the planned target
-};
-
 class HmdProcess {
  public:
-  /// Loads the URDF, scene and configs (std::runtime_error naming the file and key), validates the
-  /// options (std::invalid_argument naming the flag), opens LCM (std::runtime_error naming the URL),
-  /// starts the worker thread (threaded). Interactive mode opens its window in Run().
+  /// Validates the options (ResolveHmdOptions: std::invalid_argument naming the flag), builds the
+  /// core (Headset: loads the URDF, scene and configs, std::runtime_error naming the file and key),
+  /// opens LCM (std::runtime_error naming the URL), starts the worker thread (threaded).
+  /// Interactive mode opens its window in Run().
   HmdProcess(const orbed::CommonFlags& flags, const HmdOptions& options);
   ~HmdProcess();
   HmdProcess(const HmdProcess&) = delete;
@@ -182,15 +120,16 @@ class HmdProcess {
   /// display). Writes the screenshot at the end.
   int Run();
   orbed::Process& process() { return *process_; }
-  const HmdOptions& options() const { return options_; }
-  const HmdConfigSet& config() const { return config_; }
+  const HmdOptions& options() const { return headset_->options(); }
+  const HmdConfigSet& config() const { return headset_->config(); }
   /// The live walk's time at the last HMD_POSE [s], and how far the emulated trials have moved it
   /// on (the alignment time not already spent on the live stream) [s].
-  double walk_t_s() const;
-  double walk_offset_s() const { return walk_offset_s_; }
+  double walk_t_s() const { return headset_->walk_t_s(); }
+  double walk_offset_s() const { return headset_->walk_offset_s(); }
 
   // The timers' callbacks, public so tests can drive them without waiting (Run() thread only).
-  /// Steps the head and SLAM model to t and publishes HMD_POSE + HMD_POSE_TRUTH.
+  /// Steps the head and SLAM model to t and publishes HMD_POSE + HMD_POSE_TRUTH (then a trial
+  /// whose tracking faults have played).
   void PublishPose();
   void PublishGaze();
   /// Requests (threaded) or makes and publishes (inline) a camera frame / the reflective views /
@@ -198,100 +137,48 @@ class HmdProcess {
   void RequestCamera();
   void RequestReflective();
   void RequestArView();
-  /// Interactive mode: handles one key as if typed (ApplyKey plus submit, reset, recapture, quit).
+  /// Interactive mode: handles one key as if typed (Headset::HandleKey, then its actions).
   void HandleKey(int key);
   /// The window's current picture (interactive mode's content; works without a window).
   cv::Mat CurrentWindowImage();
   /// Waits until the worker has finished every pending request (no-op inline).
   void Flush();
 
-  /// What the hologram shows now. A person planning a target (interactive, t): that target in
-  /// AR_VIEW and the displays. Else during a set-up (a GUIDANCE fresher than kGuidanceFreshS, no
-  /// alignment session): ar: AR_VIEW at the target, the displays without a hologram (the mode has
-  /// none); ar_reflective: both at the target; fixed: neither (the guidance is on the monitor).
-  /// Otherwise the real arm's joints everywhere (empty q: the joints of the frame drawn on).
-  struct HologramShown {
-    bool hidden{false};
-    Eigen::VectorXd q_rad;
-    bool reflective_hidden{false};
-    Eigen::VectorXd reflective_q_rad;
-  };
-  static constexpr double kGuidanceFreshS = 1.0;
-  HologramShown Hologram() const;
+  /// What the hologram shows now (Headset::Hologram on the process clock).
+  using HologramShown = hmd::HologramShown;
+  static constexpr double kGuidanceFreshS = hmd::kGuidanceFreshS;
+  HologramShown Hologram() const { return headset_->Hologram(process_->ClockSeconds()); }
 
-  /// The current X_WV (see the file comment) and the active session ("" when none).
-  Eigen::Isometry3d CurrentX_WV() const;
-  const std::string& active_session() const { return session_.state().id; }
+  /// The current X_WV (hmd.h) and the active session ("" when none).
+  Eigen::Isometry3d CurrentX_WV() const { return headset_->CurrentX_WV(); }
+  const std::string& active_session() const { return headset_->session().state().id; }
   int64_t skipped_frames() const { return pipeline_->skipped(); }
 
  private:
-  // The constructor's steps, in its order.
-  void ResolveOptions();
-  void LoadConfigs();
-  sim::Scene LoadSceneAndRobot();
-  void RestoreOrStartSession();
-  void BuildHeadset(const sim::Scene& scene);
+  HeadsetClock Now() const;
   void ConnectToTheBus(const orbed::CommonFlags& flags);
   void BuildImagePipeline();
   void AddTimers();
 
+  template <typename Message>
+  void Listen(const std::string& channel, void (HmdProcess::*handler)(const Message&, const std::string&));
+  // Posts `job` with the latest inputs; a request that replaced one not started: "<channel>/busy".
+  void Request(ImagePipeline::Job job, const std::string& channel);
+  void OnSessionControl(const orbed::session_control_t& msg, const std::string& channel);
   void OnIiwaStatus(const orbed::iiwa_status_t& msg, const std::string& channel);
   void OnRobotState(const orbed::robot_state_t& msg, const std::string& channel);
-  void OnSessionControl(const orbed::session_control_t& msg, const std::string& channel);
   void OnRegistration(const orbed::registration_t& msg, const std::string& channel);
   void OnTrial(const orbed::alignment_trial_t& msg, const std::string& channel);
   void OnGuidance(const orbed::guidance_t& msg, const std::string& channel);
   void OnCollaboratorPose(const orbed::hmd_pose_t& msg, const std::string& channel);
-  void SaveState();
-  void EmulateTrial(const std::string& channel);
-  void SubmitInteractiveTrial();
-  void TurnArmJoint(int joint, double delta_rad);
-  void EditTarget(std::optional<std::pair<int, double>> turn);
-  void SendPlannedTarget();
-  std::string GuidanceStatus() const;
-  /// The latest valid GUIDANCE if it came within kGuidanceFreshS, else null.
-  const orbed::guidance_t* FreshGuidance() const;
-  void PublishTrial(const Eigen::Isometry3d& X_WV, double duration_s, const std::string& user_id,
-                    const TrackingFaultRecord& faults = {},
-                    const std::vector<AnnotationRay>& annotation = {});
-  // `played_s`: walk time the trial already spent live (its tracking faults played on HMD_POSE).
-  void PublishEmulatedTrial(const TrialOutcome& outcome, double played_s = 0);
+  /// Carries out the core's actions in HeadsetActions' order; a refusal under "<channel>/<key>".
+  void Act(const HeadsetActions& actions, const std::string& channel = "");
   void InteractiveTick();
-  FrameInputs Inputs() const;
 
-  HmdOptions options_;
-  HmdConfigSet config_;
-  std::optional<orbed::guidance_t> guidance_;  // the latest valid GUIDANCE
-  double guidance_received_s_{0};              // when it came [process clock s]
-  std::unique_ptr<sim::RobotModel> robot_model_;
+  std::unique_ptr<Headset> headset_;
   std::unique_ptr<orbed::Process> process_;
-  std::unique_ptr<PoseStream> stream_;
   std::unique_ptr<ImagePipeline> pipeline_;
-  HmdSession session_;
-  SavedSession saved_;                             // what the state file holds
-  SessionMapCache session_map_;                    // the session's map after its last trial
-  std::optional<InteractiveSession> interactive_;  // always set; the person only with --interactive
-  double t0_s_{0};                                 // the walk's t = 0: the first pose tick [process clock s]
-  double walk_offset_s_{0};                        // emulated seconds of the trials published [s]
-  bool started_{false};
   bool window_open_{false};
-
-  // Latest valid inputs (Run() thread).
-  RobotState robot_;
-  // The collaborator's camera, truly (its latest valid HMD_POSE_TRUTH), and the shared anchor's
-  // error of the live display, drawn once from --seed (AnchorError).
-  std::optional<Eigen::Isometry3d> collaborator_X_WC_true_;
-  int64_t collaborator_utime_{0};
-  Eigen::Isometry3d live_anchor_error_{Eigen::Isometry3d::Identity()};
-  std::optional<Eigen::Isometry3d> X_WV_registration_, X_WV_user_;
-  Eigen::Isometry3d X_WV_start_{Eigen::Isometry3d::Identity()};
-  std::string user_id_;
-  // An emulated trial waiting for its tracking faults to play on HMD_POSE (see the file comment).
-  std::optional<TrialOutcome> pending_trial_;
-  double pending_trial_walk_t_s_{0};  // the live walk's time when pending_trial_ was requested
-  // The target the person plans (interactive, key t): drawn as the hologram while planning.
-  Eigen::VectorXd planned_target_q_;
-  int planned_targets_sent_{0};
 };
 
 }  // namespace orbed::hmd
