@@ -29,7 +29,9 @@
 /// session; a repeated request id answers with its first trial again (no save); an accepted
 /// REQUEST_TRIAL asks the person (interactive) or runs RunHeadsetTrial() (headset_trial.h) at once,
 /// in emulated time, at the latest q against the latest X_WR from the start offset, seeded from
-/// (process seed, session, index); a trial that fails is refused "trial_failed". The trial (index
+/// (process seed, session, index); a trial that fails is refused "trial_failed". A trial without
+/// tracking faults is then ready (trial_ready()): the shell has PublishReadyTrial() stamp it with
+/// the process clock after the run (on the wall clock the run takes time). The trial (index
 /// taken from the session, stamped clock_utime, request id the REQUEST_TRIAL's, user_id
 /// "emulated-seed-<user seed>", the tracking faults met, the annotation rays) is saved before it
 /// goes out. A trial that met tracking faults is pending: its faults are scheduled on the pose

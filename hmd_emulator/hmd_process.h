@@ -1,8 +1,11 @@
 #pragma once
 /// @file
 /// The orbed-hmd process: the headset and the person wearing it, wired to the bus. A thin shell:
-/// the work is done by cores that know nothing of LCM or of the clock, and this class feeds them
-/// what arrives, drives them from its timers and publishes what they produce:
+/// the work is done by cores that know nothing of LCM or of the clock, and this class checks what
+/// arrives (the contract's checks), feeds it to them with the time, drives them from its timers and
+/// carries out what they answer (publish, reject, save the state file):
+///   hmd.h              the core, Headset: the options resolved, the inputs kept, the hologram's
+///                      pose and joints, the sessions' trials, the person's keys (HeadsetActions);
 ///   pose_stream.h      the walk, the SLAM model, HMD_POSE / HMD_POSE_TRUTH and GAZE_RAY;
 ///   image_pipeline.h   HMD_CAMERA, REFLECTIVE_VIEW and AR_VIEW (threaded or inline);
 ///   hmd_session.h      the SESSION_CONTROL state machine and its refusals;
@@ -33,15 +36,13 @@
 /// skipped deadlines (e.g. timer/HMD_POSE), "<channel>/busy" for an image request that replaced one
 /// the renderer had not started (HMD_CAMERA/busy, REFLECTIVE_VIEW/busy, AR_VIEW/busy).
 ///
-/// The robot: one RobotState (robot_state.h), the latest valid q and X_WR.
-/// The current X_WV (map coordinates): in interactive mode the person's; otherwise the latest valid
-/// REGISTRATION.X_WV_mean (of the active session while one is active), else the emulated user's
-/// last X_WV, else the configured start offset X_WR_nominal · X_RV_start (user.yaml start_offset,
-/// X_WR_nominal from the scene file). A new session forgets the first two.
+/// The robot (one RobotState, robot_state.h: the latest valid q and X_WR), the hologram's pose
+/// X_WV and what it shows are the core's (hmd.h).
 ///
-/// Sessions (hmd_session.h): an accepted REQUEST_TRIAL runs RunHeadsetTrial() (headset_trial.h) at
-/// once, in emulated time, at the latest q against the latest X_WR from the start offset, seeded
-/// from (--seed, session, index); then ALIGNMENT_TRIAL {session, index (per session from 0), mode,
+/// Sessions (hmd_session.h, hmd.h): an accepted REQUEST_TRIAL runs RunHeadsetTrial()
+/// (headset_trial.h) at once, in emulated time, at the latest q against the latest X_WR from the
+/// start offset, seeded from (--seed, session, index); then, stamped on the process clock when the
+/// run is done, ALIGNMENT_TRIAL {session, index (per session from 0), mode,
 /// num_mirrors, q, X_WV, duration_s = the emulated alignment time, user_id "emulated-seed-<user
 /// seed>", request_id = the REQUEST_TRIAL's, the tracking faults the person met while aligning
 /// (tracking_losses, relocalizations, tracking_wait_s, alignment_repeats)}.
@@ -58,7 +59,7 @@
 /// START / RESET / STOP changes nothing (hmd_session.h).
 ///
 /// Crash recovery (options.state_file, session_file.h): the session and its last trial are saved on
-/// every change (a trial after it is published), and a headset started on the file continues the
+/// every change (a trial just before it is published), and a headset started on the file continues the
 /// session with the next index.
 ///
 /// Rejections (Process::Reject, key "<channel>/<class>"; the process keeps running):
