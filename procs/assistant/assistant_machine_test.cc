@@ -14,6 +14,7 @@
 
 #include "base/source_paths.h"
 #include "base/units.h"
+#include "procs/assistant/assistant_test_people.h"
 
 namespace orbed::assistant {
 namespace {
@@ -21,23 +22,12 @@ namespace {
 // Steps of 1/32 s and re-sends of 1/4 s: sums of them are exact in binary, so "every 8 steps" is.
 constexpr double kStep_s = 1.0 / 32;
 
-sim::RobotModel Model() {
-  return sim::RobotModel::LoadFile(SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath));
-}
+using test::Model;
+using test::Perfect;
 
-// A person who sees almost perfectly, whose hand is exact and whose pace is the model's.
-AssistantConfig Perfect() {
-  AssistantConfig c;
-  c.user_scale_log_sigma = 0;
-  c.lateral_noise_arcmin = 1e-3;
-  c.depth_noise_fraction_std = 1e-5;
-  c.placement_noise_deg = 0;
-  c.mental_rotation_std_deg = 0;
-  c.picture_scale_log_sigma = 0;
-  c.picture_noise_arcmin = 1e-3;
-  c.picture_depth_fraction_std = 1e-5;
-  c.pace_log_sigma = 0;
-  return c;
+orbed::guidance_t Guidance(int8_t mode, const Eigen::VectorXd& q_target) {
+  return test::Guidance(mode, std::vector<double>(q_target.data(), q_target.data() + q_target.size()),
+                        static_cast<int>(q_target.size()));
 }
 
 // Joint angles on the grid a first look searches (kGridStepDeg from each joint's lower limit), near
@@ -52,21 +42,6 @@ Eigen::VectorXd OnGrid(const sim::RobotModel& model, std::initializer_list<doubl
     ++i;
   }
   return q;
-}
-
-orbed::guidance_t Guidance(int8_t mode, const Eigen::VectorXd& q_target) {
-  orbed::guidance_t g{};
-  g.mode = mode;
-  g.num_joints = static_cast<int32_t>(q_target.size());
-  for (int i = 0; i < q_target.size(); ++i) {
-    g.target_position.push_back(q_target[i]);
-    g.current_position.push_back(0);
-    g.error_deg.push_back(0);
-    g.joint_kind.push_back(
-        int8_t{i % 2 == 0 ? orbed::guidance_t::JOINT_TWIST : orbed::guidance_t::JOINT_REVOLVE});
-  }
-  g.next_joint = 0;
-  return g;
 }
 
 orbed::setup_task_t Task(int64_t request_id, int8_t mode, const Eigen::VectorXd& q_target) {

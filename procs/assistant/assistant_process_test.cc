@@ -19,6 +19,7 @@
 
 #include "base/units.h"
 #include "lcmtypes/contract/conversions.h"
+#include "procs/assistant/assistant_test_people.h"
 
 namespace orbed::assistant {
 namespace {
@@ -70,18 +71,7 @@ orbed::registration_t Registration() {
 }
 
 orbed::guidance_t Guidance(const std::vector<double>& q_target, int num_joints = kJoints) {
-  orbed::guidance_t g{};
-  g.mode = orbed::guidance_t::MODE_AR;
-  g.num_joints = num_joints;
-  for (int i = 0; i < num_joints; ++i) {
-    g.target_position.push_back(q_target[i]);
-    g.current_position.push_back(0);
-    g.error_deg.push_back(0);
-    g.joint_kind.push_back(
-        int8_t{i % 2 == 0 ? orbed::guidance_t::JOINT_TWIST : orbed::guidance_t::JOINT_REVOLVE});
-  }
-  g.next_joint = 0;
-  return g;
+  return test::Guidance(orbed::guidance_t::MODE_AR, q_target, num_joints);
 }
 
 // The arm: every IIWA_COMMAND is where the arm is at once (an IIWA_STATUS back on the same bus).

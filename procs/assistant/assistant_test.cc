@@ -11,30 +11,15 @@
 
 #include "base/source_paths.h"
 #include "base/units.h"
+#include "procs/assistant/assistant_test_people.h"
 
 namespace orbed::assistant {
 namespace {
 
+using test::Model;
+using test::Perfect;
+
 constexpr double kInf = std::numeric_limits<double>::infinity();
-
-sim::RobotModel Model() {
-  return sim::RobotModel::LoadFile(SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath));
-}
-
-// A person who sees almost perfectly and whose hand is exact.
-AssistantConfig Perfect() {
-  AssistantConfig c;
-  c.user_scale_log_sigma = 0;
-  c.lateral_noise_arcmin = 1e-3;
-  c.depth_noise_fraction_std = 1e-5;
-  c.placement_noise_deg = 0;
-  c.mental_rotation_std_deg = 0;
-  c.picture_scale_log_sigma = 0;
-  c.picture_noise_arcmin = 1e-3;
-  c.picture_depth_fraction_std = 1e-5;
-  c.pace_log_sigma = 0;
-  return c;
-}
 
 Viewing Overlay(const Eigen::Isometry3d& X_WR) {
   Viewing v;
