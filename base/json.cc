@@ -2,91 +2,107 @@
 
 #include <cmath>
 
+#include <nlohmann/json.hpp>
+
 #include "base/format.h"
 
 namespace orbed {
 
 std::string JsonNumber(double value) { return std::isfinite(value) ? ShortestDecimal(value) : "null"; }
 
-nlohmann::ordered_json& JsonWriter::Add(nlohmann::ordered_json value) {
-  if (open_.empty()) {
-    root_ = std::move(value);
-    return root_;
+struct JsonWriter::State {
+  int indent;
+  nlohmann::ordered_json root;
+  std::vector<nlohmann::ordered_json*> open;  // the open objects and arrays, innermost last
+  std::string key;                            // the key of the next value in an object
+
+  // Puts `value` where the writer stands (the root, after a Key, or at the end of an array) and
+  // returns it there.
+  nlohmann::ordered_json& Add(nlohmann::ordered_json value) {
+    if (open.empty()) {
+      root = std::move(value);
+      return root;
+    }
+    nlohmann::ordered_json& parent = *open.back();
+    if (parent.is_array()) {
+      parent.push_back(std::move(value));
+      return parent.back();
+    }
+    nlohmann::ordered_json& slot = parent[key];
+    slot = std::move(value);
+    return slot;
   }
-  nlohmann::ordered_json& parent = *open_.back();
-  if (parent.is_array()) {
-    parent.push_back(std::move(value));
-    return parent.back();
-  }
-  nlohmann::ordered_json& slot = parent[key_];
-  slot = std::move(value);
-  return slot;
-}
+};
+
+JsonWriter::JsonWriter(int indent) : state_(std::make_unique<State>()) { state_->indent = indent; }
+
+JsonWriter::~JsonWriter() = default;
 
 JsonWriter& JsonWriter::BeginObject() {
-  open_.push_back(&Add(nlohmann::ordered_json::object()));
+  state_->open.push_back(&state_->Add(nlohmann::ordered_json::object()));
   return *this;
 }
 
 JsonWriter& JsonWriter::EndObject() {
-  open_.pop_back();
+  state_->open.pop_back();
   return *this;
 }
 
 JsonWriter& JsonWriter::BeginArray() {
-  open_.push_back(&Add(nlohmann::ordered_json::array()));
+  state_->open.push_back(&state_->Add(nlohmann::ordered_json::array()));
   return *this;
 }
 
 JsonWriter& JsonWriter::EndArray() {
-  open_.pop_back();
+  state_->open.pop_back();
   return *this;
 }
 
 JsonWriter& JsonWriter::Key(const std::string& key) {
-  key_ = key;
+  state_->key = key;
   return *this;
 }
 
 JsonWriter& JsonWriter::String(const std::string& value) {
-  Add(value);
+  state_->Add(value);
   return *this;
 }
 
 JsonWriter& JsonWriter::Number(double value) {
-  Add(std::isfinite(value) ? nlohmann::ordered_json(value) : nlohmann::ordered_json(nullptr));
+  state_->Add(std::isfinite(value) ? nlohmann::ordered_json(value) : nlohmann::ordered_json(nullptr));
   return *this;
 }
 
 JsonWriter& JsonWriter::Int(int64_t value) {
-  Add(value);
+  state_->Add(value);
   return *this;
 }
 
 JsonWriter& JsonWriter::Bool(bool value) {
-  Add(value);
+  state_->Add(value);
   return *this;
 }
 
 JsonWriter& JsonWriter::Null() {
-  Add(nullptr);
+  state_->Add(nullptr);
   return *this;
 }
 
 JsonWriter& JsonWriter::Array(const std::vector<double>& values) {
   nlohmann::ordered_json array = nlohmann::ordered_json::array();
   for (double v : values) array.push_back(std::isfinite(v) ? nlohmann::ordered_json(v) : nullptr);
-  Add(std::move(array));
+  state_->Add(std::move(array));
   return *this;
 }
 
 JsonWriter& JsonWriter::Array(const std::vector<int>& values) {
-  Add(values);
+  state_->Add(values);
   return *this;
 }
 
 std::string JsonWriter::str() const {
-  return root_.dump(indent_ > 0 ? indent_ : -1, ' ', false, nlohmann::ordered_json::error_handler_t::replace);
+  return state_->root.dump(state_->indent > 0 ? state_->indent : -1, ' ', false,
+                           nlohmann::ordered_json::error_handler_t::replace);
 }
 
 }  // namespace orbed

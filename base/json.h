@@ -18,11 +18,10 @@
 /// whole numbers (2.0); integers written with Int() have none.
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 namespace orbed {
 
@@ -32,7 +31,10 @@ std::string JsonNumber(double value);
 class JsonWriter {
  public:
   /// indent > 0 pretty-prints with that many spaces per level; 0 writes one line.
-  explicit JsonWriter(int indent = 0) : indent_(indent) {}
+  explicit JsonWriter(int indent = 0);
+  ~JsonWriter();
+  JsonWriter(const JsonWriter&) = delete;
+  JsonWriter& operator=(const JsonWriter&) = delete;
   JsonWriter& BeginObject();
   JsonWriter& EndObject();
   JsonWriter& BeginArray();
@@ -51,13 +53,10 @@ class JsonWriter {
   std::string str() const;
 
  private:
-  // Puts `value` where the writer stands (the root, after a Key, or at the end of an array) and
-  // returns it there.
-  nlohmann::ordered_json& Add(nlohmann::ordered_json value);
-  int indent_;
-  nlohmann::ordered_json root_;
-  std::vector<nlohmann::ordered_json*> open_;  // the open objects and arrays, innermost last
-  std::string key_;                            // the key of the next value in an object
+  // The document and where the writer stands, over nlohmann::ordered_json (json.cc), so that the
+  // ~110 k lines of nlohmann do not reach every file that writes JSON.
+  struct State;
+  std::unique_ptr<State> state_;
 };
 
 }  // namespace orbed

@@ -6,6 +6,8 @@
 #include <limits>
 #include <set>
 
+#include <nlohmann/json.hpp>
+
 #include "base/format.h"
 #include "base/json.h"
 #include "base/replace_file.h"

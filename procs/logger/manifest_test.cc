@@ -12,6 +12,7 @@
 #include <string>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "procs/logger/event_log_reader.h"
 #include "procs/logger/event_log_writer.h"
