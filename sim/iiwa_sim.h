@@ -3,7 +3,10 @@
 /// The orbed-iiwa-sim process: a simulated KUKA LBR iiwa 7 R800 in the OR scene, driven like a
 /// hand-guided arm in manual mode (the motion law is ManualArm's, sim/manual_arm.h: synchronised
 /// straight joint-space moves at the URDF velocity limits, commands clamped to the joint limits,
-/// steps refused before a collision).
+/// steps refused before a collision). What decides is the core ArmSim (sim/arm_sim.h: options,
+/// command acceptance, ticks and the sim clock's pace, the outputs' content, the state file's
+/// saves); IiwaSim below is its LCM shell: subscriptions, the lockstep rounds, publications, the
+/// state file's write. This comment describes the process as a whole.
 ///
 ///   Subscribes: IIWA_COMMAND (iiwa_command_t, Drake's lcmt_iiwa_command layout) — the target;
 ///               PLAN_CHECK_REQUEST (plan_check_request_t).
@@ -89,92 +92,22 @@
 ///
 /// Threading: everything on the Process::Run() thread.
 
-#include <chrono>
 #include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
-#include <orbed/iiwa_command_t.hpp>
-#include <orbed/iiwa_status_t.hpp>
-#include <orbed/plan_check_request_t.hpp>
-#include <orbed/robot_state_t.hpp>
 #include <orbed/sim_clock_ack_t.hpp>
 
-#include "base/source_paths.h"
-#include "lcmtypes/contract/channels.h"
 #include "runtime/process.h"
 #include "runtime/sim_clock.h"
-#include "sim/manual_arm.h"
-#include "sim/robot_model.h"
-#include "sim/scene.h"
+#include "sim/arm_sim.h"
 
 namespace orbed::sim {
 
-/// The most steps of P one tick may make (and K x P at most kMaxSimClockStepUs).
-inline constexpr int kMaxStepsPerTick = 1000;
-/// Lockstep: a round still missing answers after this long [s of wall time] is sent again (a lost
-/// datagram; the default of IiwaSimOptions::lockstep_resend_s); a tick steps on after this many rounds
-/// (counted as the drop "lockstep/rounds"); a held clock's rounds go out at most this often [Hz].
-inline constexpr double kLockstepResendS = 0.1;
-inline constexpr int32_t kMaxLockstepRounds = 1000;
-inline constexpr double kHeldRoundsHz = 20.0;
-
-struct IiwaSimOptions {
-  /// URDF and scene files; "" = the files shipped in the source tree (SourceTreePath()).
-  std::string urdf_path;
-  std::string scene_path;
-  /// Tick = status period [s]; rounded to whole microseconds, which must leave >= 1 us.
-  double period_s{0.005};
-  /// Sim seconds per wall second, 1..kMaxRealtimeRate (Drake's target realtime rate, whole numbers
-  /// here; in lockstep the most, see Lockstep).
-  int realtime_rate{1};
-  /// K: each tick steps the arm K times by P and publishes once (see Clocks); 0 = realtime_rate.
-  /// At most kMaxStepsPerTick.
-  int steps_per_tick{0};
-  /// Lockstep (see Lockstep): before each step, wait until the followers have answered.
-  bool lockstep{false};
-  /// How long a lockstep round waits for a follower before leaving it out [s of wall time], > 0.
-  double lockstep_timeout_s{10.0};
-  /// A lockstep round still missing answers after this long is sent again [s of wall time], > 0.
-  double lockstep_resend_s{kLockstepResendS};
-  /// Initial joint vector [deg]; empty = all zero (the arm upright). Must be within the limits.
-  std::vector<double> initial_q_deg;
-  /// The state file (sim_state.h): read at start (over initial_q_deg) and written as the arm moves;
-  /// "" = none.
-  std::string state_file;
-  /// Longest time between two saves while the arm moves [s of sim time], > 0.
-  double state_save_period_s{0.1};
-  /// Commands whose utime is further than this from the wall clock are rejected [s]; 0 = never.
-  double stale_command_s{1.0};
-  /// Motion stops this far before contact [m] (ManualArmOptions::stop_margin_m).
-  double stop_margin_m{0.01};
-  /// COLLISION_STATUS lists pairs closer than this [m].
-  double report_distance_m{0.05};
-  /// robot_state_t::robot_name (with `arm`, unless set: the arm's name).
-  std::string robot_name{"iiwa7"};
-  /// Several arms: "" = the single arm (the scene's robot.base_pose, plain channel
-  /// names). Else the name of one of the scene's `arms:`: its base, every channel below suffixed
-  /// with channels::ForArm (IIWA_STATUS_A1, ...; SIM_CLOCK too: each arm's sim keeps its own
-  /// clock), and every other arm of the scene a moving obstacle, posed from its ROBOT_STATE_<NAME>
-  /// (checked as CheckRobotState, its link count the model's, each X_RL a pose; refused as
-  /// "<channel>/field"), not checked until its first.
-  std::string arm;
-  std::string iiwa_status_channel{channels::kIiwaStatus};
-  std::string iiwa_command_channel{channels::kIiwaCommand};
-  std::string robot_state_channel{channels::kRobotState};
-  std::string collision_status_channel{channels::kCollisionStatus};
-  std::string plan_check_request_channel{channels::kPlanCheckRequest};
-  std::string plan_check_reply_channel{channels::kPlanCheckReply};
-  /// SIM_CLOCK (sim_clock_t, each tick's stamp, before the tick's other outputs); "" = not published.
-  std::string sim_clock_channel{channels::kSimClock};
-  /// "" = the clock runs from the start. Else the sim holds its clock (publishes only SIM_CLOCK, at
-  /// the start stamp, and does not step) until PROCESS_STATUS shows the process of this name
-  /// running: a launch whose last process is NAME then starts every follower of the sim clock at
-  /// the same sim moment, whatever the rate and however long each took to start.
-  std::string hold_for;
-};
-
+/// The LCM shell around ArmSim (sim/arm_sim.h, the core that decides): it subscribes, hands the
+/// core the messages and the clocks, publishes what it answers, writes the state file and keeps the
+/// lockstep rounds (LockstepBarrier).
 class IiwaSim {
  public:
   /// Loads the URDF and scene (std::runtime_error naming the file, element/key and what was
@@ -186,24 +119,24 @@ class IiwaSim {
   int Run() { return process_->Run(); }
   orbed::Process& process() { return *process_; }
   /// The options with the file paths resolved and period_s = P (whole microseconds).
-  const IiwaSimOptions& options() const { return options_; }
+  const IiwaSimOptions& options() const { return core_.options(); }
   /// The sim clock (see Clocks): P [us], start_utime [us since the epoch], k of the last tick (the
   /// number of Tick() calls, plus any deadlines skipped after a stall); the last outputs carry
   /// start_utime() + ticks() * period_us().
-  int64_t period_us() const { return period_us_; }
-  int64_t start_utime() const { return start_utime_; }
-  int64_t ticks() const { return ticks_; }
+  int64_t period_us() const { return core_.period_us(); }
+  int64_t start_utime() const { return core_.start_utime(); }
+  int64_t ticks() const { return core_.ticks(); }
   /// Whether the clock is still held (IiwaSimOptions::hold_for).
-  bool holding() const { return holding_; }
+  bool holding() const { return core_.holding(); }
   /// Sim time per tick K x P [us].
-  int64_t tick_us() const { return tick_us_; }
+  int64_t tick_us() const { return core_.tick_us(); }
   /// Lockstep: the followers waited for, the current tick's round (0 before the first).
   std::vector<std::string> lockstep_followers() const { return barrier_.followers(); }
   int32_t lockstep_round() const { return round_; }
   /// How far behind its deadline a tick may run before the sim clock skips ahead [us].
-  int64_t MaxLagMicros() const;
-  const Scene& scene() const { return scene_; }
-  const ManualArm& arm() const { return *arm_; }
+  int64_t MaxLagMicros() const { return core_.MaxLagMicros(); }
+  const Scene& scene() const { return core_.scene(); }
+  const ManualArm& arm() const { return core_.arm(); }
 
   /// One tick: step the arm by P, advance the sim clock by P and publish IIWA_STATUS, ROBOT_STATE,
   /// COLLISION_STATUS stamped with it (the timer's callback; public so tests can drive it without
@@ -215,11 +148,7 @@ class IiwaSim {
   void Advance();
 
  private:
-  void OnCommand(const orbed::iiwa_command_t& msg, const std::string& channel);
-  void OnPlanCheck(const orbed::plan_check_request_t& msg, const std::string& channel);
-  void OnOtherArm(int index, const orbed::robot_state_t& msg, const std::string& channel);
-  // SIM_CLOCK, then PublishState.
-  void PublishAll(int64_t utime, const CollisionResult& r);
+  void Reject(const std::string& channel, const Refusal& refusal);
   // IIWA_STATUS, ROBOT_STATE, COLLISION_STATUS at `utime` (saving the state file).
   void PublishState(int64_t utime, const CollisionResult& r);
   // SIM_CLOCK at `utime` (nothing without a sim_clock_channel); in lockstep round `round_`, which
@@ -228,37 +157,13 @@ class IiwaSim {
   void OnAck(const orbed::sim_clock_ack_t& msg, const std::string& channel);
   // Ends the hold once hold_for runs (in lockstep: and has answered a round).
   void MaybeRelease();
-  // The round that is out, again (SIM_CLOCK; the barrier keeps the answers it has).
-  void ResendClock();
-  // The sim time of the last tick [us since the epoch].
-  int64_t NowUtime() const { return start_utime_ + ticks_ * tick_us_; }
-  void SaveState(const orbed::iiwa_status_t& status);
 
-  IiwaSimOptions options_;
-  Scene scene_;
-  std::unique_ptr<ManualArm> arm_;
+  ArmSim core_;
   std::unique_ptr<orbed::Process> process_;
-  std::vector<int> reported_links_;  // links with geometry and a finite clearance
-  std::vector<Eigen::Isometry3d> X_RL_;
-  std::vector<Eigen::Isometry3d> other_X_WL_;  // scratch: another arm's link poses
-  int64_t period_us_{0};
-  int steps_per_tick_{1};    // K
-  int64_t tick_us_{0};       // K x P
-  int64_t tick_wall_ns_{0};  // K x P / R: the wall time between ticks
-  int64_t start_utime_{0};
   LockstepBarrier barrier_;
   int32_t round_{0};           // the round out (lockstep), 0 before the first
   double round_sent_s_{-1e9};  // when it (or the held clock's last round) went out [monotonic s]
   std::optional<CollisionResult> unpublished_state_;  // lockstep: the tick's state, for round 2
-  std::chrono::steady_clock::time_point start_mono_;
-  bool holding_{false};
-  bool hold_for_running_{false};
-  int64_t ticks_{0};
-  int64_t skipped_ticks_{0};  // since the last warning
-  std::chrono::steady_clock::time_point last_skip_warning_{};
-  std::vector<double> saved_q_;  // q in the state file
-  int64_t save_every_ticks_{1};
-  int64_t next_save_tick_{0};
   int64_t save_failures_{0};
 };
 
