@@ -1,81 +1,17 @@
 #include "procs/logger/logger.h"
 
-#include <lcm/lcm.h>
-
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
-#include <optional>
 #include <stdexcept>
 
-#include "base/format.h"
 #include "base/log.h"
-#include "base/sha256.h"
 #include "lcmtypes/contract/conversions.h"
-#include "procs/logger/event_log_reader.h"
 
 namespace orbed::logger {
 namespace {
 
-namespace fs = std::filesystem;
-
 constexpr char kLcmSelfTestChannel[] = "LCM_SELF_TEST";
-
-std::string ChooseLogPath(const LoggerOptions& options, int64_t start_utime) {
-  if (!options.file.empty()) return options.file;
-  const std::string stem = "orbed-" + FormatUtc(start_utime, "%Y%m%dT%H%M%SZ");
-  fs::path path = fs::path(options.log_dir) / (stem + ".lcmlog");
-  for (int i = 1; fs::exists(path); ++i) {
-    path = fs::path(options.log_dir) / (stem + "-" + std::to_string(i) + ".lcmlog");
-  }
-  return path.string();
-}
-
-// The folder of the log's parts.
-fs::path LogFolder(const LoggerOptions& options) {
-  return options.file.empty() ? fs::path(options.log_dir) : fs::path(options.file).parent_path();
-}
-
-// What is really in a part whose logger died: its whole events, per channel, and the bytes that
-// are not a whole event (a torn tail). Throws when the file cannot be read.
-void Recount(const fs::path& path, ManifestPart* part) {
-  const MappedLog log(path.string());
-  if (!log.ok()) throw std::runtime_error(log.error());
-  EventLogScanner scanner = log.Scanner();
-  ManifestPart recounted;
-  recounted.file = part->file;
-  recounted.start_utime = part->start_utime;
-  recounted.drops = part->drops;
-  LogEvent event;
-  while (scanner.Next(&event)) {
-    ++recounted.events;
-    recounted.bytes += static_cast<int64_t>(EventLogWriter::kHeaderBytes + event.channel.size() + event.size);
-    ChannelStats one{1, static_cast<int64_t>(event.size), event.timestamp_us, event.timestamp_us};
-    Accumulate(one, &recounted.channels[event.channel]);
-    recounted.stop_utime = std::max(recounted.stop_utime.value_or(part->start_utime), event.timestamp_us);
-  }
-  recounted.damaged_bytes = static_cast<int64_t>(scanner.damaged_bytes());
-  if (!recounted.stop_utime) recounted.stop_utime = part->start_utime;
-  *part = recounted;
-}
-
-// The unfinished recording at `manifest_path` that this logger continues, if any.
-std::optional<Manifest> RecordingToContinue(const std::string& manifest_path, const LoggerOptions& options) {
-  std::error_code ec;
-  if (!fs::exists(manifest_path, ec)) return std::nullopt;
-  Manifest previous;
-  try {
-    previous = ReadManifestFile(manifest_path);
-  } catch (const JsonReadError& e) {
-    throw std::runtime_error(std::string("cannot continue the recording: ") + e.what() +
-                             " (move the manifest away to start a new recording)");
-  }
-  if (previous.complete) return std::nullopt;
-  if (!options.file.empty() && previous.parts.front().file != fs::path(options.file).filename().string()) {
-    return std::nullopt;
-  }
-  return previous;
-}
 
 }  // namespace
 
@@ -93,50 +29,16 @@ Logger::Logger(const CommonFlags& flags, LoggerOptions options)
       [this](const lcm::ReceiveBuffer& rbuf, const std::string& channel) { OnMessage(rbuf, channel); });
   subscription->setQueueCapacity(options_.lcm_queue_capacity);
 
-  const fs::path folder = LogFolder(options_);
-  if (std::optional<Manifest> previous = RecordingToContinue(manifest_path(), options_)) {
-    manifest_ = *previous;
-    ManifestPart& last = manifest_.parts.back();
-    try {
-      Recount(folder / last.file, &last);
-    } catch (const std::runtime_error& e) {
-      throw std::runtime_error(std::string("cannot continue the recording: ") + e.what());
-    }
-    int number = static_cast<int>(manifest_.parts.size()) + 1;
-    while (fs::exists(folder / PartFileName(manifest_.parts.front().file, number))) ++number;
-    log_path_ = (folder / PartFileName(manifest_.parts.front().file, number)).string();
-    ORBED_LOG(kWarn) << "continuing the unfinished recording " << manifest_.parts.front().file << " in part "
-                     << number << ": its part " << last.file << " holds " << last.events << " events"
-                     << (last.damaged_bytes > 0
-                             ? " and " + std::to_string(last.damaged_bytes) + " damaged bytes"
-                             : "");
-  } else {
-    log_path_ = ChooseLogPath(options_, start_utime_);
-    manifest_.start_utime = start_utime_;
-  }
-  const fs::path parent = fs::path(log_path_).parent_path();
+  RecordingStart start = StartRecording(options_, flags_.lcm_url, start_utime_);
+  if (!start.continuing.empty()) ORBED_LOG(kWarn) << start.continuing;
+  manifest_ = std::move(start.manifest);
+  log_path_ = std::move(start.log_path);
+  const std::filesystem::path parent = std::filesystem::path(log_path_).parent_path();
   std::error_code ec;
-  if (!parent.empty()) fs::create_directories(parent, ec);
+  if (!parent.empty()) std::filesystem::create_directories(parent, ec);
   if (ec) throw std::runtime_error("cannot create " + parent.string() + ": " + ec.message());
   file_ = std::make_unique<EventLogWriter>(log_path_);
   if (!file_->ok()) throw std::runtime_error(file_->error());
-  ManifestPart part;
-  part.file = fs::path(log_path_).filename().string();
-  part.start_utime = start_utime_;
-  manifest_.parts.push_back(part);
-  manifest_.command_line = options_.command_line;
-  manifest_.orbed_version = ORBED_VERSION;
-  manifest_.lcm_version = std::to_string(LCM_MAJOR_VERSION) + "." + std::to_string(LCM_MINOR_VERSION) + "." +
-                          std::to_string(LCM_MICRO_VERSION);
-  manifest_.lcm_url = flags_.lcm_url;
-  manifest_.channels_regex = options_.channels;
-  // The files do not change while we record: hash them once.
-  manifest_.files.clear();
-  for (const std::string& path : options_.hash_files) {
-    std::string error;
-    const std::string hash = Sha256FileHex(path, &error);
-    manifest_.files.push_back({path, hash, hash.empty() ? error : ""});
-  }
   process_.AddTimer(1.0, [this] { process_.Publish(options_.status_channel, MakeStatus()); });
   process_.AddTimer(5.0, [this] {
     std::string error;
@@ -155,10 +57,7 @@ Logger::~Logger() {
   }
 }
 
-std::string Logger::manifest_path() const {
-  if (!options_.manifest.empty()) return options_.manifest;
-  return (LogFolder(options_) / "manifest.json").string();
-}
+std::string Logger::manifest_path() const { return ManifestPath(options_); }
 
 void Logger::OnMessage(const lcm::ReceiveBuffer& rbuf, const std::string& channel) {
   // LCM's own start-up probe (each new LCM instance sends one): not testbed traffic, and no type
@@ -167,10 +66,8 @@ void Logger::OnMessage(const lcm::ReceiveBuffer& rbuf, const std::string& channe
   const int64_t size = static_cast<int64_t>(rbuf.data_size);
   {
     std::lock_guard<std::mutex> lock(queue_mutex_);
-    if (static_cast<int64_t>(queue_.size()) >= options_.queue_capacity_events ||
-        queue_bytes_ + size > options_.queue_capacity_bytes) {
-      ++drops_;
-      if (drops_ == 1 || drops_ % 1000 == 0) {
+    if (!QueueFits(options_, static_cast<int64_t>(queue_.size()), queue_bytes_, size)) {
+      if (LogDrop(++drops_)) {
         ORBED_LOG(kWarn) << "queue full (" << queue_.size() << " events, " << queue_bytes_
                          << " bytes): dropped " << drops_ << " so far";
       }
@@ -232,17 +129,12 @@ void Logger::WriteBatch(const std::deque<Event>& batch) {
       // drops, and stop the logger (its exit code and heartbeat say FAILED).
       StopOnWriteError(file_->error(), true);
       std::lock_guard<std::mutex> lock(stats_mutex_);
-      ++lost_events_;
+      ++counts_.lost_events;
       continue;
     }
     std::lock_guard<std::mutex> lock(stats_mutex_);
-    ++events_written_;
-    bytes_written_ += static_cast<int64_t>(written);
-    ChannelStats& stats = stats_[event.channel];
-    if (stats.events == 0) stats.first_utime = event.utime;
-    ++stats.events;
-    stats.bytes += static_cast<int64_t>(event.data.size());
-    stats.last_utime = event.utime;
+    counts_.Written(event.channel, event.utime, static_cast<int64_t>(event.data.size()),
+                    static_cast<int64_t>(written));
   }
 }
 
@@ -289,22 +181,11 @@ int Logger::EndFailedRecording() {
     std::lock_guard<std::mutex> lock(stats_mutex_);
     error = write_error_;
     in_log = log_write_failed_;
-    handed_to_writer = events_written_;
+    handed_to_writer = counts_.events_written;
   }
-  // What the file really holds, whatever was handed to the writer before the failure.
-  Manifest manifest = MakeManifest(false);
-  ManifestPart& part = manifest.parts.back();
   std::string line;
-  try {
-    Recount(log_path_, &part);
-    const int64_t size = part.bytes + part.damaged_bytes;  // the file's size: every byte is one or the other
-    line = error + (in_log ? " after " : "; the log " + log_path_ + " holds ") + std::to_string(size) +
-           " bytes, " + std::to_string(part.events) + " events";
-  } catch (const std::exception& e) {
-    line = error + "; the log cannot be read back: " + e.what();
-  }
-  part.drops += handed_to_writer - part.events;  // buffered when the write failed: not in the file
-  part.error = line;
+  const Manifest manifest =
+      FailedRecording(MakeManifest(false), error, in_log, log_path_, handed_to_writer, &line);
   std::string manifest_error;
   if (WriteManifestFile(manifest_path(), manifest, &manifest_error)) {
     line += "; recorded in " + manifest_path();
@@ -319,16 +200,13 @@ orbed::logger_status_t Logger::MakeStatus() const {
   orbed::logger_status_t status{};
   status.utime = NowMicros();
   status.file = log_path_;
-  {
-    std::lock_guard<std::mutex> lock(stats_mutex_);
-    status.events_written = events_written_;
-    status.bytes_written = bytes_written_;
-    status.last_flush_utime = last_flush_utime_;
-  }
   int64_t lost = 0;
   {
     std::lock_guard<std::mutex> lock(stats_mutex_);
-    lost = lost_events_;
+    status.events_written = counts_.events_written;
+    status.bytes_written = counts_.bytes_written;
+    status.last_flush_utime = last_flush_utime_;
+    lost = counts_.lost_events;
   }
   std::lock_guard<std::mutex> lock(queue_mutex_);
   status.drops = drops_ + lost;
@@ -339,25 +217,13 @@ orbed::logger_status_t Logger::MakeStatus() const {
 
 std::map<std::string, ChannelStats> Logger::channel_stats() const {
   std::lock_guard<std::mutex> lock(stats_mutex_);
-  return stats_;
+  return counts_.channels;
 }
 
 Manifest Logger::MakeManifest(bool complete) const {
-  Manifest m = manifest_;
-  ManifestPart& part = m.parts.back();
-  const orbed::logger_status_t status = MakeStatus();
-  part.drops = status.drops;
-  {
-    std::lock_guard<std::mutex> lock(stats_mutex_);
-    part.events = events_written_;
-    part.bytes = bytes_written_;
-    part.channels = stats_;
-  }
-  if (complete) {
-    m.complete = part.complete = true;
-    m.stop_utime = part.stop_utime = stop_utime_;
-  }
-  return m;
+  const int64_t drops = MakeStatus().drops;
+  std::lock_guard<std::mutex> lock(stats_mutex_);
+  return ManifestNow(manifest_, counts_, drops, complete, stop_utime_);
 }
 
 bool Logger::WriteManifest(bool complete, std::string* error) const {

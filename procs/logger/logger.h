@@ -1,6 +1,9 @@
 #pragma once
 /// @file
-/// orbed-logger's engine: records LCM traffic to a standard LCM event log.
+/// orbed-logger's shell: records LCM traffic to a standard LCM event log. What a recording is (its
+/// file, the continued recording, the manifest's content, the counts, the queue's bounds, a failed
+/// recording's account) is the core, recording.h; here the subscription, the queue, the writer
+/// thread, the timers and the writes.
 ///
 /// LCM's internal LCM_SELF_TEST probe packets are not recorded.
 ///
@@ -48,34 +51,10 @@
 
 #include "procs/logger/event_log_writer.h"
 #include "procs/logger/manifest.h"
+#include "procs/logger/recording.h"
 #include "runtime/process.h"
 
 namespace orbed::logger {
-
-struct LoggerOptions {
-  /// Folder for the log (created if missing); the file is named by start time (UTC):
-  /// orbed-YYYYMMDDTHHMMSSZ.lcmlog.
-  std::string log_dir = "logs";
-  /// Explicit log path; overrides log_dir + start-time name when set.
-  std::string file;
-  /// Manifest path; empty = manifest.json in the log's folder.
-  std::string manifest;
-  /// Regular expression of the channels to record (LCM's full-match channel regex).
-  std::string channels = ".*";
-  /// Queue bounds: a message that does not fit is dropped and counted.
-  int64_t queue_capacity_events = 100000;
-  int64_t queue_capacity_bytes = 128ll << 20;
-  /// Period of the writer's fflush [s].
-  double flush_interval_s = 0.25;
-  /// Files whose SHA-256 the manifest records (URDF, scene, launch file, ...).
-  std::vector<std::string> hash_files;
-  /// The command line, for the manifest.
-  std::string command_line;
-  /// Capacity of LCM's own per-subscription queue (LCM's default, 30, drops bursts).
-  int lcm_queue_capacity = 10000;
-  /// Channel of this logger's status messages.
-  std::string status_channel = "LOGGER_STATUS";
-};
 
 class Logger {
  public:
@@ -135,13 +114,10 @@ class Logger {
   bool writer_stop_ = false;  // guarded by queue_mutex_
 
   mutable std::mutex stats_mutex_;
-  std::map<std::string, ChannelStats> stats_;  // guarded by stats_mutex_
-  int64_t events_written_ = 0;                 // guarded by stats_mutex_
-  int64_t bytes_written_ = 0;                  // guarded by stats_mutex_
-  int64_t last_flush_utime_ = 0;               // guarded by stats_mutex_
-  std::string write_error_;                    // guarded by stats_mutex_
-  bool log_write_failed_ = false;              // guarded by stats_mutex_ (else the manifest's)
-  int64_t lost_events_ = 0;                    // guarded by stats_mutex_ (after a write error)
+  PartCounts counts_;              // guarded by stats_mutex_
+  int64_t last_flush_utime_ = 0;   // guarded by stats_mutex_
+  std::string write_error_;        // guarded by stats_mutex_
+  bool log_write_failed_ = false;  // guarded by stats_mutex_ (else the manifest's)
 
   std::unique_ptr<EventLogWriter> file_;  // used by the writer thread only, after Run() starts
   std::thread writer_;
