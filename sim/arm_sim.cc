@@ -143,7 +143,8 @@ ArmSim::ArmSim(const IiwaSimOptions& options)
   // The other arms of the scene, wherever their ROBOT_STATE will say they are.
   if (!options_.arm.empty()) {
     for (const ArmPlacement& other : scene_.arms) {
-      if (other.name != options_.arm) other_arms_.push_back({arm_->AddOtherArm(other.name, model), other.name});
+      if (other.name != options_.arm)
+        other_arms_.push_back({arm_->AddOtherArm(other.name, model), other.name});
     }
   }
 }

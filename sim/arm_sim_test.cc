@@ -17,7 +17,7 @@ namespace orbed::sim {
 namespace {
 
 constexpr int64_t kStart = 1'700'000'000'000'000;  // start_utime [us since the epoch]
-constexpr int64_t kMs = 1'000'000;                  // 1 ms of the monotonic clock [ns]
+constexpr int64_t kMs = 1'000'000;                 // 1 ms of the monotonic clock [ns]
 
 orbed::iiwa_command_t Command(int64_t utime, const std::vector<double>& q_deg) {
   orbed::iiwa_command_t cmd{};
@@ -254,7 +254,7 @@ TEST(ArmSim, AnswersPlanChecks) {
 TEST(ArmSim, SavesTheStateWhenQChangesAtMostEverySavePeriodWhileMoving) {
   IiwaSimOptions o;
   o.state_file = ::testing::TempDir() + "arm_sim_test_never_written.state";  // not there: start at q0
-  o.state_save_period_s = 0.1;  // 20 ticks of 5 ms
+  o.state_save_period_s = 0.1;                                               // 20 ticks of 5 ms
   ArmSim sim(o);
   sim.Start(kStart, 0);
   EXPECT_FALSE(sim.ShouldSave(sim.IiwaStatus(kStart)));  // q as in the file (q0)
