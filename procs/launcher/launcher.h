@@ -1,12 +1,12 @@
 #pragma once
 /// @file
-/// orbed-launch's engine: starts a launch file's groups in order, each group's processes together,
-/// and waits for every process to be ready (its first PROCESS_STATUS heartbeat from its own pid,
-/// unless `ready: none`) before starting the next group; a process that is not ready in time stops
-/// the testbed with an error naming it. While running it re-emits each child's output prefixed with
-/// the child's name, restarts children marked `respawn` (at once, then with a growing back-off if
-/// they keep dying within a second), and stops the testbed when a required child fails or a child
-/// marked `exit_stops_all` exits (one killed by a signal: an error, "before it finished"). A
+/// orbed-launch's shell (its core, the launch plan's decisions, is launch_plan.h): starts a launch file's
+/// groups in order, each group's processes together, and waits for every process to be ready (its first
+/// PROCESS_STATUS heartbeat from its own pid, unless `ready: none`) before starting the next group; a process
+/// that is not ready in time stops the testbed with an error naming it. While running it re-emits each
+/// child's output prefixed with the child's name, restarts children marked `respawn` (at once, then with a
+/// growing back-off if they keep dying within a second), and stops the testbed when a required child fails or
+/// a child marked `exit_stops_all` exits (one killed by a signal: an error, "before it finished"). A
 /// respawned process is ready again at its new instance's first heartbeat; a required one that is
 /// not ready again within its ready_timeout_s of dying (e.g. it keeps dying at start) stops the
 /// testbed with an error naming it. A process that exits with kExitCannotWrite (74, process.h: it
@@ -41,7 +41,6 @@
 ///
 /// Threading: one thread (Process::Run); children are polled every 20 ms.
 
-#include <chrono>
 #include <memory>
 #include <string>
 #include <vector>
@@ -51,16 +50,10 @@
 #include "procs/launcher/child.h"
 #include "procs/launcher/deputy_link.h"
 #include "procs/launcher/launch_file.h"
+#include "procs/launcher/launch_plan.h"
 #include "runtime/process.h"
 
 namespace orbed::launcher {
-
-/// The run folder's name, as deputies make it under their logs folders (deputy_command_t.run_dir):
-/// `log_dir`'s own name after those of the run folders it is in (folders holding a provenance
-/// record, base/run_folder.h), joined by '.': "study-<time>-<random>.setup-u1" for a study's user,
-/// whose own name repeats in every study, so that it is as unique on every host as on this one;
-/// "" when it has none that RunDirOk accepts.
-std::string RunFolderName(const std::string& log_dir);
 
 class Launcher {
  public:
@@ -76,50 +69,24 @@ class Launcher {
   Process& process() { return process_; }
 
  private:
-  using Clock = std::chrono::steady_clock;
-  struct Managed {
-    ProcessSpec spec;
-    size_t group = 0;
-    std::unique_ptr<ChildHandle> child;
-    bool remote = false;
-    std::string prefix;
-    bool started = false;
-    bool ready = false;
-    bool finished = false;  // exited and will not be restarted
-    int restarts = 0;
-    int fast_failures = 0;  // consecutive deaths within 1 s of starting
-    Clock::time_point started_at;
-    Clock::time_point unready_since;  // when it died after its last readiness (respawns)
-    Clock::time_point respawn_at;
-    bool respawn_pending = false;
-    std::string last_exit;
-  };
-
-  std::unique_ptr<ChildHandle> MakeChild(const Managed& managed);
+  std::unique_ptr<ChildHandle> MakeChild(const LaunchPlan::Entry& e);
   void Tick();
-  void OnHeartbeat(const orbed::process_status_t& status, int64_t recv_utime);
-  bool StartProcess(Managed* managed);
+  // Starts entry i's child (again); false when it could not.
+  bool StartProcess(size_t i);
   void StartGroup(size_t group);
-  void HandleExit(Managed* managed);
+  void HandleExit(size_t i);
   void StopEverything();
   void FailTestbed(const std::string& reason);
-  void PrintSummary() const;
 
   CommonFlags flags_;
-  LaunchSpec spec_;
+  LaunchPlan plan_;
   std::string bin_dir_;
   std::string host_;
   std::string log_dir_;
   Process process_;
   DeputyLink deputies_;
-  std::vector<Managed> managed_;
-  size_t starting_group_ = 0;
-  bool all_started_ = false;
-  Clock::time_point group_started_at_;
-  Clock::time_point launch_started_at_;
-  int exit_code_ = 0;
-  bool stopping_ = false;
-  size_t name_width_ = 0;
+  std::vector<std::unique_ptr<ChildHandle>> children_;  // entry i's child
+  double launch_started_at_s_ = 0;
 };
 
 }  // namespace orbed::launcher
