@@ -91,11 +91,11 @@ RecordingStart StartRecording(const LoggerOptions& options, const std::string& l
     int number = static_cast<int>(manifest.parts.size()) + 1;
     while (fs::exists(folder / PartFileName(manifest.parts.front().file, number))) ++number;
     start.log_path = (folder / PartFileName(manifest.parts.front().file, number)).string();
-    start.continuing = "continuing the unfinished recording " + manifest.parts.front().file + " in part " +
-                       std::to_string(number) + ": its part " + last.file + " holds " +
-                       std::to_string(last.events) + " events" +
-                       (last.damaged_bytes > 0 ? " and " + std::to_string(last.damaged_bytes) + " damaged bytes"
-                                               : "");
+    start.continuing =
+        "continuing the unfinished recording " + manifest.parts.front().file + " in part " +
+        std::to_string(number) + ": its part " + last.file + " holds " + std::to_string(last.events) +
+        " events" +
+        (last.damaged_bytes > 0 ? " and " + std::to_string(last.damaged_bytes) + " damaged bytes" : "");
   } else {
     start.log_path = NewLogPath(options, start_utime);
     manifest.start_utime = start_utime;
@@ -148,8 +148,8 @@ Manifest ManifestNow(const Manifest& recording, const PartCounts& counts, int64_
   return m;
 }
 
-Manifest FailedRecording(Manifest manifest, const std::string& error, bool in_log, const std::string& log_path,
-                         int64_t handed_to_writer, std::string* line) {
+Manifest FailedRecording(Manifest manifest, const std::string& error, bool in_log,
+                         const std::string& log_path, int64_t handed_to_writer, std::string* line) {
   // What the file really holds, whatever was handed to the writer before the failure.
   ManifestPart& part = manifest.parts.back();
   try {

@@ -96,7 +96,7 @@ Manifest ManifestNow(const Manifest& recording, const PartCounts& counts, int64_
 /// After a write error: the manifest with this part re-counted from `log_path` as it is (the events
 /// handed to the writer but not in the file counted as drops) and the error in the part's "error";
 /// *line is what the logger says (the file's size and whole events, or why it cannot be read).
-Manifest FailedRecording(Manifest manifest, const std::string& error, bool in_log, const std::string& log_path,
-                         int64_t handed_to_writer, std::string* line);
+Manifest FailedRecording(Manifest manifest, const std::string& error, bool in_log,
+                         const std::string& log_path, int64_t handed_to_writer, std::string* line);
 
 }  // namespace orbed::logger

@@ -22,7 +22,8 @@ namespace fs = std::filesystem;
 constexpr int64_t kStart = 1'704'164'645'000'000;  // 2024-01-02T03:04:05Z [us]
 
 fs::path EmptyDir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("orbed_recording_test_" + name + "_" + std::to_string(getpid()));
+  const fs::path dir =
+      fs::temp_directory_path() / ("orbed_recording_test_" + name + "_" + std::to_string(getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;
@@ -30,7 +31,8 @@ fs::path EmptyDir(const std::string& name) {
 
 void WriteEvents(const fs::path& path, int events) {
   EventLogWriter writer(path.string());
-  for (int i = 0; i < events; ++i) writer.Write(1000 + i, "ABC", reinterpret_cast<const uint8_t*>("12345"), 5);
+  for (int i = 0; i < events; ++i)
+    writer.Write(1000 + i, "ABC", reinterpret_cast<const uint8_t*>("12345"), 5);
   ASSERT_TRUE(writer.Close());
 }
 
@@ -62,7 +64,8 @@ TEST(Recording, ANewRecordingIsNamedByItsStartAndNeverOverwrites) {
   EXPECT_NE(m.files[1].error, "");
   // The name is taken (a logger started within the same second): the next free suffix.
   std::ofstream(start.log_path) << "";
-  EXPECT_EQ(StartRecording(options, "memq://", kStart).log_path, (dir / "orbed-20240102T030405Z-1.lcmlog").string());
+  EXPECT_EQ(StartRecording(options, "memq://", kStart).log_path,
+            (dir / "orbed-20240102T030405Z-1.lcmlog").string());
   // --file wins, and puts the manifest beside it.
   options.file = (dir / "sub" / "run.lcmlog").string();
   EXPECT_EQ(StartRecording(options, "memq://", kStart).log_path, options.file);
@@ -87,8 +90,9 @@ TEST(Recording, AnUnfinishedRecordingContinuesInTheNextFreePartRecounted) {
   options.log_dir = dir.string();
   const RecordingStart start = StartRecording(options, "memq://", kStart);
   EXPECT_EQ(start.log_path, (dir / "orbed-X.part3.lcmlog").string());
-  EXPECT_EQ(start.continuing,
-            "continuing the unfinished recording orbed-X.lcmlog in part 3: its part orbed-X.lcmlog holds 2 events");
+  EXPECT_EQ(
+      start.continuing,
+      "continuing the unfinished recording orbed-X.lcmlog in part 3: its part orbed-X.lcmlog holds 2 events");
   ASSERT_EQ(start.manifest.parts.size(), 2u);
   const ManifestPart& recounted = start.manifest.parts[0];
   EXPECT_EQ(recounted.events, 2);
@@ -157,8 +161,8 @@ TEST(Recording, AFailedRecordingSaysWhatItsFileHolds) {
   manifest.parts[0].file = "run.lcmlog";
   std::string line;
   // 3 events handed to the writer, 1 in the file: 2 drops.
-  Manifest failed = FailedRecording(manifest, "cannot write run.lcmlog: No space left on device (ENOSPC)", true,
-                                    log.string(), 3, &line);
+  Manifest failed = FailedRecording(manifest, "cannot write run.lcmlog: No space left on device (ENOSPC)",
+                                    true, log.string(), 3, &line);
   EXPECT_EQ(line, "cannot write run.lcmlog: No space left on device (ENOSPC) after 36 bytes, 1 events");
   EXPECT_EQ(failed.parts[0].error, line);
   EXPECT_EQ(failed.parts[0].events, 1);
