@@ -39,7 +39,8 @@ IiwaSim::IiwaSim(const orbed::CommonFlags& flags, const IiwaSimOptions& options)
       o.plan_check_request_channel,
       [this](const orbed::plan_check_request_t& msg, const std::string& channel, int64_t) {
         std::optional<Refusal> refusal;
-        const orbed::plan_check_reply_t reply = core_.PlanCheckReply(msg, NowMicros(), &refusal);
+        orbed::plan_check_reply_t reply = core_.PlanCheckReply(msg, NowMicros(), &refusal);
+        reply.utime = NowMicros();  // as the reply leaves, after the collision check
         if (refusal) Reject(channel, *refusal);
         process_->Publish(core_.options().plan_check_reply_channel, reply);
       });
