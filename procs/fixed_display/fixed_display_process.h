@@ -1,7 +1,7 @@
 #pragma once
 /// @file
 /// orbed-fixed-display: the fixed external monitor of the set-up study's `fixed` mode, as its own
-/// image channel (fixed_view.h says what it shows and how the view moves).
+/// image channel (fixed_display.h says what it shows and how the view moves).
 ///
 ///   Subscribes (sim/testbed_poses.h): ROBOT_STATE (X_WR: where the robot stands), GUIDANCE (the
 ///               target configuration and the mode; checked, refusals counted "GUIDANCE/field").
@@ -26,7 +26,7 @@
 #include <orbed/image_t.hpp>
 
 #include "lcmtypes/contract/channels.h"
-#include "procs/fixed_display/fixed_view.h"
+#include "procs/fixed_display/fixed_display.h"
 #include "runtime/process.h"
 #include "sim/robot_model.h"
 #include "sim/scene.h"

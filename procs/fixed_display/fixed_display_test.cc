@@ -19,8 +19,8 @@
 #include "base/test_command.h"
 #include "base/units.h"
 #include "lcmtypes/contract/conversions.h"
+#include "procs/fixed_display/fixed_display.h"
 #include "procs/fixed_display/fixed_display_process.h"
-#include "procs/fixed_display/fixed_view.h"
 #include "sim/guidance_messages.h"
 
 namespace orbed::fixed_display {

@@ -14,7 +14,7 @@
 #include "lcmtypes/contract/conversions.h"
 #include "lcmtypes/contract/requests.h"
 #include "lcmtypes/contract/validation.h"
-#include "procs/foxglove_bridge/foxglove_messages.h"
+#include "procs/foxglove_bridge/foxglove_bridge.h"
 #include "runtime/flags.h"
 #include "sim/guidance_messages.h"
 

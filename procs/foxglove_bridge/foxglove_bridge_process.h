@@ -2,7 +2,7 @@
 /// @file
 /// orbed-foxglove-bridge: a live 3D view of the testbed in Foxglove (its "Foxglove WebSocket"
 /// connection to ws://localhost:8765), over the foxglove.websocket.v1 protocol with JSON payloads
-/// (foxglove_messages.h says the channels, shapes and frames).
+/// (foxglove_bridge.h says the channels, shapes and frames).
 ///
 ///   Subscribes: ROBOT_STATE, REGISTRATION, GUIDANCE and HMD_POSE through sim/testbed_poses.h (X_WR
 ///               and q, the latest valid X_WV_mean, the guidance target as the virtual robot's

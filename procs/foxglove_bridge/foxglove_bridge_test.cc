@@ -6,7 +6,7 @@
 //   - client messages: subscribe / unsubscribe read; malformed, deep, oversized ones refused;
 //   - the server on 127.0.0.1 with websocketpp's client: the subprotocol is required, serverInfo and
 //     advertise come first, a subscription gets Message Data frames and an unsubscription stops them.
-#include "procs/foxglove_bridge/foxglove_messages.h"
+#include "procs/foxglove_bridge/foxglove_bridge.h"
 #include "procs/foxglove_bridge/foxglove_server.h"
 
 #include <chrono>

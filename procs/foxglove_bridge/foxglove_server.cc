@@ -7,7 +7,7 @@
 #include <websocketpp/config/asio_no_tls.hpp>
 #include <websocketpp/server.hpp>
 
-#include "procs/foxglove_bridge/foxglove_messages.h"
+#include "procs/foxglove_bridge/foxglove_bridge.h"
 
 namespace orbed::foxglove {
 

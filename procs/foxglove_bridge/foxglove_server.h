@@ -1,7 +1,7 @@
 #pragma once
 /// @file
 /// The WebSocket side of orbed-foxglove-bridge: a websocketpp server (Debian's websocketpp on
-/// standalone asio) that speaks foxglove.websocket.v1 (foxglove_messages.h), driven by Poll() from
+/// standalone asio) that speaks foxglove.websocket.v1 (foxglove_bridge.h), driven by Poll() from
 /// one thread (asio's poll: it runs what is ready and returns), so the bridge needs no locks.
 ///
 /// A client must offer the subprotocol foxglove.websocket.v1 (others are refused in the

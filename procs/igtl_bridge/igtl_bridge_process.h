@@ -12,7 +12,7 @@
 ///               estimate); the registration X_WV_mean (Registration) from the latest valid
 ///               REGISTRATION. A frame is sent once its message has arrived.
 ///     IMAGE at most image_hz per source: HMD_CAMERA (HMDCamera) and each REFLECTIVE_VIEW display
-///               (Reflective<display_id>), decoded to 8-bit RGB (igtl_codec.h: PackImage).
+///               (Reflective<display_id>), decoded to 8-bit RGB (igtl_bridge.h: PackImage).
 ///     STATUS    for every PROCESS_STATUS (the process's name, at most 20 bytes): code OK when
 ///               RUNNING, NOT_READY when STARTING, SHUT_DOWN when STOPPING, UNKNOWN_ERROR when
 ///               FAILED; error name the state; status string its counts and last error.
@@ -20,7 +20,7 @@
 ///   Poses from sim/testbed_poses.h (ROBOT_STATE, HMD_POSE, REGISTRATION, checked there).
 ///   Receives: TRANSFORM or POSITION from a client → IGTL_TARGET (target_pose_t, source "igtl",
 ///             name = the device name, X_WT in metres): a target planned in Slicer, for the tools
-///             on the bus. Other types are skipped; refusals as igtl_codec.h says.
+///             on the bus. Other types are skipped; refusals as igtl_bridge.h says.
 ///
 /// Every LCM input is checked (lcmtypes/contract) before use and refused with a counted reason. A
 /// client that reads slower than the bridge sends misses packets (counted as drops

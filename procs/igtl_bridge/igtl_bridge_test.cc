@@ -25,7 +25,7 @@
 #include <igtlTransformMessage.h>
 
 #include "base/source_paths.h"
-#include "procs/igtl_bridge/igtl_codec.h"
+#include "procs/igtl_bridge/igtl_bridge.h"
 #include "procs/igtl_bridge/igtl_server.h"
 
 namespace orbed::igtl_bridge {

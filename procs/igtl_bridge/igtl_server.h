@@ -2,13 +2,13 @@
 /// @file
 /// The TCP side of orbed-igtl-bridge: a listening socket and its clients (OpenIGTLink clients such
 /// as 3D Slicer's OpenIGTLinkIF connector), all non-blocking and driven by Poll() from one thread,
-/// so the bridge needs no locks. Messages are whole packets from igtl_codec.h.
+/// so the bridge needs no locks. Messages are whole packets from igtl_bridge.h.
 ///
 /// Broadcast() queues a packet for every client; a client whose queue would pass max_backlog_bytes
 /// (it reads slower than the bridge sends) misses that packet, and the miss is counted. Poll()
 /// accepts (beyond max_clients a new connection is closed at once), writes what the socket takes,
 /// reads what arrived and hands each client's bytes to its IgtlReader. A client that closes, fails
-/// or sends what igtl_codec.h calls fatal is closed.
+/// or sends what igtl_bridge.h calls fatal is closed.
 ///
 /// Threading: not thread-safe; one thread calls everything.
 
@@ -19,7 +19,7 @@
 #include <string>
 #include <vector>
 
-#include "procs/igtl_bridge/igtl_codec.h"
+#include "procs/igtl_bridge/igtl_bridge.h"
 
 namespace orbed::igtl_bridge {
 

@@ -3,7 +3,7 @@
 #include <cstdlib>
 #include <string>
 
-#include "procs/foxglove_bridge/foxglove_messages.h"
+#include "procs/foxglove_bridge/foxglove_bridge.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using orbed::foxglove::ClientRequest;

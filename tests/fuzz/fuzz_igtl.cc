@@ -1,9 +1,9 @@
-// libFuzzer: orbed-igtl-bridge's OpenIGTLink stream reader (igtl_codec.h), fed a client's bytes in
+// libFuzzer: orbed-igtl-bridge's OpenIGTLink stream reader (igtl_bridge.h), fed a client's bytes in
 // two pieces. Whatever the bytes, it ends every call without crashing; a pose it accepts is rigid
 // and finite; and it never holds more than a header, the largest body and the last piece.
 #include <cstdlib>
 
-#include "procs/igtl_bridge/igtl_codec.h"
+#include "procs/igtl_bridge/igtl_bridge.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using orbed::igtl_bridge::IgtlReader;

@@ -1,4 +1,4 @@
-#include "procs/igtl_bridge/igtl_codec.h"
+#include "procs/igtl_bridge/igtl_bridge.h"
 
 #include <algorithm>
 #include <cmath>

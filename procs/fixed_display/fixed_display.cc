@@ -1,4 +1,4 @@
-#include "procs/fixed_display/fixed_view.h"
+#include "procs/fixed_display/fixed_display.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "procs/foxglove_bridge/foxglove_messages.h"
+#include "procs/foxglove_bridge/foxglove_bridge.h"
 
 #include <exception>
 
