@@ -27,15 +27,26 @@ def clock(seconds):
     return f"{seconds // 3600}h {seconds % 3600 // 60:02d}m"
 
 
-def format_progress(what, k, n, elapsed_s):
-    """The progress line: WHAT k/n, elapsed, and an estimate of what is left from the mean time of
-    the k steps done ((n - k) * elapsed / k). Pure: tests/cli/test_parse.py checks it by hand."""
+def format_progress(what, k, n, elapsed_s, left_s=None):
+    """The progress line: WHAT k/n, elapsed, and an estimate of what is left: `left_s` where the
+    caller knows better (weighted_left), else from the mean time of the k steps done
+    ((n - k) * elapsed / k). Pure: tests/cli/test_parse.py checks it by hand."""
     line = f"{what} {k}/{n}, {clock(elapsed_s)} elapsed"
     if k >= n:
         return line + ", done"
+    if left_s is not None:
+        return line + f", about {clock(left_s)} left"
     if k == 0:
         return line + ", no estimate yet"
     return line + f", about {clock((n - k) * elapsed_s / k)} left"
+
+
+def weighted_left(elapsed_s, done_weight, left_weight):
+    """What is left of work whose steps weigh differently (a test suite: each test's last duration),
+    at the pace so far: elapsed * left / done. None before any weight is done."""
+    if done_weight <= 0:
+        return None
+    return elapsed_s * left_weight / done_weight
 
 
 class Console:
@@ -106,6 +117,14 @@ class Progress:
         self.started = time.monotonic()
         self.detail = ""
         self.last = None  # the line shown last
+        self.weights = None  # step name -> weight, when steps weigh differently (weighted_left)
+        self.done_weight = 0.0
+
+    def left_s(self):
+        if not self.weights:
+            return None
+        left = max(0.0, sum(self.weights.values()) - self.done_weight)
+        return weighted_left(self.elapsed(), self.done_weight, left)
 
     def elapsed(self):
         return time.monotonic() - self.started
@@ -113,7 +132,7 @@ class Progress:
     def show(self, detail=None, final=False):
         if detail is not None:
             self.detail = detail
-        line = format_progress(self.what, self.k, self.n, self.elapsed())
+        line = format_progress(self.what, self.k, self.n, self.elapsed(), self.left_s())
         line += f" ({self.detail})" if self.detail else ""
         if line != self.last or final:
             self.console.progress(line, final=final)

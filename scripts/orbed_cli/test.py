@@ -5,6 +5,7 @@ BUILD/build.log and ctest's to BUILD/ctest.log; one progress line follows each, 
 log's tail; the summary says each suite's result line and times."""
 import os
 import re
+import subprocess
 
 from .output import Progress, run_logged, show_failure
 from .paths import ROOT, build, cmake_build, setup
@@ -33,6 +34,32 @@ def build_asan(ctx, log=None):
     return cmake_build(ctx, ctx.asan_build_dir, configure_argv, log=log, env=env, what="sanitizer build")
 
 
+def last_durations(build_dir, filters):
+    """Each test ctest will run (ctest -N with the same filters) -> its duration [s] as ctest
+    recorded it in earlier runs (Testing/Temporary/CTestCostData.txt: "name runs seconds" lines, the
+    seconds averaged over the runs); tests not recorded get the median. {} when nothing is recorded
+    (a fresh build)."""
+    record = os.path.join(build_dir, "Testing", "Temporary", "CTestCostData.txt")
+    seconds = {}
+    try:
+        with open(record) as f:
+            for line in f:
+                if line.startswith("---"):
+                    break
+                parts = line.split()
+                if len(parts) == 3:
+                    seconds[parts[0]] = float(parts[2])
+    except (OSError, ValueError):
+        return {}
+    listed = subprocess.run(["ctest", "-N"] + filters, cwd=build_dir, capture_output=True, text=True)
+    names = re.findall(r"^\s*Test\s+#\d+: (\S+)", listed.stdout, flags=re.M)
+    if not seconds or not names:
+        return {}
+    known = sorted(seconds.values())
+    median = known[len(known) // 2]
+    return {name: seconds.get(name, median) for name in names}
+
+
 def run_suite(ctx, build_dir, what, labels=None, regex=None):
     """ctest in BUILD_DIR (output in BUILD_DIR/ctest.log); returns (exit code, ctest's
     "N% tests passed" line or why there is none, seconds)."""
@@ -46,12 +73,15 @@ def run_suite(ctx, build_dir, what, labels=None, regex=None):
         argv += ["-R", regex]
     ctx.say(f"test: ctest in {ctx.rel(build_dir)}{' -L ' + labels if labels else ''}{' -R ' + regex if regex else ''}")
     progress = Progress(ctx.console, f"test: {what}", 1)
+    progress.weights = last_durations(build_dir, argv[3:])  # the estimate weighs each test by its recorded time
     failed = []
 
     def on_line(line):
         m = re.match(r"\s*(\d+)/(\d+) Test\s+#\d+: (\S+) .*?(Passed|\*\*\*|Failed|Not Run|Exception)?", line)
         if m:
             progress.n, progress.k = int(m.group(2)), int(m.group(1))
+            if progress.weights:
+                progress.done_weight += progress.weights.get(m.group(3), 0.0)
             if "Passed" not in line:
                 failed.append(m.group(3))
             progress.show(f"{m.group(3)}" + (f"; failed: {', '.join(failed)}" if failed else ""))

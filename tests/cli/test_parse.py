@@ -9,7 +9,7 @@ import subprocess
 import pytest
 
 from orbed_cli import main as cli
-from orbed_cli.output import format_progress
+from orbed_cli.output import format_progress, weighted_left
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 ORBED = os.path.join(ROOT, "scripts", "orbed")
@@ -130,3 +130,12 @@ def test_the_progress_line():
     assert format_progress("sweep: point", 1, 4, 20) == "sweep: point 1/4, 20 s elapsed, about 1m 00s left"
     assert format_progress("test:", 0, 5, 2) == "test: 0/5, 2 s elapsed, no estimate yet"
     assert format_progress("test:", 5, 5, 7384) == "test: 5/5, 2h 03m elapsed, done"
+    # With the steps' weights known (tests by their recorded seconds): 30 of 120 weighed seconds done
+    # in 20 s leave 90 at that pace, 60 s; the count (1 of 4) would have said the same only by chance.
+    assert weighted_left(20, 30, 90) == 60
+    assert weighted_left(5, 0, 90) is None
+    assert format_progress("test:", 1, 4, 20, weighted_left(20, 30, 90)) == "test: 1/4, 20 s elapsed, about 1m 00s left"
+    # Two long tests left after 150 quick ones: the count says seconds, the weights say minutes.
+    assert format_progress("test:", 150, 152, 75) == "test: 150/152, 1m 15s elapsed, about 1 s left"
+    assert format_progress("test:", 150, 152, 75, weighted_left(75, 75, 120)) == \
+        "test: 150/152, 1m 15s elapsed, about 2m 00s left"
