@@ -42,11 +42,13 @@ def run_id(text):
 
 
 def numbers(text):
-    """A comma-separated list of numbers (A,B,...)."""
+    """A comma-separated list of finite numbers (A,B,...), the executables' one list syntax."""
     try:
-        [float(x) for x in text.split(",")]
+        finite = all(math.isfinite(float(x)) for x in text.split(","))
     except ValueError:
-        raise argparse.ArgumentTypeError(f"expected numbers separated by commas, not '{text}'")
+        finite = False
+    if not finite:
+        raise argparse.ArgumentTypeError(f"expected finite numbers separated by commas, not '{text}'")
     return text
 
 
