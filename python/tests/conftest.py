@@ -1,0 +1,6 @@
+# The package under test from the source tree (no install step), and helpers to build study folders.
+import os
+import sys
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, os.path.join(ROOT, "python"))
