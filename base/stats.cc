@@ -111,46 +111,4 @@ MannWhitneyResult MannWhitneyU(const std::vector<double>& x, const std::vector<d
   return r;
 }
 
-SignedRankResult WilcoxonSignedRank(const std::vector<double>& x, const std::vector<double>& y,
-                                    bool continuity_correction) {
-  SignedRankResult r;
-  if (x.size() != y.size()) return r;
-  std::vector<double> d;
-  for (std::size_t i = 0; i < x.size(); ++i) {
-    const double di = x[i] - y[i];
-    if (di == 0) {
-      ++r.n_zero;
-    } else {
-      d.push_back(di);
-    }
-  }
-  r.n = static_cast<int>(d.size());
-  if (d.empty()) return r;
-  std::vector<double> magnitude(d.size());
-  for (std::size_t i = 0; i < d.size(); ++i) magnitude[i] = std::abs(d[i]);
-  const std::vector<double> ranks = AverageRanks(magnitude);
-  for (std::size_t i = 0; i < d.size(); ++i) (d[i] > 0 ? r.w_plus : r.w_minus) += ranks[i];
-  const double n = r.n;
-  r.mean_w = n * (n + 1) / 4;
-
-  std::sort(magnitude.begin(), magnitude.end());
-  double tie_sum = 0;
-  for (std::size_t i = 0; i < magnitude.size();) {
-    std::size_t j = i;
-    while (j < magnitude.size() && magnitude[j] == magnitude[i]) ++j;
-    const double t = static_cast<double>(j - i);
-    tie_sum += t * t * t - t;
-    i = j;
-  }
-  r.variance_w = n * (n + 1) * (2 * n + 1) / 24.0 - tie_sum / 48.0;
-  if (!(r.variance_w > 0)) return r;
-  const NormalApproximation a = ApproximateByNormal(r.w_plus, r.mean_w, r.variance_w, continuity_correction);
-  r.z = a.z;
-  r.p_two_sided = a.p_two_sided;
-  r.p_x_less = a.p_less;
-  r.p_x_greater = a.p_greater;
-  r.valid = true;
-  return r;
-}
-
 }  // namespace orbed::stats

@@ -1,7 +1,9 @@
 #pragma once
 /// @file
-/// Small statistics for comparing alignment trials: mean, median, sample standard deviation, and
-/// the Mann–Whitney U (Wilcoxon rank-sum) test, implemented here.
+/// Small statistics the processes need at run time: mean, median, quantiles, sample standard
+/// deviation (geometry/, tests/load/), and the Mann–Whitney U (Wilcoxon rank-sum) test that
+/// orbed-user-study prints for its trials. The study's analysis (Tables 1-4, paired tests, mixed
+/// models, power) is Python's: python/orbed/study on scipy and statsmodels.
 ///
 /// Mann–Whitney U for samples x (n_x) and y (n_y): all values are ranked together, ties getting the
 /// average of the ranks they span; U_x = R_x − n_x(n_x + 1)/2 with R_x the sum of x's ranks, which
@@ -15,13 +17,6 @@
 ///     x_greater:  alternative "x tends to be larger than y"  = 1 − Φ((U_x − mean − c) / σ),
 /// c = 0.5 with the continuity correction, else 0. Adequate for n_x, n_y ≳ 8 (the uses here have
 /// hundreds); for tiny samples exact tables are better.
-///
-/// Wilcoxon signed-rank test for paired samples (x_i, y_i): differences d_i = x_i − y_i, zero
-/// differences dropped (Wilcoxon's convention), |d_i| ranked with average ranks for ties;
-/// W⁺ = the sum of the ranks of the positive d_i, over n non-zero pairs. Normal approximation:
-/// mean n(n + 1)/4, variance n(n + 1)(2n + 1)/24 − Σ_k (t_k³ − t_k)/48 (t_k: tie groups of |d|),
-/// the same continuity correction and one-sided alternatives as above ("x_less": the x_i tend to be
-/// smaller than their y_i). Adequate for n ≳ 10.
 ///
 /// Threading: pure functions, reentrant.
 
@@ -56,24 +51,6 @@ struct MannWhitneyResult {
 
 MannWhitneyResult MannWhitneyU(const std::vector<double>& x, const std::vector<double>& y,
                                bool continuity_correction = true);
-
-struct SignedRankResult {
-  bool valid = false;     ///< false when the sizes differ, no pair differs, or σ = 0
-  int n = 0;              ///< pairs with a non-zero difference
-  int n_zero = 0;         ///< pairs dropped for a zero difference
-  double w_plus = 0;      ///< sum of the ranks of the positive differences
-  double w_minus = 0;     ///< W⁺ + W⁻ = n(n + 1)/2
-  double mean_w = 0;      ///< n(n + 1)/4
-  double variance_w = 0;  ///< tie-corrected σ²
-  double z = 0;           ///< (W⁺ − mean, continuity-corrected toward 0) / σ
-  double p_two_sided = 1;
-  double p_x_less = 1;     ///< one-sided: x_i tend to be smaller than y_i
-  double p_x_greater = 1;  ///< one-sided: x_i tend to be larger than y_i
-};
-
-/// Paired test on (x[i], y[i]); x and y must have the same size (else valid = false).
-SignedRankResult WilcoxonSignedRank(const std::vector<double>& x, const std::vector<double>& y,
-                                    bool continuity_correction = true);
 
 /// Standard normal CDF Φ(z).
 double NormalCdf(double z);

@@ -13,7 +13,9 @@
 #include "base/format.h"
 #include "base/json.h"
 #include "base/run_folder.h"
+#include "base/source_paths.h"
 #include "experiments/viraal/paper_reference.h"
+#include "experiments/viraal/viraal_study.h"
 
 namespace orbed::study {
 namespace {
@@ -37,16 +39,6 @@ std::string Row(const std::string& user, const std::string& mode, const std::str
          duration_s + "," + e.landmarks + "," + Csv(e.truth_misalignment_mm) + "\n";
 }
 
-void WriteRow(JsonWriter* json, const viraal::Table1Row& row) {
-  json->BeginObject();
-  const char* axes[3] = {"t_x", "t_y", "t_z"};
-  for (int k = 0; k < 3; ++k)
-    json->Key(axes[k]).Array(std::vector<double>{row.axes_mean_mm[k], row.axes_std_mm[k]});
-  json->Key("norm").Array(std::vector<double>{row.mean_mm, row.std_mm});
-  json->Key("num_trials").Int(row.num_trials);
-  json->EndObject();
-}
-
 void WritePaperRow(JsonWriter* json, const viraal::PaperTable1Axes& axes, const viraal::PaperFigure& norm) {
   json->BeginObject();
   const char* names[3] = {"t_x", "t_y", "t_z"};
@@ -54,19 +46,6 @@ void WritePaperRow(JsonWriter* json, const viraal::PaperTable1Axes& axes, const 
   json->Key("norm").Array(std::vector<double>{norm.misalignment_mm, norm.std_mm});
   json->Key("num_trials").Int(40);
   json->EndObject();
-}
-
-const viraal::SessionResult* FindSession(const viraal::RunResults& r, const std::string& mode) {
-  for (const viraal::SessionResult& s : r.sessions) {
-    if (s.mode == mode) return &s;
-  }
-  return nullptr;
-}
-
-std::string RowText(const viraal::Table1Row& row) {
-  return Fixed(row.mean_mm, 1) + " +/- " + Fixed(row.std_mm, 1) + " mm  (x, y, z means " +
-         Fixed(row.axes_mean_mm.x(), 1) + ", " + Fixed(row.axes_mean_mm.y(), 1) + ", " +
-         Fixed(row.axes_mean_mm.z(), 1) + "; " + std::to_string(row.num_trials) + ")";
 }
 
 std::string FirstUserId(const viraal::RunResults& r) {
@@ -77,35 +56,6 @@ std::string FirstUserId(const viraal::RunResults& r) {
 }
 
 }  // namespace
-
-std::vector<std::string> StudyModes(const std::vector<UserRun>& runs) {
-  std::vector<std::string> modes;
-  for (const UserRun& run : runs) {
-    for (const viraal::SessionResult& s : run.results.sessions) {
-      if (std::find(modes.begin(), modes.end(), s.mode) == modes.end()) modes.push_back(s.mode);
-    }
-  }
-  return modes;
-}
-
-viraal::Table1Row ModeTrialsRow(const std::vector<UserRun>& runs, const std::string& mode) {
-  std::vector<Eigen::Vector3d> axes;
-  for (const UserRun& run : runs) {
-    if (const viraal::SessionResult* s = FindSession(run.results, mode)) {
-      for (const viraal::TrialResult& t : s->trials) axes.push_back(t.errors.misalignment_axes_mm);
-    }
-  }
-  return viraal::ComputeTable1Row(axes);
-}
-
-viraal::Table1Row ModeMeansRow(const std::vector<UserRun>& runs, const std::string& mode) {
-  std::vector<Eigen::Vector3d> axes;
-  for (const UserRun& run : runs) {
-    const viraal::SessionResult* s = FindSession(run.results, mode);
-    if (s != nullptr && s->mean) axes.push_back(s->mean->errors.misalignment_axes_mm);
-  }
-  return viraal::ComputeTable1Row(axes);
-}
 
 std::string AlignmentTrialsCsv(const std::vector<UserRun>& runs) {
   std::string csv = kColumns;
@@ -132,69 +82,58 @@ std::string AlignmentMeansCsv(const std::vector<UserRun>& runs) {
   return csv;
 }
 
-std::string TablesJson(const std::vector<UserRun>& runs, const LandmarkValidation& validation,
-                       const std::vector<SetupUserRun>& setup_runs,
-                       const std::vector<SetupUserRun>& setup_truth_runs, const std::string& provenance) {
+std::string AlignmentGroupsCsv(const std::vector<UserRun>& runs, const viraal::ScenarioConfig& scenario) {
+  std::string csv = "user,mode,group,trials,misalignment_mm\n";
+  for (const UserRun& run : runs) {
+    StudyOptions options;
+    options.scenario = scenario;
+    if (!run.results.configurations_deg.empty())
+      options.scenario.configurations_deg = run.results.configurations_deg;
+    if (!run.results.landmarks.empty()) options.scenario.landmarks = run.results.landmarks;
+    for (const viraal::SessionResult& s : run.results.sessions) {
+      const std::vector<double> groups = GroupMeanMisalignment_mm(options, s, kGroupTrials);
+      for (size_t g = 0; g < groups.size(); ++g) {
+        csv += run.user + "," + s.mode + "," + std::to_string(g + 1) + "," + std::to_string(kGroupTrials) +
+               "," + Csv(groups[g]) + "\n";
+      }
+    }
+  }
+  return csv;
+}
+
+std::string TablesJson(bool viraal, bool setup, const std::string& provenance) {
   JsonWriter json(2);
   json.BeginObject();
   if (!provenance.empty()) json.Key("provenance").String(provenance);
-  json.Key("users").Int(static_cast<int64_t>(runs.size()));
-  json.Key("table1").BeginObject();
-  for (const std::string& mode : StudyModes(runs)) {
-    json.Key(mode);
-    WriteRow(&json, ModeTrialsRow(runs, mode));
-  }
-  json.Key("se3_mean").BeginObject();
-  for (const std::string& mode : StudyModes(runs)) {
-    json.Key(mode);
-    WriteRow(&json, ModeMeansRow(runs, mode));
-  }
-  json.EndObject();
-  json.EndObject();
-  json.Key("landmark_validation_mm").Number(validation.mean_error_mm);
-  if (!setup_runs.empty()) WriteSetupTables(&json, setup_runs, setup_truth_runs);
   json.Key("paper").BeginObject();
   json.Key("source").String(viraal::kPaperSource);
-  json.Key("table1").BeginObject();
-  json.Key("ar_reflective");
-  WritePaperRow(&json, viraal::kPaperArReflectiveAxes, viraal::kPaperArReflective);
-  json.Key("ar");
-  WritePaperRow(&json, viraal::kPaperArAxes, viraal::kPaperAr);
-  json.Key("se3_mean").BeginObject();
-  json.Key("ar_reflective").BeginObject();
-  json.Key("norm").Array(std::vector<double>{viraal::kPaperArReflectiveMean.misalignment_mm,
-                                             viraal::kPaperArReflectiveMean.std_mm});
-  json.EndObject();
-  json.EndObject();
-  json.EndObject();
+  if (viraal) {
+    json.Key("table1").BeginObject();
+    json.Key("ar_reflective");
+    WritePaperRow(&json, viraal::kPaperArReflectiveAxes, viraal::kPaperArReflective);
+    json.Key("ar");
+    WritePaperRow(&json, viraal::kPaperArAxes, viraal::kPaperAr);
+    json.Key("se3_mean").BeginObject();
+    json.Key("ar_reflective").BeginObject();
+    json.Key("norm").Array(std::vector<double>{viraal::kPaperArReflectiveMean.misalignment_mm,
+                                               viraal::kPaperArReflectiveMean.std_mm});
+    json.EndObject();
+    json.EndObject();
+    json.EndObject();
+  }
   json.Key("landmark_validation_mm").Number(kPaperLandmarkValidationMm);
-  if (!setup_runs.empty()) WriteSetupPaper(&json);
+  if (setup) WriteSetupPaper(&json);
   json.EndObject();
   json.EndObject();
   return json.str() + "\n";
 }
 
-std::string StudySummary(const std::vector<UserRun>& runs, const LandmarkValidation& validation) {
-  std::string text = "ViRAAl study: " + std::to_string(runs.size()) + " users\n";
-  for (const std::string& mode : StudyModes(runs)) {
-    text += "  " + mode + "\n";
-    text += "    Table 1, all trials:     " + RowText(ModeTrialsRow(runs, mode));
-    if (mode == "ar_reflective") text += "   paper 16.5 +/- 11.0 mm (9.00, 10.3, 9.18)";
-    if (mode == "ar") text += "   paper 30.2 +/- 23.9 mm (17.4, 11.9, 21.6)";
-    text += "\n    SE(3) mean of each user: " + RowText(ModeMeansRow(runs, mode));
-    if (mode == "ar_reflective") text += "   paper 11.3 +/- 1.01 mm (means of N = 3 trials)";
-    text += "\n";
-  }
-  text += "  landmark measurement error (optical table): " + Fixed(validation.mean_error_mm, 1) +
-          " mm   paper " + Fixed(kPaperLandmarkValidationMm, 1) + " mm\n";
-  return text;
-}
-
 int RunStudyTables(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
   CLI::App app{
-      "orbed-study-tables: the files of the ViRAAl study from its runs' results.json (one run per\n"
+      "orbed-study-tables: the files of the study from its runs' results.json (one run per\n"
       "user, named u1, u2, ... in the order given): alignment_trials.csv, alignment_means.csv,\n"
-      "landmark_validation.csv and tables.json in --out, and Table 1 beside the paper's.\n"
+      "alignment_groups.csv, landmark_validation.csv, the set-up CSVs and tables.json (the paper's\n"
+      "figures) in --out; python3 -m orbed.study then computes the tables.\n"
       "`scripts/orbed study` runs the users and then this."};
   AddVersionFlag(&app);
   std::string out_dir;
@@ -274,29 +213,33 @@ int RunStudyTables(int argc, const char* const* argv, std::ostream& out, std::os
     validation.slam = LoadShippedSlamConfig(config_paths);
     const LandmarkValidation v = RunLandmarkValidation(validation);
     std::filesystem::create_directories(out_dir);
-    const std::pair<const char*, std::string> files[] = {
-        {"alignment_trials.csv", AlignmentTrialsCsv(runs)},
-        {"alignment_means.csv", AlignmentMeansCsv(runs)},
-        {"landmark_validation.csv", LandmarkValidationCsv(v)},
-        {"tables.json", TablesJson(runs, v, setup_runs, setup_truth_runs, ProvenanceRecordIn(out_dir))}};
     std::vector<std::pair<std::string, std::string>> all;
-    for (const auto& [name, text] : files) {
-      const bool alignment = std::string(name).rfind("alignment_", 0) == 0;
-      if (!alignment || !runs.empty()) all.emplace_back(name, text);  // no ViRAAl runs: no alignment files
+    if (!runs.empty()) {  // no ViRAAl runs: no alignment files
+      all.emplace_back("alignment_trials.csv", AlignmentTrialsCsv(runs));
+      all.emplace_back("alignment_means.csv", AlignmentMeansCsv(runs));
+      all.emplace_back("alignment_groups.csv",
+                       AlignmentGroupsCsv(runs, viraal::LoadScenarioFile(
+                                                    SourceTreePath(viraal::kDefaultScenarioRelativePath))));
     }
+    all.emplace_back("landmark_validation.csv", LandmarkValidationCsv(v));
+    all.emplace_back("tables.json",
+                     TablesJson(!runs.empty(), !setup_runs.empty(), ProvenanceRecordIn(out_dir)));
     if (!setup_runs.empty()) {
       all.emplace_back("setup_joints.csv", SetupJointsCsv(setup_runs));
       all.emplace_back("setup_times.csv", SetupTimesCsv(setup_runs));
       all.emplace_back("setup_docking.csv", SetupDockingCsv(setup_runs));
     }
+    if (!setup_truth_runs.empty())
+      all.emplace_back("setup_truth_joints.csv", SetupJointsCsv(setup_truth_runs));
     for (const auto& [name, text] : all) {
       const std::string path = (std::filesystem::path(out_dir) / name).string();
       std::ofstream file(path);
       file << text;
       if (!file) throw std::runtime_error("cannot write " + path);
     }
-    if (!runs.empty()) out << StudySummary(runs, v);
-    if (!setup_runs.empty()) out << SetupSummary(setup_runs, setup_truth_runs);
+    out << "orbed-study-tables: wrote";
+    for (const auto& [name, text] : all) out << " " << name;
+    out << " into " << out_dir << " (the tables: python3 -m orbed.study " << out_dir << ")\n";
   } catch (const std::exception& e) {
     err << "orbed-study-tables: " << e.what() << "\n";
     return 1;

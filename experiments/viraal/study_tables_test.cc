@@ -1,11 +1,10 @@
 // The study's files from its runs (study_tables.h), against independent figures:
-//   - one user: Table 1 per mode equals the pinned run's `table1`, which Python's statistics module
-//     computed from the file's trials;
-//   - the same user twice: the means stay, each per-axis std becomes std·sqrt(4/5) (each value twice:
-//     2·Σ(x − m)² over 6 − 1 instead of Σ(x − m)² over 3 − 1);
-//   - the CSVs have STUDY's columns, a row per trial (per user and mode for the means), values from
-//     the files; tables.json has the documented shape, the paper's rows consistent with their norms;
-//   - the command writes the four files, refuses a run that did not finish.
+//   - the CSVs have STUDY's columns, a row per trial (per user and mode for the means, per group of
+//     three trials for the groups), values from the files; a group of all three pinned trials is the
+//     session's mean the conductor scored with the truth's landmarks;
+//   - tables.json has the documented shape, the paper's rows consistent with their norms;
+//   - the command writes the files, refuses a run that did not finish.
+// Table 1 itself (from these CSVs) is python/tests/test_tables.py's.
 #include "experiments/viraal/study_tables.h"
 
 #include <cmath>
@@ -45,37 +44,6 @@ std::vector<std::string> Lines(const std::string& text) {
   return lines;
 }
 
-TEST(StudyTables, OneUserGivesThePinnedRunsTable1) {
-  const nlohmann::json pinned = PinnedJson();
-  const std::vector<UserRun> runs = Users(1);
-  ASSERT_EQ(StudyModes(runs), (std::vector<std::string>{"ar_reflective", "ar"}));
-  for (const nlohmann::json& session : pinned["sessions"]) {
-    const viraal::Table1Row row = ModeTrialsRow(runs, session["mode"]);
-    const nlohmann::json& expected = session["table1"];
-    EXPECT_EQ(row.num_trials, expected["num_trials"].get<int>());
-    for (int k = 0; k < 3; ++k) {
-      EXPECT_NEAR(row.axes_mean_mm[k], expected["axes_mean_mm"][k].get<double>(), 1e-12);
-      EXPECT_NEAR(row.axes_std_mm[k], expected["axes_std_mm"][k].get<double>(), 1e-12);
-    }
-    EXPECT_NEAR(row.mean_mm, expected["mean_mm"].get<double>(), 1e-12);
-    EXPECT_NEAR(row.std_mm, expected["std_mm"].get<double>(), 1e-12);
-  }
-}
-
-TEST(StudyTables, TheSameUserTwiceKeepsTheMeansAndShrinksTheStds) {
-  const std::vector<UserRun> one = Users(1), two = Users(2);
-  for (const char* mode : {"ar_reflective", "ar"}) {
-    const viraal::Table1Row a = ModeTrialsRow(one, mode), b = ModeTrialsRow(two, mode);
-    EXPECT_EQ(b.num_trials, 2 * a.num_trials);
-    EXPECT_NEAR((b.axes_mean_mm - a.axes_mean_mm).norm(), 0.0, 1e-12);
-    EXPECT_NEAR((b.axes_std_mm - a.axes_std_mm * std::sqrt(4.0 / 5.0)).norm(), 0.0, 1e-12);
-    // The users' SE(3) means: two equal values, no spread.
-    const viraal::Table1Row means = ModeMeansRow(two, mode);
-    EXPECT_EQ(means.num_trials, 2);
-    EXPECT_NEAR(means.std_mm, 0.0, 1e-12);
-  }
-}
-
 TEST(StudyTables, CsvsHaveTheStudyColumnsAndTheFilesValues) {
   const nlohmann::json pinned = PinnedJson();
   const std::vector<UserRun> runs = Users(2);
@@ -111,18 +79,21 @@ TEST(StudyTables, CsvsHaveTheStudyColumnsAndTheFilesValues) {
   ASSERT_EQ(means.size(), 1u + 2 * 2);
   EXPECT_EQ(means[0], header);
   EXPECT_EQ(means[1].rfind("u1,ar_reflective,mean,", 0), 0u) << means[1];
+
+  // Three trials per session make one group: its SE(3) mean is the session's mean.
+  const std::vector<std::string> groups = Lines(AlignmentGroupsCsv(
+      runs, viraal::LoadScenarioFile(SourceTreePath(viraal::kDefaultScenarioRelativePath))));
+  ASSERT_EQ(groups.size(), 1u + 2 * 2);
+  EXPECT_EQ(groups[0], "user,mode,group,trials,misalignment_mm");
+  double group_mm = 0;
+  ASSERT_EQ(std::sscanf(groups[4].c_str(), "u2,ar,1,3,%lf", &group_mm), 1) << groups[4];
+  EXPECT_NEAR(group_mm, pinned["sessions"][1]["mean"]["truth_misalignment_mm"].get<double>(), 1e-9);
 }
 
 TEST(StudyTables, TablesJsonHasTheDocumentedShape) {
-  LandmarkValidation validation;
-  validation.mean_error_mm = 4.25;
-  const nlohmann::json tables = nlohmann::json::parse(TablesJson(Users(1), validation));
-  EXPECT_EQ(tables["users"], 1);
+  const nlohmann::json tables = nlohmann::json::parse(TablesJson(true, false, "provenance.json"));
+  EXPECT_EQ(tables["provenance"], "provenance.json");
   for (const char* mode : {"ar_reflective", "ar"}) {
-    for (const char* key : {"t_x", "t_y", "t_z", "norm"}) {
-      EXPECT_EQ(tables["table1"][mode][key].size(), 2u) << mode << key;
-      EXPECT_EQ(tables["table1"]["se3_mean"][mode][key].size(), 2u) << mode << key;
-    }
     // The paper's rows: their norms are the norms of their per-axis figures (to the print's rounding).
     const nlohmann::json& paper = tables["paper"]["table1"][mode];
     double mean2 = 0, std2 = 0;
@@ -135,8 +106,12 @@ TEST(StudyTables, TablesJsonHasTheDocumentedShape) {
   }
   EXPECT_EQ(tables["paper"]["table1"]["ar"]["norm"], nlohmann::json({30.2, 23.9}));
   EXPECT_EQ(tables["paper"]["table1"]["se3_mean"]["ar_reflective"]["norm"], nlohmann::json({11.3, 1.01}));
-  EXPECT_EQ(tables["landmark_validation_mm"], 4.25);
   EXPECT_EQ(tables["paper"]["landmark_validation_mm"], 3.6);
+  EXPECT_FALSE(tables["paper"].contains("table2"));  // no set-up runs
+  const nlohmann::json setup = nlohmann::json::parse(TablesJson(false, true));
+  EXPECT_FALSE(setup.contains("provenance"));
+  EXPECT_FALSE(setup["paper"].contains("table1"));
+  EXPECT_EQ(setup["paper"]["table2"]["fixed"]["median"].get<double>(), 50.6);
 }
 
 TEST(StudyTables, TheCommandWritesTheFilesAndRefusesAnUnfinishedRun) {
@@ -155,10 +130,11 @@ TEST(StudyTables, TheCommandWritesTheFilesAndRefusesAnUnfinishedRun) {
   EXPECT_NE(r.err.find("user u2 is the same person as u1 ('emulated-seed-1')"), std::string::npos) << r.err;
   r = test::RunCommand(RunStudyTables, "orbed-study-tables", {"--out", dir, pinned, other_path});
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_NE(r.out.find("ViRAAl study: 2 users"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("paper 30.2 +/- 23.9 mm"), std::string::npos) << r.out;
-  for (const char* name :
-       {"alignment_trials.csv", "alignment_means.csv", "landmark_validation.csv", "tables.json"}) {
+  EXPECT_NE(r.out.find("wrote alignment_trials.csv alignment_means.csv alignment_groups.csv"),
+            std::string::npos)
+      << r.out;
+  for (const char* name : {"alignment_trials.csv", "alignment_means.csv", "alignment_groups.csv",
+                           "landmark_validation.csv", "tables.json"}) {
     EXPECT_TRUE(std::filesystem::exists(dir + "/" + name)) << name;
   }
 
