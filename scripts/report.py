@@ -10,9 +10,14 @@ alignment_trials.csv (orbed-study-tables writes them) and writes:
   figures/total_errors.png   every joint's error per mode (violins; the paper's Fig. 7)
   figures/joint_rank.png     the mean error per joint and mode on a log scale, twisting joints (odd)
                              and revolving joints (even) told apart (the paper's Fig. 8)
-  report.html                Tables 1-4 beside the paper's, the figures, the ground-truth columns
-                             the paper could not measure, and what was calibrated to which figure.
-Needs python3-matplotlib (Debian); nothing else outside the standard library.
+  report.html                Tables 1-4 beside the paper's, the figures, the reviewer's analysis of
+                             the set-up half (tables.json setup_analysis: paired tests with the set-up
+                             and the user as the unit, Holm-corrected per-joint tests, the mixed
+                             model, effect sizes, per target, half-turn rates) beside the paper's
+                             reading, the ground-truth columns the paper could not measure, and what
+                             was calibrated to which figure.
+tables.json's numbers are python/orbed/study's (python3 -m orbed.study STUDY_DIR); this only
+formats them. Needs python3-matplotlib (Debian); nothing else outside the standard library.
 """
 import csv
 import html
@@ -101,14 +106,18 @@ def power_figure(study_dir, beyond):
     curves = beyond.get("power", {})
     if not curves:
         return False
-    fig, ax = plt.subplots(figsize=(6, 4))
-    for pair, curve in curves.items():
-        ax.plot(curve["users"], curve["power"], marker="o", label=pair)
-    ax.axhline(0.8, color="grey", linestyle="--", linewidth=1)
+    fig, ax = plt.subplots(figsize=(7, 4))
+    for i, (pair, curve) in enumerate(curves.items()):
+        color = "C%d" % i
+        ax.plot(curve["users"], curve["power"], marker="o", linestyle="--", color=color,
+                label=pair + ", pooled (paper's reading)")
+        if "power_paired" in curve:
+            ax.plot(curve["users"], curve["power_paired"], marker="s", color=color, label=pair + ", paired set-ups")
+    ax.axhline(0.8, color="grey", linestyle=":", linewidth=1)
     ax.set_ylim(-0.02, 1.02)
     ax.set_xlabel("users in the study")
     ax.set_ylabel("power of the total test (alpha 0.05)")
-    ax.legend()
+    ax.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.01, 0.5))
     fig.tight_layout()
     os.makedirs(os.path.join(study_dir, "figures"), exist_ok=True)
     fig.savefig(os.path.join(study_dir, "figures", "power.png"), dpi=100)
@@ -145,14 +154,118 @@ def beyond_section(study_dir, beyond):
                      "assistant moved the arm.</p>")
     power = beyond.get("power", {})
     if power:
-        parts.append("<p>Power analysis (%s). Users needed for 80 %% power: %s.</p>" % (
-            html.escape(beyond.get("power_method", "")),
-            ", ".join("%s %s" % (html.escape(pair), curve["users_for_80"] if curve["users_for_80"] is not None
-                                 else "more than %d" % curve["users"][-1])
-                      for pair, curve in power.items())))
+        def needed(curve, key):
+            return curve.get(key) if curve.get(key) is not None else "more than %d" % curve["users"][-1]
+        parts.append("<p>Power analysis (%s). Users needed for 80 %% power, pooled (the paper's reading) / "
+                     "paired set-ups: %s.</p>" % (
+                         html.escape(beyond.get("power_method", "")),
+                         ", ".join("%s %s / %s" % (html.escape(pair), needed(curve, "users_for_80"),
+                                                   needed(curve, "users_for_80_paired") if "power_paired" in curve
+                                                   else "-")
+                                   for pair, curve in power.items())))
         if power_figure(study_dir, beyond):
             parts.append("<figure><img src='figures/power.png'><figcaption>Power of Table 3's total test "
                          "against the number of users, from the emulated people</figcaption></figure>")
+    return parts
+
+
+def pv(p):
+    return "-" if p is None else "%.2g" % p
+
+
+def ci(pair_of_values, digits=1):
+    lo, hi = pair_of_values
+    return "-" if lo is None else "[%s, %s]" % (fmt(lo, digits), fmt(hi, digits))
+
+
+def setup_analysis_section(a):
+    """The reviewer's analysis (tables.json setup_analysis) beside the paper's reading."""
+    parts = ["<h2>The set-up half as a reviewer reads it</h2>",
+             "<p>The paper's Table 3 pools every joint of every set-up and compares two modes unpaired; its "
+             "values are neither independent (seven joints of one set-up, three set-ups of one person) nor "
+             "unpaired (every user did every mode on the same targets). Below, each test names its unit. All "
+             "tests are two-sided; r is the matched-pairs rank-biserial correlation (positive: the first mode's "
+             "errors larger), delta Cliff's delta; the median paired difference is first minus second mode "
+             "[deg] with a 95 % bootstrap CI.</p>",
+             "<table><tr><th>modes</th><th>test</th><th>unit</th><th>n</th><th>p</th><th>effect size</th>"
+             "<th>median difference [deg]</th></tr>"]
+    for pair, t in a.get("pairs", {}).items():
+        m = t["pooled_mwu"]
+        parts.append("<tr><th>%s</th><td>Mann-Whitney U (the paper's reading)</td><td>%s</td><td>%d + %d</td>"
+                     "<td>%s</td><td>delta %s</td><td>-</td></tr>" % (
+                         html.escape(pair), html.escape(m["unit"]), m["n_a"], m["n_b"], pv(m["p"]),
+                         fmt(m["cliffs_delta"], 2)))
+        for key in ("by_setup", "by_user"):
+            w = t[key]
+            parts.append("<tr><th>%s</th><td>Wilcoxon signed-rank (%s)</td><td>%s</td><td>%d</td><td>%s</td>"
+                         "<td>r %s</td><td>%s %s</td></tr>" % (
+                             html.escape(pair), w["method"] or "-", html.escape(w["unit"]), w["n"], pv(w["p"]),
+                             fmt(w["rank_biserial"], 2), fmt(w["median_difference"]), ci(w["median_difference_ci95"])))
+    parts.append("</table>")
+    joints = sorted({j for t in a.get("pairs", {}).values() for j in t["per_joint"]}, key=lambda k: int(k[5:]))
+    if joints:
+        parts.append("<h3>Per joint: paired Wilcoxon on each set-up's joint error, Holm-corrected over the "
+                     "joints</h3><table><tr><th></th>%s</tr>" % "".join("<th>%s</th>" % j for j in joints))
+        for pair, t in a["pairs"].items():
+            parts.append("<tr><th>%s</th>%s</tr>" % (html.escape(pair), "".join(
+                "<td>%s<br><b>%s</b><br>r %s</td>" % (pv(t["per_joint"][j]["p"]), pv(t["per_joint"][j]["p_holm"]),
+                                                     fmt(t["per_joint"][j]["rank_biserial"], 2)) for j in joints)))
+        parts.append("</table><p>Each cell: the raw p, the Holm-adjusted p (bold), the rank-biserial r.</p>")
+    mm = a.get("mixed_model")
+    if mm:
+        ratio = mm["scale"].startswith("ln(")
+        parts.append("<h3>Mixed-effects model</h3><p><code>%s</code>, REML (statsmodels MixedLM, crossed random "
+                     "intercepts); reference mode %s, reference kind revolving; %d joint errors of %d users on %d "
+                     "targets. Scale: %s (%s). Variance components: %s; residual %s.%s</p>" % (
+                         html.escape(mm["formula"]), html.escape(mm["reference"]["mode"]), mm["n"], mm["users"],
+                         mm["targets"], html.escape(mm["scale"]), html.escape(mm["why"]),
+                         ", ".join("%s %s" % (html.escape(k), fmt(v, 3)) for k, v in mm["variance_components"].items()),
+                         fmt(mm["residual_variance"], 3), "" if mm["converged"] else " <b>Did not converge.</b>"))
+        parts.append("<table><tr><th>term</th><th>estimate</th><th>95 %% CI</th><th>p</th>%s</tr>" % (
+            "<th>factor on the error</th><th>95 % CI</th>" if ratio else ""))
+        for c in mm["coefficients"]:
+            parts.append("<tr><th>%s</th><td>%s</td><td>%s</td><td>%s</td>%s</tr>" % (
+                html.escape(c["term"]), fmt(c["estimate"], 3), ci(c["ci95"], 3), pv(c["p"]),
+                "<td>%s</td><td>%s</td>" % (fmt(c["ratio"], 2), ci(c["ratio_ci95"], 2)) if ratio else ""))
+        parts.append("</table>")
+    per_target = a.get("per_target", {})
+    if per_target:
+        parts.append("<h3>Per target (grouped by %s)</h3><table><tr><th>target</th><th>mode</th><th>set-ups</th>"
+                     "<th>mean [deg]</th><th>median</th><th>max</th><th>half-turn rate</th></tr>" %
+                     html.escape(a.get("target_grouping", "target")))
+        for key, t in per_target.items():
+            for mode, s in t["modes"].items():
+                parts.append("<tr><th>%s</th><td>%s</td><td>%d</td><td>%s</td><td>%s</td><td>%s</td><td>%s</td></tr>" % (
+                    html.escape(key), LABELS.get(mode, mode), s["setups"], fmt(s["mean"]), fmt(s["median"]),
+                    fmt(s["max"]), fmt(100 * s["half_turn_rate"], 0) + " %"))
+        parts.append("</table><table><tr><th>target</th>%s</tr>" % "".join(
+            "<th>%s: p (n, r)</th>" % html.escape(pair) for pair in a.get("pairs", {})))
+        for key, t in per_target.items():
+            parts.append("<tr><th>%s</th>%s</tr>" % (html.escape(key), "".join(
+                "<td>%s (%d, %s)</td>" % (pv(w["p"]), w["n"], fmt(w["rank_biserial"], 2)) if w else "<td>-</td>"
+                for w in (t["paired"].get(pair) for pair in a.get("pairs", {})))))
+        parts.append("</table><p>Paired Wilcoxon over the users' set-ups on that target (per-set-up mean error).</p>")
+    h = a.get("half_turns")
+    if h:
+        parts.append("<h3>Half-turns (a set-up joint with an error above %s deg)</h3><table><tr><th>mode</th>"
+                     "<th>joints</th><th>half-turns</th><th>rate</th><th>set-ups with one</th></tr>" %
+                     fmt(h["threshold_deg"], 0))
+        for mode, c in h["by_mode"].items():
+            parts.append("<tr><th>%s</th><td>%d</td><td>%d</td><td>%s %%</td><td>%d of %d</td></tr>" % (
+                LABELS.get(mode, mode), c["joints"], c["half_turns"], fmt(100 * c["rate"], 1),
+                c["setups_with_half_turn"], c["setups"]))
+        parts.append("</table>")
+        if h.get("by_relation"):
+            parts.append("<p>By the start-target relation over the bending joints 2, 4, 6 (same signs, mirrored, "
+                         "mixed):</p><table><tr><th>relation</th><th>mode</th><th>set-ups</th><th>half-turn rate"
+                         "</th></tr>")
+            for relation, modes in h["by_relation"].items():
+                for mode, c in modes.items():
+                    parts.append("<tr><th>%s</th><td>%s</td><td>%d</td><td>%s %%</td></tr>" % (
+                        relation, LABELS.get(mode, mode), c["setups"], fmt(100 * c["rate"], 1)))
+            parts.append("</table>")
+        else:
+            parts.append("<p>No start angles in setup_joints.csv: no breakdown by start-target relation.</p>")
     return parts
 
 
@@ -226,7 +339,32 @@ def report(study_dir):
                 parts.append("<tr><th>%s</th><td>%s</td><td>%s</td><td class=paper>%s</td></tr>" % (
                     LABELS[mode], fmt(row["norm"][0]), fmt(row["norm"][1]),
                     "%s +/- %s" % (fmt(prow["norm"][0]), fmt(prow["norm"][1])) if prow else "-"))
+        pse3 = paper.get("table1", {}).get("se3_mean", {})
+        for mode, row in tables["table1"].get("se3_n3", {}).items():
+            p = pse3.get(mode)
+            parts.append("<tr><th>%s: SE(3) means of N = 3 trials (%d groups; the paper's statistic, scored with "
+                         "the truth's landmarks)</th><td>%s</td><td>%s</td><td class=paper>%s</td></tr>" % (
+                             LABELS[mode], row["groups"], fmt(row["norm"][0]), fmt(row["norm"][1]),
+                             "%s +/- %s" % (fmt(p["norm"][0]), fmt(p["norm"][1], 2)) if p else "-"))
+        for mode, row in tables["table1"].get("se3_mean", {}).items():
+            parts.append("<tr><th>%s: SE(3) mean of each user's %s trials (one per user; not the paper's "
+                         "N = 3)</th><td>%s</td><td>%s</td><td class=paper>-</td></tr>" % (
+                             LABELS[mode], "all", fmt(row["norm"][0]), fmt(row["norm"][1])))
         parts.append("</table>")
+        for frame, key in (("W (the OR frame, z up)", "table1"), ("the viewer's (z along the line of sight)",
+                                                                   "table1_viewer")):
+            rows1 = tables.get(key)
+            if not rows1 or key == "table1" and not tables.get("table1_viewer"):
+                continue
+            parts.append("<p>Per axis in %s [mm], mean +/- std:</p><table><tr><th></th><th>x</th><th>y</th>"
+                         "<th>z</th><th class=paper>paper x, y, z</th></tr>" % frame)
+            for mode in ("ar_reflective", "ar"):
+                row, prow = rows1.get(mode), paper.get("table1", {}).get(mode)
+                if row:
+                    parts.append("<tr><th>%s</th>%s<td class=paper>%s</td></tr>" % (LABELS[mode], "".join(
+                        "<td>%s +/- %s</td>" % (fmt(row[a][0]), fmt(row[a][1])) for a in ("t_x", "t_y", "t_z")),
+                        ", ".join(fmt(prow[a][0]) for a in ("t_x", "t_y", "t_z")) if prow else "-"))
+            parts.append("</table>")
     if "table2" in tables:
         head = ("<tr><th></th>" + "".join("<th>%s</th>" % k for k in ("mean", "median", "min", "max", "std"))
                 + "".join("<th class=paper>paper %s</th>" % k for k in ("mean", "median", "min", "max", "std"))
@@ -236,8 +374,9 @@ def report(study_dir):
             if mode in tables["table2"]:
                 parts.append(stats_row(LABELS[mode], tables["table2"][mode], paper.get("table2", {}).get(mode)))
         parts.append("</table>")
-        parts.append("<h2>Table 3: p-values (%s, two-sided, unpaired)</h2><table><tr><th></th>%s"
-                     "</tr>" % (html.escape(tables.get("table3_test", "")),
+        parts.append("<h2>Table 3: p-values, %s (%s, two-sided)</h2><table><tr><th></th>%s"
+                     "</tr>" % (html.escape(tables.get("table3_reading", "unpaired, every joint of every set-up pooled")),
+                                html.escape(tables.get("table3_test", "")),
                                 "".join("<th>%s</th>" % k for k in
                                         ["joint%d" % j for j in range(1, 8)] + ["total"])))
         for pair, row in tables.get("table3", {}).items():
@@ -266,6 +405,8 @@ def report(study_dir):
                               ("joint_rank.png", "Mean error per joint, log scale; twisting joints "
                                                  "red-edged (Fig. 8)")):
             parts.append("<figure><img src='figures/%s'><figcaption>%s</figcaption></figure>" % (name, caption))
+    if tables.get("setup_analysis"):
+        parts.extend(setup_analysis_section(tables["setup_analysis"]))
     if tables.get("beyond"):
         parts.extend(beyond_section(study_dir, tables["beyond"]))
     trials_path = os.path.join(study_dir, "alignment_trials.csv")

@@ -1,7 +1,8 @@
 """study: the paper's ViRAAl design (Sec. III-B: 4 users x 10 trials per display mode) and its robot
 set-up design (Sec. IV-B: 8 users x 3 guidance modes x 3 targets) over the bus: one launch per user,
 each a different emulated person (--arg user_seed=S, S+1, ...). Then orbed-study-tables writes the
-study's files and scripts/report.py the report into logs/study-<time>-<random>/. Each user's launch
+study's files, the analysis (python/orbed/study: scipy, statsmodels) its tables and scripts/report.py
+the report into logs/study-<time>-<random>/. Each user's launch
 prints into STUDY/<name>.log (shown with --verbose); one progress line says how far the study is."""
 import collections
 import csv
@@ -10,6 +11,7 @@ import json
 import os
 import shutil
 import subprocess
+import sys
 import tempfile
 
 from . import checks, launch as launch_verb
@@ -25,8 +27,8 @@ drawn from the seed, K targets each, default 3; 3 alignments before each headset
 alignment_trials.csv, alignment_means.csv, landmark_validation.csv, setup_joints.csv,
 setup_times.csv, setup_docking.csv, tables.json, report.html and figures/ in
 logs/study-<time>-<random>/ (every user's run folder inside it, and each one's output in
-<name>.log), and Tables 1, 2 and 4 beside the paper's, the docking error, collisions and a power
-analysis. --users 0 or --setup-users 0 leaves a half out; --registration-share runs each set-up
+<name>.log), and Tables 1, 2 and 4 beside the paper's, Table 3 as the paper read it (pooled) and with
+the set-up as the unit (paired), the docking error, collisions and a power analysis. --users 0 or --setup-users 0 leaves a half out; --registration-share runs each set-up
 user's headset modes again with the true registration (the registration's share of the error).
 The run ids (which seed the alignments) are ID-u<k> and ID-setup-u<k>, ID by default study-s<S>: the
 same arguments give the same study, bit for bit: every process runs on the sim's clock in lockstep
@@ -90,6 +92,20 @@ def drops(ctx, study_dir):
     worst = ", ".join(f"{r} {c}" for r, c in dropped.most_common(3))
     return (f"{n} launches, {complete} logs complete, {logger_drops} events dropped by the logger, "
             f"{sum(dropped.values())} dropped by the processes" + (f" ({worst})" if worst else ""))
+
+
+def analyze(ctx, study_dir, log):
+    """The study's analysis (python/orbed/study) on the CSVs orbed-study-tables wrote: the tables into
+    tables.json, their summary appended to the log."""
+    sys.path.insert(0, os.path.join(ctx.root, "python"))
+    from orbed.study import analysis  # scipy and statsmodels: imported only when a study ends
+
+    try:
+        tables = analysis.write(study_dir)
+    except (OSError, ValueError, KeyError) as e:
+        raise Failure(f"study: the analysis of {ctx.rel(study_dir)} failed ({e})")
+    with open(log, "a") as f:
+        f.write(analysis.summary(tables))
 
 
 def run(args, ctx):
@@ -172,6 +188,7 @@ def run(args, ctx):
     if run_logged([os.path.join(ctx.bin, "orbed-study-tables"), "--out", study_dir, *tables_argv], log, ctx.console):
         show_failure(ctx.console, log)
         raise Failure("study: orbed-study-tables failed")
+    analyze(ctx, study_dir, log)
     if args.setup_users > 0:
         if run_logged(["/usr/bin/python3", ctx.script("report.py"), study_dir], log, ctx.console):
             show_failure(ctx.console, log)
@@ -181,7 +198,7 @@ def run(args, ctx):
         whole = drops(ctx, study_dir)
     except (OSError, ValueError, KeyError, subprocess.CalledProcessError) as e:
         raise Failure(f"study: a run folder has no readable manifest.json or log ({e})")
-    # The tables as orbed-study-tables printed them: the results, once.
+    # The tables as orbed-study-tables and the analysis printed them: the results, once.
     with open(log, errors="replace") as f:
         ctx.console.results(f.read())
     mode = ", wall clock" if args.realtime else ", on the sim clock in lockstep"
