@@ -4,7 +4,7 @@
 # opened in headless Chromium:
 #   - every picture the page shows decodes in the browser (report.html sets data-images-loaded on
 #     <body> once loaded: "4/4");
-#   - Tables 1-4 are there, and Table 2's means per mode equal the means recomputed here from
+#   - Tables 1-4 and the reviewer's analysis (python/orbed/study, run first) are there, and Table 2's means per mode equal the means recomputed here from
 #     setup_joints.csv with Python's statistics module (the page formats them from tables.json);
 #   - a screenshot of the page (WORKDIR/report.png) is a real picture.
 # Needs Debian's chromium and python3-matplotlib (`scripts/orbed setup` installs them).
@@ -13,6 +13,8 @@ root=$1 work=$2
 rm -rf "$work"
 mkdir -p "$work/study"
 cp "$root"/tests/testdata/study/* "$work/study/"
+# The analysis first, as scripts/orbed study runs it (python/orbed/study rewrites tables.json).
+PYTHONPATH="$root/python" /usr/bin/python3 -m orbed.study "$work/study" >/dev/null
 /usr/bin/python3 "$root/scripts/report.py" "$work/study" >/dev/null
 for f in joint_errors total_errors joint_rank power; do
   [[ -s "$work/study/figures/$f.png" ]] || { echo "report_test: no figures/$f.png"; exit 1; }
@@ -33,7 +35,8 @@ dom = open(work + "/dom.html").read()
 m = re.search(r'data-images-loaded="(\d+)/(\d+)"', dom)
 assert m, "the page did not report its pictures (no data-images-loaded on <body>)"
 assert m.group(1) == m.group(2) == "4", "pictures decoded in the browser: %s/%s" % m.groups()
-for heading in ("Table 1", "Table 2", "Table 3", "Table 4"):
+for heading in ("Table 1", "Table 2", "Table 3", "Table 4", "The set-up half as a reviewer reads it",
+                "Mixed-effects model", "Holm-corrected"):
     assert heading in dom, heading + " is missing"
 table2 = dom[dom.index("Table 2"):dom.index("Table 3")]
 rows = list(csv.DictReader(open(work + "/study/setup_joints.csv")))

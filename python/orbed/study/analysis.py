@@ -134,6 +134,15 @@ def summary(t):
             p = paper.get("table4", {}).get(mode, {}).get("execution_s")
             lines.append("    %-14s %s%s" % (mode, stats_text(s["execution_s"], clock),
                                              "   paper " + stats_text(p, clock) if p else ""))
+        b = t.get("beyond", {})
+        if b.get("collisions"):
+            lines.append("  Beyond the paper: docking error at the trocar (tip [mm] / tool axis [deg], median), contacts, "
+                         "collision stops, near misses (< %s cm)" % fixed(100 * b["near_miss_m"], 0))
+            for mode, c in b["collisions"].items():
+                d = b.get("docking", {}).get(mode)
+                lines.append("    %-14s %s, %d contact(s), %d stop(s), %d near miss(es)" % (
+                    mode, "%s mm / %s deg" % (fixed(d["tip_mm"]["median"], 0), fixed(d["axis_deg"]["median"]))
+                    if d else "(not recorded)", c["contact"], c["collision_stops"], c["near_miss"]))
         lines.append("  Total test between modes: p of %s | of the set-up as the unit (paired Wilcoxon, "
                      "n set-ups, rank-biserial r)" % TABLE3_READING)
         for pair, a in t["setup_analysis"]["pairs"].items():
