@@ -75,19 +75,35 @@ void CheckConfig(const AssistantConfig& c) {
   auto require = [](bool ok, const char* what) {
     if (!ok) throw std::invalid_argument(std::string("assistant config: ") + what);
   };
-  require(c.eye_position_m.allFinite() && c.monitor_camera_m.allFinite(), "positions must be finite");
+  require(c.eye_position_m.allFinite() && c.monitor_camera_m.allFinite() && c.display_capture_m.allFinite(),
+          "positions must be finite");
   require(c.lateral_noise_arcmin > 0 && c.depth_noise_fraction_std > 0 && c.picture_noise_arcmin > 0 &&
-              c.picture_depth_fraction_std > 0,
+              c.picture_depth_fraction_std > 0 && c.display_noise_arcmin > 0 &&
+              c.display_depth_fraction_std > 0,
           "perception noises must be > 0");
-  require(c.user_scale_log_sigma >= 0 && c.mental_rotation_std_deg >= 0 && c.picture_scale_log_sigma >= 0 &&
-              c.placement_noise_deg >= 0 && c.flange_marker_offset_m >= 0,
+  require(c.user_scale_log_sigma >= 0 && c.rotation_error_base_deg >= 0 && c.rotation_error_per_deg >= 0 &&
+              c.picture_scale_log_sigma >= 0 && c.placement_noise_deg >= 0 && c.flange_marker_offset_m >= 0,
           "spreads must be >= 0");
+  require(c.turn_view_leaves_deg >= 0 && c.turn_view_leaves_deg <= c.turn_view_above_deg &&
+              c.turn_view_above_deg <= 180,
+          "0 <= turn_view_leaves_deg <= turn_view_above_deg <= 180");
   require(
       c.match_margin > 0 && c.looks_per_joint >= 1 && c.looks_per_joint <= 10 && c.correction_window_deg > 0,
       "match_margin > 0, looks_per_joint 1..10, correction_window_deg > 0");
   require(c.joint_overhead_s >= 0 && c.look_s >= 0 && c.mental_rotation_deg_per_s > 0 &&
-              c.hand_speed_deg_per_s > 0 && c.pace_log_sigma >= 0 && c.pace_log_sigma <= 2,
+              c.hand_speed_deg_per_s > 0 && c.view_turn_deg_per_s > 0 && c.view_zoom_s >= 0 &&
+              c.display_consult_s >= 0 && c.pace_log_sigma >= 0 && c.pace_log_sigma <= 2,
           "times >= 0, speeds > 0, pace_log_sigma 0..2");
+}
+
+// The weighted squared distance d^T W d of the file comment, W from the ray origin -> r.
+double WeightedSquare(const Eigen::Vector3d& d, const Eigen::Vector3d& r, const Eigen::Vector3d& origin,
+                      double lateral_rad, double depth_fraction) {
+  const double rho = std::max((r - origin).norm(), 0.05);
+  const Eigen::Vector3d n = (r - origin) / rho;
+  const double along = n.dot(d);
+  const double across2 = (d - along * n).squaredNorm();
+  return across2 / std::pow(rho * lateral_rad, 2) + along * along / std::pow(rho * depth_fraction, 2);
 }
 
 }  // namespace
@@ -98,7 +114,8 @@ AssistantConfig LoadAssistantConfig(const std::string& path) {
   f.CheckKeys(root, "", {"assistant"});
   const YAML::Node a = f.Required(root, "assistant", "assistant");
   f.CheckKeys(a, "assistant",
-              {"seed", "eye_position_m", "user_scale_log_sigma", "headset", "monitor", "acting", "time"});
+              {"seed", "eye_position_m", "user_scale_log_sigma", "headset", "reflective", "monitor", "acting",
+               "time"});
   AssistantConfig c;
   c.seed = static_cast<uint64_t>(f.IntegerOr(a, "seed", "assistant", 1, 0, 1'000'000'000));
   if (a["eye_position_m"]) c.eye_position_m = f.Vector3(a["eye_position_m"], "assistant.eye_position_m", "m");
@@ -111,24 +128,48 @@ AssistantConfig LoadAssistantConfig(const std::string& path) {
   c.depth_noise_fraction_std =
       f.NumberOr(h, "depth_noise_fraction_std", "assistant.headset", c.depth_noise_fraction_std, 1e-5, 1);
 
+  const YAML::Node r = f.Section(a, "reflective", "assistant.reflective");
+  f.CheckKeys(r, "assistant.reflective", {"capture_m", "noise_arcmin", "depth_fraction_std", "consult_s"});
+  if (r["capture_m"]) c.display_capture_m = f.Vector3(r["capture_m"], "assistant.reflective.capture_m", "m");
+  c.display_noise_arcmin =
+      f.NumberOr(r, "noise_arcmin", "assistant.reflective", c.display_noise_arcmin, 1e-3, 600, "arcmin");
+  c.display_depth_fraction_std =
+      f.NumberOr(r, "depth_fraction_std", "assistant.reflective", c.display_depth_fraction_std, 1e-5, 1);
+  c.display_consult_s = f.NumberOr(r, "consult_s", "assistant.reflective", c.display_consult_s, 0, 600, "s");
+
   const YAML::Node m = f.Section(a, "monitor", "assistant.monitor");
   f.CheckKeys(m, "assistant.monitor",
-              {"camera_m", "mental_rotation_std_deg", "picture_scale_log_sigma", "picture_noise_arcmin",
-               "picture_depth_fraction_std"});
+              {"camera_m", "rotation_error_base_deg", "rotation_error_per_deg", "picture_scale_log_sigma",
+               "picture_noise_arcmin", "picture_depth_fraction_std", "turn_view_above_deg",
+               "turn_view_leaves_deg", "view_turn_deg_per_s", "view_zoom_s"});
   if (m["camera_m"]) c.monitor_camera_m = f.Vector3(m["camera_m"], "assistant.monitor.camera_m", "m");
-  c.mental_rotation_std_deg =
-      f.NumberOr(m, "mental_rotation_std_deg", "assistant.monitor", c.mental_rotation_std_deg, 0, 90, "deg");
+  c.rotation_error_base_deg =
+      f.NumberOr(m, "rotation_error_base_deg", "assistant.monitor", c.rotation_error_base_deg, 0, 90, "deg");
+  c.rotation_error_per_deg =
+      f.NumberOr(m, "rotation_error_per_deg", "assistant.monitor", c.rotation_error_per_deg, 0, 2, "deg/deg");
   c.picture_scale_log_sigma =
       f.NumberOr(m, "picture_scale_log_sigma", "assistant.monitor", c.picture_scale_log_sigma, 0, 1);
   c.picture_noise_arcmin =
       f.NumberOr(m, "picture_noise_arcmin", "assistant.monitor", c.picture_noise_arcmin, 1e-3, 600, "arcmin");
   c.picture_depth_fraction_std =
       f.NumberOr(m, "picture_depth_fraction_std", "assistant.monitor", c.picture_depth_fraction_std, 1e-5, 1);
+  c.turn_view_above_deg =
+      f.NumberOr(m, "turn_view_above_deg", "assistant.monitor", c.turn_view_above_deg, 0, 180, "deg");
+  c.turn_view_leaves_deg =
+      f.NumberOr(m, "turn_view_leaves_deg", "assistant.monitor", c.turn_view_leaves_deg, 0, 180, "deg");
+  c.view_turn_deg_per_s =
+      f.NumberOr(m, "view_turn_deg_per_s", "assistant.monitor", c.view_turn_deg_per_s, 1e-3, 1e4, "deg/s");
+  c.view_zoom_s = f.NumberOr(m, "view_zoom_s", "assistant.monitor", c.view_zoom_s, 0, 600, "s");
+  if (c.turn_view_leaves_deg > c.turn_view_above_deg) {
+    throw std::runtime_error(
+        path + ": assistant.monitor.turn_view_leaves_deg (" + std::to_string(c.turn_view_leaves_deg) +
+        ") must not exceed turn_view_above_deg (" + std::to_string(c.turn_view_above_deg) + ")");
+  }
 
   const YAML::Node act = f.Section(a, "acting", "assistant.acting");
   f.CheckKeys(act, "assistant.acting",
               {"match_margin", "looks_per_joint", "correction_window_deg", "placement_noise_deg",
-               "flange_marker_offset_m"});
+               "flange_marker_offset_m", "choice"});
   c.match_margin = f.NumberOr(act, "match_margin", "assistant.acting", c.match_margin, 1e-3, 1e6);
   c.looks_per_joint =
       static_cast<int>(f.IntegerOr(act, "looks_per_joint", "assistant.acting", c.looks_per_joint, 1, 10));
@@ -138,6 +179,9 @@ AssistantConfig LoadAssistantConfig(const std::string& path) {
       f.NumberOr(act, "placement_noise_deg", "assistant.acting", c.placement_noise_deg, 0, 45, "deg");
   c.flange_marker_offset_m =
       f.NumberOr(act, "flange_marker_offset_m", "assistant.acting", c.flange_marker_offset_m, 0, 0.5, "m");
+  c.choice = f.OneOfOr(act, "choice", "assistant.acting", "nearest", {"nearest", "best"}) == "best"
+                 ? Choice::kBest
+                 : Choice::kNearest;
 
   const YAML::Node t = f.Section(a, "time", "assistant.time");
   f.CheckKeys(
@@ -172,62 +216,60 @@ Assistant::Assistant(const sim::RobotModel& model, const AssistantConfig& config
   }
 }
 
-std::vector<Eigen::Vector3d> Assistant::PerceiveTarget(int joint, const Eigen::VectorXd& q_target,
-                                                       const Viewing& view) {
+Perceived Assistant::PerceiveTarget(int joint, const Eigen::VectorXd& q_target, const Viewing& view) {
   const std::vector<Eigen::Isometry3d> X_RL = model_->CalcLinkPoses(q_target);
-  std::vector<Eigen::Vector3d> seen;
+  Perceived seen;
   if (view.mode != orbed::guidance_t::MODE_FIXED_DISPLAY) {
-    // The hologram, seen from the eye.
-    for (const Feature& f : FeaturesWithPivot(joint)) {
-      seen.push_back(Perturb(view.X_WV_seen * (X_RL[f.link] * f.p_L), view.p_WE,
-                             scale_ * config_.lateral_noise_arcmin * kArcminToRad,
-                             scale_ * config_.depth_noise_fraction_std, &rng_));
+    // The hologram, seen from the eye; in MODE_AR_REFLECTIVE also in the display, from its camera.
+    for (const Feature& f : features_[joint]) {
+      seen.eye.push_back(Perturb(view.X_WV_seen * (X_RL[f.link] * f.p_L), view.p_WE,
+                                 scale_ * config_.lateral_noise_arcmin * kArcminToRad,
+                                 scale_ * config_.depth_noise_fraction_std, &rng_));
+    }
+    if (view.mode == orbed::guidance_t::MODE_AR_REFLECTIVE && view.p_WC_display) {
+      for (const Feature& f : features_[joint]) {
+        seen.display.push_back(Perturb(view.X_WV_display * (X_RL[f.link] * f.p_L), *view.p_WC_display,
+                                       scale_ * config_.display_noise_arcmin * kArcminToRad,
+                                       scale_ * config_.display_depth_fraction_std, &rng_));
+      }
     }
     return seen;
   }
   // The monitor's picture turned into the person's view: a rotation about the vertical through the
-  // base and a scale about the base, per look; read with the picture's noise along the monitor
-  // camera's rays.
-  const double psi = scale_ * config_.mental_rotation_std_deg * kDegToRad * rng_.Normal();
+  // base (its spread growing with the angle between the picture's viewpoint and the eye) and a
+  // scale about the base, per look; read with the picture's noise along the monitor camera's rays.
+  const double sigma_deg = RotationErrorStdDeg(MonitorDisparityDeg(view));
+  const double psi = scale_ * sigma_deg * kDegToRad * rng_.Normal();
   const double k = std::exp(scale_ * config_.picture_scale_log_sigma * rng_.Normal());
   const Eigen::Matrix3d R_turn = Eigen::AngleAxisd(psi, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   const Eigen::Vector3d p_WR = view.X_WR.translation();
-  for (const Feature& f : FeaturesWithPivot(joint)) {
+  for (const Feature& f : features_[joint]) {
     const Eigen::Vector3d p = view.X_WR * (X_RL[f.link] * f.p_L);
-    seen.push_back(Perturb(p_WR + k * (R_turn * (p - p_WR)), view.p_WD.value_or(config_.monitor_camera_m),
-                           scale_ * config_.picture_noise_arcmin * kArcminToRad,
-                           scale_ * config_.picture_depth_fraction_std, &rng_));
+    seen.eye.push_back(Perturb(p_WR + k * (R_turn * (p - p_WR)), view.p_WD.value_or(config_.monitor_camera_m),
+                               scale_ * config_.picture_noise_arcmin * kArcminToRad,
+                               scale_ * config_.picture_depth_fraction_std, &rng_));
   }
   return seen;
 }
 
-std::vector<Feature> Assistant::FeaturesWithPivot(int joint) const {
-  std::vector<Feature> out = features_[joint];
-  out.push_back({model_->joints()[joint].link, Eigen::Vector3d::Zero()});  // the joint, on its axis
-  return out;
-}
-
-double Assistant::Discrepancy(int joint, double x_rad, const Eigen::VectorXd& q_now,
-                              const std::vector<Eigen::Vector3d>& p_W_target_seen,
+double Assistant::Discrepancy(int joint, double x_rad, const Eigen::VectorXd& q_now, const Perceived& seen,
                               const Viewing& view) const {
   Eigen::VectorXd q = q_now;
   q[joint] = x_rad;
   const std::vector<Eigen::Isometry3d> X_RL = model_->CalcLinkPoses(q);
-  const double lateral = config_.lateral_noise_arcmin * kArcminToRad;
-  const double depth = config_.depth_noise_fraction_std;
+  const std::vector<Feature>& features = features_[joint];
+  const bool display = !seen.display.empty() && view.p_WC_display;
   double sum = 0;
-  const std::vector<Feature> features = FeaturesWithPivot(joint);
-  const Eigen::Vector3d r_pivot = view.X_WR * (X_RL[features.back().link] * features.back().p_L);
-  const Eigen::Vector3d& h_pivot = p_W_target_seen.back();
-  for (size_t i = 0; i + 1 < features.size(); ++i) {
+  for (size_t i = 0; i < features.size(); ++i) {
+    // The real point against the target's point where it appears: a registration's shift and tilt
+    // both reach the joint (file comment).
     const Eigen::Vector3d r = view.X_WR * (X_RL[features[i].link] * features[i].p_L);
-    const double rho = std::max((r - view.p_WE).norm(), 0.05);
-    const Eigen::Vector3d n = (r - view.p_WE) / rho;
-    // The link's shape about its joint: a shift of the whole hologram is not a reason to turn.
-    const Eigen::Vector3d d = (r - r_pivot) - (p_W_target_seen[i] - h_pivot);
-    const double along = n.dot(d);
-    const double across2 = (d - along * n).squaredNorm();
-    sum += across2 / std::pow(rho * lateral, 2) + along * along / std::pow(rho * depth, 2);
+    sum += WeightedSquare(r - seen.eye[i], r, view.p_WE, config_.lateral_noise_arcmin * kArcminToRad,
+                          config_.depth_noise_fraction_std);
+    if (display) {
+      sum += WeightedSquare(r - seen.display[i], r, *view.p_WC_display,
+                            config_.display_noise_arcmin * kArcminToRad, config_.display_depth_fraction_std);
+    }
   }
   return sum;
 }
@@ -239,19 +281,23 @@ JointLook Assistant::Look(int joint, const Eigen::VectorXd& q_now, const Eigen::
     throw std::invalid_argument("Assistant::Look: joint or vector size does not match the model");
   }
   const sim::JointInfo& info = model_->joints()[joint];
-  const std::vector<Eigen::Vector3d> seen = PerceiveTarget(joint, q_target, view);
+  const Perceived seen = PerceiveTarget(joint, q_target, view);
   const double lo = std::max(info.lower_rad, q_now[joint] - window_rad);
   const double hi = std::min(info.upper_rad, q_now[joint] + window_rad);
   const double step = kGridStepDeg * kDegToRad;
   const int count = std::max(1, static_cast<int>(std::floor((hi - lo) / step)) + 1);
   std::vector<double> x(count), d(count);
   double d_min = std::numeric_limits<double>::infinity();
+  int i_min = 0;
   for (int i = 0; i < count; ++i) {
     x[i] = std::min(hi, lo + i * step);
     d[i] = Discrepancy(joint, x[i], q_now, seen, view);
-    d_min = std::min(d_min, d[i]);
+    if (d[i] < d_min) {
+      d_min = d[i];
+      i_min = i;
+    }
   }
-  // The angles that look right, and the one of them nearest to where the joint is.
+  // The angles that look right, and the one of them the person turns to.
   JointLook look;
   double best_distance = std::numeric_limits<double>::infinity();
   bool inside = false;
@@ -264,11 +310,14 @@ JointLook Assistant::Look(int joint, const Eigen::VectorXd& q_now, const Eigen::
       look.aim_rad = x[i];
     }
   }
+  if (config_.choice == Choice::kBest) look.aim_rad = x[i_min];
   const double placed = look.aim_rad + scale_ * config_.placement_noise_deg * kDegToRad * rng_.Normal();
   look.q_rad = std::clamp(placed, info.lower_rad, info.upper_rad);
   look.time_s = pace_ * config_.look_s;
   if (view.mode == orbed::guidance_t::MODE_FIXED_DISPLAY)
     look.time_s += pace_ * MonitorDisparityDeg(view) / config_.mental_rotation_deg_per_s;
+  if (view.mode == orbed::guidance_t::MODE_AR_REFLECTIVE && view.p_WC_display)
+    look.time_s += pace_ * config_.display_consult_s;
   return look;
 }
 
@@ -283,6 +332,34 @@ double Assistant::MonitorDisparityDeg(const Viewing& view) const {
   if (a.norm() < 1e-9 || b.norm() < 1e-9) return 0;
   const double cos_angle = std::clamp(a.normalized().dot(b.normalized()), -1.0, 1.0);
   return std::acos(cos_angle) * kRadToDeg;
+}
+
+double Assistant::RotationErrorStdDeg(double disparity_deg) const {
+  return config_.rotation_error_base_deg + config_.rotation_error_per_deg * disparity_deg;
+}
+
+MonitorTurn Assistant::PlanMonitorView(const Viewing& view) const {
+  const Eigen::Vector3d p_WR = view.X_WR.translation();
+  MonitorTurn turn;
+  turn.p_WD = view.p_WD.value_or(config_.monitor_camera_m);
+  const double theta = MonitorDisparityDeg(view);
+  if (theta > config_.turn_view_above_deg) {
+    // Orbit about the vertical through the base, towards the eye's side, until turn_view_leaves_deg
+    // is left.
+    const Eigen::Vector2d a = (turn.p_WD - p_WR).head<2>(), b = (view.p_WE - p_WR).head<2>();
+    const double sign = a.x() * b.y() - a.y() * b.x() >= 0 ? 1.0 : -1.0;
+    turn.turned_deg = theta - config_.turn_view_leaves_deg;
+    const Eigen::AngleAxisd R(sign * turn.turned_deg * kDegToRad, Eigen::Vector3d::UnitZ());
+    turn.p_WD = p_WR + R * (turn.p_WD - p_WR);
+  }
+  const double eye_m = (view.p_WE - p_WR).norm(), camera_m = (turn.p_WD - p_WR).norm();
+  if (camera_m > eye_m && eye_m > 1e-9) {
+    turn.zoomed = true;
+    turn.p_WD = p_WR + (eye_m / camera_m) * (turn.p_WD - p_WR);
+  }
+  turn.time_s =
+      pace_ * (turn.turned_deg / config_.view_turn_deg_per_s + (turn.zoomed ? config_.view_zoom_s : 0.0));
+  return turn;
 }
 
 }  // namespace orbed::assistant

@@ -103,11 +103,18 @@ Viewing AssistantMachine::CurrentView(double t_s) const {
   view.X_WR = *X_WR_;
   view.X_WV_seen = (A_ ? *A_ : Eigen::Isometry3d::Identity()) * (X_WV_ ? *X_WV_ : *X_WR_);
   view.p_WE = p_WE_ ? *p_WE_ : assistant_.config().eye_position_m;
+  // The reflective display: captured at the config's viewpoint, the hologram at the registration.
+  if (view.mode == orbed::guidance_t::MODE_AR_REFLECTIVE) {
+    view.p_WC_display = assistant_.config().display_capture_m;
+    view.X_WV_display = X_WV_ ? *X_WV_ : *X_WR_;
+  }
   // A monitor camera on or far from the robot is no view of it: the configured one instead.
   if (p_WD_ && t_s - p_WD_received_s_ <= options_.fixed_view_stale_s) {
     const double d_m = (*p_WD_ - X_WR_->translation()).norm();
     if (d_m >= kMinMonitorDistance_m && d_m <= kMaxMonitorDistance_m) view.p_WD = p_WD_;
   }
+  // The view as the person turned it for this set-up.
+  if (p_WD_turned_ && view.mode == orbed::guidance_t::MODE_FIXED_DISPLAY) view.p_WD = p_WD_turned_;
   return view;
 }
 
@@ -118,7 +125,7 @@ StepOutput AssistantMachine::Step(double t_s, int64_t utime) {
     case Phase::kDone:
       return out;
     case Phase::kWait:
-      StartSetUp(&out);
+      StartSetUp(t_s, &out);
       if (phase_ != Phase::kLook) return out;
       [[fallthrough]];
     case Phase::kLook:
@@ -132,7 +139,7 @@ StepOutput AssistantMachine::Step(double t_s, int64_t utime) {
 }
 
 // kWait: starts the set-up (phase kLook) once everything it needs is there.
-void AssistantMachine::StartSetUp(StepOutput* out) {
+void AssistantMachine::StartSetUp(double t_s, StepOutput* out) {
   const int n = model_->num_joints();
   const bool headset = guidance_ && guidance_->mode != orbed::guidance_t::MODE_FIXED_DISPLAY;
   bool shows_task = true;  // the GUIDANCE is this task's
@@ -162,11 +169,23 @@ void AssistantMachine::StartSetUp(StepOutput* out) {
   for (int8_t kind : guidance_->joint_kind)
     partial_.twisting.push_back(kind == orbed::guidance_t::JOINT_TWIST);
   partial_.headset_pose = A_.has_value();
+  // On the fixed monitor the person first turns (and zooms) its view towards their own.
+  p_WD_turned_.reset();
+  std::string turned;
+  if (guidance_->mode == orbed::guidance_t::MODE_FIXED_DISPLAY) {
+    const MonitorTurn turn = assistant_.PlanMonitorView(CurrentView(t_s));
+    p_WD_turned_ = turn.p_WD;
+    partial_.execution_s += turn.time_s;
+    std::ostringstream note;
+    note << " (monitor's view turned " << turn.turned_deg << " deg" << (turn.zoomed ? ", zoomed in" : "")
+         << ")";
+    turned = note.str();
+  }
   out->notes.push_back(
       {false,
        "assistant: set-up in mode " + std::string(guidance::GuidanceModeName(guidance_->mode)) +
            (headset ? (A_ ? " (eye and SLAM error from HMD_POSE)" : " (eye from the config, no SLAM error)")
-                    : "")});
+                    : turned)});
   joint_ = 0;
   look_ = 0;
   phase_ = Phase::kLook;

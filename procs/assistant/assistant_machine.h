@@ -7,7 +7,9 @@
 /// Phases: kIdle (no task) → kWait (a task, or --once) → kLook → kMove → (kLook → kMove)... → kDone.
 ///   kWait   until GUIDANCE shows the task's target and mode (any GUIDANCE with --once), a joint
 ///           vector and ROBOT_STATE are known, the arm is at rest (MOTION_IDLE) and, in the headset
-///           modes, a REGISTRATION gave the hologram's pose; then the set-up starts (same step).
+///           modes, a REGISTRATION gave the hologram's pose; then the set-up starts (same step). On
+///           the fixed monitor the person first turns and zooms its view (Assistant::PlanMonitorView):
+///           that view replaces FIXED_VIEW's camera until the set-up ends, its time is added.
 ///   kLook   the person looks at joint j (the first look over the whole range, the next ones within
 ///           correction_window_deg) and decides where to put it; the move starts (same step).
 ///   kMove   IIWA_COMMAND (the measured q with joint j at the goal) every command_resend_s until the
@@ -22,6 +24,12 @@
 /// Tasks (SETUP_TASK): a new request id starts a set-up; the current (or last finished) task's
 /// id again changes nothing, and once finished its SETUP_RESULT is answered again, the same message.
 /// With `once` tasks are ignored and the set-up starts from kWait at construction.
+///
+/// What the person sees (CurrentView): the eye and the SLAM error from the latest HMD_POSE pair
+/// (else the config's eye, no error); the hologram at REGISTRATION's pose; in MODE_AR_REFLECTIVE the
+/// reflective display captured at the config's `reflective.capture_m` (display 0 of hmd.yaml, at
+/// its waypoint of viraal_walk.yaml: no message carries a display's capture pose but REFLECTIVE_VIEW,
+/// an image stream this process does not read), its hologram at REGISTRATION's pose.
 ///
 /// Time: `t_s` is any monotonic clock in seconds (the process clock: wall or sim); `utime` only
 /// stamps what is published. Frames: W world, R real base, V virtual base, H head, E eye, D the
@@ -127,7 +135,7 @@ class AssistantMachine {
   const Assistant& assistant() const { return assistant_; }
 
  private:
-  void StartSetUp(StepOutput* out);
+  void StartSetUp(double t_s, StepOutput* out);
   void LookAtJoint(double t_s, StepOutput* out);
   void Move(double t_s, int64_t utime, StepOutput* out);
   void Finish(int64_t utime, StepOutput* out);
@@ -147,6 +155,7 @@ class AssistantMachine {
   std::optional<Eigen::Vector3d> p_WE_;  // the true head position of that pair
   std::optional<Eigen::Vector3d> p_WD_;  // FIXED_VIEW's camera position
   double p_WD_received_s_{0};
+  std::optional<Eigen::Vector3d> p_WD_turned_;  // the monitor's camera as the person turned it
 
   // The run.
   Phase phase_{Phase::kIdle};

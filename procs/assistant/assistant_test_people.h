@@ -26,7 +26,10 @@ inline AssistantConfig Perfect() {
   c.lateral_noise_arcmin = 1e-3;
   c.depth_noise_fraction_std = 1e-5;
   c.placement_noise_deg = 0;
-  c.mental_rotation_std_deg = 0;
+  c.rotation_error_base_deg = 0;
+  c.rotation_error_per_deg = 0;
+  c.display_noise_arcmin = 1e-3;
+  c.display_depth_fraction_std = 1e-5;
   c.picture_scale_log_sigma = 0;
   c.picture_noise_arcmin = 1e-3;
   c.picture_depth_fraction_std = 1e-5;

@@ -75,8 +75,9 @@ namespace {
 constexpr char kPerfectConfig[] = R"(assistant:
   user_scale_log_sigma: 0
   headset: {lateral_noise_arcmin: 0.001, depth_noise_fraction_std: 0.00001}
-  monitor: {mental_rotation_std_deg: 0, picture_scale_log_sigma: 0, picture_noise_arcmin: 0.001,
-            picture_depth_fraction_std: 0.00001}
+  reflective: {noise_arcmin: 0.001, depth_fraction_std: 0.00001}
+  monitor: {rotation_error_base_deg: 0, rotation_error_per_deg: 0, picture_scale_log_sigma: 0,
+            picture_noise_arcmin: 0.001, picture_depth_fraction_std: 0.00001}
   acting: {placement_noise_deg: 0}
 )";
 
