@@ -300,6 +300,43 @@ TEST_F(AssistantMachineTest, OnceNeedsNoTaskAndStopsWhenDone) {
   EXPECT_EQ(m.result()->mode, int8_t{orbed::guidance_t::MODE_FIXED_DISPLAY});
 }
 
+// On the fixed monitor the person turns the view once, at the start: the configured camera is
+// about 80 deg around from the configured eye, beyond turn_view_above_deg, so the view is turned
+// until turn_view_leaves_deg is left, and that view is the one seen until the set-up ends. The time
+// model's total adds the turn and, per look, the mental rotation over what is left:
+// turn + 7 joint_overhead_s + 14 (look_s + leaves / mental_rotation_deg_per_s) + 30 deg / hand speed.
+// In ar_reflective the view has the display's capture viewpoint and the registration's hologram.
+TEST_F(AssistantMachineTest, TheMonitorsViewIsTurnedOnceAndTheDisplayIsConsulted) {
+  MachineOptions options = Options();
+  options.once = true;
+  const AssistantConfig c = Perfect();
+  AssistantMachine m(model_, c, options);
+  FeedTheRoom(&m);
+  m.OnGuidance(Guidance(orbed::guidance_t::MODE_FIXED_DISPLAY, q_target_));
+  const MonitorTurn turn = m.assistant().PlanMonitorView(m.CurrentView(0));
+  ASSERT_GT(turn.turned_deg, 0);
+  const Stepped run = Steps(&m, &arm_, 0, 40);
+  ASSERT_TRUE(m.result());
+  ASSERT_TRUE(m.CurrentView(0).p_WD);
+  EXPECT_TRUE(m.CurrentView(0).p_WD->isApprox(turn.p_WD));
+  EXPECT_NEAR(m.assistant().MonitorDisparityDeg(m.CurrentView(0)), c.turn_view_leaves_deg, 1e-9);
+  EXPECT_NEAR(m.result()->execution_s,
+              turn.time_s + 7 * c.joint_overhead_s +
+                  14 * (c.look_s + c.turn_view_leaves_deg / c.mental_rotation_deg_per_s) +
+                  30.0 / c.hand_speed_deg_per_s,
+              1e-9);
+
+  AssistantMachine r(model_, c, Options());
+  FeedTheRoom(&r);
+  r.OnGuidance(Guidance(orbed::guidance_t::MODE_AR_REFLECTIVE, q_target_));
+  const Viewing view = r.CurrentView(0);
+  ASSERT_TRUE(view.p_WC_display);
+  EXPECT_TRUE(view.p_WC_display->isApprox(c.display_capture_m));
+  EXPECT_TRUE(view.X_WV_display.isApprox(Eigen::Isometry3d::Identity()));
+  r.OnGuidance(Guidance(orbed::guidance_t::MODE_AR, q_target_));
+  EXPECT_FALSE(r.CurrentView(0).p_WC_display);
+}
+
 // A task the check refuses (request id 0, a target beyond the limits) starts nothing.
 TEST_F(AssistantMachineTest, ABadTaskIsRefused) {
   AssistantMachine m(model_, Perfect(), Options());
