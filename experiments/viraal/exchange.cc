@@ -1,5 +1,6 @@
 #include "experiments/viraal/exchange.h"
 
+#include <algorithm>
 #include <stdexcept>
 
 #include "base/units.h"
@@ -19,8 +20,23 @@ AlignmentError TrialError(const orbed::pose_t& X_WR, const orbed::alignment_tria
 
 AlignmentError MeanError(const orbed::pose_t& X_WR, const orbed::registration_t& mean,
                          const std::vector<RobotPoints>& session_points,
-                         const std::vector<std::vector<Eigen::Vector3d>>& session_real_annotated) {
+                         const std::vector<std::vector<Eigen::Vector3d>>& session_real_annotated,
+                         const std::vector<std::optional<Eigen::Vector3d>>& session_eyes) {
   AlignmentError error = EvaluateOverConfigurations(FromPose(X_WR), FromPose(mean.X_WV_mean), session_points);
+  if (!session_eyes.empty() && session_eyes.size() != session_points.size()) {
+    throw std::invalid_argument("MeanError: " + std::to_string(session_eyes.size()) + " trials' eyes for " +
+                                std::to_string(session_points.size()) + " trials");
+  }
+  const bool every_eye =
+      !session_eyes.empty() &&
+      std::all_of(session_eyes.begin(), session_eyes.end(), [](const auto& eye) { return eye.has_value(); });
+  if (every_eye) {
+    for (size_t i = 0; i < session_points.size(); ++i) {
+      const AlignmentError trial = WithViewer(
+          EvaluateAlignment(FromPose(X_WR), FromPose(mean.X_WV_mean), session_points[i]), *session_eyes[i]);
+      error.R_WS.insert(error.R_WS.end(), trial.R_WS.begin(), trial.R_WS.end());
+    }
+  }
   if (session_real_annotated.empty()) return error;
   if (session_real_annotated.size() != session_points.size()) {
     throw std::invalid_argument("MeanError: " + std::to_string(session_real_annotated.size()) +
@@ -42,6 +58,27 @@ AlignmentError MeanError(const orbed::pose_t& X_WR, const orbed::registration_t&
   error.p_W_virtual_annotated = error.p_W_virtual;  // X_WV_mean at each trial's q
   error.virtual_annotated = false;
   return error;
+}
+
+std::optional<Eigen::Vector3d> AlignmentViewpoint(const orbed::AlignmentTrial& trial) {
+  if (trial.annotation.empty()) return std::nullopt;
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  int count = 0;
+  for (const auto& sides : trial.annotation) {
+    for (const LandmarkRays& rays : sides) {
+      if (rays.origin_W_m.empty()) continue;
+      sum += rays.origin_W_m.front();
+      ++count;
+    }
+  }
+  if (count == 0) return std::nullopt;
+  return Eigen::Vector3d(sum / count);
+}
+
+std::vector<std::optional<Eigen::Vector3d>> ViewerEyes(const SessionResult& session) {
+  std::vector<std::optional<Eigen::Vector3d>> out;
+  for (const TrialResult& t : session.trials) out.push_back(t.viewer_eye_W_m);
+  return out;
 }
 
 std::vector<orbed::landmark_request_t> LandmarkRequests(const orbed::AlignmentTrial& trial, int64_t utime,
@@ -117,6 +154,12 @@ ErrorMeasures Measures(const AlignmentError& error, const orbed::misalignment_t&
   m.landmarks = error.p_W_real_annotated.empty() ? "truth" : error.virtual_annotated ? "gaze" : "gaze_real";
   m.truth_misalignment_mm =
       geometry::EvaluateMisalignment(error.p_W_real, error.p_W_virtual).mean_error_norm_m * 1e3;
+  if (!error.R_WS.empty()) {
+    const bool annotated = !error.p_W_real_annotated.empty();
+    m.viewer_axes_mm =
+        1e3 * ViewerAxesError(annotated ? error.p_W_real_annotated : error.p_W_real,
+                              annotated ? error.p_W_virtual_annotated : error.p_W_virtual, error.R_WS);
+  }
   return m;
 }
 
@@ -128,9 +171,11 @@ std::vector<std::vector<Eigen::Vector3d>> AnnotatedRealLandmarks(const SessionRe
 
 TrialResult TrialResultFrom(const orbed::alignment_trial_t& trial, const orbed::pose_t& X_WR,
                             const ErrorMeasures& errors,
-                            const std::vector<Eigen::Vector3d>& annotated_real_W_m) {
+                            const std::vector<Eigen::Vector3d>& annotated_real_W_m,
+                            const std::optional<Eigen::Vector3d>& viewer_eye_W_m) {
   TrialResult result;
   result.annotated_real_W_m = annotated_real_W_m;
+  result.viewer_eye_W_m = viewer_eye_W_m;
   result.index = trial.trial_index;
   for (double q : trial.joint_position) result.q_deg.push_back(q * kRadToDeg);
   result.errors = errors;

@@ -19,6 +19,7 @@
 /// Threading: pure functions.
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -50,9 +51,24 @@ AlignmentError TrialError(const orbed::pose_t& X_WR, const orbed::alignment_tria
 /// at each trial's q (virtual_annotated = false); otherwise (a trial without annotation) with the
 /// truth's pairs alone. Throws std::invalid_argument when session_real_annotated is not empty and
 /// its size or a trial's landmark count does not match.
+/// The viewer frames: when session_eyes (ViewerEyes) has an eye for every trial, the pairs at trial
+/// i's q get trial i's frame (ViewerFrame from its eye to the centroid of its real landmarks):
+/// the mean's error as each trial's viewer would see it. Otherwise none (R_WS empty). Throws
+/// std::invalid_argument when session_eyes is not empty and its size does not match.
 AlignmentError MeanError(const orbed::pose_t& X_WR, const orbed::registration_t& mean,
                          const std::vector<RobotPoints>& session_points,
-                         const std::vector<std::vector<Eigen::Vector3d>>& session_real_annotated = {});
+                         const std::vector<std::vector<Eigen::Vector3d>>& session_real_annotated = {},
+                         const std::vector<std::optional<Eigen::Vector3d>>& session_eyes = {});
+
+/// Where the person stood when aligning, in the headset's map [m]: the mean of the origins of the
+/// first gaze ray aimed at each landmark on each side. The emulated person annotates from where
+/// they aligned first, then from a second position (hmd_emulator/viraal_trial.h), so these rays
+/// start at the alignment viewpoint, as the headset estimated its head there. Unset without
+/// annotation.
+std::optional<Eigen::Vector3d> AlignmentViewpoint(const orbed::AlignmentTrial& trial);
+
+/// Each trial's viewer_eye_W_m, in order: MeanError's session_eyes.
+std::vector<std::optional<Eigen::Vector3d>> ViewerEyes(const SessionResult& session);
 
 /// The annotation of a checked trial (lcmtypes/contract/alignment_trial.h) as LANDMARK_REQUESTs: for each
 /// landmark l, the real robot's rays then the virtual one's, named "<session>/<index>/real/<l>" and
@@ -74,13 +90,16 @@ orbed::misalignment_request_t MisalignmentRequest(const AlignmentError& error, c
 /// The measures of one pose: point errors from `error`, the paper's misalignment from `misalignment`
 /// (landmarks "gaze" when `error` has annotated pairs, "gaze_real" when only their real side was
 /// annotated), truth_misalignment_mm from error's truth
-/// pairs (geometry/misalignment.h, as orbed-registration computes it).
+/// pairs (geometry/misalignment.h, as orbed-registration computes it); viewer_axes_mm, when error
+/// has viewer frames, from the same pairs as the misalignment (ViewerAxesError).
 ErrorMeasures Measures(const AlignmentError& error, const orbed::misalignment_t& misalignment);
 
-/// One row of results.json for a trial; `annotated_real_W_m`: error's p_W_real_annotated.
+/// One row of results.json for a trial; `annotated_real_W_m`: error's p_W_real_annotated;
+/// `viewer_eye_W_m`: error's p_WE.
 TrialResult TrialResultFrom(const orbed::alignment_trial_t& trial, const orbed::pose_t& X_WR,
                             const ErrorMeasures& errors,
-                            const std::vector<Eigen::Vector3d>& annotated_real_W_m = {});
+                            const std::vector<Eigen::Vector3d>& annotated_real_W_m = {},
+                            const std::optional<Eigen::Vector3d>& viewer_eye_W_m = std::nullopt);
 
 /// Each trial's annotated_real_W_m, in order: MeanError's session_real_annotated.
 std::vector<std::vector<Eigen::Vector3d>> AnnotatedRealLandmarks(const SessionResult& session);

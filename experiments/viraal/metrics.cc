@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <stdexcept>
+#include <string>
 
 namespace orbed::viraal {
 
@@ -37,6 +38,44 @@ double RotationAngle(const Eigen::Matrix3d& R_a, const Eigen::Matrix3d& R_b) {
   // acos((trace − 1) / 2).
   const Eigen::Quaterniond q(R_a.transpose() * R_b);
   return 2.0 * std::atan2(q.vec().norm(), std::abs(q.w()));
+}
+
+Eigen::Matrix3d ViewerFrame(const Eigen::Vector3d& p_WE, const Eigen::Vector3d& p_WT) {
+  const Eigen::Vector3d line_of_sight = p_WT - p_WE;
+  if (!(line_of_sight.norm() >= 1e-3))
+    throw std::invalid_argument("ViewerFrame: the eye and the point looked at are less than 1 mm apart");
+  const Eigen::Vector3d z = line_of_sight.normalized();
+  Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitZ());  // horizontal, to the right of the line of sight
+  if (x.norm() < 1e-9) x = Eigen::Vector3d::UnitX();      // looking straight up or down
+  x.normalize();
+  Eigen::Matrix3d R_WS;
+  R_WS.col(0) = x;
+  R_WS.col(1) = z.cross(x);
+  R_WS.col(2) = z;
+  return R_WS;
+}
+
+AlignmentError WithViewer(AlignmentError error, const Eigen::Vector3d& p_WE) {
+  if (error.p_W_real.empty()) throw std::invalid_argument("WithViewer: no landmark pairs");
+  Eigen::Vector3d p_WT = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& p : error.p_W_real) p_WT += p;
+  p_WT /= static_cast<double>(error.p_W_real.size());
+  error.R_WS.assign(error.p_W_real.size(), ViewerFrame(p_WE, p_WT));
+  error.p_WE = p_WE;
+  return error;
+}
+
+Eigen::Vector3d ViewerAxesError(const std::vector<Eigen::Vector3d>& p_W_real,
+                                const std::vector<Eigen::Vector3d>& p_W_virtual,
+                                const std::vector<Eigen::Matrix3d>& R_WS) {
+  if (p_W_real.empty() || p_W_real.size() != p_W_virtual.size() || p_W_real.size() != R_WS.size())
+    throw std::invalid_argument("ViewerAxesError: " + std::to_string(p_W_real.size()) + " real, " +
+                                std::to_string(p_W_virtual.size()) + " virtual landmarks, " +
+                                std::to_string(R_WS.size()) + " frames");
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (size_t k = 0; k < p_W_real.size(); ++k)
+    sum += (R_WS[k].transpose() * (p_W_virtual[k] - p_W_real[k])).cwiseAbs();
+  return sum / static_cast<double>(p_W_real.size());
 }
 
 AlignmentError EvaluateAlignment(const Eigen::Isometry3d& X_WR, const Eigen::Isometry3d& X_WV,

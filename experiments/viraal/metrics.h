@@ -24,8 +24,18 @@
 /// For a session's mean X_WV there is no single q: EvaluateOverConfigurations averages the point
 /// errors over the session's configurations and concatenates their landmark pairs.
 ///
+/// The viewer frame S (ViewerFrame), for the per-axis errors as the person saw them: origin at the
+/// eye E (where the person stood when aligning; exchange.h AlignmentViewpoint takes it from the
+/// annotation's gaze rays), z the line of sight from E to T, the centroid of the real robot's
+/// landmarks at the trial's q (X_WR·p_RL, the truth); x horizontal (perpendicular to W's z, which
+/// points up), to the viewer's right; y = z × x, downward in the vertical plane of the line of
+/// sight. x right, y down, z away from the eye: the camera convention the paper uses for its
+/// displays (Sec. II). An error along z is depth along the line of sight. Only if the line of sight
+/// is vertical (within 1e-9 rad) is x instead W's x.
+///
 /// Threading: pure functions; RobotPointSet is a value. Reentrant.
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -75,10 +85,30 @@ struct AlignmentError {
   /// With annotated pairs: false when the virtual side was placed by the pose itself rather than
   /// annotated (a session mean, which no hologram ever showed: exchange.h MeanError).
   bool virtual_annotated{true};
+  /// The viewer frame of each landmark pair, R_WS (ViewerFrame), in p_W_real's order; empty when no
+  /// eye is known (nobody annotated: WithViewer, exchange.h MeanError).
+  std::vector<Eigen::Matrix3d> R_WS;
+  /// The eye a trial's frames were made from, in W [m] (WithViewer); unset for a mean.
+  std::optional<Eigen::Vector3d> p_WE;
 };
 
 /// Geodesic angle between two rotations [rad], in [0, π]: the angle of R_a^T·R_b.
 double RotationAngle(const Eigen::Matrix3d& R_a, const Eigen::Matrix3d& R_b);
+
+/// The viewer frame's orientation R_WS for an eye at p_WE looking at p_WT (both in W [m]); see the
+/// file comment. Throws std::invalid_argument when the two points are less than 1 mm apart.
+Eigen::Matrix3d ViewerFrame(const Eigen::Vector3d& p_WE, const Eigen::Vector3d& p_WT);
+
+/// `error` (one trial's) with its viewer frames: every pair's R_WS = ViewerFrame(p_WE, centroid of
+/// error.p_W_real), and p_WE kept.
+AlignmentError WithViewer(AlignmentError error, const Eigen::Vector3d& p_WE);
+
+/// Per-axis errors of landmark pairs in their viewer frames: mean over the pairs k of
+/// |R_WS[k]ᵀ·(p_W_virtual[k] − p_W_real[k])| per axis of S [m]. Throws std::invalid_argument when
+/// the three lists' sizes differ or are 0.
+Eigen::Vector3d ViewerAxesError(const std::vector<Eigen::Vector3d>& p_W_real,
+                                const std::vector<Eigen::Vector3d>& p_W_virtual,
+                                const std::vector<Eigen::Matrix3d>& R_WS);
 
 /// The errors of one trial (X_WV at q) against the truth X_WR.
 AlignmentError EvaluateAlignment(const Eigen::Isometry3d& X_WR, const Eigen::Isometry3d& X_WV,

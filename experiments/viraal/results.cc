@@ -20,6 +20,18 @@
 namespace orbed::viraal {
 namespace {
 
+std::vector<double> Numbers(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+
+void WriteTable1(JsonWriter* json, const Table1Row& row) {
+  json->BeginObject();
+  json->Key("num_trials").Int(row.num_trials);
+  json->Key("axes_mean_mm").Array(Numbers(row.axes_mean_mm));
+  json->Key("axes_std_mm").Array(Numbers(row.axes_std_mm));
+  json->Key("mean_mm").Number(row.mean_mm);
+  json->Key("std_mm").Number(row.std_mm);
+  json->EndObject();
+}
+
 void WritePose(JsonWriter* json, const Eigen::Isometry3d& X) {
   const Eigen::Quaterniond q(X.linear());
   // w >= 0, as ToPose does, so equal rotations print equally.
@@ -41,6 +53,7 @@ void WriteMeasures(JsonWriter* json, const ErrorMeasures& e) {
       .Array(std::vector<double>{e.misalignment_axes_mm.x(), e.misalignment_axes_mm.y(),
                                  e.misalignment_axes_mm.z()});
   json->Key("misalignment_mean_pair_distance_mm").Number(e.misalignment_mean_pair_distance_mm);
+  if (e.viewer_axes_mm) json->Key("viewer_axes_mm").Array(Numbers(*e.viewer_axes_mm));
   json->Key("landmarks").String(e.landmarks);
   json->Key("truth_misalignment_mm").Number(e.truth_misalignment_mm);
 }
@@ -89,6 +102,15 @@ Table1Row ComputeTable1Row(const std::vector<Eigen::Vector3d>& trial_axes_mm) {
 Table1Row SessionTable1Row(const SessionResult& session) {
   std::vector<Eigen::Vector3d> axes;
   for (const TrialResult& t : session.trials) axes.push_back(t.errors.misalignment_axes_mm);
+  return ComputeTable1Row(axes);
+}
+
+std::optional<Table1Row> SessionViewerTable1Row(const SessionResult& session) {
+  std::vector<Eigen::Vector3d> axes;
+  for (const TrialResult& t : session.trials) {
+    if (!t.errors.viewer_axes_mm) return std::nullopt;
+    axes.push_back(*t.errors.viewer_axes_mm);
+  }
   return ComputeTable1Row(axes);
 }
 
@@ -172,6 +194,7 @@ std::string ResultsJson(const RunResults& r) {
       WritePose(&json, t.X_WV);
       json.Key("X_WR");
       WritePose(&json, t.X_WR);
+      if (t.viewer_eye_W_m) json.Key("viewer_eye_W_m").Array(Numbers(*t.viewer_eye_W_m));
       json.Key("annotated_real_W_m").BeginArray();
       for (const Eigen::Vector3d& p : t.annotated_real_W_m)
         json.Array(std::vector<double>{p.x(), p.y(), p.z()});
@@ -195,15 +218,12 @@ std::string ResultsJson(const RunResults& r) {
       json.Key(name).BeginObject().Key("mean").Number(stats.mean).Key("std").Number(stats.std).EndObject();
     }
     json.EndObject();
-    const Table1Row table1 = SessionTable1Row(s);
-    const auto vector = [](const Eigen::Vector3d& v) { return std::vector<double>{v.x(), v.y(), v.z()}; };
-    json.Key("table1").BeginObject();
-    json.Key("num_trials").Int(table1.num_trials);
-    json.Key("axes_mean_mm").Array(vector(table1.axes_mean_mm));
-    json.Key("axes_std_mm").Array(vector(table1.axes_std_mm));
-    json.Key("mean_mm").Number(table1.mean_mm);
-    json.Key("std_mm").Number(table1.std_mm);
-    json.EndObject();
+    json.Key("table1");
+    WriteTable1(&json, SessionTable1Row(s));
+    if (const std::optional<Table1Row> viewer = SessionViewerTable1Row(s)) {
+      json.Key("table1_viewer");
+      WriteTable1(&json, *viewer);
+    }
     json.Key("mean");
     if (s.mean) {
       const MeanResult& m = *s.mean;
@@ -272,6 +292,15 @@ std::string ResultsTable(const RunResults& r) {
       out << "   (paper: " << Fixed(kPaperAr.misalignment_mm, 1) << " +/- " << Fixed(kPaperAr.std_mm, 1)
           << " mm)";
     }
+    const auto axes = [](const Eigen::Vector3d& v) {
+      return "(" + Fixed(v.x(), 1) + ", " + Fixed(v.y(), 1) + ", " + Fixed(v.z(), 1) + ")";
+    };
+    out << "\n" << PadRight("", 23) << "per axis, means: W (x, y, z) " << axes(table1.axes_mean_mm);
+    if (const std::optional<Table1Row> viewer = SessionViewerTable1Row(s)) {
+      out << ", viewer S (across, down, line of sight) " << axes(viewer->axes_mean_mm) << " = "
+          << Fixed(viewer->mean_mm, 1) << " +/- " << Fixed(viewer->std_mm, 1);
+    }
+    out << " mm";
     const MeanStd stats = ComputeMeanStd(misalignment);
     out << "\n"
         << PadRight("", 23) << "mean of the trials' mis " << Fixed(stats.mean, 1) << " +/- "
@@ -331,6 +360,10 @@ ErrorMeasures ReadMeasures(const JsonFields& f, const JsonAt& at) {
   }
   if (const auto truth = f.OptionalMember(at, "truth_misalignment_mm")) {
     e.truth_misalignment_mm = f.Number(*truth, 0, kMaxMeasure);
+  }
+  if (const auto viewer = f.OptionalMember(at, "viewer_axes_mm")) {
+    const std::vector<double> v = f.Numbers(*viewer, 3, 0, kMaxMeasure);
+    e.viewer_axes_mm = Eigen::Vector3d(v[0], v[1], v[2]);
   }
   return e;
 }
@@ -403,6 +436,10 @@ RunResults ParseResultsJson(const std::string& text, const std::string& source) 
       t.user_id = f.String(f.Member(t_at, "user_id"), kMaxName);
       t.X_WV = ReadPose(f, f.Member(t_at, "X_WV"));
       t.X_WR = ReadPose(f, f.Member(t_at, "X_WR"));
+      if (const auto eye = f.OptionalMember(t_at, "viewer_eye_W_m")) {
+        const std::vector<double> p = f.Numbers(*eye, 3, -kMaxCoordinate, kMaxCoordinate);
+        t.viewer_eye_W_m = Eigen::Vector3d(p[0], p[1], p[2]);
+      }
       if (const auto annotated = f.OptionalMember(t_at, "annotated_real_W_m")) {
         for (size_t l = 0, n = f.ArraySize(*annotated, kMaxAnnotatedLandmarks); l < n; ++l) {
           const std::vector<double> p =

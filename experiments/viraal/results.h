@@ -21,13 +21,14 @@
 ///                  "trials": [ {"index", "q_deg", "translation_error_mm", "rotation_error_deg",
 ///                               "misalignment_mm", "base_translation_error_mm",
 ///                               "flange_translation_error_mm", "misalignment_axes_mm" [t̄x,t̄y,t̄z],
-///                               "misalignment_mean_pair_distance_mm", "landmarks" ("gaze" | "gaze_real" (a
-///                               mean) | "truth"), "truth_misalignment_mm" (both absent in files written
-///                               before ALIGNMENT_TRIAL's contract change 5: read as "truth" and
-///                               misalignment_mm), "user_duration_s",
-///                               "user_id", "X_WV", "X_WR", "annotated_real_W_m" ([[x, y, z], ...]
-///                               [m], the triangulated real landmarks; [] without annotation; absent
-///                               in older files, read as []),
+///                               "misalignment_mean_pair_distance_mm", "viewer_axes_mm" ([t̄x, t̄y, t̄z]
+///                               in the trial's viewer frame S, metrics.h; only when the trial was
+///                               annotated), "viewer_eye_W_m" (S's eye [m], the same trials), "landmarks"
+///                               ("gaze" | "gaze_real" (a mean) | "truth"), "truth_misalignment_mm" (both
+///                               absent in files written before ALIGNMENT_TRIAL's contract change 5: read as
+///                               "truth" and misalignment_mm), "user_duration_s", "user_id", "X_WV", "X_WR",
+///                               "annotated_real_W_m" ([[x, y, z], ...] [m], the triangulated real landmarks;
+///                               [] without annotation; absent in older files, read as []),
 ///                               "tracking_faults": {"losses", "relocalizations", "wait_s",
 ///                                                   "repeats"} (only on a trial whose user met
 ///                                                   a tracking fault while aligning: see
@@ -36,9 +37,13 @@
 ///                                      N − 1; 0 for one trial),
 ///                  "table1": {"num_trials", "axes_mean_mm", "axes_std_mm", "mean_mm", "std_mm"}
 ///                            (the paper's statistic over the trials: Table1Row),
+///                  "table1_viewer": the same in the viewer frames (only when every trial has
+///                                   viewer_axes_mm),
 ///                  "mean": {"translation_error_mm", "rotation_error_deg", "misalignment_mm",
 ///                           "base_translation_error_mm", "flange_translation_error_mm",
 ///                           "misalignment_axes_mm", "misalignment_mean_pair_distance_mm",
+///                           "viewer_axes_mm" (each pair in the frame of the trial at its q; only when
+///                           every trial has an eye),
 ///                           "landmarks", "truth_misalignment_mm", "X_WV", "num_used", "rejected_indices",
 ///                           "rotation_rms_deg", "translation_rms_mm", "iterations", "converged", "unique"} }
 ///                           ]
@@ -47,8 +52,8 @@
 ///
 /// ReadResultsFile reads the document back (the conductor resuming a run), checked like any input
 /// from outside (base/json_fields.h): every field with its type and range, bounded counts, unit
-/// quaternions; "trial_statistics" and "table1" are derived, not read; "started_utime" and "duration_s" may
-/// be absent (a pinned file leaves them out).
+/// quaternions; "trial_statistics", "table1" and "table1_viewer" are derived, not read; "started_utime" and
+/// "duration_s" may be absent (a pinned file leaves them out).
 ///
 /// Threading: plain data and pure functions.
 
@@ -78,6 +83,10 @@ struct ErrorMeasures {
   std::string landmarks{"truth"};
   /// ‖t̄‖₂ of the truth pairs, whatever `landmarks` says (= misalignment_mm when it says "truth").
   double truth_misalignment_mm{0};
+  /// t̄ of the same pairs as misalignment_axes_mm, per axis of the viewer frame S instead of W
+  /// (metrics.h ViewerFrame: z the line of sight from where the person aligned); unset when no eye
+  /// is known (a trial nobody annotated, a mean of a session with such a trial).
+  std::optional<Eigen::Vector3d> viewer_axes_mm;
 };
 
 /// The tracking faults the user met while aligning (ALIGNMENT_TRIAL's contract change 2 fields).
@@ -103,6 +112,9 @@ struct TrialResult {
   /// [m], in the scenario's landmark order; empty when nobody annotated. What the session mean is
   /// measured against (exchange.h MeanError), kept here so that a resumed run measures it too.
   std::vector<Eigen::Vector3d> annotated_real_W_m;
+  /// Where the person stood when aligning (exchange.h AlignmentViewpoint), in the headset's map (W)
+  /// [m]: the eye of the trial's viewer frame, kept so that a resumed run's mean gets its frames.
+  std::optional<Eigen::Vector3d> viewer_eye_W_m;
 };
 
 struct MeanResult {
@@ -170,6 +182,8 @@ struct Table1Row {
 Table1Row ComputeTable1Row(const std::vector<Eigen::Vector3d>& trial_axes_mm);
 /// The row of a session's trials (their misalignment_axes_mm).
 Table1Row SessionTable1Row(const SessionResult& session);
+/// The same statistic in the viewer frames (the trials' viewer_axes_mm); unset when a trial has none.
+std::optional<Table1Row> SessionViewerTable1Row(const SessionResult& session);
 
 /// results.json text (pretty-printed, 2 spaces).
 std::string ResultsJson(const RunResults& results);

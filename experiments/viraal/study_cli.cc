@@ -98,9 +98,14 @@ std::string Summary(const StudyOptions& options, const viraal::RunResults& resul
             "   (the same from the truth's landmarks: the registration, not the user's view)\n";
     text += "  translation [mm]   " + MeanStdText(trans, 1) + "\n";
     text += "  rotation [deg]     " + MeanStdText(rot, 2) + "\n";
-    const std::vector<double> triples = GroupMeanMisalignment_mm(options, s, 3);
+    std::vector<double> triples, true_triples;
+    for (const GroupMean& g : GroupMeans(options, s, 3)) {
+      triples.push_back(g.errors.misalignment_mm);
+      true_triples.push_back(g.errors.truth_misalignment_mm);
+    }
     text += "  SE(3) means of N = 3 consecutive trials (" + std::to_string(triples.size()) +
-            "): misalignment " + MeanStdText(triples, 1) + " mm (the truth's landmarks)\n";
+            "): misalignment " + MeanStdText(triples, 1) + " mm, from the truth's landmarks " +
+            MeanStdText(true_triples, 1) + " mm\n";
   }
   if (misalignment.size() >= 2) {
     const std::string a = results.sessions[0].mode, b = results.sessions[1].mode;

@@ -15,6 +15,7 @@
 #include "base/run_folder.h"
 #include "base/source_paths.h"
 #include "experiments/viraal/paper_reference.h"
+#include "experiments/viraal/protocol.h"
 #include "experiments/viraal/viraal_study.h"
 
 namespace orbed::study {
@@ -29,14 +30,18 @@ std::string Csv(double value) {
 
 const char* kColumns =
     "user,mode,trial,t_x_mm,t_y_mm,t_z_mm,misalignment_mm,true_translation_mm,true_rotation_deg,duration_s,"
-    "landmarks,true_misalignment_mm\n";
+    "landmarks,true_misalignment_mm,v_x_mm,v_y_mm,v_z_mm\n";
 
 std::string Row(const std::string& user, const std::string& mode, const std::string& trial,
                 const viraal::ErrorMeasures& e, const std::string& duration_s) {
   const Eigen::Vector3d& t = e.misalignment_axes_mm;
   return user + "," + mode + "," + trial + "," + Csv(t.x()) + "," + Csv(t.y()) + "," + Csv(t.z()) + "," +
          Csv(t.norm()) + "," + Csv(e.translation_error_mm) + "," + Csv(e.rotation_error_deg) + "," +
-         duration_s + "," + e.landmarks + "," + Csv(e.truth_misalignment_mm) + "\n";
+         duration_s + "," + e.landmarks + "," + Csv(e.truth_misalignment_mm) + "," +
+         (e.viewer_axes_mm ? Csv(e.viewer_axes_mm->x()) + "," + Csv(e.viewer_axes_mm->y()) + "," +
+                                 Csv(e.viewer_axes_mm->z())
+                           : std::string(",,")) +
+         "\n";
 }
 
 void WritePaperRow(JsonWriter* json, const viraal::PaperTable1Axes& axes, const viraal::PaperFigure& norm) {
@@ -82,19 +87,18 @@ std::string AlignmentMeansCsv(const std::vector<UserRun>& runs) {
   return csv;
 }
 
-std::string AlignmentGroupsCsv(const std::vector<UserRun>& runs, const viraal::ScenarioConfig& scenario) {
-  std::string csv = "user,mode,group,trials,misalignment_mm\n";
+std::string AlignmentGroupsCsv(const std::vector<UserRun>& runs, int8_t method, int group_size) {
+  std::string csv =
+      "user,mode,group,trials,misalignment_mm,true_translation_mm,true_rotation_deg,landmarks,"
+      "true_misalignment_mm\n";
   for (const UserRun& run : runs) {
-    StudyOptions options;
-    options.scenario = scenario;
-    if (!run.results.configurations_deg.empty())
-      options.scenario.configurations_deg = run.results.configurations_deg;
-    if (!run.results.landmarks.empty()) options.scenario.landmarks = run.results.landmarks;
     for (const viraal::SessionResult& s : run.results.sessions) {
-      const std::vector<double> groups = GroupMeanMisalignment_mm(options, s, kGroupTrials);
-      for (size_t g = 0; g < groups.size(); ++g) {
-        csv += run.user + "," + s.mode + "," + std::to_string(g + 1) + "," + std::to_string(kGroupTrials) +
-               "," + Csv(groups[g]) + "\n";
+      for (const GroupMean& g : GroupMeans(s, group_size, run.results.landmarks, method)) {
+        const viraal::ErrorMeasures& e = g.errors;
+        csv += run.user + "," + s.mode + "," + std::to_string(g.first_trial / group_size + 1) + "," +
+               std::to_string(g.first_trial + 1) + "-" + std::to_string(g.first_trial + g.num_trials) + "," +
+               Csv(e.misalignment_mm) + "," + Csv(e.translation_error_mm) + "," + Csv(e.rotation_error_deg) +
+               "," + e.landmarks + "," + Csv(e.truth_misalignment_mm) + "\n";
       }
     }
   }
@@ -142,6 +146,9 @@ int RunStudyTables(int argc, const char* const* argv, std::ostream& out, std::os
   std::vector<std::string> config_paths;
   app.add_option("--out", out_dir, "Folder to write the files into (created if missing)")->required();
   app.add_option("--seed", validation.seed, "Seed of the landmark check")->capture_default_str();
+  std::string scenario_path = SourceTreePath(viraal::kDefaultScenarioRelativePath);
+  app.add_option("--scenario", scenario_path, "The runs' scenario: its SE(3) averaging method for the groups")
+      ->capture_default_str();
   app.add_option("--config", config_paths,
                  "Headset config applied over the shipped ones (the runs' --config)");
   std::vector<std::string> setup_paths;
@@ -218,8 +225,7 @@ int RunStudyTables(int argc, const char* const* argv, std::ostream& out, std::os
       all.emplace_back("alignment_trials.csv", AlignmentTrialsCsv(runs));
       all.emplace_back("alignment_means.csv", AlignmentMeansCsv(runs));
       all.emplace_back("alignment_groups.csv",
-                       AlignmentGroupsCsv(runs, viraal::LoadScenarioFile(
-                                                    SourceTreePath(viraal::kDefaultScenarioRelativePath))));
+                       AlignmentGroupsCsv(runs, viraal::LoadScenarioFile(scenario_path).method));
     }
     all.emplace_back("landmark_validation.csv", LandmarkValidationCsv(v));
     all.emplace_back("tables.json",

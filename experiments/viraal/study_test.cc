@@ -51,19 +51,32 @@ TEST(ViraalStudy, EqualsThePinnedLiveRun) {
                                  {"started_utime", "duration_s"});
 }
 
-// One group of three is the session itself: its mean is the session mean the conductor scored, with
-// the truth's pairs (the group means have no annotated landmarks to be measured against).
+// One group of three is the session itself: its mean is the session mean the conductor scored,
+// measured the same way (against the real landmarks annotated in its trials, in their viewer
+// frames), and its truth errors are the session mean's.
 TEST(ViraalStudy, AGroupOfAllTheTrialsIsTheSessionMean) {
   const StudyOptions o = Shipped(3, "pinned");
   const viraal::RunResults results = RunViraalStudy(o);
   for (const viraal::SessionResult& s : results.sessions) {
-    const std::vector<double> groups = GroupMeanMisalignment_mm(o, s, 3);
+    const std::vector<GroupMean> groups = GroupMeans(o, s, 3);
     ASSERT_EQ(groups.size(), 1u);
     ASSERT_TRUE(s.mean.has_value());
-    EXPECT_EQ(s.mean->errors.landmarks, "gaze_real");
-    EXPECT_NEAR(groups[0], s.mean->errors.truth_misalignment_mm, 1e-9) << s.mode;
+    const viraal::ErrorMeasures& want = s.mean->errors;
+    const viraal::ErrorMeasures& got = groups[0].errors;
+    EXPECT_EQ(groups[0].first_trial, 0);
+    EXPECT_EQ(groups[0].num_trials, 3);
+    EXPECT_EQ(got.landmarks, "gaze_real");
+    EXPECT_NEAR(got.misalignment_mm, want.misalignment_mm, 1e-9) << s.mode;
+    EXPECT_NEAR(got.truth_misalignment_mm, want.truth_misalignment_mm, 1e-9) << s.mode;
+    EXPECT_NEAR(got.translation_error_mm, want.translation_error_mm, 1e-9) << s.mode;
+    EXPECT_NEAR(got.rotation_error_deg, want.rotation_error_deg, 1e-9) << s.mode;
+    ASSERT_TRUE(got.viewer_axes_mm && want.viewer_axes_mm);
+    EXPECT_NEAR((*got.viewer_axes_mm - *want.viewer_axes_mm).norm(), 0, 1e-9) << s.mode;
   }
-  EXPECT_EQ(GroupMeanMisalignment_mm(o, results.sessions[0], 2).size(), 1u);  // the third trial left out
+  const std::vector<GroupMean> pairs = GroupMeans(o, results.sessions[0], 2);
+  ASSERT_EQ(pairs.size(), 1u);  // the third trial left out
+  EXPECT_EQ(pairs[0].num_trials, 2);
+  EXPECT_THROW(GroupMeans(o, results.sessions[0], 0), std::invalid_argument);
 }
 
 TEST(ViraalStudy, SeedAndRunIdChooseTheTrials) {

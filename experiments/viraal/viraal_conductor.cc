@@ -233,6 +233,8 @@ ConductorActions ViraalConductor::OnTrial(const orbed::alignment_trial_t& msg, c
   const viraal::RobotPoints points = viraal::TrialPoints(*points_, msg);
   session_points_.push_back(points);
   pending_error_ = viraal::TrialError(robot_state_->X_WR, msg, points);
+  if (const auto eye = viraal::AlignmentViewpoint(std::get<orbed::AlignmentTrial>(checked)))
+    pending_error_ = viraal::WithViewer(pending_error_, *eye);
   Enter(Phase::kAwaitTrialResults);
   landmark_requests_ = viraal::LandmarkRequests(std::get<orbed::AlignmentTrial>(checked), now_.utime, 0);
   landmark_answers_.assign(landmark_requests_.size(), std::nullopt);
@@ -519,7 +521,8 @@ void ViraalConductor::Step() {
         }
         try {
           pending_error_ = viraal::MeanError(robot_state_->X_WR, mean, session_points_,
-                                             viraal::AnnotatedRealLandmarks(results_.sessions.back()));
+                                             viraal::AnnotatedRealLandmarks(results_.sessions.back()),
+                                             viraal::ViewerEyes(results_.sessions.back()));
         } catch (const std::invalid_argument& e) {
           FailRun(e.what());
           return;
@@ -652,7 +655,7 @@ void ViraalConductor::FinishTrial() {
   const orbed::alignment_trial_t& trial = *trial_;
   const viraal::TrialResult result =
       viraal::TrialResultFrom(trial, robot_state_->X_WR, viraal::Measures(pending_error_, *misalignment_),
-                              pending_error_.p_W_real_annotated);
+                              pending_error_.p_W_real_annotated, pending_error_.p_WE);
   results_.sessions.back().trials.push_back(result);
   Say(StepLabel() + ": robot at q=" + JointList(result.q_deg, 1) + " deg (reached in " + Fixed(reach_s_, 1) +
       " s); aligned in " + Fixed(trial.duration_s, 1) + " s of user time: " +

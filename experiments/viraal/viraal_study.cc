@@ -150,10 +150,12 @@ viraal::RunResults RunViraalStudy(const StudyOptions& options) {
         landmarks.push_back(service.HandleLandmarkRequest(request));
       }
       if (!landmarks.empty()) error = viraal::WithAnnotation(error, landmarks);
+      if (const auto eye = viraal::AlignmentViewpoint(std::get<orbed::AlignmentTrial>(checked)))
+        error = viraal::WithViewer(error, *eye);
       const orbed::misalignment_t misalignment = Checked(
           service.HandleMisalignmentRequest(viraal::MisalignmentRequest(error, session.session_id, 0, i)));
       session.trials.push_back(viraal::TrialResultFrom(trial, X_WR, viraal::Measures(error, misalignment),
-                                                       error.p_W_real_annotated));
+                                                       error.p_W_real_annotated, error.p_WE));
       if (options.progress) options.progress(++done, total);
     }
 
@@ -162,8 +164,8 @@ viraal::RunResults RunViraalStudy(const StudyOptions& options) {
     if (!mean || !mean->valid) {
       throw std::runtime_error("session '" + session.session_id + "': orbed-registration has no valid mean");
     }
-    const viraal::AlignmentError error =
-        viraal::MeanError(X_WR, *mean, session_points, viraal::AnnotatedRealLandmarks(session));
+    const viraal::AlignmentError error = viraal::MeanError(
+        X_WR, *mean, session_points, viraal::AnnotatedRealLandmarks(session), viraal::ViewerEyes(session));
     const orbed::misalignment_t misalignment = Checked(
         service.HandleMisalignmentRequest(viraal::MisalignmentRequest(error, session.session_id, 0, -1)));
     session.mean = viraal::MeanResultFrom(*mean, viraal::Measures(error, misalignment));
@@ -175,50 +177,50 @@ viraal::RunResults RunViraalStudy(const StudyOptions& options) {
   return results;
 }
 
-std::vector<double> GroupMeanMisalignment_mm(const StudyOptions& options,
-                                             const viraal::SessionResult& session, int group_size) {
+std::vector<GroupMean> GroupMeans(const viraal::SessionResult& session, int group_size,
+                                  const std::vector<std::string>& landmarks, int8_t method,
+                                  const std::string& urdf_path) {
   if (group_size < 1) throw std::invalid_argument("group size must be >= 1");
-  const viraal::ScenarioConfig& scenario = options.scenario;
-  const std::string urdf_path = UrdfPath(options);
-  const std::string scene_path = ScenePath(options);
-  const sim::RobotModel model = sim::RobotModel::LoadFile(urdf_path);
-  const viraal::RobotPointSet points(model, scenario.landmarks);
-  const orbed::pose_t X_WR = ToPose(sim::LoadSceneFile(scene_path).X_WR);
-  viraal::ModeSpec mode{session.mode, static_cast<int8_t>(session.display_mode), session.num_mirrors};
+  const sim::RobotModel model = sim::RobotModel::LoadFile(
+      urdf_path.empty() ? SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath) : urdf_path);
+  const viraal::RobotPointSet points(model, landmarks);
+  const viraal::ModeSpec mode{session.mode, static_cast<int8_t>(session.display_mode), session.num_mirrors};
 
-  std::vector<double> out;
+  std::vector<GroupMean> out;
   const int groups = static_cast<int>(session.trials.size()) / group_size;
   for (int g = 0; g < groups; ++g) {
     registration::RegistrationService service = MakeService();
     const std::string id = session.session_id + "-group-" + std::to_string(g);
-    service.HandleSessionControl(Control(orbed::session_control_t::START, id, mode, scenario.method));
+    service.HandleSessionControl(Control(orbed::session_control_t::START, id, mode, method));
+    // The group as a session of its own: its trials, what the user annotated in them, their eyes.
+    viraal::SessionResult group;
     std::vector<viraal::RobotPoints> group_points;
     for (int k = 0; k < group_size; ++k) {
-      const int i = g * group_size + k;
-      const viraal::TrialResult& result = session.trials[i];
-      orbed::alignment_trial_t trial{};
+      const viraal::TrialResult& result = session.trials[g * group_size + k];
+      orbed::alignment_trial_t trial = viraal::TrialMessageFrom(result, session, 0);
       trial.session_id = id;
       trial.trial_index = k;
-      trial.display_mode = mode.display_mode;
-      trial.num_mirrors = mode.num_mirrors;
-      const Eigen::VectorXd q_rad =
-          sim::DegToRad(ToVectorX(scenario.configurations_deg[i % scenario.configurations_deg.size()]));
-      trial.num_joints = static_cast<int32_t>(q_rad.size());
-      trial.joint_position = FromVectorX(q_rad);
-      trial.X_WV = ToPose(result.X_WV);
-      trial.duration_s = result.user_duration_s;
       service.HandleTrial(trial);
       group_points.push_back(viraal::TrialPoints(points, trial));
+      group.trials.push_back(result);
     }
     const auto mean =
-        service.HandleSessionControl(Control(orbed::session_control_t::COMPUTE, id, mode, scenario.method));
+        service.HandleSessionControl(Control(orbed::session_control_t::COMPUTE, id, mode, method));
     if (!mean || !mean->valid) throw std::runtime_error("group '" + id + "': no valid mean");
-    const viraal::AlignmentError error = viraal::MeanError(X_WR, *mean, group_points);
+    const orbed::pose_t X_WR = ToPose(group.trials.front().X_WR);
+    const viraal::AlignmentError error = viraal::MeanError(
+        X_WR, *mean, group_points, viraal::AnnotatedRealLandmarks(group), viraal::ViewerEyes(group));
     const orbed::misalignment_t misalignment =
         Checked(service.HandleMisalignmentRequest(viraal::MisalignmentRequest(error, id, 0, g)));
-    out.push_back(misalignment.mean_error_norm_m * 1e3);
+    out.push_back({g * group_size, group_size, viraal::Measures(error, misalignment)});
   }
   return out;
+}
+
+std::vector<GroupMean> GroupMeans(const StudyOptions& options, const viraal::SessionResult& session,
+                                  int group_size) {
+  return GroupMeans(session, group_size, options.scenario.landmarks, options.scenario.method,
+                    UrdfPath(options));
 }
 
 }  // namespace orbed::study

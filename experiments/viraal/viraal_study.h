@@ -52,12 +52,31 @@ struct StudyOptions {
 /// files, a configuration outside the joint limits or a refused message (naming it).
 viraal::RunResults RunViraalStudy(const StudyOptions& options);
 
-/// The paper's registration statistic: the trials of `session` taken `group_size` at a time in
-/// order (the last incomplete group left out), each group averaged on SE(3) by the registration
-/// server's core with the scenario's method, and scored over the group's configurations with the
-/// truth's landmark pairs (a group is not a session the conductor measured; its mean is scored as a
-/// trial without annotation would be). Returns each group mean's misalignment [mm].
-std::vector<double> GroupMeanMisalignment_mm(const StudyOptions& options,
-                                             const viraal::SessionResult& session, int group_size);
+/// One SE(3) mean of a group of consecutive trials of a session (GroupMeans).
+struct GroupMean {
+  int first_trial{0};  ///< the group's first trial, as an index into session.trials
+  int num_trials{0};
+  /// Measured as the conductor measures a session mean (experiments/viraal/exchange.h MeanError)
+  /// over the group's configurations: against the real landmarks the user annotated in the group's
+  /// trials (landmarks "gaze_real") when every one of them was annotated, else the truth's pairs;
+  /// truth_misalignment_mm, translation_error_mm (at the robot centroid, averaged over the group's
+  /// configurations) and rotation_error_deg against the truth; viewer_axes_mm in the trials'
+  /// viewer frames when every trial has an eye.
+  viraal::ErrorMeasures errors;
+};
+
+/// The paper's registration statistic (Sec. II-A, IV-B: the SE(3) average of N = 3 trials): the
+/// trials of `session` taken `group_size` at a time in order (the last incomplete group left out),
+/// each group averaged on SE(3) by the registration server's core with `method`
+/// (registration_t.METHOD_*), its trials as results.json has them (q_deg, X_WV, X_WR), the
+/// landmarks and centroid of `landmarks` on the robot of `urdf_path` ("" = the shipped model).
+/// Throws std::invalid_argument for a group size below 1, std::runtime_error when the server has no
+/// valid mean for a group.
+std::vector<GroupMean> GroupMeans(const viraal::SessionResult& session, int group_size,
+                                  const std::vector<std::string>& landmarks, int8_t method,
+                                  const std::string& urdf_path = "");
+/// The same with the scenario's landmarks and method and options' robot model.
+std::vector<GroupMean> GroupMeans(const StudyOptions& options, const viraal::SessionResult& session,
+                                  int group_size);
 
 }  // namespace orbed::study

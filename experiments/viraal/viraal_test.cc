@@ -1,6 +1,8 @@
 // The ViRAAl protocol library: the metrics against hand-computed offsets, the scenario file's
 // loading and errors, results.json's shape.
+#include <array>
 #include <cmath>
+#include <optional>
 #include <regex>
 #include <string>
 #include <vector>
@@ -138,6 +140,95 @@ TEST(ViraalErrors, TheMeanIsMeasuredAgainstTheAnnotatedRealLandmarks) {
   EXPECT_THROW(MeanError(X_WR, mean, {a, b}, {{a.p_RL[0]}, {b.p_RL[0]}}), std::invalid_argument);
   // The right total, the wrong split between the trials: refused, not shifted.
   EXPECT_THROW(MeanError(X_WR, mean, {a, b}, {{a.p_RL[0], b.p_RL[0]}, {b.p_RL[1]}}), std::invalid_argument);
+}
+
+// Eye 2 m before the target along W y, at its height: z = W y, x = z × W z = W x (to the right of
+// someone looking along +y with z up), y = z × x = −W z (down).
+TEST(ViewerFrame, LevelLineOfSightAlongWorldY) {
+  const Eigen::Matrix3d R_WS = ViewerFrame(Eigen::Vector3d(0, -2, 1.5), Eigen::Vector3d(0, 0, 1.5));
+  EXPECT_NEAR((R_WS.col(0) - Eigen::Vector3d(1, 0, 0)).norm(), 0, 1e-15);
+  EXPECT_NEAR((R_WS.col(1) - Eigen::Vector3d(0, 0, -1)).norm(), 0, 1e-15);
+  EXPECT_NEAR((R_WS.col(2) - Eigen::Vector3d(0, 1, 0)).norm(), 0, 1e-15);
+  // Looking straight down: x falls back to W x; still a rotation.
+  const Eigen::Matrix3d down = ViewerFrame(Eigen::Vector3d(0, 0, 2), Eigen::Vector3d(0, 0, 0));
+  EXPECT_NEAR((down.col(0) - Eigen::Vector3d(1, 0, 0)).norm(), 0, 1e-15);
+  EXPECT_NEAR(down.determinant(), 1, 1e-15);
+  EXPECT_THROW(ViewerFrame(Eigen::Vector3d(1, 1, 1), Eigen::Vector3d(1, 1, 1.0005)), std::invalid_argument);
+}
+
+// The eye above and beside the robot (a downward, oblique line of sight). The hologram shifted by
+// 10 mm along the line of sight from the eye to the landmarks' centroid T: in S the error is
+// (0, 0, 10) mm for every pair, while in W it spreads over all three axes (10·|d| per axis). Shifted
+// 10 mm horizontally across the line of sight: (10, 0, 0); along S's y (down, in the vertical plane
+// of the line of sight): (0, 10, 0).
+TEST(ViewerFrame, AnOffsetAlongTheLineOfSightIsDepthOnly) {
+  const Eigen::Isometry3d X_WR = Eigen::Isometry3d::Identity();
+  RobotPoints points;
+  points.p_RL = {Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0, 1, 0), Eigen::Vector3d(0, 0, 1)};
+  const Eigen::Vector3d p_WT(1.0 / 3, 1.0 / 3, 1.0 / 3);
+  const Eigen::Vector3d p_WE(2, -1, 2);
+  const Eigen::Vector3d d = (p_WT - p_WE).normalized();  // (−5, 4, −5)/√66
+  const Eigen::Vector3d across = d.cross(Eigen::Vector3d::UnitZ()).normalized();
+  const Eigen::Vector3d down = d.cross(across);
+  const orbed::misalignment_t answer{};
+  const struct {
+    Eigen::Vector3d offset_W;
+    Eigen::Vector3d viewer_mm;
+  } cases[] = {{0.01 * d, {0, 0, 10}}, {0.01 * across, {10, 0, 0}}, {0.01 * down, {0, 10, 0}}};
+  for (const auto& c : cases) {
+    Eigen::Isometry3d X_WV = X_WR;
+    X_WV.translation() += c.offset_W;
+    const AlignmentError e = WithViewer(EvaluateAlignment(X_WR, X_WV, points), p_WE);
+    ASSERT_EQ(e.R_WS.size(), 3u);
+    ASSERT_TRUE(e.p_WE.has_value());
+    const ErrorMeasures m = Measures(e, answer);
+    ASSERT_TRUE(m.viewer_axes_mm.has_value());
+    EXPECT_NEAR((*m.viewer_axes_mm - c.viewer_mm).norm(), 0, 1e-12) << m.viewer_axes_mm->transpose();
+  }
+  // The W axes of the depth offset: 10 mm · |d| = 10/√66 · (5, 4, 5) mm.
+  const Eigen::Vector3d W_mm =
+      1e3 * ViewerAxesError({p_WT}, {p_WT + 0.01 * d}, {Eigen::Matrix3d::Identity()});
+  EXPECT_NEAR((W_mm - 10 / std::sqrt(66.0) * Eigen::Vector3d(5, 4, 5)).norm(), 0, 1e-12);
+  // No eye, no viewer axes.
+  EXPECT_FALSE(Measures(EvaluateAlignment(X_WR, X_WR, points), answer).viewer_axes_mm.has_value());
+  EXPECT_THROW(ViewerAxesError({p_WT}, {p_WT}, {}), std::invalid_argument);
+}
+
+// A session mean 10 mm off along W x, measured in each trial's frame: trial a looked along +W x (the
+// offset is its depth, z), trial b along +W y (the offset is across its line of sight, x). a has one
+// landmark pair, b two: (2·10, 0, 1·10) / 3 mm.
+TEST(ViewerFrame, TheMeanIsMeasuredInEachTrialsFrame) {
+  orbed::pose_t X_WR{};
+  X_WR.quaternion_wxyz[0] = 1;
+  orbed::registration_t mean{};
+  mean.X_WV_mean = X_WR;
+  mean.X_WV_mean.position_m[0] = 0.01;
+  RobotPoints a, b;
+  a.p_RL = {Eigen::Vector3d(1, 0, 1)};
+  b.p_RL = {Eigen::Vector3d(0, 1, 1), Eigen::Vector3d(0, 3, 1)};  // centroid (0, 2, 1)
+  const std::vector<std::optional<Eigen::Vector3d>> eyes = {Eigen::Vector3d(-1, 0, 1),
+                                                            Eigen::Vector3d(0, 0, 1)};
+  const AlignmentError e = MeanError(X_WR, mean, {a, b}, {}, eyes);
+  ASSERT_EQ(e.R_WS.size(), 3u);
+  const ErrorMeasures m = Measures(e, orbed::misalignment_t{});
+  ASSERT_TRUE(m.viewer_axes_mm.has_value());
+  EXPECT_NEAR((*m.viewer_axes_mm - Eigen::Vector3d(20.0 / 3, 0, 10.0 / 3)).norm(), 0, 1e-12);
+  // A trial without an eye: no frames for the mean; the wrong count is refused.
+  EXPECT_TRUE(MeanError(X_WR, mean, {a, b}, {}, {eyes[0], std::nullopt}).R_WS.empty());
+  EXPECT_THROW(MeanError(X_WR, mean, {a, b}, {}, {eyes[0]}), std::invalid_argument);
+}
+
+// The eye is where the first ray at each landmark and side starts (the alignment viewpoint).
+TEST(ViewerFrame, TheEyeIsWhereTheFirstRaysStart) {
+  orbed::AlignmentTrial trial;
+  EXPECT_FALSE(AlignmentViewpoint(trial).has_value());
+  std::array<orbed::LandmarkRays, 2> sides;
+  sides[0].origin_W_m = {Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(5, 5, 5)};
+  sides[1].origin_W_m = {Eigen::Vector3d(3, 0, 2), Eigen::Vector3d(7, 7, 7)};
+  trial.annotation = {sides};
+  const std::optional<Eigen::Vector3d> eye = AlignmentViewpoint(trial);
+  ASSERT_TRUE(eye.has_value());
+  EXPECT_NEAR((*eye - Eigen::Vector3d(2, 0, 1)).norm(), 0, 1e-15);
 }
 
 TEST(ViraalErrors, RobotPointsOfTheIiwaUpright) {

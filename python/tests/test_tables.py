@@ -89,12 +89,13 @@ def test_the_same_user_twice_keeps_the_means_and_shrinks_the_stds():
 
 def test_table1_of_groups_of_three_and_in_the_viewer_frame():
     groups = pd.DataFrame({"user": ["u1", "u1", "u2", "u1"], "mode": ["ar_reflective"] * 3 + ["ar"],
-                           "group": ["1", "2", "1", "1"], "trials": [3, 3, 3, 3],
+                           "group": ["1", "2", "1", "1"], "trials": ["1-3", "4-6", "1-3", "1-3"],
                            "misalignment_mm": [10.0, 12.0, 14.0, 20.0]})
     g = tables.table1_groups(groups)
     assert g["ar_reflective"]["norm"] == pytest.approx([12.0, 2.0])  # (4 + 0 + 4) / 2 = 4
     assert g["ar_reflective"]["groups"] == 3 and g["ar_reflective"]["users"] == 2
-    assert g["ar"]["norm"] == [20.0, 0.0]
+    assert g["ar"]["norm"] == [20.0, 0.0] and g["ar"]["trials_per_group"] == 3
+    assert tables.group_size("4-6") == 3 and tables.group_size("3") == 3
     trials = pd.DataFrame({"user": ["u1"] * 2, "mode": ["ar"] * 2, "t_x_mm": [1.0, 3.0], "t_y_mm": [0.0, 0.0],
                            "t_z_mm": [0.0, 0.0]})
     assert tables.table1_viewer(trials) is None

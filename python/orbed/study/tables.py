@@ -59,14 +59,25 @@ def table1(trials, means=None, groups=None):
     return out
 
 
+def group_size(trials):
+    """Trials in a group from alignment_groups.csv's `trials` cell: a range "1-3" or a count "3"."""
+    first, _, last = str(trials).partition("-")
+    return int(last) - int(first) + 1 if last else int(first)
+
+
 def table1_groups(groups):
+    """The SE(3) row, means of N = 3 trials: mean +/- std of the groups' misalignment (measured as the
+    paper measured a mean) and, when the file has it, of true_misalignment_mm (the truth's landmarks)."""
     out = {}
     for mode in modes_in(groups):
         rows = groups[groups["mode"] == mode]
         x = rows["misalignment_mm"].astype(float).to_numpy()
         out[mode] = {"norm": [float(x.mean()), float(x.std(ddof=1)) if x.size > 1 else 0.0],
-                     "groups": int(x.size), "trials_per_group": int(rows["trials"].astype(int).iloc[0]),
+                     "groups": int(x.size), "trials_per_group": group_size(rows["trials"].iloc[0]),
                      "users": int(rows["user"].nunique())}
+        if "true_misalignment_mm" in rows.columns:
+            t = rows["true_misalignment_mm"].astype(float).to_numpy()
+            out[mode]["true_norm"] = [float(t.mean()), float(t.std(ddof=1)) if t.size > 1 else 0.0]
     return out
 
 
