@@ -18,6 +18,7 @@
 #include "base/stats.h"
 #include "experiments/viraal/landmark_validation.h"
 #include "experiments/viraal/paper_reference.h"
+#include "experiments/viraal/rank_flip.h"
 #include "experiments/viraal/viraal_study.h"
 
 namespace orbed::study {
@@ -191,9 +192,69 @@ int RunUserStudy(int argc, const char* const* argv, std::ostream& out, std::ostr
       ->check(orbed::NonNegativeNumber())
       ->capture_default_str()
       ->needs(validation_flag);
-  app.add_option("--csv", csv_path, "--landmark-validation: write landmark_validation.csv to this file")
-      ->needs(validation_flag);
+  int studies = 0, users = 4;
+  std::uint64_t user_seed = 1;
+  auto* studies_option =
+      app.add_option("--studies", studies,
+                     "Instead of one run: M studies of --users users each (the paper's 4 x 10 trials per "
+                     "mode; --trials defaults to 10), seeded as `scripts/orbed study --seed S+users*m`; "
+                     "writes one row per study and mode to --csv (rank_flip.h)")
+          ->transform(PositiveDecimalInt())
+          ->excludes(validation_flag);
+  app.add_option("--users", users, "--studies: users per study")
+      ->transform(PositiveDecimalInt())
+      ->capture_default_str()
+      ->needs(studies_option);
+  auto* user_seed_option = app.add_option("--user-seed", user_seed,
+                                          "The emulated person, as orbed-hmd --user-seed (with --studies: S, "
+                                          "the first user's of the first study)");
+  app.add_option("--csv", csv_path,
+                 "--landmark-validation: write landmark_validation.csv to this file; --studies: the rows "
+                 "(required)");
   if (const auto code = ParseArguments(&app, argc, argv, out, err)) return *code;
+  if (!csv_path.empty() && !landmark_validation && studies == 0) {
+    err << "orbed-user-study: --csv needs --landmark-validation or --studies\n";
+    return 2;
+  }
+  if (studies > 0 && csv_path.empty()) {
+    err << "orbed-user-study: --studies needs --csv FILE for its rows\n";
+    return 2;
+  }
+  if (studies > 0) {
+    try {
+      RankFlipOptions rank;
+      rank.study.scenario = viraal::LoadScenarioFile(scenario_path);
+      viraal::ApplyOverrides(&rank.study.scenario, trials > 0 ? trials : 10, modes, {});
+      rank.study.seed = o.seed;
+      rank.study.urdf_path = o.urdf_path;
+      rank.study.scene_path = o.scene_path;
+      rank.study.headset_config_paths = o.headset_config_paths;
+      rank.studies = studies;
+      rank.users = users;
+      rank.first_user_seed = user_seed;
+      int last_tenth = -1;
+      if (!quiet) {
+        rank.progress = [&err, &last_tenth](int done, int total) {
+          const int tenth = 10 * done / total;
+          if (tenth == last_tenth) return;
+          last_tenth = tenth;
+          err << "orbed-user-study: " << done << "/" << total << " studies\n";
+        };
+      }
+      const std::vector<StudyModeRow> rows = RunRankFlipStudies(rank);
+      std::ofstream file(csv_path);
+      file << RankFlipCsv(rows);
+      if (!file) throw std::runtime_error("cannot write " + csv_path);
+      out << "orbed-user-study: " << studies << " studies of " << users << " users x "
+          << rank.study.scenario.trials << " trials per mode: " << rows.size() << " rows in " << csv_path
+          << " (the flip fraction: python/orbed/study/rank_flip.py)\n";
+    } catch (const std::exception& e) {
+      err << "orbed-user-study: " << e.what() << "\n";
+      return 1;
+    }
+    return 0;
+  }
+  if (*user_seed_option) o.user_seed = user_seed;
   if (landmark_validation) {
     try {
       validation.seed = o.seed;

@@ -8,6 +8,7 @@
 //   - the command line: help, bad arguments, a small run and its results.json.
 #include "experiments/viraal/viraal_study.h"
 
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <string>
@@ -19,6 +20,7 @@
 #include "base/source_paths.h"
 #include "base/stats.h"
 #include "base/test_command.h"
+#include "experiments/viraal/rank_flip.h"
 #include "experiments/viraal/results.h"
 #include "experiments/viraal/study_cli.h"
 #include "tests/same_tree.h"
@@ -125,6 +127,99 @@ TEST(ViraalStudy, DisplayFromTheAlignmentViewpointDoesNotHelp) {
   const stats::MannWhitneyResult mw = stats::MannWhitneyU(with, without);
   ASSERT_TRUE(mw.valid);
   EXPECT_GT(mw.p_x_less, 0.05) << stats::Mean(with) << " vs " << stats::Mean(without) << " mm";
+}
+
+// The rows of one study, by hand: mode ar pools user A's trials t̄ = (3, 0, 0) and (0, 4, 0) mm and
+// user B's (0, 0, 12) mm: per-axis means (1, 4/3, 4), norm √(1 + 16/9 + 16) = 13/3 mm; true
+// translation errors 10, 20, 60 mm: mean 30. In mode ar_reflective one trial has no viewer frame:
+// measured_s_mm is NaN.
+TEST(RankFlip, RowsAreTheTable1FigureAndTheTruthsMeanOverThePooledTrials) {
+  const auto trial = [](const Eigen::Vector3d& axes, double translation, double truth, bool viewer) {
+    viraal::TrialResult t;
+    t.errors.misalignment_axes_mm = axes;
+    t.errors.translation_error_mm = translation;
+    t.errors.truth_misalignment_mm = truth;
+    if (viewer) t.errors.viewer_axes_mm = Eigen::Vector3d(0, 0, 3);
+    return t;
+  };
+  const auto session = [](const std::string& mode, std::vector<viraal::TrialResult> trials) {
+    viraal::SessionResult s;
+    s.mode = mode;
+    s.trials = std::move(trials);
+    return s;
+  };
+  viraal::RunResults a, b;
+  a.sessions = {session("ar_reflective", {trial({1, 1, 1}, 5, 1, true)}),
+                session("ar", {trial({3, 0, 0}, 10, 1, true), trial({0, 4, 0}, 20, 2, true)})};
+  b.sessions = {session("ar_reflective", {trial({1, 1, 1}, 7, 1, false)}),
+                session("ar", {trial({0, 0, 12}, 60, 3, true)})};
+  const std::vector<StudyModeRow> rows = StudyRows(7, 29, {a, b});
+  ASSERT_EQ(rows.size(), 2u);
+  EXPECT_EQ(rows[1].mode, "ar");
+  EXPECT_EQ(rows[1].study, 7);
+  EXPECT_EQ(rows[1].first_user_seed, 29u);
+  EXPECT_EQ(rows[1].users, 2);
+  EXPECT_EQ(rows[1].trials, 3);
+  EXPECT_NEAR(rows[1].measured_w_mm, 13.0 / 3, 1e-12);
+  EXPECT_NEAR(rows[1].measured_s_mm, 3.0, 1e-12);
+  EXPECT_NEAR(rows[1].true_translation_mm, 30.0, 1e-12);
+  EXPECT_NEAR(rows[1].true_misalignment_mm, 2.0, 1e-12);
+  EXPECT_NEAR(rows[0].measured_w_mm, std::sqrt(3.0), 1e-12);
+  EXPECT_TRUE(std::isnan(rows[0].measured_s_mm));
+  const std::string csv = RankFlipCsv(rows);
+  EXPECT_EQ(
+      csv.rfind("study,first_user_seed,mode,users,trials,measured_w_mm,measured_s_mm,true_translation_mm,"
+                "true_misalignment_mm\n7,29,ar_reflective,2,2,",
+                0),
+      0u)
+      << csv;
+}
+
+// Study m is `scripts/orbed study --seed S + U·m`: its users are the persons of seeds S + U·m, +1, ...
+// with run ids study-s<S + U·m>-u<k>.
+TEST(RankFlip, StudyMIsTheStudyWhoseFirstUserSeedIsSPlusUsersTimesM) {
+  EXPECT_EQ(StudyUserSeed(5, 1), 5u);
+  EXPECT_EQ(StudyUserSeed(5, 4), 8u);
+  EXPECT_EQ(StudyRunId(5, 2), "study-s5-u2");
+  RankFlipOptions options;
+  options.study = Shipped(2, "ignored");
+  options.studies = 2;
+  options.users = 2;
+  options.first_user_seed = 3;
+  const std::vector<StudyModeRow> rows = RunRankFlipStudies(options);
+  ASSERT_EQ(rows.size(), 4u);
+  std::vector<viraal::RunResults> second;
+  for (int k = 1; k <= 2; ++k) {
+    StudyOptions o = Shipped(2, StudyRunId(5, k));
+    o.user_seed = StudyUserSeed(5, k);
+    second.push_back(RunViraalStudy(o));
+  }
+  EXPECT_EQ(second[1].sessions[0].trials[0].user_id, "emulated-seed-6");
+  const std::vector<StudyModeRow> want = StudyRows(1, 5, second);
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_EQ(rows[2 + i].first_user_seed, 5u);
+    EXPECT_EQ(rows[2 + i].mode, want[i].mode);
+    EXPECT_EQ(rows[2 + i].measured_w_mm, want[i].measured_w_mm);
+    EXPECT_EQ(rows[2 + i].true_translation_mm, want[i].true_translation_mm);
+  }
+  EXPECT_NE(rows[0].measured_w_mm, rows[2].measured_w_mm);  // another study, other persons
+  options.studies = 0;
+  EXPECT_THROW(RunRankFlipStudies(options), std::invalid_argument);
+}
+
+TEST(UserStudyCli, StudiesWriteTheirRowsAndNeedACsv) {
+  const std::string csv = ::testing::TempDir() + "rank_flip.csv";
+  test::CommandRun r =
+      test::RunCommand(RunUserStudy, "orbed-user-study",
+                       {"--studies", "2", "--users", "1", "--trials", "1", "--csv", csv, "--quiet"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::ifstream in(csv);
+  int lines = 0;
+  for (std::string line; std::getline(in, line);) ++lines;
+  EXPECT_EQ(lines, 1 + 2 * 2);
+  EXPECT_EQ(test::RunCommand(RunUserStudy, "orbed-user-study", {"--studies", "2"}).code, 2);
+  EXPECT_EQ(test::RunCommand(RunUserStudy, "orbed-user-study", {"--csv", csv}).code, 2);
+  EXPECT_EQ(test::RunCommand(RunUserStudy, "orbed-user-study", {"--users", "2"}).code, 2);
 }
 
 TEST(UserStudyCli, HelpGoesToOutAndExitsZero) {

@@ -71,7 +71,8 @@ viraal::RunResults RunViraalStudy(const StudyOptions& options) {
     headset_paths.push_back(hmd::HmdSourcePath(relative));
   headset_paths.insert(headset_paths.end(), options.headset_config_paths.begin(),
                        options.headset_config_paths.end());
-  const hmd::HmdConfigSet headset = hmd::LoadHmdConfigs(headset_paths);
+  hmd::HmdConfigSet headset = hmd::LoadHmdConfigs(headset_paths);
+  if (options.user_seed) headset.user.seed = *options.user_seed;
   const Eigen::Isometry3d X_WV_start = hmd::EmulatedUser(headset.user).StartPose(scene.X_WR);
   const std::string user_id = "emulated-seed-" + std::to_string(headset.user.seed);
 

@@ -24,6 +24,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -42,6 +43,8 @@ struct StudyOptions {
   std::vector<std::string> headset_config_paths;
   /// orbed-hmd's --seed (the per-trial seeds derive from it) and the conductor's (results.json).
   std::uint64_t seed{1};
+  /// orbed-hmd's --user-seed: the emulated person (overrides the configs' user.seed when set).
+  std::optional<std::uint64_t> user_seed;
   /// Session ids are "<run_id>-<mode>".
   std::string run_id{"study"};
   /// Called after each trial with (trials done, trials in all); may be empty.
