@@ -43,7 +43,7 @@ struct RankFlipOptions {
 };
 
 struct StudyModeRow {
-  int study{0};  ///< m, from 0
+  int study{0};                      ///< m, from 0
   std::uint64_t first_user_seed{0};  ///< S + users·m
   std::string mode;
   int users{0};
