@@ -78,6 +78,7 @@ std::vector<StudyModeRow> RunRankFlipStudies(const RankFlipOptions& options) {
       users.push_back(RunViraalStudy(o));
     }
     for (StudyModeRow& row : StudyRows(m, seed, users)) rows.push_back(std::move(row));
+    if (options.on_study) options.on_study(m, users);
     if (options.progress) options.progress(m + 1, options.studies);
   }
   return rows;

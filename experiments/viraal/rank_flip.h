@@ -40,6 +40,9 @@ struct RankFlipOptions {
   std::uint64_t first_user_seed{1};  ///< S
   /// Called after each study with (studies done, studies in all); may be empty.
   std::function<void(int, int)> progress;
+  /// Called after each study, in order, with its index m and its users' results (user k at k − 1);
+  /// may be empty (orbed-user-study --tables-dir writes the study's CSVs from it).
+  std::function<void(int, const std::vector<viraal::RunResults>&)> on_study;
 };
 
 struct StudyModeRow {

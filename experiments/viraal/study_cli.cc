@@ -19,6 +19,7 @@
 #include "experiments/viraal/landmark_validation.h"
 #include "experiments/viraal/paper_reference.h"
 #include "experiments/viraal/rank_flip.h"
+#include "experiments/viraal/study_tables.h"
 #include "experiments/viraal/viraal_study.h"
 
 namespace orbed::study {
@@ -211,6 +212,12 @@ int RunUserStudy(int argc, const char* const* argv, std::ostream& out, std::ostr
   app.add_option("--csv", csv_path,
                  "--landmark-validation: write landmark_validation.csv to this file; --studies: the rows "
                  "(required)");
+  std::string tables_dir;
+  app.add_option(
+         "--tables-dir", tables_dir,
+         "--studies: also write every study's alignment_trials.csv and alignment_groups.csv rows into "
+         "this folder, each row led by its study's index (the predictive bands read them)")
+      ->needs(studies_option);
   if (const auto code = ParseArguments(&app, argc, argv, out, err)) return *code;
   if (!csv_path.empty() && !landmark_validation && studies == 0) {
     err << "orbed-user-study: --csv needs --landmark-validation or --studies\n";
@@ -241,7 +248,23 @@ int RunUserStudy(int argc, const char* const* argv, std::ostream& out, std::ostr
           err << "orbed-user-study: " << done << "/" << total << " studies\n";
         };
       }
+      std::ofstream trials_file, groups_file;
+      if (!tables_dir.empty()) {
+        trials_file.open(tables_dir + "/alignment_trials.csv");
+        groups_file.open(tables_dir + "/alignment_groups.csv");
+        if (!trials_file || !groups_file) throw std::runtime_error("cannot write into " + tables_dir);
+        const int8_t method = rank.study.scenario.method;
+        rank.on_study = [&](int m, const std::vector<viraal::RunResults>& results) {
+          std::vector<UserRun> runs;
+          for (size_t k = 0; k < results.size(); ++k)
+            runs.push_back({"u" + std::to_string(k + 1), results[k]});
+          trials_file << WithStudyColumn(AlignmentTrialsCsv(runs), m);
+          groups_file << WithStudyColumn(AlignmentGroupsCsv(runs, method), m);
+        };
+      }
       const std::vector<StudyModeRow> rows = RunRankFlipStudies(rank);
+      if (!tables_dir.empty() && !(trials_file.flush() && groups_file.flush()))
+        throw std::runtime_error("cannot write into " + tables_dir);
       std::ofstream file(csv_path);
       file << RankFlipCsv(rows);
       if (!file) throw std::runtime_error("cannot write " + csv_path);

@@ -105,6 +105,24 @@ std::string AlignmentGroupsCsv(const std::vector<UserRun>& runs, int8_t method, 
   return csv;
 }
 
+std::string WithStudyColumn(const std::string& csv, int m) {
+  std::string out;
+  size_t begin = 0;
+  bool header = true;
+  while (begin < csv.size()) {
+    size_t end = csv.find('\n', begin);
+    if (end == std::string::npos) end = csv.size();
+    if (!header) {
+      out += std::to_string(m) + "," + csv.substr(begin, end - begin) + "\n";
+    } else if (m == 0) {
+      out += "study," + csv.substr(begin, end - begin) + "\n";
+    }
+    header = false;
+    begin = end + 1;
+  }
+  return out;
+}
+
 std::string TablesJson(bool viraal, bool setup, const std::string& provenance) {
   JsonWriter json(2);
   json.BeginObject();
@@ -162,7 +180,30 @@ int RunStudyTables(int argc, const char* const* argv, std::ostream& out, std::os
                  "of the error); one per --setup-truth")
       ->allow_extra_args(false);
   app.add_option("runs", run_paths, "Each ViRAAl user's results.json or its run folder");
+  bool paper_only = false;
+  app.add_flag(
+      "--paper-only", paper_only,
+      "Write only tables.json with the paper's figures of both halves (no runs; the predictive bands "
+      "compare with them)");
   if (const auto code = ParseArguments(&app, argc, argv, out, err)) return *code;
+  if (paper_only) {
+    if (!run_paths.empty() || !setup_paths.empty() || !setup_truth_paths.empty()) {
+      err << "orbed-study-tables: --paper-only takes no runs (see --help)\n";
+      return 2;
+    }
+    try {
+      std::filesystem::create_directories(out_dir);
+      const std::string path = (std::filesystem::path(out_dir) / "tables.json").string();
+      std::ofstream file(path);
+      file << TablesJson(true, true);
+      if (!file) throw std::runtime_error("cannot write " + path);
+    } catch (const std::exception& e) {
+      err << "orbed-study-tables: " << e.what() << "\n";
+      return 1;
+    }
+    out << "orbed-study-tables: wrote tables.json (the paper's figures) in " << out_dir << "\n";
+    return 0;
+  }
   if (run_paths.empty() && setup_paths.empty()) {
     err << "orbed-study-tables: no runs: give ViRAAl runs and/or --setup runs\n";
     return 2;

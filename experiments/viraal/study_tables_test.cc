@@ -188,5 +188,28 @@ TEST(StudyTables, TheCommandWritesTheFilesAndRefusesAnUnfinishedRun) {
   EXPECT_EQ(test::RunCommand(RunStudyTables, "orbed-study-tables", {pinned}).code, 2);  // no --out
 }
 
+// Studies written one after the other make one CSV: the header once, with `study` first.
+TEST(StudyTables, WithStudyColumnLeadsEveryRowWithTheStudy) {
+  const std::string csv = "user,mode\nu1,ar\nu2,ar\n";
+  EXPECT_EQ(WithStudyColumn(csv, 0), "study,user,mode\n0,u1,ar\n0,u2,ar\n");
+  EXPECT_EQ(WithStudyColumn(csv, 7), "7,u1,ar\n7,u2,ar\n");
+  EXPECT_EQ(WithStudyColumn("user,mode\n", 3), "");
+}
+
+// --paper-only: tables.json with both halves' paper figures and nothing else; runs beside it are a
+// usage error.
+TEST(StudyTables, PaperOnlyWritesThePapersFigures) {
+  const std::string dir = ::testing::TempDir() + "/study_tables_paper_only";
+  test::CommandRun r = test::RunCommand(RunStudyTables, "orbed-study-tables", {"--out", dir, "--paper-only"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::ifstream file(dir + "/tables.json");
+  const nlohmann::json tables = nlohmann::json::parse(file);
+  EXPECT_DOUBLE_EQ(tables["paper"]["table1"]["ar"]["norm"][0].get<double>(), 30.2);
+  EXPECT_DOUBLE_EQ(tables["paper"]["table2"]["fixed"]["mean"].get<double>(), 71.4);
+  EXPECT_FALSE(tables.contains("table1"));
+  r = test::RunCommand(RunStudyTables, "orbed-study-tables", {"--out", dir, "--paper-only", "run"});
+  EXPECT_EQ(r.code, 2);
+}
+
 }  // namespace
 }  // namespace orbed::study
