@@ -18,6 +18,15 @@ double LargestJointDifferenceDeg(const Eigen::VectorXd& a_rad, const Eigen::Vect
   return (a_rad.head(n) - b_rad.head(n)).cwiseAbs().maxCoeff() * kRadToDeg;
 }
 
+double BranchShortfallDeg(const Eigen::VectorXd& q_rad, const std::vector<int>& joint_signs,
+                          double min_bend_deg) {
+  double shortfall = 0;
+  for (size_t i = 0; i < joint_signs.size() && static_cast<Eigen::Index>(i) < q_rad.size(); ++i) {
+    if (joint_signs[i] != 0) shortfall += std::max(0.0, min_bend_deg - joint_signs[i] * q_rad[i] * kRadToDeg);
+  }
+  return shortfall;
+}
+
 std::vector<PlannedTarget> PlanTrocarTargets(const RobotModel& model, const Scene& scene,
                                              const TrocarPlanOptions& options) {
   if (options.num_targets < 1 || options.num_targets > 20) {
@@ -32,6 +41,15 @@ std::vector<PlannedTarget> PlanTrocarTargets(const RobotModel& model, const Scen
   }
   if (options.starts < 1 || options.starts > 1000)
     throw std::invalid_argument("plan: starts must be 1..1000");
+  if (!options.joint_signs.empty()) {
+    if (static_cast<int>(options.joint_signs.size()) != model.num_joints())
+      throw std::invalid_argument("plan: joint_signs must have one entry per joint");
+    for (int s : options.joint_signs) {
+      if (s < -1 || s > 1) throw std::invalid_argument("plan: joint_signs must be -1, 0 or 1");
+    }
+  }
+  if (!(options.min_bend_deg >= 0 && options.min_bend_deg <= 90))
+    throw std::invalid_argument("plan: min_bend_deg must be in [0, 90]");
 
   const ClearanceFunction clearance = MakeTrocarClearanceFunction(model, scene);
   const ClearanceFunction arm_clearance = MakeTrocarArmClearanceFunction(model, scene);
@@ -46,10 +64,13 @@ std::vector<PlannedTarget> PlanTrocarTargets(const RobotModel& model, const Scen
       }
       return smallest;
     };
-    // Inside the separation: the clearance objective [m]; outside: minus the shortfall [rad], below
-    // any clearance the IK accepts.
+    const auto branch = [&options](const Eigen::VectorXd& q) {
+      return BranchShortfallDeg(q, options.joint_signs, options.min_bend_deg);
+    };
+    // Inside the separation and the branch: the clearance objective [m]; outside: minus the
+    // shortfalls [rad], below any clearance the IK accepts.
     const ClearanceFunction objective = [&](const Eigen::VectorXd& q) {
-      const double shortfall_deg = options.min_separation_deg - separation(q);
+      const double shortfall_deg = std::max(0.0, options.min_separation_deg - separation(q)) + branch(q);
       return shortfall_deg > 0 ? -1.0 - shortfall_deg * kDegToRad : clearance(q);
     };
     TrocarIkOptions ik_options;
@@ -71,6 +92,10 @@ std::vector<PlannedTarget> PlanTrocarTargets(const RobotModel& model, const Scen
                                " deg from an earlier target, less than " +
                                Fixed(options.min_separation_deg, 1) +
                                " (fewer targets or a smaller separation)");
+    }
+    if (branch(ik.q_rad) > 0) {
+      throw std::runtime_error(which + ": the best configuration found is outside the branch (" +
+                               Fixed(branch(ik.q_rad), 1) + " deg short)");
     }
     if (!ik.success || t.clearance_m < options.min_clearance_m) {
       throw std::runtime_error(which +

@@ -13,6 +13,13 @@
 /// objective. Which distinct configurations the paper's targets were is not published: the separation is a
 /// choice of the study (20 deg default).
 ///
+/// A branch (joint_signs, the design catalog's use: experiments/setup/design.h): each target must
+/// also have the given sign in the given joints, each at least min_bend_deg from 0 (e.g. joints 2,
+/// 4, 6 of the iiwa, whose signs tell its shoulder, elbow and wrist branches apart: (+, −, +) and
+/// (−, +, −) are kinematic mirrors). Outside the branch the objective is minus the shortfall, as for
+/// the separation, so the search is pulled into the branch; a branch the search cannot enter is
+/// reported as a failure like any other.
+///
 /// Frames: joint angles of the model [rad]; the trocar in the scene's W, converted to R.
 /// Threading: pure function (builds its own collision worlds); deterministic for a seed.
 
@@ -33,7 +40,15 @@ struct TrocarPlanOptions {
   double min_clearance_m{0.05};
   std::uint64_t seed{1};
   int starts{48};  ///< IK starts per target
+  /// Per joint: +1 or −1 (that sign, at least min_bend_deg from 0) or 0 (free); empty = no branch.
+  std::vector<int> joint_signs;
+  double min_bend_deg{10.0};
 };
+
+/// How far q [rad] is outside the branch: the sum over the signed joints of max(0, min_bend −
+/// sign · q_i) [deg]; 0 inside (and for an empty branch).
+double BranchShortfallDeg(const Eigen::VectorXd& q_rad, const std::vector<int>& joint_signs,
+                          double min_bend_deg);
 
 struct PlannedTarget {
   Eigen::VectorXd q_rad;
@@ -48,8 +63,10 @@ struct PlannedTarget {
 double LargestJointDifferenceDeg(const Eigen::VectorXd& a_rad, const Eigen::VectorXd& b_rad, int joints = -1);
 
 /// Throws std::invalid_argument for options out of range (1..20 targets, separation in [0, 180],
-/// clearance >= 0, starts in 1..1000) and std::runtime_error naming the first target that could not
-/// be found and why (no IK solution, too little clearance, or too close to an earlier target).
+/// clearance >= 0, starts in 1..1000, joint_signs of another size than the model's joints or not in
+/// {−1, 0, 1}, min_bend_deg outside [0, 90]) and std::runtime_error naming the first target that could not
+/// be found and why (no IK solution, too little clearance, too close to an earlier target, or
+/// outside the branch).
 /// `model` must carry the scene's tool length (LoadRobotForScene).
 std::vector<PlannedTarget> PlanTrocarTargets(const RobotModel& model, const Scene& scene,
                                              const TrocarPlanOptions& options);

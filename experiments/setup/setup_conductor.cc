@@ -68,6 +68,15 @@ std::string SetupRunJson(const SetupRun& run, bool partial) {
     json.Key("mode").String(ModeName(r.mode));
     json.Key("order").Int(r.order);
     json.Key("target").Int(r.target);
+    for (const auto& [key, id] : {std::pair{"start_id", &r.start_id}, std::pair{"target_id", &r.target_id}}) {
+      json.Key(key);
+      if (id->empty()) {
+        json.Null();
+      } else {
+        json.String(*id);
+      }
+    }
+    json.Key("start_deg").Array(r.start_deg);
     json.Key("target_deg").Array(r.target_deg);
     json.Key("reached_deg").Array(r.reached_deg);
     json.Key("assistant_reached_deg").Array(r.assistant_reached_deg);
@@ -182,6 +191,9 @@ SetupRun SetupRunFromJson(const JsonFields& f, const nlohmann::json& doc, std::s
     r.mode = ModeNamed(f, f.Member(at, "mode"));
     r.order = static_cast<int>(f.Integer(f.Member(at, "order"), 1, 3));
     r.target = static_cast<int>(f.Integer(f.Member(at, "target"), 1, 1000));
+    if (const auto id = f.OptionalMember(at, "start_id")) r.start_id = f.String(*id, 256);
+    if (const auto id = f.OptionalMember(at, "target_id")) r.target_id = f.String(*id, 256);
+    if (const auto q = f.OptionalMember(at, "start_deg")) r.start_deg = Degrees(f, *q);
     r.target_deg = Degrees(f, f.Member(at, "target_deg"));
     r.reached_deg = Degrees(f, f.Member(at, "reached_deg"));
     r.assistant_reached_deg = Degrees(f, f.Member(at, "assistant_reached_deg"));
@@ -250,6 +262,15 @@ std::vector<SetupRecord> KeptSetups(const SetupRun& earlier, const std::string& 
     bool same = r.target_deg.size() == target.size();
     for (size_t j = 0; same && j < target.size(); ++j) same = std::abs(r.target_deg[j] - target[j]) <= 1e-9;
     if (!same) refuse(task_id + "'s target is not this plan's target " + std::to_string(target_index + 1));
+    const std::vector<double>& start =
+        options.starts_deg.empty() ? options.start_deg : options.starts_deg[target_index];
+    bool same_start = r.start_deg.empty() || r.start_deg.size() == start.size();
+    for (size_t j = 0; same_start && j < r.start_deg.size(); ++j)
+      same_start = std::abs(r.start_deg[j] - start[j]) <= 1e-9;
+    const std::string start_id = options.start_ids.empty() ? "" : options.start_ids[target_index];
+    const std::string target_id = options.target_ids.empty() ? "" : options.target_ids[target_index];
+    if (!same_start || (!r.start_deg.empty() && (r.start_id != start_id || r.target_id != target_id)))
+      refuse(task_id + "'s start or design ids are not this run's (another --design or user seed?)");
     const bool truth = options.perfect_registration && mode != orbed::guidance_t::MODE_FIXED_DISPLAY;
     if (r.perfect_registration != truth)
       refuse(task_id + " was made with another registration (--registration)");
@@ -282,7 +303,15 @@ SetupConductor::SetupConductor(SetupOptions options, sim::RobotModel model)
   };
   for (size_t k = 0; k < options_.targets_deg.size(); ++k)
     check(options_.targets_deg[k], "target " + std::to_string(k + 1));
-  check(options_.start_deg, "the start");
+  const size_t n = options_.targets_deg.size();
+  if ((!options_.starts_deg.empty() && options_.starts_deg.size() != n) ||
+      (!options_.start_ids.empty() && options_.start_ids.size() != n) ||
+      (!options_.target_ids.empty() && options_.target_ids.size() != n)) {
+    throw std::invalid_argument("set-up study: per-target starts and ids must be one per target");
+  }
+  if (options_.starts_deg.empty()) check(options_.start_deg, "the start");
+  for (size_t k = 0; k < options_.starts_deg.size(); ++k)
+    check(options_.starts_deg[k], "the start of target " + std::to_string(k + 1));
   for (int8_t kind : guidance::JointKinds(*model_))
     twisting_.push_back(kind == orbed::guidance_t::JOINT_TWIST);
   run_.user = options_.user;
@@ -327,6 +356,10 @@ SetupConductor::Actions SetupConductor::Start(const ConductorTime& now) {
                                    : "; resumed with the " + std::to_string(options_.kept.size()) +
                                          " set-up(s) kept, next " + TaskId()));
   return Take();
+}
+
+const std::vector<double>& SetupConductor::StartDeg() const {
+  return options_.starts_deg.empty() ? options_.start_deg : options_.starts_deg[target_index_];
 }
 
 void SetupConductor::StartTask() {
@@ -407,9 +440,9 @@ void SetupConductor::Step() {
     }
     case Phase::kPark: {
       bool there = robot_state_ && robot_state_->motion_state == orbed::robot_state_t::MOTION_IDLE;
-      for (size_t i = 0; there && i < options_.start_deg.size(); ++i) {
-        there = std::abs(robot_state_->joint_position[i] * kRadToDeg - options_.start_deg[i]) <
-                options_.tolerance_deg;
+      for (size_t i = 0; there && i < StartDeg().size(); ++i) {
+        there =
+            std::abs(robot_state_->joint_position[i] * kRadToDeg - StartDeg()[i]) < options_.tolerance_deg;
       }
       if (there) {
         task_ = orbed::setup_task_t{};
@@ -435,7 +468,7 @@ void SetupConductor::Step() {
         orbed::iiwa_command_t command{};
         command.utime = now_.utime;
         command.num_joints = model_->num_joints();
-        for (double q : options_.start_deg) command.joint_position.push_back(q * kDegToRad);
+        for (double q : StartDeg()) command.joint_position.push_back(q * kDegToRad);
         command.num_torques = 0;
         actions_.publish.push_back({options_.iiwa_command_channel, command});
         last_send_s_ = now_.t_s;
@@ -525,6 +558,9 @@ void SetupConductor::Record(const orbed::setup_result_t& msg) {
   r.order = static_cast<int>(mode_index_) + 1;
   r.target = static_cast<int>(target_index_) + 1;
   r.target_deg = options_.targets_deg[target_index_];
+  r.start_deg = StartDeg();
+  if (!options_.start_ids.empty()) r.start_id = options_.start_ids[target_index_];
+  if (!options_.target_ids.empty()) r.target_id = options_.target_ids[target_index_];
   for (double q : robot_state_->joint_position) r.reached_deg.push_back(q * kRadToDeg);
   for (double q : msg.reached_position) r.assistant_reached_deg.push_back(q * kRadToDeg);
   r.twisting = twisting_;

@@ -12,8 +12,10 @@
 ///     that mode only and run id "<run_id>-<task_id>" (so session "<run_id>-<task_id>-<mode>") runs to
 ///     its end; its every input and tick
 ///     are forwarded to it, its actions passed on. Its failure fails the run.
-///   kPark: IIWA_COMMAND the start configuration (re-sent every command_resend_s) until every joint
-///     is within tolerance_deg and the motion is IDLE: the experimenter parks the arm.
+///   kPark: IIWA_COMMAND target k's start configuration (the design's per-target start, else the
+///     one start; re-sent every command_resend_s) until every joint is within tolerance_deg and the
+///     motion is IDLE: the experimenter parks the arm. Every mode runs the same (start, target)
+///     pairs in the same order, so the modes of a user stay paired.
 ///   kTask: SETUP_TASK (task "<user>-<mode>-<k>", the target, the mode; a new request id) re-sent
 ///     every task_resend_s until the SETUP_RESULT with its id comes back (from orbed-assistant);
 ///     orbed-guidance shows the target. The record: the target, the joints the sim measured after
@@ -71,9 +73,14 @@ struct SetupOptions {
   std::string run_id{"setup"};
   /// guidance_t::MODE_* in the user's order (each at most once).
   std::vector<int8_t> modes;
-  /// The targets [deg] (the plan), in order; the start configuration [deg].
+  /// The targets [deg] (the plan or the user's draw from the design), in order; the start
+  /// configuration [deg] of every target, unless starts_deg gives one per target.
   std::vector<std::vector<double>> targets_deg;
   std::vector<double> start_deg;
+  /// Per target (the design, experiments/setup/design.h): its start [deg] and the catalog ids of
+  /// its start and target ("ready", "medium/umbilicus/2"); empty = start_deg and no ids.
+  std::vector<std::vector<double>> starts_deg;
+  std::vector<std::string> start_ids, target_ids;
   /// The alignment protocol of the headset modes (its modes are replaced per task; its trials are N).
   viraal::ScenarioConfig alignment;
   int reflective_mirrors{1};
@@ -105,6 +112,9 @@ struct SetupRecord {
   int8_t mode{0};
   int order{0};   ///< the mode's place in the user's order, 1-based
   int target{0};  ///< 1-based
+  /// The design's ids of the start and the target ("" without a design or in older files).
+  std::string start_id, target_id;
+  std::vector<double> start_deg;  ///< where the arm was parked (empty in older files)
   std::vector<double> target_deg, reached_deg, assistant_reached_deg;
   std::vector<int> twisting;  ///< 1 for a twisting joint (guidance::JointKinds)
   std::vector<int> ranges;
@@ -143,7 +153,8 @@ struct SetupRun {
 };
 /// setup_results.json's text: {"user", "run_id", "provenance" (only when the run folder has a
 /// record: "provenance.json"), "status": "ok" | "failed" | "partial", "error",
-/// "order", "setups": [{task_id, mode, order, target, target_deg, reached_deg,
+/// "order", "setups": [{task_id, mode, order, target, start_id, target_id (null without a design),
+/// start_deg, target_deg, reached_deg,
 /// assistant_reached_deg, error_deg, twisting, ranges, execution_s, alignment_s (null for fixed),
 /// person_scale, registration ("measured" | "truth" | null for fixed), docking_tip_mm, docking_axis_deg,
 /// min_clearance_m (null when unknown), contact, collision_stops, alignment: null | {session_id, trials,
@@ -155,7 +166,8 @@ std::string SetupRunJson(const SetupRun& run, bool partial);
 /// file from outside (base/json_fields.h): every field with its type and range, counts bounded;
 /// error_deg is derived and not read. A record's alignment comes back as what the file holds (the
 /// session id, as many empty trials as it counts, the mean's three errors), so that SetupRunJson
-/// writes it again byte for byte. `status` gets "ok", "failed" or "partial". Throws
+/// writes it again byte for byte. start_id, target_id and start_deg may be absent (files written
+/// before the design). `status` gets "ok", "failed" or "partial". Throws
 /// orbed::JsonReadError naming the file and the key.
 SetupRun ReadSetupRunFile(const std::string& path, std::string* status);
 /// The same from the file's text (`source` names it in errors).
@@ -165,10 +177,10 @@ SetupRun ParseSetupRunJson(const std::string& text, const std::string& source, s
 /// order. Refused (std::invalid_argument with the reason): status "ok" (nothing to run); another
 /// user, run id or mode order; a set-up that is not the next of this run's (task id
 /// "<user>-<mode>-<k>", mode, order and target in sequence) or whose target differs from this
-/// plan's (1e-9 deg); a registration ("measured" / "truth") other than this run's; as many set-ups
-/// as the run has (nothing left) or more. The set-ups left are new draws of the same emulated
-/// person (the assistant's random stream starts afresh), not those an uninterrupted run would have
-/// made.
+/// plan's (1e-9 deg), or whose start or ids (when recorded) differ from this run's; a registration
+/// ("measured" / "truth") other than this run's; as many set-ups as the run has (nothing left) or more. The
+/// set-ups left are new draws of the same emulated person (the assistant's random stream starts afresh), not
+/// those an uninterrupted run would have made.
 std::vector<SetupRecord> KeptSetups(const SetupRun& earlier, const std::string& status,
                                     const SetupOptions& options);
 
@@ -234,6 +246,7 @@ class SetupConductor {
   void Fail(const std::string& reason);
   std::string TaskId() const;
   int8_t Mode() const { return options_.modes[mode_index_]; }
+  const std::vector<double>& StartDeg() const;  // the current target's start
 
   SetupOptions options_;
   std::unique_ptr<const sim::RobotModel> model_;

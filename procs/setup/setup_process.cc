@@ -152,6 +152,25 @@ void SetupProcess::Write(bool partial) {
   }
 }
 
+UserDesign UserDesignFor(const std::string& design_path, const std::string& scene_path, uint64_t user_seed,
+                         int k) {
+  const DesignCatalog catalog = ReadDesignFile(design_path);
+  std::optional<std::string> patient;
+  if (!scene_path.empty()) {
+    std::string names;
+    for (const DesignPatient& p : catalog.patients) {
+      std::error_code ec;
+      if (std::filesystem::equivalent(SourceTreePath(p.scene), scene_path, ec)) patient = p.name;
+      names += (names.empty() ? "" : ", ") + p.scene;
+    }
+    if (!patient) {
+      throw std::invalid_argument("--scene " + scene_path + " is no patient's of " + design_path + " (" +
+                                  names + "); give --plan and --start-deg for another scene");
+    }
+  }
+  return DrawUserDesign(catalog, user_seed, k, patient);
+}
+
 int RunSetup(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
   CLI::App app{
       "orbed-setup: one user's part of the paper's robot set-up study (Sec. IV-B, Tables 2-4). For\n"
@@ -167,18 +186,33 @@ int RunSetup(int argc, const char* const* argv, std::ostream& out, std::ostream&
   int targets = 3, trials = 3;
   app.add_option("--user", options.user, "The user's name in task ids and results (u1, u2, ...)")
       ->capture_default_str();
-  app.add_option("--user-seed", user_seed, "The user's seed: the order of the modes (unless --modes)")
+  app.add_option("--user-seed", user_seed,
+                 "The user's seed: the order of the modes (unless --modes) and the draw from the design")
       ->capture_default_str();
   app.add_option("--modes", modes,
                  "The order of the modes, e.g. fixed,ar,ar_reflective (default: drawn from "
                  "--user-seed)");
-  app.add_option("--plan", plan_path,
-                 "Targets from `orbed-robot plan` (default: experiments/setup/targets.json)");
+  std::string design_path, scene_path;
+  app.add_option(
+      "--design", design_path,
+      "The design catalog (default: experiments/setup/design.json): the patient and --targets (start, "
+      "target) pairs drawn from --user-seed, the same for every mode. Not used with --plan or "
+      "--start-deg");
+  app.add_option(
+      "--scene", scene_path,
+      "The scene the sim loads (the launch's): fixes the patient to the catalog's patient of that scene "
+      "(default: the patient drawn from --user-seed)");
+  CLI::Option* plan_option =
+      app.add_option("--plan", plan_path,
+                     "Targets from `orbed-robot plan` instead of the design (with --start-deg; default "
+                     "experiments/setup/targets.json)");
   app.add_option("--targets", targets, "How many of the plan's targets per mode")
       ->check(orbed::NumberIn(1, 20))
       ->capture_default_str();
-  app.add_option("--start-deg", start_deg, "Where the arm is parked before each set-up [deg]")
-      ->capture_default_str();
+  CLI::Option* start_option = app.add_option("--start-deg", start_deg,
+                                             "Where the arm is parked before each set-up [deg], with the "
+                                             "plan's targets instead of the design")
+                                  ->capture_default_str();
   app.add_option("--scenario", scenario_path,
                  "The alignment protocol (default: experiments/viraal/viraal.yaml)");
   app.add_option("--trials", trials, "Alignments before each headset set-up (the paper: N = 3)")
@@ -229,7 +263,22 @@ int RunSetup(int argc, const char* const* argv, std::ostream& out, std::ostream&
       results_dir = env && *env ? env : ".";
     }
     const sim::RobotModel model = sim::RobotModel::LoadFile(urdf_path);
-    options.targets_deg = PlanTargetsDeg(plan_path, targets, model);
+    if (plan_option->count() > 0 || start_option->count() > 0) {
+      options.targets_deg = PlanTargetsDeg(plan_path, targets, model);
+    } else {
+      const UserDesign design =
+          UserDesignFor(design_path.empty() ? SourceTreePath(kDefaultDesignRelativePath) : design_path,
+                        scene_path, user_seed, targets);
+      out << "design: patient " << design.patient << " (" << design.scene << "):";
+      for (const DesignPair& p : design.pairs) {
+        options.targets_deg.push_back(p.target_deg);
+        options.starts_deg.push_back(p.start_deg);
+        options.start_ids.push_back(p.start_id);
+        options.target_ids.push_back(p.target_id);
+        out << " " << p.start_id << " -> " << p.target_id << ";";
+      }
+      out << "\n";
+    }
     options.alignment = viraal::LoadScenarioFile(scenario_path);
     options.alignment.trials = trials;
     if (!resume.empty()) {

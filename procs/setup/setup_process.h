@@ -14,6 +14,11 @@
 /// set-up and once at the end ("ok" or "failed"); then the process stops: exit 0 on success, 1 on a
 /// failure (the reason on stdout and the heartbeat) or when stopped from outside before the end.
 ///
+/// The targets and starts: by default the user's draw from the design catalog (--design,
+/// UserDesignFor): the patient (fixed by --scene when the launch gives the sim's scene) and K
+/// (start, target) pairs, the same for every mode; with --plan or --start-deg the plan's first K
+/// targets, each from the one start (as before the design).
+///
 /// The user's order of the three modes: given (ModeOrderFromNames), or drawn from the user seed
 /// (ModeOrderForSeed, setup_conductor.h), so a study's users meet the modes in randomized orders as
 /// the paper's did, reproducibly.
@@ -27,6 +32,7 @@
 #include <memory>
 #include <string>
 
+#include "experiments/setup/design.h"
 #include "experiments/setup/setup_conductor.h"
 #include "runtime/process.h"
 
@@ -58,6 +64,12 @@ class SetupProcess {
   bool finished_{false};
   bool started_{false};
 };
+
+/// The user's draw from the design catalog at `design_path` (experiments/setup/design.h); a
+/// non-empty `scene_path` fixes the patient to the catalog's patient whose scene file it is (the
+/// same file: std::filesystem::equivalent), std::invalid_argument when none is.
+UserDesign UserDesignFor(const std::string& design_path, const std::string& scene_path, uint64_t user_seed,
+                         int k);
 
 /// orbed-setup's command line (flags: --help). Exit 0 when every set-up finished; 1 on a failure; 2
 /// or CLI11's usage code (106-109) on bad arguments.
