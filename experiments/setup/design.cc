@@ -25,9 +25,11 @@ DesignSpec DefaultDesignSpec() {
   // sim/models/scenes/trocar_or{_small,,_large}.yaml.
   const std::string sad = "torso depth = supine sagittal abdominal diameter, Kahn et al. PLoS ONE 2014 ";
   s.patients = {
-      {"small", "sim/models/scenes/trocar_or_small.yaml", sad + "5th percentile (16.4 cm); width 0.36 m chosen"},
+      {"small", "sim/models/scenes/trocar_or_small.yaml",
+       sad + "5th percentile (16.4 cm); width 0.36 m chosen"},
       {"medium", "sim/models/scenes/trocar_or.yaml", sad + "median (21.9 cm; 22 cm); width 0.42 m chosen"},
-      {"large", "sim/models/scenes/trocar_or_large.yaml", sad + "75th percentile (25.2 cm; the 95th, 30.5 cm, meets the alignment moves); width 0.48 m chosen"},
+      {"large", "sim/models/scenes/trocar_or_large.yaml",
+       sad + "75th percentile (25.2 cm; the 95th, 30.5 cm, meets the alignment moves); width 0.48 m chosen"},
   };
   // Ports after the usual laparoscopic layouts (the camera port at the umbilicus; an epigastric
   // port as in cholecystectomy; lower-quadrant ports lateral to the rectus sheath as in
@@ -41,14 +43,20 @@ DesignSpec DefaultDesignSpec() {
   };
   // Parked configurations. Joint 2 > 0 leans the arm toward the table (the base faces +y).
   s.starts = {
-      {"ready", {0, 20, 0, -60, 0, 40, 0},
+      {"ready",
+       {0, 20, 0, -60, 0, 40, 0},
        "the study's former single start: leaning over the table, elbow and wrist bent, ready to be guided"},
-      {"ready_away", {0, -20, 0, 60, 0, -40, 0},
+      {"ready_away",
+       {0, -20, 0, 60, 0, -40, 0},
        "the mirror of ready (joints 2, 4, 6 negated): leaning back from the table, as after a retreat"},
-      {"candle", {0, 0, 0, 0, 0, 0, 0}, "the arm's zero: stretched vertically (KUKA's 'candle'), as powered up"},
-      {"folded", {0, -30, 0, 100, 0, -60, 0},
+      {"candle",
+       {0, 0, 0, 0, 0, 0, 0},
+       "the arm's zero: stretched vertically (KUKA's 'candle'), as powered up"},
+      {"folded",
+       {0, -30, 0, 100, 0, -60, 0},
        "chosen: folded back over its cart, elbow up, as wheeled in (not KUKA's published transport pose)"},
-      {"aside", {-90, 20, 0, -60, 0, 40, 0},
+      {"aside",
+       {-90, 20, 0, -60, 0, 40, 0},
        "the ready pose turned toward the foot end, out of the surgeon's way at the table's side"},
   };
   return s;
@@ -67,7 +75,8 @@ CatalogPort PortOnPatient(const DesignSpec& spec, const DesignPort& port, const 
   const Eigen::Vector2d skin = umbilicus + port.offset_m;
   const Eigen::Vector2d toward = umbilicus + spec.field_offset_m - skin;
   // Horizontal unit toward the field's centre (none when the port is on it: straight down).
-  const Eigen::Vector2d h = toward.norm() > 1e-9 ? Eigen::Vector2d(toward.normalized()) : Eigen::Vector2d::Zero();
+  const Eigen::Vector2d h =
+      toward.norm() > 1e-9 ? Eigen::Vector2d(toward.normalized()) : Eigen::Vector2d::Zero();
   const double tilt = (toward.norm() > 1e-9 ? spec.port_tilt_deg : 0.0) * kDegToRad;
   CatalogPort c;
   c.port = port.name;
@@ -98,7 +107,8 @@ double SegmentClearance(sim::CollisionWorld* world, const Eigen::VectorXd& a, co
   const double travel_deg = (b - a).cwiseAbs().maxCoeff() * kRadToDeg;
   const int n = std::max(1, static_cast<int>(std::ceil(travel_deg / step_deg)));
   double smallest = std::numeric_limits<double>::infinity();
-  for (int i = 0; i <= n; ++i) smallest = std::min(smallest, world->Check(a + (b - a) * (double(i) / n)).min_distance_m);
+  for (int i = 0; i <= n; ++i)
+    smallest = std::min(smallest, world->Check(a + (b - a) * (double(i) / n)).min_distance_m);
   return smallest;
 }
 
@@ -163,8 +173,8 @@ DesignCatalog MakeDesignCatalog(const DesignSpec& spec, const std::string& urdf_
       for (const auto& [name, q_deg] : others) {
         const double path = SegmentClearance(&world, Rad(q_deg), Rad(start.q_deg), spec.path_step_deg);
         if (path < spec.path_clearance_m) {
-          throw std::runtime_error("start " + start.id + ": the move to " + name + " comes " + std::to_string(path) +
-                                   " m close in " + scenes[p].source);
+          throw std::runtime_error("start " + start.id + ": the move to " + name + " comes " +
+                                   std::to_string(path) + " m close in " + scenes[p].source);
         }
       }
     }
@@ -251,7 +261,8 @@ std::string DesignCatalogJson(const DesignCatalog& c) {
   j.Key("command").String(c.command);
   j.Key("about").String(
       "The set-up study's design catalog: patients, ports, targets and parked starts "
-      "(experiments/setup/design.h; docs/studies.md). Each user draws a patient and K (start, target) pairs.");
+      "(experiments/setup/design.h; docs/studies.md). Each user draws a patient and K (start, target) "
+      "pairs.");
   const DesignSpec& s = c.spec;
   j.Key("rules").BeginObject();
   j.Key("umbilicus_offset_m");

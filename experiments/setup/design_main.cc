@@ -58,13 +58,17 @@ int Run(int argc, const char* const* argv) {
   catalog->add_option("--urdf", urdf, "robot URDF (default: sim/models/iiwa7.urdf)");
   auto* draw = app.add_subcommand("draw", "one user's patient and (start, target) pairs");
   draw->add_option("--user-seed", user_seed, "the user's seed")->required();
-  auto* relations = app.add_subcommand("relations", "same / mirror / mixed counts of the catalog and of draws");
+  auto* relations =
+      app.add_subcommand("relations", "same / mirror / mixed counts of the catalog and of draws");
   for (CLI::App* sub : {draw, relations}) {
     sub->add_option("--design", design, "the catalog (default: experiments/setup/design.json)");
-    sub->add_option("--targets", targets, "K pairs per user")->check(orbed::NumberIn(1, 100))->capture_default_str();
+    sub->add_option("--targets", targets, "K pairs per user")
+        ->check(orbed::NumberIn(1, 100))
+        ->capture_default_str();
   }
   draw->add_option("--patient", patient, "this patient instead of the drawn one");
-  relations->add_option("--users", users, "draws of this many users")->check(orbed::NumberIn(1, 1000000))
+  relations->add_option("--users", users, "draws of this many users")
+      ->check(orbed::NumberIn(1, 1000000))
       ->capture_default_str();
   relations->add_option("--seed", seed, "the first user's seed")->capture_default_str();
   if (const auto code = ParseArguments(&app, argc, argv, std::cout, std::cerr)) return *code;
@@ -76,8 +80,8 @@ int Run(int argc, const char* const* argv) {
       spec.alignment_deg =
           viraal::LoadScenarioFile(SourceTreePath(viraal::kDefaultScenarioRelativePath)).configurations_deg;
       const DesignCatalog c = MakeDesignCatalog(
-          spec, urdf.empty() ? SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath) : urdf, SourceTreePath(""),
-          command);
+          spec, urdf.empty() ? SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath) : urdf,
+          SourceTreePath(""), command);
       const std::string text = DesignCatalogJson(c);
       if (out_path.empty()) {
         std::cout << text;
@@ -93,11 +97,12 @@ int Run(int argc, const char* const* argv) {
       }
       return 0;
     }
-    const DesignCatalog c = ReadDesignFile(design.empty() ? SourceTreePath(kDefaultDesignRelativePath) : design);
+    const DesignCatalog c =
+        ReadDesignFile(design.empty() ? SourceTreePath(kDefaultDesignRelativePath) : design);
     JsonWriter j(2);
     if (*draw) {
-      const UserDesign d =
-          DrawUserDesign(c, user_seed, targets, patient.empty() ? std::nullopt : std::optional<std::string>(patient));
+      const UserDesign d = DrawUserDesign(
+          c, user_seed, targets, patient.empty() ? std::nullopt : std::optional<std::string>(patient));
       j.BeginObject();
       j.Key("patient").String(d.patient);
       j.Key("scene").String(d.scene);

@@ -57,9 +57,15 @@ TEST(DesignRelation, SignsOfTheBendingJoints) {
 DesignCatalog SmallCatalog() {
   DesignCatalog c;
   c.patients = {{"a", "scene_a.yaml", ""}, {"b", "scene_b.yaml", ""}};
-  for (int i = 1; i <= 5; ++i) c.targets.push_back({"a/p/" + std::to_string(i), "a", "p", "+-+", {double(i), 20, 0, -60, 0, 40, 0}, 0.1, 0.1});
-  for (int i = 1; i <= 3; ++i) c.targets.push_back({"b/p/" + std::to_string(i), "b", "p", "-+-", {double(i), -20, 0, 60, 0, -40, 0}, 0.1, 0.1});
-  c.starts = {{"s1", {0, 20, 0, -60, 0, 40, 0}, "", 0.1}, {"s2", {0, 0, 0, 0, 0, 0, 0}, "", 0.1}, {"s3", {0, -20, 0, 60, 0, -40, 0}, "", 0.1}};
+  for (int i = 1; i <= 5; ++i)
+    c.targets.push_back(
+        {"a/p/" + std::to_string(i), "a", "p", "+-+", {double(i), 20, 0, -60, 0, 40, 0}, 0.1, 0.1});
+  for (int i = 1; i <= 3; ++i)
+    c.targets.push_back(
+        {"b/p/" + std::to_string(i), "b", "p", "-+-", {double(i), -20, 0, 60, 0, -40, 0}, 0.1, 0.1});
+  c.starts = {{"s1", {0, 20, 0, -60, 0, 40, 0}, "", 0.1},
+              {"s2", {0, 0, 0, 0, 0, 0, 0}, "", 0.1},
+              {"s3", {0, -20, 0, 60, 0, -40, 0}, "", 0.1}};
   return c;
 }
 
@@ -84,7 +90,8 @@ TEST(DrawUserDesign, DeterministicPerSeedDistinctTargetsOfThePatientFromTheCatal
       starts.insert(p.start_id);
       // Every target is the catalog's, of the drawn patient, with its joints; every start too.
       bool found = false;
-      for (const CatalogTarget& t : c.targets) found |= t.id == p.target_id && t.patient == d.patient && t.q_deg == p.target_deg;
+      for (const CatalogTarget& t : c.targets)
+        found |= t.id == p.target_id && t.patient == d.patient && t.q_deg == p.target_deg;
       EXPECT_TRUE(found) << p.target_id;
       bool start = false;
       for (const CatalogStart& s : c.starts) start |= s.id == p.start_id && s.q_deg == p.start_deg;
@@ -130,7 +137,8 @@ TEST(DesignFile, WrittenAndReadBack) {
   EXPECT_EQ(back.targets[6].id, "b/p/2");
   EXPECT_EQ(back.targets[6].q_deg, c.targets[6].q_deg);
   ASSERT_EQ(back.starts.size(), 3u);
-  for (uint64_t seed : {1, 2, 3}) EXPECT_EQ(Key(DrawUserDesign(back, seed, 3)), Key(DrawUserDesign(c, seed, 3)));
+  for (uint64_t seed : {1, 2, 3})
+    EXPECT_EQ(Key(DrawUserDesign(back, seed, 3)), Key(DrawUserDesign(c, seed, 3)));
   // A target of a patient the file does not list is refused.
   std::string text = DesignCatalogJson(c);
   text.replace(text.find("\"patient\": \"b\""), 14, "\"patient\": \"z\"");

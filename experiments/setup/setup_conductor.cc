@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <stdexcept>
 #include <utility>
 
@@ -314,6 +315,10 @@ SetupConductor::SetupConductor(SetupOptions options, sim::RobotModel model)
     check(options_.starts_deg[k], "the start of target " + std::to_string(k + 1));
   for (int8_t kind : guidance::JointKinds(*model_))
     twisting_.push_back(kind == orbed::guidance_t::JOINT_TWIST);
+  if (options_.retract && !options_.retract_scene_path.empty()) {
+    retract_scene_ = std::make_unique<sim::Scene>(sim::LoadSceneFile(options_.retract_scene_path));
+    retract_world_ = std::make_unique<sim::CollisionWorld>(*model_, retract_scene_.get());
+  }
   run_.user = options_.user;
   run_.run_id = options_.run_id;
   for (int8_t m : options_.modes) run_.order.push_back(ModeName(m));
@@ -387,6 +392,73 @@ void SetupConductor::StartTask() {
   }
 }
 
+void SetupConductor::EnterRetract() {
+  std::vector<double> q;
+  for (double v : robot_state_->joint_position) q.push_back(v * kRadToDeg);
+  // Whether the sim would let the arm move straight from a to b (see the file comment).
+  const auto passes = [this](const std::vector<double>& a, const std::vector<double>& b) {
+    if (!retract_world_) return true;
+    double travel = 0;
+    for (size_t i = 0; i < a.size(); ++i) travel = std::max(travel, std::abs(b[i] - a[i]));
+    const int n = std::max(1, static_cast<int>(std::ceil(travel / 2.0)));
+    double before = std::numeric_limits<double>::infinity();
+    for (int k = 0; k <= n; ++k) {
+      Eigen::VectorXd x(a.size());
+      for (size_t i = 0; i < a.size(); ++i) x[i] = (a[i] + (b[i] - a[i]) * k / n) * kDegToRad;
+      const double d = retract_world_->Check(x).min_distance_m;
+      if (k > 0 && d < 0.01 && d < before) return false;
+      before = d;
+    }
+    return true;
+  };
+  retract_route_.clear();
+  std::vector<size_t> left;
+  for (size_t j : {3, 1, 5, 0}) {
+    if (j < q.size()) left.push_back(j);
+  }
+  while (!left.empty()) {
+    size_t pick = 0;
+    for (size_t i = 0; i < left.size(); ++i) {
+      std::vector<double> next = q;
+      next[left[i]] = 0;
+      if (passes(q, next)) {
+        pick = i;
+        break;
+      }
+    }
+    q[left[pick]] = 0;
+    left.erase(left.begin() + static_cast<std::ptrdiff_t>(pick));
+    retract_route_.push_back(q);
+  }
+  retract_route_.push_back(std::vector<double>(q.size(), 0.0));
+  phase_ = Phase::kRetract;
+  phase_start_s_ = now_.t_s;
+  last_send_s_ = -1e9;
+  Step();
+}
+
+bool SetupConductor::MoveTo(const std::vector<double>& q_deg, const std::string& what) {
+  bool there = robot_state_ && robot_state_->motion_state == orbed::robot_state_t::MOTION_IDLE;
+  for (size_t i = 0; there && i < q_deg.size(); ++i)
+    there = std::abs(robot_state_->joint_position[i] * kRadToDeg - q_deg[i]) < options_.tolerance_deg;
+  if (there) return true;
+  if (now_.t_s - phase_start_s_ > options_.move_timeout_s) {
+    Fail(TaskId() + ": the arm did not reach " + what + " within " + Fixed(options_.move_timeout_s, 1) +
+         " s (orbed-iiwa-sim)");
+    return false;
+  }
+  if (now_.t_s - last_send_s_ >= options_.command_resend_s) {
+    orbed::iiwa_command_t command{};
+    command.utime = now_.utime;
+    command.num_joints = model_->num_joints();
+    for (double q : q_deg) command.joint_position.push_back(q * kDegToRad);
+    command.num_torques = 0;
+    actions_.publish.push_back({options_.iiwa_command_channel, command});
+    last_send_s_ = now_.t_s;
+  }
+  return false;
+}
+
 void SetupConductor::EnterPark() {
   phase_ = Phase::kPark;
   phase_start_s_ = now_.t_s;
@@ -438,42 +510,38 @@ void SetupConductor::Step() {
       alignment_.reset();
       return EnterPark();
     }
+    case Phase::kRetract: {
+      // A waypoint the sim stops short of (before a collision) is passed over for the next one,
+      // after kRetryAfterStopS (so that a state from before the command does not count); the
+      // last, the candle, is not.
+      constexpr double kRetryAfterStopS = 0.5;
+      const bool blocked = robot_state_ && Stopped(robot_state_->motion_state) &&
+                           now_.t_s - phase_start_s_ >= kRetryAfterStopS && retract_route_.size() > 1;
+      if (!blocked &&
+          !MoveTo(retract_route_.front(), retract_route_.size() > 1 ? "the straightened arm" : "the candle"))
+        return;
+      retract_route_.erase(retract_route_.begin());
+      phase_start_s_ = now_.t_s;
+      last_send_s_ = -1e9;
+      if (retract_route_.empty()) return StartTask();
+      return Step();
+    }
     case Phase::kPark: {
-      bool there = robot_state_ && robot_state_->motion_state == orbed::robot_state_t::MOTION_IDLE;
-      for (size_t i = 0; there && i < StartDeg().size(); ++i) {
-        there =
-            std::abs(robot_state_->joint_position[i] * kRadToDeg - StartDeg()[i]) < options_.tolerance_deg;
-      }
-      if (there) {
-        task_ = orbed::setup_task_t{};
-        task_.utime = now_.utime;
-        task_.request_id = request_id_base_ + next_request_id_++;
-        task_.task_id = TaskId();
-        task_.mode = Mode();
-        task_.num_joints = model_->num_joints();
-        for (double q : options_.targets_deg[target_index_]) task_.target_position.push_back(q * kDegToRad);
-        phase_ = Phase::kTask;
-        phase_start_s_ = now_.t_s;
-        task_min_clearance_m_.reset();
-        task_contact_ = false;
-        task_collision_stops_ = 0;
-        actions_.progress.push_back(TaskId() + ": set-up (SETUP_TASK to orbed-assistant)");
-        return SendTask();
-      }
-      if (now_.t_s - phase_start_s_ > options_.move_timeout_s) {
-        return Fail(TaskId() + ": the arm did not reach the start within " +
-                    Fixed(options_.move_timeout_s, 1) + " s (orbed-iiwa-sim)");
-      }
-      if (now_.t_s - last_send_s_ >= options_.command_resend_s) {
-        orbed::iiwa_command_t command{};
-        command.utime = now_.utime;
-        command.num_joints = model_->num_joints();
-        for (double q : StartDeg()) command.joint_position.push_back(q * kDegToRad);
-        command.num_torques = 0;
-        actions_.publish.push_back({options_.iiwa_command_channel, command});
-        last_send_s_ = now_.t_s;
-      }
-      return;
+      if (!MoveTo(StartDeg(), "the start")) return;
+      task_ = orbed::setup_task_t{};
+      task_.utime = now_.utime;
+      task_.request_id = request_id_base_ + next_request_id_++;
+      task_.task_id = TaskId();
+      task_.mode = Mode();
+      task_.num_joints = model_->num_joints();
+      for (double q : options_.targets_deg[target_index_]) task_.target_position.push_back(q * kDegToRad);
+      phase_ = Phase::kTask;
+      phase_start_s_ = now_.t_s;
+      task_min_clearance_m_.reset();
+      task_contact_ = false;
+      task_collision_stops_ = 0;
+      actions_.progress.push_back(TaskId() + ": set-up (SETUP_TASK to orbed-assistant)");
+      return SendTask();
     }
     case Phase::kTask:
       if (now_.t_s - phase_start_s_ > options_.task_timeout_s) {
@@ -597,6 +665,7 @@ void SetupConductor::Record(const orbed::setup_result_t& msg) {
     phase_ = Phase::kDone;
     return;
   }
+  if (options_.retract) return EnterRetract();
   StartTask();
 }
 

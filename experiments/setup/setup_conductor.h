@@ -27,6 +27,17 @@
 ///     COLLISION_STATUS and ROBOT_STATE while the assistant moved the arm, the smallest clearance
 ///     to anything (self or scene) [m], whether any pair touched, and how often the sim stopped the
 ///     arm before a collision (the paper's Sec. IV-B "beyond": collisions and near misses).
+///   kRetract (retract, the design's runs): after each set-up, before the next task's alignment or
+///     park, the experimenter takes the arm up out of the way: joints 4, 2, 6 and 1 are zeroed one at
+///     a time (each waypoint the reached joints with those zeroed so far), then the zero
+///     configuration (the candle), each until reached as in kPark. With a scene the next joint is
+///     the first of those left whose straight move the sim would let through (the manual arm's
+///     rule: sampled every 2 deg, no sample both within 1 cm of a collision and closer than the
+///     one before; sim/manual_arm.h); a waypoint the sim stops short of is passed over for the next
+///     (0.5 s after it was commanded). The arm may stop anywhere the assistant left it, and the sim moves
+///     straight in joint space and stops before a collision, so a direct move to a start or to the
+///     alignment's first configuration can be blocked; the design catalog checks the moves from the
+///     candle to every start and alignment configuration (experiments/setup/design.h).
 /// With perfect_registration (the "registration's share" experiment beyond the paper) the
 /// headset modes skip kAlign: the conductor publishes a REGISTRATION (session
 /// "<run_id>-<task_id>-truth", valid, num_trials 0) whose X_WV_mean is the true base pose X_WR of
@@ -59,7 +70,9 @@
 #include "experiments/viraal/results.h"
 #include "experiments/viraal/viraal_conductor.h"
 #include "lcmtypes/contract/channels.h"
+#include "sim/collision_world.h"
 #include "sim/robot_model.h"
+#include "sim/scene.h"
 
 namespace orbed::setup {
 
@@ -86,6 +99,10 @@ struct SetupOptions {
   int reflective_mirrors{1};
   /// Headset modes: the true registration instead of N alignments (see the file comment).
   bool perfect_registration{false};
+  /// kRetract after every set-up (orbed-setup sets it with a design), its route checked in this
+  /// scene ("" = unchecked: joints 4, 2, 6, 1 zeroed in that order).
+  bool retract{false};
+  std::string retract_scene_path;
   double tolerance_deg{0.1};
   double startup_timeout_s{10.0};
   double move_timeout_s{30.0};
@@ -204,7 +221,7 @@ struct SetupPublication {
 
 class SetupConductor {
  public:
-  enum class Phase { kNotStarted, kWaitRobot, kAlign, kPark, kTask, kDone };
+  enum class Phase { kNotStarted, kWaitRobot, kAlign, kRetract, kPark, kTask, kDone };
 
   /// Throws std::invalid_argument for empty modes or targets, a mode twice or out of range,
   /// targets or start outside the joint limits or of the wrong size.
@@ -241,6 +258,9 @@ class SetupConductor {
   void Step();
   void StartTask();  // enters kAlign or kPark for task_index_
   void EnterPark();
+  void EnterRetract();
+  // kPark and kRetract: IIWA_COMMAND `q_deg` until the arm is there at rest; true when it is.
+  bool MoveTo(const std::vector<double>& q_deg, const std::string& what);
   void SendTask();
   void Record(const orbed::setup_result_t& msg);  // the answered task's SetupRecord; then the next task
   void Fail(const std::string& reason);
@@ -257,6 +277,10 @@ class SetupConductor {
   double phase_start_s_{0};
   double last_send_s_{-1e9};
   std::optional<orbed::robot_state_t> robot_state_;
+  std::vector<std::vector<double>> retract_route_;
+  std::unique_ptr<sim::Scene> retract_scene_;  // with retract_scene_path
+  std::unique_ptr<sim::CollisionWorld>
+      retract_world_;  // in retract_scene_  // kRetract's waypoints [deg], the next first
   // What the arm met during the current kTask (reset when it starts).
   std::optional<double> task_min_clearance_m_;
   bool task_contact_{false};

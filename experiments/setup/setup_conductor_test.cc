@@ -9,6 +9,7 @@
 #include <set>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 #include <orbed/guidance_t.hpp>
 
 #include "base/json_fields.h"
@@ -386,6 +387,103 @@ TEST(SetupConductor, PerfectRegistrationPublishesTheTrueBasePose) {
   EXPECT_TRUE(c.run().setups[0].perfect_registration);
   EXPECT_FALSE(c.run().setups[0].alignment_s.has_value());
   EXPECT_NE(SetupRunJson(c.run(), false).find("\"registration\": \"truth\""), std::string::npos);
+}
+
+// The design: per-target starts and ids, the same (start, target) pairs in every mode in the same
+// order, and the retract after each set-up (without a scene: joints 4, 2, 6, 1 zeroed one after
+// the other, then the zero configuration) before the next park. A fake arm goes wherever it is commanded; the
+// fake assistant leaves it 1 deg past every joint of the target.
+TEST(SetupConductor, TheDesignsPairsAreTheSameInEveryModeWithARetractBetween) {
+  SetupOptions o = FixedOnly();
+  o.modes = {kFixed, orbed::guidance_t::MODE_AR};
+  o.perfect_registration = true;  // no alignment: the pairs alone
+  o.retract = true;
+  o.starts_deg = {{0, -20, 0, 60, 0, -40, 0}, {-90, 20, 0, -60, 0, 40, 0}};
+  o.start_ids = {"ready_away", "aside"};
+  o.target_ids = {"medium/umbilicus/1", "medium/umbilicus/2"};
+  SetupConductor c(o, Model());
+  c.Start(At(0));
+  std::vector<double> arm = {0, 0, 0, 0, 0, 0, 0};
+  std::vector<std::vector<double>> commands;  // every distinct IIWA_COMMAND, in order
+  double t = 0.1;
+  SetupConductor::Actions a = c.OnRobotState(State(arm, 0), At(t));
+  for (int step = 0; step < 200 && !c.done(); ++step) {
+    t += 0.5;
+    if (const orbed::setup_task_t* task = FindTask(a)) {
+      std::vector<double> reached;
+      for (double q : task->target_position) reached.push_back(q * kRadToDeg + 1.0);
+      c.OnSetupResult(Answer(*task, 50, 1), At(t));
+      arm = reached;
+      a = c.OnRobotState(State(arm, 0), At(t + 0.1));
+      continue;
+    }
+    for (const SetupPublication& p : a.publish) {
+      if (const auto* command = std::get_if<orbed::iiwa_command_t>(&p.message)) {
+        arm.clear();
+        for (double q : command->joint_position) arm.push_back(q * kRadToDeg);
+        if (commands.empty() || commands.back() != arm) commands.push_back(arm);
+      }
+    }
+    a = c.OnRobotState(State(arm, 0), At(t));
+  }
+  ASSERT_TRUE(c.done());
+  ASSERT_TRUE(c.run().ok) << c.run().error;
+  ASSERT_EQ(c.run().setups.size(), 4u);
+  for (size_t i = 0; i < 4; ++i) {
+    const SetupRecord& r = c.run().setups[i];
+    const size_t k = i % 2;  // the same pair at the same place in both modes
+    EXPECT_EQ(r.target, static_cast<int>(k) + 1);
+    EXPECT_EQ(r.start_id, o.start_ids[k]);
+    EXPECT_EQ(r.target_id, o.target_ids[k]);
+    EXPECT_EQ(r.start_deg, o.starts_deg[k]);
+    EXPECT_EQ(r.target_deg, o.targets_deg[k]);
+  }
+  // Start 1; then after each set-up: straightened, candle, the next start.
+  auto zeroed = [](std::vector<double> q, std::vector<int> joints) {
+    for (int j : joints) q[j] = 0;
+    return q;
+  };
+  auto past = [](std::vector<double> q) {
+    for (double& v : q) v += 1.0;
+    return q;
+  };
+  const std::vector<double> zero(7, 0.0);
+  std::vector<std::vector<double>> expected = {o.starts_deg[0]};
+  for (size_t k : {0, 1, 0}) {
+    const std::vector<double> reached = past(o.targets_deg[k]);
+    for (const std::vector<double>& q : {zeroed(reached, {3}), zeroed(reached, {3, 1}),
+                                         zeroed(reached, {3, 1, 5}), zeroed(reached, {3, 1, 5, 0}), zero})
+      expected.push_back(q);
+    expected.push_back(o.starts_deg[1 - k]);
+  }
+  ASSERT_EQ(commands.size(), expected.size());
+  for (size_t i = 0; i < expected.size(); ++i) {
+    for (size_t j = 0; j < 7; ++j) EXPECT_NEAR(commands[i][j], expected[i][j], 1e-9) << i << " " << j;
+  }
+  // The ids and the start come back from the file; a run with another start is refused.
+  const std::string json = SetupRunJson(c.run(), true);
+  EXPECT_NE(json.find("\"target_id\": \"medium/umbilicus/2\""), std::string::npos) << json;
+  std::string status;
+  SetupRun back = ParseSetupRunJson(json, "setup_results.json", &status);
+  EXPECT_EQ(SetupRunJson(back, true), json);
+  back.setups.resize(3);
+  EXPECT_EQ(KeptSetups(back, "partial", o).size(), 3u);
+  SetupOptions other = o;
+  other.starts_deg[1] = {0, 20, 0, -60, 0, 40, 0};
+  EXPECT_THROW(KeptSetups(back, "partial", other), std::invalid_argument);
+  other = o;
+  other.target_ids[0] = "small/umbilicus/1";
+  EXPECT_THROW(KeptSetups(back, "partial", other), std::invalid_argument);
+  // A file from before the design (no ids, no start) still reads.
+  nlohmann::json doc = nlohmann::json::parse(json);
+  for (auto& r : doc["setups"]) {
+    for (const char* key : {"start_id", "target_id", "start_deg"}) r.erase(key);
+  }
+  const SetupRun read = ParseSetupRunJson(doc.dump(), "old.json", &status);
+  ASSERT_EQ(read.setups.size(), 4u);
+  EXPECT_TRUE(read.setups[0].start_id.empty());
+  EXPECT_TRUE(read.setups[0].start_deg.empty());
+  EXPECT_EQ(read.setups[3].target_deg, o.targets_deg[1]);
 }
 
 TEST(SetupConductor, TimeoutsNameWhoDidNotAnswer) {

@@ -71,6 +71,12 @@ SetupUserRun ReadSetupResults(const std::string& path) {
     num_joints = joints;
     row.target_deg = f.Numbers(target, joints, -360, 360);
     row.reached_deg = f.Numbers(f.Member(s, "reached_deg"), joints, -360, 360);
+    // The design's (absent or null in results written before it).
+    if (const std::optional<JsonAt> v = f.OptionalMember(s, "start_id")) row.start_id = f.String(*v, 256);
+    if (const std::optional<JsonAt> v = f.OptionalMember(s, "target_id")) row.target_id = f.String(*v, 256);
+    if (const std::optional<JsonAt> v = f.OptionalMember(s, "start_deg")) {
+      if (f.ArraySize(*v, kMaxJoints) > 0) row.start_deg = f.Numbers(*v, joints, -360, 360);
+    }
     for (double t : f.Numbers(f.Member(s, "twisting"), joints, 0, 1)) row.twisting.push_back(t != 0);
     row.execution_s = f.Number(f.Member(s, "execution_s"), 0, 1e6);
     // null (fixed display: no alignment) reads as absent.
@@ -97,16 +103,29 @@ SetupUserRun ReadSetupResults(const std::string& path) {
   return run;
 }
 
+namespace {
+// An id as a CSV cell: the design's ids are words and '/', quoted only if they ever hold a comma or
+// a quote.
+std::string CsvCell(const std::string& text) {
+  if (text.find_first_of(",\"\n") == std::string::npos) return text;
+  std::string quoted = "\"";
+  for (char c : text) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return quoted + "\"";
+}
+}  // namespace
+
 std::string SetupJointsCsv(const std::vector<SetupUserRun>& runs) {
-  std::string csv = "user,mode,order,target,joint,twisting,target_deg,reached_deg,error_deg\n";
+  std::string csv =
+      "user,mode,order,target,joint,twisting,target_deg,reached_deg,error_deg,start_id,target_id,start_deg\n";
   for (const SetupUserRun& run : runs) {
     for (const SetupRow& row : run.setups) {
       for (size_t j = 0; j < row.target_deg.size(); ++j) {
-        csv += run.user + "," + row.mode + "," + std::to_string(row.order) + "," +
-               std::to_string(row.target) + "," + std::to_string(j + 1) + "," +
-               std::to_string(row.twisting[j]) + "," + JsonNumber(row.target_deg[j]) + "," +
-               JsonNumber(row.reached_deg[j]) + "," +
-               JsonNumber(std::abs(row.reached_deg[j] - row.target_deg[j])) + "\n";
+        csv +=
+            run.user + "," + row.mode + "," + std::to_string(row.order) + "," + std::to_string(row.target) +
+            "," + std::to_string(j + 1) + "," + std::to_string(row.twisting[j]) + "," +
+            JsonNumber(row.target_deg[j]) + "," + JsonNumber(row.reached_deg[j]) + "," +
+            JsonNumber(std::abs(row.reached_deg[j] - row.target_deg[j])) + "," + CsvCell(row.start_id) + "," +
+            CsvCell(row.target_id) + "," + (row.start_deg.empty() ? "" : JsonNumber(row.start_deg[j])) + "\n";
       }
     }
   }
@@ -114,12 +133,12 @@ std::string SetupJointsCsv(const std::vector<SetupUserRun>& runs) {
 }
 
 std::string SetupTimesCsv(const std::vector<SetupUserRun>& runs) {
-  std::string csv = "user,mode,order,target,execution_s,alignment_s\n";
+  std::string csv = "user,mode,order,target,execution_s,alignment_s,start_id,target_id\n";
   for (const SetupUserRun& run : runs) {
     for (const SetupRow& row : run.setups) {
       csv += run.user + "," + row.mode + "," + std::to_string(row.order) + "," + std::to_string(row.target) +
              "," + JsonNumber(row.execution_s) + "," + (row.alignment_s ? JsonNumber(*row.alignment_s) : "") +
-             "\n";
+             "," + CsvCell(row.start_id) + "," + CsvCell(row.target_id) + "\n";
     }
   }
   return csv;

@@ -4,11 +4,15 @@
 /// each a different emulated person) writes setup_results.json (experiments/setup/setup_conductor.h); this
 /// reads them and writes the study's set-up files:
 ///
-///   setup_joints.csv  user,mode,order,target,joint,twisting,target_deg,reached_deg,error_deg
+///   setup_joints.csv  user,mode,order,target,joint,twisting,target_deg,reached_deg,error_deg,
+///                     start_id,target_id,start_deg
 ///                     (one row per set-up and joint; joint 1..7; twisting 1/0; error_deg =
 ///                     |reached − target|, reached = the sim's measured joints when the assistant
-///                     said it was done)
-///   setup_times.csv   user,mode,order,target,execution_s,alignment_s (alignment_s empty for fixed)
+///                     said it was done; start_id and target_id the design catalog's ids
+///                     (experiments/setup/design.h), start_deg that joint's start angle; empty
+///                     cells for runs without a design or older results)
+///   setup_times.csv   user,mode,order,target,execution_s,alignment_s,start_id,target_id
+///                     (alignment_s empty for fixed)
 ///   setup_docking.csv user,mode,order,target,docking_tip_mm,docking_axis_deg,min_clearance_m,
 ///                     contact,collision_stops (beyond the paper: what the joint errors do at the
 ///                     trocar, and what the arm came close to while the assistant moved it; empty
@@ -33,6 +37,9 @@ struct SetupRow {
   std::string mode;  ///< ar_reflective, ar or fixed
   int order{0};
   int target{0};
+  /// The design's ids and the start [deg] (empty without a design or in older results).
+  std::string start_id, target_id;
+  std::vector<double> start_deg;
   std::vector<double> target_deg, reached_deg;
   std::vector<int> twisting;
   double execution_s{0};

@@ -55,15 +55,38 @@ TEST(SetupTables, ReadsTheRunsAndWritesTheCsvFiles) {
   EXPECT_FALSE(runs[0].setups[2].alignment_s.has_value());
   EXPECT_EQ(*runs[0].setups[1].alignment_s, 140);
   const std::string joints = SetupJointsCsv(runs);
-  EXPECT_EQ(joints.substr(0, joints.find('\n')),
-            "user,mode,order,target,joint,twisting,target_deg,reached_deg,error_deg");
-  EXPECT_NE(joints.find("\nu1,ar,1,1,1,1,10,11,1\n"), std::string::npos) << joints;
-  EXPECT_NE(joints.find("\nu1,fixed,2,2,1,1,10,5,5\n"), std::string::npos) << joints;
+  EXPECT_EQ(
+      joints.substr(0, joints.find('\n')),
+      "user,mode,order,target,joint,twisting,target_deg,reached_deg,error_deg,start_id,target_id,start_deg");
+  // Results without a design: its three cells empty.
+  EXPECT_NE(joints.find("\nu1,ar,1,1,1,1,10,11,1,,,\n"), std::string::npos) << joints;
+  EXPECT_NE(joints.find("\nu1,fixed,2,2,1,1,10,5,5,,,\n"), std::string::npos) << joints;
   EXPECT_EQ(std::count(joints.begin(), joints.end(), '\n'), 1 + 7 * 7);
   const std::string times = SetupTimesCsv(runs);
-  EXPECT_EQ(times.substr(0, times.find('\n')), "user,mode,order,target,execution_s,alignment_s");
-  EXPECT_NE(times.find("\nu1,fixed,2,1,100,\n"), std::string::npos) << times;
-  EXPECT_NE(times.find("\nu2,ar,2,1,75,120\n"), std::string::npos) << times;
+  EXPECT_EQ(times.substr(0, times.find('\n')),
+            "user,mode,order,target,execution_s,alignment_s,start_id,target_id");
+  EXPECT_NE(times.find("\nu1,fixed,2,1,100,,,\n"), std::string::npos) << times;
+  EXPECT_NE(times.find("\nu2,ar,2,1,75,120,,\n"), std::string::npos) << times;
+}
+
+// A design's run: the ids in both files, each joint's start angle in setup_joints.csv.
+TEST(SetupTables, TheDesignsIdsAndStartsAreAppended) {
+  std::string setup = SetupJson("ar", 1, 1, 1, 60, "100");
+  setup.insert(
+      1,
+      R"("start_id": "aside", "target_id": "medium/umbilicus/2", "start_deg": [-90, 20, 0, -60, 0, 40, 0], )");
+  const std::string u1 =
+      R"({"user": "u1", "run_id": "r", "status": "ok", "error": "", "order": ["ar"], "setups": [)" + setup +
+      "]}";
+  const std::vector<SetupUserRun> runs = {ReadSetupResults(Write("design.json", u1))};
+  EXPECT_EQ(runs[0].setups[0].target_id, "medium/umbilicus/2");
+  const std::string joints = SetupJointsCsv(runs);
+  EXPECT_NE(joints.find("\nu1,ar,1,1,1,1,10,11,1,aside,medium/umbilicus/2,-90\n"), std::string::npos)
+      << joints;
+  EXPECT_NE(joints.find("\nu1,ar,1,1,4,0,-60,-60,0,aside,medium/umbilicus/2,-60\n"), std::string::npos)
+      << joints;
+  const std::string times = SetupTimesCsv(runs);
+  EXPECT_NE(times.find("\nu1,ar,1,1,60,100,aside,medium/umbilicus/2\n"), std::string::npos) << times;
 }
 
 TEST(SetupTables, ThePapersTablesUnchanged) {

@@ -273,6 +273,8 @@ int RunSetup(int argc, const char* const* argv, std::ostream& out, std::ostream&
       for (const DesignPair& p : design.pairs) {
         options.targets_deg.push_back(p.target_deg);
         options.starts_deg.push_back(p.start_deg);
+        options.retract = true;
+        options.retract_scene_path = scene_path.empty() ? SourceTreePath(design.scene) : scene_path;
         options.start_ids.push_back(p.start_id);
         options.target_ids.push_back(p.target_id);
         out << " " << p.start_id << " -> " << p.target_id << ";";

@@ -23,7 +23,9 @@ HELP = "the paper's two studies over the bus (ViRAAl and robot set-up), tables a
 DESCRIPTION = """The paper's two studies over the bus, each user a different emulated person (--user-seed S,
 S+1, ...). ViRAAl: one run of viraal.yaml per user (default 4 users, 10 trials per display mode).
 Robot set-up: one run of setup.yaml per user (default 8 users, the three guidance modes in an order
-drawn from the seed, K targets each, default 3; 3 alignments before each headset set-up). Then
+drawn from the seed; the patient and K (start, target) pairs drawn from the seed out of the design
+catalog experiments/setup/design.json, the same for every mode, default K = 3; 3 alignments before
+each headset set-up). Then
 alignment_trials.csv, alignment_means.csv, landmark_validation.csv, setup_joints.csv,
 setup_times.csv, setup_docking.csv, tables.json, report.html and figures/ in
 logs/study-<time>-<random>/ (every user's run folder inside it, and each one's output in
@@ -44,8 +46,9 @@ def configure(p):
     p.add_argument("--trials", type=checks.whole(1, 999), default=10, metavar="N",
                    help="ViRAAl trials per display mode (default 10)")
     p.add_argument("--setup-users", type=checks.whole(0, 99), default=8, metavar="N", help="set-up users (default 8)")
-    p.add_argument("--targets", type=checks.whole(1, 3), default=3, metavar="K",
-                   help="set-up targets per mode, 1..3 (experiments/setup/targets.json has 3; default 3)")
+    p.add_argument("--targets", type=checks.whole(1, 6), default=3, metavar="K",
+                   help="set-up (start, target) pairs per mode drawn from experiments/setup/design.json, 1..6 "
+                        "(the smallest patient's count of targets bounds it; default 3)")
     p.add_argument("--seed", type=checks.whole(0, 999999999), default=1, metavar="S", help="the first user's seed")
     p.add_argument("--run-id", type=checks.run_id, metavar="ID", help="default study-s<S>")
     p.add_argument("--registration-share", action="store_true",
@@ -161,7 +164,14 @@ def run(args, ctx):
                                                                        f", 3 modes x {args.targets} target(s)"))
             # A set-up takes 5-15 s here, an alignment of three trials a few seconds.
             duration, launch_file = 300 + 300 * args.targets, os.path.join(ctx.root, "scripts", "launch", "setup.yaml")
-            launch_args = [f"user=u{k}", f"user_seed={user_seed}", f"setup_targets={args.targets}"]
+            # The user's patient (the design's draw from the seed): the sim collides with the
+            # patient the targets were planned for; orbed-setup reads the same scene.
+            draw = subprocess.run([os.path.join(ctx.bin, "orbed-design"), "draw", "--user-seed", str(user_seed),
+                                   "--targets", str(args.targets)], capture_output=True, text=True)
+            if draw.returncode != 0:
+                raise Failure(f"study: orbed-design draw for user u{k} failed: {draw.stderr.strip()}")
+            scene = json.loads(draw.stdout)["scene"]
+            launch_args = [f"user=u{k}", f"user_seed={user_seed}", f"setup_targets={args.targets}", f"scene={scene}"]
             if truth:
                 # The same person and targets, headset modes only, with the true registration
                 # instead of the alignments: what a perfect registration would leave of the error.
