@@ -25,6 +25,32 @@ struct Shipped {
   RobotModel model = LoadRobotForScene(SourceTreePath(RobotModel::kDefaultUrdfRelativePath), scene);
 };
 
+// A branch: the shortfall by hand, and a planned target in the branch the former plan's first
+// target is the mirror of (joints 2, 4, 6 of signs +, -, +).
+TEST(TrocarPlan, ABranchIsPlannedInsideItsSigns) {
+  Eigen::VectorXd q(7);
+  q << 0, 20, 0, -5, 0, -30, 0;
+  q *= kDegToRad;
+  const std::vector<int> signs = {0, 1, 0, -1, 0, 1, 0};
+  // Joint 2: 20 >= 10, none; joint 4: -(-5) = 5, short by 5; joint 6: -30, short by 40.
+  EXPECT_NEAR(BranchShortfallDeg(q, signs, 10), 45.0, 1e-9);
+  EXPECT_EQ(BranchShortfallDeg(q, {}, 10), 0.0);
+  const Shipped s;
+  for (const std::vector<int>& branch : {signs, std::vector<int>{0, -1, 0, 1, 0, -1, 0}}) {
+    TrocarPlanOptions options;
+    options.num_targets = 1;
+    options.joint_signs = branch;
+    const std::vector<PlannedTarget> plan = PlanTrocarTargets(s.model, s.scene, options);
+    ASSERT_EQ(plan.size(), 1u);
+    for (int j : {1, 3, 5}) EXPECT_GE(branch[j] * plan[0].q_rad[j] * kRadToDeg, 10.0) << "joint " << j + 1;
+    const Eigen::Isometry3d X_WT = s.scene.X_WR * s.model.CalcToolTipPose(plan[0].q_rad);
+    EXPECT_LT((X_WT.translation() - s.scene.trocar.p_WT).norm(), 1e-4);
+  }
+  TrocarPlanOptions bad;
+  bad.joint_signs = {0, 2, 0, 0, 0, 0, 0};
+  EXPECT_THROW(PlanTrocarTargets(s.model, s.scene, bad), std::invalid_argument);
+}
+
 TEST(TrocarPlan, ThreeDistinctDockingConfigurationsWithClearance) {
   const Shipped s;
   TrocarPlanOptions options;
