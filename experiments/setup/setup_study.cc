@@ -59,9 +59,9 @@ struct HeadPose {
 using Message =
     std::variant<orbed::iiwa_status_t, orbed::robot_state_t, orbed::collision_status_t, orbed::iiwa_command_t,
                  orbed::plan_check_request_t, orbed::plan_check_reply_t, orbed::session_control_t,
-                 orbed::alignment_trial_t, orbed::registration_t, orbed::landmark_request_t, orbed::landmark_t,
-                 orbed::misalignment_request_t, orbed::misalignment_t, HeadPose, orbed::guidance_t,
-                 orbed::setup_task_t, orbed::setup_result_t, FixedView>;
+                 orbed::alignment_trial_t, orbed::registration_t, orbed::landmark_request_t,
+                 orbed::landmark_t, orbed::misalignment_request_t, orbed::misalignment_t, HeadPose,
+                 orbed::guidance_t, orbed::setup_task_t, orbed::setup_result_t, FixedView>;
 
 // A timer on the sim clock as runtime/process.h runs it: deadlines k·period since the first
 // SIM_CLOCK (every process is constructed before it), each run with the clock at its deadline.
@@ -103,9 +103,9 @@ class UserBus {
     const int64_t max_ticks = static_cast<int64_t>(options_.max_sim_s * 1e6 / static_cast<double>(tick_us));
     for (int64_t k = 1; !conductor_.done(); ++k) {
       if (k > max_ticks) {
-        Apply(conductor_.Abort("in-process run: no end within " + std::to_string(options_.max_sim_s) +
-                                   " s of sim time",
-                               HandlerTime()));
+        Apply(conductor_.Abort(
+            "in-process run: no end within " + std::to_string(options_.max_sim_s) + " s of sim time",
+            HandlerTime()));
         break;
       }
       const sim::ArmSim::TickResult tick = sim_.Tick(k * sim_.tick_wall_ns());
@@ -272,7 +272,9 @@ class UserBus {
     reply.utime = now_utime_;
     Send(reply);
   }
-  void Handle(const orbed::plan_check_reply_t& msg) { Apply(conductor_.OnPlanCheckReply(msg, HandlerTime())); }
+  void Handle(const orbed::plan_check_reply_t& msg) {
+    Apply(conductor_.OnPlanCheckReply(msg, HandlerTime()));
+  }
   void Handle(const orbed::session_control_t& msg) {
     Act(headset_.OnSessionControl(msg, HeadsetTime(HandlerTime())));
     if (headset_.trial_ready()) Act(headset_.PublishReadyTrial(now_utime_));
@@ -289,7 +291,8 @@ class UserBus {
       Eigen::Isometry3d X_WV = FromPose(msg.X_WV_mean);
       if (options_.injection.active()) {
         const auto [d_W, a_W] = InjectionFor(options_.injection, options_.user_seed, msg.session_id);
-        X_WV = InjectRegistrationError(X_WV, options_.injection.offset_m, options_.injection.tilt_rad, d_W, a_W);
+        X_WV =
+            InjectRegistrationError(X_WV, options_.injection.offset_m, options_.injection.tilt_rad, d_W, a_W);
       }
       machine_.OnRegistration(X_WV);
     }
@@ -299,7 +302,9 @@ class UserBus {
   void Handle(const orbed::landmark_t& msg) { Apply(conductor_.OnLandmark(msg, HandlerTime())); }
   void Handle(const orbed::misalignment_request_t& msg) { Send(service_.HandleMisalignmentRequest(msg)); }
   void Handle(const orbed::misalignment_t& msg) { Apply(conductor_.OnMisalignment(msg, HandlerTime())); }
-  void Handle(const HeadPose& pose) { machine_.OnHeadPose(pose.truth, pose.msg.seq, FromPose(pose.msg.X_WH)); }
+  void Handle(const HeadPose& pose) {
+    machine_.OnHeadPose(pose.truth, pose.msg.seq, FromPose(pose.msg.X_WH));
+  }
   void Handle(const orbed::guidance_t& msg) {
     machine_.OnGuidance(msg);
     headset_.OnGuidance(msg, HandlerTime().t_s);
@@ -357,7 +362,8 @@ Eigen::Isometry3d InjectRegistrationError(const Eigen::Isometry3d& X_WV, double 
 
 std::pair<Eigen::Vector3d, Eigen::Vector3d> InjectionFor(const RegistrationInjection& injection,
                                                          uint64_t user_seed, const std::string& task_id) {
-  if (!injection.random_direction) return {injection.direction_W.normalized(), injection.tilt_axis_W.normalized()};
+  if (!injection.random_direction)
+    return {injection.direction_W.normalized(), injection.tilt_axis_W.normalized()};
   Random rng(SplitMix64(user_seed ^ Fnv1a64(task_id)));
   // Uniform on the sphere: z uniform in [-1, 1], azimuth uniform (Archimedes).
   const double z = rng.Uniform(-1.0, 1.0);

@@ -1,0 +1,257 @@
+#include "experiments/setup/setup_study_cli.h"
+
+#include <atomic>
+#include <chrono>
+#include <exception>
+#include <filesystem>
+#include <mutex>
+#include <sstream>
+#include <thread>
+
+#include <CLI/CLI.hpp>
+#include <orbed/guidance_t.hpp>
+
+#include "base/command_line.h"
+#include "base/format.h"
+#include "base/log.h"
+#include "base/replace_file.h"
+#include "experiments/setup/setup_tables.h"
+#include "sim/guidance_messages.h"
+
+namespace orbed::setup {
+namespace {
+
+// The study's table rows of one run (what ReadSetupResults reads back from setup_results.json).
+study::SetupUserRun TableRun(const SetupRun& run) {
+  study::SetupUserRun out;
+  out.user = run.user;
+  out.order = run.order;
+  for (const SetupRecord& r : run.setups) {
+    study::SetupRow row;
+    row.mode = guidance::GuidanceModeName(r.mode);
+    row.order = r.order;
+    row.target = r.target;
+    row.target_deg = r.target_deg;
+    row.reached_deg = r.reached_deg;
+    row.twisting = r.twisting;
+    row.execution_s = r.execution_s;
+    row.alignment_s = r.alignment_s;
+    if (r.mode != orbed::guidance_t::MODE_FIXED_DISPLAY) row.registration = r.perfect_registration ? "truth" : "measured";
+    row.docking_tip_mm = r.docking_tip_mm;
+    row.docking_axis_deg = r.docking_axis_deg;
+    row.min_clearance_m = r.min_clearance_m;
+    row.contact = r.contact;
+    row.collision_stops = r.collision_stops;
+    out.setups.push_back(std::move(row));
+  }
+  return out;
+}
+
+// The CSVs of every study, each line after the header with "<study>," first when there are several.
+std::string StudyCsv(const std::vector<std::vector<study::SetupUserRun>>& studies,
+                     std::string (*writer)(const std::vector<study::SetupUserRun>&)) {
+  if (studies.size() == 1) return writer(studies[0]);
+  std::string out;
+  for (size_t m = 0; m < studies.size(); ++m) {
+    std::istringstream lines(writer(studies[m]));
+    std::string line;
+    bool header = true;
+    while (std::getline(lines, line)) {
+      if (header) {
+        if (m == 0) out += "study," + line + "\n";
+        header = false;
+        continue;
+      }
+      out += std::to_string(m + 1) + "," + line + "\n";
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+SetupUserOptions StudyUser(const SetupUserOptions& base, uint64_t seed, const std::string& run_id, int users,
+                           int study, int k) {
+  SetupUserOptions o = base;
+  o.user = "u" + std::to_string(k);
+  o.user_seed = seed + static_cast<uint64_t>(study) * static_cast<uint64_t>(users) + static_cast<uint64_t>(k - 1);
+  o.run_id = run_id + (study == 0 ? "" : "-m" + std::to_string(study)) + "-setup-u" + std::to_string(k);
+  return o;
+}
+
+std::vector<SetupRun> RunSetupUsers(const std::vector<SetupUserOptions>& jobs, int threads,
+                                    const std::function<void(int, int)>& progress) {
+  std::vector<SetupRun> runs(jobs.size());
+  std::vector<std::exception_ptr> errors(jobs.size());
+  std::atomic<size_t> next{0};
+  std::atomic<int> done{0};
+  std::mutex progress_mutex;
+  auto work = [&] {
+    for (size_t i = next++; i < jobs.size(); i = next++) {
+      try {
+        runs[i] = RunSetupUser(jobs[i]);
+      } catch (...) {
+        errors[i] = std::current_exception();
+      }
+      const int finished = ++done;
+      if (progress) {
+        std::lock_guard<std::mutex> lock(progress_mutex);
+        progress(finished, static_cast<int>(jobs.size()));
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int t = 1; t < threads; ++t) pool.emplace_back(work);
+  work();
+  for (std::thread& t : pool) t.join();
+  for (const std::exception_ptr& e : errors)
+    if (e) std::rethrow_exception(e);
+  return runs;
+}
+
+int RunSetupStudy(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
+  CLI::App app{
+      "orbed-setup-study: the robot set-up study (paper Sec. IV-B) without the bus: each user's\n"
+      "launch of scripts/launch/setup.yaml done in one process by the same cores in lockstep order\n"
+      "(equal to the bus run), many users and studies on threads; writes setup_joints.csv,\n"
+      "setup_times.csv and setup_docking.csv (a leading `study` column for --studies > 1)."};
+  AddVersionFlag(&app);
+  int users = 8, studies = 1, threads = 2, targets = 3, trials = 3;
+  uint64_t seed = 1;
+  std::string run_id, out_dir = ".", json_dir, registration = "measured", direction, assistant_config;
+  double offset_mm = 0, tilt_deg = 0;
+  std::vector<double> axis;
+  bool quiet = false;
+  app.add_option("--users", users, "Users per study")->check(NumberIn(1, 10000))->capture_default_str();
+  app.add_option("--studies", studies, "Studies (study m uses seeds S + m*U ...)")
+      ->check(NumberIn(1, 100000))
+      ->capture_default_str();
+  app.add_option("--seed", seed, "The first user's seed")->check(NumberIn(0, 1e15))->capture_default_str();
+  app.add_option("--run-id", run_id, "Run ids <ID>-setup-u<k> (default study-s<S>, as scripts/orbed study)");
+  app.add_option("--targets", targets, "Targets per mode, 1..3 (experiments/setup/targets.json)")
+      ->check(NumberIn(1, 3))
+      ->capture_default_str();
+  app.add_option("--trials", trials, "Alignments before each headset set-up (the paper: N = 3)")
+      ->check(NumberIn(1, 100))
+      ->capture_default_str();
+  app.add_option("--threads", threads, "Users run at a time")->check(NumberIn(1, 256))->capture_default_str();
+  app.add_option("--out", out_dir, "Folder of the CSVs")->capture_default_str();
+  app.add_option("--json-dir", json_dir, "Also each user's setup_results.json under this folder");
+  app.add_option("--registration", registration,
+                 "Headset modes: 'measured' (N alignments, their mean) or 'truth' (the true registration)")
+      ->check(CLI::IsMember({"measured", "truth"}))
+      ->capture_default_str();
+  app.add_option("--registration-offset-mm", offset_mm,
+                 "Move every registration the assistant receives by this along the direction [mm]")
+      ->check(NumberIn(-1000, 1000))
+      ->capture_default_str();
+  app.add_option("--registration-tilt-deg", tilt_deg,
+                 "Turn every registration the assistant receives by this about the axis [deg]")
+      ->check(NumberIn(-180, 180))
+      ->capture_default_str();
+  app.add_option("--registration-direction", direction,
+                 "The offset's direction in W, X,Y,Z (default 1,0,0), or 'random' (per set-up, with a "
+                 "random horizontal tilt axis)");
+  AddNumberListOption(&app, "--registration-axis", &axis, 3, "The tilt's axis in W, X,Y,Z (default 0,1,0)");
+  app.add_option("--assistant-config", assistant_config, "The assistant's parameters (orbed-assistant --config)");
+  app.add_flag("--quiet", quiet, "No progress on stderr");
+  if (const auto code = ParseArguments(&app, argc, argv, out, err)) return *code;
+
+  SetupUserOptions base;
+  base.targets = targets;
+  base.trials = trials;
+  base.perfect_registration = registration == "truth";
+  base.assistant_config_path = assistant_config;
+  base.injection.offset_m = offset_mm * 1e-3;
+  base.injection.tilt_rad = tilt_deg * M_PI / 180.0;
+  auto unit = [&](const std::vector<double>& v, const char* flag, Eigen::Vector3d* u) {
+    const Eigen::Vector3d x(v[0], v[1], v[2]);
+    if (!(x.norm() > 1e-9)) {
+      err << "orbed-setup-study: " << flag << " must not be the zero vector (see --help)\n";
+      return false;
+    }
+    *u = x.normalized();
+    return true;
+  };
+  if (direction == "random") {
+    base.injection.random_direction = true;
+  } else if (!direction.empty()) {
+    std::vector<double> d;
+    std::istringstream parts(direction);
+    std::string part;
+    while (std::getline(parts, part, ',')) {
+      try {
+        size_t used = 0;
+        d.push_back(std::stod(part, &used));
+        if (used != part.size() || !std::isfinite(d.back())) d.clear();
+      } catch (const std::exception&) {
+        d.clear();
+      }
+      if (d.empty()) break;
+    }
+    if (d.size() != 3) {
+      err << "orbed-setup-study: --registration-direction needs X,Y,Z or 'random', got '" << direction
+          << "' (see --help)\n";
+      return kExitUsage;
+    }
+    if (!unit(d, "--registration-direction", &base.injection.direction_W)) return kExitUsage;
+  }
+  if (!axis.empty() && !unit(axis, "--registration-axis", &base.injection.tilt_axis_W)) return kExitUsage;
+  if (run_id.empty()) run_id = "study-s" + std::to_string(seed);
+  if (GetLogLevel() < LogLevel::kWarn) SetLogLevel(LogLevel::kWarn);  // the cores' lines per trial
+
+  std::vector<SetupUserOptions> jobs;
+  for (int m = 0; m < studies; ++m)
+    for (int k = 1; k <= users; ++k) jobs.push_back(StudyUser(base, seed, run_id, users, m, k));
+  const auto start = std::chrono::steady_clock::now();
+  int shown_s = -1;
+  auto progress = [&](int done, int total) {
+    if (quiet) return;
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (done < total && static_cast<int>(s) == shown_s) return;
+    shown_s = static_cast<int>(s);
+    err << "setup-study: " << done << "/" << total << " users, " << Fixed(s, 0) << " s elapsed"
+        << (done < total ? ", about " + Fixed(s / done * (total - done), 0) + " s left" : ", done") << "\n";
+  };
+  std::vector<SetupRun> runs;
+  try {
+    runs = RunSetupUsers(jobs, threads, progress);
+  } catch (const std::exception& e) {
+    err << "orbed-setup-study: " << e.what() << "\n";
+    return 1;
+  }
+  std::vector<std::vector<study::SetupUserRun>> tables(studies);
+  for (size_t i = 0; i < runs.size(); ++i) {
+    if (!runs[i].ok) {
+      err << "orbed-setup-study: " << runs[i].run_id << " failed: " << runs[i].error << "\n";
+      return 1;
+    }
+    tables[i / users].push_back(TableRun(runs[i]));
+  }
+  std::string error;
+  auto write = [&](const std::string& path, const std::string& text) {
+    std::error_code ec;
+    std::filesystem::create_directories(std::filesystem::path(path).parent_path(), ec);
+    if (ReplaceFile(path, text, &error)) return true;
+    err << "orbed-setup-study: cannot write " << path << ": " << error << "\n";
+    return false;
+  };
+  if (!write(out_dir + "/setup_joints.csv", StudyCsv(tables, study::SetupJointsCsv)) ||
+      !write(out_dir + "/setup_times.csv", StudyCsv(tables, study::SetupTimesCsv)) ||
+      !write(out_dir + "/setup_docking.csv", StudyCsv(tables, study::SetupDockingCsv)))
+    return 1;
+  if (!json_dir.empty()) {
+    for (size_t i = 0; i < runs.size(); ++i) {
+      const std::string folder = json_dir + (studies > 1 ? "/m" + std::to_string(i / users) : "") + "/setup-" +
+                                 runs[i].user;
+      if (!write(folder + "/setup_results.json", SetupRunJson(runs[i], false))) return 1;
+    }
+  }
+  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  out << "orbed-setup-study: " << studies << " stud" << (studies == 1 ? "y" : "ies") << " of " << users
+      << " users (" << runs.size() << " users, " << runs.size() * runs[0].setups.size() << " set-ups) in "
+      << Fixed(s, 1) << " s on " << threads << " thread(s); files in " << out_dir << "\n";
+  return 0;
+}
+
+}  // namespace orbed::setup
