@@ -121,7 +121,7 @@ int RunSetupStudy(int argc, const char* const* argv, std::ostream& out, std::ost
   std::string run_id, out_dir = ".", json_dir, registration = "measured", direction, assistant_config;
   double offset_mm = 0, tilt_deg = 0;
   std::vector<double> axis;
-  bool quiet = false;
+  bool quiet = false, allow_failures = false;
   app.add_option("--users", users, "Users per study")->check(NumberIn(1, 10000))->capture_default_str();
   app.add_option("--studies", studies, "Studies (study m uses seeds S + m*U ...)")
       ->check(NumberIn(1, 100000))
@@ -155,6 +155,9 @@ int RunSetupStudy(int argc, const char* const* argv, std::ostream& out, std::ost
   AddNumberListOption(&app, "--registration-axis", &axis, 3, "The tilt's axis in W, X,Y,Z (default 0,1,0)");
   app.add_option("--assistant-config", assistant_config, "The assistant's parameters (orbed-assistant --config)");
   app.add_flag("--quiet", quiet, "No progress on stderr");
+  app.add_flag("--allow-failures", allow_failures,
+               "A user whose run failed (e.g. the arm stopped before a collision on its way to the start) is "
+               "left out of the CSVs and listed in failed_users.csv, instead of failing the study");
   if (const auto code = ParseArguments(&app, argc, argv, out, err)) return *code;
 
   SetupUserOptions base;
@@ -221,10 +224,20 @@ int RunSetupStudy(int argc, const char* const* argv, std::ostream& out, std::ost
     return 1;
   }
   std::vector<std::vector<study::SetupUserRun>> tables(studies);
+  std::string failed = "study,user,user_seed,run_id,error\n";
+  int failures = 0;
   for (size_t i = 0; i < runs.size(); ++i) {
     if (!runs[i].ok) {
-      err << "orbed-setup-study: " << runs[i].run_id << " failed: " << runs[i].error << "\n";
-      return 1;
+      err << "orbed-setup-study: " << runs[i].run_id << " (seed " << jobs[i].user_seed
+          << ") failed: " << runs[i].error << "\n";
+      if (!allow_failures) return 1;
+      ++failures;
+      std::string reason = runs[i].error;
+      for (char& c : reason)
+        if (c == ',' || c == '"' || c == '\n') c = ';';
+      failed += std::to_string(i / users + 1) + "," + runs[i].user + "," + std::to_string(jobs[i].user_seed) +
+                "," + runs[i].run_id + "," + reason + "\n";
+      continue;
     }
     tables[i / users].push_back(TableRun(runs[i]));
   }
@@ -240,6 +253,7 @@ int RunSetupStudy(int argc, const char* const* argv, std::ostream& out, std::ost
       !write(out_dir + "/setup_times.csv", StudyCsv(tables, study::SetupTimesCsv)) ||
       !write(out_dir + "/setup_docking.csv", StudyCsv(tables, study::SetupDockingCsv)))
     return 1;
+  if (allow_failures && !write(out_dir + "/failed_users.csv", failed)) return 1;
   if (!json_dir.empty()) {
     for (size_t i = 0; i < runs.size(); ++i) {
       const std::string folder = json_dir + (studies > 1 ? "/m" + std::to_string(i / users) : "") + "/setup-" +
@@ -249,8 +263,10 @@ int RunSetupStudy(int argc, const char* const* argv, std::ostream& out, std::ost
   }
   const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   out << "orbed-setup-study: " << studies << " stud" << (studies == 1 ? "y" : "ies") << " of " << users
-      << " users (" << runs.size() << " users, " << runs.size() * runs[0].setups.size() << " set-ups) in "
-      << Fixed(s, 1) << " s on " << threads << " thread(s); files in " << out_dir << "\n";
+      << " users (" << runs.size() << " users, " << runs.size() * static_cast<size_t>(3 * targets) << " set-ups) in "
+      << Fixed(s, 1) << " s on " << threads << " thread(s)"
+      << (failures > 0 ? ", " + std::to_string(failures) + " user(s) failed (failed_users.csv)" : "")
+      << "; files in " << out_dir << "\n";
   return 0;
 }
 

@@ -8,7 +8,7 @@
 ///                     [--threads T] [--out DIR] [--json-dir DIR] [--registration measured|truth]
 ///                     [--registration-offset-mm X] [--registration-tilt-deg Y]
 ///                     [--registration-direction X,Y,Z | random] [--registration-axis X,Y,Z]
-///                     [--assistant-config FILE] [--quiet]
+///                     [--assistant-config FILE] [--allow-failures] [--quiet]
 ///
 /// Users and seeds, as `scripts/orbed study` numbers them: study m (0-based) has users u1 .. uU,
 /// user k with seed S + m·U + k − 1 and run id "<ID>-setup-u<k>" for m = 0 (so study 0 is the bus
@@ -30,7 +30,8 @@
 /// Threads: users run independently (one RunSetupUser each), T at a time (default 2); the files
 /// are the same for every T. Progress on `err` unless --quiet; --version as every orbed program.
 /// Exit codes: 0 done (or --help, --version); 2 bad arguments (one line on `err` naming the flag);
-/// 1 a user's run failed or a file could not be read or written.
+/// 1 a user's run failed (unless --allow-failures: the user is left out of the CSVs and listed in
+/// failed_users.csv: study,user,user_seed,run_id,error) or a file could not be read or written.
 
 #include <cstdint>
 #include <ostream>
