@@ -36,7 +36,8 @@ study::SetupUserRun TableRun(const SetupRun& run) {
     row.twisting = r.twisting;
     row.execution_s = r.execution_s;
     row.alignment_s = r.alignment_s;
-    if (r.mode != orbed::guidance_t::MODE_FIXED_DISPLAY) row.registration = r.perfect_registration ? "truth" : "measured";
+    if (r.mode != orbed::guidance_t::MODE_FIXED_DISPLAY)
+      row.registration = r.perfect_registration ? "truth" : "measured";
     row.docking_tip_mm = r.docking_tip_mm;
     row.docking_axis_deg = r.docking_axis_deg;
     row.min_clearance_m = r.min_clearance_m;
@@ -74,7 +75,8 @@ SetupUserOptions StudyUser(const SetupUserOptions& base, uint64_t seed, const st
                            int study, int k) {
   SetupUserOptions o = base;
   o.user = "u" + std::to_string(k);
-  o.user_seed = seed + static_cast<uint64_t>(study) * static_cast<uint64_t>(users) + static_cast<uint64_t>(k - 1);
+  o.user_seed =
+      seed + static_cast<uint64_t>(study) * static_cast<uint64_t>(users) + static_cast<uint64_t>(k - 1);
   o.run_id = run_id + (study == 0 ? "" : "-m" + std::to_string(study)) + "-setup-u" + std::to_string(k);
   return o;
 }
@@ -153,7 +155,8 @@ int RunSetupStudy(int argc, const char* const* argv, std::ostream& out, std::ost
                  "The offset's direction in W, X,Y,Z (default 1,0,0), or 'random' (per set-up, with a "
                  "random horizontal tilt axis)");
   AddNumberListOption(&app, "--registration-axis", &axis, 3, "The tilt's axis in W, X,Y,Z (default 0,1,0)");
-  app.add_option("--assistant-config", assistant_config, "The assistant's parameters (orbed-assistant --config)");
+  app.add_option("--assistant-config", assistant_config,
+                 "The assistant's parameters (orbed-assistant --config)");
   app.add_flag("--quiet", quiet, "No progress on stderr");
   app.add_flag("--allow-failures", allow_failures,
                "A user whose run failed (e.g. the arm stopped before a collision on its way to the start) is "
@@ -256,15 +259,15 @@ int RunSetupStudy(int argc, const char* const* argv, std::ostream& out, std::ost
   if (allow_failures && !write(out_dir + "/failed_users.csv", failed)) return 1;
   if (!json_dir.empty()) {
     for (size_t i = 0; i < runs.size(); ++i) {
-      const std::string folder = json_dir + (studies > 1 ? "/m" + std::to_string(i / users) : "") + "/setup-" +
-                                 runs[i].user;
+      const std::string folder =
+          json_dir + (studies > 1 ? "/m" + std::to_string(i / users) : "") + "/setup-" + runs[i].user;
       if (!write(folder + "/setup_results.json", SetupRunJson(runs[i], false))) return 1;
     }
   }
   const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   out << "orbed-setup-study: " << studies << " stud" << (studies == 1 ? "y" : "ies") << " of " << users
-      << " users (" << runs.size() << " users, " << runs.size() * static_cast<size_t>(3 * targets) << " set-ups) in "
-      << Fixed(s, 1) << " s on " << threads << " thread(s)"
+      << " users (" << runs.size() << " users, " << runs.size() * static_cast<size_t>(3 * targets)
+      << " set-ups) in " << Fixed(s, 1) << " s on " << threads << " thread(s)"
       << (failures > 0 ? ", " + std::to_string(failures) + " user(s) failed (failed_users.csv)" : "")
       << "; files in " << out_dir << "\n";
   return 0;

@@ -64,7 +64,8 @@ TEST(SetupStudy, TheSameForAnyThreadCount) {
   SetupUserOptions base;
   base.targets = 1;
   std::vector<SetupUserOptions> jobs;
-  for (int k = 1; k <= 4; ++k) jobs.push_back(StudyUser(base, 11, "threads", 2, k > 2 ? 1 : 0, (k - 1) % 2 + 1));
+  for (int k = 1; k <= 4; ++k)
+    jobs.push_back(StudyUser(base, 11, "threads", 2, k > 2 ? 1 : 0, (k - 1) % 2 + 1));
   const std::vector<SetupRun> one = RunSetupUsers(jobs, 1);
   const std::vector<SetupRun> three = RunSetupUsers(jobs, 3);
   ASSERT_EQ(one.size(), jobs.size());
