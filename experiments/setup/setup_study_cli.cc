@@ -231,8 +231,10 @@ int RunSetupStudy(int argc, const char* const* argv, std::ostream& out, std::ost
   int failures = 0;
   for (size_t i = 0; i < runs.size(); ++i) {
     if (!runs[i].ok) {
-      err << "orbed-setup-study: " << runs[i].run_id << " (seed " << jobs[i].user_seed
-          << ") failed: " << runs[i].error << "\n";
+      if (!allow_failures || !quiet) {
+        err << "orbed-setup-study: " << runs[i].run_id << " (seed " << jobs[i].user_seed
+            << ") failed: " << runs[i].error << "\n";
+      }
       if (!allow_failures) return 1;
       ++failures;
       std::string reason = runs[i].error;
