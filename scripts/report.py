@@ -22,6 +22,7 @@ formats them. Needs python3-matplotlib (Debian); nothing else outside the standa
 import csv
 import html
 import json
+import math
 import os
 import statistics
 import sys
@@ -29,9 +30,12 @@ import sys
 import matplotlib
 
 matplotlib.use("Agg")
+import matplotlib.patches  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.ticker  # noqa: E402
 
 MODES = ("ar_reflective", "ar", "fixed")
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 LABELS = {"ar_reflective": "AR + reflective display", "ar": "AR", "fixed": "fixed display"}
 COLORS = {"ar_reflective": "#4c72b0", "ar": "#55a868", "fixed": "#c44e52"}
 
@@ -47,81 +51,155 @@ def violins(ax, data, positions, color):
     for body in parts["bodies"]:
         body.set_facecolor(color)
         body.set_alpha(0.6)
+    for key in ("cbars", "cmins", "cmaxes", "cmedians"):
+        parts[key].set_color("0.3")
+        parts[key].set_linewidth(1)
 
 
-def figures(study_dir, joints_rows):
-    os.makedirs(os.path.join(study_dir, "figures"), exist_ok=True)
+# A log axis of angles in degrees reads best with round decades written out (0.1, 1, 10, 100),
+# not matplotlib's 10^k labels.
+DEGREE_TICKS = (0.01, 0.1, 1, 10, 100, 1000)
+
+
+def decade_label(value):
+    return "%g" % value
+
+
+def log_degree_axis(ax, lo, hi):
+    """y on a log scale from lo to hi [deg], ticked at the decades of DEGREE_TICKS inside it."""
+    ax.set_yscale("log")
+    ax.set_ylim(lo, hi)
+    ticks = [t for t in DEGREE_TICKS if lo <= t <= hi]
+    ax.set_yticks(ticks)
+    ax.set_yticklabels([decade_label(t) for t in ticks])
+    ax.yaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+
+
+def save(fig, study_dir, name):
+    """figures/NAME.pdf (vector) and figures/NAME.png (300 dpi) of one figure, then closes it."""
+    folder = os.path.join(study_dir, "figures")
+    os.makedirs(folder, exist_ok=True)
+    fig.savefig(os.path.join(folder, name + ".pdf"))
+    fig.savefig(os.path.join(folder, name + ".png"), dpi=300)
+    plt.close(fig)
+
+
+def figure_html(path, caption):
+    """A figure of the page: the PNG shown, linked to its PDF beside it (path without extension,
+    relative to report.html)."""
+    return ("<figure><a href='%s.pdf'><img src='%s.png'></a><figcaption>%s (<a href='%s.pdf'>PDF</a>)"
+            "</figcaption></figure>" % (path, path, caption, path))
+
+
+def figures(study_dir, joints_rows, paper_table2=None):
+    """The paper's Figs. 6-8 from setup_joints.csv, Table 2's paper values (mean, median over all
+    joints per mode) marked on them when given."""
+    paper_table2 = paper_table2 or {}
     modes = [m for m in MODES if any(r["mode"] == m for r in joints_rows)]
     num_joints = max(int(r["joint"]) for r in joints_rows)
+    joints = list(range(1, num_joints + 1))
 
     def errors(mode, joint=None):
         return [float(r["error_deg"]) for r in joints_rows
                 if r["mode"] == mode and (joint is None or int(r["joint"]) == joint)]
 
-    fig, axes = plt.subplots(1, len(modes), figsize=(5 * len(modes), 4), sharey=True)
-    axes = axes if len(modes) > 1 else [axes]
+    # Fig. 6: per joint and mode; the paper's median over all joints of the mode as a dashed line.
+    fig, axes = plt.subplots(1, len(modes), figsize=(4.2 * len(modes) + 1.6, 3.8), sharey=True, squeeze=False)
+    axes = axes[0]
     for ax, mode in zip(axes, modes):
-        violins(ax, [errors(mode, j) for j in range(1, num_joints + 1)], list(range(1, num_joints + 1)),
-                COLORS[mode])
+        violins(ax, [errors(mode, j) for j in joints], joints, COLORS[mode])
+        p = paper_table2.get(mode)
+        if p:
+            ax.axhline(p["median"], color="k", linestyle="--", linewidth=1)
         ax.set_title(LABELS[mode])
         ax.set_xlabel("joint")
-        ax.set_xticks(list(range(1, num_joints + 1)))
+        ax.set_xticks(joints)
     axes[0].set_ylabel("|reached - target| [deg]")
+    if any(paper_table2.get(m) for m in modes):
+        axes[-1].legend(handles=[plt.Line2D([], [], color="k", linestyle="--", label="paper: median over\nall joints (Table 2)")],
+                        loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize=8, frameon=False)
     fig.tight_layout()
-    fig.savefig(os.path.join(study_dir, "figures", "joint_errors.png"), dpi=100)
-    plt.close(fig)
+    save(fig, study_dir, "joint_errors")
 
-    fig, ax = plt.subplots(figsize=(6, 4))
+    # Fig. 7: every joint's error per mode; the paper's mean and median per mode as markers.
+    fig, ax = plt.subplots(figsize=(7.5, 4))
     for i, mode in enumerate(modes):
         violins(ax, [errors(mode)], [i + 1], COLORS[mode])
+        p = paper_table2.get(mode)
+        if p:
+            ax.plot([i + 1.45], [p["mean"]], marker="D", color="k", ls="none")
+            ax.plot([i + 1.45], [p["median"]], marker="_", color="k", ms=14, mew=2, ls="none")
+        values = errors(mode)
+        if values:
+            ax.plot([i + 1], [statistics.mean(values)], marker="D", color="w", mec="k", ls="none")
     ax.set_xticks(list(range(1, len(modes) + 1)))
     ax.set_xticklabels([LABELS[m] for m in modes])
+    ax.set_xlim(0.4, len(modes) + 0.8)
+    ax.set_xlabel("guidance mode")
     ax.set_ylabel("joint error, all joints [deg]")
+    handles = [plt.Line2D([], [], color="0.3", linewidth=1, label="this study: median (bar)"),
+               plt.Line2D([], [], marker="D", color="w", mec="k", ls="none", label="this study: mean"),
+               plt.Line2D([], [], marker="D", color="k", ls="none", label="paper: mean (Table 2)"),
+               plt.Line2D([], [], marker="_", color="k", ms=14, mew=2, ls="none", label="paper: median (Table 2)")]
+    ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize=8, frameon=False)
     fig.tight_layout()
-    fig.savefig(os.path.join(study_dir, "figures", "total_errors.png"), dpi=100)
-    plt.close(fig)
+    save(fig, study_dir, "total_errors")
 
-    fig, ax = plt.subplots(figsize=(7, 4))
+    # Fig. 8: mean per joint and mode on a log scale; the paper's mean over all joints per mode as a
+    # dashed line of the mode's colour (the paper gives no per-joint numbers).
+    fig, ax = plt.subplots(figsize=(8.5, 4))
     width = 0.8 / len(modes)
+    means = []
     for i, mode in enumerate(modes):
-        for j in range(1, num_joints + 1):
+        for j in joints:
             values = errors(mode, j)
             mean = statistics.mean(values) if values else 0.0
+            means.append(mean)
             twisting = any(r["twisting"] == "1" for r in joints_rows if int(r["joint"]) == j)
             ax.bar(j - 0.4 + (i + 0.5) * width, max(mean, 1e-3), width, color=COLORS[mode],
-                   edgecolor="red" if twisting else "blue", linewidth=1.5,
-                   label=LABELS[mode] if j == 1 else None)
-    ax.set_yscale("log")
-    ax.set_xticks(list(range(1, num_joints + 1)))
-    ax.set_xlabel("joint (red edge: twisting, blue edge: revolving)")
+                   edgecolor="red" if twisting else "blue", linewidth=1.5)
+        p = paper_table2.get(mode)
+        if p:
+            ax.axhline(p["mean"], color=COLORS[mode], linestyle="--", linewidth=1.2)
+            means.append(p["mean"])
+    positive = [m for m in means if m > 0] or [1.0]
+    lo = 10 ** math.floor(math.log10(min(positive)))
+    hi = 10 ** math.ceil(math.log10(max(positive) * 1.01))
+    log_degree_axis(ax, max(lo, DEGREE_TICKS[0]), max(hi, 10 * lo))
+    ax.set_xticks(joints)
+    ax.set_xlabel("joint")
     ax.set_ylabel("mean error [deg], log scale")
-    ax.legend()
+    handles = [matplotlib.patches.Patch(facecolor=COLORS[m], label=LABELS[m]) for m in modes]
+    handles += [matplotlib.patches.Patch(facecolor="white", edgecolor="red", linewidth=1.5, label="twisting joint"),
+                matplotlib.patches.Patch(facecolor="white", edgecolor="blue", linewidth=1.5, label="revolving joint")]
+    if any(paper_table2.get(m) for m in modes):
+        handles.append(plt.Line2D([], [], color="0.3", linestyle="--", label="paper: mean over all\njoints (Table 2)"))
+    ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize=8, frameon=False)
     fig.tight_layout()
-    fig.savefig(os.path.join(study_dir, "figures", "joint_rank.png"), dpi=100)
-    plt.close(fig)
+    save(fig, study_dir, "joint_rank")
 
 
-def power_figure(study_dir, beyond):
-    """The power analysis's curves (tables.json beyond.power): one line per pair of modes."""
+def power_figure(study_dir, beyond, paper_users=8):
+    """The power analysis's curves (tables.json beyond.power): one line per pair of modes; the
+    paper's number of users marked."""
     curves = beyond.get("power", {})
     if not curves:
         return False
-    fig, ax = plt.subplots(figsize=(7, 4))
+    fig, ax = plt.subplots(figsize=(8, 4))
     for i, (pair, curve) in enumerate(curves.items()):
         color = "C%d" % i
         ax.plot(curve["users"], curve["power"], marker="o", linestyle="--", color=color,
                 label=pair + ", pooled (paper's reading)")
         if "power_paired" in curve:
             ax.plot(curve["users"], curve["power_paired"], marker="s", color=color, label=pair + ", paired set-ups")
-    ax.axhline(0.8, color="grey", linestyle=":", linewidth=1)
+    ax.axhline(0.8, color="grey", linestyle=":", linewidth=1, label="power 0.8")
+    ax.axvline(paper_users, color="k", linestyle="-.", linewidth=1, label="the paper's %d users" % paper_users)
     ax.set_ylim(-0.02, 1.02)
-    ax.set_xlabel("users in the study")
-    ax.set_ylabel("power of the total test (alpha 0.05)")
-    ax.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.01, 0.5))
+    ax.set_xlabel("users in the study [people]")
+    ax.set_ylabel("power of the total test (alpha 0.05) [probability]")
+    ax.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.01, 0.5), frameon=False)
     fig.tight_layout()
-    os.makedirs(os.path.join(study_dir, "figures"), exist_ok=True)
-    fig.savefig(os.path.join(study_dir, "figures", "power.png"), dpi=100)
-    plt.close(fig)
+    save(fig, study_dir, "power")
     return True
 
 
@@ -164,9 +242,89 @@ def beyond_section(study_dir, beyond):
                                                    else "-")
                                    for pair, curve in power.items())))
         if power_figure(study_dir, beyond):
-            parts.append("<figure><img src='figures/power.png'><figcaption>Power of Table 3's total test "
-                         "against the number of users, from the emulated people</figcaption></figure>")
+            parts.append(figure_html("figures/power", "Power of Table 3's total test against the number of "
+                                                      "users, from the emulated people"))
     return parts
+
+
+BAND_UNITS = {"table1": "mm", "table2": "deg", "table3": "p", "table4": "s"}
+
+
+def band_status(record):
+    if record["calibrated"]:
+        return "calibrated (%s; not counted)" % ("inside" if record["inside"] else "outside")
+    return "inside" if record["inside"] else "<b>outside</b>"
+
+
+def bands_section(study_dir):
+    """The predictive bands (STUDY/bands/bands.json, python/orbed/study/bands.py) and the rank flip
+    (STUDY/bands/rank_flip.csv); nothing when the study ran without --bands."""
+    folder = os.path.join(study_dir, "bands")
+    path = os.path.join(folder, "bands.json")
+    if not os.path.exists(path):
+        return []
+    with open(path) as f:
+        b = json.load(f)
+    level = round(100 * b["level"])
+    parts = ["<h2>Predictive bands: the paper's figures against %d simulated studies</h2>" % b["studies"],
+             "<p class=count><b>%d of %d paper figures inside</b> their %d %% predictive interval (calibrated ones "
+             "not counted: %d figures a parameter was fitted to, experiments/calibration.yaml). Each simulated "
+             "study has the paper's size and is analysed as this one; the band of a figure is the central %d %% "
+             "of its values over the studies (2.5th to 97.5th percentile). The same seed as this study "
+             "(<code>scripts/orbed study --bands %d</code>).</p>" % (
+                 b["inside"], b["counted"], level, len(b["calibrated"]), level, b["studies"])]
+    parts.append(figure_html("bands/figures/bands", "Each figure's %d %% predictive interval (bar), the studies' "
+                                                    "median (tick) and the paper's value (dot)" % level))
+    flips = rank_flip_line(folder)
+    if flips:
+        parts.append("<p class=rank-flip>%s</p>" % flips)
+    parts.append("<table class=bands><tr><th>figure</th><th>unit</th><th class=paper>paper</th><th>band (%d %%)</th>"
+                 "<th>median of the studies</th><th>paper</th></tr>" % level)
+    for r in b["figures"]:
+        digits = 2 if r["figure"].startswith("table3.") else 1
+        number = (lambda v: "%.2g" % v) if digits == 2 else (lambda v: fmt(v))
+        parts.append("<tr><th>%s</th><td>%s</td><td class=paper>%s</td><td>[%s, %s]</td><td>%s</td><td>%s</td></tr>" % (
+            html.escape(r["figure"]), BAND_UNITS.get(r["figure"].split(".")[0], ""), number(r["paper"]),
+            number(r["lo"]), number(r["hi"]), number(r["median"]), band_status(r)))
+    parts.append("</table>")
+    return parts
+
+
+def rank_flip_line(folder):
+    """One sentence on how often the paper's Table 1 measurement ranks the two display modes
+    opposite to the truth, from FOLDER/rank_flip.csv (python/orbed/study/rank_flip.py); None without
+    the file."""
+    path = os.path.join(folder, "rank_flip.csv")
+    if not os.path.exists(path):
+        return None
+    sys.path.insert(0, os.path.join(ROOT, "python"))
+    from orbed.study import rank_flip  # statsmodels: imported only when there is a rank flip to show
+
+    try:
+        s = rank_flip.summarize(rank_flip.read_rows(path))
+    except (ValueError, KeyError) as e:
+        return "Rank flip: %s has no usable rows (%s)." % (html.escape(os.path.basename(path)), html.escape(str(e)))
+    return ("Rank flip: in %d of %d simulated studies (%s %%, 95 %% Wilson interval %s-%s %%) the paper's Table 1 "
+            "measurement (norm of the per-axis means, axes of W) ranks the AR + reflective display and AR alone "
+            "opposite to the truth (the registration's translation error at the robot's centroid)." % (
+                s["flips"], s["studies"], fmt(100 * s["fraction"]), fmt(100 * s["low"]), fmt(100 * s["high"])))
+
+
+def landmark_check(tables, study_dir):
+    """The measurement's own error: landmarks a known distance apart annotated by gaze (the paper's
+    optical-table check, 3.6 mm)."""
+    if "landmark_validation_mm" not in tables:
+        return ""
+    rows_path = os.path.join(study_dir, "landmark_validation.csv")
+    rows = read_csv(rows_path) if os.path.exists(rows_path) else []
+    separations = sorted({float(r["separation_mm"]) for r in rows})
+    what = (" (%d measurements of pairs %s mm apart)" % (len(rows), ", ".join("%g" % d for d in separations))
+            if rows else "")
+    paper = tables.get("paper", {}).get("landmark_validation_mm")
+    return ("<p class=landmark-check>Landmark check, the measurement's own error: the distance between two "
+            "landmarks annotated by gaze against their true separation%s: mean error %s mm (paper %s mm, "
+            "targets 5-20 cm apart on an optical table, 12 measurements).</p>" % (
+                what, fmt(tables["landmark_validation_mm"]), fmt(paper) if paper is not None else "-"))
 
 
 def pv(p):
@@ -291,21 +449,25 @@ def stats_row(name, ours, paper, as_clock=False):
 
 
 def provenance_footer(study_dir):
-    """Where the numbers came from: the study folder's provenance record (scripts/provenance.py)."""
+    """Where the numbers came from: the study folder's provenance record (scripts/provenance.py:
+    version, commit and whether the tree was dirty, the command line, host, start and end times,
+    settings)."""
     path = os.path.join(study_dir, "provenance.json")
     if not os.path.exists(path):
         return "<footer><p>No provenance.json in this folder: made without scripts/orbed.</p></footer>"
     with open(path) as f:
         p = json.load(f)
-    git = p.get("git", {})
+    git = p.get("git") or {}
     commit = (git.get("commit") or "unknown commit") + (" (uncommitted changes)" if git.get("dirty") else "")
-    settings = ", ".join("%s=%s" % (k, v) for k, v in sorted(p.get("settings", {}).items()))
-    return ("<footer><hr><p>Made by orbed %s at commit %s, run %s on %s, started %s: <code>%s</code>. "
-            "Settings: %s. Every input and output with its SHA-256: provenance.json (and each user's "
-            "run folder's); check them with <code>scripts/orbed verify</code>.</p></footer>" % (
+    settings = ", ".join("%s=%s" % (k, v) for k, v in sorted((p.get("settings") or {}).items()))
+    ended = ("finished %s with exit code %s" % (p["ended_utc"], p.get("exit_code")) if p.get("ended_utc")
+             else "not finished when the report was made")
+    return ("<footer class=provenance><hr><p>Made by orbed %s at commit %s, run %s on host %s, started %s, %s: "
+            "<code>%s</code>. Settings: %s. Every input and output with its SHA-256: provenance.json (and each "
+            "user's run folder's); check them with <code>scripts/orbed verify</code>.</p></footer>" % (
                 html.escape(str(p.get("orbed_version"))), html.escape(commit), html.escape(p.get("run", "")),
-                html.escape(p.get("host", "")), html.escape(p.get("started_utc", "")),
-                html.escape(" ".join(p.get("command_line", []))), html.escape(settings)))
+                html.escape(p.get("host", "")), html.escape(p.get("started_utc", "")), html.escape(ended),
+                html.escape(" ".join(p.get("command_line") or [])), html.escape(settings or "none")))
 
 
 def report(study_dir):
@@ -365,6 +527,7 @@ def report(study_dir):
                         "<td>%s +/- %s</td>" % (fmt(row[a][0]), fmt(row[a][1])) for a in ("t_x", "t_y", "t_z")),
                         ", ".join(fmt(prow[a][0]) for a in ("t_x", "t_y", "t_z")) if prow else "-"))
             parts.append("</table>")
+    parts.append(landmark_check(tables, study_dir))
     if "table2" in tables:
         head = ("<tr><th></th>" + "".join("<th>%s</th>" % k for k in ("mean", "median", "min", "max", "std"))
                 + "".join("<th class=paper>paper %s</th>" % k for k in ("mean", "median", "min", "max", "std"))
@@ -400,13 +563,16 @@ def report(study_dir):
                                        paper.get("table4", {}).get(mode, {}).get("alignment_s"), True))
         parts.append("</table>")
         parts.append("<h2>Figures</h2>")
-        for name, caption in (("joint_errors.png", "Per-joint error per guidance mode (the paper's Fig. 6)"),
-                              ("total_errors.png", "All joints' errors per mode (Fig. 7)"),
-                              ("joint_rank.png", "Mean error per joint, log scale; twisting joints "
-                                                 "red-edged (Fig. 8)")):
-            parts.append("<figure><img src='figures/%s'><figcaption>%s</figcaption></figure>" % (name, caption))
+        for name, caption in (("joint_errors", "Per-joint error per guidance mode (the paper's Fig. 6); dashed: "
+                                               "the paper's median over all joints of the mode"),
+                              ("total_errors", "All joints' errors per mode (Fig. 7), the paper's mean and median "
+                                               "beside each violin"),
+                              ("joint_rank", "Mean error per joint, log scale; twisting joints red-edged (Fig. 8); "
+                                             "dashed: the paper's mean over all joints per mode")):
+            parts.append(figure_html("figures/" + name, caption))
     if tables.get("setup_analysis"):
         parts.extend(setup_analysis_section(tables["setup_analysis"]))
+    parts.extend(bands_section(study_dir))
     if tables.get("beyond"):
         parts.extend(beyond_section(study_dir, tables["beyond"]))
     trials_path = os.path.join(study_dir, "alignment_trials.csv")
@@ -450,7 +616,9 @@ def main():
         print("report.py: %s has no tables.json (run orbed-study-tables first)" % study_dir, file=sys.stderr)
         return 1
     if os.path.exists(joints_path):
-        figures(study_dir, read_csv(joints_path))
+        with open(os.path.join(study_dir, "tables.json")) as f:
+            paper_table2 = json.load(f).get("paper", {}).get("table2", {})
+        figures(study_dir, read_csv(joints_path), paper_table2)
     report(study_dir)
     print("report: %s" % os.path.join(study_dir, "report.html"))
     return 0

@@ -32,6 +32,10 @@ def configure(p):
                    help="set-up users run at a time (default 2)")
 
 
+BINARIES = ["orbed-user-study", "orbed-setup-study", "orbed-study-tables"]
+STEPS = 4  # the progress steps simulate() takes: ViRAAl, set-up, the paper's figures, the bands
+
+
 def step(ctx, progress, what, argv, log):
     """One in-process tool, its progress lines (k/n) shown on the bands' progress line."""
     progress.show(what)
@@ -47,20 +51,18 @@ def step(ctx, progress, what, argv, log):
     progress.k += 1
 
 
-def run(args, ctx):
-    quiet_build(ctx, ["orbed-user-study", "orbed-setup-study", "orbed-study-tables"])
-    out = new_run_dir(ctx, "bands-")
+def simulate(ctx, out, studies, seed, threads, progress):
+    """The bands' work into the folder OUT (it exists): M studies of each half in-process, the paper's
+    figures, then bands.{csv,json}, figures/bands.{pdf,png}; the tools' output in OUT/bands.log. Takes
+    STEPS steps of PROGRESS. Returns (bands.write's summary, rank_flip.summarize's). Both `scripts/orbed
+    bands` and `scripts/orbed study --bands M` (into STUDY/bands/) call it; the binaries are built."""
     log = os.path.join(out, "bands.log")
-    provenance(ctx, "start", out, "--kind", "bands", "--setting", f"studies={args.studies}",
-               "--setting", f"seed={args.seed}", "--config", os.path.join(ctx.root, "experiments/calibration.yaml"))
-    ctx.say(f"bands: {args.studies} studies in {ctx.rel(out)}/ (the tools' output in bands.log)")
-    progress = Progress(ctx.console, "bands:", 4)
-    step(ctx, progress, "ViRAAl studies", [os.path.join(ctx.bin, "orbed-user-study"), "--studies", str(args.studies),
-                                           "--users", "4", "--trials", "10", "--user-seed", str(args.seed),
+    step(ctx, progress, "ViRAAl studies", [os.path.join(ctx.bin, "orbed-user-study"), "--studies", str(studies),
+                                           "--users", "4", "--trials", "10", "--user-seed", str(seed),
                                            "--csv", os.path.join(out, "rank_flip.csv"), "--tables-dir", out], log)
-    step(ctx, progress, "set-up studies", [os.path.join(ctx.bin, "orbed-setup-study"), "--studies", str(args.studies),
-                                           "--users", "8", "--targets", "3", "--trials", "3", "--seed", str(args.seed),
-                                           "--threads", str(args.threads), "--allow-failures", "--out", out], log)
+    step(ctx, progress, "set-up studies", [os.path.join(ctx.bin, "orbed-setup-study"), "--studies", str(studies),
+                                           "--users", "8", "--targets", "3", "--trials", "3", "--seed", str(seed),
+                                           "--threads", str(threads), "--allow-failures", "--out", out], log)
     step(ctx, progress, "the paper's figures",
          [os.path.join(ctx.bin, "orbed-study-tables"), "--paper-only", "--out", out], log)
     progress.show("the bands")
@@ -69,18 +71,35 @@ def run(args, ctx):
 
     try:
         summary = bands.write(out)
+        flips = rank_flip.summarize(rank_flip.read_rows(os.path.join(out, "rank_flip.csv")))
     except (OSError, ValueError, KeyError) as e:
         raise Failure(f"bands: the bands of {ctx.rel(out)} failed ({e})")
-    progress.done()
-    provenance(ctx, "finish", out, "--exit-code", "0")
+    progress.k += 1
+    return summary, flips
+
+
+def say_summary(ctx, out, summary, flips):
+    """The bands' lines on the console: k of n, the figures outside, the rank flip, the files."""
     outside = [r["figure"] for r in summary["figures"] if not r["inside"] and not r["calibrated"]]
     ctx.console.echo(f"bands: {summary['inside']} of {summary['counted']} paper figures inside their 95 % predictive "
                      f"interval over {summary['studies']} studies ({len(summary['calibrated'])} calibrated, not "
                      f"counted); outside: {', '.join(outside) if outside else 'none'}")
-    flips = rank_flip.summarize(rank_flip.read_rows(os.path.join(out, "rank_flip.csv")))
     ctx.console.echo(f"bands: the paper's Table 1 measurement ranks ar_reflective and ar opposite to the truth "
                      f"(translation error) in {flips['flips']} of {flips['studies']} studies, "
                      f"{100 * flips['fraction']:.1f} % (95 % Wilson interval {100 * flips['low']:.1f}-"
                      f"{100 * flips['high']:.1f} %)")
     ctx.console.echo(f"bands: {ctx.rel(os.path.join(out, 'bands.csv'))}, {ctx.rel(os.path.join(out, 'figures', 'bands.pdf'))}")
+
+
+def run(args, ctx):
+    quiet_build(ctx, BINARIES)
+    out = new_run_dir(ctx, "bands-")
+    provenance(ctx, "start", out, "--kind", "bands", "--setting", f"studies={args.studies}",
+               "--setting", f"seed={args.seed}", "--config", os.path.join(ctx.root, "experiments/calibration.yaml"))
+    ctx.say(f"bands: {args.studies} studies in {ctx.rel(out)}/ (the tools' output in bands.log)")
+    progress = Progress(ctx.console, "bands:", STEPS)
+    summary, flips = simulate(ctx, out, args.studies, args.seed, args.threads, progress)
+    progress.done()
+    provenance(ctx, "finish", out, "--exit-code", "0")
+    say_summary(ctx, out, summary, flips)
     return 0

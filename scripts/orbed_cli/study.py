@@ -14,7 +14,7 @@ import subprocess
 import sys
 import tempfile
 
-from . import checks, launch as launch_verb
+from . import bands as bands_verb, checks, launch as launch_verb
 from .output import Failure, Progress, run_logged, show_failure
 from .paths import quiet_build
 from .runs import new_run_dir, provenance, write_settings
@@ -32,6 +32,8 @@ logs/study-<time>-<random>/ (every user's run folder inside it, and each one's o
 <name>.log), and Tables 1, 2 and 4 beside the paper's, Table 3 as the paper read it (pooled) and with
 the set-up as the unit (paired), the docking error, collisions and a power analysis. --users 0 or --setup-users 0 leaves a half out; --registration-share runs each set-up
 user's headset modes again with the true registration (the registration's share of the error).
+--bands M then runs M simulated studies of the paper's size in-process with the same seed (what
+`scripts/orbed bands --studies M --seed S` does) into STUDY/bands/, and the report shows them.
 The run ids (which seed the alignments) are ID-u<k> and ID-setup-u<k>, ID by default study-s<S>: the
 same arguments give the same study, bit for bit: every process runs on the sim's clock in lockstep
 (steps_per_tick=10), so neither the machine's load nor the rate changes a number; --sim-rate R
@@ -53,6 +55,9 @@ def configure(p):
     p.add_argument("--run-id", type=checks.run_id, metavar="ID", help="default study-s<S>")
     p.add_argument("--registration-share", action="store_true",
                    help="the set-up users' headset modes again with the true registration")
+    p.add_argument("--bands", type=checks.whole(0, 100000), default=0, metavar="M",
+                   help="after the study, its predictive bands from M simulated studies into STUDY/bands/ "
+                        "(default 0: none)")
     p.add_argument("--sim-rate", type=checks.whole(1, 100), default=100, metavar="R",
                    help="the most times faster than real time the sim may run (default 100)")
     p.add_argument("--realtime", action="store_true", help="the wall clock, without lockstep (needs --sim-rate 1)")
@@ -123,13 +128,13 @@ def run(args, ctx):
         hold_viraal, hold_setup = ["hold_for=scenario"], ["hold_for=setup"]
     # The run id seeds the alignments: from the seed, so a study is repeatable (not from the clock).
     run_id = args.run_id or f"study-s{args.seed}"
-    quiet_build(ctx, ["testbed"])
+    quiet_build(ctx, ["testbed", *(bands_verb.BINARIES if args.bands else [])])
     steps = [("viraal", k) for k in range(1, args.users + 1)]
     for k in range(1, args.setup_users + 1):
         steps.append(("setup", k))
         if args.registration_share:
             steps.append(("setup-truth", k))
-    progress = Progress(ctx.console, "study:", len(steps) + 1)
+    progress = Progress(ctx.console, "study:", len(steps) + 1 + (bands_verb.STEPS if args.bands else 0))
     # The study's folder holds every user's run folder (viraal-u<k>, setup-u<k>, setup-truth-u<k>),
     # each with its own provenance record and its output (<name>.log) beside the study's files.
     study_dir = new_run_dir(ctx, "study-")
@@ -144,7 +149,7 @@ def run(args, ctx):
                "--setting", f"trials={args.trials}", "--setting", f"setup_users={args.setup_users}",
                "--setting", f"targets={args.targets}", "--setting", f"seed={args.seed}", "--setting", f"run_id={run_id}",
                "--setting", f"registration_share={int(args.registration_share)}", "--setting", f"sim_rate={args.sim_rate}",
-               "--setting", f"realtime={int(args.realtime)}")
+               "--setting", f"realtime={int(args.realtime)}", "--setting", f"bands={args.bands}")
     ctx.say(f"study: {len(steps)} launches in {ctx.rel(study_dir)}/ (each one's output in <name>.log there)")
     tables_args, runs = ["--seed", str(args.seed)], []
     for kind, k in steps:
@@ -199,7 +204,14 @@ def run(args, ctx):
         show_failure(ctx.console, log)
         raise Failure("study: orbed-study-tables failed")
     analyze(ctx, study_dir, log)
-    if args.setup_users > 0:
+    bands = None
+    if args.bands:
+        # The same seed as the study: its study 0 is this study's design run in-process.
+        bands_dir = os.path.join(study_dir, "bands")
+        os.makedirs(bands_dir, exist_ok=True)
+        bands = bands_verb.simulate(ctx, bands_dir, args.bands, args.seed, 2, progress)
+        progress.show("the report")
+    if args.setup_users > 0 or args.bands:
         if run_logged(["/usr/bin/python3", ctx.script("report.py"), study_dir], log, ctx.console):
             show_failure(ctx.console, log)
             raise Failure("study: the report failed")
@@ -214,6 +226,8 @@ def run(args, ctx):
     mode = ", wall clock" if args.realtime else ", on the sim clock in lockstep"
     ctx.say(f"study: {round(progress.elapsed())} s of wall time at sim rate {args.sim_rate}{mode} "
             f"(the runs, the tables and the report); {whole}")
+    if bands:
+        bands_verb.say_summary(ctx, bands_dir, *bands)
     provenance(ctx, "finish", study_dir, "--exit-code", "0")
     ctx.say(f"study: files in {ctx.rel(study_dir)}/ (runs.txt lists each user's run folder; provenance.json says "
             f"what made them; check them with scripts/orbed verify {ctx.rel(study_dir)})")

@@ -28,6 +28,8 @@ import math
 import os
 import sys
 
+import matplotlib
+import matplotlib.ticker
 import numpy as np
 import yaml
 
@@ -156,23 +158,65 @@ def write(folder, calibration=CALIBRATION):
     return summary
 
 
-PANELS = (("table1", "Table 1: alignment error [mm]", False), ("table2", "Table 2: joint error [deg]", True),
-          ("table3", "Table 3: p-value (the paper's reading)", True), ("table4", "Table 4: time [s]", True))
+# Per table: the panel's title, its x axis (label with unit) and scale. Joint errors span 0 (a
+# joint set exactly) to 250 deg: symmetric-log, linear below 0.01 deg so that a 0 shows. p-values
+# span 1e-18 to 1: log. Alignment errors (mm) and times (s) are linear.
+PANELS = (("table1", "Table 1", "alignment error [mm]", "linear"),
+          ("table2", "Table 2", "joint error [deg] (log scale; linear below 0.01)", "symlog"),
+          ("table3", "Table 3, the paper's reading", "p-value, two-sided (log scale)", "log"),
+          ("table4", "Table 4", "time [s] (ticks every minute)", "minutes"))
+SYMLOG_THRESHOLD_DEG = 0.01
+
+
+def decade_ticks(lo, hi, most=8):
+    """Powers of ten covering [lo, hi] (lo > 0), every k-th decade so that at most `most` remain."""
+    first, last = math.floor(math.log10(lo)), math.ceil(math.log10(hi))
+    step = max(1, math.ceil((last - first + 1) / most))
+    return [10.0 ** e for e in range(last, first - 1, -step)][::-1]
+
+
+def tick_label(value):
+    """0.01, 0.1, 1, 10, 100 as written; 1e-16 and the like for the p-values' far decades."""
+    if value == 0:
+        return "0"
+    return "%g" % value if 1e-3 <= abs(value) < 1e5 else "1e%d" % round(math.log10(value))
+
+
+def set_axis(ax, scale, values):
+    """The panel's x scale with explicit, readable ticks over the values shown."""
+    if scale == "symlog":
+        ax.set_xscale("symlog", linthresh=SYMLOG_THRESHOLD_DEG)
+        top = max(max(values), SYMLOG_THRESHOLD_DEG)
+        ticks = [0.0] + decade_ticks(SYMLOG_THRESHOLD_DEG, top)
+        ax.set_xlim(-0.2 * SYMLOG_THRESHOLD_DEG, ticks[-1] * 1.05)
+    elif scale == "log":
+        positive = [v for v in values if v > 0] or [1.0]
+        ticks = decade_ticks(max(min(positive), 1e-300), max(max(positive), 1.0))
+        ax.set_xscale("log")
+        ax.set_xlim(ticks[0] / 2, ticks[-1] * 2)
+    elif scale == "minutes":
+        ticks = [60.0 * i for i in range(int(1.03 * max(values) // 60) + 2)]
+        ax.set_xlim(0.0, ticks[-1])
+    else:
+        return
+    ax.set_xticks(ticks)
+    ax.set_xticklabels([tick_label(t) for t in ticks])
+    ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
 
 
 def plot(records, m, k, n, out_dir):
     """One panel per table: each figure's band (bar), the studies' median (tick) and the paper's value
-    (dot: filled inside, a cross outside, grey when calibrated)."""
-    import matplotlib
+    (dot: filled inside, a cross outside, grey when calibrated). Vector PDF and 300-dpi PNG."""
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     os.makedirs(out_dir, exist_ok=True)
-    panels = [(key, title, log, [r for r in records if r["figure"].startswith(key + ".")]) for key, title, log in PANELS]
-    panels = [p for p in panels if p[3]]
-    heights = [max(2.0, 0.22 * len(p[3]) + 0.8) for p in panels]
+    panels = [(key, title, label, scale, [r for r in records if r["figure"].startswith(key + ".")])
+              for key, title, label, scale in PANELS]
+    panels = [p for p in panels if p[4]]
+    heights = [max(2.0, 0.22 * len(p[4]) + 1.1) for p in panels]
     fig, axes = plt.subplots(len(panels), 1, figsize=(8.5, sum(heights)), gridspec_kw={"height_ratios": heights},
                              squeeze=False)
-    for ax, (key, title, log, rows) in zip(axes[:, 0], panels):
+    for ax, (key, title, label, scale, rows) in zip(axes[:, 0], panels):
         y = np.arange(len(rows))[::-1]
         for yi, r in zip(y, rows):
             ax.plot([r["lo"], r["hi"]], [yi, yi], color="#4c72b0", lw=4, solid_capstyle="butt", alpha=0.6)
@@ -182,9 +226,9 @@ def plot(records, m, k, n, out_dir):
         ax.set_yticks(y)
         ax.set_yticklabels([r["figure"].split(".", 1)[1] for r in rows], fontsize=7)
         ax.set_title(title, fontsize=10, loc="left")
-        if log:
-            ax.set_xscale("log")
-        ax.grid(axis="x", which="both", alpha=0.3)
+        ax.set_xlabel(label, fontsize=9)
+        set_axis(ax, scale, [v for r in rows for v in (r["lo"], r["hi"], r["paper"])])
+        ax.grid(axis="x", which="major", alpha=0.3)
         ax.set_ylim(-0.7, len(rows) - 0.3)
     handles = [plt.Line2D([], [], color="#4c72b0", lw=4, alpha=0.6, label="95 % predictive interval"),
                plt.Line2D([], [], color="#1f3b73", marker="|", ls="none", ms=9, label="median of the studies"),
