@@ -279,7 +279,7 @@ def bands_section(study_dir):
     if flips:
         parts.append("<p class=rank-flip>%s</p>" % flips)
     parts.append("<table class=bands><tr><th>figure</th><th>unit</th><th class=paper>paper</th><th>band (%d %%)</th>"
-                 "<th>median of the studies</th><th>paper</th></tr>" % level)
+                 "<th>median of the studies</th><th>the paper's figure is</th></tr>" % level)
     for r in b["figures"]:
         digits = 2 if r["figure"].startswith("table3.") else 1
         number = (lambda v: "%.2g" % v) if digits == 2 else (lambda v: fmt(v))
@@ -470,6 +470,58 @@ def provenance_footer(study_dir):
                 html.escape(" ".join(p.get("command_line") or [])), html.escape(settings or "none")))
 
 
+def table1_section(tables):
+    """Table 1 (tables.json table1, table1_viewer) beside the paper's: the per-trial rows, the SE(3)
+    rows (means of N = 3 trials: the paper's statistic; the mean of each user's trials, labelled as
+    not the paper's), the per-axis errors in W and in the viewer's frame."""
+    if not tables.get("table1"):
+        return []
+    paper = tables.get("paper", {})
+    parts = []
+    parts.append("<h2>Table 1: ViRAAl landmark misalignment [mm]</h2>"
+                 "<p>Measured as the paper did: three landmarks on the real robot and on the hologram, "
+                 "each annotated by head gaze from two positions (rays from the headset's estimated "
+                 "pose) and triangulated by orbed-registration. Nobody looks at an SE(3) mean: it is scored "
+                 "against the real landmarks annotated in the user's trials, its virtual landmarks "
+                 "placed by the mean.</p><table>"
+                 "<tr><th></th><th>norm of means</th><th>norm of stds</th>"
+                 "<th class=paper>paper</th></tr>")
+    for mode in ("ar_reflective", "ar"):
+        row = tables["table1"].get(mode)
+        prow = paper.get("table1", {}).get(mode)
+        if row:
+            parts.append("<tr><th>%s</th><td>%s</td><td>%s</td><td class=paper>%s</td></tr>" % (
+                LABELS[mode], fmt(row["norm"][0]), fmt(row["norm"][1]),
+                "%s +/- %s" % (fmt(prow["norm"][0]), fmt(prow["norm"][1])) if prow else "-"))
+    pse3 = paper.get("table1", {}).get("se3_mean", {})
+    for mode, row in tables["table1"].get("se3_n3", {}).items():
+        p = pse3.get(mode)
+        parts.append("<tr><th>%s: SE(3) means of N = 3 trials (%d groups; the paper's statistic, scored with "
+                     "the truth's landmarks)</th><td>%s</td><td>%s</td><td class=paper>%s</td></tr>" % (
+                         LABELS[mode], row["groups"], fmt(row["norm"][0]), fmt(row["norm"][1]),
+                         "%s +/- %s" % (fmt(p["norm"][0]), fmt(p["norm"][1], 2)) if p else "-"))
+    for mode, row in tables["table1"].get("se3_mean", {}).items():
+        parts.append("<tr><th>%s: SE(3) mean of each user's %s trials (one per user; not the paper's "
+                     "N = 3)</th><td>%s</td><td>%s</td><td class=paper>-</td></tr>" % (
+                         LABELS[mode], "all", fmt(row["norm"][0]), fmt(row["norm"][1])))
+    parts.append("</table>")
+    for frame, key in (("W (the OR frame, z up)", "table1"), ("the viewer's (z along the line of sight)",
+                                                               "table1_viewer")):
+        rows1 = tables.get(key)
+        if not rows1 or key == "table1" and not tables.get("table1_viewer"):
+            continue
+        parts.append("<p>Per axis in %s [mm], mean +/- std:</p><table><tr><th></th><th>x</th><th>y</th>"
+                     "<th>z</th><th class=paper>paper x, y, z</th></tr>" % frame)
+        for mode in ("ar_reflective", "ar"):
+            row, prow = rows1.get(mode), paper.get("table1", {}).get(mode)
+            if row:
+                parts.append("<tr><th>%s</th>%s<td class=paper>%s</td></tr>" % (LABELS[mode], "".join(
+                    "<td>%s +/- %s</td>" % (fmt(row[a][0]), fmt(row[a][1])) for a in ("t_x", "t_y", "t_z")),
+                    ", ".join(fmt(prow[a][0]) for a in ("t_x", "t_y", "t_z")) if prow else "-"))
+        parts.append("</table>")
+    return parts
+
+
 def report(study_dir):
     tables = json.load(open(os.path.join(study_dir, "tables.json")))
     paper = tables.get("paper", {})
@@ -485,48 +537,7 @@ def report(study_dir):
              "(to Table 4's AR execution mean and spread); every joint error and the other modes' "
              "times are predictions.</p>"
              % html.escape(paper.get("setup_source", paper.get("source", "")))]
-    if tables.get("table1"):
-        parts.append("<h2>Table 1: ViRAAl landmark misalignment [mm]</h2>"
-                     "<p>Measured as the paper did: three landmarks on the real robot and on the hologram, "
-                     "each annotated by head gaze from two positions (rays from the headset's estimated "
-                     "pose) and triangulated by orbed-registration. Nobody looks at an SE(3) mean: it is scored "
-                     "against the real landmarks annotated in the user's trials, its virtual landmarks "
-                     "placed by the mean.</p><table>"
-                     "<tr><th></th><th>norm of means</th><th>norm of stds</th>"
-                     "<th class=paper>paper</th></tr>")
-        for mode in ("ar_reflective", "ar"):
-            row = tables["table1"].get(mode)
-            prow = paper.get("table1", {}).get(mode)
-            if row:
-                parts.append("<tr><th>%s</th><td>%s</td><td>%s</td><td class=paper>%s</td></tr>" % (
-                    LABELS[mode], fmt(row["norm"][0]), fmt(row["norm"][1]),
-                    "%s +/- %s" % (fmt(prow["norm"][0]), fmt(prow["norm"][1])) if prow else "-"))
-        pse3 = paper.get("table1", {}).get("se3_mean", {})
-        for mode, row in tables["table1"].get("se3_n3", {}).items():
-            p = pse3.get(mode)
-            parts.append("<tr><th>%s: SE(3) means of N = 3 trials (%d groups; the paper's statistic, scored with "
-                         "the truth's landmarks)</th><td>%s</td><td>%s</td><td class=paper>%s</td></tr>" % (
-                             LABELS[mode], row["groups"], fmt(row["norm"][0]), fmt(row["norm"][1]),
-                             "%s +/- %s" % (fmt(p["norm"][0]), fmt(p["norm"][1], 2)) if p else "-"))
-        for mode, row in tables["table1"].get("se3_mean", {}).items():
-            parts.append("<tr><th>%s: SE(3) mean of each user's %s trials (one per user; not the paper's "
-                         "N = 3)</th><td>%s</td><td>%s</td><td class=paper>-</td></tr>" % (
-                             LABELS[mode], "all", fmt(row["norm"][0]), fmt(row["norm"][1])))
-        parts.append("</table>")
-        for frame, key in (("W (the OR frame, z up)", "table1"), ("the viewer's (z along the line of sight)",
-                                                                   "table1_viewer")):
-            rows1 = tables.get(key)
-            if not rows1 or key == "table1" and not tables.get("table1_viewer"):
-                continue
-            parts.append("<p>Per axis in %s [mm], mean +/- std:</p><table><tr><th></th><th>x</th><th>y</th>"
-                         "<th>z</th><th class=paper>paper x, y, z</th></tr>" % frame)
-            for mode in ("ar_reflective", "ar"):
-                row, prow = rows1.get(mode), paper.get("table1", {}).get(mode)
-                if row:
-                    parts.append("<tr><th>%s</th>%s<td class=paper>%s</td></tr>" % (LABELS[mode], "".join(
-                        "<td>%s +/- %s</td>" % (fmt(row[a][0]), fmt(row[a][1])) for a in ("t_x", "t_y", "t_z")),
-                        ", ".join(fmt(prow[a][0]) for a in ("t_x", "t_y", "t_z")) if prow else "-"))
-            parts.append("</table>")
+    parts.extend(table1_section(tables))
     parts.append(landmark_check(tables, study_dir))
     if "table2" in tables:
         head = ("<tr><th></th>" + "".join("<th>%s</th>" % k for k in ("mean", "median", "min", "max", "std"))

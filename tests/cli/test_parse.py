@@ -60,7 +60,8 @@ def test_a_typo_is_answered_with_the_nearest_verb(orbed):
 @pytest.mark.parametrize("argv, message", [
     (["study", "--users"], "argument --users: expected one argument"),
     (["study", "--users", "abc"], "argument --users: must be a whole number 0..99, not 'abc'"),
-    (["study", "--targets", "4"], "argument --targets: must be a whole number 1..3, not '4'"),
+    (["study", "--targets", "7"], "argument --targets: must be a whole number 1..6, not '7'"),
+    (["study", "--bands", "x"], "argument --bands: must be a whole number 0..100000, not 'x'"),
     (["study", "--users", "0", "--setup-users", "0"], "--users 0 and --setup-users 0 leave nothing to run"),
     (["study", "--realtime"], "--realtime keeps the wall clock, so --sim-rate must be 1"),
     (["study", "--run-id", "a b"], "argument --run-id: must be 1-64 letters"),
@@ -117,6 +118,9 @@ def test_version_names_the_project_version_and_the_commit(orbed):
 def test_global_flags_go_before_or_after_the_verb():
     args = cli.parse_args(["--quiet", "study", "--users", "2"])
     assert (args.verb, args.quiet, args.verbose, args.users) == ("study", True, False, 2)
+    args = cli.parse_args(["study", "--bands", "20"])
+    assert (args.bands, args.seed) == (20, 1)
+    assert cli.parse_args(["study"]).bands == 0
     args = cli.parse_args(["study", "--verbose"])
     assert (args.quiet, args.verbose, args.users, args.setup_users, args.trials) == (False, True, 4, 8, 10)
 
