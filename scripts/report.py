@@ -1,23 +1,32 @@
 #!/usr/bin/python3
-"""orbed study report: report.html and figures/*.png from a study folder (scripts/orbed study).
+"""orbed study report: report.html and figures/ from a study folder (scripts/orbed study).
 
 Usage: /usr/bin/python3 scripts/report.py STUDY_DIR
 
 Reads STUDY_DIR/tables.json, setup_joints.csv, setup_times.csv and, when present,
-alignment_trials.csv (orbed-study-tables writes them) and writes:
-  figures/joint_errors.png   per-joint error distributions per guidance mode (violins; the paper's
-                             Fig. 6)
-  figures/total_errors.png   every joint's error per mode (violins; the paper's Fig. 7)
-  figures/joint_rank.png     the mean error per joint and mode on a log scale, twisting joints (odd)
-                             and revolving joints (even) told apart (the paper's Fig. 8)
-  report.html                Tables 1-4 beside the paper's, the figures, the reviewer's analysis of
-                             the set-up half (tables.json setup_analysis: paired tests with the set-up
-                             and the user as the unit, Holm-corrected per-joint tests, the mixed
-                             model, effect sizes, per target, half-turn rates) beside the paper's
-                             reading, the ground-truth columns the paper could not measure, and what
-                             was calibrated to which figure.
+alignment_trials.csv, landmark_validation.csv (orbed-study-tables writes them), provenance.json
+(scripts/provenance.py) and bands/ (scripts/orbed study --bands M: bands.json, rank_flip.csv,
+figures/bands.{pdf,png}), and writes, each figure as a vector PDF and a 300-dpi PNG:
+  figures/joint_errors   per-joint error distributions per guidance mode (violins; the paper's
+                         Fig. 6), the paper's median over all joints (Table 2) dashed
+  figures/total_errors   every joint's error per mode (violins; the paper's Fig. 7), the paper's mean
+                         and median (Table 2) beside each violin
+  figures/joint_rank     the mean error per joint and mode on a log scale (ticks 0.1, 1, 10, 100 deg),
+                         twisting joints (odd) and revolving joints (even) told apart (the paper's
+                         Fig. 8), the paper's mean per mode dashed
+  figures/power          the power analysis's curves, the paper's 8 users marked
+  report.html            Tables 1-4 beside the paper's (Table 1 with its SE(3) row of groups of N = 3
+                         and the landmark check), the figures (PNG shown, PDF linked), the reviewer's
+                         analysis of the set-up half (tables.json setup_analysis: paired tests with
+                         the set-up and the user as the unit, Holm-corrected per-joint tests, the
+                         mixed model, effect sizes, per target, half-turn rates) beside the paper's
+                         reading, the predictive bands (k of n paper figures inside, each figure's
+                         band, the bands figure) and the rank flip when bands/ exists, the
+                         ground-truth columns the paper could not measure, and a provenance footer
+                         (commit, command line, host, times, settings).
 tables.json's numbers are python/orbed/study's (python3 -m orbed.study STUDY_DIR); this only
-formats them. Needs python3-matplotlib (Debian); nothing else outside the standard library.
+formats them. Needs python3-matplotlib (Debian); for the rank flip python/orbed/study/rank_flip.py
+(statsmodels).
 """
 import csv
 import html
