@@ -9,6 +9,7 @@
 #include "base/json.h"
 #include "base/json_fields.h"
 #include "base/random.h"
+#include "base/source_paths.h"
 #include "base/units.h"
 #include "sim/collision_world.h"
 #include "sim/scene.h"
@@ -451,6 +452,25 @@ UserDesign DrawUserDesign(const DesignCatalog& catalog, std::uint64_t user_seed,
     design.pairs.push_back({start.id, pool[i]->id, start.q_deg, pool[i]->q_deg});
   }
   return design;
+}
+
+UserDesign UserDesignFor(const std::string& design_path, const std::string& scene_path, uint64_t user_seed,
+                         int k) {
+  const DesignCatalog catalog = ReadDesignFile(design_path);
+  std::optional<std::string> patient;
+  if (!scene_path.empty()) {
+    std::string names;
+    for (const DesignPatient& p : catalog.patients) {
+      std::error_code ec;
+      if (std::filesystem::equivalent(SourceTreePath(p.scene), scene_path, ec)) patient = p.name;
+      names += (names.empty() ? "" : ", ") + p.scene;
+    }
+    if (!patient) {
+      throw std::invalid_argument("--scene " + scene_path + " is no patient's of " + design_path + " (" +
+                                  names + "); give --plan and --start-deg for another scene");
+    }
+  }
+  return DrawUserDesign(catalog, user_seed, k, patient);
 }
 
 namespace {

@@ -160,6 +160,12 @@ struct UserDesign {
 UserDesign DrawUserDesign(const DesignCatalog& catalog, std::uint64_t user_seed, int k,
                           const std::optional<std::string>& patient = std::nullopt);
 
+/// The user's draw from the design catalog at `design_path` (experiments/setup/design.h); a
+/// non-empty `scene_path` fixes the patient to the catalog's patient whose scene file it is (the
+/// same file: std::filesystem::equivalent), std::invalid_argument when none is.
+UserDesign UserDesignFor(const std::string& design_path, const std::string& scene_path, uint64_t user_seed,
+                         int k);
+
 enum class Relation { kSame, kMirror, kMixed };
 /// See the file comment; `start_deg` and `target_deg` have at least 6 joints.
 Relation BendingRelation(const std::vector<double>& start_deg, const std::vector<double>& target_deg);

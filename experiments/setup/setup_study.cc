@@ -22,6 +22,7 @@
 #include "base/hash.h"
 #include "base/random.h"
 #include "base/source_paths.h"
+#include "experiments/setup/design.h"
 #include "experiments/viraal/registration_service.h"
 #include "hmd_emulator/hmd.h"
 #include "lcmtypes/contract/conversions.h"
@@ -75,24 +76,66 @@ std::string Shipped(const std::string& path, const char* relative) {
   return path.empty() ? SourceTreePath(relative) : path;
 }
 
+// What the user's launch gives its processes: the scene (the launch's `scene` argument: the sim,
+// the headset, the monitor) and orbed-setup's options, as `scripts/orbed study` and RunSetup
+// (procs/setup/setup_process.cc) make them.
+struct Launch {
+  std::string scene_path;
+  SetupOptions setup;
+};
+
+Launch LaunchOf(const SetupUserOptions& o, const sim::RobotModel& model) {
+  Launch launch;
+  SetupOptions& s = launch.setup;
+  s.user = o.user;
+  s.run_id = o.run_id;
+  s.modes = o.modes.empty() ? ModeOrderForSeed(o.user_seed) : o.modes;
+  s.start_deg = o.start_deg;
+  s.perfect_registration = o.perfect_registration;
+  if (o.use_plan) {
+    launch.scene_path = Shipped(o.scene_path, sim::kDefaultSceneRelativePath);
+    s.targets_deg = PlanTargetsDeg(Shipped(o.plan_path, "experiments/setup/targets.json"), o.targets, model);
+  } else {
+    // `scripts/orbed study` gives the launch the drawn patient's scene (orbed-design draw), and
+    // orbed-setup draws again with the patient fixed by that scene: the same pairs.
+    const UserDesign design = UserDesignFor(Shipped(o.design_path, kDefaultDesignRelativePath), o.scene_path,
+                                            o.user_seed, o.targets);
+    launch.scene_path = o.scene_path.empty() ? SourceTreePath(design.scene) : o.scene_path;
+    for (const DesignPair& p : design.pairs) {
+      s.targets_deg.push_back(p.target_deg);
+      s.starts_deg.push_back(p.start_deg);
+      s.start_ids.push_back(p.start_id);
+      s.target_ids.push_back(p.target_id);
+    }
+    s.retract = true;
+    s.retract_scene_path = launch.scene_path;
+  }
+  s.alignment = viraal::LoadScenarioFile(Shipped(o.scenario_path, viraal::kDefaultScenarioRelativePath));
+  s.alignment.trials = o.trials;
+  s.request_deadline_s = 60.0;  // the launch file's --request-deadline-s
+  return launch;
+}
+
 // One user's launch: the cores of its processes and the messages between them.
 class UserBus {
  public:
   explicit UserBus(const SetupUserOptions& o)
       : options_(o),
-        sim_(SimOptions()),
         model_(sim::RobotModel::LoadFile(SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath))),
-        headset_(HeadsetOptions(o), o.hmd_process_seed, 0.0),
+        launch_(LaunchOf(o, model_)),
+        sim_(SimOptions(launch_.scene_path)),
+        headset_(HeadsetOptions(o, launch_.scene_path), o.hmd_process_seed, 0.0),
         service_({}, [](const std::string&, const std::string&) {}),
         machine_(model_, AssistantConfigOf(o), assistant::MachineOptions{}),
-        conductor_(ConductorOptions(o, model_), model_),
+        conductor_(launch_.setup, model_),
         pose_timer_(1.0 / kPoseHz),
         registration_timer_(kRegistrationStatePeriodS),
         guidance_timer_(1.0 / kGuidanceRateHz),
         fixed_timer_(1.0 / kFixedViewRateHz),
         assistant_timer_(kAssistantStepS),
         setup_timer_(kSetupTickS) {
-    const sim::Scene scene = sim::LoadSceneFile(SourceTreePath(sim::kDefaultSceneRelativePath));
+    // orbed-fixed-display's home view: the configured camera about the scene's base.
+    const sim::Scene scene = sim::LoadSceneFile(launch_.scene_path);
     fixed_home_ = fixed_display::OrbitView::Through(fixed_display::kDefaultCamera_m,
                                                     fixed_display::OrbitCentre(scene.X_WR));
   }
@@ -123,18 +166,19 @@ class UserBus {
   }
 
  private:
-  static sim::IiwaSimOptions SimOptions() {
+  static sim::IiwaSimOptions SimOptions(const std::string& scene_path) {
     sim::IiwaSimOptions o;
     o.urdf_path = SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath);
-    o.scene_path = SourceTreePath(sim::kDefaultSceneRelativePath);
+    o.scene_path = scene_path;
     o.realtime_rate = kRealtimeRate;
     o.steps_per_tick = kStepsPerTick;
     o.lockstep = true;
     return o;
   }
-  static hmd::HmdOptions HeadsetOptions(const SetupUserOptions& o) {
+  static hmd::HmdOptions HeadsetOptions(const SetupUserOptions& o, const std::string& scene_path) {
     hmd::HmdOptions h;
     h.user_seed = o.user_seed;
+    h.scene_path = scene_path;
     h.config_paths = o.headset_config_paths;
     h.threaded = false;
     return hmd::ResolveHmdOptions(h);
@@ -145,20 +189,6 @@ class UserBus {
     c.seed = o.user_seed;
     return c;
   }
-  static SetupOptions ConductorOptions(const SetupUserOptions& o, const sim::RobotModel& model) {
-    SetupOptions s;
-    s.user = o.user;
-    s.run_id = o.run_id;
-    s.modes = o.modes.empty() ? ModeOrderForSeed(o.user_seed) : o.modes;
-    s.start_deg = o.start_deg;
-    s.perfect_registration = o.perfect_registration;
-    s.targets_deg = PlanTargetsDeg(Shipped(o.plan_path, "experiments/setup/targets.json"), o.targets, model);
-    s.alignment = viraal::LoadScenarioFile(Shipped(o.scenario_path, viraal::kDefaultScenarioRelativePath));
-    s.alignment.trials = o.trials;
-    s.request_deadline_s = 60.0;  // the launch file's --request-deadline-s
-    return s;
-  }
-
   // The clock inside a timer (its deadline) and in a handler (the latest SIM_CLOCK).
   ConductorTime TimerTime(int64_t deadline_ns) const {
     return {1e-9 * static_cast<double>(deadline_ns), UtimeAt(deadline_ns)};
@@ -326,8 +356,9 @@ class UserBus {
   void Handle(const FixedView& view) { machine_.OnMonitorCamera(view.p_WD, HandlerTime().t_s); }
 
   SetupUserOptions options_;
-  sim::ArmSim sim_;
   sim::RobotModel model_;
+  Launch launch_;
+  sim::ArmSim sim_;
   hmd::Headset headset_;
   registration::RegistrationService service_;
   assistant::AssistantMachine machine_;

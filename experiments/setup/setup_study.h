@@ -76,13 +76,26 @@ struct SetupUserOptions {
   uint64_t user_seed{1};
   std::string run_id{"setup"};  ///< sessions "<run_id>-<task id>-<mode>"
   std::vector<int8_t> modes;    ///< empty: ModeOrderForSeed(user_seed)
-  int targets{3};               ///< the plan's first `targets` targets
-  int trials{3};                ///< alignments before each headset set-up (N)
-  std::vector<double> start_deg{0, 20, 0, -60, 0, 40, 0};
-  bool perfect_registration{false};  ///< orbed-setup --registration truth
+  /// K: the (start, target) pairs drawn from the design per mode (or the plan's first K targets).
+  int targets{3};
+  int trials{3};  ///< alignments before each headset set-up (N)
+  /// The design (orbed-setup's default, as `scripts/orbed study` launches it): UserDesignFor(
+  /// design_path, scene_path, user_seed, targets) draws the patient and the K pairs; the patient's
+  /// scene is the sim's collision world, the headset's, the monitor's and the conductor's (its
+  /// retract after each set-up; the plan checks go to the sim), as the launch's `scene` argument.
+  std::string design_path;  ///< "" = experiments/setup/design.json
+  /// The scene (the launch's `scene` argument): "" = the drawn patient's (the design), or
+  /// sim/models/scenes/trocar_or.yaml (the plan); with the design it fixes the patient to that
+  /// scene's (orbed-setup --scene).
+  std::string scene_path;
+  /// The plan instead of the design (orbed-setup --plan / --start-deg): the plan's first K targets
+  /// (plan_path), each from start_deg, no retract.
+  bool use_plan{false};
+  std::vector<double> start_deg{0, 20, 0, -60, 0, 40, 0};  ///< with use_plan
+  bool perfect_registration{false};                        ///< orbed-setup --registration truth
   RegistrationInjection injection;
-  /// Files; "" = the shipped ones (as the launch file: iiwa7.urdf, trocar_or.yaml,
-  /// experiments/setup/targets.json, experiments/viraal/viraal.yaml, procs/assistant/assistant.yaml).
+  /// Files; "" = the shipped ones (as the launch file: iiwa7.urdf, experiments/setup/targets.json,
+  /// experiments/viraal/viraal.yaml, procs/assistant/assistant.yaml).
   std::string plan_path, scenario_path, assistant_config_path;
   /// Headset config files applied after the shipped ones (orbed-hmd --config).
   std::vector<std::string> headset_config_paths;

@@ -130,9 +130,25 @@ int RunSetupStudy(int argc, const char* const* argv, std::ostream& out, std::ost
       ->capture_default_str();
   app.add_option("--seed", seed, "The first user's seed")->check(NumberIn(0, 1e15))->capture_default_str();
   app.add_option("--run-id", run_id, "Run ids <ID>-setup-u<k> (default study-s<S>, as scripts/orbed study)");
-  app.add_option("--targets", targets, "Targets per mode, 1..3 (experiments/setup/targets.json)")
-      ->check(NumberIn(1, 3))
+  app.add_option("--targets", targets,
+                 "K, the (start, target) pairs per mode each user draws from the design (or the plan's "
+                 "first K targets with --plan); 1..6, as scripts/orbed study")
+      ->check(NumberIn(1, 6))
       ->capture_default_str();
+  std::string design_path, plan_path;
+  std::vector<double> start_deg;
+  app.add_option("--design", design_path,
+                 "The design catalog each user draws their patient and pairs from (default "
+                 "experiments/setup/design.json)");
+  CLI::Option* plan_option =
+      app.add_option("--plan", plan_path,
+                     "Instead of the design: the targets of this `orbed-robot plan` file (e.g. "
+                     "experiments/setup/targets.json), each from --start-deg, in trocar_or.yaml (orbed-setup "
+                     "--plan)");
+  CLI::Option* start_option =
+      AddNumberListOption(&app, "--start-deg", &start_deg, 7,
+                          "With --plan: where the arm is parked before each set-up [deg] (default "
+                          "0,20,0,-60,0,40,0)");
   app.add_option("--trials", trials, "Alignments before each headset set-up (the paper: N = 3)")
       ->check(NumberIn(1, 100))
       ->capture_default_str();
@@ -165,6 +181,10 @@ int RunSetupStudy(int argc, const char* const* argv, std::ostream& out, std::ost
 
   SetupUserOptions base;
   base.targets = targets;
+  base.design_path = design_path;
+  base.use_plan = plan_option->count() > 0 || start_option->count() > 0;
+  base.plan_path = plan_path;
+  if (!start_deg.empty()) base.start_deg = start_deg;
   base.trials = trials;
   base.perfect_registration = registration == "truth";
   base.assistant_config_path = assistant_config;

@@ -5,6 +5,7 @@
 /// threads, and the study's CSVs.
 ///
 ///   orbed-setup-study [--users U] [--studies M] [--seed S] [--run-id ID] [--targets K] [--trials N]
+///                     [--design FILE | --plan FILE [--start-deg Q]]
 ///                     [--threads T] [--out DIR] [--json-dir DIR] [--registration measured|truth]
 ///                     [--registration-offset-mm X] [--registration-tilt-deg Y]
 ///                     [--registration-direction X,Y,Z | random] [--registration-axis X,Y,Z]
@@ -14,7 +15,11 @@
 /// user k with seed S + m·U + k − 1 and run id "<ID>-setup-u<k>" for m = 0 (so study 0 is the bus
 /// study `scripts/orbed study --seed S --setup-users U --users 0`, number for number) and
 /// "<ID>-m<m>-setup-u<k>" for m ≥ 1; ID defaults to "study-s<S>". Each user's modes come in the
-/// order drawn from their seed.
+/// order drawn from their seed, and their patient and K (start, target) pairs from the design
+/// (--design, default experiments/setup/design.json; the patient's scene for the sim, headset,
+/// monitor and the conductor's retract), as the bus study launches them; --plan FILE (and
+/// --start-deg) gives every user the plan's first K targets from one start instead (orbed-setup
+/// --plan).
 ///
 /// Writes into --out (default .): setup_joints.csv, setup_times.csv, setup_docking.csv
 /// (experiments/setup/setup_tables.h's writers) over every user; with M > 1 each line starts with

@@ -4,9 +4,13 @@
 //     setup_results.json, equals byte for byte what orbed-setup wrote over the bus
 //     (tests/integration/testdata/setup_pinned_results.json: user u1, seed 5, measured
 //     registration; setup_truth_pinned_results.json: user u2, seed 6, headset modes with the true
-//     registration). Made by `scripts/orbed study --users 0 --setup-users 3 --seed 5
-//     --registration-share` (lockstep, sim rate 100): its setup-u1/ and setup-truth-u2/
-//     setup_results.json with the "provenance" line taken out (the file names the run folder's record);
+//     registration), each user's patient and (start, target) pairs drawn from the design. Made by
+//     `scripts/orbed study --users 0 --setup-users 3 --seed 5 --registration-share` (lockstep, sim
+//     rate 100): its setup-u1/ and setup-truth-u2/ setup_results.json with the "provenance" line
+//     taken out (the file names the run folder's record); re-pin them so whenever the set-up's
+//     cores change a number;
+//   - the design reaches the run (the pairs are UserDesignFor's draw, the patient's scene the
+//     sim's), and --plan / --start-deg still give the plan's targets from one start;
 //   - the same files for any thread count;
 //   - the injected registration error is exactly the asked shift and turn (closed form), reaches
 //     the assistant (a shifted hologram moves the reached joints) and not the conductor's record of
@@ -22,6 +26,7 @@
 #include <orbed/guidance_t.hpp>
 
 #include "base/source_paths.h"
+#include "experiments/setup/design.h"
 #include "experiments/setup/setup_study_cli.h"
 
 namespace orbed::setup {
@@ -144,6 +149,48 @@ TEST(SetupStudy, InjectionReachesTheAssistantNotTheAlignmentRecord) {
   EXPECT_NE(plain.setups[0].reached_deg, injected.setups[0].reached_deg);
 }
 
+TEST(SetupStudy, RunsTheUsersDrawFromTheDesign) {
+  SetupUserOptions o;
+  o.user_seed = 12;
+  o.targets = 2;
+  o.modes = {orbed::guidance_t::MODE_AR};
+  const UserDesign design = UserDesignFor(SourceTreePath(kDefaultDesignRelativePath), "", 12, 2);
+  const SetupRun run = RunSetupUser(o);
+  ASSERT_TRUE(run.ok) << run.error;
+  ASSERT_EQ(run.setups.size(), design.pairs.size());
+  for (size_t i = 0; i < design.pairs.size(); ++i) {
+    EXPECT_EQ(run.setups[i].start_id, design.pairs[i].start_id);
+    EXPECT_EQ(run.setups[i].target_id, design.pairs[i].target_id);
+    EXPECT_EQ(run.setups[i].start_deg, design.pairs[i].start_deg);
+    EXPECT_EQ(run.setups[i].target_deg, design.pairs[i].target_deg);
+  }
+  // Another patient's scene fixes the patient (orbed-setup --scene): its own targets.
+  const DesignCatalog catalog = ReadDesignFile(SourceTreePath(kDefaultDesignRelativePath));
+  for (const DesignPatient& p : catalog.patients) {
+    if (p.name == design.patient) continue;
+    o.scene_path = SourceTreePath(p.scene);
+    const SetupRun other = RunSetupUser(o);
+    ASSERT_TRUE(other.ok) << other.error;
+    EXPECT_EQ(other.setups[0].target_id.rfind(p.name + "/", 0), 0u) << other.setups[0].target_id;
+    break;
+  }
+}
+
+TEST(SetupStudy, ThePlanRunsItsTargetsFromOneStart) {
+  SetupUserOptions o;
+  o.user_seed = 3;
+  o.targets = 1;
+  o.modes = {orbed::guidance_t::MODE_FIXED_DISPLAY};
+  o.use_plan = true;
+  o.start_deg = {0, 20, 0, -60, 0, 40, 0};
+  const SetupRun run = RunSetupUser(o);
+  ASSERT_TRUE(run.ok) << run.error;
+  ASSERT_EQ(run.setups.size(), 1u);
+  EXPECT_EQ(run.setups[0].start_deg, o.start_deg);
+  EXPECT_EQ(run.setups[0].start_id, "");
+  EXPECT_EQ(run.setups[0].target_id, "");
+}
+
 int RunCli(std::vector<const char*> args) {
   args.insert(args.begin(), "orbed-setup-study");
   std::ostringstream out, err;
@@ -154,7 +201,8 @@ TEST(SetupStudyCli, BadOptionsExit2) {
   EXPECT_EQ(RunCli({"--users", "0"}), 2);
   EXPECT_EQ(RunCli({"--studies", "-1"}), 2);
   EXPECT_EQ(RunCli({"--threads", "0"}), 2);
-  EXPECT_EQ(RunCli({"--targets", "4"}), 2);
+  EXPECT_EQ(RunCli({"--targets", "7"}), 2);
+  EXPECT_EQ(RunCli({"--plan", "x.json", "--start-deg", "0,1"}), 2);
   EXPECT_EQ(RunCli({"--registration", "perfect"}), 2);
   EXPECT_EQ(RunCli({"--registration-offset-mm", "nan"}), 2);
   EXPECT_EQ(RunCli({"--registration-tilt-deg", "inf"}), 2);

@@ -145,7 +145,7 @@ TEST(SetupTables, ReadsTheRegistration) {
   };
   const std::vector<SetupUserRun> truth = {User("t1", {with("truth", 1)})};
   EXPECT_EQ(truth[0].setups[0].registration, "truth");
-  EXPECT_NE(SetupJointsCsv(truth).find("\nt1,ar,1,1,1,1,10,11,1\n"), std::string::npos)
+  EXPECT_NE(SetupJointsCsv(truth).find("\nt1,ar,1,1,1,1,10,11,1,,,\n"), std::string::npos)
       << SetupJointsCsv(truth);
   EXPECT_THROW(User("bad", {with("guess", 1)}), std::runtime_error);
 }

@@ -152,25 +152,6 @@ void SetupProcess::Write(bool partial) {
   }
 }
 
-UserDesign UserDesignFor(const std::string& design_path, const std::string& scene_path, uint64_t user_seed,
-                         int k) {
-  const DesignCatalog catalog = ReadDesignFile(design_path);
-  std::optional<std::string> patient;
-  if (!scene_path.empty()) {
-    std::string names;
-    for (const DesignPatient& p : catalog.patients) {
-      std::error_code ec;
-      if (std::filesystem::equivalent(SourceTreePath(p.scene), scene_path, ec)) patient = p.name;
-      names += (names.empty() ? "" : ", ") + p.scene;
-    }
-    if (!patient) {
-      throw std::invalid_argument("--scene " + scene_path + " is no patient's of " + design_path + " (" +
-                                  names + "); give --plan and --start-deg for another scene");
-    }
-  }
-  return DrawUserDesign(catalog, user_seed, k, patient);
-}
-
 int RunSetup(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
   CLI::App app{
       "orbed-setup: one user's part of the paper's robot set-up study (Sec. IV-B, Tables 2-4). For\n"

@@ -65,12 +65,6 @@ class SetupProcess {
   bool started_{false};
 };
 
-/// The user's draw from the design catalog at `design_path` (experiments/setup/design.h); a
-/// non-empty `scene_path` fixes the patient to the catalog's patient whose scene file it is (the
-/// same file: std::filesystem::equivalent), std::invalid_argument when none is.
-UserDesign UserDesignFor(const std::string& design_path, const std::string& scene_path, uint64_t user_seed,
-                         int k);
-
 /// orbed-setup's command line (flags: --help). Exit 0 when every set-up finished; 1 on a failure; 2
 /// or CLI11's usage code (106-109) on bad arguments.
 int RunSetup(int argc, const char* const* argv, std::ostream& out, std::ostream& err);
