@@ -408,6 +408,19 @@ std::string RobotModel::ValidateJointVector(const Eigen::VectorXd& q_rad, double
   return "";
 }
 
+namespace {
+// X_RL of `link` from its parent's pose X_RP: CalcLinkPoses and UpdateLinkPosesForJoint share it,
+// so both give the same bits.
+Eigen::Isometry3d ChildPose(const RobotLink& link, const Eigen::Isometry3d& X_RP,
+                            const Eigen::VectorXd& q_rad) {
+  Eigen::Isometry3d X = X_RP * link.X_PJ;
+  if (link.joint_index >= 0) {
+    X.linear() = X.linear() * Eigen::AngleAxisd(q_rad[link.joint_index], link.axis_J).toRotationMatrix();
+  }
+  return X;
+}
+}  // namespace
+
 void RobotModel::CalcLinkPoses(const Eigen::VectorXd& q_rad, std::vector<Eigen::Isometry3d>* X_RL) const {
   if (q_rad.size() != num_joints()) {
     throw std::invalid_argument("CalcLinkPoses: expected " + std::to_string(num_joints()) +
@@ -415,16 +428,29 @@ void RobotModel::CalcLinkPoses(const Eigen::VectorXd& q_rad, std::vector<Eigen::
   }
   X_RL->resize(links_.size());
   for (size_t i = 0; i < links_.size(); ++i) {
-    const RobotLink& link = links_[i];
-    if (link.parent < 0) {
+    if (links_[i].parent < 0) {
       (*X_RL)[i].setIdentity();
       continue;
     }
-    Eigen::Isometry3d X = (*X_RL)[link.parent] * link.X_PJ;
-    if (link.joint_index >= 0) {
-      X.linear() = X.linear() * Eigen::AngleAxisd(q_rad[link.joint_index], link.axis_J).toRotationMatrix();
-    }
-    (*X_RL)[i] = X;
+    (*X_RL)[i] = ChildPose(links_[i], (*X_RL)[links_[i].parent], q_rad);
+  }
+}
+
+void RobotModel::UpdateLinkPosesForJoint(const Eigen::VectorXd& q_rad, int joint, int last_link,
+                                         std::vector<Eigen::Isometry3d>* X_RL) const {
+  if (q_rad.size() != num_joints() || joint < 0 || joint >= num_joints() || X_RL->size() != links_.size() ||
+      last_link >= num_links()) {
+    throw std::invalid_argument(
+        "UpdateLinkPosesForJoint: joint, link or vector size does not match the model");
+  }
+  // A parent comes before its children (LoadFile orders the links so), so the links the joint
+  // moves follow its child link, and each one's parent is updated before it.
+  const int first = joints_[joint].link;
+  for (int i = first; i <= last_link; ++i) {
+    int up = i;
+    while (up > first) up = links_[up].parent;
+    if (up != first) continue;
+    (*X_RL)[i] = ChildPose(links_[i], (*X_RL)[links_[i].parent], q_rad);
   }
 }
 

@@ -113,6 +113,12 @@ class RobotModel {
   std::vector<Eigen::Isometry3d> CalcLinkPoses(const Eigen::VectorXd& q_rad) const;
   /// Same without allocation; `X_RL` is resized to num_links().
   void CalcLinkPoses(const Eigen::VectorXd& q_rad, std::vector<Eigen::Isometry3d>* X_RL) const;
+  /// X_RL of CalcLinkPoses(q_old) updated to q_rad, where q_rad differs from q_old in `joint` only:
+  /// the links that joint moves, up to index `last_link`, are recomputed by the same operations as
+  /// CalcLinkPoses (bit for bit its poses of q_rad there); the other links are left as they are. No
+  /// allocation: for searches over one joint's angle (the assistant's grid).
+  void UpdateLinkPosesForJoint(const Eigen::VectorXd& q_rad, int joint, int last_link,
+                               std::vector<Eigen::Isometry3d>* X_RL) const;
   Eigen::Isometry3d CalcFlangePose(const Eigen::VectorXd& q_rad) const;   ///< X_RF
   Eigen::Isometry3d CalcToolTipPose(const Eigen::VectorXd& q_rad) const;  ///< X_RT
 

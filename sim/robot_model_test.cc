@@ -90,6 +90,33 @@ TEST(RobotModelTest, FlangeAndJointFramesMatchDhOracle) {
   }
 }
 
+// Updating the poses for one joint's new angle gives CalcLinkPoses' poses bit for bit, and leaves
+// the links the joint does not move (those before it, those past last_link) as they were.
+TEST(RobotModelTest, UpdateLinkPosesForJointIsCalcLinkPosesBitForBit) {
+  const RobotModel model = LoadIiwa();
+  Eigen::VectorXd q(7);
+  q << 0.3, -0.7, 1.1, -1.4, 0.5, 0.9, -2.0;
+  const std::vector<Eigen::Isometry3d> X_old = model.CalcLinkPoses(q);
+  for (int j = 0; j < model.num_joints(); ++j) {
+    Eigen::VectorXd q_new = q;
+    q_new[j] = -0.123456789 + 0.2 * j;
+    const std::vector<Eigen::Isometry3d> X_new = model.CalcLinkPoses(q_new);
+    std::vector<Eigen::Isometry3d> X = X_old;
+    model.UpdateLinkPosesForJoint(q_new, j, model.num_links() - 1, &X);
+    for (int i = 0; i < model.num_links(); ++i)
+      EXPECT_TRUE(X[i].matrix() == X_new[i].matrix()) << "joint " << j << ", link " << i;
+    const int last = model.joints()[j].link;  // only the joint's child link
+    X = X_old;
+    model.UpdateLinkPosesForJoint(q_new, j, last, &X);
+    for (int i = 0; i < model.num_links(); ++i) {
+      const Eigen::Isometry3d& expected = i == last ? X_new[i] : X_old[i];
+      EXPECT_TRUE(X[i].matrix() == expected.matrix()) << "joint " << j << ", link " << i;
+    }
+  }
+  std::vector<Eigen::Isometry3d> wrong(2);
+  EXPECT_THROW(model.UpdateLinkPosesForJoint(q, 0, 3, &wrong), std::invalid_argument);
+}
+
 TEST(RobotModelTest, JacobianMatchesFiniteDifferences) {
   const RobotModel m = LoadIiwa();
   const Eigen::VectorXd q = Deg({25, -35, 50, 70, -40, 55, 10});

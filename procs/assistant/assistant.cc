@@ -207,12 +207,14 @@ Assistant::Assistant(const sim::RobotModel& model, const AssistantConfig& config
   pace_ = std::exp(sigma * pace_stream.Normal() - 0.5 * sigma * sigma);
   const int n = model.num_joints();
   features_.resize(n);
+  last_link_.assign(n, 0);
   for (int j = 0; j < n; ++j) {
     AddBody(model, model.links()[model.joints()[j].link].body, config_.flange_marker_offset_m, &features_[j]);
     if (j + 1 < n) {
       AddBody(model, model.links()[model.joints()[j + 1].link].body, config_.flange_marker_offset_m,
               &features_[j]);
     }
+    for (const Feature& f : features_[j]) last_link_[j] = std::max(last_link_[j], f.link);
   }
 }
 
@@ -256,7 +258,11 @@ double Assistant::Discrepancy(int joint, double x_rad, const Eigen::VectorXd& q_
                               const Viewing& view) const {
   Eigen::VectorXd q = q_now;
   q[joint] = x_rad;
-  const std::vector<Eigen::Isometry3d> X_RL = model_->CalcLinkPoses(q);
+  return DiscrepancyAt(joint, model_->CalcLinkPoses(q), seen, view);
+}
+
+double Assistant::DiscrepancyAt(int joint, const std::vector<Eigen::Isometry3d>& X_RL, const Perceived& seen,
+                                const Viewing& view) const {
   const std::vector<Feature>& features = features_[joint];
   const bool display = !seen.display.empty() && view.p_WC_display;
   double sum = 0;
@@ -289,9 +295,15 @@ JointLook Assistant::Look(int joint, const Eigen::VectorXd& q_now, const Eigen::
   std::vector<double> x(count), d(count);
   double d_min = std::numeric_limits<double>::infinity();
   int i_min = 0;
+  // Discrepancy(joint, x, ...) without its allocations: the links before the joint keep q_now's
+  // poses; only those it moves, up to the last one it is judged by, are recomputed (the same bits).
+  Eigen::VectorXd q = q_now;
+  std::vector<Eigen::Isometry3d> X_RL = model_->CalcLinkPoses(q_now);
   for (int i = 0; i < count; ++i) {
     x[i] = std::min(hi, lo + i * step);
-    d[i] = Discrepancy(joint, x[i], q_now, seen, view);
+    q[joint] = x[i];
+    model_->UpdateLinkPosesForJoint(q, joint, last_link_[joint], &X_RL);
+    d[i] = DiscrepancyAt(joint, X_RL, seen, view);
     if (d[i] < d_min) {
       d_min = d[i];
       i_min = i;

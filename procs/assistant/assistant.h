@@ -246,6 +246,11 @@ class Assistant {
   double scale_{1.0};
   double pace_{1.0};
   std::vector<std::vector<Feature>> features_;
+  std::vector<int> last_link_;  // per joint: the highest link index of its features
+
+  // D(x) of the file comment from the link poses X_RL of x (Discrepancy's sum).
+  double DiscrepancyAt(int joint, const std::vector<Eigen::Isometry3d>& X_RL, const Perceived& seen,
+                       const Viewing& view) const;
 };
 
 }  // namespace orbed::assistant
