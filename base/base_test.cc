@@ -255,5 +255,14 @@ TEST(YamlFields, DocBlockAndKeyPaths) {
             std::string::npos);
 }
 
+// Studies written one after the other make one CSV: the header once, with `study` first.
+TEST(Format, WithStudyColumnLeadsEveryRowWithTheStudy) {
+  const std::string csv = "user,mode\nu1,ar\nu2,ar\n";
+  EXPECT_EQ(WithStudyColumn(csv, 0), "study,user,mode\n0,u1,ar\n0,u2,ar\n");
+  EXPECT_EQ(WithStudyColumn(csv, 7), "7,u1,ar\n7,u2,ar\n");
+  EXPECT_EQ(WithStudyColumn("user,mode\n", 3), "");
+}
+
 }  // namespace
+
 }  // namespace orbed

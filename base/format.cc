@@ -59,4 +59,22 @@ std::string DescribeErrno(int error_number) {
   return std::string(std::strerror(error_number)) + " (" + (name ? name : std::to_string(error_number)) + ")";
 }
 
+std::string WithStudyColumn(const std::string& csv, int m) {
+  std::string out;
+  size_t begin = 0;
+  bool header = true;
+  while (begin < csv.size()) {
+    size_t end = csv.find('\n', begin);
+    if (end == std::string::npos) end = csv.size();
+    if (!header) {
+      out += std::to_string(m) + "," + csv.substr(begin, end - begin) + "\n";
+    } else if (m == 0) {
+      out += "study," + csv.substr(begin, end - begin) + "\n";
+    }
+    header = false;
+    begin = end + 1;
+  }
+  return out;
+}
+
 }  // namespace orbed

@@ -29,4 +29,8 @@ std::string DescribeErrno(int error_number);
 /// A utime [µs since the Unix epoch] as UTC text by strftime's `format`, e.g. "%Y-%m-%dT%H:%M:%SZ".
 std::string FormatUtc(int64_t utime, const char* format);
 
+/// A CSV text with a first column `study` = m on every row; the header row (given `study` first) only
+/// for m = 0, so that the texts of studies 0, 1, ... written one after the other make one CSV file.
+std::string WithStudyColumn(const std::string& csv, int m);
+
 }  // namespace orbed

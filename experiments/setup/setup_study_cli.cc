@@ -53,19 +53,7 @@ std::string StudyCsv(const std::vector<std::vector<study::SetupUserRun>>& studie
                      std::string (*writer)(const std::vector<study::SetupUserRun>&)) {
   if (studies.size() == 1) return writer(studies[0]);
   std::string out;
-  for (size_t m = 0; m < studies.size(); ++m) {
-    std::istringstream lines(writer(studies[m]));
-    std::string line;
-    bool header = true;
-    while (std::getline(lines, line)) {
-      if (header) {
-        if (m == 0) out += "study," + line + "\n";
-        header = false;
-        continue;
-      }
-      out += std::to_string(m + 1) + "," + line + "\n";
-    }
-  }
+  for (size_t m = 0; m < studies.size(); ++m) out += WithStudyColumn(writer(studies[m]), static_cast<int>(m));
   return out;
 }
 
@@ -260,7 +248,7 @@ int RunSetupStudy(int argc, const char* const* argv, std::ostream& out, std::ost
       std::string reason = runs[i].error;
       for (char& c : reason)
         if (c == ',' || c == '"' || c == '\n') c = ';';
-      failed += std::to_string(i / users + 1) + "," + runs[i].user + "," + std::to_string(jobs[i].user_seed) +
+      failed += std::to_string(i / users) + "," + runs[i].user + "," + std::to_string(jobs[i].user_seed) +
                 "," + runs[i].run_id + "," + reason + "\n";
       continue;
     }

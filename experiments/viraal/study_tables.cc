@@ -105,24 +105,6 @@ std::string AlignmentGroupsCsv(const std::vector<UserRun>& runs, int8_t method, 
   return csv;
 }
 
-std::string WithStudyColumn(const std::string& csv, int m) {
-  std::string out;
-  size_t begin = 0;
-  bool header = true;
-  while (begin < csv.size()) {
-    size_t end = csv.find('\n', begin);
-    if (end == std::string::npos) end = csv.size();
-    if (!header) {
-      out += std::to_string(m) + "," + csv.substr(begin, end - begin) + "\n";
-    } else if (m == 0) {
-      out += "study," + csv.substr(begin, end - begin) + "\n";
-    }
-    header = false;
-    begin = end + 1;
-  }
-  return out;
-}
-
 std::string TablesJson(bool viraal, bool setup, const std::string& provenance) {
   JsonWriter json(2);
   json.BeginObject();

@@ -49,10 +49,6 @@ std::string AlignmentMeansCsv(const std::vector<UserRun>& runs);
 /// alignment_groups.csv with groups of `group_size` and the SE(3) averaging `method`
 /// (registration_t.METHOD_*), on the shipped robot model.
 std::string AlignmentGroupsCsv(const std::vector<UserRun>& runs, int8_t method, int group_size = 3);
-/// A study's CSV text with a first column `study` = m on every row; the header row only for m = 0,
-/// so that the texts of studies 0, 1, ... written one after the other make one CSV file.
-std::string WithStudyColumn(const std::string& csv, int m);
-
 /// tables.json as this writes it: the paper's figures of the halves given (see the file comment);
 /// with a `provenance` record name (base/run_folder.h), a first key "provenance" naming it.
 std::string TablesJson(bool viraal, bool setup, const std::string& provenance = "");

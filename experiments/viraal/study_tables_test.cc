@@ -188,14 +188,6 @@ TEST(StudyTables, TheCommandWritesTheFilesAndRefusesAnUnfinishedRun) {
   EXPECT_EQ(test::RunCommand(RunStudyTables, "orbed-study-tables", {pinned}).code, 2);  // no --out
 }
 
-// Studies written one after the other make one CSV: the header once, with `study` first.
-TEST(StudyTables, WithStudyColumnLeadsEveryRowWithTheStudy) {
-  const std::string csv = "user,mode\nu1,ar\nu2,ar\n";
-  EXPECT_EQ(WithStudyColumn(csv, 0), "study,user,mode\n0,u1,ar\n0,u2,ar\n");
-  EXPECT_EQ(WithStudyColumn(csv, 7), "7,u1,ar\n7,u2,ar\n");
-  EXPECT_EQ(WithStudyColumn("user,mode\n", 3), "");
-}
-
 // --paper-only: tables.json with both halves' paper figures and nothing else; runs beside it are a
 // usage error.
 TEST(StudyTables, PaperOnlyWritesThePapersFigures) {
