@@ -256,10 +256,12 @@ def beyond_section(study_dir, beyond):
     return parts
 
 
-BAND_UNITS = {"table1": "mm", "table2": "deg", "table3": "p", "table4": "s"}
+BAND_UNITS = {"table1": "mm", "table1_viewer": "mm", "table2": "deg", "table3": "p", "table4": "s"}
 
 
 def band_status(record):
+    if record.get("alternative"):
+        return "viewer-frame reading (%s; not counted)" % ("inside" if record["inside"] else "outside")
     if record["calibrated"]:
         return "calibrated (%s; not counted)" % ("inside" if record["inside"] else "outside")
     return "inside" if record["inside"] else "<b>outside</b>"

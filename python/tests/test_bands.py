@@ -69,3 +69,12 @@ def test_a_folder_of_studies_end_to_end(tmp_path):
     assert by["table2.ar.std"]["hi"] == 0 and not by["table2.ar.std"]["inside"]
     assert (s["inside"], s["counted"]) == bands.count(s["figures"])
     assert os.path.exists(tmp_path / "figures" / "bands.pdf") and os.path.exists(tmp_path / "figures" / "bands.png")
+
+
+def test_the_viewer_frame_is_an_alternative_reading_not_counted():
+    paper = {"table1.ar.t_z_mean": 21.6}
+    values = {"table1.ar.t_z_mean": [5.0, 6.0, 7.0], "table1_viewer.ar.t_z_mean": [20.0, 21.0, 22.0]}
+    records = {r["figure"]: r for r in bands.bands(values, paper, set())}
+    assert not records["table1.ar.t_z_mean"]["inside"] and not records["table1.ar.t_z_mean"]["alternative"]
+    assert records["table1_viewer.ar.t_z_mean"]["inside"] and records["table1_viewer.ar.t_z_mean"]["alternative"]
+    assert bands.count(list(records.values())) == (0, 1)
