@@ -20,11 +20,12 @@ Tests (all two-sided):
   errors are larger. The median paired difference (first - second) with a 95 % percentile bootstrap
   CI over pairs (BOOTSTRAP resamples, seeded: the same files give the same CI).
   Holm's step-down correction over the joints' p-values (statsmodels multipletests, "holm").
-  Mixed model (statsmodels MixedLM, REML, fitted by L-BFGS, then Powell if that fails):
-  y ~ mode * kind, kind twisting/revolving, with crossed random intercepts for user and target (one
-  group holding every row, vc_formula). y is the joint error [deg] or ln(error + LOG_OFFSET_DEG):
-  both are fitted and the one whose residuals are less skewed is reported (errors are bounded below by 0 and have a half-turn tail near 180 deg, so the
-  raw scale's residuals are expected to be far from normal); "scale" and "why" say which.
+  Mixed model (statsmodels MixedLM, REML, fitted by L-BFGS, then Powell if that fails): y ~ mode *
+  kind, kind twisting/revolving, with crossed random intercepts for user and target (one group
+  holding every row, vc_formula). y is the joint error [deg] or ln(error + LOG_OFFSET_DEG): both are
+  fitted and the one whose residuals are less skewed is reported (errors are bounded below by 0 and
+  have a half-turn tail near 180 deg, so the raw scale's residuals are expected to be far from
+  normal); "scale" and "why" say which.
 
 Half-turns: a set-up joint with an error above HALF_TURN_DEG (the arm left in the other
 kinematic branch). With setup_joints.csv's start_deg (the set-up's start), each set-up's start-target
