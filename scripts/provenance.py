@@ -14,11 +14,11 @@
   provenance.py verify RUN [--bin DIR]
       recomputes what can be recomputed and says what differs: the outputs' hashes; the
       configuration files as the source tree has them now; for a study, its tables made again by
-      orbed-study-tables from the run folders it lists (byte for byte); every run folder inside RUN
-      in turn. Exit code 0 when nothing differs, 1 when something does, 2 on a usage error.
+      orbed-study-tables and the analysis (python/orbed/study) from the run folders it lists (byte for
+      byte); every run folder inside RUN in turn. Exit code 0 when nothing differs, 1 when something does, 2 on a usage error.
 
-Written and read by scripts/orbed; the format is documented in docs/runs.md. Needs nothing outside
-Python's standard library and python3-yaml (Debian).
+Written and read by scripts/orbed; the format is documented in docs/runs.md. Needs Python's standard
+library and python3-yaml (Debian); verifying a study's tables also pandas, scipy and statsmodels.
 """
 import argparse
 import datetime
@@ -37,9 +37,10 @@ import yaml
 FORMAT = "orbed.provenance/1"
 RECORD = "provenance.json"
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-# The study's files that orbed-study-tables writes (verify makes them again).
-TABLE_FILES = ("alignment_trials.csv", "alignment_means.csv", "landmark_validation.csv",
-               "setup_joints.csv", "setup_times.csv", "setup_docking.csv", "tables.json")
+# The study's files that orbed-study-tables and the analysis (python/orbed/study) write; verify makes
+# them again.
+TABLE_FILES = ("alignment_trials.csv", "alignment_means.csv", "alignment_groups.csv", "landmark_validation.csv",
+               "setup_joints.csv", "setup_times.csv", "setup_docking.csv", "setup_truth_joints.csv", "tables.json")
 
 
 def now_utc():
@@ -306,6 +307,10 @@ def verify_tables(run, bin_dir, pad):
         if made.returncode != 0:
             print(f"{pad}  the tables could not be made again: {made.stderr.strip()}")
             return 1
+        # The tables themselves: the study's analysis, as `scripts/orbed study` runs it.
+        sys.path.insert(0, os.path.join(ROOT, "python"))
+        from orbed.study import analysis  # scipy, statsmodels: only for a study
+        analysis.write(tmp)
         same = 0
         for name in TABLE_FILES:
             ours, again = os.path.join(run, name), os.path.join(tmp, name)
