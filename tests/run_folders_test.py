@@ -29,7 +29,7 @@ import unittest
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 PROVENANCE = os.path.join(ROOT, "scripts", "provenance.py")
 ORBED = os.path.join(ROOT, "scripts", "orbed")
-TABLES = ("alignment_trials.csv", "alignment_means.csv", "landmark_validation.csv",
+TABLES = ("alignment_trials.csv", "alignment_means.csv", "alignment_groups.csv", "landmark_validation.csv",
           "setup_joints.csv", "setup_times.csv", "setup_docking.csv", "tables.json")
 
 
@@ -287,7 +287,7 @@ class Studies(unittest.TestCase):
         verified = subprocess.run([ORBED, "verify", os.path.join(logs, last)], env=env,
                                   capture_output=True, text=True)
         self.assertEqual(verified.returncode, 0, verified.stdout + verified.stderr)
-        self.assertIn("7 files identical", verified.stdout)
+        self.assertIn("8 files identical", verified.stdout)
         # A number changed in a user's results: the tables made again differ, and the hash says so.
         results = os.path.join(logs, last, "setup-u1", "setup_results.json")
         with open(results) as f:
@@ -300,6 +300,8 @@ class Studies(unittest.TestCase):
         self.assertEqual(tampered.returncode, 1, tampered.stdout)
         self.assertIn("changed since the run: setup_results.json", tampered.stdout)
         self.assertIn("setup_joints.csv: differs from the tables made again", tampered.stdout)
+        # The analysis made again from the changed joints: its tables differ too.
+        self.assertIn("tables.json: differs from the tables made again", tampered.stdout)
 
 
 if __name__ == "__main__":
