@@ -507,8 +507,9 @@ def table1_section(tables):
     pse3 = paper.get("table1", {}).get("se3_mean", {})
     for mode, row in tables["table1"].get("se3_n3", {}).items():
         p = pse3.get(mode)
-        parts.append("<tr><th>%s: SE(3) means of N = 3 trials (%d groups; the paper's statistic, scored with "
-                     "the truth's landmarks)</th><td>%s</td><td>%s</td><td class=paper>%s</td></tr>" % (
+        parts.append("<tr><th>%s: SE(3) means of N = 3 trials (%d groups; the paper's statistic, measured "
+                     "against the landmarks annotated in the group's trials)</th>"
+                     "<td>%s</td><td>%s</td><td class=paper>%s</td></tr>" % (
                          LABELS[mode], row["groups"], fmt(row["norm"][0]), fmt(row["norm"][1]),
                          "%s +/- %s" % (fmt(p["norm"][0]), fmt(p["norm"][1], 2)) if p else "-"))
     for mode, row in tables["table1"].get("se3_mean", {}).items():

@@ -54,8 +54,9 @@ def table1(trials, means=None, groups=None):
     if groups is not None and len(groups):
         out["se3_n3"] = table1_groups(groups)
         out["se3_n3_label"] = ("the paper's statistic: the SE(3) means of N = 3 consecutive trials of a user's "
-                               "session, mean +/- sample std over every group of the mode's users, scored with "
-                               "the truth's landmarks")
+                               "session, mean +/- sample std over every group of the mode's users, measured as a "
+                               "session mean is (against the real landmarks annotated in the group's trials); "
+                               "true_norm: the same from the truth's landmarks")
     return out
 
 
