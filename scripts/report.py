@@ -301,6 +301,40 @@ def bands_section(study_dir):
     return parts
 
 
+def sensitivity_section(study_dir):
+    """The set-up half's one-at-a-time sensitivity (STUDY/sensitivity/sensitivity.csv,
+    python/orbed/study/sensitivity.py): per setting, each mode's mean joint error, half-turn rate and
+    execution time beside the shipped parameters'; nothing when the study ran without --sensitivity."""
+    path = os.path.join(study_dir, "sensitivity", "sensitivity.csv")
+    if not os.path.exists(path):
+        return []
+    values = {}  # setting -> output -> value
+    for row in read_csv(path):
+        values.setdefault(row["setting"], {})[row["output"]] = float(row["value"])
+    base = values.get("baseline", {})
+    columns = [(m, o) for o in ("mean_error_deg", "half_turn_rate", "execution_s") for m in
+               ("ar_reflective", "ar", "fixed") if "%s.%s" % (m, o) in base]
+    heads = {"mean_error_deg": "mean error [deg]", "half_turn_rate": "half-turn rate", "execution_s": "execution [s]"}
+    parts = ["<h2>Sensitivity to the parameters without a source</h2>",
+             "<p>The set-up half's simulated studies again for every assistant parameter whose source is a choice, "
+             "at each end of its band (experiments/setup/sensitivity.yaml), one key at a time, the same seeds "
+             "in every setting (<code>scripts/orbed sensitivity</code>). The first row is the shipped "
+             "parameters.</p>"]
+    parts.append(figure_html("sensitivity/figures/sensitivity", "Each setting's mean joint error, half-turn rate "
+                                                               "and mean execution time per mode; dashed: the "
+                                                               "shipped parameters"))
+    parts.append("<table class=sensitivity><tr><th>setting</th>%s</tr>" % "".join(
+        "<th>%s %s</th>" % (LABELS.get(m, m), heads[o]) for m, o in columns))
+    for setting, row in values.items():
+        cells = []
+        for m, o in columns:
+            v = row.get("%s.%s" % (m, o))
+            cells.append("<td>%s</td>" % ("-" if v is None else ("%.2f" % v if o == "half_turn_rate" else fmt(v))))
+        parts.append("<tr><th>%s</th>%s</tr>" % (html.escape(setting), "".join(cells)))
+    parts.append("</table>")
+    return parts
+
+
 def rank_flip_line(folder):
     """One sentence on how often the paper's Table 1 measurement ranks the two display modes
     opposite to the truth, from FOLDER/rank_flip.csv (python/orbed/study/rank_flip.py); None without
@@ -596,6 +630,7 @@ def report(study_dir):
     if tables.get("setup_analysis"):
         parts.extend(setup_analysis_section(tables["setup_analysis"]))
     parts.extend(bands_section(study_dir))
+    parts.extend(sensitivity_section(study_dir))
     if tables.get("beyond"):
         parts.extend(beyond_section(study_dir, tables["beyond"]))
     trials_path = os.path.join(study_dir, "alignment_trials.csv")

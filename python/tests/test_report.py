@@ -161,3 +161,20 @@ def test_bands_decade_ticks(lo, hi, most, ticks):
     from orbed.study import bands
     assert bands.decade_ticks(lo, hi, most) == pytest.approx(ticks, rel=1e-12)
     assert [bands.tick_label(t) for t in ticks][:2] == (["0.01", "0.1"] if lo == 0.01 else ["1e-18", "1e-15"])
+
+
+def test_sensitivity_section_lists_each_setting_beside_the_shipped_one(tmp_path):
+    assert report.sensitivity_section(str(tmp_path)) == []  # no --sensitivity: no section
+    (tmp_path / "sensitivity").mkdir()
+    (tmp_path / "sensitivity" / "sensitivity.csv").write_text(
+        "setting,output,value,baseline,change\n"
+        "baseline,ar.mean_error_deg,80,80,0\n"
+        "baseline,ar.half_turn_rate,0.44,0.44,0\n"
+        "assistant.acting.choice=best,ar.mean_error_deg,104.25,80,24.25\n"
+        "assistant.acting.choice=best,ar.half_turn_rate,0.5,0.44,0.06\n")
+    page = "\n".join(report.sensitivity_section(str(tmp_path)))
+    rows = dict(re.findall(r"<tr><th>([^<]+)</th>(.*?)</tr>", page))
+    assert rows["baseline"] == "<td>80.0</td><td>0.44</td>"
+    assert rows["assistant.acting.choice=best"] == "<td>104.2</td><td>0.50</td>"
+    assert "<th>AR mean error [deg]</th><th>AR half-turn rate</th>" in page
+    assert "<img src='sensitivity/figures/sensitivity.png'>" in page

@@ -80,7 +80,8 @@ def simulate(ctx, out, studies, seed, threads, progress):
 
 def say_summary(ctx, out, summary, flips):
     """The bands' lines on the console: k of n, the figures outside, the rank flip, the files."""
-    outside = [r["figure"] for r in summary["figures"] if not r["inside"] and not r["calibrated"]]
+    outside = [r["figure"] for r in summary["figures"]
+               if not r["inside"] and not r["calibrated"] and not r.get("alternative")]
     ctx.console.echo(f"bands: {summary['inside']} of {summary['counted']} paper figures inside their 95 % predictive "
                      f"interval over {summary['studies']} studies ({len(summary['calibrated'])} calibrated, not "
                      f"counted); outside: {', '.join(outside) if outside else 'none'}")

@@ -15,7 +15,8 @@ DESCRIPTION = """The set-up half's one-at-a-time sensitivity: for the shipped as
 ends of its band), N simulated studies of the paper's size (8 users x 3 modes x 3 targets) in-process
 with orbed-setup-study, the same seeds in every setting. Per setting and mode: mean and median joint
 error, half-turn rate, mean execution time; sensitivity.csv and figures/sensitivity.{pdf,png} in
-logs/sensitivity-<time>-<random>/."""
+logs/sensitivity-<time>-<random>/ (`scripts/orbed study --sensitivity N`: into the study's folder and
+its report)."""
 
 
 def configure(p):
@@ -26,25 +27,27 @@ def configure(p):
                    help="users run at a time (default 2)")
 
 
-def run(args, ctx):
-    sys.path.insert(0, os.path.join(ctx.root, "python"))
+def settings():
+    sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))),
+                                    "python"))
     from orbed.study import sensitivity  # numpy, pandas: imported only here
+    return sensitivity
 
-    quiet_build(ctx, ["orbed-setup-study"])
-    out = new_run_dir(ctx, "sensitivity-")
+
+def simulate(ctx, out, studies, seed, threads, progress):
+    """Every setting's studies into OUT/<k>/ (OUT exists), then sensitivity.csv and the figure; the
+    tool's output in OUT/sensitivity.log. Takes one step of PROGRESS per setting (len(settings)).
+    Both `scripts/orbed sensitivity` and `scripts/orbed study --sensitivity N` call it; the binary
+    is built. Returns {setting: outputs}."""
+    sensitivity = settings()
     log = os.path.join(out, "sensitivity.log")
-    provenance(ctx, "start", out, "--kind", "sensitivity", "--setting", f"studies={args.studies}",
-               "--setting", f"seed={args.seed}", "--config", sensitivity.SWEEP)
-    todo = sensitivity.settings()
-    ctx.say(f"sensitivity: {len(todo)} settings x {args.studies} studies in {ctx.rel(out)}/")
-    progress = Progress(ctx.console, "sensitivity:", len(todo))
     folders = {}
-    for i, (name, key, value) in enumerate(todo):
-        progress.show(name)
+    for i, (name, key, value) in enumerate(sensitivity.settings()):
+        progress.show(f"sensitivity: {name}")
         folder = os.path.join(out, "%02d" % i)
         os.mkdir(folder)
-        argv = [os.path.join(ctx.bin, "orbed-setup-study"), "--studies", str(args.studies), "--users", "8",
-                "--targets", "3", "--trials", "3", "--seed", str(args.seed), "--threads", str(args.threads),
+        argv = [os.path.join(ctx.bin, "orbed-setup-study"), "--studies", str(studies), "--users", "8",
+                "--targets", "3", "--trials", "3", "--seed", str(seed), "--threads", str(threads),
                 "--allow-failures", "--quiet", "--out", folder]
         if key is not None:
             config = os.path.join(folder, "assistant.yaml")
@@ -56,10 +59,13 @@ def run(args, ctx):
             raise Failure(f"sensitivity: orbed-setup-study failed for {name}")
         folders[name] = folder
         progress.k += 1
-    progress.done()
     results = sensitivity.table(folders)
     sensitivity.write(results, out)
-    provenance(ctx, "finish", out, "--exit-code", "0")
+    return results
+
+
+def say_summary(ctx, out, results):
+    sensitivity = settings()
     base = results[sensitivity.BASELINE]
     for output in ("ar_reflective.mean_error_deg", "ar.mean_error_deg", "fixed.mean_error_deg",
                    "ar_reflective-ar.mean_error_deg", "ar.half_turn_rate"):
@@ -69,4 +75,22 @@ def run(args, ctx):
                          f"({results[moved][output]:.3g})")
     ctx.console.echo(f"sensitivity: {ctx.rel(os.path.join(out, 'sensitivity.csv'))}, "
                      f"{ctx.rel(os.path.join(out, 'figures', 'sensitivity.pdf'))}")
+
+
+def count():
+    return len(settings().settings())
+
+
+def run(args, ctx):
+    quiet_build(ctx, ["orbed-setup-study"])
+    out = new_run_dir(ctx, "sensitivity-")
+    sensitivity = settings()
+    provenance(ctx, "start", out, "--kind", "sensitivity", "--setting", f"studies={args.studies}",
+               "--setting", f"seed={args.seed}", "--config", sensitivity.SWEEP)
+    ctx.say(f"sensitivity: {count()} settings x {args.studies} studies in {ctx.rel(out)}/")
+    progress = Progress(ctx.console, "sensitivity:", count())
+    results = simulate(ctx, out, args.studies, args.seed, args.threads, progress)
+    progress.done()
+    provenance(ctx, "finish", out, "--exit-code", "0")
+    say_summary(ctx, out, results)
     return 0

@@ -14,7 +14,7 @@ import subprocess
 import sys
 import tempfile
 
-from . import bands as bands_verb, checks, launch as launch_verb
+from . import bands as bands_verb, checks, launch as launch_verb, sensitivity as sensitivity_verb
 from .output import Failure, Progress, run_logged, show_failure
 from .paths import quiet_build
 from .runs import new_run_dir, provenance, write_settings
@@ -55,6 +55,9 @@ def configure(p):
     p.add_argument("--run-id", type=checks.run_id, metavar="ID", help="default study-s<S>")
     p.add_argument("--registration-share", action="store_true",
                    help="the set-up users' headset modes again with the true registration")
+    p.add_argument("--sensitivity", type=checks.whole(0, 10000), default=0, metavar="N",
+                   help="after the study, the set-up half's one-at-a-time sensitivity with N studies per setting "
+                        "into STUDY/sensitivity/ (scripts/orbed sensitivity; default 0: none)")
     p.add_argument("--bands", type=checks.whole(0, 100000), default=0, metavar="M",
                    help="after the study, its predictive bands from M simulated studies into STUDY/bands/ "
                         "(default 0: none)")
@@ -128,13 +131,14 @@ def run(args, ctx):
         hold_viraal, hold_setup = ["hold_for=scenario"], ["hold_for=setup"]
     # The run id seeds the alignments: from the seed, so a study is repeatable (not from the clock).
     run_id = args.run_id or f"study-s{args.seed}"
-    quiet_build(ctx, ["testbed", *(bands_verb.BINARIES if args.bands else [])])
+    quiet_build(ctx, ["testbed", *(bands_verb.BINARIES if args.bands or args.sensitivity else [])])
     steps = [("viraal", k) for k in range(1, args.users + 1)]
     for k in range(1, args.setup_users + 1):
         steps.append(("setup", k))
         if args.registration_share:
             steps.append(("setup-truth", k))
-    progress = Progress(ctx.console, "study:", len(steps) + 1 + (bands_verb.STEPS if args.bands else 0))
+    progress = Progress(ctx.console, "study:", len(steps) + 1 + (bands_verb.STEPS if args.bands else 0) +
+                        (sensitivity_verb.count() if args.sensitivity else 0))
     # The study's folder holds every user's run folder (viraal-u<k>, setup-u<k>, setup-truth-u<k>),
     # each with its own provenance record and its output (<name>.log) beside the study's files.
     study_dir = new_run_dir(ctx, "study-")
@@ -149,7 +153,8 @@ def run(args, ctx):
                "--setting", f"trials={args.trials}", "--setting", f"setup_users={args.setup_users}",
                "--setting", f"targets={args.targets}", "--setting", f"seed={args.seed}", "--setting", f"run_id={run_id}",
                "--setting", f"registration_share={int(args.registration_share)}", "--setting", f"sim_rate={args.sim_rate}",
-               "--setting", f"realtime={int(args.realtime)}", "--setting", f"bands={args.bands}")
+               "--setting", f"realtime={int(args.realtime)}", "--setting", f"bands={args.bands}",
+               "--setting", f"sensitivity={args.sensitivity}")
     ctx.say(f"study: {len(steps)} launches in {ctx.rel(study_dir)}/ (each one's output in <name>.log there)")
     tables_args, runs = ["--seed", str(args.seed)], []
     for kind, k in steps:
@@ -211,7 +216,13 @@ def run(args, ctx):
         os.makedirs(bands_dir, exist_ok=True)
         bands = bands_verb.simulate(ctx, bands_dir, args.bands, args.seed, 2, progress)
         progress.show("the report")
-    if args.setup_users > 0 or args.bands:
+    sensitivity = None
+    if args.sensitivity:
+        sensitivity_dir = os.path.join(study_dir, "sensitivity")
+        os.makedirs(sensitivity_dir, exist_ok=True)
+        sensitivity = sensitivity_verb.simulate(ctx, sensitivity_dir, args.sensitivity, args.seed, 2, progress)
+        progress.show("the report")
+    if args.setup_users > 0 or args.bands or args.sensitivity:
         if run_logged(["/usr/bin/python3", ctx.script("report.py"), study_dir], log, ctx.console):
             show_failure(ctx.console, log)
             raise Failure("study: the report failed")
@@ -228,6 +239,8 @@ def run(args, ctx):
             f"(the runs, the tables and the report); {whole}")
     if bands:
         bands_verb.say_summary(ctx, bands_dir, *bands)
+    if sensitivity:
+        sensitivity_verb.say_summary(ctx, sensitivity_dir, sensitivity)
     provenance(ctx, "finish", study_dir, "--exit-code", "0")
     ctx.say(f"study: files in {ctx.rel(study_dir)}/ (runs.txt lists each user's run folder; provenance.json says "
             f"what made them; check them with scripts/orbed verify {ctx.rel(study_dir)})")

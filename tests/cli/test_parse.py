@@ -79,6 +79,7 @@ def test_a_typo_is_answered_with_the_nearest_verb(orbed):
     (["fuzz", "0"], "argument SECONDS: must be a whole number 1..1000000000, not '0'"),
     (["scale", "--grid", "2by2"], "argument --grid: expected AxH,... (e.g. 1x1,2x2), not '2by2'"),
     (["load", "--factor", "nan"], "argument --factor: must be a positive number, not 'nan'"),
+    (["study", "--sensitivity", "x"], "argument --sensitivity: must be a whole number 0..10000, not 'x'"),
     (["sensitivity", "--studies", "0"], "argument --studies: must be a whole number 1..10000, not '0'"),
     (["bands", "--studies", "0"], "argument --studies: must be a whole number 1..100000, not '0'"),
     (["bands", "--threads", "x"], "argument --threads: must be a whole number 1..64, not 'x'"),
