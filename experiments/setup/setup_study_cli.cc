@@ -19,9 +19,6 @@
 #include "sim/guidance_messages.h"
 
 namespace orbed::setup {
-namespace {
-
-// The study's table rows of one run (what ReadSetupResults reads back from setup_results.json).
 study::SetupUserRun TableRun(const SetupRun& run) {
   study::SetupUserRun out;
   out.user = run.user;
@@ -31,6 +28,9 @@ study::SetupUserRun TableRun(const SetupRun& run) {
     row.mode = guidance::GuidanceModeName(r.mode);
     row.order = r.order;
     row.target = r.target;
+    row.start_id = r.start_id;
+    row.target_id = r.target_id;
+    row.start_deg = r.start_deg;
     row.target_deg = r.target_deg;
     row.reached_deg = r.reached_deg;
     row.twisting = r.twisting;
@@ -47,6 +47,8 @@ study::SetupUserRun TableRun(const SetupRun& run) {
   }
   return out;
 }
+
+namespace {
 
 // The CSVs of every study, each line after the header with "<study>," first when there are several.
 std::string StudyCsv(const std::vector<std::vector<study::SetupUserRun>>& studies,

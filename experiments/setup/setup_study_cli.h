@@ -44,6 +44,7 @@
 #include <vector>
 
 #include "experiments/setup/setup_study.h"
+#include "experiments/setup/setup_tables.h"
 
 namespace orbed::setup {
 
@@ -54,6 +55,10 @@ SetupUserOptions StudyUser(const SetupUserOptions& base, uint64_t seed, const st
 /// Runs `jobs` on `threads` threads (each index once); results by index, the same for any count.
 std::vector<SetupRun> RunSetupUsers(const std::vector<SetupUserOptions>& jobs, int threads,
                                     const std::function<void(int done, int total)>& progress = {});
+
+/// The study's table rows of one run: what study::ReadSetupResults reads back from the run's
+/// setup_results.json (setup_study_test holds the two equal through the CSVs they make).
+study::SetupUserRun TableRun(const SetupRun& run);
 
 int RunSetupStudy(int argc, const char* const* argv, std::ostream& out, std::ostream& err);
 

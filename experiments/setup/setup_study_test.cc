@@ -58,6 +58,18 @@ TEST(SetupStudy, EqualsTheBusRun) {
   EXPECT_EQ(SetupRunJson(RunSetupUser(PinnedUser(1, false)), false), pinned);
 }
 
+// The in-process rows make the CSVs the bus run's setup_results.json makes, every column (the
+// design's ids and starts included).
+TEST(SetupStudy, TheTableRowsAreTheResultFilesRows) {
+  const std::string pinned = SourceTreePath("tests/integration/testdata/setup_pinned_results.json");
+  const SetupRun run = RunSetupUser(PinnedUser(1, false));
+  const std::vector<study::SetupUserRun> ours = {TableRun(run)}, bus = {study::ReadSetupResults(pinned)};
+  EXPECT_EQ(study::SetupJointsCsv(ours), study::SetupJointsCsv(bus));
+  EXPECT_EQ(study::SetupTimesCsv(ours), study::SetupTimesCsv(bus));
+  EXPECT_EQ(study::SetupDockingCsv(ours), study::SetupDockingCsv(bus));
+  EXPECT_NE(study::SetupJointsCsv(ours).find(",ready,"), std::string::npos);  // a design id is there
+}
+
 TEST(SetupStudy, EqualsTheBusRunWithTheTrueRegistration) {
   const std::string pinned =
       ReadText(SourceTreePath("tests/integration/testdata/setup_truth_pinned_results.json"));
