@@ -289,6 +289,18 @@ def bands_section(study_dir):
     flips = rank_flip_line(folder)
     if flips:
         parts.append("<p class=rank-flip>%s</p>" % flips)
+    relations = b.get("by_relation") or {}
+    if relations:
+        parts.append("<p>Where the arm started, over every simulated set-up: the start-target relation of "
+                     "the bending joints 2, 4, 6 (same signs, all opposite: mirror, else mixed).</p>")
+        parts.append("<table class=relations><tr><th>relation</th><th>mode</th><th>set-ups</th>"
+                     "<th>median error [deg]</th><th>mean error [deg]</th><th>half-turn rate</th></tr>")
+        for relation, modes in relations.items():
+            for mode, v in modes.items():
+                parts.append("<tr><th>%s</th><td>%s</td><td>%d</td><td>%s</td><td>%s</td><td>%.2f</td></tr>" % (
+                    html.escape(relation), LABELS.get(mode, html.escape(mode)), v["setups"], fmt(v["median_deg"]),
+                    fmt(v["mean_deg"]), v["half_turn_rate"]))
+        parts.append("</table>")
     parts.append("<table class=bands><tr><th>figure</th><th>unit</th><th class=paper>paper</th><th>band (%d %%)</th>"
                  "<th>median of the studies</th><th>the paper's figure is</th></tr>" % level)
     for r in b["figures"]:

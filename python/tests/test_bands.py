@@ -78,3 +78,23 @@ def test_the_viewer_frame_is_an_alternative_reading_not_counted():
     assert not records["table1.ar.t_z_mean"]["inside"] and not records["table1.ar.t_z_mean"]["alternative"]
     assert records["table1_viewer.ar.t_z_mean"]["inside"] and records["table1_viewer.ar.t_z_mean"]["alternative"]
     assert bands.count(list(records.values())) == (0, 1)
+
+
+def test_by_relation_classifies_each_setup_by_its_bending_joints():
+    import pandas as pd
+    rows = []
+    # Set-up 1: start signs (+, -, +) = target's -> same; 2: all opposite -> mirror; 3: a start joint
+    # at 0 -> mixed. Errors: joint 1 of set-up 2 is a half turn (170 deg).
+    for target, start in ((1, (20, -60, 40)), (2, (-20, 60, -40)), (3, (0, -60, 40))):
+        for joint in range(1, 8):
+            k = {2: 0, 4: 1, 6: 2}.get(joint)
+            rows.append({"study": 0, "user": "u1", "mode": "ar", "target": target, "joint": joint,
+                         "target_deg": (30, -70, 50)[k] if k is not None else 10.0,
+                         "start_deg": start[k] if k is not None else 0.0,
+                         "error_deg": 170.0 if (target == 2 and joint == 1) else 1.0})
+    r = bands.by_relation(pd.DataFrame(rows))
+    assert set(r) == {"same", "mirror", "mixed"}
+    assert r["mirror"]["ar"]["setups"] == 1 and r["mirror"]["ar"]["half_turn_rate"] == pytest.approx(1 / 7)
+    assert r["same"]["ar"]["half_turn_rate"] == 0 and r["same"]["ar"]["median_deg"] == 1.0
+    assert r["mirror"]["ar"]["mean_deg"] == pytest.approx((170 + 6) / 7)
+    assert bands.by_relation(pd.DataFrame(rows).drop(columns="start_deg")) is None

@@ -89,6 +89,10 @@ def say_summary(ctx, out, summary, flips):
                      f"(translation error) in {flips['flips']} of {flips['studies']} studies, "
                      f"{100 * flips['fraction']:.1f} % (95 % Wilson interval {100 * flips['low']:.1f}-"
                      f"{100 * flips['high']:.1f} %)")
+    for relation, modes in (summary.get("by_relation") or {}).items():
+        ctx.console.echo(f"bands: set-ups whose start is '{relation}' to the target: " + "; ".join(
+            f"{mode} median {v['median_deg']:.1f} deg, mean {v['mean_deg']:.1f} deg, half turns "
+            f"{100 * v['half_turn_rate']:.1f} % ({v['setups']} set-ups)" for mode, v in modes.items()))
     ctx.console.echo(f"bands: {ctx.rel(os.path.join(out, 'bands.csv'))}, {ctx.rel(os.path.join(out, 'figures', 'bands.pdf'))}")
 
 

@@ -157,6 +157,29 @@ def count(records):
     return sum(r["inside"] for r in counted), len(counted)
 
 
+def by_relation(joints):
+    """Over every simulated set-up pooled: per start-target relation (bending joints 2, 4, 6: "same"
+    every sign the target's, "mirror" every sign opposite, "mixed" otherwise; a start joint at 0 is
+    mixed) and mode, the set-ups, the half-turn rate (joints with error > 90 deg) and the joint error's
+    median and mean [deg]; None without start_deg. The model's answer to "where did the arm start?"."""
+    if joints is None or "start_deg" not in joints.columns or joints["start_deg"].isna().any():
+        return None
+    keys = ["study", "user", "mode", "target"]
+    bending = joints[joints["joint"].astype(int).isin((2, 4, 6))]
+    start, target = np.sign(bending["start_deg"].astype(float)), np.sign(bending["target_deg"].astype(float))
+    signs = bending.assign(same=start == target, mirror=(start == -target) & (target != 0))
+    setups = signs.groupby(keys).agg(same=("same", "all"), mirror=("mirror", "all")).reset_index()
+    setups["relation"] = np.where(setups["same"], "same", np.where(setups["mirror"], "mirror", "mixed"))
+    tagged = joints.merge(setups[keys + ["relation"]], on=keys)
+    error = tagged["error_deg"].astype(float)
+    out = {}
+    for (relation, mode), rows in tagged.assign(error=error).groupby(["relation", "mode"]):
+        out.setdefault(relation, {})[mode] = {
+            "setups": int(len(rows.groupby(keys))), "half_turn_rate": float((rows["error"] > 90).mean()),
+            "median_deg": float(rows["error"].median()), "mean_deg": float(rows["error"].mean())}
+    return out
+
+
 def write(folder, calibration=CALIBRATION):
     with open(os.path.join(folder, "tables.json")) as f:
         paper = flatten(json.load(f)["paper"])
@@ -170,7 +193,8 @@ def write(folder, calibration=CALIBRATION):
                                                               r["studies"], r["inside"], r["calibrated"],
                                                               r["alternative"]))
     summary = {"studies": m, "level": LEVEL, "inside": k, "counted": n,
-               "calibrated": sorted(r["figure"] for r in records if r["calibrated"]), "figures": records}
+               "calibrated": sorted(r["figure"] for r in records if r["calibrated"]), "figures": records,
+               "by_relation": by_relation(files.read(folder, "setup_joints.csv"))}
     with open(os.path.join(folder, "bands.json"), "w") as f:
         json.dump(summary, f, indent=1)
     plot(records, m, k, n, os.path.join(folder, "figures"))
