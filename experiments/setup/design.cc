@@ -254,6 +254,20 @@ namespace {
 void Vec3(JsonWriter& j, const Eigen::Vector3d& v) { j.Array(std::vector<double>{v.x(), v.y(), v.z()}); }
 void Vec2(JsonWriter& j, const Eigen::Vector2d& v) { j.Array(std::vector<double>{v.x(), v.y()}); }
 
+// One target of the catalog file; a dropped one (kept false) has no id and no clearance of its own.
+void WriteTarget(JsonWriter* j, const CatalogTarget& t, bool kept) {
+  j->BeginObject();
+  if (kept) j->Key("id").String(t.id);
+  j->Key("patient").String(t.patient);
+  j->Key("port").String(t.port);
+  j->Key("branch").String(t.branch);
+  j->Key("q_deg").Array(t.q_deg);
+  if (kept) j->Key("clearance_m").Number(t.clearance_m);
+  j->Key("path_clearance_m").Number(t.path_clearance_m);
+  j->Key("worst_segment").String(t.worst_segment);
+  j->EndObject();
+}
+
 }  // namespace
 
 std::string DesignCatalogJson(const DesignCatalog& c) {
@@ -327,31 +341,11 @@ std::string DesignCatalogJson(const DesignCatalog& c) {
   }
   j.EndArray();
   j.Key("targets").BeginArray();
-  for (const CatalogTarget& t : c.targets) {
-    j.BeginObject();
-    j.Key("id").String(t.id);
-    j.Key("patient").String(t.patient);
-    j.Key("port").String(t.port);
-    j.Key("branch").String(t.branch);
-    j.Key("q_deg").Array(t.q_deg);
-    j.Key("clearance_m").Number(t.clearance_m);
-    j.Key("path_clearance_m").Number(t.path_clearance_m);
-    j.Key("worst_segment").String(t.worst_segment);
-    j.EndObject();
-  }
+  for (const CatalogTarget& t : c.targets) WriteTarget(&j, t, true);
   j.EndArray();
   // What the path rule dropped, for the record (not read back).
   j.Key("dropped").BeginArray();
-  for (const CatalogTarget& t : c.dropped) {
-    j.BeginObject();
-    j.Key("patient").String(t.patient);
-    j.Key("port").String(t.port);
-    j.Key("branch").String(t.branch);
-    j.Key("q_deg").Array(t.q_deg);
-    j.Key("path_clearance_m").Number(t.path_clearance_m);
-    j.Key("worst_segment").String(t.worst_segment);
-    j.EndObject();
-  }
+  for (const CatalogTarget& t : c.dropped) WriteTarget(&j, t, false);
   j.EndArray();
   j.EndObject();
   return j.str() + "\n";
