@@ -55,3 +55,16 @@ def test_mixed_pool_has_the_binomial_power():
     assert curve["paired_setup"][0] == pytest.approx(expected_paired, abs=0.04)
     assert power.power_curve(samples, users=(n,), resamples=200, seed=7) == \
         power.power_curve(samples, users=(n,), resamples=200, seed=7)
+
+
+def test_the_bootstraps_pooled_p_is_scipys():
+    rng = np.random.default_rng(3)
+    for _ in range(300):
+        n1, n2 = rng.integers(2, 60, size=2)
+        # Rounded values: many ties, as joint errors of a drawn user twice have.
+        x, y = np.round(rng.gamma(1.0, 30.0, n1), int(rng.integers(0, 2))), np.round(rng.gamma(1.2, 30.0, n2), 0)
+        if np.ptp(np.concatenate([x, y])) == 0:
+            continue
+        expected = scipy.stats.mannwhitneyu(x, y, alternative="two-sided", use_continuity=True,
+                                            method="asymptotic").pvalue
+        assert power.pooled_p(x, y) == pytest.approx(expected, rel=1e-9, abs=1e-15)

@@ -54,11 +54,25 @@ def rejects_paired(x, y, alpha):
     return bool(p < alpha)
 
 
+def pooled_p(x, y):
+    """The two-sided Mann-Whitney U p-value of scipy.stats.mannwhitneyu(x, y, alternative="two-sided",
+    use_continuity=True, method="asymptotic"), from scipy's ranks and normal distribution without its
+    per-call checks (the bootstrap calls it 12 000 times a study; pytest holds it to scipy's):
+    U = max(U_x, U_y), z = (U - n_x n_y / 2 - 1/2) / s with the tie-corrected
+    s^2 = n_x n_y / 12 ((n + 1) - sum(t^3 - t) / (n (n - 1))), p = min(1, 2 sf(z))."""
+    both = np.concatenate([x, y])
+    n1, n2, n = x.size, y.size, both.size
+    u1 = scipy.stats.rankdata(both)[:n1].sum() - n1 * (n1 + 1) / 2
+    u = max(u1, n1 * n2 - u1)
+    _, ties = np.unique(both, return_counts=True)
+    s = np.sqrt(n1 * n2 / 12 * ((n + 1) - (ties ** 3 - ties).sum() / (n * (n - 1))))
+    return float(min(1.0, 2 * scipy.stats.norm.sf((u - n1 * n2 / 2 - 0.5) / s)))
+
+
 def rejects_pooled(x, y, alpha):
     if np.ptp(np.concatenate([x, y])) == 0:
         return False
-    p = scipy.stats.mannwhitneyu(x, y, alternative="two-sided", use_continuity=True, method="asymptotic").pvalue
-    return bool(p < alpha)
+    return pooled_p(x, y) < alpha
 
 
 def power_curve(samples, users=USERS, resamples=RESAMPLES, alpha=ALPHA, seed=1):
