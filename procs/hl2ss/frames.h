@@ -57,7 +57,9 @@ inline std::array<float, 16> PoseMatrixRowMajor(const Eigen::Isometry3d& X_DF) {
 }
 
 /// The pose hl2ss reports for an orbed camera at X_WC: X_DĈ = X_WD⁻¹ · X_WC · X_CĈ.
-inline Eigen::Isometry3d CameraPoseForClient(const Eigen::Isometry3d& X_WC) { return X_WD().inverse() * X_WC * X_CCh(); }
+inline Eigen::Isometry3d CameraPoseForClient(const Eigen::Isometry3d& X_WC) {
+  return X_WD().inverse() * X_WC * X_CCh();
+}
 
 /// Unity (U, left-handed) position to D: negate z.
 inline Eigen::Vector3d p_D_FromUnity(const Eigen::Vector3d& p_U) { return {p_U.x(), p_U.y(), -p_U.z()}; }
