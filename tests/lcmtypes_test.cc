@@ -113,7 +113,8 @@ TEST(LcmTypes, EveryTypeRoundTripsAndHasAUniqueFingerprint) {
 // another fingerprint ("<channel>/decode/fingerprint"): any change of a type is a breaking change
 // on the wire. docs/design.md §3 "Changing the contract" says how one is made: fields appended at the
 // end, the change listed there with the old and new fingerprints, and this table updated in the same
-// commit. Last change: contract change 10 (run_dir appended to deputy_command_t, the last lines of
+// commit. Last change: contract change 11 (hologram_scene_t added, the holograms a client placed
+// through hl2ss); before it, contract change 10 (run_dir appended to deputy_command_t, the last lines of
 // output to deputy_child_t and so deputy_status_t); before it, contract change 9 (host appended to
 // process_status_t; the four deputy_*_t types of launch across hosts); before it, contract change 8
 // (lockstep_round appended to sim_clock_t, sim_clock_ack_t added); contract change 5 (the landmark annotation
@@ -133,6 +134,7 @@ TEST(LcmTypes, FingerprintsArePinned) {
                                                   {"gaze_ray_t", 0x65a37e31d5a2eea1ULL},
                                                   {"guidance_t", 0x00fc655bb50b4853ULL},
                                                   {"hmd_pose_t", 0xdafcd85796f0e809ULL},
+                                                  {"hologram_scene_t", 0xb7ba7ed6390181d1ULL},
                                                   {"iiwa_command_t", 0xddc7c7738c815334ULL},
                                                   {"iiwa_status_t", 0xf16fb804284abca3ULL},
                                                   {"image_t", 0xc1d60fc65b87f013ULL},

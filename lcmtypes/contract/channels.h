@@ -38,6 +38,7 @@ inline constexpr char kSimClock[] = "SIM_CLOCK";                        // sim_c
 inline constexpr char kSimClockAck[] = "SIM_CLOCK_ACK";  // sim_clock_ack_t, each follower, per lockstep round
 inline constexpr char kDeputyCommand[] = "DEPUTY_COMMAND";  // deputy_command_t, launcher, 5 Hz per deputy
 inline constexpr char kDeputyStatus[] = "DEPUTY_STATUS";    // deputy_status_t, each deputy, 5 Hz
+inline constexpr char kHolograms[] = "HOLOGRAMS";  // hologram_scene_t, orbed-hl2ss, per change and 1 Hz
 
 /// A name that may suffix channels: 1..32 characters of a-z, 0-9 and _ (an arm's, a headset's).
 inline bool IsInstanceName(const std::string& name) {
@@ -75,6 +76,7 @@ inline constexpr const char* kAllChannels[] = {
     kGazeRay,         kReflectiveView, kAlignmentTrial,      kRegistration,    kSessionControl,
     kLandmarkRequest, kLandmark,       kMisalignmentRequest, kMisalignment,    kGuidance,
     kProcessStatus,   kLoggerStatus,   kSetupTask,           kSetupResult,     kIgtlTarget,
-    kFixedView,       kSimClock,       kSimClockAck,         kDeputyCommand,   kDeputyStatus};
+    kFixedView,       kSimClock,       kSimClockAck,         kDeputyCommand,   kDeputyStatus,
+    kHolograms};
 
 }  // namespace orbed::channels

@@ -47,7 +47,8 @@ UnityScene::UnityScene(const UnitySceneLimits& limits) : limits_(limits) {
   if (limits.max_objects < 1 || limits.max_objects > orbed::hologram_scene_t::MAX_HOLOGRAMS)
     throw std::invalid_argument("unity scene: max_objects must be in [1, " +
                                 std::to_string(orbed::hologram_scene_t::MAX_HOLOGRAMS) + "]");
-  if (limits.max_command_bytes < 64) throw std::invalid_argument("unity scene: max_command_bytes must be >= 64");
+  if (limits.max_command_bytes < 64)
+    throw std::invalid_argument("unity scene: max_command_bytes must be >= 64");
   if (!(limits.max_position_m > 0) || !(limits.max_scale > 0))
     throw std::invalid_argument("unity scene: max_position_m and max_scale must be > 0");
 }
@@ -65,8 +66,9 @@ bool UmqSession::Consume(const std::uint8_t* data, std::size_t size, std::vector
       size_ = LoadU32(header_.data() + 4);
       data_got_ = 0;
       if (size_ > scene_->limits_.max_command_bytes) {
-        Refuse("size", "command " + std::to_string(id_) + " of " + std::to_string(size_) + " bytes (at most " +
-                           std::to_string(scene_->limits_.max_command_bytes) + "): closing the connection");
+        Refuse("size", "command " + std::to_string(id_) + " of " + std::to_string(size_) +
+                           " bytes (at most " + std::to_string(scene_->limits_.max_command_bytes) +
+                           "): closing the connection");
         closed_ = true;
         break;
       }
@@ -148,7 +150,8 @@ std::uint32_t UmqSession::SetTransform() {
   double f[10];
   for (int i = 0; i < 10; ++i) {
     f[i] = LoadF32(head_.data() + 4 + 4 * i);
-    if (!std::isfinite(f[i])) return Refuse("non_finite", "set transform: value " + std::to_string(i) + " not finite");
+    if (!std::isfinite(f[i]))
+      return Refuse("non_finite", "set transform: value " + std::to_string(i) + " not finite");
   }
   const Eigen::Vector3d p_U(f[0], f[1], f[2]);
   const Eigen::Vector4d q_U(f[3], f[4], f[5], f[6]);
@@ -173,7 +176,8 @@ std::uint32_t UmqSession::SetColor() {
   std::array<float, 4> rgba;
   for (int i = 0; i < 4; ++i) {
     rgba[i] = LoadF32(head_.data() + 4 + 4 * i);
-    if (!std::isfinite(rgba[i])) return Refuse("non_finite", "set color: value " + std::to_string(i) + " not finite");
+    if (!std::isfinite(rgba[i]))
+      return Refuse("non_finite", "set color: value " + std::to_string(i) + " not finite");
   }
   if (rgba != object->rgba) ++scene_->revision_;
   object->rgba = rgba;
@@ -184,11 +188,13 @@ std::uint32_t UmqSession::SetText() {
   if (Short(24, "set text")) return 0;
   UnityObject* object = Target("set text");
   if (!object) return 0;
-  if (object->kind != ObjectKind::kText) return Refuse("unknown_key", "set text: object is not a text object");
+  if (object->kind != ObjectKind::kText)
+    return Refuse("unknown_key", "set text: object is not a text object");
   std::array<float, 5> f;  // font size, r, g, b, a
   for (int i = 0; i < 5; ++i) {
     f[i] = LoadF32(head_.data() + 4 + 4 * i);
-    if (!std::isfinite(f[i])) return Refuse("non_finite", "set text: value " + std::to_string(i) + " not finite");
+    if (!std::isfinite(f[i]))
+      return Refuse("non_finite", "set text: value " + std::to_string(i) + " not finite");
   }
   const std::array<float, 4> rgba{f[1], f[2], f[3], f[4]};
   if (rgba != object->rgba) ++scene_->revision_;
@@ -269,7 +275,8 @@ std::uint32_t UmqSession::Execute(std::uint32_t id) {
       in_display_list_ = false;
       return umq::kDisconnect;
     default:
-      Refuse("unknown_command", "command id " + std::to_string(id) + " (" + std::to_string(size_) + " bytes)");
+      Refuse("unknown_command",
+             "command id " + std::to_string(id) + " (" + std::to_string(size_) + " bytes)");
       return 0;
   }
 }

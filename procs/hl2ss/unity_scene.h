@@ -103,7 +103,15 @@ inline constexpr std::uint32_t kDisconnect = 0xFFFFFFFFu;
 }  // namespace umq
 
 /// What an object is (the values of hologram_scene_t's KIND_*; the primitive ids are the client's).
-enum class ObjectKind : std::int8_t { kSphere = 0, kCapsule = 1, kCylinder = 2, kCube = 3, kPlane = 4, kQuad = 5, kText = 6 };
+enum class ObjectKind : std::int8_t {
+  kSphere = 0,
+  kCapsule = 1,
+  kCylinder = 2,
+  kCube = 3,
+  kPlane = 4,
+  kQuad = 5,
+  kText = 6
+};
 
 /// One object of the scene.
 struct UnityObject {
@@ -115,7 +123,7 @@ struct UnityObject {
 };
 
 struct UnitySceneLimits {
-  int max_objects{1024};  ///< at most hologram_scene_t::MAX_HOLOGRAMS
+  int max_objects{1024};                       ///< at most hologram_scene_t::MAX_HOLOGRAMS
   std::uint32_t max_command_bytes{16u << 20};  ///< a command's data [bytes] (a texture's image fits)
   double max_position_m{1e4};                  ///< |p_W| of an object [m]
   double max_scale{1e3};                       ///< |scale| on each axis

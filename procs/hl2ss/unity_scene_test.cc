@@ -47,7 +47,9 @@ struct Buffer {
   void Create(std::uint32_t type) { Add(umq::kCreatePrimitive, U32s({type})); }
   void TargetMode(std::uint32_t mode) { Add(umq::kSetTargetMode, U32s({mode})); }
   void Active(std::uint32_t key, std::uint32_t state) { Add(umq::kSetActive, U32s({key, state})); }
-  void Transform(std::uint32_t key, const std::vector<float>& ten) { Add(umq::kSetWorldTransform, KeyFloats(key, ten)); }
+  void Transform(std::uint32_t key, const std::vector<float>& ten) {
+    Add(umq::kSetWorldTransform, KeyFloats(key, ten));
+  }
   void Color(std::uint32_t key, const std::vector<float>& rgba) { Add(umq::kSetColor, KeyFloats(key, rgba)); }
   void Remove(std::uint32_t key) { Add(umq::kRemove, U32s({key})); }
   static Bytes U32s(const std::vector<std::uint32_t>& v) {
@@ -67,7 +69,8 @@ std::vector<std::uint32_t> Answers(const Bytes& reply) {
   EXPECT_EQ(reply.size() % 4, 0u);
   std::vector<std::uint32_t> out;
   for (std::size_t i = 0; i + 4 <= reply.size(); i += 4) {
-    out.push_back(reply[i] | reply[i + 1] << 8 | reply[i + 2] << 16 | static_cast<std::uint32_t>(reply[i + 3]) << 24);
+    out.push_back(reply[i] | reply[i + 1] << 8 | reply[i + 2] << 16 |
+                  static_cast<std::uint32_t>(reply[i + 3]) << 24);
   }
   return out;
 }
@@ -137,9 +140,9 @@ TEST(UnityScene, KeysCountUpAndUseIdTargetsTheKeyGiven) {
   UnityScene scene;
   UmqSession session(&scene);
   Buffer b;
-  b.Create(0);   // sphere → 1
-  b.Create(2);   // cylinder → 2
-  b.Create(77);  // any other type: a quad (the plugin's default) → 3
+  b.Create(0);                  // sphere → 1
+  b.Create(2);                  // cylinder → 2
+  b.Create(77);                 // any other type: a quad (the plugin's default) → 3
   b.Add(umq::kCreateText, {});  // → 4
   b.Active(2, 1);
   b.Active(9, 1);  // no object 9
@@ -162,24 +165,22 @@ TEST(UnityScene, RefusalsAnswerZeroChangeNothingAndKeepTheStreamInStep) {
   const float nan = std::numeric_limits<float>::quiet_NaN();
   const float inf = std::numeric_limits<float>::infinity();
   Buffer b;
-  b.Add(umq::kSetWorldTransform, Buffer::U32s({1, 0, 0}));        // short: 12 of 44 bytes
-  b.Transform(1, {0, 0, 0, 0, 0, 0, 1, 1, nan, 1});                // non_finite
-  b.Transform(1, {2e4f, 0, 0, 0, 0, 0, 1, 1, 1, 1});               // range: 20 km
-  b.Transform(1, {0, 0, 0, 0, 0, 0, 1, 1, 1, 5e3f});               // range: scale
-  b.Transform(1, {0, 0, 0, 0, 0, 0, 0, 1, 1, 1});                  // range: zero rotation
-  b.Color(1, {inf, 0, 0, 1});                                      // non_finite
-  b.Add(15, Bytes(100, 0xAB));                                     // load mesh: unknown here
-  b.Add(12345, {});                                                // unknown
-  b.Add(umq::kSetText, Buffer::KeyFloats(1, {1, 1, 1, 1, 1}));     // a cube is no text object
-  b.Remove(42);                                                    // unknown_key
-  b.Add(umq::kSetColor, Buffer::U32s({1}));                        // short
-  b.Active(1, 0);                                                  // in step: accepted
+  b.Add(umq::kSetWorldTransform, Buffer::U32s({1, 0, 0}));      // short: 12 of 44 bytes
+  b.Transform(1, {0, 0, 0, 0, 0, 0, 1, 1, nan, 1});             // non_finite
+  b.Transform(1, {2e4f, 0, 0, 0, 0, 0, 1, 1, 1, 1});            // range: 20 km
+  b.Transform(1, {0, 0, 0, 0, 0, 0, 1, 1, 1, 5e3f});            // range: scale
+  b.Transform(1, {0, 0, 0, 0, 0, 0, 0, 1, 1, 1});               // range: zero rotation
+  b.Color(1, {inf, 0, 0, 1});                                   // non_finite
+  b.Add(15, Bytes(100, 0xAB));                                  // load mesh: unknown here
+  b.Add(12345, {});                                             // unknown
+  b.Add(umq::kSetText, Buffer::KeyFloats(1, {1, 1, 1, 1, 1}));  // a cube is no text object
+  b.Remove(42);                                                 // unknown_key
+  b.Add(umq::kSetColor, Buffer::U32s({1}));                     // short
+  b.Active(1, 0);                                               // in step: accepted
   EXPECT_EQ(Feed(&session, b.bytes, 13), (std::vector<std::uint32_t>{0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1}));
-  EXPECT_EQ(Keys(&session), (std::map<std::string, int>{{"short", 2},
-                                                         {"non_finite", 2},
-                                                         {"range", 3},
-                                                         {"unknown_command", 2},
-                                                         {"unknown_key", 2}}));
+  EXPECT_EQ(Keys(&session),
+            (std::map<std::string, int>{
+                {"short", 2}, {"non_finite", 2}, {"range", 3}, {"unknown_command", 2}, {"unknown_key", 2}}));
   const UnityObject& after = scene.objects().at(1);
   EXPECT_EQ(after.X_WG.matrix(), before.X_WG.matrix());
   EXPECT_EQ(after.scale, before.scale);
