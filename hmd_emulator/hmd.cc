@@ -9,6 +9,7 @@
 #include "base/format.h"
 #include "base/log.h"
 #include "base/units.h"
+#include "hmd_emulator/holograms.h"
 #include "lcmtypes/contract/alignment_trial.h"
 #include "lcmtypes/contract/conversions.h"
 #include "sim/guidance_messages.h"
@@ -31,7 +32,7 @@ HmdOptions ResolveHmdOptions(HmdOptions o) {
     throw std::invalid_argument("--collaborator " + o.collaborator + ": that is this headset");
   for (std::string* channel : {&o.hmd_pose_channel, &o.hmd_pose_truth_channel, &o.camera_channel,
                                &o.gaze_channel, &o.reflective_channel, &o.ar_view_channel, &o.trial_channel,
-                               &o.session_control_channel, &o.registration_channel}) {
+                               &o.session_control_channel, &o.registration_channel, &o.holograms_channel}) {
     *channel = channels::ForHeadset(*channel, o.headset);
   }
   for (std::string* channel : {&o.iiwa_status_channel, &o.robot_state_channel, &o.iiwa_command_channel,
@@ -137,6 +138,24 @@ void Headset::OnCollaboratorCamera(const Eigen::Isometry3d& X_WC_true, std::int6
 void Headset::OnGuidance(const orbed::guidance_t& msg, double clock_s) {
   guidance_ = msg;
   guidance_received_s_ = clock_s;
+}
+
+void Headset::OnHolograms(const orbed::hologram_scene_t& msg, double clock_s) {
+  orbed::hologram_scene_t scene = msg;
+  scene.utime = 0;  // the same scene re-sent is the same scene
+  std::vector<std::uint8_t> bytes(scene.getEncodedSize());
+  scene.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  if (!holograms_ || bytes != holograms_bytes_) {
+    auto mesh = std::make_shared<render::Mesh>();
+    TessellateHolograms(msg, {}, mesh.get());
+    holograms_ = std::move(mesh);
+    holograms_bytes_ = std::move(bytes);
+  }
+  holograms_received_s_ = clock_s;
+}
+
+std::shared_ptr<const render::Mesh> Headset::Holograms(double clock_s) const {
+  return clock_s - holograms_received_s_ <= kHologramsFreshS ? holograms_ : nullptr;
 }
 
 bool Headset::WantsRegistration(const orbed::registration_t& msg) const {
@@ -473,6 +492,7 @@ FrameInputs Headset::Inputs(double clock_s) const {
   in.hide_reflective_hologram = hologram.reflective_hidden;
   in.q_reflective_rad = hologram.reflective_q_rad;
   in.t_s = stream_->t_s();
+  in.holograms = Holograms(clock_s);
   if (collaborator_X_WC_true_ && in.have_sample) {
     // In this headset's map of the moment, through the shared anchor (CollaboratorView's relation).
     const Eigen::Isometry3d M = in.sample.X_WH_est * in.sample.X_WH_true.inverse();

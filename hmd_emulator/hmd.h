@@ -23,6 +23,8 @@
 /// process clock, no alignment session): ar: AR_VIEW at the target, the displays without a
 /// hologram; ar_reflective: both at the target; fixed: neither (the guidance is on the monitor).
 /// Otherwise the real arm's joints everywhere (empty q: the joints of the frame drawn on).
+/// A client's holograms (HOLOGRAMS from orbed-hl2ss, holograms.h) are drawn with it in AR_VIEW and
+/// the displays, whatever it shows, while the latest came within kHologramsFreshS.
 ///
 /// Sessions (OnSessionControl): the decision of HmdSession, and then: a START saves the START and
 /// forgets the registered and the user's X_WV; a RESET saves without the last trial; a STOP saves no
@@ -66,6 +68,7 @@
 #include <opencv2/core.hpp>
 #include <orbed/alignment_trial_t.hpp>
 #include <orbed/guidance_t.hpp>
+#include <orbed/hologram_scene_t.hpp>
 #include <orbed/iiwa_command_t.hpp>
 #include <orbed/registration_t.hpp>
 #include <orbed/session_control_t.hpp>
@@ -134,6 +137,8 @@ struct HmdOptions {
   /// Interactive: the person turns a joint of the real arm (keys 1-7 and , .) through the sim.
   std::string iiwa_command_channel{channels::kIiwaCommand};
   std::string setup_task_channel{channels::kSetupTask};  ///< interactive: the planned target
+  /// The holograms an hl2ss client placed (orbed-hl2ss), drawn in AR_VIEW and the displays.
+  std::string holograms_channel{channels::kHolograms};
 };
 
 /// Fills the default model and scene, checks the instance names, suffixes the channels and checks
@@ -157,6 +162,8 @@ struct HologramShown {
 };
 /// A GUIDANCE this young [s, process clock] is fresh.
 inline constexpr double kGuidanceFreshS = 1.0;
+/// A HOLOGRAMS this young [s, process clock] is drawn (its publisher re-sends it every second).
+inline constexpr double kHologramsFreshS = 3.0;
 
 /// What the shell does after an entry point, in this order.
 struct HeadsetActions {
@@ -185,6 +192,12 @@ class Headset {
   void OnRobotBase(const Eigen::Isometry3d& X_WR);
   void OnCollaboratorCamera(const Eigen::Isometry3d& X_WC_true, std::int64_t utime);
   void OnGuidance(const orbed::guidance_t& msg, double clock_s);
+  /// A HOLOGRAMS checked by CheckHologramScene, at clock_s: tessellated when it holds another scene
+  /// than the last (utime aside).
+  void OnHolograms(const orbed::hologram_scene_t& msg, double clock_s);
+  /// The client's holograms to draw at clock_s: the latest HOLOGRAMS's if it came within
+  /// kHologramsFreshS, else null.
+  std::shared_ptr<const render::Mesh> Holograms(double clock_s) const;
   /// A REGISTRATION worth checking: valid, and of the active session while one is active.
   bool WantsRegistration(const orbed::registration_t& msg) const;
   void OnRegistration(const Eigen::Isometry3d& X_WV_mean) { X_WV_registration_ = X_WV_mean; }
@@ -263,6 +276,9 @@ class Headset {
   std::optional<InteractiveSession> interactive_;  // always set; the person only with --interactive
   std::optional<orbed::guidance_t> guidance_;      // the latest valid GUIDANCE
   double guidance_received_s_{0};                  // when it came [process clock s]
+  std::vector<std::uint8_t> holograms_bytes_;      // the latest HOLOGRAMS encoded with utime 0
+  std::shared_ptr<const render::Mesh> holograms_;  // and tessellated
+  double holograms_received_s_{0};                 // when it came [process clock s]
   bool started_{false};
   double t0_s_{0};           // the walk's t = 0: the first StepPose [process clock s]
   double walk_offset_s_{0};  // emulated seconds of the trials published [s]

@@ -83,6 +83,9 @@ int RunHmd(int argc, const char* const* argv, std::ostream& out, std::ostream& e
   app.add_option("--reflective-channel", o.reflective_channel)->capture_default_str();
   app.add_option("--ar-view-channel", o.ar_view_channel)->capture_default_str();
   app.add_option("--trial-channel", o.trial_channel)->capture_default_str();
+  app.add_option("--holograms-channel", o.holograms_channel,
+                 "The holograms an hl2ss client placed (orbed-hl2ss), drawn in AR_VIEW and the displays")
+      ->capture_default_str();
   bool check_config = false;
   app.add_flag("--check-config", check_config,
                "Read the shipped configuration and every --config over it as a run would, say whether "

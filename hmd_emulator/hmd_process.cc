@@ -11,6 +11,7 @@
 #include "base/log.h"
 #include "lcmtypes/contract/alignment_trial.h"
 #include "lcmtypes/contract/conversions.h"
+#include "lcmtypes/contract/holograms.h"
 #include "lcmtypes/contract/validation.h"
 #include "sim/guidance_messages.h"
 #include "sim/iiwa_status_check.h"
@@ -59,6 +60,7 @@ void HmdProcess::ConnectToTheBus(const orbed::CommonFlags& flags) {
   if (!o.collaborator.empty())
     Listen(channels::ForHeadset(channels::kHmdPoseTruth, o.collaborator), &HmdProcess::OnCollaboratorPose);
   Listen(o.trial_channel, &HmdProcess::OnTrial);
+  Listen(o.holograms_channel, &HmdProcess::OnHolograms);
 }
 
 // pipeline_: the camera frame, reflective views and AR view, published through process_.
@@ -179,6 +181,12 @@ void HmdProcess::OnGuidance(const orbed::guidance_t& msg, const std::string& cha
   const std::string problem = guidance::CheckGuidance(msg, headset_->robot_model(), kJointLimitSlackRad);
   if (!problem.empty()) return process_->Reject(channel + "/field", problem);
   headset_->OnGuidance(msg, process_->ClockSeconds());
+}
+
+void HmdProcess::OnHolograms(const orbed::hologram_scene_t& msg, const std::string& channel) {
+  if (const auto refusal = CheckHologramScene(msg))
+    return process_->Reject(channel + "/" + refusal->key, refusal->reason);
+  headset_->OnHolograms(msg, process_->ClockSeconds());
 }
 
 void HmdProcess::OnRegistration(const orbed::registration_t& msg, const std::string& channel) {

@@ -19,7 +19,10 @@
 ///               ALIGNMENT_TRIAL (alignment_trial_t): another's trial of the active session moves
 ///               the next trial index past it (HmdSession::ObserveTrial);
 ///               HMD_POSE_TRUTH_<NAME> (hmd_pose_t) with --collaborator NAME: where that headset's
-///               camera truly is, display 0 and the trials' first display (CollaboratorDisplay).
+///               camera truly is, display 0 and the trials' first display (CollaboratorDisplay);
+///               HOLOGRAMS (hologram_scene_t): the holograms an hl2ss client placed (orbed-hl2ss),
+///               drawn with the virtual robot in AR_VIEW and over the REFLECTIVE_VIEW frames while
+///               the latest came within 3 s (holograms.h: Unity's primitives at Unity's sizes).
 ///   Publishes:  HMD_POSE and HMD_POSE_TRUTH (hmd_pose_t) at pose_hz (pose_stream.h);
 ///               HMD_CAMERA (image_t, JPEG) at camera_hz, REFLECTIVE_VIEW (reflective_view_t) at
 ///               hmd.reflective_hz per display (--displays), AR_VIEW (image_t, JPEG) at
@@ -67,6 +70,8 @@
 ///   ROBOT_STATE/pose (X_WR not finite or not a unit quaternion);
 ///   HMD_POSE_TRUTH_<NAME>/pose (the collaborator's X_WC not a world pose, CheckWorldPose);
 ///   REGISTRATION/pose (a valid mean with a bad X_WV_mean);
+///   HOLOGRAMS/<field> (orbed::CheckHologramScene's keys: num_holograms, id, kind, pose, scale,
+///   rgba), the whole message refused and the holograms drawn before kept;
 ///   SESSION_CONTROL/<key> with the keys of hmd_session.h, /trial_failed, and /busy (a request
 ///   while a trial waits for its tracking faults to play);
 ///   ALIGNMENT_TRIAL/<key> (orbed::CheckAlignmentTrial's keys) for a bad trial of the active session;
@@ -95,6 +100,7 @@
 #include <orbed/alignment_trial_t.hpp>
 #include <orbed/guidance_t.hpp>
 #include <orbed/hmd_pose_t.hpp>
+#include <orbed/hologram_scene_t.hpp>
 #include <orbed/iiwa_status_t.hpp>
 #include <orbed/registration_t.hpp>
 #include <orbed/robot_state_t.hpp>
@@ -172,6 +178,7 @@ class HmdProcess {
   void OnTrial(const orbed::alignment_trial_t& msg, const std::string& channel);
   void OnGuidance(const orbed::guidance_t& msg, const std::string& channel);
   void OnCollaboratorPose(const orbed::hmd_pose_t& msg, const std::string& channel);
+  void OnHolograms(const orbed::hologram_scene_t& msg, const std::string& channel);
   /// Carries out the core's actions in HeadsetActions' order; a refusal under "<channel>/<key>".
   void Act(const HeadsetActions& actions, const std::string& channel = "");
   void InteractiveTick();

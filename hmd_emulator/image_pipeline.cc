@@ -13,6 +13,11 @@ namespace {
 
 bool SamePose(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) { return a.matrix() == b.matrix(); }
 
+// The client's holograms when there is anything to draw, else null.
+const render::Mesh* Drawable(const std::shared_ptr<const render::Mesh>& holograms) {
+  return holograms && !holograms->triangles.empty() ? holograms.get() : nullptr;
+}
+
 void Encode(const cv::Mat& bgr, int quality, std::vector<std::uint8_t>* jpeg) {
   if (!render::EncodeJpeg(bgr, quality, jpeg)) throw std::runtime_error("JPEG encoding failed");
 }
@@ -261,15 +266,22 @@ void ImagePipeline::Reflective(const FrameInputs& in) {
     const bool hidden = in.hide_reflective_hologram || !d.robot.known();
     const Eigen::VectorXd& q =
         in.q_reflective_rad.size() == d.frame.q_rad.size() ? in.q_reflective_rad : d.frame.q_rad;
+    const render::Mesh* holograms = Drawable(in.holograms);
     if (d.composed_version != d.version || !SamePose(d.composed_X_WV, in.X_WV) ||
-        hidden != d.composed_hidden || (!hidden && q != d.composed_q_rad)) {
+        hidden != d.composed_hidden || (!hidden && q != d.composed_q_rad) ||
+        in.holograms != d.composed_holograms) {
       ReflectiveView view;
       if (!hidden) {
         CapturedFrame frame = d.frame;  // shares the pixels
         frame.q_rad = q;
-        compositor_.ComposeReflective(frame, d.D_m, in.X_WV, &view);
+        compositor_.ComposeReflective(frame, d.D_m, in.X_WV, &view, nullptr, holograms);
       } else {
-        view.bgr = d.frame.bgr.clone();
+        if (holograms) {
+          compositor_.ComposeHolograms(d.frame.bgr, d.frame.intrinsics, d.frame.X_WC_est, *holograms,
+                                       &view.bgr);
+        } else {
+          view.bgr = d.frame.bgr.clone();
+        }
         view.geometry = MakeReflectiveGeometry(d.frame.intrinsics, d.frame.X_WC_est, d.D_m);
       }
       Encode(view.bgr, options_.jpeg_quality, &d.jpeg);
@@ -278,6 +290,7 @@ void ImagePipeline::Reflective(const FrameInputs& in) {
       d.composed_X_WV = in.X_WV;
       d.composed_hidden = hidden;
       d.composed_q_rad = hidden ? Eigen::VectorXd() : q;
+      d.composed_holograms = in.holograms;
       std::lock_guard<std::mutex> lock(out_mutex_);
       if (reflective_latest_.size() < displays_.size()) reflective_latest_.resize(displays_.size());
       reflective_latest_[i] = view.bgr;
@@ -298,10 +311,14 @@ void ImagePipeline::Reflective(const FrameInputs& in) {
 void ImagePipeline::ArView(const FrameInputs& in, bool publish) {
   if (!have_frame_) return;
   cv::Mat ar;
+  const render::Mesh* holograms = Drawable(in.holograms);
   if (robot_.known() && !in.hide_hologram) {
     const Eigen::VectorXd& q =
         in.q_hologram_rad.size() == robot_.q_rad.size() ? in.q_hologram_rad : robot_.q_rad;
-    compositor_.ComposeArView(bgr_, renderer_.intrinsics(), frame_X_WC_est_, q, in.X_WV, &ar);
+    compositor_.ComposeArView(bgr_, renderer_.intrinsics(), frame_X_WC_est_, q, in.X_WV, &ar, nullptr,
+                              holograms);
+  } else if (holograms) {
+    compositor_.ComposeHolograms(bgr_, renderer_.intrinsics(), frame_X_WC_est_, *holograms, &ar);
   } else {
     ar = bgr_.clone();
   }

@@ -13,12 +13,15 @@
 ///     (REFLECTIVE_VIEW);
 ///   - the AR view: the hologram at X_WV over the latest camera frame, drawn with that frame's
 ///     estimated pose (AR_VIEW);
+/// a client's holograms (FrameInputs::holograms) in the same overlay as the virtual robot, in the
+/// AR view and the reflective views alike;
 /// and hands each message to a callback (ImagePipelineOutputs). It neither publishes nor logs.
 ///
 /// Reuse: a camera frame whose inputs (X_WC_true, q, X_WR) equal the previous frame's reuses its
 /// JPEG bytes (a standing wearer and a resting arm give the same picture), restamped. A reflective
-/// view is composited again only when its frame or X_WV changed. After the robot moved, a captured
-/// display renders its frame again from the same viewpoint, at most every recapture_period_s.
+/// view is composited again only when its frame, X_WV or the client's holograms changed. After the robot
+/// moved, a captured display renders its frame again from the same viewpoint, at most every
+/// recapture_period_s.
 ///
 /// Threading: with options.threaded the work runs on one worker thread owned by the pipeline.
 /// Post() hands it a job with its inputs, latest wins: a job that finds the previous request of its
@@ -38,6 +41,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -77,6 +81,10 @@ struct FrameInputs {
   /// no reflective display).
   bool hide_reflective_hologram{false};
   double t_s{0};  ///< walk time of the sample [s]
+  /// A client's holograms (HOLOGRAMS tessellated in W, holograms.h): drawn in AR_VIEW and over
+  /// every display's frame with the virtual robot (whatever hides the robot: they are the
+  /// client's). Shared, not copied, per frame; a new pointer is a new scene. Null or empty: none.
+  std::shared_ptr<const render::Mesh> holograms;
   /// A live collaborator's camera as display 0 (orbed-hmd --collaborator; viraal_trial.h's
   /// CollaboratorDisplay): truly at X_WC_true, placed in this headset's map at X_WC_est. Display 0
   /// then shows the scene and the real robot rendered from X_WC_true (the picture that camera
@@ -165,6 +173,7 @@ class ImagePipeline {
     Eigen::Isometry3d composed_X_WV{Eigen::Isometry3d::Identity()};
     Eigen::VectorXd composed_q_rad;  // empty: no hologram
     bool composed_hidden{false};
+    std::shared_ptr<const render::Mesh> composed_holograms;
     ReflectiveGeometry geometry;
     std::vector<std::uint8_t> jpeg;
   };

@@ -44,21 +44,31 @@ Compositor::Compositor(const sim::RobotModel& robot, const render::OverlayStyle&
 }
 
 void Compositor::Overlay(const geometry::Intrinsics& intrinsics, const Eigen::Isometry3d& X_WC,
-                         const Eigen::VectorXd& q_rad, const Eigen::Isometry3d& X_WV, cv::Mat* image,
-                         cv::Mat* body_id) {
-  if (q_rad.size() != robot_.num_joints())
-    throw std::invalid_argument("compositor: q has " + std::to_string(q_rad.size()) + " entries, the robot " +
-                                std::to_string(robot_.num_joints()));
+                         const Eigen::VectorXd* q_rad, const Eigen::Isometry3d& X_WV,
+                         const render::Mesh* holograms, cv::Mat* image, cv::Mat* body_id) {
+  if (q_rad && q_rad->size() != robot_.num_joints())
+    throw std::invalid_argument("compositor: q has " + std::to_string(q_rad->size()) +
+                                " entries, the robot " + std::to_string(robot_.num_joints()));
   if (!renderer_ || !SameIntrinsics(renderer_->intrinsics(), intrinsics))
     renderer_ = std::make_unique<render::Renderer>(intrinsics);
-  virtual_robot_.PoseRobot(handle_, q_rad, X_WV);
   mesh_.Clear();
-  render::Tessellate(virtual_robot_, render::kVirtualOnly, tessellation_, &mesh_);
+  if (q_rad) {
+    virtual_robot_.PoseRobot(handle_, *q_rad, X_WV);
+    render::Tessellate(virtual_robot_, render::kVirtualOnly, tessellation_, &mesh_);
+  }
+  if (holograms) {
+    const int offset = static_cast<int>(mesh_.p_W.size());
+    mesh_.p_W.insert(mesh_.p_W.end(), holograms->p_W.begin(), holograms->p_W.end());
+    for (render::Mesh::Triangle t : holograms->triangles) {
+      for (int& v : t.v) v += offset;
+      mesh_.triangles.push_back(t);
+    }
+  }
   renderer_->RenderOverlay(mesh_, X_WC, style_, image, body_id);
 }
 
 void Compositor::ComposeReflective(const CapturedFrame& frame, double D_m, const Eigen::Isometry3d& X_WV,
-                                   ReflectiveView* view, cv::Mat* body_id) {
+                                   ReflectiveView* view, cv::Mat* body_id, const render::Mesh* holograms) {
   const geometry::Intrinsics& K = frame.intrinsics;
   if (frame.bgr.empty() || frame.bgr.type() != CV_8UC3 || frame.bgr.cols != K.width_px ||
       frame.bgr.rows != K.height_px)
@@ -67,17 +77,28 @@ void Compositor::ComposeReflective(const CapturedFrame& frame, double D_m, const
   view->X_WV = X_WV;
   view->source_utime = frame.utime;
   frame.bgr.copyTo(view->bgr);
-  Overlay(K, frame.X_WC_est, frame.q_rad, X_WV, &view->bgr, body_id);
+  Overlay(K, frame.X_WC_est, &frame.q_rad, X_WV, holograms, &view->bgr, body_id);
 }
 
 void Compositor::ComposeArView(const cv::Mat& live_bgr, const geometry::Intrinsics& intrinsics,
                                const Eigen::Isometry3d& X_WC_est, const Eigen::VectorXd& q_rad,
-                               const Eigen::Isometry3d& X_WV, cv::Mat* out, cv::Mat* body_id) {
+                               const Eigen::Isometry3d& X_WV, cv::Mat* out, cv::Mat* body_id,
+                               const render::Mesh* holograms) {
   if (live_bgr.empty() || live_bgr.type() != CV_8UC3 || live_bgr.cols != intrinsics.width_px ||
       live_bgr.rows != intrinsics.height_px)
     throw std::invalid_argument("AR view: the frame must be CV_8UC3 of its intrinsics' size");
   if (out != &live_bgr) live_bgr.copyTo(*out);
-  Overlay(intrinsics, X_WC_est, q_rad, X_WV, out, body_id);
+  Overlay(intrinsics, X_WC_est, &q_rad, X_WV, holograms, out, body_id);
+}
+
+void Compositor::ComposeHolograms(const cv::Mat& bgr, const geometry::Intrinsics& intrinsics,
+                                  const Eigen::Isometry3d& X_WC_est, const render::Mesh& holograms,
+                                  cv::Mat* out) {
+  if (bgr.empty() || bgr.type() != CV_8UC3 || bgr.cols != intrinsics.width_px ||
+      bgr.rows != intrinsics.height_px)
+    throw std::invalid_argument("holograms: the frame must be CV_8UC3 of its intrinsics' size");
+  if (out != &bgr) bgr.copyTo(*out);
+  Overlay(intrinsics, X_WC_est, nullptr, Eigen::Isometry3d::Identity(), &holograms, out, nullptr);
 }
 
 }  // namespace orbed::hmd

@@ -102,23 +102,35 @@ class Compositor {
 
   /// Reflective display: `frame` + the virtual robot at (frame.q_rad, X_WV) drawn with P_o of
   /// frame.X_WC_est, and the geometry for D. `body_id` (optional, CV_32S) receives the overlay's
-  /// body indices into virtual_geometry().bodies(), -1 elsewhere. Throws std::invalid_argument on an
-  /// empty or mis-sized frame, a wrong q size or a bad D.
+  /// body indices into virtual_geometry().bodies(), -1 elsewhere. `holograms` (optional): a client's
+  /// holograms (holograms.h, triangles in W) drawn in the same overlay, z-buffered with the robot.
+  /// Throws std::invalid_argument on an empty or mis-sized frame, a wrong q size or a bad D.
   void ComposeReflective(const CapturedFrame& frame, double D_m, const Eigen::Isometry3d& X_WV,
-                         ReflectiveView* view, cv::Mat* body_id = nullptr);
+                         ReflectiveView* view, cv::Mat* body_id = nullptr,
+                         const render::Mesh* holograms = nullptr);
 
   /// AR view: the virtual robot at (q, X_WV) over a live frame, drawn from the current estimate
-  /// X_WC_est. `out` may alias `live_bgr`'s buffer only if it is the same Mat object.
+  /// X_WC_est, with `holograms` as above. `out` may alias `live_bgr`'s buffer only if it is the
+  /// same Mat object.
   void ComposeArView(const cv::Mat& live_bgr, const geometry::Intrinsics& intrinsics,
                      const Eigen::Isometry3d& X_WC_est, const Eigen::VectorXd& q_rad,
-                     const Eigen::Isometry3d& X_WV, cv::Mat* out, cv::Mat* body_id = nullptr);
+                     const Eigen::Isometry3d& X_WV, cv::Mat* out, cv::Mat* body_id = nullptr,
+                     const render::Mesh* holograms = nullptr);
+
+  /// A client's holograms alone (no virtual robot) over a frame taken at X_WC_est, in the hologram
+  /// style; `out` as for ComposeArView. Throws std::invalid_argument on a mis-sized frame.
+  void ComposeHolograms(const cv::Mat& bgr, const geometry::Intrinsics& intrinsics,
+                        const Eigen::Isometry3d& X_WC_est, const render::Mesh& holograms, cv::Mat* out);
 
   /// The virtual robot's bodies (names "virtual/<link>"), posed at the last call.
   const render::SceneGeometry& virtual_geometry() const { return virtual_robot_; }
 
  private:
+  // The virtual robot at (*q_rad, X_WV) when q_rad is given, and the holograms when given, in one
+  // overlay.
   void Overlay(const geometry::Intrinsics& intrinsics, const Eigen::Isometry3d& X_WC,
-               const Eigen::VectorXd& q_rad, const Eigen::Isometry3d& X_WV, cv::Mat* image, cv::Mat* body_id);
+               const Eigen::VectorXd* q_rad, const Eigen::Isometry3d& X_WV, const render::Mesh* holograms,
+               cv::Mat* image, cv::Mat* body_id);
 
   const sim::RobotModel& robot_;
   render::OverlayStyle style_;

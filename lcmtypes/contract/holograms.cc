@@ -13,9 +13,8 @@ std::optional<Refusal> CheckHologramScene(const orbed::hologram_scene_t& m) {
   const auto n = static_cast<std::size_t>(m.num_holograms);
   if (m.num_holograms < 0 || m.num_holograms > M::MAX_HOLOGRAMS || m.id.size() != n || m.kind.size() != n ||
       m.X_WG.size() != n || m.scale.size() != n || m.rgba.size() != n || m.active.size() != n) {
-    return Refusal{"num_holograms", "num_holograms " + std::to_string(m.num_holograms) +
-                                        " out of [0, " + std::to_string(M::MAX_HOLOGRAMS) +
-                                        "] or not the arrays' length"};
+    return Refusal{"num_holograms", "num_holograms " + std::to_string(m.num_holograms) + " out of [0, " +
+                                        std::to_string(M::MAX_HOLOGRAMS) + "] or not the arrays' length"};
   }
   if (m.revision < 0) return Refusal{"num_holograms", "revision " + std::to_string(m.revision) + " < 0"};
   std::set<std::int32_t> ids;

@@ -11,7 +11,7 @@
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using orbed::hl2ss::UmqSession;
   orbed::hl2ss::UnitySceneLimits limits;
-  limits.max_objects = 16;         // reachable by a fuzzer
+  limits.max_objects = 16;          // reachable by a fuzzer
   limits.max_command_bytes = 4096;  // the size cap too
   orbed::hl2ss::UnityScene scene(limits);
   const size_t a = size > 0 ? data[0] % (size + 1) : 0;
