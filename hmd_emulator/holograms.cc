@@ -65,7 +65,9 @@ render::Mesh UnitShape(std::int8_t kind, const render::TessellationOptions& opti
   return mesh;
 }
 
-std::uint8_t Channel(float c) { return static_cast<std::uint8_t>(std::lround(255.0 * std::clamp(c, 0.0f, 1.0f))); }
+std::uint8_t Channel(float c) {
+  return static_cast<std::uint8_t>(std::lround(255.0 * std::clamp(c, 0.0f, 1.0f)));
+}
 
 }  // namespace
 

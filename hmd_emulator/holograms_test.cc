@@ -88,12 +88,14 @@ TEST(Holograms, UnitysPrimitivesAtUnitysSizes) {
     EXPECT_NEAR(max_r, 0.5, 1e-6) << int{kind};
   }
   // Plane: 10 m square in x_G z_G facing +y_G; quad: 1 m square in x_G y_G facing +z_G.
-  for (const auto& [kind, half, normal_G] : {std::tuple{HS::KIND_PLANE, 5.0, Eigen::Vector3d::UnitY().eval()},
-                                             std::tuple{HS::KIND_QUAD, 0.5, Eigen::Vector3d::UnitZ().eval()}}) {
+  for (const auto& [kind, half, normal_G] :
+       {std::tuple{HS::KIND_PLANE, 5.0, Eigen::Vector3d::UnitY().eval()},
+        std::tuple{HS::KIND_QUAD, 0.5, Eigen::Vector3d::UnitZ().eval()}}) {
     render::Mesh mesh;
     TessellateHolograms(One(kind, X_WG, {1, 1, 1}), {}, &mesh);
     ASSERT_EQ(mesh.triangles.size(), 2u);
-    for (const auto& t : mesh.triangles) EXPECT_LT((t.normal_W.cast<double>() - X_WG.linear() * normal_G).norm(), 1e-6);
+    for (const auto& t : mesh.triangles)
+      EXPECT_LT((t.normal_W.cast<double>() - X_WG.linear() * normal_G).norm(), 1e-6);
     for (const auto& p_W : mesh.p_W) {
       const Eigen::Vector3d p_G = X_WG.inverse() * p_W.cast<double>();
       EXPECT_NEAR(p_G.dot(normal_G), 0, 1e-6);
@@ -134,8 +136,8 @@ Commands RedSphere(const Eigen::Vector3d& p_U, float d_m) {
   c.U32(1);  // UseLast
   c.Add(hl2ss::umq::kSetWorldTransform, 44);
   c.U32(0);
-  for (float f : {static_cast<float>(p_U.x()), static_cast<float>(p_U.y()), static_cast<float>(p_U.z()), 0.f, 0.f,
-                  0.f, 1.f, d_m, d_m, d_m})
+  for (float f : {static_cast<float>(p_U.x()), static_cast<float>(p_U.y()), static_cast<float>(p_U.z()), 0.f,
+                  0.f, 0.f, 1.f, d_m, d_m, d_m})
     c.F32(f);
   c.Add(hl2ss::umq::kSetColor, 20);
   c.U32(0);
@@ -153,7 +155,9 @@ template <typename Msg>
 void CollectInto(lcm::LCM& lcm, const std::string& channel, std::vector<Msg>* out) {
   lcm.subscribeFunction(
       channel,
-      +[](const lcm::ReceiveBuffer*, const std::string&, const Msg* m, std::vector<Msg>* o) { o->push_back(*m); },
+      +[](const lcm::ReceiveBuffer*, const std::string&, const Msg* m, std::vector<Msg>* o) {
+        o->push_back(*m);
+      },
       out);
 }
 
@@ -219,14 +223,16 @@ TEST(Holograms, ASpherePlacedByAClientShowsWhereTheCameraModelProjectsIt) {
   // The AR view's own camera model: p_C = X_WC⁻¹ p_W, (u, v) = (fx x/z + cx, fy y/z + cy).
   const orbed::image_t& view = ar[0];
   const Eigen::Vector3d p_C = FromPose(view.X_WC).inverse() * p_W;
-  const Eigen::Vector2d uv(view.fx_px * p_C.x() / p_C.z() + view.cx_px, view.fy_px * p_C.y() / p_C.z() + view.cy_px);
+  const Eigen::Vector2d uv(view.fx_px * p_C.x() / p_C.z() + view.cx_px,
+                           view.fy_px * p_C.y() / p_C.z() + view.cy_px);
   const cv::Mat frame = render::DecodeJpeg(camera[0].data);
   const cv::Mat with_sphere = render::DecodeJpeg(view.data);
   const auto [centre, pixels] = Changed(with_sphere, frame);
   // Radius ≈ f r / z = 1545 · 0.125 / 2 ≈ 97 px: about 29 000 pixels.
   EXPECT_GT(pixels, 20000);
   EXPECT_LT(pixels, 36000);
-  EXPECT_LT((centre - uv).norm(), 2.0) << "drawn at " << centre.transpose() << ", projected " << uv.transpose();
+  EXPECT_LT((centre - uv).norm(), 2.0)
+      << "drawn at " << centre.transpose() << ", projected " << uv.transpose();
   const cv::Vec3b at = with_sphere.at<cv::Vec3b>(static_cast<int>(uv.y()), static_cast<int>(uv.x()));
   EXPECT_GT(int{at[2]} - int{at[1]}, 60) << "red over the room: BGR " << at;  // red, not the grey room
   // Over the reflective display's frame (captured at this very pose) in the same place.

@@ -1,7 +1,7 @@
 #pragma once
 /// @file
 /// The reflective-AR display (paper Sec. II-B) and the AR view: the virtual robot at X_WV drawn as
-/// a hologram over a camera frame.
+/// a hologram over a camera frame, with a client's holograms (holograms.h) in the same overlay.
 ///
 /// What is in the picture (the physical mechanism the alignment study relies on):
 ///   * The captured frame shows the REAL robot (at X_WR) as the camera truly saw it, from X_WC_true.
