@@ -136,6 +136,29 @@ TEST(UnityScene, TheSampleSequenceAnswersAsThePluginWhateverTheSplit) {
   }
 }
 
+// PoseFromUnity against the frames written out directly: Unity's coordinates to W swap y and z
+// (P), and G is Unity's local frame with z negated (S): R_WG = P R_U S, p_W = P p_U; R_U from the
+// quaternion by the textbook formula (Unity's Quaternion is the usual Hamilton quaternion).
+TEST(UnityScene, PoseFromUnityIsTheSwapOfUnitysAxes) {
+  Eigen::Matrix3d P;
+  P << 1, 0, 0, 0, 0, 1, 0, 1, 0;
+  const Eigen::Matrix3d S = Eigen::Vector3d(1, 1, -1).asDiagonal();
+  for (const Eigen::Vector4d& q : {Eigen::Vector4d(0.1, -0.7, 0.3, 0.6),
+                                   Eigen::Vector4d(0.9, 0.2, -0.1, -0.3), Eigen::Vector4d(0, 0, 0, 2)}) {
+    const Eigen::Vector4d u = q.normalized();
+    const double x = u[0], y = u[1], z = u[2], w = u[3];
+    Eigen::Matrix3d R_U;
+    R_U << 1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w),  //
+        2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w),     //
+        2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y);
+    const Eigen::Vector3d p_U(0.4, -1.5, 2.5);
+    const Eigen::Isometry3d X_WG = PoseFromUnity(p_U, q);
+    EXPECT_LT((X_WG.linear() - P * R_U * S).norm(), 1e-12) << q.transpose();
+    EXPECT_LT((X_WG.translation() - P * p_U).norm(), 1e-12);
+    EXPECT_NEAR(X_WG.linear().determinant(), 1.0, 1e-12);
+  }
+}
+
 TEST(UnityScene, KeysCountUpAndUseIdTargetsTheKeyGiven) {
   UnityScene scene;
   UmqSession session(&scene);
