@@ -19,16 +19,6 @@
 #include "sim/guidance_messages.h"
 
 namespace orbed::foxglove {
-namespace {
-
-nlohmann::json PoseJson(const Eigen::Isometry3d& X) {
-  const Eigen::Quaterniond q(X.linear());
-  return {{"position", {{"x", X.translation().x()}, {"y", X.translation().y()}, {"z", X.translation().z()}}},
-          {"orientation", {{"x", q.x()}, {"y", q.y()}, {"z", q.z()}, {"w", q.w()}}}};
-}
-
-}  // namespace
-
 FoxgloveBridge::FoxgloveBridge(const CommonFlags& flags, const BridgeOptions& options)
     : process_(flags),
       options_(options),
@@ -49,8 +39,7 @@ FoxgloveBridge::FoxgloveBridge(const CommonFlags& flags, const BridgeOptions& op
   const auto on_image = [this](const orbed::image_t& img, uint32_t channel_id, const std::string& frame,
                                const std::string& channel) {
     if (!server_.HasSubscribers(channel_id) || !Due(frame, options_.image_hz, NowMicros())) return;
-    std::string problem = CheckImage(img);
-    if (problem.empty() && img.pixel_format != orbed::image_t::FORMAT_JPEG) problem = "image: not JPEG";
+    const std::string problem = ImageProblem(img);
     if (!problem.empty()) return process_.Reject(channel + "/image", problem);
     Send(channel_id, img.utime, CompressedImage(img.data, "jpeg", frame, img.utime).dump());
   };
@@ -103,22 +92,12 @@ FoxgloveBridge::FoxgloveBridge(const CommonFlags& flags, const BridgeOptions& op
 
 void FoxgloveBridge::SendRegistration(const orbed::registration_t& msg) {
   if (!server_.HasSubscribers(kRegistration)) return;
-  const nlohmann::json j = {{"utime", msg.utime},
-                            {"session_id", EscapeText(msg.session_id)},
-                            {"valid", true},
-                            {"num_used", msg.num_used},
-                            {"X_WV_mean", PoseJson(*poses_.X_WV())}};
-  Send(kRegistration, msg.utime, j.dump());
+  Send(kRegistration, msg.utime, Registration(msg, *poses_.X_WV()).dump());
 }
 
 void FoxgloveBridge::SendGuidance(const orbed::guidance_t& msg) {
   if (!server_.HasSubscribers(kGuidance) || !Due("guidance", options_.rate_hz, NowMicros())) return;
-  const nlohmann::json j = {{"utime", msg.utime},
-                            {"mode", guidance::GuidanceModeName(msg.mode)},
-                            {"error_deg", msg.error_deg},
-                            {"next_joint", msg.next_joint},
-                            {"done", static_cast<bool>(msg.done)}};
-  Send(kGuidance, msg.utime, j.dump());
+  Send(kGuidance, msg.utime, Guidance(msg).dump());
 }
 
 void FoxgloveBridge::Send(uint32_t channel, int64_t utime, const std::string& payload) {

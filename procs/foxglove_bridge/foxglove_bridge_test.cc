@@ -1,5 +1,7 @@
 // orbed-foxglove-bridge's protocol pieces and server:
-//   - advertise: the six channels with their Foxglove schema names and parseable JSON schemas;
+//   - advertise: the seven channels with their Foxglove schema names and JSON schemas in the form
+//     Foxglove's reader takes (every object with "properties" an object, every property one "type"
+//     string; a "properties": null made Foxglove drop /scene); ajv validates them in the MCAP test;
 //   - /tf: the flange frame 1.266 m above R at q = 0 (KUKA data sheet), R in W, the virtual links;
 //   - Message Data: opcode 1, little-endian subscription id and nanoseconds, then the payload;
 //   - CompressedImage: base64 by RFC 4648's test vectors ("foobar" → "Zm9vYmFy");
@@ -26,6 +28,18 @@ namespace {
 
 using json = nlohmann::json;
 
+// What Foxglove's JSON Schema reader needs of an object schema, recursively.
+void ExpectFoxgloveReadable(const json& schema, const std::string& path) {
+  ASSERT_TRUE(schema.is_object()) << path;
+  ASSERT_TRUE(schema.contains("type") && schema["type"].is_string()) << path << ": " << schema.dump();
+  if (schema["type"] == "array") return ExpectFoxgloveReadable(schema["items"], path + "[]");
+  if (schema["type"] != "object") return;
+  ASSERT_TRUE(schema.contains("properties") && schema["properties"].is_object())
+      << path << ": " << schema.dump();
+  for (const auto& [name, property] : schema["properties"].items())
+    ExpectFoxgloveReadable(property, path + "." + name);
+}
+
 TEST(FoxgloveMessages, AdvertisesSevenChannelsWithSchemas) {
   const json a = Advertise();
   EXPECT_EQ(a["op"], "advertise");
@@ -41,7 +55,9 @@ TEST(FoxgloveMessages, AdvertisesSevenChannelsWithSchemas) {
     EXPECT_EQ(c["topic"], expected[i].first);
     EXPECT_EQ(c["schemaName"], expected[i].second);
     EXPECT_EQ(c["encoding"], "json");
-    EXPECT_EQ(json::parse(c["schema"].get<std::string>())["type"], "object");
+    const json schema = json::parse(c["schema"].get<std::string>());
+    EXPECT_EQ(schema["type"], "object");
+    ExpectFoxgloveReadable(schema, c["topic"]);
   }
   EXPECT_EQ(ServerInfo("s")["supportedEncodings"], json::array({"json"}));
 }
