@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <exception>
+#include <filesystem>
 #include <map>
 #include <regex>
 #include <string>
@@ -14,6 +15,8 @@
 #include "procs/logger/csv_export.h"
 #include "procs/logger/event_log_reader.h"
 #include "procs/logger/event_log_writer.h"
+#include "procs/logger/mcap_export.h"
+#include "sim/foxglove_messages.h"
 
 namespace orbed::logger {
 namespace {
@@ -153,12 +156,53 @@ int Export(const MappedLog& log, const CsvExportOptions& options, std::ostream& 
   return 0;
 }
 
+int ExportMcapFile(const MappedLog& log, const McapExportOptions& options, std::ostream& out,
+                   std::ostream& err) {
+  const McapExportResult result = ExportMcap(log, options);
+  if (!result.ok()) {
+    err << "orbed-log: " << EscapeText(result.error) << "\n";
+    return 1;
+  }
+  char line[512];
+  std::snprintf(line, sizeof(line), "%-28s %-24s %10s %9s\n", "channel / topic", "type", "messages",
+                "refused");
+  out << line;
+  int64_t total = 0;
+  for (const McapChannelResult& c : result.channels) {
+    int64_t refused = c.unknown;
+    for (const auto& [reason, n] : c.refused) refused += n;
+    total += c.messages;
+    std::snprintf(line, sizeof(line), "%-28s %-24s %10lld %9lld\n", EscapeText(c.channel).c_str(),
+                  c.type.empty() ? "(none known)" : c.type.c_str(), static_cast<long long>(c.messages),
+                  static_cast<long long>(refused));
+    out << line;
+    for (const auto& [reason, n] : c.refused) out << "  refused " << n << ": " << reason << "\n";
+    if (c.unknown > 0) out << "  refused " << c.unknown << ": unknown fingerprint (not exported)\n";
+  }
+  for (const auto& [topic, n] : result.topics) {
+    total += n;
+    std::string schema;
+    for (const foxglove::ChannelSpec& spec : foxglove::Channels())
+      if (spec.topic == topic) schema = spec.schema_name;
+    std::snprintf(line, sizeof(line), "%-28s %-24s %10lld %9s\n", topic.c_str(), schema.c_str(),
+                  static_cast<long long>(n), "");
+    out << line;
+  }
+  if (!options.provenance_path.empty())
+    out << "provenance: " << EscapeText(options.provenance_path)
+        << (result.provenance ? " (metadata \"provenance\")" : " left out: " + result.provenance_problem)
+        << "\n";
+  out << "orbed-log: " << total << " messages on " << result.channels.size() + result.topics.size()
+      << " channels in " << EscapeText(options.out_path) << " (MCAP, chunked and indexed)\n";
+  return 0;
+}
+
 }  // namespace
 
 int RunLogTool(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
   CLI::App app{
       "orbed-log: what is in an LCM event log (orbed-logger's or lcm-logger's), whether it is damaged,\n"
-      "a cut of it by time and channel, and its messages as CSV tables."};
+      "a cut of it by time and channel, and its messages as CSV tables or as an MCAP file for Foxglove."};
   AddVersionFlag(&app);
   app.require_subcommand(1);
   std::string log_path, out_path, channels = ".*";
@@ -177,11 +221,25 @@ int RunLogTool(int argc, const char* const* argv, std::ostream& out, std::ostrea
   cut->add_option("--channels", channels, "keep channels whose whole name matches this regex")
       ->capture_default_str();
   auto* export_cmd = app.add_subcommand(
-      "export", "one CSV file per channel: every field a column, named by its path, with its unit");
+      "export",
+      "CSV: one file per channel, every field a column named by its path with its unit; MCAP: one file "
+      "for Foxglove");
   export_cmd->add_option("log", log_path, "the log")->required();
-  export_cmd->add_option("dir", out_path, "the folder for the CSV files (created; files overwritten)")
+  export_cmd
+      ->add_option("out", out_path,
+                   "the folder for the CSV files (created; files overwritten), or the MCAP file")
       ->required();
-  export_cmd->add_flag("--csv", "CSV (the only format, and the default)");
+  bool csv = false, mcap = false;
+  std::string urdf_path, scene_path;
+  auto* csv_flag =
+      export_cmd->add_flag("--csv", csv, "one CSV file per channel into the folder OUT (the default)");
+  export_cmd
+      ->add_flag("--mcap", mcap, "one MCAP file OUT for Foxglove: its channels and every LCM channel as JSON")
+      ->excludes(csv_flag);
+  export_cmd->add_option("--urdf", urdf_path,
+                         "--mcap: the robot of /scene and /tf (default: the shipped iiwa 7)");
+  export_cmd->add_option("--scene", scene_path,
+                         "--mcap: the scene of /scene (default: the shipped OR; none: no scene)");
   export_cmd->add_option("--from-s", from_s, "from this many seconds after the first event")
       ->check(orbed::NonNegativeNumber());
   export_cmd->add_option("--to-s", to_s, "to this many seconds after the first event")
@@ -214,6 +272,20 @@ int RunLogTool(int argc, const char* const* argv, std::ostream& out, std::ostrea
   try {
     if (*info) return Info(log, log_path, out);
     if (*check) return Check(log, log_path, out);
+    if (*export_cmd && mcap) {
+      McapExportOptions options;
+      options.out_path = out_path;
+      options.from_s = from_s;
+      options.to_s = to_s;
+      options.channels = channel_regex;
+      options.urdf_path = urdf_path;
+      options.scene_path = scene_path;
+      options.log_name = std::filesystem::path(log_path).filename().string();
+      const std::filesystem::path provenance =
+          std::filesystem::path(log_path).parent_path() / "provenance.json";
+      if (std::filesystem::is_regular_file(provenance)) options.provenance_path = provenance.string();
+      return ExportMcapFile(log, options, out, err);
+    }
     if (*export_cmd) {
       CsvExportOptions options;
       options.out_dir = out_path;

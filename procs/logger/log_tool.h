@@ -15,9 +15,13 @@
 ///   orbed-log export LOG DIR [--csv] [--from-s A] [--to-s B] [--channels REGEX]
 ///                          one CSV file per channel of a known type (csv_export.h): a column per
 ///                          field, named by its path with its unit; refusals counted per reason
+///   orbed-log export LOG OUT.mcap --mcap [--from-s A] [--to-s B] [--channels REGEX] [--urdf F] [--scene F]
+///                          one MCAP file for Foxglove (mcap_export.h): the Foxglove bridge's channels
+///                          and every LCM channel of a known type as JSON, the provenance.json beside
+///                          the log as metadata
 ///
-/// Exit codes: 0 ok; 1 check found damage, or a log or a CSV file cannot be read or written (one line on
-/// stderr); 2 bad arguments. Threading: single-threaded.
+/// Exit codes: 0 ok; 1 check found damage, or a log, a CSV or an MCAP file cannot be read or written (one
+/// line on stderr); 2 bad arguments. Threading: single-threaded.
 
 #include <ostream>
 
