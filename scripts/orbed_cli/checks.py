@@ -27,6 +27,17 @@ def positive(text):
     return text  # passed on as written
 
 
+def non_negative(text):
+    """A finite number >= 0."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not math.isfinite(value) or value < 0:
+        raise argparse.ArgumentTypeError(f"must be a number >= 0, not '{text}'")
+    return text  # passed on as written
+
+
 def key_value(text):
     """NAME=VALUE with a non-empty NAME."""
     name, sep, _ = text.partition("=")

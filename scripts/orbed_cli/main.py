@@ -13,7 +13,7 @@ import sys
 from .output import Console, Failure
 
 VERBS = ["setup", "build", "launch", "run", "deputy", "test", "spy", "join", "replay", "bench", "fuzz", "load",
-         "scale", "study", "bands", "sensitivity", "sweep", "fit", "verify"]
+         "scale", "study", "bands", "sensitivity", "sweep", "fit", "verify", "export"]
 PROG = "scripts/orbed"
 
 
