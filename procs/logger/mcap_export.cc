@@ -46,7 +46,7 @@ template <class Msg>
 bool HandleAs(Exporter& exporter, const MessageType& type, const LogEvent& e, std::string* reason);
 
 const std::vector<MessageType>& MessageTypes() {
-#define ORBED_MESSAGE_TYPE(T)                                                            \
+#define ORBED_MESSAGE_TYPE(T)                                                                \
   {orbed::T::getHash(), #T, lcm_json::JsonSchemaText(static_cast<const orbed::T*>(nullptr)), \
    &HandleAs<orbed::T>},
   static const std::vector<MessageType> types = {ORBED_FOR_EACH_LCM_TYPE(ORBED_MESSAGE_TYPE)};
@@ -72,12 +72,9 @@ std::string Hex(int64_t fingerprint) {
 // The walk over the log: the LCM channels as JSON, the Foxglove channels from the testbed's poses.
 class Exporter {
  public:
-  Exporter(const McapExportOptions& options, RecordSink* sink)
-      : options_(options),
-        sink_(sink),
-        model_(sim::RobotModel::LoadFlag(options.urdf_path)),
-        scene_(sim::LoadSceneFlag(options.scene_path)),
-        poses_(model_) {}
+  Exporter(const McapExportOptions& options, const sim::RobotModel& model, const sim::Scene* scene,
+           RecordSink* sink)
+      : options_(options), sink_(sink), model_(model), scene_(scene), poses_(model_) {}
 
   void Metadata(const std::string& name, const std::map<std::string, std::string>& entries) {
     ok_ = ok_ && sink_->Add(McapMetadataRecord{name, entries});
@@ -147,7 +144,8 @@ class Exporter {
     return id;
   }
 
-  uint16_t Channel(const std::string& topic, uint16_t schema_id, std::map<std::string, std::string> metadata) {
+  uint16_t Channel(const std::string& topic, uint16_t schema_id,
+                   std::map<std::string, std::string> metadata) {
     if (next_channel_id_ == 0xffff) throw std::runtime_error("more than 65534 channels");
     const uint16_t id = next_channel_id_++;
     ok_ = ok_ && sink_->Add(McapChannelRecord{id, schema_id, topic, "json", std::move(metadata)});
@@ -186,7 +184,7 @@ class Exporter {
     const bool with_virtual = poses_.X_WV().has_value();
     if (!last_scene_us_ || t - *last_scene_us_ >= static_cast<int64_t>(options_.scene_period_s * 1e6) ||
         with_virtual != scene_with_virtual_) {
-      Send(foxglove::kScene, t, foxglove::SceneUpdate(model_, scene_ ? &*scene_ : nullptr, with_virtual, t));
+      Send(foxglove::kScene, t, foxglove::SceneUpdate(model_, scene_, with_virtual, t));
       last_scene_us_ = t;
       scene_with_virtual_ = with_virtual;
     }
@@ -243,8 +241,8 @@ class Exporter {
   const McapExportOptions& options_;
   RecordSink* sink_;
   bool ok_ = true;
-  sim::RobotModel model_;
-  std::optional<sim::Scene> scene_;
+  const sim::RobotModel& model_;
+  const sim::Scene* scene_;
   sim::TestbedPoseState poses_;
   std::optional<Eigen::Isometry3d> X_WD_;
   std::optional<int64_t> last_tf_us_, last_scene_us_;
@@ -319,10 +317,10 @@ class PipeSink : public RecordSink {
   /// The last frame: the export is whole (without it the writer leaves no file).
   bool End() { return Frame('E', "{}", ""); }
   bool Add(const McapMetadataRecord& r) override {
-    return Frame('D',
-                 json{{"name", r.name}, {"metadata", r.metadata}}.dump(-1, ' ', false,
-                                                                        json::error_handler_t::replace),
-                 "");
+    return Frame(
+        'D',
+        json{{"name", r.name}, {"metadata", r.metadata}}.dump(-1, ' ', false, json::error_handler_t::replace),
+        "");
   }
 
  private:
@@ -353,8 +351,15 @@ class PipeSink : public RecordSink {
 }  // namespace
 
 McapExportResult WriteMcapRecords(const MappedLog& log, const McapExportOptions& options, RecordSink* sink) {
+  const sim::RobotModel model = sim::RobotModel::LoadFlag(options.urdf_path);
+  const std::optional<sim::Scene> scene = sim::LoadSceneFlag(options.scene_path);
+  return WriteMcapRecords(log.data(), log.size(), options, model, scene ? &*scene : nullptr, sink);
+}
+
+McapExportResult WriteMcapRecords(const uint8_t* data, size_t size, const McapExportOptions& options,
+                                  const sim::RobotModel& model, const sim::Scene* scene, RecordSink* sink) {
   McapExportResult result;
-  Exporter exporter(options, sink);
+  Exporter exporter(options, model, scene, sink);
   std::map<std::string, std::string> provenance;
   if (!options.provenance_path.empty()) {
     provenance = ProvenanceEntries(options.provenance_path, &result.provenance_problem);
@@ -363,7 +368,7 @@ McapExportResult WriteMcapRecords(const MappedLog& log, const McapExportOptions&
   exporter.Metadata("orbed.export", {{"log", options.log_name},
                                      {"from_s", ShortestDecimal(options.from_s)},
                                      {"to_s", ShortestDecimal(options.to_s)}});
-  EventLogScanner scanner = log.Scanner();
+  EventLogScanner scanner(data, size);
   LogEvent e;
   bool have_start = false;
   int64_t start_us = 0;
@@ -373,7 +378,8 @@ McapExportResult WriteMcapRecords(const MappedLog& log, const McapExportOptions&
       have_start = true;
     }
     const double t_s = (e.timestamp_us - start_us) * 1e-6;
-    if (t_s < options.from_s || t_s > options.to_s || !std::regex_match(e.channel, options.channels)) continue;
+    if (t_s < options.from_s || t_s > options.to_s || !std::regex_match(e.channel, options.channels))
+      continue;
     exporter.Event(e);
   }
   const std::string problem = result.provenance_problem;
@@ -415,7 +421,8 @@ McapExportResult ExportMcap(const MappedLog& log, const McapExportOptions& optio
     return result;
   }
   // A writer that died must not kill this process with SIGPIPE: its exit code says what happened.
-  struct sigaction ignore {}, previous {};
+  struct sigaction ignore {
+  }, previous{};
   ignore.sa_handler = SIG_IGN;
   sigaction(SIGPIPE, &ignore, &previous);
   try {

@@ -37,15 +37,17 @@
 #include <vector>
 
 #include "procs/logger/event_log_reader.h"
+#include "sim/robot_model.h"
+#include "sim/scene.h"
 
 namespace orbed::logger {
 
 struct McapExportOptions {
-  std::string out_path;            ///< the MCAP file (replaced when the export succeeds)
-  double from_s = 0, to_s = 1e18;  ///< seconds after the log's first event
-  std::regex channels{".*"};       ///< whole LCM channel name must match
-  std::string provenance_path;     ///< "" = none
-  std::string log_name;            ///< for the metadata
+  std::string out_path;               ///< the MCAP file (replaced when the export succeeds)
+  double from_s = 0, to_s = 1e18;     ///< seconds after the log's first event
+  std::regex channels{".*"};          ///< whole LCM channel name must match
+  std::string provenance_path;        ///< "" = none
+  std::string log_name;               ///< for the metadata
   std::string urdf_path, scene_path;  ///< the Foxglove channels' robot and scene ("" = shipped)
   double tf_hz = 30.0, scene_period_s = 1.0;
 };
@@ -99,8 +101,12 @@ struct McapExportResult {
   bool ok() const { return error.empty(); }
 };
 
-/// The records of `log` into `sink` (pure but for reading the provenance file and the model).
+/// The records of `log` into `sink` (pure but for reading the provenance file, the model and scene).
 McapExportResult WriteMcapRecords(const MappedLog& log, const McapExportOptions& options, RecordSink* sink);
+/// The same on log bytes in memory with the robot and scene given (`scene` may be null); the
+/// provenance file is read when options name one. The fuzz target's entry (fuzz_event_log).
+McapExportResult WriteMcapRecords(const uint8_t* data, size_t size, const McapExportOptions& options,
+                                  const sim::RobotModel& model, const sim::Scene* scene, RecordSink* sink);
 
 /// Writes options.out_path through node and the MCAP writer (see the file comment).
 McapExportResult ExportMcap(const MappedLog& log, const McapExportOptions& options);

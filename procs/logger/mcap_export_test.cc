@@ -128,8 +128,8 @@ TEST(McapExport, ReadBackByMcapCoreIndexedReader) {
   std::vector<uint8_t> jpeg;
   ASSERT_TRUE(cv::imencode(".jpg", picture, jpeg));
   const std::string jpeg_path = (dir / "frame.jpg").string();
-  std::ofstream(jpeg_path, std::ios::binary).write(reinterpret_cast<const char*>(jpeg.data()),
-                                                     static_cast<std::streamsize>(jpeg.size()));
+  std::ofstream(jpeg_path, std::ios::binary)
+      .write(reinterpret_cast<const char*>(jpeg.data()), static_cast<std::streamsize>(jpeg.size()));
 
   {
     EventLogWriter w(log);
@@ -216,9 +216,10 @@ TEST(McapExport, ReadBackByMcapCoreIndexedReader) {
 
   // Per channel: the events that decode as the channel's type (what orbed-log info counts, less
   // the refusals above); per Foxglove topic: what the bridge would have sent.
-  expect["counts"] = {{"ROBOT_STATE", 4},  {"IIWA_STATUS", 2}, {"HMD_POSE", 1},     {"HMD_CAMERA", 2},
-                      {"REFLECTIVE_VIEW", 1}, {"REGISTRATION", 1}, {"GUIDANCE", 1},  {"COLLISION_STATUS", 1},
-                      {"/tf", 2},          {"/scene", 2},       {"/hmd/camera", 1}, {"/reflective", 1},
+  expect["counts"] = {{"ROBOT_STATE", 4},   {"IIWA_STATUS", 2},      {"HMD_POSE", 1},
+                      {"HMD_CAMERA", 2},    {"REFLECTIVE_VIEW", 1},  {"REGISTRATION", 1},
+                      {"GUIDANCE", 1},      {"COLLISION_STATUS", 1}, {"/tf", 2},
+                      {"/scene", 2},        {"/hmd/camera", 1},      {"/reflective", 1},
                       {"/registration", 1}, {"/guidance", 1}};
   expect["nulls"] = {{{"topic", "IIWA_STATUS"}, {"sequence", 0}, {"path", "/joint_torque_external/3"}},
                      {{"topic", "COLLISION_STATUS"}, {"sequence", 0}, {"path", "/min_distance_m"}}};
@@ -232,8 +233,8 @@ TEST(McapExport, ReadBackByMcapCoreIndexedReader) {
 
   std::string output;
   const std::string writer_dir = ORBED_MCAP_WRITER_DIR;
-  const int code = Shell("ORBED_MCAP_FILE='" + mcap + "' ORBED_EXPECT_JSON='" + expect_path + "' '" + ORBED_NODE +
-                             "' --test '" + writer_dir + "/mcap_export.test.mjs'",
+  const int code = Shell("ORBED_MCAP_FILE='" + mcap + "' ORBED_EXPECT_JSON='" + expect_path + "' '" +
+                             ORBED_NODE + "' --test '" + writer_dir + "/mcap_export.test.mjs'",
                          &output);
   EXPECT_EQ(code, 0) << output;
   EXPECT_NE(output.find("# fail 0"), std::string::npos) << output;
@@ -245,8 +246,8 @@ TEST(McapExport, WriterLeavesNoFileWithoutTheEndFrame) {
   std::string output;
   const std::string writer_dir = ORBED_MCAP_WRITER_DIR;
   // The input ends before any frame (as when orbed-log stops half-way).
-  const int code = Shell("'" + std::string(ORBED_NODE) + "' '" + writer_dir + "/mcap_writer.mjs' '" + out.string() +
-                             "' < /dev/null",
+  const int code = Shell("'" + std::string(ORBED_NODE) + "' '" + writer_dir + "/mcap_writer.mjs' '" +
+                             out.string() + "' < /dev/null",
                          &output);
   EXPECT_EQ(code, 1) << output;
   EXPECT_NE(output.find("ended before its end frame"), std::string::npos) << output;
