@@ -224,6 +224,7 @@ TEST(McapExport, ReadBackByMcapCoreIndexedReader) {
   expect["nulls"] = {{{"topic", "IIWA_STATUS"}, {"sequence", 0}, {"path", "/joint_torque_external/3"}},
                      {{"topic", "COLLISION_STATUS"}, {"sequence", 0}, {"path", "/min_distance_m"}}};
   expect["registration_request_id"] = "9007199254740993";
+  expect["X_WH_on_second_tf"] = true;
   expect["provenance"] = provenance;
   expect["jpeg_path"] = jpeg_path;
   expect["log_times_ns"] = {{"/hmd/camera", std::to_string(kT0 + 8000) + "000"},

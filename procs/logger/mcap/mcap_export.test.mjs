@@ -1,6 +1,7 @@
 // orbed-log export --mcap read back by independent readers, run by procs/logger/mcap_export_test.cc
-// (node --test) on the file it exported ($ORBED_MCAP_FILE) with what the log held
-// ($ORBED_EXPECT_JSON):
+// (a log made by hand) and tests/integration/mcap_integration_test.cc (a real run's log) with node
+// --test on the file they exported ($ORBED_MCAP_FILE) and what the log held ($ORBED_EXPECT_JSON;
+// each check below runs when its expectation is there):
 //   - @mcap/core's McapIndexedReader opens it through its summary: a header, chunk indexes, the
 //     statistics, the metadata index; it reads every message through the indexes, with the chunks'
 //     CRCs checked; McapStreamReader reads it again front to back (every record, the chunks opened,
@@ -28,6 +29,7 @@ const foxgloveSchemas = createRequire(import.meta.url)("@foxglove/schemas/jsonsc
 const expected = JSON.parse(readFileSync(process.env.ORBED_EXPECT_JSON, "utf8"));
 const path = process.env.ORBED_MCAP_FILE;
 const decoder = new TextDecoder();
+let messagesRead = -1, metadataIndexed = -1;  // by the indexed reader, for the stream reader's counts
 
 async function openIndexed() {
   const handle = await open(path, "r");
@@ -66,7 +68,8 @@ test("the exported MCAP file, read back by @mcap/core", async () => {
     assert.ok(reader.chunkIndexes.length >= 1, "chunk indexes");
     assert.ok(reader.statistics, "statistics");
     assert.equal(reader.header.profile, "");
-    assert.ok(reader.metadataIndexes.some((m) => m.name === "provenance"), "metadata index");
+    assert.ok(reader.metadataIndexes.some((m) => m.name === "orbed.export"), "metadata index");
+    metadataIndexed = reader.metadataIndexes.length;
 
     const ajv = new Ajv({ strict: true, allErrors: true });
     const validators = new Map();  // channel id -> validate
@@ -89,22 +92,24 @@ test("the exported MCAP file, read back by @mcap/core", async () => {
     };
 
     const counts = {}, bySequence = {}, firstLogTime = {};
+    const keep = (topic, sequence) => sequence < 2 || topic === "IIWA_STATUS" && sequence < 8;
     for await (const message of reader.readMessages({ validateCrcs: true })) {
       const topic = topicOf.get(message.channelId);
       const text = decoder.decode(message.data);
       const value = JSON.parse(text);
       counts[topic] = (counts[topic] ?? 0) + 1;
-      (bySequence[topic] ??= new Map()).set(message.sequence, { value, text });
+      if (keep(topic, message.sequence)) (bySequence[topic] ??= new Map()).set(message.sequence, { value, text });
       if (!(topic in firstLogTime)) firstLogTime[topic] = message.logTime;
       assert.equal(message.publishTime, message.logTime);
       const { own, schemaName } = validators.get(message.channelId);
       if (!own(value)) {
-        // The one stated exception: a non-finite double is null where the schema says number.
-        const nulls = expected.nulls.filter((n) => n.topic === topic && n.sequence === message.sequence);
-        assert.ok(nulls.length > 0, `${topic} #${message.sequence}: ${JSON.stringify(own.errors)}`);
+        // The one stated exception: a non-finite double is null where the schema says number (where
+        // the log had one, when the expectation lists them).
+        const nulls = (expected.nulls ?? []).filter((n) => n.topic === topic && n.sequence === message.sequence);
+        assert.ok(!expected.nulls || nulls.length > 0, `${topic} #${message.sequence}: ${JSON.stringify(own.errors)}`);
         for (const error of own.errors) {
           assert.equal(error.keyword, "type", `${topic}: ${JSON.stringify(error)}`);
-          assert.ok(nulls.some((n) => n.path === error.instancePath), `${topic}: ${JSON.stringify(error)}`);
+          assert.ok(!expected.nulls || nulls.some((n) => n.path === error.instancePath), `${topic}: ${JSON.stringify(error)}`);
           assert.equal(pointer(value, error.instancePath), null);
         }
       }
@@ -112,10 +117,14 @@ test("the exported MCAP file, read back by @mcap/core", async () => {
         assert.ok(official[schemaName](value), `${topic} against @foxglove/schemas: ${JSON.stringify(official[schemaName].errors)}`);
       }
     }
-    assert.deepEqual(counts, expected.counts);
+    for (const [topic, n] of Object.entries(expected.counts)) assert.equal(counts[topic], n, topic);
+    for (const [topic, n] of Object.entries(expected.min_counts ?? {})) assert.ok(counts[topic] >= n, `${topic}: ${counts[topic]}`);
+    const listed = Object.keys(expected.counts).concat(Object.keys(expected.min_counts ?? {}));
+    assert.deepEqual(Object.keys(counts).sort(), listed.sort(), "the topics");
+    messagesRead = Object.values(counts).reduce((a, b) => a + b, 0);
     for (const [id, n] of reader.statistics.channelMessageCounts) assert.equal(Number(n), counts[topicOf.get(id)]);
     assert.equal(Number(reader.statistics.messageCount), Object.values(counts).reduce((a, b) => a + b, 0));
-    for (const [topic, ns] of Object.entries(expected.log_times_ns)) assert.equal(firstLogTime[topic], BigInt(ns));
+    for (const [topic, ns] of Object.entries(expected.log_times_ns ?? {})) assert.equal(firstLogTime[topic], BigInt(ns));
 
     // Values, exactly.
     const iiwa = bySequence["IIWA_STATUS"];
@@ -127,31 +136,39 @@ test("the exported MCAP file, read back by @mcap/core", async () => {
     const tf = bySequence["/tf"].get(0).value.transforms;
     const base = tf.find((t) => t.parent_frame_id === "W" && t.child_frame_id === "R");
     assert.deepEqual([base.translation.x, base.translation.y, base.translation.z], expected.X_WR.position_m);
-    assert.equal(tf.find((t) => t.child_frame_id === "H"), undefined, "no headset before its first HMD_POSE");
-    const head = bySequence["/tf"].get(1).value.transforms.find((t) => t.child_frame_id === "H");
-    assert.deepEqual([head.translation.x, head.translation.y, head.translation.z], expected.X_WH.position_m);
+    if (expected.X_WH_on_second_tf) {
+      assert.equal(tf.find((t) => t.child_frame_id === "H"), undefined, "no headset before its first HMD_POSE");
+      const head = bySequence["/tf"].get(1).value.transforms.find((t) => t.child_frame_id === "H");
+      assert.deepEqual([head.translation.x, head.translation.y, head.translation.z], expected.X_WH.position_m);
+    }
     const [w, x, y, z] = expected.X_WR.quaternion_wxyz, r = base.rotation;
     for (const [got, want] of [[r.w, w], [r.x, x], [r.y, y], [r.z, z]]) assert.ok(Math.abs(got - want) < 1e-15);
-    const virtualBase = bySequence["/tf"].get(1).value.transforms.find((t) => t.child_frame_id === "V");
-    assert.deepEqual([virtualBase.translation.x, virtualBase.translation.y, virtualBase.translation.z],
-      expected.X_WV.position_m);
-    const registration = bySequence["/registration"].get(0).value.X_WV_mean.position;
-    assert.deepEqual([registration.x, registration.y, registration.z], expected.X_WV.position_m);
+    if (expected.X_WV) {
+      const virtualBase = bySequence["/tf"].get(1).value.transforms.find((t) => t.child_frame_id === "V");
+      assert.deepEqual([virtualBase.translation.x, virtualBase.translation.y, virtualBase.translation.z],
+        expected.X_WV.position_m);
+      const registration = bySequence["/registration"].get(0).value.X_WV_mean.position;
+      assert.deepEqual([registration.x, registration.y, registration.z], expected.X_WV.position_m);
+      assert.ok(bySequence["/scene"].get(1).value.entities.some((e) => e.id.startsWith("virtual_robot/")));
+    }
     const jpeg = await readFile(expected.jpeg_path);
     const image = bySequence["/hmd/camera"].get(0).value;
     assert.equal(image.format, "jpeg");
     assert.deepEqual(Buffer.from(image.data, "base64"), jpeg);
     assert.deepEqual(Buffer.from(bySequence["HMD_CAMERA"].get(0).value.data, "base64"), jpeg);
-    assert.match(bySequence["REGISTRATION"].get(0).text, new RegExp(`"request_id":${expected.registration_request_id}\\b`));
-    assert.equal(bySequence["REGISTRATION"].get(0).value.session_id, "s\uFFFD1");
-    assert.equal(bySequence["/scene"].get(1).value.entities.filter((e) => e.id.startsWith("virtual_robot/")).length > 0, true);
+    if (expected.registration_request_id) {
+      assert.match(bySequence["REGISTRATION"].get(0).text, new RegExp(`"request_id":${expected.registration_request_id}\\b`));
+      assert.equal(bySequence["REGISTRATION"].get(0).value.session_id, "s\uFFFD1");
+    }
 
     // The provenance record.
-    const metadata = [];
-    for await (const m of reader.readMetadata({ name: "provenance" })) metadata.push(m);
-    assert.equal(metadata.length, 1);
-    for (const [key, value] of Object.entries(expected.provenance)) {
-      assert.equal(metadata[0].metadata.get(key), typeof value === "string" ? value : JSON.stringify(value));
+    if (expected.provenance) {
+      const metadata = [];
+      for await (const m of reader.readMetadata({ name: "provenance" })) metadata.push(m);
+      assert.equal(metadata.length, 1);
+      for (const [key, value] of Object.entries(expected.provenance)) {
+        assert.equal(metadata[0].metadata.get(key), typeof value === "string" ? value : JSON.stringify(value));
+      }
     }
   } finally {
     await handle.close();
@@ -168,7 +185,6 @@ test("the same file front to back with McapStreamReader", async () => {
   // (the reader opens the chunks and yields what is inside them)
   assert.ok(kinds.MessageIndex >= 1 && kinds.ChunkIndex >= 1 && kinds.SummaryOffset >= 1, JSON.stringify(kinds));
   assert.equal(kinds.Statistics, 1);
-  assert.equal(kinds.MetadataIndex, 2);
-  const total = Object.values(expected.counts).reduce((a, b) => a + b, 0);
-  assert.equal(kinds.Message, total);
+  assert.equal(kinds.MetadataIndex, metadataIndexed);
+  assert.equal(kinds.Message, messagesRead);
 });
