@@ -188,6 +188,9 @@ int ExportMcapFile(const MappedLog& log, const McapExportOptions& options, std::
                   static_cast<long long>(n), "");
     out << line;
   }
+  if (result.events_on_channels_left_out > 0)
+    out << "left out: " << result.events_on_channels_left_out << " events on channels beyond the first "
+        << kMaxMcapChannels << "\n";
   if (!options.provenance_path.empty())
     out << "provenance: " << EscapeText(options.provenance_path)
         << (result.provenance ? " (metadata \"provenance\")" : " left out: " + result.provenance_problem)

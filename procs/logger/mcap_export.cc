@@ -81,6 +81,10 @@ class Exporter {
   }
 
   void Event(const LogEvent& e) {
+    if (channels_.size() >= kMaxMcapChannels && !channels_.count(e.channel)) {
+      ++events_left_out_;
+      return;
+    }
     ChannelState& c = channels_[e.channel];
     if (c.result.channel.empty()) c.result.channel = e.channel;
     const MessageType* type = TypeOf(e.data, e.size);
@@ -118,6 +122,7 @@ class Exporter {
     McapExportResult result;
     for (const auto& [name, c] : channels_) result.channels.push_back(c.result);
     for (const auto& [id, t] : topics_) result.topics[t.topic] = t.messages;
+    result.events_on_channels_left_out = events_left_out_;
     return result;
   }
 
@@ -146,7 +151,6 @@ class Exporter {
 
   uint16_t Channel(const std::string& topic, uint16_t schema_id,
                    std::map<std::string, std::string> metadata) {
-    if (next_channel_id_ == 0xffff) throw std::runtime_error("more than 65534 channels");
     const uint16_t id = next_channel_id_++;
     ok_ = ok_ && sink_->Add(McapChannelRecord{id, schema_id, topic, "json", std::move(metadata)});
     return id;
@@ -251,6 +255,7 @@ class Exporter {
   std::map<uint32_t, TopicState> topics_;
   std::map<std::string, uint16_t> schema_ids_;
   uint16_t next_channel_id_ = 1;
+  int64_t events_left_out_ = 0;
 };
 
 template <class Msg>

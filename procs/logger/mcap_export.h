@@ -53,6 +53,9 @@ struct McapExportOptions {
 };
 
 inline constexpr size_t kMaxProvenanceBytes = 16 << 20;
+/// LCM channels beyond this many (in the order they first appear) are left out and counted: MCAP
+/// channel ids are 16-bit, and a hostile log must not make a map of millions of names.
+inline constexpr size_t kMaxMcapChannels = 4096;
 
 /// One record for the MCAP file. Ids are this export's, from 1, in the order they are handed out.
 struct McapSchemaRecord {
@@ -95,6 +98,7 @@ struct McapChannelResult {
 struct McapExportResult {
   std::vector<McapChannelResult> channels;  ///< LCM channels, in name order
   std::map<std::string, int64_t> topics;    ///< Foxglove topic → messages
+  int64_t events_on_channels_left_out = 0;  ///< events of the channels beyond kMaxMcapChannels
   bool provenance = false;                  ///< the provenance record went in
   std::string provenance_problem;           ///< why a provenance file was left out
   std::string error;

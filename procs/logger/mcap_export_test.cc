@@ -256,6 +256,35 @@ TEST(McapExport, WriterLeavesNoFileWithoutTheEndFrame) {
   EXPECT_FALSE(std::filesystem::exists(out.string() + ".part"));
 }
 
+// A log of more channels than kMaxMcapChannels: the channels after it are left out and their
+// events counted, before any state is kept for them.
+TEST(McapExport, ChannelsBeyondTheLimitAreLeftOutAndCounted) {
+  const std::string log = ::testing::TempDir() + "many_channels.lcmlog";
+  {
+    EventLogWriter w(log);
+    const std::vector<uint8_t> status = Encode(IiwaStatus(kT0, {0.5}));
+    for (size_t i = 0; i < kMaxMcapChannels + 10; ++i) {
+      const std::string channel = "C" + std::to_string(i);
+      ASSERT_GT(w.Write(kT0 + static_cast<int64_t>(i), channel, status.data(), status.size()), 0u);
+    }
+    w.Close();
+  }
+  struct Counter : RecordSink {
+    int channels = 0, messages = 0;
+    bool Add(const McapSchemaRecord&) override { return true; }
+    bool Add(const McapChannelRecord&) override { return ++channels, true; }
+    bool Add(const McapMessageRecord&) override { return ++messages, true; }
+    bool Add(const McapMetadataRecord&) override { return true; }
+  } sink;
+  const MappedLog mapped(log);
+  const McapExportResult result = WriteMcapRecords(mapped, McapExportOptions{}, &sink);
+  ASSERT_TRUE(result.ok()) << result.error;
+  EXPECT_EQ(result.channels.size(), kMaxMcapChannels);
+  EXPECT_EQ(result.events_on_channels_left_out, 10);
+  EXPECT_EQ(sink.channels, static_cast<int>(kMaxMcapChannels));
+  EXPECT_EQ(sink.messages, static_cast<int>(kMaxMcapChannels));
+}
+
 TEST(McapExport, MissingLogAndBadArguments) {
   std::ostringstream out, err;
   const char* both[] = {"orbed-log", "export", "x.lcmlog", "y", "--mcap", "--csv"};
