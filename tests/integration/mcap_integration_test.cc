@@ -102,7 +102,8 @@ TEST(McapExport, ARealRunReadBackByMcapCore) {
   expect["X_WR"] = PoseJson(state.X_WR);
   expect["jpeg_path"] = dir + "/camera.jpg";
   std::ofstream(dir + "/camera.jpg", std::ios::binary)
-      .write(reinterpret_cast<const char*>(camera.data.data()), static_cast<std::streamsize>(camera.data.size()));
+      .write(reinterpret_cast<const char*>(camera.data.data()),
+             static_cast<std::streamsize>(camera.data.size()));
   std::ofstream(dir + "/expect.json") << expect.dump(2);
 
   RunningProcess reader({ORBED_NODE, "--test", std::string(ORBED_MCAP_WRITER_DIR) + "/mcap_export.test.mjs"},
