@@ -1,0 +1,84 @@
+#pragma once
+/// @file
+/// The emulated device's state as hl2ss clients change and read it, without sockets: the
+/// remote-configuration (RC, port 3809) commands' answers and settings, and the PV subsystem that a
+/// client opens and closes through the PV port's control bits (protocol.h PvConfig start/stop).
+///
+/// What the answers mean (hl2ss.py ipc_rc):
+///   application version  4 × u16, the --app-version this emulator was given
+///   UTC offset           u64 FILETIME − ticks (protocol.h TimeBase::UtcOffset)
+///   PV subsystem status  u8: 1 while open
+///   current time         u64: ticks (source 0, QPC) or FILETIME (source 1, UTC) of `now_us`
+///   rig-node world poses count × 16 float32 zeros: the emulator keeps no rig-node history, and an
+///                        all-zero matrix is what the client's is_valid_pose reads as "not located"
+/// The PV settings (focus, exposure, white balance, ISO, ...) are kept as sent, for the PV metadata
+/// trailer; they do not change the emulated picture. Mapping camera points (0x16) is refused: the
+/// research-mode cameras' unprojection is not emulated. The SI sampling delay is kept (si_sampling_delay_ticks)
+/// but the SI stream samples the latest pose.
+///
+/// Threading: not thread-safe; one thread calls everything.
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "procs/hl2ss/protocol.h"
+
+namespace orbed::hl2ss {
+
+/// The PV camera settings a client set over RC (0 = never set; the client's units).
+struct PvSettings {
+  std::array<uint32_t, 5> focus{};         ///< mode, auto range, distance, value, driver fallback
+  uint32_t temporal_denoising{0};
+  uint32_t white_balance_preset{0};
+  uint32_t white_balance_value{0};         ///< [25 K]
+  std::array<uint32_t, 2> exposure{1, 0};  ///< mode (1 auto), value [10 µs]
+  uint32_t exposure_priority_video{0};
+  std::array<uint32_t, 2> iso_speed{1, 0};  ///< mode (1 auto), value
+  uint32_t backlight_compensation{0};
+  uint32_t scene_mode{0};
+  uint32_t desired_optimization{0};
+  uint32_t primary_use{0};
+  uint32_t optical_image_stabilization{0};
+  uint32_t hdr_video{0};
+};
+
+/// What the device does with one RC command: the bytes to answer (maybe none), or a refusal.
+struct RcOutcome {
+  std::vector<uint8_t> reply;
+  bool refused{false};
+  std::string key, reason;
+};
+
+class EmulatedDevice {
+ public:
+  EmulatedDevice(const TimeBase& time_base, std::array<uint16_t, 4> app_version)
+      : time_base_(time_base), app_version_(app_version) {}
+
+  const TimeBase& time_base() const { return time_base_; }
+  /// Applies or answers one parsed command at `now_us` (µs since the Unix epoch).
+  RcOutcome HandleRc(const RcCommand& command, int64_t now_us);
+
+  bool pv_open() const { return pv_open_; }
+  void OpenPv(const MrcVideoOptions& options) {
+    pv_open_ = true;
+    mrc_ = options;
+  }
+  void ClosePv() { pv_open_ = false; }
+  const MrcVideoOptions& mrc() const { return mrc_; }
+  const PvSettings& pv_settings() const { return pv_; }
+  int64_t si_sampling_delay_ticks() const { return si_sampling_delay_ticks_; }
+  bool marker() const { return marker_; }
+
+ private:
+  TimeBase time_base_;
+  std::array<uint16_t, 4> app_version_;
+  bool pv_open_{false};
+  MrcVideoOptions mrc_;
+  PvSettings pv_;
+  int64_t si_sampling_delay_ticks_{0};
+  bool marker_{false}, flat_mode_{false}, quiet_mode_{false}, eye_selection_{false};
+};
+
+}  // namespace orbed::hl2ss

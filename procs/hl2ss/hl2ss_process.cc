@@ -1,0 +1,313 @@
+#include "procs/hl2ss/hl2ss_process.h"
+
+#include <chrono>
+#include <cmath>
+#include <exception>
+#include <sstream>
+
+#include <CLI/CLI.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "base/log.h"
+#include "lcmtypes/contract/channels.h"
+#include "lcmtypes/contract/conversions.h"
+#include "lcmtypes/contract/requests.h"
+#include "lcmtypes/contract/validation.h"
+#include "procs/hl2ss/frames.h"
+#include "runtime/flags.h"
+
+namespace orbed::hl2ss {
+namespace {
+
+int64_t MonotonicMicros() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
+// "" or why an image cannot be served; on success *bgr holds its picture.
+std::string DecodeImage(const orbed::image_t& img, cv::Mat* bgr) {
+  std::string problem = CheckImage(img);
+  if (problem.empty() && (!std::isfinite(img.cx_px) || !std::isfinite(img.cy_px)))
+    problem = "image: cx_px, cy_px must be finite";
+  if (!problem.empty()) return problem;
+  if (img.width % 2 || img.height % 2) return "image: odd size (NV12 needs even sides)";
+  if (img.pixel_format == orbed::image_t::FORMAT_JPEG) {
+    *bgr = cv::imdecode(img.data, cv::IMREAD_COLOR);
+  } else if (img.pixel_format == orbed::image_t::FORMAT_BGR8) {
+    *bgr = cv::Mat(img.height, img.width, CV_8UC3, const_cast<uint8_t*>(img.data.data()), img.row_stride).clone();
+  } else {
+    return "image: pixel format " + std::to_string(img.pixel_format) + " (JPEG and BGR8 are served)";
+  }
+  if (bgr->empty() || bgr->cols != img.width || bgr->rows != img.height) return "image: data do not decode to its size";
+  return "";
+}
+
+}  // namespace
+
+Hl2ssProcess::Hl2ssProcess(const CommonFlags& flags, const Hl2ssOptions& options)
+    : process_(flags),
+      options_(options),
+      server_(options.server),
+      device_(TimeBase{NowMicros()}, options.app_version) {
+  handlers_.on_configured = [this](int client, PortKind port, const StreamConfig& config) {
+    return OnConfigured(client, port, config);
+  };
+  handlers_.on_rc = [this](int, const RcCommand& command) {
+    const RcOutcome outcome = device_.HandleRc(command, NowMicros());
+    Decision d;
+    if (outcome.refused) {
+      d.kind = Decision::kRefuse;
+      d.key = outcome.key;
+      d.reason = outcome.reason;
+    }
+    d.reply = outcome.reply;
+    return d;
+  };
+  handlers_.on_event = [this](const ServerEvent& event) { OnEvent(event); };
+
+  process_.Subscribe<orbed::hmd_pose_t>(
+      options_.pose_channel,
+      [this](const orbed::hmd_pose_t& msg, const std::string& channel, int64_t) { OnPose(msg, channel); });
+  process_.Subscribe<orbed::gaze_ray_t>(
+      options_.gaze_channel,
+      [this](const orbed::gaze_ray_t& msg, const std::string& channel, int64_t) { OnGaze(msg, channel); });
+  process_.Subscribe<orbed::image_t>(
+      options_.camera_channel,
+      [this](const orbed::image_t& msg, const std::string& channel, int64_t) { OnCamera(msg, channel); });
+  process_.AddWallTimer(
+      1.0 / options_.si_hz, [this] { SendSpatialInput(); }, "hl2ss/si");
+  process_.AddWallPoll(options_.poll_period_s, [this] { server_.Poll(MonotonicMicros(), handlers_); });
+
+  std::ostringstream ports;
+  for (PortKind kind : {PortKind::kRc, PortKind::kPv, PortKind::kSi, PortKind::kRmDepthLongThrow})
+    if (server_.port(kind) != 0) ports << " " << PortName(kind) << " " << server_.port(kind);
+  ORBED_LOG(kInfo) << "hl2ss: serving on " << options_.server.bind_address << ":" << ports.str()
+                   << "; UTC offset " << device_.time_base().UtcOffset();
+}
+
+void Hl2ssProcess::OnPose(const orbed::hmd_pose_t& msg, const std::string& channel) {
+  const std::string problem = FirstError({CheckWorldPose(msg.X_WH, "X_WH"), CheckWorldPose(msg.X_WC, "X_WC"),
+                                          CheckEnum(msg.tracking_state, 0, 3, "tracking_state")});
+  if (!problem.empty()) return process_.Reject(channel + "/field", problem);
+  pose_ = msg;
+  pose_received_us_ = MonotonicMicros();
+}
+
+void Hl2ssProcess::OnGaze(const orbed::gaze_ray_t& msg, const std::string& channel) {
+  const Eigen::Vector3d origin = ToVector3(msg.origin_W_m), direction = ToVector3(msg.direction_W);
+  std::string problem = FirstError({CheckBounded(msg.origin_W_m, 3, kMaxWorldDistance_m, "origin_W_m"),
+                                    CheckFinite(msg.direction_W, 3, "direction_W")});
+  if (problem.empty() && std::abs(direction.norm() - 1.0) > 1e-6) problem = "direction_W is not a unit vector";
+  if (!problem.empty()) return process_.Reject(channel + "/field", problem);
+  gaze_ = GazeSample{origin, direction};
+  gaze_received_us_ = MonotonicMicros();
+  gaze_utime_ = msg.utime;
+}
+
+void Hl2ssProcess::SendSpatialInput() {
+  const auto clients = server_.Serving(PortKind::kSi);
+  if (clients.empty()) return;
+  const int64_t now = MonotonicMicros();
+  const int64_t stale_us = static_cast<int64_t>(options_.stale_s * 1e6);
+  std::optional<HeadSample> head;
+  if (pose_ && now - pose_received_us_ <= stale_us)
+    head = HeadSample{FromPose(pose_->X_WH), pose_->tracking_state == orbed::hmd_pose_t::LOST};
+  std::optional<GazeSample> gaze;
+  if (gaze_ && now - gaze_received_us_ <= stale_us) gaze = gaze_;
+  const uint64_t stamp = device_.time_base().TicksOf(head ? pose_->utime : NowMicros());
+  const std::vector<uint8_t> packet = PackPacket(stamp, SiPayload(head, gaze), nullptr);
+  for (const auto& [client, config] : clients) server_.Send(client, packet, handlers_.on_event);
+}
+
+void Hl2ssProcess::OnCamera(const orbed::image_t& msg, const std::string& channel) {
+  const auto clients = server_.Serving(PortKind::kPv);
+  if (clients.empty()) return;
+  std::vector<int> due;
+  for (const auto& [client, config] : clients) {
+    const auto it = pv_clients_.find(client);
+    if (it != pv_clients_.end() && it->second.pacer.Next()) due.push_back(client);
+  }
+  if (due.empty()) return;
+  cv::Mat bgr;
+  const std::string problem = DecodeImage(msg, &bgr);
+  if (!problem.empty()) return process_.Reject(channel + "/image", problem);
+  const std::array<float, 16> pose = PoseMatrixRowMajor(CameraPoseForClient(FromPose(msg.X_WC)));
+  const uint64_t stamp = device_.time_base().TicksOf(msg.utime);
+  std::map<std::pair<int, int>, cv::Mat> resized;  // by (width, height): one resize per size
+  for (const auto& [client, config] : clients) {
+    if (std::find(due.begin(), due.end(), client) == due.end()) continue;
+    const PvConfig& c = std::get<PvConfig>(*config);
+    const std::pair<int, int> size{c.width, c.height};
+    if (!resized.count(size)) {
+      if (c.width == bgr.cols && c.height == bgr.rows) {
+        resized[size] = bgr;
+      } else {
+        cv::resize(bgr, resized[size], cv::Size(c.width, c.height), 0, 0, cv::INTER_LINEAR);
+      }
+    }
+    PvFrameInfo info;
+    info.timestamp = stamp;
+    info.width = c.width;
+    info.height = c.height;
+    const double sx = static_cast<double>(c.width) / bgr.cols, sy = static_cast<double>(c.height) / bgr.rows;
+    info.fx_px = msg.fx_px * sx;
+    info.fy_px = msg.fy_px * sy;
+    info.cx_px = (msg.cx_px + 0.5) * sx - 0.5;  // pixel centres at integers
+    info.cy_px = (msg.cy_px + 0.5) * sy - 0.5;
+    info.settings = &device_.pv_settings();
+    std::vector<uint8_t> payload;
+    try {
+      payload = pv_clients_.at(client).payload(resized[size], info);
+    } catch (const std::exception& e) {
+      process_.SetLastError(std::string("pv payload: ") + e.what());
+      continue;
+    }
+    server_.Send(client, PackPacket(stamp, payload, c.mode == kMode1 ? &pose : nullptr), handlers_.on_event);
+  }
+}
+
+Decision Hl2ssProcess::OnConfigured(int client, PortKind port, const StreamConfig& config) {
+  Decision d;
+  const auto refuse = [&d](const std::string& key, const std::string& reason) {
+    d.kind = Decision::kRefuse;
+    d.key = key;
+    d.reason = reason;
+    return d;
+  };
+  if (port == PortKind::kSi) return d;
+  if (port == PortKind::kRmDepthLongThrow) {
+    if (!options_.rm_depth_available)
+      return refuse("rm_depth/not_available", "the research-mode depth stream is not built into this orbed-hl2ss");
+    return d;
+  }
+  if (port != PortKind::kPv) return refuse(PortName(port) + "/unexpected", "no stream on this port");
+  const PvConfig& c = std::get<PvConfig>(config);
+  if (c.start) {
+    device_.OpenPv(c.mrc);
+    ORBED_LOG(kInfo) << "hl2ss: PV subsystem opened";
+  }
+  if (c.mode == kMode3) {
+    if (c.stop && device_.pv_open()) {
+      device_.ClosePv();
+      ORBED_LOG(kInfo) << "hl2ss: PV subsystem closed";
+    }
+    d.kind = Decision::kReplyAndClose;
+    return d;
+  }
+  if (!device_.pv_open())
+    return refuse("pv/subsystem_closed", "the PV subsystem is not open (a client opens it first: start_subsystem_pv)");
+  if (c.mode == kMode2) {
+    if (!options_.pv_calibration)
+      return refuse("pv/mode2", "PV calibration (mode 2) is not built into this orbed-hl2ss");
+    d.kind = Decision::kReplyAndClose;
+    d.reply = options_.pv_calibration(c);
+    return d;
+  }
+  std::string refusal;
+  PvPayloadFn payload = options_.pv_encoder(c, &refusal);
+  if (!payload) return refuse("pv/profile", refusal);
+  pv_clients_.insert_or_assign(client, PvClient{std::move(payload), PvPacer(c)});
+  return d;
+}
+
+void Hl2ssProcess::OnEvent(const ServerEvent& event) {
+  const std::string who = PortName(event.port) + " client " + event.peer;
+  switch (event.kind) {
+    case ServerEvent::kConnected:
+      ORBED_LOG(kInfo) << "hl2ss: " << who << " connected";
+      break;
+    case ServerEvent::kDisconnected:
+      pv_clients_.erase(event.client);
+      ORBED_LOG(kInfo) << "hl2ss: " << who << " left: " << event.detail;
+      break;
+    case ServerEvent::kRefused:
+      process_.Reject(event.key, event.peer + ": " + event.detail);
+      break;
+    case ServerEvent::kDropped:
+      process_.CountDrop(event.key);
+      break;
+    case ServerEvent::kStalled:
+      process_.CountDrop(event.key);
+      ORBED_LOG(kWarn) << "hl2ss: " << who << " dropped: " << event.detail;
+      break;
+  }
+}
+
+int RunHl2ss(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
+  CLI::App app{
+      "orbed-hl2ss: the emulated headset served as hl2ss serves a HoloLens 2, for unmodified hl2ss\n"
+      "clients (viewer/hl2ss.py, hl2ss_lnm.py): remote configuration on 3809, the front camera (PV,\n"
+      "RAW NV12 with the pose) on 3810 from HMD_CAMERA, spatial input (head pose, eye-gaze ray) on\n"
+      "3812 from HMD_POSE and GAZE_RAY; research-mode depth on 3805 is refused. docs/hl2ss.md."};
+  CommonFlags common("orbed-hl2ss");
+  AddCommonFlags(&app, &common);
+  Hl2ssOptions options;
+  int pv_port = kPortPersonalVideo, si_port = kPortSpatialInput, rc_port = kPortRemoteConfiguration,
+      rm_depth_port = kPortRmDepthLongThrow;
+  double max_queue_mb = 64;
+  std::string app_version = "1.0.0.0";
+  app.add_option("--bind", options.server.bind_address,
+                 "IPv4 address to listen on (0.0.0.0: every interface, for a client on another host)")
+      ->capture_default_str();
+  app.add_option("--pv-port", pv_port, "Personal-video port (0: any free port, printed at start)")
+      ->check(orbed::NumberIn(0, 65535))
+      ->capture_default_str();
+  app.add_option("--si-port", si_port, "Spatial-input port")->check(orbed::NumberIn(0, 65535))->capture_default_str();
+  app.add_option("--rc-port", rc_port, "Remote-configuration port")
+      ->check(orbed::NumberIn(0, 65535))
+      ->capture_default_str();
+  app.add_option("--rm-depth-port", rm_depth_port, "Research-mode depth long-throw port")
+      ->check(orbed::NumberIn(0, 65535))
+      ->capture_default_str();
+  app.add_option("--max-clients", options.server.max_clients, "Connections served at once per port")
+      ->check(orbed::NumberIn(1, 64))
+      ->capture_default_str();
+  app.add_option("--max-queue-mb", max_queue_mb, "Bytes queued per client before its packets are dropped [MiB]")
+      ->check(orbed::NumberIn(1.0, 1024.0))
+      ->capture_default_str();
+  app.add_option("--max-drops", options.server.max_consecutive_drops,
+                 "Packets dropped in a row before a client that stopped reading is closed")
+      ->check(orbed::NumberIn(1, 100000))
+      ->capture_default_str();
+  app.add_option("--config-timeout-s", options.server.config_timeout_s,
+                 "Seconds a client has to send its configuration (or finish an RC command)")
+      ->check(orbed::NumberIn(0.1, 600.0))
+      ->capture_default_str();
+  app.add_option("--si-hz", options.si_hz, "Spatial-input rate [Hz]")->check(orbed::NumberIn(1.0, 120.0))->capture_default_str();
+  app.add_option("--stale-s", options.stale_s, "Age after which a pose or gaze ray is reported invalid [s]")
+      ->check(orbed::NumberIn(0.01, 60.0))
+      ->capture_default_str();
+  app.add_option("--app-version", app_version, "What RC's application version answers (four numbers)")
+      ->capture_default_str();
+  app.add_option("--pose-channel", options.pose_channel, "hmd_pose_t channel (the head)")->capture_default_str();
+  app.add_option("--gaze-channel", options.gaze_channel, "gaze_ray_t channel (the eye-gaze ray)")->capture_default_str();
+  app.add_option("--camera-channel", options.camera_channel, "image_t channel (the front camera)")
+      ->capture_default_str();
+  if (const auto code = ParseCommandLine(&app, common, argc, argv, out, err)) return *code;
+  {
+    unsigned a = 0, b = 0, c = 0, d = 0;
+    char tail = 0;
+    if (std::sscanf(app_version.c_str(), "%u.%u.%u.%u%c", &a, &b, &c, &d, &tail) != 4 || a > 65535 || b > 65535 ||
+        c > 65535 || d > 65535) {
+      err << "orbed-hl2ss: --app-version: expected four numbers 0..65535 as a.b.c.d, got '" << app_version << "'\n";
+      return 2;
+    }
+    options.app_version = {static_cast<uint16_t>(a), static_cast<uint16_t>(b), static_cast<uint16_t>(c),
+                           static_cast<uint16_t>(d)};
+  }
+  options.server.ports = {{PortKind::kPv, pv_port},
+                          {PortKind::kSi, si_port},
+                          {PortKind::kRc, rc_port},
+                          {PortKind::kRmDepthLongThrow, rm_depth_port}};
+  options.server.max_queue_bytes = static_cast<size_t>(max_queue_mb * (1 << 20));
+  try {
+    Hl2ssProcess hl2ss(common, options);
+    return hl2ss.Run();
+  } catch (const std::exception& e) {
+    err << "orbed-hl2ss: " << e.what() << "\n";
+    return 1;
+  }
+}
+
+}  // namespace orbed::hl2ss

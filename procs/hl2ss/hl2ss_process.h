@@ -1,0 +1,105 @@
+#pragma once
+/// @file
+/// orbed-hl2ss: the emulated headset served the way hl2ss serves a HoloLens 2, so that an
+/// unmodified hl2ss client (viewer/hl2ss.py and hl2ss_lnm.py) connected to it gets orbed's data
+/// (docs/hl2ss.md). One TCP port per stream (hl2ss_server.h; loopback by default):
+///
+///   RC  3809  remote configuration (emulated_device.h): application version, UTC offset, PV
+///             subsystem status, current time, the PV settings; rig-node poses answered "not
+///             located"; mapping camera points refused
+///   PV  3810  the front camera: each HMD_CAMERA (JPEG, 30 Hz) decoded, resized to the client's
+///             size (the device's video sizes, 15 or 30 fps, divisor), its payload from the
+///             client's PvPayloadFn (streams.h; RAW = NV12 + metadata trailer), stamped with
+///             HMD_CAMERA's utime and, in mode 1, posed with its X_WC (the SLAM estimate) in D.
+///             The subsystem must be opened first (the START bit), as on the device. Mode 2
+///             (calibration) and the H.26x profiles are refused until their libraries are attached
+///             (Hl2ssOptions::pv_encoder, pv_calibration).
+///   SI  3812  spatial input at si_hz (30 Hz): the latest HMD_POSE's X_WH (the estimate) and
+///             GAZE_RAY's ray in D, stamped with that HMD_POSE's utime; a pose or ray older than
+///             stale_s is not valid; hands not tracked
+///   RM depth long throw 3805: configurations parsed and checked; refused until a depth source
+///             is attached (Hl2ssOptions::rm_depth_available)
+///
+/// Timestamps: hl2ss ticks since the process started (protocol.h TimeBase), so ticks + the UTC
+/// offset RC answers is the message's utime as a FILETIME.
+///
+/// Every LCM input is checked before use and refused with a counted reason ("<channel>/field");
+/// every client refusal is counted under its key ("pv/size", "rc/unknown", "si/unexpected", ...);
+/// frames a slow client misses are counted as drops "<port>/backlog", a client dropped for it as
+/// "<port>/stalled". Connections are logged.
+///
+/// Threading: everything on the Process::Run thread; the sockets are polled by a timer every
+/// poll_period_s without blocking.
+
+#include <array>
+#include <iosfwd>
+#include <map>
+#include <optional>
+#include <string>
+
+#include <orbed/gaze_ray_t.hpp>
+#include <orbed/hmd_pose_t.hpp>
+#include <orbed/image_t.hpp>
+
+#include "procs/hl2ss/emulated_device.h"
+#include "procs/hl2ss/hl2ss_server.h"
+#include "procs/hl2ss/streams.h"
+#include "runtime/process.h"
+
+namespace orbed::hl2ss {
+
+struct Hl2ssOptions {
+  ServerOptions server;
+  std::string pose_channel{"HMD_POSE"};
+  std::string gaze_channel{"GAZE_RAY"};
+  std::string camera_channel{"HMD_CAMERA"};
+  double si_hz{30.0};
+  double stale_s{0.5};  ///< an HMD_POSE or GAZE_RAY older than this is not reported valid
+  double poll_period_s{0.002};
+  std::array<uint16_t, 4> app_version{1, 0, 0, 0};
+  /// Makes each PV client's payload function (the seam for the video encoder).
+  PvEncoderFactory pv_encoder = RawOnlyPvEncoderFactory();
+  /// The PV mode-2 answer for a format (the calibration); empty function: mode 2 refused.
+  std::function<std::vector<uint8_t>(const PvConfig&)> pv_calibration;
+  bool rm_depth_available{false};
+};
+
+class Hl2ssProcess {
+ public:
+  /// Throws std::runtime_error when a port cannot be opened.
+  Hl2ssProcess(const CommonFlags& flags, const Hl2ssOptions& options);
+  int Run() { return process_.Run(); }
+  Process& process() { return process_; }
+  const Hl2ssServer& server() const { return server_; }
+  const EmulatedDevice& device() const { return device_; }
+
+ private:
+  void OnPose(const orbed::hmd_pose_t& msg, const std::string& channel);
+  void OnGaze(const orbed::gaze_ray_t& msg, const std::string& channel);
+  void OnCamera(const orbed::image_t& msg, const std::string& channel);
+  void SendSpatialInput();
+  Decision OnConfigured(int client, PortKind port, const StreamConfig& config);
+  void OnEvent(const ServerEvent& event);
+
+  Process process_;
+  Hl2ssOptions options_;
+  Hl2ssServer server_;
+  EmulatedDevice device_;
+  ServerHandlers handlers_;
+  struct PvClient {
+    PvPayloadFn payload;
+    PvPacer pacer;
+  };
+  std::map<int, PvClient> pv_clients_;
+  std::optional<orbed::hmd_pose_t> pose_;
+  int64_t pose_received_us_{0};
+  std::optional<GazeSample> gaze_;
+  int64_t gaze_received_us_{0};
+  int64_t gaze_utime_{0};
+};
+
+/// orbed-hl2ss's command line (--help). Exit 0; 2 on bad arguments; 1 when it cannot start (a
+/// port is taken).
+int RunHl2ss(int argc, const char* const* argv, std::ostream& out, std::ostream& err);
+
+}  // namespace orbed::hl2ss
