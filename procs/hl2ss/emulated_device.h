@@ -13,8 +13,8 @@
 ///                        all-zero matrix is what the client's is_valid_pose reads as "not located"
 /// The PV settings (focus, exposure, white balance, ISO, ...) are kept as sent, for the PV metadata
 /// trailer; they do not change the emulated picture. Mapping camera points (0x16) is refused: the
-/// research-mode cameras' unprojection is not emulated. The SI sampling delay is kept (si_sampling_delay_ticks)
-/// but the SI stream samples the latest pose.
+/// research-mode cameras' unprojection is not emulated. The SI sampling delay is kept
+/// (si_sampling_delay_ticks) but the SI stream samples the latest pose.
 ///
 /// Threading: not thread-safe; one thread calls everything.
 
@@ -29,7 +29,7 @@ namespace orbed::hl2ss {
 
 /// The PV camera settings a client set over RC (0 = never set; the client's units).
 struct PvSettings {
-  std::array<uint32_t, 5> focus{};         ///< mode, auto range, distance, value, driver fallback
+  std::array<uint32_t, 5> focus{};  ///< mode, auto range, distance, value, driver fallback
   uint32_t temporal_denoising{0};
   uint32_t white_balance_preset{0};
   uint32_t white_balance_value{0};         ///< [25 K]

@@ -21,7 +21,8 @@ namespace orbed::hl2ss {
 namespace {
 
 int64_t MonotonicMicros() {
-  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now().time_since_epoch())
+  return std::chrono::duration_cast<std::chrono::microseconds>(
+             std::chrono::steady_clock::now().time_since_epoch())
       .count();
 }
 
@@ -35,11 +36,13 @@ std::string DecodeImage(const orbed::image_t& img, cv::Mat* bgr) {
   if (img.pixel_format == orbed::image_t::FORMAT_JPEG) {
     *bgr = cv::imdecode(img.data, cv::IMREAD_COLOR);
   } else if (img.pixel_format == orbed::image_t::FORMAT_BGR8) {
-    *bgr = cv::Mat(img.height, img.width, CV_8UC3, const_cast<uint8_t*>(img.data.data()), img.row_stride).clone();
+    *bgr = cv::Mat(img.height, img.width, CV_8UC3, const_cast<uint8_t*>(img.data.data()), img.row_stride)
+               .clone();
   } else {
     return "image: pixel format " + std::to_string(img.pixel_format) + " (JPEG and BGR8 are served)";
   }
-  if (bgr->empty() || bgr->cols != img.width || bgr->rows != img.height) return "image: data do not decode to its size";
+  if (bgr->empty() || bgr->cols != img.width || bgr->rows != img.height)
+    return "image: data do not decode to its size";
   return "";
 }
 
@@ -98,7 +101,8 @@ void Hl2ssProcess::OnGaze(const orbed::gaze_ray_t& msg, const std::string& chann
   const Eigen::Vector3d origin = ToVector3(msg.origin_W_m), direction = ToVector3(msg.direction_W);
   std::string problem = FirstError({CheckBounded(msg.origin_W_m, 3, kMaxWorldDistance_m, "origin_W_m"),
                                     CheckFinite(msg.direction_W, 3, "direction_W")});
-  if (problem.empty() && std::abs(direction.norm() - 1.0) > 1e-6) problem = "direction_W is not a unit vector";
+  if (problem.empty() && std::abs(direction.norm() - 1.0) > 1e-6)
+    problem = "direction_W is not a unit vector";
   if (!problem.empty()) return process_.Reject(channel + "/field", problem);
   gaze_ = GazeSample{origin, direction};
   gaze_received_us_ = MonotonicMicros();
@@ -178,7 +182,8 @@ Decision Hl2ssProcess::OnConfigured(int client, PortKind port, const StreamConfi
   if (port == PortKind::kSi) return d;
   if (port == PortKind::kRmDepthLongThrow) {
     if (!options_.rm_depth_available)
-      return refuse("rm_depth/not_available", "the research-mode depth stream is not built into this orbed-hl2ss");
+      return refuse("rm_depth/not_available",
+                    "the research-mode depth stream is not built into this orbed-hl2ss");
     return d;
   }
   if (port != PortKind::kPv) return refuse(PortName(port) + "/unexpected", "no stream on this port");
@@ -196,7 +201,8 @@ Decision Hl2ssProcess::OnConfigured(int client, PortKind port, const StreamConfi
     return d;
   }
   if (!device_.pv_open())
-    return refuse("pv/subsystem_closed", "the PV subsystem is not open (a client opens it first: start_subsystem_pv)");
+    return refuse("pv/subsystem_closed",
+                  "the PV subsystem is not open (a client opens it first: start_subsystem_pv)");
   if (c.mode == kMode2) {
     if (!options_.pv_calibration)
       return refuse("pv/mode2", "PV calibration (mode 2) is not built into this orbed-hl2ss");
@@ -253,7 +259,9 @@ int RunHl2ss(int argc, const char* const* argv, std::ostream& out, std::ostream&
   app.add_option("--pv-port", pv_port, "Personal-video port (0: any free port, printed at start)")
       ->check(orbed::NumberIn(0, 65535))
       ->capture_default_str();
-  app.add_option("--si-port", si_port, "Spatial-input port")->check(orbed::NumberIn(0, 65535))->capture_default_str();
+  app.add_option("--si-port", si_port, "Spatial-input port")
+      ->check(orbed::NumberIn(0, 65535))
+      ->capture_default_str();
   app.add_option("--rc-port", rc_port, "Remote-configuration port")
       ->check(orbed::NumberIn(0, 65535))
       ->capture_default_str();
@@ -263,7 +271,8 @@ int RunHl2ss(int argc, const char* const* argv, std::ostream& out, std::ostream&
   app.add_option("--max-clients", options.server.max_clients, "Connections served at once per port")
       ->check(orbed::NumberIn(1, 64))
       ->capture_default_str();
-  app.add_option("--max-queue-mb", max_queue_mb, "Bytes queued per client before its packets are dropped [MiB]")
+  app.add_option("--max-queue-mb", max_queue_mb,
+                 "Bytes queued per client before its packets are dropped [MiB]")
       ->check(orbed::NumberIn(1.0, 1024.0))
       ->capture_default_str();
   app.add_option("--max-drops", options.server.max_consecutive_drops,
@@ -274,23 +283,28 @@ int RunHl2ss(int argc, const char* const* argv, std::ostream& out, std::ostream&
                  "Seconds a client has to send its configuration (or finish an RC command)")
       ->check(orbed::NumberIn(0.1, 600.0))
       ->capture_default_str();
-  app.add_option("--si-hz", options.si_hz, "Spatial-input rate [Hz]")->check(orbed::NumberIn(1.0, 120.0))->capture_default_str();
+  app.add_option("--si-hz", options.si_hz, "Spatial-input rate [Hz]")
+      ->check(orbed::NumberIn(1.0, 120.0))
+      ->capture_default_str();
   app.add_option("--stale-s", options.stale_s, "Age after which a pose or gaze ray is reported invalid [s]")
       ->check(orbed::NumberIn(0.01, 60.0))
       ->capture_default_str();
   app.add_option("--app-version", app_version, "What RC's application version answers (four numbers)")
       ->capture_default_str();
-  app.add_option("--pose-channel", options.pose_channel, "hmd_pose_t channel (the head)")->capture_default_str();
-  app.add_option("--gaze-channel", options.gaze_channel, "gaze_ray_t channel (the eye-gaze ray)")->capture_default_str();
+  app.add_option("--pose-channel", options.pose_channel, "hmd_pose_t channel (the head)")
+      ->capture_default_str();
+  app.add_option("--gaze-channel", options.gaze_channel, "gaze_ray_t channel (the eye-gaze ray)")
+      ->capture_default_str();
   app.add_option("--camera-channel", options.camera_channel, "image_t channel (the front camera)")
       ->capture_default_str();
   if (const auto code = ParseCommandLine(&app, common, argc, argv, out, err)) return *code;
   {
     unsigned a = 0, b = 0, c = 0, d = 0;
     char tail = 0;
-    if (std::sscanf(app_version.c_str(), "%u.%u.%u.%u%c", &a, &b, &c, &d, &tail) != 4 || a > 65535 || b > 65535 ||
-        c > 65535 || d > 65535) {
-      err << "orbed-hl2ss: --app-version: expected four numbers 0..65535 as a.b.c.d, got '" << app_version << "'\n";
+    if (std::sscanf(app_version.c_str(), "%u.%u.%u.%u%c", &a, &b, &c, &d, &tail) != 4 || a > 65535 ||
+        b > 65535 || c > 65535 || d > 65535) {
+      err << "orbed-hl2ss: --app-version: expected four numbers 0..65535 as a.b.c.d, got '" << app_version
+          << "'\n";
       return 2;
     }
     options.app_version = {static_cast<uint16_t>(a), static_cast<uint16_t>(b), static_cast<uint16_t>(c),

@@ -88,13 +88,15 @@ void Hl2ssServer::Queue(Client& c, std::vector<uint8_t> bytes) {
   c.out.push_back(std::move(bytes));
 }
 
-void Hl2ssServer::Refuse(Client& c, const std::string& key, const std::string& reason, const ServerHandlers& h) {
+void Hl2ssServer::Refuse(Client& c, const std::string& key, const std::string& reason,
+                         const ServerHandlers& h) {
   if (h.on_event) h.on_event({ServerEvent::kRefused, c.port, c.id, c.peer, key, reason});
 }
 
 bool Hl2ssServer::Send(int client, std::vector<uint8_t> packet,
                        const std::function<void(const ServerEvent&)>& on_event) {
-  const auto it = std::find_if(clients_.begin(), clients_.end(), [client](const auto& c) { return c->id == client; });
+  const auto it =
+      std::find_if(clients_.begin(), clients_.end(), [client](const auto& c) { return c->id == client; });
   if (it == clients_.end() || (*it)->state != Client::kServing) return false;
   Client& c = **it;
   if (c.out.size() < options_.max_queue_packets && c.out_bytes + packet.size() <= options_.max_queue_bytes) {
@@ -105,7 +107,8 @@ bool Hl2ssServer::Send(int client, std::vector<uint8_t> packet,
   ++c.consecutive_drops;
   if (on_event) on_event({ServerEvent::kDropped, c.port, c.id, c.peer, PortName(c.port) + "/backlog", ""});
   if (c.consecutive_drops >= options_.max_consecutive_drops) {
-    const std::string why = "stalled: " + std::to_string(c.consecutive_drops) + " packets in a row found its queue full";
+    const std::string why =
+        "stalled: " + std::to_string(c.consecutive_drops) + " packets in a row found its queue full";
     if (on_event) on_event({ServerEvent::kStalled, c.port, c.id, c.peer, PortName(c.port) + "/stalled", why});
     if (on_event) on_event({ServerEvent::kDisconnected, c.port, c.id, c.peer, "", why});
     close(c.fd);
@@ -118,7 +121,8 @@ void Hl2ssServer::Accept(Listener& listener, int64_t now_us, const ServerHandler
   for (;;) {
     sockaddr_in address{};
     socklen_t size = sizeof(address);
-    const int fd = accept4(listener.fd, reinterpret_cast<sockaddr*>(&address), &size, SOCK_NONBLOCK | SOCK_CLOEXEC);
+    const int fd =
+        accept4(listener.fd, reinterpret_cast<sockaddr*>(&address), &size, SOCK_NONBLOCK | SOCK_CLOEXEC);
     if (fd < 0) return;
     const size_t on_port = static_cast<size_t>(std::count_if(
         clients_.begin(), clients_.end(), [&](const auto& c) { return c->port == listener.kind; }));
@@ -139,7 +143,8 @@ void Hl2ssServer::Accept(Listener& listener, int64_t now_us, const ServerHandler
     if (h.on_event) h.on_event({ServerEvent::kConnected, client->port, client->id, client->peer, "", ""});
     if (listener.kind == PortKind::kSi) {  // no configuration: served at once
       client->config = SiConfig{};
-      const Decision d = h.on_configured ? h.on_configured(client->id, PortKind::kSi, client->config) : Decision{};
+      const Decision d =
+          h.on_configured ? h.on_configured(client->id, PortKind::kSi, client->config) : Decision{};
       if (d.kind == Decision::kRefuse) {
         Refuse(*client, d.key, d.reason, h);
         close(fd);
@@ -159,8 +164,9 @@ bool Hl2ssServer::Consume(Client& c, int64_t now_us, const ServerHandlers& h, st
   };
   if (c.in.empty()) return true;
   if (c.state == Client::kServing && c.port != PortKind::kRc)
-    return refuse(PortName(c.port) + "/unexpected",
-                  std::to_string(c.in.size()) + " bytes after the configuration (a stream client only reads)");
+    return refuse(
+        PortName(c.port) + "/unexpected",
+        std::to_string(c.in.size()) + " bytes after the configuration (a stream client only reads)");
   if (c.state == Client::kClosing) {
     c.in.clear();
     return true;
@@ -220,7 +226,8 @@ bool Hl2ssServer::Read(Client& c, int64_t now_us, const ServerHandlers& h, std::
     const ssize_t n = recv(c.fd, buffer, sizeof(buffer), MSG_DONTWAIT);
     if (n > 0) {
       if (c.in.size() + static_cast<size_t>(n) > max_in) {
-        Refuse(c, PortName(c.port) + "/too_long", "more than " + std::to_string(max_in) + " bytes unparsed", h);
+        Refuse(c, PortName(c.port) + "/too_long", "more than " + std::to_string(max_in) + " bytes unparsed",
+               h);
         *why = "refused: input too long";
         return false;
       }
@@ -274,8 +281,10 @@ void Hl2ssServer::Poll(int64_t now_us, const ServerHandlers& h) {
       why = "refused: configuration timeout";
       keep = false;
     }
-    if (keep && c.port == PortKind::kRc && c.pending_since_us != 0 && now_us - c.pending_since_us > timeout_us) {
-      Refuse(c, "rc/timeout", "a command left unfinished for " + std::to_string(options_.config_timeout_s) + " s", h);
+    if (keep && c.port == PortKind::kRc && c.pending_since_us != 0 &&
+        now_us - c.pending_since_us > timeout_us) {
+      Refuse(c, "rc/timeout",
+             "a command left unfinished for " + std::to_string(options_.config_timeout_s) + " s", h);
       why = "refused: command timeout";
       keep = false;
     }

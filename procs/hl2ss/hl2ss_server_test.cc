@@ -105,8 +105,8 @@ bool Closed(Harness* h, int fd) {
       {fd});
 }
 
-const std::vector<uint8_t> kPvRaw720 = {0x01, 0x00, 0x05, 0xd0, 0x02, 0x1e, 0x01, 0xff, 0xff,
-                                        0x00, 0x00, 0x10, 0x00, 0x00};  // no encoder options
+const std::vector<uint8_t> kPvRaw720 = {0x01, 0x00, 0x05, 0xd0, 0x02, 0x1e, 0x01,
+                                        0xff, 0xff, 0x00, 0x00, 0x10, 0x00, 0x00};  // no encoder options
 
 TEST(Hl2ssServer, ConfigurationInPiecesThenThePacketsSent) {
   Harness h;
@@ -179,7 +179,8 @@ TEST(Hl2ssServer, AClientThatStopsReadingLosesPacketsThenIsClosed) {
   const std::vector<uint8_t> packet = PackPacket(5, std::vector<uint8_t>(1 << 20, 9), nullptr);
   int delivered = 0;
   for (int i = 0; i < 60 && h.Count(ServerEvent::kStalled) == 0; ++i) {
-    for (const auto& [id, config] : h.server.Serving(PortKind::kSi)) h.server.Send(id, packet, h.handlers.on_event);
+    for (const auto& [id, config] : h.server.Serving(PortKind::kSi))
+      h.server.Send(id, packet, h.handlers.on_event);
     const std::vector<uint8_t> got = ReadN(&h, reader, packet.size());
     ASSERT_EQ(got, packet);
     ++delivered;

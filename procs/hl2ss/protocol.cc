@@ -52,8 +52,8 @@ void PutF32(std::vector<uint8_t>* out, float v) {
 }
 uint16_t GetU16(const uint8_t* p) { return static_cast<uint16_t>(p[0] | (p[1] << 8)); }
 uint32_t GetU32(const uint8_t* p) {
-  return static_cast<uint32_t>(p[0]) | (static_cast<uint32_t>(p[1]) << 8) | (static_cast<uint32_t>(p[2]) << 16) |
-         (static_cast<uint32_t>(p[3]) << 24);
+  return static_cast<uint32_t>(p[0]) | (static_cast<uint32_t>(p[1]) << 8) |
+         (static_cast<uint32_t>(p[2]) << 16) | (static_cast<uint32_t>(p[3]) << 24);
 }
 uint64_t GetU64(const uint8_t* p) { return GetU32(p) | (static_cast<uint64_t>(GetU32(p + 4)) << 32); }
 float GetF32(const uint8_t* p) {
@@ -77,9 +77,9 @@ std::vector<uint8_t> PackPacket(uint64_t timestamp, const std::vector<uint8_t>& 
 
 // ---------------------------------------------------------------------------------------------
 const std::vector<PvFormatSize>& PvVideoSizes() {
-  static const std::vector<PvFormatSize> kSizes = {
-      {2272, 1278}, {1952, 1100}, {1920, 1080}, {1504, 846}, {1280, 720}, {1128, 636},
-      {960, 540},   {896, 504},   {760, 428},   {640, 360},  {500, 282},  {424, 240}};
+  static const std::vector<PvFormatSize> kSizes = {{2272, 1278}, {1952, 1100}, {1920, 1080}, {1504, 846},
+                                                   {1280, 720},  {1128, 636},  {960, 540},   {896, 504},
+                                                   {760, 428},   {640, 360},   {500, 282},   {424, 240}};
   return kSizes;
 }
 
@@ -91,7 +91,8 @@ std::string CheckVideoFormat(uint16_t width, uint16_t height, uint8_t framerate,
   for (const PvFormatSize& s : PvVideoSizes()) known = known || (s.width == width && s.height == height);
   if (!known) {
     *key = "pv/size";
-    return "video size " + std::to_string(width) + "x" + std::to_string(height) + " is not one the camera offers";
+    return "video size " + std::to_string(width) + "x" + std::to_string(height) +
+           " is not one the camera offers";
   }
   if (framerate != 15 && framerate != 30) {
     *key = "pv/framerate";
@@ -101,9 +102,9 @@ std::string CheckVideoFormat(uint16_t width, uint16_t height, uint8_t framerate,
 }
 
 bool KnownLevel(uint8_t level) {
-  static const uint8_t kLevels[] = {10,  11,  12,  13,  20,  21,  22,  30,  31,  32,  40,  41,  42,  50,
-                                    51,  52,  60,  63,  90,  93,  120, 123, 150, 153, 156, 180, 183, 186,
-                                    kLevelDefault};
+  static const uint8_t kLevels[] = {10,  11,  12,  13,  20,  21,  22,  30,  31,           32,
+                                    40,  41,  42,  50,  51,  52,  60,  63,  90,           93,
+                                    120, 123, 150, 153, 156, 180, 183, 186, kLevelDefault};
   for (uint8_t l : kLevels)
     if (l == level) return true;
   return false;
@@ -124,7 +125,8 @@ Parsed<PvConfig> ParsePvConfig(const uint8_t* data, size_t size) {
     if (size < at + kMrcVideoOptionsBytes) return NeedMore<PvConfig>();
     const uint8_t* p = data + at;
     for (int i = 0; i < 7; ++i)
-      if (p[i] > 1) return Refuse<PvConfig>("pv/mrc", "MRC flag " + std::to_string(i) + " is " + std::to_string(p[i]));
+      if (p[i] > 1)
+        return Refuse<PvConfig>("pv/mrc", "MRC flag " + std::to_string(i) + " is " + std::to_string(p[i]));
     c.mrc.enable = p[0];
     c.mrc.hologram_composition = p[1];
     c.mrc.recording_indicator = p[2];
@@ -143,7 +145,8 @@ Parsed<PvConfig> ParsePvConfig(const uint8_t* data, size_t size) {
         !(c.mrc.output_height >= 0.0f && c.mrc.output_height <= 8192.0f))
       return Refuse<PvConfig>("pv/mrc", "MRC output size outside 0..8192");
     if (c.mrc.video_stabilization_length > 30)
-      return Refuse<PvConfig>("pv/mrc", OutOf("video stabilization length", c.mrc.video_stabilization_length, 0, 30));
+      return Refuse<PvConfig>("pv/mrc",
+                              OutOf("video stabilization length", c.mrc.video_stabilization_length, 0, 30));
     if (c.mrc.hologram_perspective > 1)
       return Refuse<PvConfig>("pv/mrc", OutOf("hologram perspective", c.mrc.hologram_perspective, 0, 1));
     at += kMrcVideoOptionsBytes;
@@ -173,7 +176,8 @@ Parsed<PvConfig> ParsePvConfig(const uint8_t* data, size_t size) {
   if (!KnownLevel(c.level)) return Refuse<PvConfig>("pv/level", "H.26x level " + std::to_string(c.level));
   if (c.bitrate == 0) return Refuse<PvConfig>("pv/bitrate", "bitrate 0");
   if (size < at + 16u * count) return NeedMore<PvConfig>();
-  for (int i = 0; i < count; ++i) c.options.emplace_back(GetU64(data + at + 16 * i), GetU64(data + at + 16 * i + 8));
+  for (int i = 0; i < count; ++i)
+    c.options.emplace_back(GetU64(data + at + 16 * i), GetU64(data + at + 16 * i + 8));
   at += 16u * count;
   return Done(at, std::move(c));
 }
@@ -194,7 +198,8 @@ Parsed<RmDepthLongThrowConfig> ParseRmDepthLongThrowConfig(const uint8_t* data, 
 }
 
 Parsed<SiConfig> ParseSiConfig(const uint8_t* /*data*/, size_t size) {
-  if (size > 0) return Refuse<SiConfig>("si/unexpected", "the spatial-input port takes no bytes from a client");
+  if (size > 0)
+    return Refuse<SiConfig>("si/unexpected", "the spatial-input port takes no bytes from a client");
   return Done<SiConfig>(0, SiConfig{});
 }
 
@@ -262,7 +267,8 @@ std::string CheckRcArguments(const RcCommand& c) {
     case RcCommandId::kSetPvFocus: {
       std::string r = in(0, 0, 3, "focus mode");
       if (r.empty()) r = in(1, 0, 2, "auto focus range");
-      if (r.empty() && c.u[2] != 0 && c.u[2] != 2) r = "manual focus distance " + std::to_string(c.u[2]) + " (0 or 2)";
+      if (r.empty() && c.u[2] != 0 && c.u[2] != 2)
+        r = "manual focus distance " + std::to_string(c.u[2]) + " (0 or 2)";
       if (r.empty()) r = in(3, 170, 10000, "focus value");
       if (r.empty()) r = in(4, 0, 1, "driver fallback");
       return r;
@@ -337,9 +343,11 @@ Parsed<RcCommand> ParseRcCommand(const uint8_t* data, size_t size) {
   if (c.id == RcCommandId::kRmMapCameraPoints) {
     if (size < 13) return NeedMore<RcCommand>();
     const uint32_t port = GetU32(data + 1), operation = GetU32(data + 5), count = GetU32(data + 9);
-    if (port < 3800 || port > 3805) return Refuse<RcCommand>("rc/map_points", OutOf("camera port", port, 3800, 3805));
+    if (port < 3800 || port > 3805)
+      return Refuse<RcCommand>("rc/map_points", OutOf("camera port", port, 3800, 3805));
     if (operation > 1) return Refuse<RcCommand>("rc/map_points", OutOf("operation", operation, 0, 1));
-    if (count > kMaxRcPoints) return Refuse<RcCommand>("rc/map_points", OutOf("point count", count, 0, kMaxRcPoints));
+    if (count > kMaxRcPoints)
+      return Refuse<RcCommand>("rc/map_points", OutOf("point count", count, 0, kMaxRcPoints));
     const size_t total = 13 + static_cast<size_t>(count) * 8;
     if (size < total) return NeedMore<RcCommand>();
     c.u = {port, operation, count};
@@ -352,7 +360,8 @@ Parsed<RcCommand> ParseRcCommand(const uint8_t* data, size_t size) {
   if (c.id == RcCommandId::kRmGetRigNodeWorldPoses) {
     if (size < 5) return NeedMore<RcCommand>();
     const uint32_t count = GetU32(data + 1);
-    if (count > kMaxRcPoints) return Refuse<RcCommand>("rc/rig_poses", OutOf("timestamp count", count, 0, kMaxRcPoints));
+    if (count > kMaxRcPoints)
+      return Refuse<RcCommand>("rc/rig_poses", OutOf("timestamp count", count, 0, kMaxRcPoints));
     const size_t total = 5 + static_cast<size_t>(count) * 8;
     if (size < total) return NeedMore<RcCommand>();
     c.u = {count};

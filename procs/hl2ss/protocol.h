@@ -126,16 +126,16 @@ inline constexpr size_t kMrcVideoOptionsBytes = 7 + 3 * 4 + 2 * 4;
 
 /// What a client sends first on the PV port (3810).
 struct PvConfig {
-  uint8_t mode{kMode1};      ///< 0, 1 (stream), 2 (calibration), 3 (control only)
-  bool start{false};         ///< START bit: open the subsystem with `mrc` first
-  bool stop{false};          ///< STOP bit: close the subsystem after
-  MrcVideoOptions mrc;       ///< with `start`
+  uint8_t mode{kMode1};  ///< 0, 1 (stream), 2 (calibration), 3 (control only)
+  bool start{false};     ///< START bit: open the subsystem with `mrc` first
+  bool stop{false};      ///< STOP bit: close the subsystem after
+  MrcVideoOptions mrc;   ///< with `start`
   uint16_t width{0}, height{0};
-  uint8_t framerate{0};      ///< frames per second asked for (15 or 30)
-  uint8_t divisor{1};        ///< send every divisor-th frame (≥ 1); modes 0 and 1
+  uint8_t framerate{0};  ///< frames per second asked for (15 or 30)
+  uint8_t divisor{1};    ///< send every divisor-th frame (≥ 1); modes 0 and 1
   uint8_t profile{kProfileRaw};
   uint8_t level{kLevelDefault};
-  uint32_t bitrate{0};       ///< bits per second (> 0), for the encoder
+  uint32_t bitrate{0};                                 ///< bits per second (> 0), for the encoder
   std::vector<std::pair<uint64_t, uint64_t>> options;  ///< encoder options, as sent
 };
 Parsed<PvConfig> ParsePvConfig(const uint8_t* data, size_t size);
@@ -167,17 +167,17 @@ inline constexpr size_t kSiPayloadBytes = 4 + (9 + 6) * 4 + 2 * kSiHandJoints * 
 // Remote configuration (port 3809, hl2ss.py ipc_rc): a stream of commands, each a command byte
 // and its arguments; some are answered.
 enum class RcCommandId : uint8_t {
-  kGetApplicationVersion = 0x00,    // -> 4 × u16
-  kGetUtcOffset = 0x01,             // -> u64
-  kSetMarkerState = 0x02,           // u32
-  kGetPvSubsystemStatus = 0x03,     // -> u8 (bool)
-  kSetPvFocus = 0x04,               // 5 × u32: mode, auto range, distance, value, driver fallback
+  kGetApplicationVersion = 0x00,  // -> 4 × u16
+  kGetUtcOffset = 0x01,           // -> u64
+  kSetMarkerState = 0x02,         // u32
+  kGetPvSubsystemStatus = 0x03,   // -> u8 (bool)
+  kSetPvFocus = 0x04,             // 5 × u32: mode, auto range, distance, value, driver fallback
   kSetPvVideoTemporalDenoising = 0x05,
   kSetPvWhiteBalancePreset = 0x06,
   kSetPvWhiteBalanceValue = 0x07,
-  kSetPvExposure = 0x08,            // 2 × u32: mode, value
+  kSetPvExposure = 0x08,  // 2 × u32: mode, value
   kSetPvExposurePriorityVideo = 0x09,
-  kSetPvIsoSpeed = 0x0A,            // 2 × u32: mode, value
+  kSetPvIsoSpeed = 0x0A,  // 2 × u32: mode, value
   kSetPvBacklightCompensation = 0x0B,
   kSetPvSceneMode = 0x0C,
   kSetFlatMode = 0x0D,
@@ -186,13 +186,13 @@ enum class RcCommandId : uint8_t {
   kSetPvPrimaryUse = 0x10,
   kSetPvOpticalImageStabilization = 0x11,
   kSetPvHdrVideo = 0x12,
-  kSetPvRegionsOfInterest = 0x13,   // u32 mode bits, 4 × float32: x, y, w, h
-  kSetInterfacePriority = 0x14,     // u32 port, i32 priority
+  kSetPvRegionsOfInterest = 0x13,  // u32 mode bits, 4 × float32: x, y, w, h
+  kSetInterfacePriority = 0x14,    // u32 port, i32 priority
   kSetQuietMode = 0x15,
-  kRmMapCameraPoints = 0x16,        // u32 port, u32 operation, u32 count, count × 2 float32
-  kRmGetRigNodeWorldPoses = 0x17,   // u32 count, count × u64 timestamps -> count × 16 float32
-  kGetCurrentTime = 0x18,           // u32 source (0 QPC, 1 UTC) -> u64
-  kSetSiSamplingDelay = 0x19,       // i64 [ticks]
+  kRmMapCameraPoints = 0x16,       // u32 port, u32 operation, u32 count, count × 2 float32
+  kRmGetRigNodeWorldPoses = 0x17,  // u32 count, count × u64 timestamps -> count × 16 float32
+  kGetCurrentTime = 0x18,          // u32 source (0 QPC, 1 UTC) -> u64
+  kSetSiSamplingDelay = 0x19,      // i64 [ticks]
 };
 /// The largest count accepted in the two variable-length commands (a 320×288 image's pixels).
 inline constexpr uint32_t kMaxRcPoints = 320 * 288;

@@ -90,14 +90,15 @@ std::vector<uint8_t> BasicPvTrailer(const PvFrameInfo& info) {
   PutF32(&out, static_cast<float>(info.cx_px));
   PutF32(&out, static_cast<float>(info.cy_px));
   const PvSettings& s = *info.settings;
-  PutU64(&out, s.exposure[0] == 0 ? static_cast<uint64_t>(s.exposure[1]) * 100 : 0);  // exposure time [100 ns]
+  PutU64(&out,
+         s.exposure[0] == 0 ? static_cast<uint64_t>(s.exposure[1]) * 100 : 0);  // exposure time [100 ns]
   PutU64(&out, 0);  // exposure compensation (2 × u64)
   PutU64(&out, 0);
-  PutU32(&out, 0);                                  // lens position
-  PutU32(&out, 0);                                  // focus state
+  PutU32(&out, 0);                                         // lens position
+  PutU32(&out, 0);                                         // focus state
   PutU32(&out, s.iso_speed[0] == 0 ? s.iso_speed[1] : 0);  // ISO speed
-  PutU32(&out, s.white_balance_value * 25);        // white balance [K] (0 when automatic)
-  for (int i = 0; i < 5; ++i) PutF32(&out, 0.0f);  // ISO gains (2), white-balance gains (3)
+  PutU32(&out, s.white_balance_value * 25);                // white balance [K] (0 when automatic)
+  for (int i = 0; i < 5; ++i) PutF32(&out, 0.0f);          // ISO gains (2), white-balance gains (3)
   PutU16(&out, static_cast<uint16_t>(info.width));
   PutU16(&out, static_cast<uint16_t>(info.height));
   return out;

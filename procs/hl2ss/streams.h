@@ -58,10 +58,10 @@ std::vector<uint8_t> SiPayload(const std::optional<HeadSample>& head, const std:
 /// What one PV frame is, for the payload function: the picture's stamp and camera at the size the
 /// client asked for.
 struct PvFrameInfo {
-  uint64_t timestamp{0};       ///< hl2ss ticks
-  int width{0}, height{0};     ///< of `bgr`, the client's size
+  uint64_t timestamp{0};                          ///< hl2ss ticks
+  int width{0}, height{0};                        ///< of `bgr`, the client's size
   double fx_px{0}, fy_px{0}, cx_px{0}, cy_px{0};  ///< intrinsics at that size
-  const PvSettings* settings{nullptr};           ///< the RC settings (never null when called)
+  const PvSettings* settings{nullptr};            ///< the RC settings (never null when called)
 };
 /// One frame's payload (encoded picture and trailer) from the picture at the client's size.
 using PvPayloadFn = std::function<std::vector<uint8_t>(const cv::Mat& bgr, const PvFrameInfo& info)>;
@@ -85,7 +85,8 @@ PvEncoderFactory RawOnlyPvEncoderFactory();
 /// divisor-th of those. Call once per camera frame; true = send this one.
 class PvPacer {
  public:
-  explicit PvPacer(const PvConfig& config) : skip_(config.framerate == 15 ? 2 : 1), divisor_(config.divisor) {}
+  explicit PvPacer(const PvConfig& config)
+      : skip_(config.framerate == 15 ? 2 : 1), divisor_(config.divisor) {}
   bool Next() {
     const bool camera_due = (count_++ % skip_) == 0;
     if (!camera_due) return false;

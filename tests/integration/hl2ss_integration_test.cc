@@ -1,0 +1,396 @@
+// orbed-hl2ss over real LCM and real TCP in a private network namespace, read by a client written
+// here from hl2ss's protocol facts (viewer/hl2ss.py: little-endian '<QI' headers, 16 float32 poses
+// in mode 1, decode_si's and decode_pv's layouts, cv2.COLOR_YUV2BGR_NV12 for RAW), not from
+// orbed's protocol library. The test plays the headset: it publishes HMD_POSE (60 Hz), GAZE_RAY
+// (10 Hz) and HMD_CAMERA (30 Hz, 1280×720 JPEG of smooth pictures, one of 6 per frame) and keeps
+// what it sent by utime.
+//   - RC: the application version given by flag, the UTC offset, the PV subsystem closed, then
+//     open after start_subsystem_pv's bytes;
+//   - SI: every packet's head position, forward and up equal the HMD_POSE of its stamp (stamp +
+//     UTC offset = the utime as a FILETIME) in D (frames.h), its eye ray one of GAZE_RAY's;
+//   - PV RAW mode 1 at 1280×720: the NV12 decodes to the HMD_CAMERA picture of its stamp within
+//     colour-conversion rounding, the trailer says its intrinsics and size, the pose is
+//     frames.h's CameraPoseForClient(X_WC);
+//   - hostile clients: a garbage PV configuration is refused ("pv/mode"), a PV client that never
+//     reads is dropped ("pv/backlog", "pv/stalled"), an unknown RC command refused ("rc/unknown"),
+//     while the SI and PV clients above keep receiving; all counted on PROCESS_STATUS.
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <sys/time.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <mutex>
+#include <thread>
+
+#include <gtest/gtest.h>
+#include <lcm/lcm-cpp.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <orbed/gaze_ray_t.hpp>
+#include <orbed/hmd_pose_t.hpp>
+#include <orbed/image_t.hpp>
+
+#include "lcmtypes/contract/conversions.h"
+#include "procs/hl2ss/frames.h"
+#include "tests/integration/testbed_util.h"
+
+namespace orbed::testing {
+namespace {
+
+constexpr uint64_t kUnixEpochFiletime = 116444736000000000ULL;
+constexpr int kWidth = 1280, kHeight = 720;
+
+// ---- the client: blocking sockets with a generous receive timeout ------------------------------
+class Socket {
+ public:
+  Socket(int port, int receive_buffer = 0) {
+    fd_ = socket(AF_INET, SOCK_STREAM, 0);
+    if (receive_buffer > 0) setsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &receive_buffer, sizeof(receive_buffer));
+    timeval tv{static_cast<time_t>(20 * TestTimeFactor()), 0};
+    setsockopt(fd_, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof(tv));
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_port = htons(static_cast<uint16_t>(port));
+    inet_pton(AF_INET, "127.0.0.1", &a.sin_addr);
+    ok_ = WaitFor([&] { return connect(fd_, reinterpret_cast<sockaddr*>(&a), sizeof(a)) == 0; }, 20);
+  }
+  ~Socket() { close(fd_); }
+  bool ok() const { return ok_; }
+  void Send(const std::vector<uint8_t>& b) { ASSERT_EQ(send(fd_, b.data(), b.size(), MSG_NOSIGNAL), (ssize_t)b.size()); }
+  // Exactly n bytes, or fewer when the server closes or the timeout passes.
+  std::vector<uint8_t> Read(size_t n) {
+    std::vector<uint8_t> out(n);
+    size_t got = 0;
+    while (got < n) {
+      const ssize_t k = recv(fd_, out.data() + got, n - got, 0);
+      if (k <= 0) break;
+      got += static_cast<size_t>(k);
+    }
+    out.resize(got);
+    return out;
+  }
+  bool ClosedByServer() {
+    uint8_t b;
+    return recv(fd_, &b, 1, 0) == 0;
+  }
+
+ private:
+  int fd_{-1};
+  bool ok_{false};
+};
+
+template <class T>
+T Le(const uint8_t* p) {
+  T v;
+  std::memcpy(&v, p, sizeof(T));  // x86-64: little-endian as the protocol
+  return v;
+}
+
+struct Packet {
+  uint64_t timestamp{0};
+  std::vector<uint8_t> payload;
+  std::array<float, 16> pose{};
+  bool ok{false};
+};
+
+// One packet as hl2ss.py's _unpacker reads it: '<QI', the payload, 64 bytes of pose in mode 1.
+Packet ReadPacket(Socket* s, bool mode1) {
+  Packet p;
+  const std::vector<uint8_t> header = s->Read(12);
+  if (header.size() != 12) return p;
+  p.timestamp = Le<uint64_t>(header.data());
+  const uint32_t size = Le<uint32_t>(header.data() + 8);
+  p.payload = s->Read(size);
+  if (p.payload.size() != size) return p;
+  if (mode1) {
+    const std::vector<uint8_t> pose = s->Read(64);
+    if (pose.size() != 64) return p;
+    std::memcpy(p.pose.data(), pose.data(), 64);
+  }
+  p.ok = true;
+  return p;
+}
+
+// ---- the headset the test plays ------------------------------------------------------------------
+struct Sent {
+  std::mutex mutex;
+  std::map<int64_t, orbed::hmd_pose_t> poses;   // by utime
+  std::map<int64_t, orbed::gaze_ray_t> gazes;   // by utime
+  std::map<int64_t, std::pair<int, orbed::pose_t>> frames;  // utime -> (picture index, X_WC)
+};
+
+cv::Mat Picture(int k) {  // smooth, different for each k
+  cv::Mat bgr(kHeight, kWidth, CV_8UC3);
+  for (int r = 0; r < kHeight; ++r)
+    for (int c = 0; c < kWidth; ++c)
+      bgr.at<cv::Vec3b>(r, c) = cv::Vec3b(static_cast<uint8_t>(20 + c / 8 + 15 * k),
+                                          static_cast<uint8_t>(20 + r / 4), static_cast<uint8_t>(220 - c / 7));
+  return bgr;
+}
+
+Eigen::Isometry3d HeadAt(double t) {  // walking along x, turning slowly, upright
+  const double yaw = 0.3 * std::sin(t);
+  Eigen::Matrix3d R_look;  // z forward along +x rotated by yaw, y down
+  const Eigen::Vector3d z(std::cos(yaw), std::sin(yaw), 0), y(0, 0, -1);
+  R_look.col(0) = y.cross(z);
+  R_look.col(1) = y;
+  R_look.col(2) = z;
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  X.linear() = R_look;
+  X.translation() = Eigen::Vector3d(0.2 * t, -1.0, 1.7);
+  return X;
+}
+
+void Publish(std::atomic<bool>* stop, Sent* sent) {
+  lcm::LCM lcm;
+  std::vector<std::vector<uint8_t>> jpegs;
+  for (int k = 0; k < 6; ++k) {
+    jpegs.emplace_back();
+    cv::imencode(".jpg", Picture(k), jpegs.back(), {cv::IMWRITE_JPEG_QUALITY, 95});
+  }
+  const auto start = std::chrono::steady_clock::now();
+  Eigen::Isometry3d X_HC = Eigen::Isometry3d::Identity();
+  X_HC.translation() = Eigen::Vector3d(0.0, -0.02, 0.08);
+  for (int64_t tick = 0; !*stop; ++tick) {  // 60 Hz
+    std::this_thread::sleep_until(start + std::chrono::microseconds(tick * 1'000'000 / 60));
+    const int64_t utime = NowMicros();
+    const double t = tick / 60.0;
+    orbed::hmd_pose_t pose{};
+    pose.utime = utime;
+    pose.seq = tick;
+    pose.hmd_name = "hmd";
+    pose.X_WH = ToPose(HeadAt(t));
+    pose.X_WC = ToPose(HeadAt(t) * X_HC);
+    pose.tracking_state = orbed::hmd_pose_t::TRACKING;
+    {
+      std::lock_guard<std::mutex> lock(sent->mutex);
+      sent->poses[utime] = pose;
+    }
+    lcm.publish("HMD_POSE", &pose);
+    if (tick % 6 == 0) {
+      orbed::gaze_ray_t gaze{};
+      gaze.utime = utime;
+      gaze.hmd_name = "hmd";
+      const Eigen::Isometry3d X_WH = HeadAt(t);
+      FromVector3(X_WH.translation(), gaze.origin_W_m);
+      FromVector3((X_WH.linear() * Eigen::Vector3d(0.1, 0.05, 1.0)).normalized(), gaze.direction_W);
+      {
+        std::lock_guard<std::mutex> lock(sent->mutex);
+        sent->gazes[utime] = gaze;
+      }
+      lcm.publish("GAZE_RAY", &gaze);
+    }
+    if (tick % 2 == 0) {
+      const int k = static_cast<int>((tick / 2) % 6);
+      geometry::Intrinsics K;
+      K.width_px = kWidth;
+      K.height_px = kHeight;
+      K.fx_px = 1000;
+      K.fy_px = 1001;
+      K.cx_px = 639.5;
+      K.cy_px = 359.5;
+      const orbed::image_t img = JpegImageMessage(jpegs[k], K, utime, FromPose(pose.X_WC), utime);
+      {
+        std::lock_guard<std::mutex> lock(sent->mutex);
+        sent->frames[utime] = {k, pose.X_WC};
+      }
+      lcm.publish("HMD_CAMERA", &img);
+    }
+  }
+}
+
+std::vector<uint8_t> MrcStart() {  // 0x04|3, then '<BBBBBBBfffII' as hl2ss_lnm.start_subsystem_pv's defaults
+  std::vector<uint8_t> b = {0x07, 0, 1, 0, 0, 0, 0, 0};
+  const float f[3] = {0.9f, 0.0f, 0.0f};
+  const uint32_t u[2] = {0, 1};
+  b.insert(b.end(), reinterpret_cast<const uint8_t*>(f), reinterpret_cast<const uint8_t*>(f) + 12);
+  b.insert(b.end(), reinterpret_cast<const uint8_t*>(u), reinterpret_cast<const uint8_t*>(u) + 8);
+  return b;
+}
+
+std::vector<uint8_t> PvRawConfig(uint16_t width, uint16_t height) {  // '<BHHBBBBI' + '<B' (no options)
+  std::vector<uint8_t> b = {0x01};
+  const uint32_t bitrate = width * height * 30u * 12u;
+  for (int i = 0; i < 2; ++i) b.push_back(static_cast<uint8_t>(width >> (8 * i)));
+  for (int i = 0; i < 2; ++i) b.push_back(static_cast<uint8_t>(height >> (8 * i)));
+  b.insert(b.end(), {30, 1, 0xFF, 0xFF});
+  for (int i = 0; i < 4; ++i) b.push_back(static_cast<uint8_t>(bitrate >> (8 * i)));
+  b.push_back(0);
+  return b;
+}
+
+int64_t CountOf(const orbed::process_status_t& s, const std::string& key, bool drops) {
+  const auto& keys = drops ? s.drop_reason : s.reject_reason;
+  const auto& counts = drops ? s.drop_count : s.reject_count;
+  for (size_t i = 0; i < keys.size(); ++i)
+    if (keys[i] == key) return counts[i];
+  return 0;
+}
+
+TEST(Hl2ss, AnHl2ssClientSeesTheHeadsetAndHostileClientsAreRefused) {
+  BusWatcher bus;
+  bus.Start();
+  RunningProcess server({BinPath("orbed-hl2ss"), "--app-version", "1.2.3.4", "--max-drops", "10", "--max-queue-mb",
+                         "8"});
+  Sent sent;
+  std::atomic<bool> stop{false};
+  std::thread headset(Publish, &stop, &sent);
+  struct Stopper {
+    std::atomic<bool>* stop;
+    std::thread* t;
+    ~Stopper() {
+      *stop = true;
+      t->join();
+    }
+  } stopper{&stop, &headset};
+
+  // RC: version, UTC offset, PV subsystem status.
+  uint64_t offset = 0;
+  {
+    Socket rc(3809);
+    ASSERT_TRUE(rc.ok());
+    rc.Send({0x00});
+    const std::vector<uint8_t> version = rc.Read(8);
+    ASSERT_EQ(version.size(), 8u);
+    EXPECT_EQ(Le<uint16_t>(version.data()), 1);
+    EXPECT_EQ(Le<uint16_t>(version.data() + 6), 4);
+    rc.Send({0x01});
+    offset = Le<uint64_t>(rc.Read(8).data());
+    rc.Send({0x03});
+    EXPECT_EQ(rc.Read(1), std::vector<uint8_t>{0});
+  }
+  const auto utime_of = [offset](uint64_t ticks) {
+    return static_cast<int64_t>((ticks + offset - kUnixEpochFiletime) / 10);
+  };
+  {
+    Socket start(3810);
+    start.Send(MrcStart());
+    EXPECT_TRUE(start.ClosedByServer());
+    Socket rc(3809);
+    rc.Send({0x03});
+    EXPECT_EQ(rc.Read(1), std::vector<uint8_t>{1}) << "the PV subsystem is open";
+  }
+
+  Socket si(3812);
+
+  // SI: 15 packets (half a second), each the HMD_POSE of its stamp.
+  const Eigen::Matrix3d R_DW = hl2ss::R_WD().transpose();
+  int si_checked = 0, eye_checked = 0;
+  for (int i = 0; i < 15; ++i) {
+    const Packet p = ReadPacket(&si, false);
+    ASSERT_TRUE(p.ok);
+    ASSERT_EQ(p.payload.size(), 4u + 15 * 4 + 2 * 26 * 9 * 4);
+    const uint32_t valid = Le<uint32_t>(p.payload.data());
+    if (!(valid & 1)) continue;  // before the first pose
+    EXPECT_EQ(valid & 0x0C, 0u) << "hands are not tracked";
+    orbed::hmd_pose_t pose;
+    std::vector<orbed::gaze_ray_t> gazes;
+    {
+      std::lock_guard<std::mutex> lock(sent.mutex);
+      const auto it = sent.poses.find(utime_of(p.timestamp));
+      ASSERT_NE(it, sent.poses.end()) << "no HMD_POSE at the stamp's utime " << utime_of(p.timestamp);
+      pose = it->second;
+      for (const auto& [t, g] : sent.gazes) gazes.push_back(g);
+    }
+    const Eigen::Isometry3d X_WH = FromPose(pose.X_WH);
+    const auto f3 = [&](size_t at) {
+      return Eigen::Vector3d(Le<float>(p.payload.data() + at), Le<float>(p.payload.data() + at + 4),
+                             Le<float>(p.payload.data() + at + 8));
+    };
+    EXPECT_LT((f3(4) - R_DW * X_WH.translation()).norm(), 1e-5);
+    EXPECT_LT((f3(16) - R_DW * X_WH.linear().col(2)).norm(), 1e-6);   // forward: H's +z
+    EXPECT_LT((f3(28) - R_DW * -X_WH.linear().col(1)).norm(), 1e-6);  // up: H's −y
+    ++si_checked;
+    if (valid & 2) {
+      bool found = false;
+      for (const orbed::gaze_ray_t& g : gazes)
+        found = found || ((f3(40) - R_DW * ToVector3(g.origin_W_m)).norm() < 1e-5 &&
+                          (f3(52) - R_DW * ToVector3(g.direction_W)).norm() < 1e-6);
+      EXPECT_TRUE(found) << "the eye ray is one of GAZE_RAY's";
+      ++eye_checked;
+    }
+  }
+  EXPECT_GE(si_checked, 10);
+  EXPECT_GE(eye_checked, 5);
+
+  // PV: 10 frames, each the picture and pose of its stamp.
+  Socket pv(3810);  // connected now: a client that reads nothing meanwhile would lose frames
+  pv.Send(PvRawConfig(kWidth, kHeight));
+  std::vector<cv::Mat> pictures;
+  for (int k = 0; k < 6; ++k) pictures.push_back(Picture(k));
+  for (int i = 0; i < 10; ++i) {
+    const Packet p = ReadPacket(&pv, true);
+    ASSERT_TRUE(p.ok);
+    const size_t stride = (kWidth + 63) & ~63;
+    ASSERT_EQ(p.payload.size(), stride * kHeight * 3 / 2 + 80);
+    const uint8_t* trailer = p.payload.data() + p.payload.size() - 80;
+    EXPECT_FLOAT_EQ(Le<float>(trailer), 1000.0f);
+    EXPECT_FLOAT_EQ(Le<float>(trailer + 4), 1001.0f);
+    EXPECT_FLOAT_EQ(Le<float>(trailer + 8), 639.5f);
+    EXPECT_EQ(Le<uint16_t>(trailer + 76), kWidth);
+    EXPECT_EQ(Le<uint16_t>(trailer + 78), kHeight);
+    std::pair<int, orbed::pose_t> frame;
+    {
+      std::lock_guard<std::mutex> lock(sent.mutex);
+      const auto it = sent.frames.find(utime_of(p.timestamp));
+      ASSERT_NE(it, sent.frames.end()) << "no HMD_CAMERA at the stamp";
+      frame = it->second;
+    }
+    cv::Mat nv12(kHeight * 3 / 2, static_cast<int>(stride), CV_8UC1, const_cast<uint8_t*>(p.payload.data()));
+    cv::Mat bgr;
+    cv::cvtColor(nv12(cv::Rect(0, 0, kWidth, kHeight * 3 / 2)).clone(), bgr, cv::COLOR_YUV2BGR_NV12);
+    // The HMD_CAMERA picture after its JPEG decode (what the server had), against the picture the
+    // client decoded: colour-conversion rounding on top of JPEG's own loss of the smooth picture.
+    std::vector<uint8_t> jpeg;
+    cv::imencode(".jpg", pictures[frame.first], jpeg, {cv::IMWRITE_JPEG_QUALITY, 95});
+    const cv::Mat expected = cv::imdecode(jpeg, cv::IMREAD_COLOR);
+    cv::Mat diff;
+    cv::absdiff(bgr, expected, diff);
+    double max_diff = 0;
+    cv::minMaxLoc(diff.reshape(1), nullptr, &max_diff);
+    EXPECT_LE(max_diff, 8) << "frame " << i;
+    EXPECT_LT(cv::mean(diff)[0], 1.5);
+    // The pose: row-major M = X_DĈᵀ.
+    Eigen::Matrix4d M;
+    for (int r = 0; r < 4; ++r)
+      for (int c = 0; c < 4; ++c) M(r, c) = p.pose[4 * r + c];
+    const Eigen::Matrix4d expected_X = hl2ss::CameraPoseForClient(FromPose(frame.second)).matrix();
+    EXPECT_LT((M.transpose() - expected_X).cwiseAbs().maxCoeff(), 1e-5);
+  }
+
+  // Hostile clients, while SI and PV go on.
+  Socket garbage(3810);
+  garbage.Send({0xF3, 0x42, 0x42, 0x42});
+  EXPECT_TRUE(garbage.ClosedByServer());
+  Socket bad_rc(3809);
+  bad_rc.Send({0x7F});
+  EXPECT_TRUE(bad_rc.ClosedByServer());
+  Socket stuck(3810, 4096);  // 1920×1080 RAW, never read
+  stuck.Send(PvRawConfig(1920, 1080));
+  bool stalled = false;
+  for (int i = 0; i < 300 && !stalled; ++i) {  // up to 10 s of frames
+    ASSERT_TRUE(ReadPacket(&pv, true).ok) << "the PV client keeps receiving";
+    ASSERT_TRUE(ReadPacket(&si, false).ok) << "the SI client keeps receiving";
+    const auto beats = bus.Heartbeats("orbed-hl2ss");
+    stalled = !beats.empty() && CountOf(beats.back().status, "pv/stalled", true) >= 1;
+  }
+  EXPECT_TRUE(stalled) << "the client that never reads was dropped";
+  EXPECT_TRUE(WaitFor(
+      [&] {
+        const auto beats = bus.Heartbeats("orbed-hl2ss");
+        if (beats.empty()) return false;
+        const orbed::process_status_t& s = beats.back().status;
+        return CountOf(s, "pv/mode", false) == 1 && CountOf(s, "rc/unknown", false) == 1 &&
+               CountOf(s, "pv/backlog", true) >= 10;
+      },
+      10));
+  for (int i = 0; i < 5; ++i) ASSERT_TRUE(ReadPacket(&pv, true).ok);
+}
+
+}  // namespace
+}  // namespace orbed::testing
