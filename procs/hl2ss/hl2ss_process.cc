@@ -213,7 +213,7 @@ Decision Hl2ssProcess::OnConfigured(int client, PortKind port, const StreamConfi
   std::string refusal;
   PvPayloadFn payload = options_.pv_encoder(c, &refusal);
   if (!payload) return refuse("pv/profile", refusal);
-  pv_clients_.insert_or_assign(client, PvClient{std::move(payload), PvPacer(c)});
+  pv_clients_.insert_or_assign(client, PvClient{std::move(payload), PvPacer(c), c.stop});
   return d;
 }
 
@@ -223,10 +223,16 @@ void Hl2ssProcess::OnEvent(const ServerEvent& event) {
     case ServerEvent::kConnected:
       ORBED_LOG(kInfo) << "hl2ss: " << who << " connected";
       break;
-    case ServerEvent::kDisconnected:
-      pv_clients_.erase(event.client);
+    case ServerEvent::kDisconnected: {
+      const auto it = pv_clients_.find(event.client);
+      if (it != pv_clients_.end() && it->second.stop_after && device_.pv_open()) {
+        device_.ClosePv();
+        ORBED_LOG(kInfo) << "hl2ss: PV subsystem closed";
+      }
+      if (it != pv_clients_.end()) pv_clients_.erase(it);
       ORBED_LOG(kInfo) << "hl2ss: " << who << " left: " << event.detail;
       break;
+    }
     case ServerEvent::kRefused:
       process_.Reject(event.key, event.peer + ": " + event.detail);
       break;

@@ -89,6 +89,7 @@ class Hl2ssProcess {
   struct PvClient {
     PvPayloadFn payload;
     PvPacer pacer;
+    bool stop_after{false};  // the STOP bit: close the subsystem when this client leaves
   };
   std::map<int, PvClient> pv_clients_;
   std::optional<orbed::hmd_pose_t> pose_;

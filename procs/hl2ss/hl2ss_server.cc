@@ -152,6 +152,7 @@ void Hl2ssServer::Accept(Listener& listener, int64_t now_us, const ServerHandler
       }
       client->state = Client::kServing;
     }
+    if (listener.kind == PortKind::kRc) client->state = Client::kServing;  // commands, no configuration
     clients_.push_back(std::move(client));
   }
 }

@@ -194,6 +194,22 @@ TEST(Hl2ssServer, AClientThatStopsReadingLosesPacketsThenIsClosed) {
   close(reader);
 }
 
+TEST(Hl2ssServer, AnIdleRcClientStaysAndAHalfCommandTimesOut) {
+  Harness h;
+  const int idle = Connect(h.server.port(PortKind::kRc));
+  const int half = Connect(h.server.port(PortKind::kRc));
+  ASSERT_TRUE(h.PumpUntil([&] { return h.Count(ServerEvent::kConnected) == 2; }));
+  SendAll(half, {0x04, 0x03, 0x00});  // pv_set_focus, 2 of its 21 bytes
+  for (int i = 0; i < 20; ++i) h.server.Poll(1'000'000, h.handlers);
+  h.PumpUntil([] { return true; }, {}, 7'000'000);  // 6 s after the half command began
+  EXPECT_TRUE(Closed(&h, half));
+  EXPECT_TRUE(h.Refused("rc/timeout"));
+  SendAll(idle, {0x00});  // idle for 7 s: still answered
+  EXPECT_EQ(ReadN(&h, idle, 2), (std::vector<uint8_t>{0x00, 0x42}));
+  close(idle);
+  close(half);
+}
+
 TEST(Hl2ssServer, ReplyAndCloseSendsTheAnswerFirst) {
   Harness h;
   h.decision.kind = Decision::kReplyAndClose;

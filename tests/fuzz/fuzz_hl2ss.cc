@@ -32,7 +32,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       const PvConfig& c = p.value;
       if (c.mode == kMode3) break;
       bool known = false;
-      for (const PvFormatSize& s : PvVideoSizes()) known = known || (s.width == c.width && s.height == c.height);
+      for (const PvFormatSize& s : PvVideoSizes())
+        known = known || (s.width == c.width && s.height == c.height);
       Check(known && (c.framerate == 15 || c.framerate == 30));
       if (c.mode != kMode2) Check(c.divisor >= 1 && c.bitrate > 0 && c.options.size() <= kMaxEncoderOptions);
       break;

@@ -61,7 +61,9 @@ class Socket {
   }
   ~Socket() { close(fd_); }
   bool ok() const { return ok_; }
-  void Send(const std::vector<uint8_t>& b) { ASSERT_EQ(send(fd_, b.data(), b.size(), MSG_NOSIGNAL), (ssize_t)b.size()); }
+  void Send(const std::vector<uint8_t>& b) {
+    ASSERT_EQ(send(fd_, b.data(), b.size(), MSG_NOSIGNAL), (ssize_t)b.size());
+  }
   // Exactly n bytes, or fewer when the server closes or the timeout passes.
   std::vector<uint8_t> Read(size_t n) {
     std::vector<uint8_t> out(n);
@@ -119,8 +121,8 @@ Packet ReadPacket(Socket* s, bool mode1) {
 // ---- the headset the test plays ------------------------------------------------------------------
 struct Sent {
   std::mutex mutex;
-  std::map<int64_t, orbed::hmd_pose_t> poses;   // by utime
-  std::map<int64_t, orbed::gaze_ray_t> gazes;   // by utime
+  std::map<int64_t, orbed::hmd_pose_t> poses;               // by utime
+  std::map<int64_t, orbed::gaze_ray_t> gazes;               // by utime
   std::map<int64_t, std::pair<int, orbed::pose_t>> frames;  // utime -> (picture index, X_WC)
 };
 
@@ -128,8 +130,9 @@ cv::Mat Picture(int k) {  // smooth, different for each k
   cv::Mat bgr(kHeight, kWidth, CV_8UC3);
   for (int r = 0; r < kHeight; ++r)
     for (int c = 0; c < kWidth; ++c)
-      bgr.at<cv::Vec3b>(r, c) = cv::Vec3b(static_cast<uint8_t>(20 + c / 8 + 15 * k),
-                                          static_cast<uint8_t>(20 + r / 4), static_cast<uint8_t>(220 - c / 7));
+      bgr.at<cv::Vec3b>(r, c) =
+          cv::Vec3b(static_cast<uint8_t>(20 + c / 8 + 15 * k), static_cast<uint8_t>(20 + r / 4),
+                    static_cast<uint8_t>(220 - c / 7));
   return bgr;
 }
 
@@ -235,8 +238,8 @@ int64_t CountOf(const orbed::process_status_t& s, const std::string& key, bool d
 TEST(Hl2ss, AnHl2ssClientSeesTheHeadsetAndHostileClientsAreRefused) {
   BusWatcher bus;
   bus.Start();
-  RunningProcess server({BinPath("orbed-hl2ss"), "--app-version", "1.2.3.4", "--max-drops", "10", "--max-queue-mb",
-                         "8"});
+  RunningProcess server(
+      {BinPath("orbed-hl2ss"), "--app-version", "1.2.3.4", "--max-drops", "10", "--max-queue-mb", "8"});
   Sent sent;
   std::atomic<bool> stop{false};
   std::thread headset(Publish, &stop, &sent);
