@@ -50,33 +50,30 @@ std::vector<uint8_t> Nv12FromBgr(const cv::Mat& bgr, int stride) {
     throw std::invalid_argument("Nv12FromBgr: an 8-bit BGR picture of even size and a stride >= its width");
   const int w = bgr.cols, h = bgr.rows;
   std::vector<uint8_t> out(static_cast<size_t>(stride) * h * 3 / 2, 0);
-  // BT.601 video range: Y = 16 + (65.481 R + 128.553 G + 24.966 B) / 255, Cb/Cr around 128.
-  const auto clamp8 = [](double v) { return static_cast<uint8_t>(std::clamp(std::lround(v), 0L, 255L)); };
+  // BT.601 video range in 16-bit fixed point (coefficient × 65536 / 255, rounded):
+  //   Y  = 16  + ( 65.481 R + 128.553 G + 24.966 B) / 255
+  //   Cb = 128 + (−37.797 R −  74.203 G + 112.0  B) / 255
+  //   Cr = 128 + ( 112.0  R −  93.786 G −  18.214 B) / 255
+  constexpr int32_t kYR = 16829, kYG = 33039, kYB = 6416;
+  constexpr int32_t kUR = -9714, kUG = -19070, kUB = 28784;
+  constexpr int32_t kVR = 28784, kVG = -24103, kVB = -4681;
+  const auto clamp8 = [](int32_t v) { return static_cast<uint8_t>(v < 0 ? 0 : v > 255 ? 255 : v); };
   for (int r = 0; r < h; ++r) {
-    const uint8_t* row = bgr.ptr<uint8_t>(r);
+    const uint8_t* p = bgr.ptr<uint8_t>(r);
     uint8_t* y = out.data() + static_cast<size_t>(r) * stride;
-    for (int c = 0; c < w; ++c) {
-      const double B = row[3 * c], G = row[3 * c + 1], R = row[3 * c + 2];
-      y[c] = clamp8(16.0 + (65.481 * R + 128.553 * G + 24.966 * B) / 255.0);
-    }
+    for (int c = 0; c < w; ++c, p += 3)
+      y[c] = clamp8((kYR * p[2] + kYG * p[1] + kYB * p[0] + (16 << 16) + (1 << 15)) >> 16);
   }
   uint8_t* uv_plane = out.data() + static_cast<size_t>(stride) * h;
-  for (int r = 0; r < h / 2; ++r) {
-    const uint8_t* row0 = bgr.ptr<uint8_t>(2 * r);
-    const uint8_t* row1 = bgr.ptr<uint8_t>(2 * r + 1);
+  for (int r = 0; r < h / 2; ++r) {  // chroma of each 2 × 2 block's sums: the mean's, ÷ 4 = >> 2 more
+    const uint8_t* p0 = bgr.ptr<uint8_t>(2 * r);
+    const uint8_t* p1 = bgr.ptr<uint8_t>(2 * r + 1);
     uint8_t* uv = uv_plane + static_cast<size_t>(r) * stride;
-    for (int c = 0; c < w / 2; ++c) {
-      double B = 0, G = 0, R = 0;
-      for (const uint8_t* p : {row0 + 6 * c, row0 + 6 * c + 3, row1 + 6 * c, row1 + 6 * c + 3}) {
-        B += p[0];
-        G += p[1];
-        R += p[2];
-      }
-      B /= 4;
-      G /= 4;
-      R /= 4;
-      uv[2 * c] = clamp8(128.0 + (-37.797 * R - 74.203 * G + 112.0 * B) / 255.0);
-      uv[2 * c + 1] = clamp8(128.0 + (112.0 * R - 93.786 * G - 18.214 * B) / 255.0);
+    for (int c = 0; c < w / 2; ++c, p0 += 6, p1 += 6) {
+      const int32_t B = p0[0] + p0[3] + p1[0] + p1[3], G = p0[1] + p0[4] + p1[1] + p1[4],
+                    R = p0[2] + p0[5] + p1[2] + p1[5];
+      uv[2 * c] = clamp8((kUR * R + kUG * G + kUB * B + (128 << 18) + (1 << 17)) >> 18);
+      uv[2 * c + 1] = clamp8((kVR * R + kVG * G + kVB * B + (128 << 18) + (1 << 17)) >> 18);
     }
   }
   return out;
