@@ -1,7 +1,9 @@
 #include "procs/hl2ss/hl2ss_process.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <exception>
 #include <sstream>
 

@@ -1,7 +1,5 @@
 #include "procs/hl2ss/streams.h"
 
-#include <algorithm>
-#include <cmath>
 #include <stdexcept>
 
 #include "procs/hl2ss/frames.h"
