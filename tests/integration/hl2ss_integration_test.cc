@@ -11,6 +11,8 @@
 //   - PV RAW mode 1 at 1280×720: the NV12 decodes to the HMD_CAMERA picture of its stamp within
 //     colour-conversion rounding, the trailer says its intrinsics and size, the pose is
 //     frames.h's CameraPoseForClient(X_WC);
+//   - refused as this server does not serve them yet: a PV stream before start_subsystem_pv (as
+//     the device), the H.265 profile, PV calibration, the depth stream;
 //   - hostile clients: a garbage PV configuration is refused ("pv/mode"), a PV client that never
 //     reads is dropped ("pv/backlog", "pv/stalled"), an unknown RC command refused ("rc/unknown"),
 //     while the SI and PV clients above keep receiving; all counted on PROCESS_STATUS.
@@ -267,6 +269,11 @@ TEST(Hl2ss, AnHl2ssClientSeesTheHeadsetAndHostileClientsAreRefused) {
     rc.Send({0x03});
     EXPECT_EQ(rc.Read(1), std::vector<uint8_t>{0});
   }
+  {  // before start_subsystem_pv the device closes a PV stream at once
+    Socket early(3810);
+    early.Send(PvRawConfig(kWidth, kHeight));
+    EXPECT_TRUE(early.ClosedByServer());
+  }
   const auto utime_of = [offset](uint64_t ticks) {
     return static_cast<int64_t>((ticks + offset - kUnixEpochFiletime) / 10);
   };
@@ -279,6 +286,19 @@ TEST(Hl2ss, AnHl2ssClientSeesTheHeadsetAndHostileClientsAreRefused) {
     EXPECT_EQ(rc.Read(1), std::vector<uint8_t>{1}) << "the PV subsystem is open";
   }
 
+  {  // what this server does not serve yet: refused at once, with a reason
+    std::vector<uint8_t> h265 = PvRawConfig(kWidth, kHeight);
+    h265[7] = 3;  // profile H265_MAIN
+    Socket encoded(3810);
+    encoded.Send(h265);
+    EXPECT_TRUE(encoded.ClosedByServer());
+    Socket calibration(3810);
+    calibration.Send({0x02, 0x00, 0x05, 0xd0, 0x02, 0x1e});  // download_calibration_pv(1280, 720, 30)
+    EXPECT_TRUE(calibration.ClosedByServer());
+    Socket depth(3805);
+    depth.Send({0x01, 0x01, 0x05, 0x00, 0x00, 0x00});  // rx_rm_depth_longthrow's defaults
+    EXPECT_TRUE(depth.ClosedByServer());
+  }
   Socket si(3812);
 
   // SI: 15 packets (half a second), each the HMD_POSE of its stamp.
@@ -389,6 +409,8 @@ TEST(Hl2ss, AnHl2ssClientSeesTheHeadsetAndHostileClientsAreRefused) {
         if (beats.empty()) return false;
         const orbed::process_status_t& s = beats.back().status;
         return CountOf(s, "pv/mode", false) == 1 && CountOf(s, "rc/unknown", false) == 1 &&
+               CountOf(s, "pv/subsystem_closed", false) == 1 && CountOf(s, "pv/profile", false) == 1 &&
+               CountOf(s, "pv/mode2", false) == 1 && CountOf(s, "rm_depth/not_available", false) == 1 &&
                CountOf(s, "pv/backlog", true) >= 10;
       },
       10));
