@@ -54,7 +54,8 @@ Hl2ssProcess::Hl2ssProcess(const CommonFlags& flags, const Hl2ssOptions& options
     : process_(flags),
       options_(options),
       server_(options.server),
-      device_(TimeBase{NowMicros()}, options.app_version) {
+      device_(TimeBase{NowMicros()}, options.app_version),
+      unity_scene_(options.unity_limits) {
   handlers_.on_configured = [this](int client, PortKind port, const StreamConfig& config) {
     return OnConfigured(client, port, config);
   };
@@ -70,6 +71,9 @@ Hl2ssProcess::Hl2ssProcess(const CommonFlags& flags, const Hl2ssOptions& options
     return d;
   };
   handlers_.on_event = [this](const ServerEvent& event) { OnEvent(event); };
+  handlers_.on_bytes = [this](int client, const uint8_t* data, size_t size, std::vector<uint8_t>* reply) {
+    return OnUmqBytes(client, data, size, reply);
+  };
 
   process_.Subscribe<orbed::hmd_pose_t>(
       options_.pose_channel,
@@ -82,10 +86,18 @@ Hl2ssProcess::Hl2ssProcess(const CommonFlags& flags, const Hl2ssOptions& options
       [this](const orbed::image_t& msg, const std::string& channel, int64_t) { OnCamera(msg, channel); });
   process_.AddWallTimer(
       1.0 / options_.si_hz, [this] { SendSpatialInput(); }, "hl2ss/si");
+  if (server_.port(PortKind::kUmq) != 0)
+    process_.AddWallTimer(
+        1.0,
+        [this] {
+          if (unity_scene_.revision() != 0) PublishHolograms();  // nothing placed yet: nothing to say
+        },
+        "hl2ss/holograms");
   process_.AddWallPoll(options_.poll_period_s, [this] { server_.Poll(MonotonicMicros(), handlers_); });
 
   std::ostringstream ports;
-  for (PortKind kind : {PortKind::kRc, PortKind::kPv, PortKind::kSi, PortKind::kRmDepthLongThrow})
+  for (PortKind kind :
+       {PortKind::kRc, PortKind::kPv, PortKind::kSi, PortKind::kRmDepthLongThrow, PortKind::kUmq})
     if (server_.port(kind) != 0) ports << " " << PortName(kind) << " " << server_.port(kind);
   ORBED_LOG(kInfo) << "hl2ss: serving on " << options_.server.bind_address << ":" << ports.str()
                    << "; UTC offset " << device_.time_base().UtcOffset();
@@ -173,6 +185,20 @@ void Hl2ssProcess::OnCamera(const orbed::image_t& msg, const std::string& channe
   }
 }
 
+bool Hl2ssProcess::OnUmqBytes(int client, const uint8_t* data, size_t size, std::vector<uint8_t>* reply) {
+  UmqSession& session = umq_sessions_.try_emplace(client, &unity_scene_).first->second;
+  const bool keep = session.Consume(data, size, reply);
+  for (const Refusal& r : session.TakeRefusals()) process_.Reject("umq/" + r.key, r.reason);
+  if (unity_scene_.revision() != published_revision_ && !session.in_display_list()) PublishHolograms();
+  return keep;
+}
+
+void Hl2ssProcess::PublishHolograms() {
+  // Every second even when unchanged: orbed-hmd forgets holograms it has not heard of for 3 s.
+  process_.Publish(options_.holograms_channel, HologramSceneMessage(unity_scene_, NowMicros()));
+  published_revision_ = unity_scene_.revision();
+}
+
 Decision Hl2ssProcess::OnConfigured(int client, PortKind port, const StreamConfig& config) {
   Decision d;
   const auto refuse = [&d](const std::string& key, const std::string& reason) {
@@ -232,6 +258,11 @@ void Hl2ssProcess::OnEvent(const ServerEvent& event) {
         ORBED_LOG(kInfo) << "hl2ss: PV subsystem closed";
       }
       if (it != pv_clients_.end()) pv_clients_.erase(it);
+      const auto umq = umq_sessions_.find(event.client);
+      if (umq != umq_sessions_.end()) {
+        umq->second.OnDisconnect();
+        umq_sessions_.erase(umq);
+      }
       ORBED_LOG(kInfo) << "hl2ss: " << who << " left: " << event.detail;
       break;
     }
@@ -253,12 +284,13 @@ int RunHl2ss(int argc, const char* const* argv, std::ostream& out, std::ostream&
       "orbed-hl2ss: the emulated headset served as hl2ss serves a HoloLens 2, for unmodified hl2ss\n"
       "clients (viewer/hl2ss.py, hl2ss_lnm.py): remote configuration on 3809, the front camera (PV,\n"
       "RAW NV12 with the pose) on 3810 from HMD_CAMERA, spatial input (head pose, eye-gaze ray) on\n"
-      "3812 from HMD_POSE and GAZE_RAY; research-mode depth on 3805 is refused. docs/hl2ss.md."};
+      "3812 from HMD_POSE and GAZE_RAY; research-mode depth on 3805 is refused; the Unity message\n"
+      "queue on 3816 (holograms a client places, published on HOLOGRAMS). docs/hl2ss.md."};
   CommonFlags common("orbed-hl2ss");
   AddCommonFlags(&app, &common);
   Hl2ssOptions options;
   int pv_port = kPortPersonalVideo, si_port = kPortSpatialInput, rc_port = kPortRemoteConfiguration,
-      rm_depth_port = kPortRmDepthLongThrow;
+      rm_depth_port = kPortRmDepthLongThrow, umq_port = kPortUnityMessageQueue;
   double max_queue_mb = 64;
   std::string app_version = "1.0.0.0";
   app.add_option("--bind", options.server.bind_address,
@@ -274,6 +306,9 @@ int RunHl2ss(int argc, const char* const* argv, std::ostream& out, std::ostream&
       ->check(orbed::NumberIn(0, 65535))
       ->capture_default_str();
   app.add_option("--rm-depth-port", rm_depth_port, "Research-mode depth long-throw port")
+      ->check(orbed::NumberIn(0, 65535))
+      ->capture_default_str();
+  app.add_option("--umq-port", umq_port, "Unity message-queue port (holograms a client places)")
       ->check(orbed::NumberIn(0, 65535))
       ->capture_default_str();
   app.add_option("--max-clients", options.server.max_clients, "Connections served at once per port")
@@ -305,6 +340,9 @@ int RunHl2ss(int argc, const char* const* argv, std::ostream& out, std::ostream&
       ->capture_default_str();
   app.add_option("--camera-channel", options.camera_channel, "image_t channel (the front camera)")
       ->capture_default_str();
+  app.add_option("--holograms-channel", options.holograms_channel,
+                 "hologram_scene_t channel the Unity message queue's scene is published on")
+      ->capture_default_str();
   if (const auto code = ParseCommandLine(&app, common, argc, argv, out, err)) return *code;
   {
     unsigned a = 0, b = 0, c = 0, d = 0;
@@ -321,7 +359,8 @@ int RunHl2ss(int argc, const char* const* argv, std::ostream& out, std::ostream&
   options.server.ports = {{PortKind::kPv, pv_port},
                           {PortKind::kSi, si_port},
                           {PortKind::kRc, rc_port},
-                          {PortKind::kRmDepthLongThrow, rm_depth_port}};
+                          {PortKind::kRmDepthLongThrow, rm_depth_port},
+                          {PortKind::kUmq, umq_port}};
   options.server.max_queue_bytes = static_cast<size_t>(max_queue_mb * (1 << 20));
   try {
     Hl2ssProcess hl2ss(common, options);

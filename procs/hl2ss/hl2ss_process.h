@@ -19,6 +19,10 @@
 ///             stale_s is not valid; hands not tracked
 ///   RM depth long throw 3805: configurations parsed and checked; refused until a depth source
 ///             is attached (Hl2ssOptions::rm_depth_available)
+///   UMQ 3816  the Unity plugin's message queue (unity_scene.h): the remote Unity scene a client
+///             builds (primitives, poses, colours) is published on HOLOGRAMS after each command
+///             outside a display list that changed it, and every second, for orbed-hmd to draw in
+///             AR_VIEW and the reflective displays
 ///
 /// Timestamps: hl2ss ticks since the process started (protocol.h TimeBase), so ticks + the UTC
 /// offset RC answers is the message's utime as a FILETIME.
@@ -44,6 +48,7 @@
 #include "procs/hl2ss/emulated_device.h"
 #include "procs/hl2ss/hl2ss_server.h"
 #include "procs/hl2ss/streams.h"
+#include "procs/hl2ss/unity_scene.h"
 #include "runtime/process.h"
 
 namespace orbed::hl2ss {
@@ -53,6 +58,8 @@ struct Hl2ssOptions {
   std::string pose_channel{"HMD_POSE"};
   std::string gaze_channel{"GAZE_RAY"};
   std::string camera_channel{"HMD_CAMERA"};
+  std::string holograms_channel{"HOLOGRAMS"};
+  UnitySceneLimits unity_limits;
   double si_hz{30.0};
   double stale_s{0.5};  ///< an HMD_POSE or GAZE_RAY older than this is not reported valid
   double poll_period_s{0.002};
@@ -80,6 +87,8 @@ class Hl2ssProcess {
   void SendSpatialInput();
   Decision OnConfigured(int client, PortKind port, const StreamConfig& config);
   void OnEvent(const ServerEvent& event);
+  bool OnUmqBytes(int client, const uint8_t* data, size_t size, std::vector<uint8_t>* reply);
+  void PublishHolograms();
 
   Process process_;
   Hl2ssOptions options_;
@@ -97,6 +106,9 @@ class Hl2ssProcess {
   std::optional<GazeSample> gaze_;
   int64_t gaze_received_us_{0};
   int64_t gaze_utime_{0};
+  UnityScene unity_scene_;
+  std::map<int, UmqSession> umq_sessions_;
+  int64_t published_revision_{-1};
 };
 
 /// orbed-hl2ss's command line (--help). Exit 0; 2 on bad arguments; 1 when it cannot start (a

@@ -22,6 +22,7 @@ std::string Peer(const sockaddr_in& address) {
 // The most a client may have sent and we not yet used: its port's largest legal message.
 size_t MaxInput(PortKind kind) {
   if (kind == PortKind::kRc) return 13 + static_cast<size_t>(kMaxRcPoints) * 8;
+  if (kind == PortKind::kUmq) return 64 << 10;  // one read: on_bytes takes all of it at once
   return 1 + kMrcVideoOptionsBytes + 5 + 8 + 16 * kMaxEncoderOptions;
 }
 
@@ -37,6 +38,8 @@ std::string PortName(PortKind kind) {
       return "rc";
     case PortKind::kRmDepthLongThrow:
       return "rm_depth";
+    case PortKind::kUmq:
+      return "umq";
   }
   return "?";
 }
@@ -152,7 +155,8 @@ void Hl2ssServer::Accept(Listener& listener, int64_t now_us, const ServerHandler
       }
       client->state = Client::kServing;
     }
-    if (listener.kind == PortKind::kRc) client->state = Client::kServing;  // commands, no configuration
+    if (listener.kind == PortKind::kRc || listener.kind == PortKind::kUmq)
+      client->state = Client::kServing;  // commands, no configuration
     clients_.push_back(std::move(client));
   }
 }
@@ -164,12 +168,25 @@ bool Hl2ssServer::Consume(Client& c, int64_t now_us, const ServerHandlers& h, st
     return false;
   };
   if (c.in.empty()) return true;
-  if (c.state == Client::kServing && c.port != PortKind::kRc)
+  const bool commands = c.port == PortKind::kRc || c.port == PortKind::kUmq;
+  if (commands && c.out_bytes > options_.max_queue_bytes)
+    return refuse(
+        PortName(c.port) + "/not_reading",
+        std::to_string(c.out_bytes) + " bytes of answers unread (it sends commands but does not read)");
+  if (c.state == Client::kServing && !commands)
     return refuse(
         PortName(c.port) + "/unexpected",
         std::to_string(c.in.size()) + " bytes after the configuration (a stream client only reads)");
   if (c.state == Client::kClosing) {
     c.in.clear();
+    return true;
+  }
+  if (c.port == PortKind::kUmq) {
+    std::vector<uint8_t> reply;
+    const bool keep = h.on_bytes && h.on_bytes(c.id, c.in.data(), c.in.size(), &reply);
+    c.in.clear();
+    Queue(c, std::move(reply));
+    if (!keep) c.state = Client::kClosing;
     return true;
   }
   if (c.port == PortKind::kRc) {

@@ -9,15 +9,17 @@
 /// complete within config_timeout_s of connecting; the owner's on_configured decides: serve it
 /// (stream clients then get packets through Send()), answer bytes and close (a calibration or a
 /// control-only connection), or refuse it. The RC port instead carries a stream of commands, each
-/// answered through on_rc; a command left half-sent for config_timeout_s is refused. Bytes a stream
+/// answered through on_rc; the Unity message queue (UMQ) port a stream of commands the owner parses
+/// (on_bytes); a command left half-sent for config_timeout_s is refused. Bytes a stream
 /// client sends after its configuration, a configuration a parser refuses, an unknown RC command:
 /// refused (the client closed), other clients unaffected.
 ///
 /// Memory: a client's unread input is at most its port's largest legal message (the parsers refuse
-/// larger counts first); its output queue at most max_queue_bytes and max_queue_packets whole
-/// packets. Send() to a full queue drops that packet (a client that stops reading loses frames);
-/// after max_consecutive_drops drops in a row the client is closed as stalled. Packets are never
-/// cut: a queued packet is sent whole.
+/// larger counts first; a UMQ client's input is handed over as it arrives); its output queue at most
+/// max_queue_bytes and max_queue_packets whole packets; an RC or UMQ client whose answers pile up
+/// beyond max_queue_bytes (it sends commands but does not read) is refused ("<port>/not_reading"). Send() to
+/// a full queue drops that packet (a client that stops reading loses frames); after max_consecutive_drops
+/// drops in a row the client is closed as stalled. Packets are never cut: a queued packet is sent whole.
 ///
 /// Threading: not thread-safe; one thread calls everything.
 
@@ -35,8 +37,8 @@
 
 namespace orbed::hl2ss {
 
-enum class PortKind { kPv, kSi, kRc, kRmDepthLongThrow };
-std::string PortName(PortKind kind);  // "pv", "si", "rc", "rm_depth"
+enum class PortKind { kPv, kSi, kRc, kRmDepthLongThrow, kUmq };
+std::string PortName(PortKind kind);  // "pv", "si", "rc", "rm_depth", "umq"
 
 struct ServerOptions {
   std::string bind_address{"127.0.0.1"};  ///< an IPv4 address; 0.0.0.0 for every interface
@@ -44,7 +46,8 @@ struct ServerOptions {
   std::map<PortKind, int> ports{{PortKind::kPv, kPortPersonalVideo},
                                 {PortKind::kSi, kPortSpatialInput},
                                 {PortKind::kRc, kPortRemoteConfiguration},
-                                {PortKind::kRmDepthLongThrow, kPortRmDepthLongThrow}};
+                                {PortKind::kRmDepthLongThrow, kPortRmDepthLongThrow},
+                                {PortKind::kUmq, kPortUnityMessageQueue}};
   size_t max_clients{4};              ///< per port
   size_t max_queue_bytes{64u << 20};  ///< per client
   size_t max_queue_packets{8};        ///< per client
@@ -73,6 +76,9 @@ struct ServerEvent {
 struct ServerHandlers {
   std::function<Decision(int client, PortKind port, const StreamConfig& config)> on_configured;
   std::function<Decision(int client, const RcCommand& command)> on_rc;
+  /// The Unity message queue's bytes as they arrive (the owner's parser keeps its own state): append
+  /// the answers to *reply; false closes the client once *reply is sent.
+  std::function<bool(int client, const uint8_t* data, size_t size, std::vector<uint8_t>* reply)> on_bytes;
   std::function<void(const ServerEvent&)> on_event;
 };
 

@@ -37,6 +37,7 @@ inline constexpr int kPortRmDepthLongThrow = 3805;
 inline constexpr int kPortRemoteConfiguration = 3809;
 inline constexpr int kPortPersonalVideo = 3810;
 inline constexpr int kPortSpatialInput = 3812;
+inline constexpr int kPortUnityMessageQueue = 3816;  // the Unity plugin's message queue (unity_scene.h)
 
 // ---------------------------------------------------------------------------------------------
 // Time base (hl2ss.TimeBase).

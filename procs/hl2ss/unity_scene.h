@@ -75,9 +75,6 @@
 
 namespace orbed::hl2ss {
 
-/// hl2ss's IPCPort.UNITY_MESSAGE_QUEUE.
-inline constexpr std::uint16_t kUnityMessageQueuePort = 3816;
-
 /// The command ids (hl2ss_rus.py's command_buffer, RemoteUnityScene.cs).
 namespace umq {
 inline constexpr std::uint32_t kCreatePrimitive = 0;

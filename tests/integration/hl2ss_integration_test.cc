@@ -16,6 +16,10 @@
 //   - hostile clients: a garbage PV configuration is refused ("pv/mode"), a PV client that never
 //     reads is dropped ("pv/backlog", "pv/stalled"), an unknown RC command refused ("rc/unknown"),
 //     while the SI and PV clients above keep receiving; all counted on PROCESS_STATUS.
+// And the Unity message queue (3816; hl2ss_rus.py's command layouts: id u32 | size u32 | data, one
+// u32 answer each): a cube created, posed, coloured and shown is published on HOLOGRAMS at Unity's
+// (x, y, z) = W's (x, z, y) (frames.h by hand: z_D = −z_U, W = (x_D, −z_D, y_D)); removing it
+// empties the scene; a command declaring 4 GiB closes the connection, counted as "umq/size".
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
@@ -35,6 +39,7 @@
 #include <opencv2/imgproc.hpp>
 #include <orbed/gaze_ray_t.hpp>
 #include <orbed/hmd_pose_t.hpp>
+#include <orbed/hologram_scene_t.hpp>
 #include <orbed/image_t.hpp>
 
 #include "lcmtypes/contract/conversions.h"
@@ -415,6 +420,86 @@ TEST(Hl2ss, AnHl2ssClientSeesTheHeadsetAndHostileClientsAreRefused) {
       },
       10));
   for (int i = 0; i < 5; ++i) ASSERT_TRUE(ReadPacket(&pv, true).ok);
+}
+
+// One message-queue command: id, size, data (little-endian u32s and f32s).
+std::vector<uint8_t> Command(uint32_t id, const std::vector<uint32_t>& words,
+                             const std::vector<float>& floats = {}) {
+  std::vector<uint8_t> b(8);
+  const uint32_t size = static_cast<uint32_t>(4 * (words.size() + floats.size()));
+  std::memcpy(b.data(), &id, 4);
+  std::memcpy(b.data() + 4, &size, 4);
+  for (uint32_t w : words)
+    b.insert(b.end(), reinterpret_cast<uint8_t*>(&w), reinterpret_cast<uint8_t*>(&w) + 4);
+  for (float f : floats)
+    b.insert(b.end(), reinterpret_cast<uint8_t*>(&f), reinterpret_cast<uint8_t*>(&f) + 4);
+  return b;
+}
+
+TEST(Hl2ss, HologramsAClientPlacesArePublished) {
+  BusWatcher bus;
+  bus.Start();
+  RunningProcess server({BinPath("orbed-hl2ss")});
+  lcm::LCM lcm;
+  std::vector<orbed::hologram_scene_t> scenes;
+  struct Collect {
+    std::vector<orbed::hologram_scene_t>* out;
+    void On(const lcm::ReceiveBuffer*, const std::string&, const orbed::hologram_scene_t* m) {
+      out->push_back(*m);
+    }
+  } collect{&scenes};
+  lcm.subscribe("HOLOGRAMS", &Collect::On, &collect);
+  const auto wait_for_scene = [&](const std::function<bool(const orbed::hologram_scene_t&)>& ok) {
+    return WaitFor(
+        [&] {
+          lcm.handleTimeout(50);
+          return !scenes.empty() && ok(scenes.back());
+        },
+        20);
+  };
+
+  Socket umq(3816);
+  ASSERT_TRUE(umq.ok());
+  std::vector<uint8_t> list;
+  for (const auto& c : {Command(0, {3}),  // create a cube: key 1
+                        Command(2, {1}, {0.5f, 1.2f, 2.0f, 0, 0, 0, 1, 0.1f, 0.2f, 0.3f}),  // world transform
+                        Command(4, {1}, {1.0f, 0.5f, 0.0f, 0.8f}),                          // colour
+                        Command(1, {1, 1})})                                                // shown
+    list.insert(list.end(), c.begin(), c.end());
+  umq.Send(list);
+  const std::vector<uint8_t> answers = umq.Read(16);
+  ASSERT_EQ(answers.size(), 16u);
+  EXPECT_EQ(Le<uint32_t>(answers.data()), 1u) << "the cube's key";
+  for (int i = 1; i < 4; ++i) EXPECT_EQ(Le<uint32_t>(answers.data() + 4 * i), 1u);
+  ASSERT_TRUE(
+      wait_for_scene([](const orbed::hologram_scene_t& m) { return m.num_holograms == 1 && m.active[0]; }));
+  const orbed::hologram_scene_t& placed = scenes.back();
+  EXPECT_EQ(placed.id[0], 1);
+  EXPECT_EQ(placed.kind[0], orbed::hologram_scene_t::KIND_CUBE);
+  EXPECT_NEAR(placed.X_WG[0].position_m[0], 0.5, 1e-6);
+  EXPECT_NEAR(placed.X_WG[0].position_m[1], 2.0, 1e-6);
+  EXPECT_NEAR(placed.X_WG[0].position_m[2], 1.2, 1e-6);
+  EXPECT_NEAR(placed.scale[0][0], 0.1, 1e-6);
+  EXPECT_NEAR(placed.scale[0][2], 0.3, 1e-6);
+  EXPECT_FLOAT_EQ(placed.rgba[0][1], 0.5f);
+
+  umq.Send(Command(16, {1}));  // remove
+  const std::vector<uint8_t> removed = umq.Read(4);
+  ASSERT_EQ(removed.size(), 4u);
+  EXPECT_EQ(Le<uint32_t>(removed.data()), 1u);
+  EXPECT_TRUE(wait_for_scene([](const orbed::hologram_scene_t& m) { return m.num_holograms == 0; }));
+
+  Socket hostile(3816);
+  hostile.Send({0, 0, 0, 0, 0xFF, 0xFF, 0xFF, 0xFF});  // create, 4 GiB of data
+  EXPECT_TRUE(hostile.ClosedByServer());
+  EXPECT_TRUE(WaitFor(
+      [&] {
+        const auto beats = bus.Heartbeats("orbed-hl2ss");
+        return !beats.empty() && CountOf(beats.back().status, "umq/size", false) == 1;
+      },
+      10));
+  umq.Send(Command(17, {}));  // remove all: the first client is still served
+  EXPECT_EQ(umq.Read(4).size(), 4u);
 }
 
 }  // namespace
