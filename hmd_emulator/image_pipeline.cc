@@ -40,10 +40,8 @@ ImagePipeline::ImagePipeline(const sim::RobotModel& robot, const render::SceneGe
       outputs_(std::move(outputs)),
       clocks_(std::move(clocks)),
       renderer_(options_.intrinsics),
-      compositor_(robot) {
-  robot_geometry_.AddRobot(robot, render::BodyKind::kRealRobot);
-  render::Tessellate(scene_objects, render::kAllKinds, {}, &scene_mesh_);
-  mesh_ = scene_mesh_;
+      compositor_(robot),
+      room_(robot, scene_objects) {
   for (double t_s : options_.display_capture_t_s) {
     Display d;
     d.capture_t_s = t_s;
@@ -142,10 +140,10 @@ void ImagePipeline::Run(Job job, const FrameInputs& in, bool publish) {
 
 void ImagePipeline::PoseRobot(const RobotState& robot) {
   if (robot.SameAs(robot_)) return;
-  mesh_ = scene_mesh_;
   if (robot.known()) {
-    robot_geometry_.PoseRobot(0, robot.q_rad, robot.X_WR);
-    render::Tessellate(robot_geometry_, render::kAllKinds, {}, &mesh_);
+    room_.PoseRobot(robot.q_rad, robot.X_WR);
+  } else {
+    room_.ClearRobot();
   }
   robot_ = robot;
 }
@@ -159,7 +157,8 @@ double ImagePipeline::GazeDistance(const Eigen::Isometry3d& X_WH, const Eigen::I
   const double fallback_m = options_.gaze_fallback_distance_m;
   if (!robot_.known()) return fallback_m;
   const Eigen::Vector3d p_WH = X_WH.translation(), d_W = X_WH.linear().col(2);
-  const RayHit hit = CastRay(robot_geometry_, p_WH, d_W, render::kRealWorld, options_.max_gaze_distance_m);
+  const RayHit hit =
+      CastRay(room_.robot_geometry(), p_WH, d_W, render::kRealWorld, options_.max_gaze_distance_m);
   if (!hit.hit) return fallback_m;
   const double D_m = (hit.p_WQ - X_WC.translation()).norm();
   return std::isfinite(D_m) && D_m > 0.01 ? D_m : fallback_m;
@@ -182,7 +181,7 @@ void ImagePipeline::Capture(Display* d, const FrameInputs& in) {
 
 // The robot moved since the display captured: render its frame again from the same viewpoint.
 void ImagePipeline::Recapture(Display* d) {
-  renderer_.Render(mesh_, d->X_WC_true, &d->frame.bgr);
+  renderer_.Render(room_.mesh(), d->X_WC_true, &d->frame.bgr);
   d->frame.bgr = d->frame.bgr.clone();  // own its pixels (the renderer may reuse the buffer)
   d->frame.q_rad = robot_.known() ? robot_.q_rad : Eigen::VectorXd();
   d->robot = robot_;
@@ -196,7 +195,7 @@ void ImagePipeline::FromCollaborator(Display* d, const FrameInputs::Collaborator
       SamePose(d->frame.X_WC_est, camera.X_WC_est) && robot_.SameAs(d->robot)) {
     return;
   }
-  renderer_.Render(mesh_, camera.X_WC_true, &d->frame.bgr);
+  renderer_.Render(room_.mesh(), camera.X_WC_true, &d->frame.bgr);
   d->frame.bgr = d->frame.bgr.clone();  // own its pixels (the renderer may reuse the buffer)
   d->frame.intrinsics = renderer_.intrinsics();
   d->frame.X_WC_est = camera.X_WC_est;
@@ -219,7 +218,7 @@ void ImagePipeline::Camera(const FrameInputs& in) {
   } else {
     have_frame_ = false;
     PoseRobot(in.robot);
-    renderer_.Render(mesh_, X_WC_true, &bgr_);
+    renderer_.Render(room_.mesh(), X_WC_true, &bgr_);
     Encode(bgr_, options_.jpeg_quality, &jpeg_);
     ++rendered_;
   }

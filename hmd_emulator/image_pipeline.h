@@ -58,6 +58,7 @@
 #include "hmd_emulator/robot_state.h"
 #include "hmd_emulator/slam_model.h"
 #include "render/renderer.h"
+#include "render/room_mesh.h"
 #include "render/scene_geometry.h"
 #include "sim/robot_model.h"
 
@@ -197,9 +198,8 @@ class ImagePipeline {
   // Worker state (the worker thread, or the caller's inline).
   render::Renderer renderer_;
   Compositor compositor_;
-  render::SceneGeometry robot_geometry_;  // the real robot only, handle 0
-  render::Mesh scene_mesh_, mesh_;        // mesh_ = scene_mesh_ + the robot at robot_ when known
-  RobotState robot_;                      // the robot drawn in mesh_, bgr_ and robot_geometry_
+  render::RoomMesh room_;  // the scene + the robot at robot_ when known (render/room_mesh.h)
+  RobotState robot_;       // the robot drawn in room_ and bgr_
   // The latest camera frame.
   bool have_frame_{false};
   cv::Mat bgr_;
