@@ -34,6 +34,9 @@ find_library(TINYXML_LIBRARY tinyxml REQUIRED)
 # Bullet in double precision only; never link the single-precision libraries beside it.
 pkg_check_modules(BULLET REQUIRED IMPORTED_TARGET bullet-float64)
 find_package(fcl QUIET)
+# libavcodec (FFmpeg) with Debian's libx264 and libx265 for the emulated HoloLens 2's PV video
+# (procs/hl2ss/pv_encoder.h); its decoder is the independent reader in the tests.
+pkg_check_modules(LIBAV REQUIRED IMPORTED_TARGET libavcodec libavutil)
 
 # OpenIGTLink 1.11 (protocol v2) for orbed-igtl-bridge. Debian's config file is pre-target CMake
 # (variables only), so the library is found by hand; the example sources the integration test
