@@ -13,6 +13,7 @@
 #include <cstdlib>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "base/source_paths.h"
@@ -40,10 +41,11 @@ double Percentile(std::vector<double> v, double p) {
 }
 
 struct Stream {
+  Stream(std::string n, double p) : name(std::move(n)), period_s(p) {}
   std::string name;
   double period_s;
   double next_s{0};
-  std::vector<double> ms;
+  std::vector<double> ms;  // per-frame times
   size_t bytes{0};
 };
 
