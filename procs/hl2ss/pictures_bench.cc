@@ -3,7 +3,9 @@
 // long-throw depth camera at 5 Hz (render + PNG). Prints p50 / p99 per stream [ms] and the
 // process's CPU share of one core over the run. Pictures are rendered beforehand (the headset
 // renders them anyway); only the depth camera renders here, as the server will.
-//   hl2ss_pictures_bench [seconds (default 10)] [encoder threads (default 1)]
+//   hl2ss_pictures_bench [seconds (default 10)] [encoder threads (default 1)] [h265]
+// With "h265" the H.264 stream is replaced by the client's default: H.265 main at 1920×1080 30 Hz
+// (bitrate 1920·1080·30·12/150), from the same 1280×720 pictures resized.
 // Pacing sleeps until each stream's next frame time: a benchmark at the device's rates, not a test.
 #include <sys/resource.h>
 
@@ -55,6 +57,7 @@ int main(int argc, char** argv) {
   using namespace orbed;
   const double seconds = argc > 1 ? std::atof(argv[1]) : 10.0;
   const int threads = argc > 2 ? std::atoi(argv[2]) : 1;
+  const bool hevc = argc > 3 && std::string(argv[3]) == "h265";
 
   const std::optional<sim::Scene> scene = sim::LoadSceneFlag("");
   const sim::RobotModel robot =
@@ -84,6 +87,11 @@ int main(int argc, char** argv) {
   h264_config.bitrate_bps = 1280 * 720 * 30 * 12 / 75;
   h264_config.gop_frames = 30;
   h264_config.threads = threads;
+  if (hevc) {
+    h264_config.format = {1920, 1080, 30};
+    h264_config.profile = hl2ss::VideoProfile::kH265Main;
+    h264_config.bitrate_bps = 1920 * 1080 * 30 * 12 / 150;
+  }
   auto raw = hl2ss::PvEncoder::Create(raw_config, &error);
   auto h264 = hl2ss::PvEncoder::Create(h264_config, &error);
   if (!raw || !h264) {
@@ -93,10 +101,11 @@ int main(int argc, char** argv) {
   hl2ss::LongThrowCamera depth_camera;
   hl2ss::LongThrowFrame depth_frame;
 
-  std::vector<Stream> streams = {{"PV raw NV12 1280x720 30 Hz", 1.0 / 30},
-                                 {"PV H.264 main 1280x720 30 Hz", 1.0 / 30},
-                                 {"depth render 320x288 5 Hz", 1.0 / hl2ss::kLongThrowHz},
-                                 {"depth PNG 5 Hz", 1.0 / hl2ss::kLongThrowHz}};
+  std::vector<Stream> streams = {
+      {"PV raw NV12 1280x720 30 Hz", 1.0 / 30},
+      {hevc ? "PV H.265 main 1920x1080 30 Hz" : "PV H.264 main 1280x720 30 Hz", 1.0 / 30},
+      {"depth render 320x288 5 Hz", 1.0 / hl2ss::kLongThrowHz},
+      {"depth PNG 5 Hz", 1.0 / hl2ss::kLongThrowHz}};
   std::vector<std::uint8_t> payload;
   const Clock::time_point t0 = Clock::now();
   const double cpu0 = CpuSeconds();

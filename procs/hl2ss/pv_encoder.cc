@@ -261,7 +261,11 @@ std::unique_ptr<PvEncoder> PvEncoder::Create(const PvEncoderConfig& config, std:
   av_opt_set(ctx->priv_data, "tune", "zerolatency", 0);
   if (hevc) {
     ctx->profile = FF_PROFILE_HEVC_MAIN;
-    av_opt_set(ctx->priv_data, "x265-params", "log-level=error:repeat-headers=1:aud=0", 0);
+    // One frame in flight (frame-threads=1: each picture's unit comes back at once); the threads
+    // work within the picture (wavefront rows).
+    const std::string params =
+        "log-level=error:repeat-headers=1:aud=0:frame-threads=1:pools=" + std::to_string(config.threads);
+    av_opt_set(ctx->priv_data, "x265-params", params.c_str(), 0);
   } else {
     // x264 signals the lowest profile its tools fit, and the ultrafast preset's fit baseline: the
     // tool that defines main (CABAC) and high's (8×8 transform) are switched back on.
