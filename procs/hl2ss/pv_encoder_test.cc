@@ -286,6 +286,11 @@ void ExpectDecodes(VideoProfile profile, int w, int h, double min_psnr_db) {
     std::vector<std::uint8_t> payload;
     ASSERT_TRUE(enc->Encode(bgr, geometry::Intrinsics::HoloLensPv(), {}, &payload, &error)) << error;
     const std::vector<std::uint8_t> image = ImagePart(payload);
+    float f_trailer[4];  // the intrinsics of the picture sent, not of the one given
+    std::memcpy(f_trailer, payload.data() + image.size(), sizeof(f_trailer));
+    const geometry::Intrinsics K_sent = ScaleIntrinsics(geometry::Intrinsics::HoloLensPv(), w, h);
+    EXPECT_FLOAT_EQ(f_trailer[0], static_cast<float>(K_sent.fx_px));
+    EXPECT_FLOAT_EQ(f_trailer[3], static_cast<float>(K_sent.cy_px));
     if (!hevc) {
       ASSERT_GE(image.size(), 6u);
       EXPECT_EQ(std::vector<std::uint8_t>(image.begin(), image.begin() + 6),
@@ -344,6 +349,24 @@ TEST(PvVideo, EachConnectionStartsWithAnIdrAndTheGopRepeatsIt) {
   }
   EXPECT_EQ(idr, (std::vector<bool>{true, false, false, true, false, false, true}));
   EXPECT_EQ(enc->frames(), 7);
+}
+
+TEST(PvVideo, TwoThreadsStillReturnEachPicturesUnit) {
+  for (VideoProfile profile : {VideoProfile::kH264High, VideoProfile::kH265Main}) {
+    std::string error;
+    PvEncoderConfig c = Config(640, 360, profile);
+    c.threads = 2;
+    auto enc = PvEncoder::Create(c, &error);
+    ASSERT_TRUE(enc) << error;
+    ClientDecoder dec(profile == VideoProfile::kH265Main);
+    for (int i = 0; i < 3; ++i) {
+      std::vector<std::uint8_t> payload;
+      ASSERT_TRUE(enc->Encode(TestPicture(1280, 720, 5 * i), geometry::Intrinsics::HoloLensPv(), {}, &payload,
+                              &error))
+          << static_cast<int>(profile) << " picture " << i << ": " << error;
+      EXPECT_FALSE(dec.Decode(ImagePart(payload)).empty()) << static_cast<int>(profile) << " picture " << i;
+    }
+  }
 }
 
 TEST(PvIntrinsics, ScaledAboutPixelEdges) {
