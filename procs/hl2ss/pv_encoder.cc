@@ -1,6 +1,7 @@
 #include "procs/hl2ss/pv_encoder.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <sstream>
 
@@ -47,6 +48,8 @@ std::string AvError(int code) {
 
 // The access unit delimiter the device's H.264 encoder starts each unit with; the client drops
 // these 6 bytes (primary_pic_type 0, then the stop bit).
+constexpr int kMaxPictureSide = 4096;  // a picture from outside is refused before it is resized
+
 constexpr std::uint8_t kH264Aud[6] = {0x00, 0x00, 0x00, 0x01, 0x09, 0x10};
 
 }  // namespace
@@ -302,8 +305,17 @@ bool PvEncoder::Encode(const cv::Mat& bgr, const geometry::Intrinsics& K_picture
     *error = "PV picture is not 8-bit BGR";
     return false;
   }
+  if (bgr.cols > kMaxPictureSide || bgr.rows > kMaxPictureSide) {
+    *error = "PV picture larger than 4096 pixels a side";
+    return false;
+  }
   if (bgr.cols != K_picture.width_px || bgr.rows != K_picture.height_px) {
     *error = "PV picture size differs from its intrinsics";
+    return false;
+  }
+  if (!(K_picture.fx_px > 0 && K_picture.fy_px > 0 && std::isfinite(K_picture.fx_px) &&
+        std::isfinite(K_picture.fy_px) && std::isfinite(K_picture.cx_px) && std::isfinite(K_picture.cy_px))) {
+    *error = "PV picture intrinsics not finite and positive";
     return false;
   }
   const int w = config_.format.width_px, h = config_.format.height_px;

@@ -144,8 +144,9 @@ class PvEncoder {
 
   /// One packet's payload for `bgr` (CV_8UC3, any size: resized to the configured one when it
   /// differs) taken by a camera with intrinsics `K_picture` (of bgr's size): the image as
-  /// configured, then the trailer. Replaces *payload. False and *error on a wrong picture type or
-  /// an encoder failure.
+  /// configured, then the trailer. Replaces *payload. False and *error, before any work, on a
+  /// picture that is not BGR, is larger than 4096 pixels a side or does not match K_picture (size,
+  /// finite positive focal lengths), and on an encoder failure.
   bool Encode(const cv::Mat& bgr, const geometry::Intrinsics& K_picture, const PvCaptureMetadata& metadata,
               std::vector<std::uint8_t>* payload, std::string* error);
 

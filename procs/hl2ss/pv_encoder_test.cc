@@ -369,6 +369,26 @@ TEST(PvVideo, TwoThreadsStillReturnEachPicturesUnit) {
   }
 }
 
+TEST(PvVideo, RefusesABadPictureBeforeEncoding) {
+  std::string error;
+  auto enc = PvEncoder::Create(Config(1280, 720, VideoProfile::kH264Main), &error);
+  ASSERT_TRUE(enc) << error;
+  std::vector<std::uint8_t> payload;
+  const geometry::Intrinsics K = geometry::Intrinsics::HoloLensPv();
+  EXPECT_FALSE(enc->Encode(cv::Mat(720, 1280, CV_8UC1, cv::Scalar(0)), K, {}, &payload, &error));
+  EXPECT_FALSE(enc->Encode(TestPicture(640, 360), K, {}, &payload, &error));  // not K's size
+  EXPECT_NE(error.find("differs"), std::string::npos) << error;
+  geometry::Intrinsics big = K;
+  big.width_px = 5000;
+  EXPECT_FALSE(enc->Encode(cv::Mat(720, 5000, CV_8UC3), big, {}, &payload, &error));
+  EXPECT_NE(error.find("4096"), std::string::npos) << error;
+  geometry::Intrinsics nan = K;
+  nan.fx_px = std::nan("");
+  EXPECT_FALSE(enc->Encode(TestPicture(1280, 720), nan, {}, &payload, &error));
+  EXPECT_EQ(enc->frames(), 0);
+  EXPECT_TRUE(enc->Encode(TestPicture(1280, 720), K, {}, &payload, &error)) << error;
+}
+
 TEST(PvIntrinsics, ScaledAboutPixelEdges) {
   const geometry::Intrinsics K = geometry::Intrinsics::HoloLensPv();
   const geometry::Intrinsics K2 = ScaleIntrinsics(K, 1920, 1080);
