@@ -118,6 +118,8 @@ int PvRawStride(int width_px) { return (width_px + 63) & ~63; }
 std::optional<std::string> CheckPvEncoderConfig(const PvEncoderConfig& config) {
   if (auto why = CheckPvFormat(config.format)) return why;
   if (config.threads < 1 || config.threads > 8) return "encoder threads must be 1 … 8";
+  if (config.divisor < 1 || config.divisor > 255)
+    return "divisor " + std::to_string(config.divisor) + " outside 1 … 255";
   if (config.profile == VideoProfile::kRaw) return std::nullopt;
   if (config.bitrate_bps == 0 || config.bitrate_bps > kMaxBitrateBps) {
     return "bitrate " + std::to_string(config.bitrate_bps) + " bit/s outside 1 … " +
@@ -251,8 +253,8 @@ std::unique_ptr<PvEncoder> PvEncoder::Create(const PvEncoderConfig& config, std:
   ctx->width = config.format.width_px;
   ctx->height = config.format.height_px;
   ctx->pix_fmt = AV_PIX_FMT_YUV420P;
-  ctx->time_base = AVRational{1, config.format.framerate_hz};
-  ctx->framerate = AVRational{config.format.framerate_hz, 1};
+  ctx->time_base = AVRational{config.divisor, config.format.framerate_hz};
+  ctx->framerate = AVRational{config.format.framerate_hz, config.divisor};
   ctx->bit_rate = config.bitrate_bps;
   ctx->gop_size = config.gop_frames;
   ctx->max_b_frames = 0;

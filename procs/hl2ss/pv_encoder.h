@@ -86,8 +86,11 @@ int PvRawStride(int width_px);
 struct PvEncoderConfig {
   PvFormat format;
   VideoProfile profile{VideoProfile::kH265Main};
+  /// The client's divisor: the server sends every divisor-th picture (1 … 255), so the encoder
+  /// sees framerate / divisor pictures a second.
+  int divisor{1};
   std::uint32_t bitrate_bps{0};  ///< > 0 unless raw; at most kMaxBitrateBps
-  int gop_frames{30};            ///< IDR period [frames], 1 … 600; ignored for raw
+  int gop_frames{30};            ///< IDR period [pictures encoded], 1 … 600; ignored for raw
   int threads{1};                ///< encoder threads, 1 … 8 (the emulation's choice, not the client's)
 };
 inline constexpr std::uint32_t kMaxBitrateBps = 200'000'000;

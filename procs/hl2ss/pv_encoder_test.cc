@@ -170,6 +170,11 @@ TEST(PvFormat, ConfigChecks) {
   c = Config(1280, 720, VideoProfile::kH265Main);
   c.gop_frames = 0;
   EXPECT_TRUE(CheckPvEncoderConfig(c));
+  c = Config(1280, 720, VideoProfile::kH265Main);
+  c.divisor = 0;
+  EXPECT_TRUE(CheckPvEncoderConfig(c));
+  c.divisor = 2;
+  EXPECT_FALSE(CheckPvEncoderConfig(c));
   EXPECT_EQ(VideoProfileFromByte(3), VideoProfile::kH265Main);
   EXPECT_EQ(VideoProfileFromByte(0xFF), VideoProfile::kRaw);
   EXPECT_FALSE(VideoProfileFromByte(4));
