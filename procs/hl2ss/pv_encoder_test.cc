@@ -394,6 +394,34 @@ TEST(PvVideo, RefusesABadPictureBeforeEncoding) {
   EXPECT_TRUE(enc->Encode(TestPicture(1280, 720), K, {}, &payload, &error)) << error;
 }
 
+TEST(PvVideo, HoldsTheClientsBitrate) {
+  // Busy content (noise scrolling by), so the rate control, not the picture, sets the size.
+  cv::Mat noise(240, 424 + 64, CV_8UC3);
+  const geometry::Intrinsics K = ScaleIntrinsics(geometry::Intrinsics::HoloLensPv(), 424, 240);
+  cv::RNG rng(7);
+  rng.fill(noise, cv::RNG::UNIFORM, 0, 255);
+  cv::GaussianBlur(noise, noise, cv::Size(9, 9), 2.0);
+  for (VideoProfile profile : {VideoProfile::kH264Main, VideoProfile::kH265Main}) {
+    for (std::uint32_t bps : {300'000u, 1'200'000u}) {
+      PvEncoderConfig c = Config(424, 240, profile);
+      c.bitrate_bps = bps;
+      std::string error;
+      auto enc = PvEncoder::Create(c, &error);
+      ASSERT_TRUE(enc) << error;
+      size_t bytes = 0;
+      for (int i = 0; i < 60; ++i) {  // two seconds at 30 Hz; the second one counted
+        std::vector<std::uint8_t> payload;
+        ASSERT_TRUE(enc->Encode(noise.colRange(i, i + 424).clone(), K, {}, &payload, &error)) << error;
+        if (i >= 30) bytes += payload.size() - kPvTrailerBytes;
+      }
+      const double measured_bps = 8.0 * bytes;
+      std::printf("profile %d at %u bit/s: %.0f bit/s\n", static_cast<int>(profile), bps, measured_bps);
+      EXPECT_GT(measured_bps, 0.8 * bps);
+      EXPECT_LT(measured_bps, 1.25 * bps);  // measured 0.97 … 1.11 of it
+    }
+  }
+}
+
 TEST(PvIntrinsics, ScaledAboutPixelEdges) {
   const geometry::Intrinsics K = geometry::Intrinsics::HoloLensPv();
   const geometry::Intrinsics K2 = ScaleIntrinsics(K, 1920, 1080);
