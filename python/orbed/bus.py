@@ -198,7 +198,8 @@ class Bus:
         self.group, self.port, self.ttl, self.recv_buf_size = parse_url(self.url)
         self.refused = collections.Counter()
         self.received = 0  # whole messages received (before decoding)
-        self._reassembler = Reassembler(self._refuse, max_message_bytes, max_partials)
+        self._reassembler = Reassembler(lambda reason: self._refuse("bus/" + reason), max_message_bytes,
+                                        max_partials)
         self._subscriptions = []
         self._seqno = 0
         self._send_lock = threading.Lock()
@@ -285,10 +286,15 @@ class Bus:
                 data, sender = self._recv.recvfrom(65536)
             except BlockingIOError:
                 return dispatched
-            whole = self._reassembler.feed(data, sender)
-            if whole is not None:
-                self.received += 1
-                dispatched += self._dispatch(*whole)
+            dispatched += self.feed(data, sender)
+
+    def feed(self, datagram, sender=("127.0.0.1", 0)):
+        """Processes one datagram as if it had arrived from `sender`; returns the callbacks run."""
+        whole = self._reassembler.feed(datagram, sender)
+        if whole is None:
+            return 0
+        self.received += 1
+        return self._dispatch(*whole)
 
     def _dispatch(self, channel, payload):
         n = 0
