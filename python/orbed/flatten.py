@@ -5,8 +5,9 @@ orbed_lcm._structure. A byte array is one cell, its length in bytes ("data (byte
 
 Cell text: integers in decimal, booleans 1/0, floating point as C++'s std::to_chars shortest form
 (shortest digits that read back to the same double, or float for `float` fields; fixed or
-scientific notation, whichever is shorter, fixed on a tie; "nan", "inf", "-inf"), strings quoted as
-RFC 4180 when they hold a comma, quote, CR or LF or start or end with a space. Pure.
+scientific notation, whichever is shorter, fixed on a tie; "nan", "inf", "-inf"), strings as they
+are; in a CSV file (csv_cell) quoted as RFC 4180 when they hold a comma, quote, CR or LF or start
+or end with a space. Pure.
 """
 import math
 
@@ -65,13 +66,13 @@ def _cell(type_name, value):
     if type_name in ("double", "float"):
         return shortest(float(value), type_name == "float")
     if type_name == "string":
-        return csv_cell(value)
+        return value
     return str(int(value))
 
 
 def flatten(message, prefix="", out=None, struct_name=None):
-    """[(column name, cell text, value)] of `message` in field order (value: the Python value, the
-    byte count for a byte array)."""
+    """[(column name, cell text, value)] of `message` in field order (value: the Python value; for a
+    byte array its length; for a float field the double its text reads as)."""
     structs = types.structs()
     out = [] if out is None else out
     for type_name, field, dims, unit in structs[struct_name or type(message).__name__]:
@@ -89,6 +90,9 @@ def _flatten_field(message, structs, type_name, path, dims, unit, value, out):
         for i in range(bound):
             _flatten_field(message, structs, type_name, f"{path}[{i}]", dims[1:], unit, value[i], out)
     elif type_name in PRIMITIVE_BYTES or type_name == "string":
-        out.append((f"{path} ({unit})" if unit else path, _cell(type_name, value), value))
+        cell = _cell(type_name, value)
+        if type_name == "float":
+            value = float(cell)  # the double its CSV text reads as (0.1, not 0.10000000149011612)
+        out.append((f"{path} ({unit})" if unit else path, cell, value))
     else:
         flatten(value, path + ".", out, type_name)

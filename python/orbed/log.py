@@ -18,7 +18,8 @@ under its reason; columns are named and written as orbed.flatten says, in the or
 merges them (an array's longer messages put their extra elements after the shorter ones' last);
 the first column is "log_utime (us)". Typed frames hold numbers (int or float, booleans as 1/0, a
 byte array as its length) and strings, NaN where a message has no such cell; text frames hold the
-CSV text, "" where the CSV cell is empty. Single-threaded.
+cells' text as a CSV reader gives it back, "" where the CSV cell is empty; csv_text(frame) is the
+file `orbed-log export --csv` writes, byte for byte. Single-threaded.
 """
 import collections
 import mmap
@@ -189,6 +190,13 @@ def _frame(t, text):
 def tables(path, text=False, channels=None):
     """{channel: DataFrame} of the log (module doc)."""
     return export(path, text, channels).frames
+
+
+def csv_text(frame):
+    """A text frame as the CSV file `orbed-log export --csv` writes (header row, '\\n' line ends)."""
+    lines = [",".join(flatten.csv_cell(c) for c in frame.columns)]
+    lines += [",".join(flatten.csv_cell(c) for c in row) for row in frame.itertuples(index=False)]
+    return "".join(line + "\n" for line in lines)
 
 
 def csv_file_stem(channel):
