@@ -17,8 +17,8 @@ PACKAGES = """
   libeigen3-dev libopencv-dev liburdfdom-dev libtinyxml-dev liburdfdom-tools libbullet-dev libfcl-dev
   libyaml-cpp-dev nlohmann-json3-dev libcli11-dev libssl-dev libopenigtlink-dev openigtlink-examples libwebsocketpp-dev libasio-dev
   libgtest-dev libbenchmark-dev
-  libavcodec-dev libavutil-dev libswscale-dev
-  iproute2 util-linux procps python3 python3-matplotlib python3-yaml python3-pytest python3-scipy python3-statsmodels python3-pandas xvfb xauth x11-utils clang-format clang libclang-rt-14-dev
+  libavcodec-dev libavutil-dev
+  iproute2 util-linux procps python3 python3-matplotlib python3-yaml python3-pytest python3-scipy python3-statsmodels python3-pandas python3-opencv xvfb xauth x11-utils clang-format clang libclang-rt-14-dev
   chromium
 """.split()
 RMEM_WANTED = 16777216  # LCM image traffic wants a large UDP receive buffer
