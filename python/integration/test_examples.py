@@ -1,6 +1,8 @@
 """examples/ run as a user runs them: each exits 0 and what it prints or writes is checked against an
 independent reading of the same input."""
 import csv
+import json
+import math
 import os
 import subprocess
 import sys
@@ -53,3 +55,37 @@ def test_hmd_camera_frames_reach_opencv(processes, tmp_path):
         assert frame.shape == (720, 1280, 3) and frame.std() > 0  # the HoloLens PV size, not blank
         assert line == f"frame {n}: 1280x720, {np.count_nonzero(edges)} edges"
     assert n == 2
+
+
+def same_numbers(got, want, path=""):
+    """Where `got` differs from `want`: numbers within 1e-9 (relative) agree, the rest must be equal."""
+    if isinstance(want, dict):
+        return [d for k in want for d in same_numbers(got.get(k), want[k], f"{path}.{k}")] + \
+            [f"{path}.{k}: not expected" for k in set(got) - set(want)]
+    if isinstance(want, list):
+        if not isinstance(got, list) or len(got) != len(want):
+            return [f"{path}: {got} != {want}"]
+        return [d for k, (g, w) in enumerate(zip(got, want)) for d in same_numbers(g, w, f"{path}[{k}]")]
+    if isinstance(want, float) and isinstance(got, (int, float)):
+        return [] if math.isclose(got, want, rel_tol=1e-9, abs_tol=1e-12) else [f"{path}: {got} != {want}"]
+    return [] if got == want else [f"{path}: {got!r} != {want!r}"]
+
+
+def test_a_python_registration_server_answers_a_viraal_run_as_orbed_registration_does(processes, tmp_path):
+    env = dict(os.environ, ORBED_SOURCE_DIR=ROOT)
+    processes.start([binary("orbed-iiwa-sim"), "--name", "sim"], env=env)
+    processes.start([binary("orbed-hmd"), "--name", "hmd"], env=env)
+    server = processes.start([sys.executable, os.path.join(EXAMPLES, "registration_server.py")], env=env)
+    assert server.stdout.readline().startswith("registration server: answering")
+    scenario = subprocess.run([binary("orbed-scenario"), "--name", "scenario", "--run-id", "pinned",
+                               "--results-dir", str(tmp_path)], env=env, capture_output=True, text=True, timeout=240)
+    assert scenario.returncode == 0, scenario.stdout[-2000:] + scenario.stderr[-2000:]
+    with open(tmp_path / "results.json", encoding="utf-8") as f:
+        results = json.load(f)
+    # The run orbed-registration answers (orbed-user-study --trials 3 --run-id pinned), number for number.
+    pinned_file = os.path.join(ROOT, "tests", "integration", "testdata", "viraal_pinned_results.json")
+    with open(pinned_file, encoding="utf-8") as f:
+        pinned = json.load(f)
+    for key in ("started_utime", "duration_s"):
+        results.pop(key)
+    assert results["status"] == "ok" and same_numbers(results, pinned) == []
