@@ -4,9 +4,9 @@ trials on SESSION_CONTROL and ALIGNMENT_TRIAL answered with the session's SE(3) 
 gaze rays triangulated (LANDMARK_REQUEST -> LANDMARK), landmark pairs compared (MISALIGNMENT_REQUEST ->
 MISALIGNMENT); the answers themselves are orbed.registration's.
 
-    PYTHONPATH=python scripts/orbed join /usr/bin/python3 examples/registration_server.py
-(with a testbed launched without orbed-registration), or beside orbed-iiwa-sim, orbed-hmd and
-orbed-scenario as python/integration/test_examples.py runs it.
+    scripts/netns-exec bash -c 'build/bin/orbed-iiwa-sim & build/bin/orbed-hmd &
+      PYTHONPATH=python /usr/bin/python3 examples/registration_server.py &
+      build/bin/orbed-scenario --run-id pinned --results-dir /tmp/viraal; kill $(jobs -p)'
 """
 import os
 import sys
