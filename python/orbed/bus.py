@@ -15,9 +15,10 @@ to 65 487 payload bytes each. One sequence number per message, counting up per s
 names are at most 63 bytes. Sent to the group and port of the URL with the URL's ttl (orbed uses 0:
 nothing leaves the host; scripts/netns-exec gives each run its own namespace).
 
-Bounds: a fragmented message larger than max_message_bytes is refused before its buffer exists;
-at most max_partials messages are being reassembled at once (the oldest is dropped for a new one),
-so reassembly holds at most max_message_bytes x max_partials. A message for a typed subscription is
+Bounds: a fragmented message larger than max_message_bytes (16 MiB) is refused before its buffer
+exists; at most max_partials (8) messages are reassembled at once, holding at most
+max_partial_bytes (32 MiB) together: the oldest are dropped to make room for a new one. A message
+for a typed subscription is
 walked (orbed.wire) before it is decoded. Every refusal is counted in `refused` under a key, as the
 C++ processes count theirs in PROCESS_STATUS: "bus/<reason>" for datagrams, "<channel>/decode/<kind>"
 for messages, "<channel>/handler" for a callback that raised; and logged (the first of a key, then
@@ -110,11 +111,13 @@ class Reassembler:
     """Datagrams in, whole (channel, payload) messages out, with the bounds of the module doc.
     refusal(reason) is called for every refused datagram or dropped partial. Pure (no sockets)."""
 
-    def __init__(self, refusal, max_message_bytes=16 << 20, max_partials=8):
+    def __init__(self, refusal, max_message_bytes=16 << 20, max_partials=8, max_partial_bytes=32 << 20):
         self.refusal = refusal
-        self.max_message_bytes = max_message_bytes
+        self.max_message_bytes = min(max_message_bytes, max_partial_bytes)
         self.max_partials = max_partials
+        self.max_partial_bytes = max_partial_bytes
         self.partials = collections.OrderedDict()  # (sender, seqno) -> _Partial, oldest first
+        self.partial_bytes = 0  # the buffers of self.partials together
 
     @staticmethod
     def _channel(data, start):
@@ -125,6 +128,9 @@ class Reassembler:
             return data[start:end].decode(), end + 1
         except UnicodeDecodeError:
             return None, None
+
+    def _drop(self, key):
+        self.partial_bytes -= self.partials.pop(key).size
 
     def feed(self, data, sender):
         """The message `data` completes, as (channel, payload bytes), or None."""
@@ -155,18 +161,20 @@ class Reassembler:
         key = (sender, seqno)
         partial = self.partials.get(key)
         if partial is not None and (partial.size != size or partial.fragments != fragments):
-            del self.partials[key]
+            self._drop(key)
             self.refusal("fragment_mismatch")
             partial = None
         if offset + len(chunk) > size:
             if partial is not None:
-                del self.partials[key]
+                self._drop(key)
             return self.refusal("fragment_range")
         if partial is None:
-            while len(self.partials) >= self.max_partials:
-                self.partials.popitem(last=False)
+            while self.partials and (len(self.partials) >= self.max_partials or
+                                     self.partial_bytes + size > self.max_partial_bytes):
+                self._drop(next(iter(self.partials)))
                 self.refusal("partial_evicted")
             partial = self.partials[key] = _Partial(size, fragments)
+            self.partial_bytes += size
         if number in partial.seen:
             return self.refusal("fragment_duplicate")
         partial.seen.add(number)
@@ -176,7 +184,7 @@ class Reassembler:
             partial.channel = channel
         if len(partial.seen) < fragments:
             return None
-        del self.partials[key]
+        self._drop(key)
         if partial.bytes != size or partial.channel is None:
             return self.refusal("fragment_range")
         return partial.channel, bytes(partial.data)
@@ -193,13 +201,13 @@ class Bus:
     """One LCM endpoint: a send socket now, a receive socket joined to the group at the first
     subscribe (as LCM does). See the module doc."""
 
-    def __init__(self, url=None, max_message_bytes=16 << 20, max_partials=8):
+    def __init__(self, url=None, max_message_bytes=16 << 20, max_partials=8, max_partial_bytes=32 << 20):
         self.url = url or default_url()
         self.group, self.port, self.ttl, self.recv_buf_size = parse_url(self.url)
         self.refused = collections.Counter()
         self.received = 0  # whole messages received (before decoding)
         self._reassembler = Reassembler(lambda reason: self._refuse("bus/" + reason), max_message_bytes,
-                                        max_partials)
+                                        max_partials, max_partial_bytes)
         self._subscriptions = []
         self._seqno = 0
         self._send_lock = threading.Lock()

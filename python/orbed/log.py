@@ -23,6 +23,7 @@ file `orbed-log export --csv` writes, byte for byte. Single-threaded.
 """
 import collections
 import mmap
+import re
 import struct
 
 import pandas as pd
@@ -130,7 +131,6 @@ class Export:
 def export(path, text=False, channels=None):
     """The log as `orbed-log export --csv` sees it (module doc); channels: a regular expression the
     whole channel name must match."""
-    import re
     pattern = re.compile(channels) if channels else None
     by_fingerprint = types.type_by_fingerprint()
     seen = {}  # channel -> {type: _TypeColumns}

@@ -89,6 +89,12 @@ def test_hostile_datagrams_are_refused_and_counted():
     assert feed_all(b, starts + starts[2:]) == 0
     assert b.refused["bus/partial_evicted"] == 1 and b.refused["bus/fragment_duplicate"] == 1
     assert len(b._reassembler.partials) == 2
+    assert b._reassembler.partial_bytes == 2 * 100000
+    # Partial messages hold at most max_partial_bytes together: a third 10 MB one drops the oldest.
+    r = bus.Reassembler(lambda reason: None, max_partials=8, max_partial_bytes=25 << 20)
+    for seq in range(3):
+        r.feed(bus.encode_datagrams("C", bytes(10 << 20), seq)[0], ("10.0.0.1", 1))
+    assert list(r.partials) == [(("10.0.0.1", 1), 1), (("10.0.0.1", 1), 2)] and r.partial_bytes == 20 << 20
     # The bus still delivers.
     assert feed_all(b, bus.encode_datagrams("OK", bytes(100000), 13)) == 1 and seen == ["OK"]
 
