@@ -10,7 +10,7 @@ import numpy as np
 import pandas as pd
 
 from conftest import binary
-from orbed import bus, log, types
+from orbed import bus, log, runs, types
 
 lcm = types.lcm_types()
 SIM_RATE_HZ = 200.0  # --period-s 0.005
@@ -141,3 +141,20 @@ def test_a_log_read_in_python_equals_orbed_log_csv_export_cell_for_cell(sim, pro
                                       check_exact=True)
     trial_columns = list(text.frames["PY_TRIAL"].columns)
     assert trial_columns.index("annotation_landmark[2]") < trial_columns.index("annotation_side[0]")
+
+
+def test_a_viraal_run_started_from_python_and_its_folder_and_log(tmp_path):
+    folder = runs.run("run", "--run-id", "pinned", "--arg", "trials=1", env=dict(os.environ, ORBED_LOGS_DIR=str(tmp_path)),
+                      output=subprocess.DEVNULL, timeout_s=600)
+    run = runs.load(folder)
+    assert os.path.dirname(folder) == str(tmp_path) and run.kind == "launch"
+    assert run.provenance["command_line"][-5:] == ["run", "--run-id", "pinned", "--arg", "trials=1"] and run.provenance["exit_code"] == 0
+    assert run.results["status"] == "ok" and run.results["run_id"] == "pinned" and len(run.logs) == 1
+    # The whole run's log, every channel (images, strings, the sim's 200 Hz), equal to the C++ export.
+    out = tmp_path / "csv"
+    subprocess.run([binary("orbed-log"), "export", "--csv", run.logs[0], str(out)], check=True, capture_output=True)
+    text = log.export(run.logs[0], text=True)
+    assert len(text.frames) >= 15 and text.damage == []
+    for channel, frame in text.frames.items():
+        assert log.csv_text(frame).encode() == (out / (log.csv_file_stem(channel) + ".csv")).read_bytes(), channel
+    assert sorted(p.name for p in out.iterdir()) == sorted(log.csv_file_stem(c) + ".csv" for c in text.frames)

@@ -4,7 +4,7 @@ it, written here because Debian's LCM has no Python binding.
     bus = orbed.bus.Bus()                        # $ORBED_LCM_URL, else udpm://239.255.76.67:7667?ttl=0
     bus.subscribe("IIWA_STATUS", orbed_lcm.iiwa_status_t, lambda channel, msg: ...)
     bus.publish("IIWA_COMMAND", command)         # a generated message, or bytes
-    bus.handle(timeout_s=1.0)                    # dispatches what arrives; returns how many
+    bus.handle(timeout_s=1.0)                    # the next message to its callbacks; 0 on timeout
 
 The wire (big-endian): a message whose channel, NUL and payload fit in 65 499 bytes is one datagram,
 LC02 magic 0x4C433032 | uint32 sequence number | channel | NUL | payload. A larger one is
@@ -264,18 +264,25 @@ class Bus:
         return self._recv.fileno()
 
     def handle(self, timeout_s=None):
-        """Receives for up to timeout_s (None: until a message) and dispatches every message that
-        completes; returns as soon as at least one was dispatched, with how many (0: timed out)."""
+        """Receives until one message has been dispatched (its callbacks run) or timeout_s passes
+        (None: no limit); returns the callbacks run, 0 on timeout. One message per call, as LCM's
+        handle(): what arrives meanwhile waits in the socket for the next call."""
         self._open_receive()
         deadline = None if timeout_s is None else time.monotonic() + timeout_s
         while True:
-            dispatched = self._drain()
+            try:
+                data, sender = self._recv.recvfrom(65536)
+            except BlockingIOError:
+                wait = None if deadline is None else deadline - time.monotonic()
+                if wait is not None and wait <= 0:
+                    return 0
+                select.select([self._recv], [], [], wait)
+                continue
+            dispatched = self.feed(data, sender)
             if dispatched:
                 return dispatched
-            wait = None if deadline is None else deadline - time.monotonic()
-            if wait is not None and wait <= 0:
+            if deadline is not None and time.monotonic() >= deadline:
                 return 0
-            select.select([self._recv], [], [], wait)
 
     def handle_until(self, done, timeout_s):
         """Handles messages until done() is true or timeout_s passes; returns done()."""
@@ -286,15 +293,6 @@ class Bus:
                 break
             self.handle(left)
         return done()
-
-    def _drain(self):
-        dispatched = 0
-        while True:
-            try:
-                data, sender = self._recv.recvfrom(65536)
-            except BlockingIOError:
-                return dispatched
-            dispatched += self.feed(data, sender)
 
     def feed(self, datagram, sender=("127.0.0.1", 0)):
         """Processes one datagram as if it had arrived from `sender`; returns the callbacks run."""
