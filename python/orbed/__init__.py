@@ -1,4 +1,5 @@
-"""orbed's Python side: the study's analysis (orbed.study) on the files the C++ tools write.
+"""orbed's Python side: the study's analysis (orbed.study) on the files the C++ tools write; the
+message types, the bus, logs and runs (orbed.bus, orbed.log, orbed.runs; docs/python.md).
 
 Scripts import it without an install step:
 
