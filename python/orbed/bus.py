@@ -15,10 +15,11 @@ to 65 487 payload bytes each. One sequence number per message, counting up per s
 names are at most 63 bytes. Sent to the group and port of the URL with the URL's ttl (orbed uses 0:
 nothing leaves the host; scripts/netns-exec gives each run its own namespace).
 
-Bounds: a fragmented message larger than max_message_bytes (16 MiB) is refused before its buffer
-exists; at most max_partials (8) messages are reassembled at once, holding at most
-max_partial_bytes (32 MiB) together: the oldest are dropped to make room for a new one. A message
-for a typed subscription is
+Bounds: a fragmented message larger than max_message_bytes (16 MiB) is refused from its first
+fragment; a partial message holds the bytes that arrived, not the size its header claims; at most
+max_partials (8) messages are reassembled at once, holding at most max_partial_bytes (32 MiB)
+together: the oldest are dropped to make room. Fragments that do not tile their message exactly
+(overlaps, holes) are refused when the last one arrives. A message for a typed subscription is
 walked (orbed.wire) before it is decoded. Every refusal is counted in `refused` under a key, as the
 C++ processes count theirs in PROCESS_STATUS: "bus/<reason>" for datagrams, "<channel>/decode/<kind>"
 for messages, "<channel>/handler" for a callback that raised; and logged (the first of a key, then
@@ -97,14 +98,25 @@ def encode_datagrams(channel, payload, seqno):
 
 
 class _Partial:
-    __slots__ = ("size", "fragments", "data", "seen", "bytes", "channel")
+    """A message being reassembled: its fragments as they came (memory = the bytes received, not
+    the size a header claims)."""
+    __slots__ = ("size", "fragments", "chunks", "bytes", "channel")
 
     def __init__(self, size, fragments):
         self.size, self.fragments = size, fragments
-        self.data = bytearray(size)
-        self.seen = set()
+        self.chunks = {}  # fragment number -> (offset, bytes)
         self.bytes = 0
         self.channel = None
+
+    def assemble(self):
+        """The payload, or None unless the fragments tile it exactly."""
+        at, parts = 0, []
+        for offset, chunk in sorted(self.chunks.values(), key=lambda c: c[0]):
+            if offset != at:
+                return None
+            parts.append(chunk)
+            at += len(chunk)
+        return b"".join(parts) if at == self.size else None
 
 
 class Reassembler:
@@ -130,7 +142,7 @@ class Reassembler:
             return None, None
 
     def _drop(self, key):
-        self.partial_bytes -= self.partials.pop(key).size
+        self.partial_bytes -= self.partials.pop(key).bytes
 
     def feed(self, data, sender):
         """The message `data` completes, as (channel, payload bytes), or None."""
@@ -168,26 +180,28 @@ class Reassembler:
             if partial is not None:
                 self._drop(key)
             return self.refusal("fragment_range")
-        if partial is None:
-            while self.partials and (len(self.partials) >= self.max_partials or
-                                     self.partial_bytes + size > self.max_partial_bytes):
-                self._drop(next(iter(self.partials)))
-                self.refusal("partial_evicted")
-            partial = self.partials[key] = _Partial(size, fragments)
-            self.partial_bytes += size
-        if number in partial.seen:
+        if partial is not None and number in partial.chunks:
             return self.refusal("fragment_duplicate")
-        partial.seen.add(number)
-        partial.data[offset:offset + len(chunk)] = chunk
+        # Room for this fragment: the oldest other partial messages are dropped.
+        while any(k != key for k in self.partials) and (
+                (partial is None and len(self.partials) >= self.max_partials) or
+                self.partial_bytes + len(chunk) > self.max_partial_bytes):
+            self._drop(next(k for k in self.partials if k != key))
+            self.refusal("partial_evicted")
+        if partial is None:
+            partial = self.partials[key] = _Partial(size, fragments)
+        partial.chunks[number] = (offset, bytes(chunk))
         partial.bytes += len(chunk)
+        self.partial_bytes += len(chunk)
         if channel is not None:
             partial.channel = channel
-        if len(partial.seen) < fragments:
+        if len(partial.chunks) < fragments:
             return None
         self._drop(key)
-        if partial.bytes != size or partial.channel is None:
+        payload = partial.assemble()
+        if payload is None or partial.channel is None:
             return self.refusal("fragment_range")
-        return partial.channel, bytes(partial.data)
+        return partial.channel, payload
 
 
 class Subscription:

@@ -89,12 +89,24 @@ def test_hostile_datagrams_are_refused_and_counted():
     assert feed_all(b, starts + starts[2:]) == 0
     assert b.refused["bus/partial_evicted"] == 1 and b.refused["bus/fragment_duplicate"] == 1
     assert len(b._reassembler.partials) == 2
-    assert b._reassembler.partial_bytes == 2 * 100000
+    assert b._reassembler.partial_bytes == 2 * (65487 - 2)  # the bytes that came, not the 100 kB claimed
+    # A flood of first fragments each claiming 1 MiB costs their own bytes, not 1 MiB each.
+    r = bus.Reassembler(lambda reason: None, max_partials=1000)
+    claim = fragment.pack(b"LC03", 0, 1 << 20, 0, 0, 17) + b"C\0" + b"x" * 10
+    for seq in range(1000):
+        r.feed(claim[:4] + struct.pack(">I", seq) + claim[8:], ("10.0.0.1", 1))
+    assert len(r.partials) == 1000 and r.partial_bytes == 10000
     # Partial messages hold at most max_partial_bytes together: a third 10 MB one drops the oldest.
     r = bus.Reassembler(lambda reason: None, max_partials=8, max_partial_bytes=25 << 20)
     for seq in range(3):
-        r.feed(bus.encode_datagrams("C", bytes(10 << 20), seq)[0], ("10.0.0.1", 1))
-    assert list(r.partials) == [(("10.0.0.1", 1), 1), (("10.0.0.1", 1), 2)] and r.partial_bytes == 20 << 20
+        for d in bus.encode_datagrams("C", bytes(10 << 20), seq)[:-1]:
+            r.feed(d, ("10.0.0.1", 1))
+    assert [k[1] for k in r.partials] == [1, 2]
+    # Fragments that overlap and leave a hole are refused when the last arrives.
+    ds = bus.encode_datagrams("C", bytes(200000), 50)
+    head = bytearray(ds[1][:20])
+    head[12:16] = struct.pack(">I", 0)  # fragment 1 claims offset 0, over fragment 0's bytes
+    assert feed_all(b, [ds[0], bytes(head) + ds[1][20:]] + ds[2:]) == 0 and b.refused["bus/fragment_range"] == 2
     # The bus still delivers.
     assert feed_all(b, bus.encode_datagrams("OK", bytes(100000), 13)) == 1 and seen == ["OK"]
 
