@@ -53,7 +53,8 @@ class Echo {
 
 int RunEcho(const std::string& in, const std::string& out) {
   const char* env = std::getenv("ORBED_LCM_URL");
-  lcm::LCM lcm(env != nullptr && env[0] != '\0' ? env : "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=8388608");
+  lcm::LCM lcm(env != nullptr && env[0] != '\0' ? env
+                                                : "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=8388608");
   if (!lcm.good()) return 1;
   Echo echo(out);
   echo.lcm_ = &lcm;
