@@ -16,9 +16,9 @@ names are at most 63 bytes. Sent to the group and port of the URL with the URL's
 nothing leaves the host; scripts/netns-exec gives each run its own namespace).
 
 Bounds: a fragmented message larger than max_message_bytes (16 MiB) is refused from its first
-fragment; a partial message holds the bytes that arrived, not the size its header claims; at most
-max_partials (8) messages are reassembled at once, holding at most max_partial_bytes (32 MiB)
-together: the oldest are dropped to make room. Fragments that do not tile their message exactly
+fragment; a partial message holds the bytes that arrived (counted with CHUNK_OVERHEAD_BYTES per
+fragment), not the size its header claims; at most max_partials (8) messages are reassembled at
+once, holding at most max_partial_bytes (32 MiB) together: the oldest are dropped to make room. Fragments that do not tile their message exactly
 (overlaps, holes) are refused when the last one arrives. A message for a typed subscription is
 walked (orbed.wire) before it is decoded. Every refusal is counted in `refused` under a key, as the
 C++ processes count theirs in PROCESS_STATUS: "bus/<reason>" for datagrams, "<channel>/decode/<kind>"
@@ -49,7 +49,8 @@ SHORT_MESSAGE_MAX_BYTES = 65499  # channel + NUL + payload in one LC02 datagram
 FRAGMENT_MAX_PAYLOAD = 65487     # bytes after the LC03 header in one datagram
 MAX_CHANNEL_BYTES = 63
 MAX_REFUSAL_KEYS = 64
-DEFAULT_RECV_BUF_BYTES = 8 << 20  # asked of the kernel (SO_RCVBUF) unless the URL says recv_buf_size
+DEFAULT_RECV_BUF_BYTES = 8 << 20
+CHUNK_OVERHEAD_BYTES = 160  # what Python holds per kept fragment beside its bytes, counted against the bounds  # asked of the kernel (SO_RCVBUF) unless the URL says recv_buf_size
 
 log = logging.getLogger("orbed.bus")
 
@@ -105,7 +106,7 @@ class _Partial:
     def __init__(self, size, fragments):
         self.size, self.fragments = size, fragments
         self.chunks = {}  # fragment number -> (offset, bytes)
-        self.bytes = 0
+        self.bytes = 0  # the chunks' bytes and their overhead
         self.channel = None
 
     def assemble(self):
@@ -185,14 +186,14 @@ class Reassembler:
         # Room for this fragment: the oldest other partial messages are dropped.
         while any(k != key for k in self.partials) and (
                 (partial is None and len(self.partials) >= self.max_partials) or
-                self.partial_bytes + len(chunk) > self.max_partial_bytes):
+                self.partial_bytes + len(chunk) + CHUNK_OVERHEAD_BYTES > self.max_partial_bytes):
             self._drop(next(k for k in self.partials if k != key))
             self.refusal("partial_evicted")
         if partial is None:
             partial = self.partials[key] = _Partial(size, fragments)
         partial.chunks[number] = (offset, bytes(chunk))
-        partial.bytes += len(chunk)
-        self.partial_bytes += len(chunk)
+        partial.bytes += len(chunk) + CHUNK_OVERHEAD_BYTES
+        self.partial_bytes += len(chunk) + CHUNK_OVERHEAD_BYTES
         if channel is not None:
             partial.channel = channel
         if len(partial.chunks) < fragments:

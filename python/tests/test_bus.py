@@ -89,13 +89,14 @@ def test_hostile_datagrams_are_refused_and_counted():
     assert feed_all(b, starts + starts[2:]) == 0
     assert b.refused["bus/partial_evicted"] == 1 and b.refused["bus/fragment_duplicate"] == 1
     assert len(b._reassembler.partials) == 2
-    assert b._reassembler.partial_bytes == 2 * (65487 - 2)  # the bytes that came, not the 100 kB claimed
+    # The bytes that came (and a fragment's overhead), not the 100 kB claimed.
+    assert b._reassembler.partial_bytes == 2 * (65487 - 2 + bus.CHUNK_OVERHEAD_BYTES)
     # A flood of first fragments each claiming 1 MiB costs their own bytes, not 1 MiB each.
     r = bus.Reassembler(lambda reason: None, max_partials=1000)
     claim = fragment.pack(b"LC03", 0, 1 << 20, 0, 0, 17) + b"C\0" + b"x" * 10
     for seq in range(1000):
         r.feed(claim[:4] + struct.pack(">I", seq) + claim[8:], ("10.0.0.1", 1))
-    assert len(r.partials) == 1000 and r.partial_bytes == 10000
+    assert len(r.partials) == 1000 and r.partial_bytes == 1000 * (10 + bus.CHUNK_OVERHEAD_BYTES)
     # Partial messages hold at most max_partial_bytes together: a third 10 MB one drops the oldest.
     r = bus.Reassembler(lambda reason: None, max_partials=8, max_partial_bytes=25 << 20)
     for seq in range(3):
