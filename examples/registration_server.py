@@ -6,7 +6,7 @@ MISALIGNMENT); the answers themselves are orbed.registration's.
 
     scripts/netns-exec bash -c 'build/bin/orbed-iiwa-sim & build/bin/orbed-hmd &
       PYTHONPATH=python /usr/bin/python3 examples/registration_server.py &
-      build/bin/orbed-scenario --run-id pinned --results-dir /tmp/viraal; kill $(jobs -p)'
+      build/bin/orbed-scenario --run-id pinned --results-dir logs/viraal-py; kill $(jobs -p)'
 """
 import os
 import sys
