@@ -10,6 +10,7 @@ MISALIGNMENT); the answers themselves are orbed.registration's.
 """
 import os
 import sys
+import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "python"))
 from orbed import bus, registration, types  # noqa: E402
@@ -30,8 +31,12 @@ def main():
     b.subscribe("LANDMARK_REQUEST", lcm.landmark_request_t, answer("LANDMARK", registration.landmark))
     b.subscribe("MISALIGNMENT_REQUEST", lcm.misalignment_request_t, answer("MISALIGNMENT", registration.misalignment))
     print("registration server: answering on REGISTRATION, LANDMARK and MISALIGNMENT", flush=True)
+    beat = 0.0
     while True:
-        b.handle()  # refusals are counted in b.refused and logged
+        b.handle(timeout_s=1.0)  # refusals are counted in b.refused, logged and sent on the heartbeat
+        if time.monotonic() >= beat:  # PROCESS_STATUS at 1 Hz, as orbed's processes (orbed-monitor shows it)
+            b.publish("PROCESS_STATUS", b.status("py-registration"))
+            beat = time.monotonic() + 1.0
 
 
 if __name__ == "__main__":

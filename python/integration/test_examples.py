@@ -12,6 +12,7 @@ import cv2
 import numpy as np
 
 from conftest import ROOT, binary
+from orbed import bus, types
 
 EXAMPLES = os.path.join(ROOT, "examples")
 STUDY = os.path.join(ROOT, "tests", "testdata", "study")
@@ -89,3 +90,10 @@ def test_a_python_registration_server_answers_a_viraal_run_as_orbed_registration
     for key in ("started_utime", "duration_s"):
         results.pop(key)
     assert results["status"] == "ok" and same_numbers(results, pinned) == []
+    # Its heartbeat: on PROCESS_STATUS like orbed's processes, nothing refused in the whole run.
+    beats = []
+    b = bus.Bus()
+    b.subscribe("PROCESS_STATUS", types.lcm_types().process_status_t,
+                lambda c, m: beats.append(m) if m.name == "py-registration" else None)
+    assert b.handle_until(lambda: beats, 10)
+    assert beats[0].rejected_inputs == 0 and beats[0].messages_in > 0 and beats[0].messages_out > 0

@@ -38,7 +38,7 @@ import threading
 import time
 import urllib.parse
 
-from orbed import wire
+from orbed import types, wire
 
 DEFAULT_URL = "udpm://239.255.76.67:7667?ttl=0"
 SHORT_MAGIC = 0x4C433032     # "LC02"
@@ -220,7 +220,9 @@ class Bus:
         self.url = url or default_url()
         self.group, self.port, self.ttl, self.recv_buf_size = parse_url(self.url)
         self.refused = collections.Counter()
-        self.received = 0  # whole messages received (before decoding)
+        self.received = 0  # whole messages on a subscribed channel (before decoding)
+        self.published = 0
+        self._started = time.monotonic()
         self._reassembler = Reassembler(lambda reason: self._refuse("bus/" + reason), max_message_bytes,
                                         max_partials, max_partial_bytes)
         self._subscriptions = []
@@ -272,6 +274,21 @@ class Bus:
             self._seqno = (self._seqno + 1) & 0xFFFFFFFF
             for datagram in datagrams:
                 self._send.sendto(datagram, (self.group, self.port))
+            self.published += 1
+
+    def status(self, name, state=None):
+        """This endpoint's heartbeat as orbed's processes send theirs on PROCESS_STATUS (1 Hz): name,
+        pid, host, uptime, messages in and out, and the refusals by key (state: RUNNING unless given).
+        Publish it with bus.publish("PROCESS_STATUS", bus.status("my-client"))."""
+        m = types.lcm_types().process_status_t()
+        m.utime, m.name, m.pid, m.host = int(time.time() * 1e6), name, os.getpid(), socket.gethostname()
+        m.state = m.STATE_RUNNING if state is None else state
+        m.uptime_s, m.messages_in, m.messages_out = time.monotonic() - self._started, self.received, self.published
+        m.reject_reason = sorted(self.refused)
+        m.reject_count = [self.refused[k] for k in m.reject_reason]
+        m.num_reasons, m.rejected_inputs = len(m.reject_reason), sum(self.refused.values())
+        m.last_error, m.drop_reason, m.drop_count = "", [], []
+        return m
 
     def fileno(self):
         """The receive socket's descriptor (for select); subscribes first."""
@@ -312,16 +329,15 @@ class Bus:
     def feed(self, datagram, sender=("127.0.0.1", 0)):
         """Processes one datagram as if it had arrived from `sender`; returns the callbacks run."""
         whole = self._reassembler.feed(datagram, sender)
-        if whole is None:
-            return 0
-        self.received += 1
-        return self._dispatch(*whole)
+        return 0 if whole is None else self._dispatch(*whole)
 
     def _dispatch(self, channel, payload):
-        n = 0
+        n, matched = 0, False
         for s in list(self._subscriptions):
             if not s.pattern.fullmatch(channel):
                 continue
+            if not matched:
+                self.received, matched = self.received + 1, True
             message = payload
             if s.message_type is not None:
                 try:

@@ -157,3 +157,16 @@ def test_urls():
     assert bus.parse_url("udpm://239.1.2.3:9000?ttl=1&recv_buf_size=4096") == ("239.1.2.3", 9000, 1, 4096)
     with pytest.raises(ValueError):
         bus.parse_url("tcpq://localhost:7700")
+
+
+def test_the_heartbeat_carries_the_counts_and_refusals():
+    b = bus.Bus()
+    b._subscriptions.append(bus.Subscription("X", lcm.iiwa_status_t, lambda c, m: None))
+    b.feed(b"LC0")
+    b.feed(bus.encode_datagrams("X", b"\0" * 8, 0)[0])
+    b.feed(bus.encode_datagrams("X", status().encode(), 1)[0])
+    m = b.status("py-test")
+    assert (m.name, m.state, m.messages_in, m.messages_out) == ("py-test", m.STATE_RUNNING, 2, 0)
+    assert list(zip(m.reject_reason, m.reject_count)) == [("X/decode/fingerprint", 1), ("bus/short_datagram", 1)]
+    assert m.rejected_inputs == 2 and m.num_reasons == 2
+    wire.check(lcm.process_status_t, m.encode())
