@@ -475,7 +475,7 @@ TEST(Hl2ss, HologramsAClientPlacesArePublished) {
       wait_for_scene([](const orbed::hologram_scene_t& m) { return m.num_holograms == 1 && m.active[0]; }));
   const orbed::hologram_scene_t& placed = scenes.back();
   EXPECT_EQ(placed.id[0], 1);
-  EXPECT_EQ(placed.kind[0], orbed::hologram_scene_t::KIND_CUBE);
+  EXPECT_EQ(int{placed.kind[0]}, int{orbed::hologram_scene_t::KIND_CUBE});
   EXPECT_NEAR(placed.X_WG[0].position_m[0], 0.5, 1e-6);
   EXPECT_NEAR(placed.X_WG[0].position_m[1], 2.0, 1e-6);
   EXPECT_NEAR(placed.X_WG[0].position_m[2], 1.2, 1e-6);
