@@ -13,6 +13,7 @@
 #include <exception>
 #include <limits>
 #include <string>
+#include <vector>
 
 #include <orbed/wire_checks.hpp>
 
@@ -27,6 +28,19 @@ struct DecodeResult {
   std::string error;
   bool ok() const { return kind == wire::WireError::kNone; }
 };
+
+/// The entry of `types` whose `fingerprint` (an LCM type hash) the encoded message `data` starts
+/// with (8 bytes, big-endian), or null (unknown, or fewer than 8 bytes). For tools that take any
+/// type (the log exports).
+template <class Type>
+const Type* FindTypeByFingerprint(const std::vector<Type>& types, const uint8_t* data, size_t size) {
+  if (size < 8) return nullptr;
+  uint64_t fingerprint = 0;
+  for (int i = 0; i < 8; ++i) fingerprint = (fingerprint << 8) | data[i];
+  for (const Type& type : types)
+    if (static_cast<uint64_t>(type.fingerprint) == fingerprint) return &type;
+  return nullptr;
+}
 
 /// Walks `size` bytes as an encoded `Msg` (fingerprint first) without allocating.
 template <class Msg>

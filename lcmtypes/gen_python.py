@@ -20,8 +20,7 @@ import sys
 import tempfile
 
 sys.dont_write_bytecode = True  # no __pycache__ in the source tree
-from gen_flatten import comment_units, unit_of  # noqa: E402 (after the line above)
-from gen_wire_checks import parse_lcm  # noqa: E402
+from gen_flatten import parse_all, unit_of  # noqa: E402 (after the line above)
 
 PACKAGE = "orbed_lcm"
 
@@ -31,15 +30,11 @@ def main():
         sys.exit(__doc__)
     lcm_gen, output_dir, lcm_files = sys.argv[1], sys.argv[2], sorted(sys.argv[3:])
     structs = {}
-    units = {}
-    for path in lcm_files:
-        package, parsed = parse_lcm(path)
+    parsed, units = parse_all(lcm_files)
+    for package, name, fields in parsed:
         if package != "orbed":
-            sys.exit(f"{path}: package '{package}', expected 'orbed'")
-        units.update(comment_units(path))
-        for name, fields in parsed:
-            structs[name] = tuple((f.type_name, f.name, tuple(f.dims), unit_of(name, f, units))
-                                  for f in fields)
+            sys.exit(f"struct {name}: package '{package}', expected 'orbed'")
+        structs[name] = tuple((f.type_name, f.name, tuple(f.dims), unit_of(name, f, units)) for f in fields)
 
     target = os.path.join(output_dir, PACKAGE)
     with tempfile.TemporaryDirectory() as staging:

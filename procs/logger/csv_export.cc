@@ -44,12 +44,7 @@ const std::vector<MessageType>& MessageTypes() {
 }
 
 const MessageType* TypeOf(const uint8_t* data, size_t size) {
-  if (size < 8) return nullptr;
-  uint64_t fingerprint = 0;
-  for (int i = 0; i < 8; ++i) fingerprint = (fingerprint << 8) | data[i];
-  for (const MessageType& type : MessageTypes())
-    if (static_cast<uint64_t>(type.fingerprint) == fingerprint) return &type;
-  return nullptr;
+  return FindTypeByFingerprint(MessageTypes(), data, size);
 }
 
 // One message type on one channel: its columns in order, its rows and refusals, and (pass 2) the
@@ -99,18 +94,11 @@ void ForEachMessage(const MappedLog& log, const CsvExportOptions& options,
                     std::map<std::string, ChannelState>* channels, Visit visit, Refused refused) {
   EventLogScanner scanner = log.Scanner();
   LogEvent e;
-  bool have_start = false;
-  int64_t start_us = 0;
+  EventWindow window(options.from_s, options.to_s, options.channels);
   flat::FlatRow row;
   std::string reason;
   while (scanner.Next(&e)) {
-    if (!have_start) {
-      start_us = e.timestamp_us;
-      have_start = true;
-    }
-    const double t_s = (e.timestamp_us - start_us) * 1e-6;
-    if (t_s < options.from_s || t_s > options.to_s || !std::regex_match(e.channel, options.channels))
-      continue;
+    if (!window.Take(e)) continue;
     ChannelState& c = (*channels)[e.channel];
     if (c.result.channel.empty()) c.result.channel = e.channel;
     const MessageType* type = TypeOf(e.data, e.size);

@@ -13,7 +13,9 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <regex>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace orbed::logger {
@@ -58,6 +60,29 @@ class EventLogScanner {
   size_t size_;
   size_t pos_ = 0;
   std::vector<LogDamage> damage_;
+};
+
+/// Which events a tool takes (orbed-log cut and export): those from `from_s` to `to_s` seconds
+/// after the log's first event (of any channel) whose channel matches `channels` whole. Give it
+/// every event in log order.
+class EventWindow {
+ public:
+  EventWindow(double from_s, double to_s, std::regex channels)
+      : from_s_(from_s), to_s_(to_s), channels_(std::move(channels)) {}
+  bool Take(const LogEvent& e) {
+    if (!have_start_) {
+      start_us_ = e.timestamp_us;
+      have_start_ = true;
+    }
+    const double t_s = (e.timestamp_us - start_us_) * 1e-6;
+    return t_s >= from_s_ && t_s <= to_s_ && std::regex_match(e.channel, channels_);
+  }
+
+ private:
+  double from_s_, to_s_;
+  std::regex channels_;
+  bool have_start_{false};
+  int64_t start_us_{0};
 };
 
 /// A log file mapped read-only (empty files are fine). Check ok() / error().

@@ -101,15 +101,10 @@ int Cut(const MappedLog& log, const std::string& out_path, double from_s, double
   }
   EventLogScanner scanner = log.Scanner();
   LogEvent e;
-  bool have_start = false;
-  int64_t start_us = 0, kept = 0;
+  EventWindow window(from_s, to_s, channels);
+  int64_t kept = 0;
   while (scanner.Next(&e)) {
-    if (!have_start) {
-      start_us = e.timestamp_us;
-      have_start = true;
-    }
-    const double t_s = (e.timestamp_us - start_us) * 1e-6;
-    if (t_s < from_s || t_s > to_s || !std::regex_match(e.channel, channels)) continue;
+    if (!window.Take(e)) continue;
     if (writer.Write(e.timestamp_us, e.channel, e.data, e.size) == 0) {
       err << "orbed-log: " << writer.error() << "\n";
       return 1;

@@ -9,8 +9,8 @@
 ///   orbed-log check LOG    every damaged range with its byte offset and what was there; exit 1 when
 ///                          there is any (the events around it are still read: resync on the sync word)
 ///   orbed-log cut LOG OUT [--from-s A] [--to-s B] [--channels REGEX]
-///                          the events from A to B seconds after the first event whose channel
-///                          matches REGEX (whole name), written as a new log (numbered from 0,
+///                          the events from A to B seconds after the log's first event whose
+///                          channel matches REGEX (whole name), written as a new log (numbered from 0,
 ///                          timestamps kept); damage is left behind
 ///   orbed-log export LOG DIR [--csv] [--from-s A] [--to-s B] [--channels REGEX]
 ///                          one CSV file per channel of a known type (csv_export.h): a column per

@@ -55,12 +55,7 @@ const std::vector<MessageType>& MessageTypes() {
 }
 
 const MessageType* TypeOf(const uint8_t* data, size_t size) {
-  if (size < 8) return nullptr;
-  uint64_t fingerprint = 0;
-  for (int i = 0; i < 8; ++i) fingerprint = (fingerprint << 8) | data[i];
-  for (const MessageType& type : MessageTypes())
-    if (static_cast<uint64_t>(type.fingerprint) == fingerprint) return &type;
-  return nullptr;
+  return FindTypeByFingerprint(MessageTypes(), data, size);
 }
 
 std::string Hex(int64_t fingerprint) {
@@ -375,18 +370,9 @@ McapExportResult WriteMcapRecords(const uint8_t* data, size_t size, const McapEx
                                      {"to_s", ShortestDecimal(options.to_s)}});
   EventLogScanner scanner(data, size);
   LogEvent e;
-  bool have_start = false;
-  int64_t start_us = 0;
-  while (exporter.ok() && scanner.Next(&e)) {
-    if (!have_start) {
-      start_us = e.timestamp_us;
-      have_start = true;
-    }
-    const double t_s = (e.timestamp_us - start_us) * 1e-6;
-    if (t_s < options.from_s || t_s > options.to_s || !std::regex_match(e.channel, options.channels))
-      continue;
-    exporter.Event(e);
-  }
+  EventWindow window(options.from_s, options.to_s, options.channels);
+  while (exporter.ok() && scanner.Next(&e))
+    if (window.Take(e)) exporter.Event(e);
   const std::string problem = result.provenance_problem;
   result = exporter.Result();
   result.provenance_problem = problem;
