@@ -55,7 +55,8 @@ Hl2ssProcess::Hl2ssProcess(const CommonFlags& flags, const Hl2ssOptions& options
       options_(options),
       server_(options.server),
       device_(TimeBase{NowMicros()}, options.app_version),
-      unity_scene_(options.unity_limits) {
+      unity_scene_(options.unity_limits),
+      depth_(std::make_unique<DepthStream>(options.rm_depth, device_.time_base())) {
   handlers_.on_configured = [this](int client, PortKind port, const StreamConfig& config) {
     return OnConfigured(client, port, config);
   };
@@ -86,6 +87,32 @@ Hl2ssProcess::Hl2ssProcess(const CommonFlags& flags, const Hl2ssOptions& options
       [this](const orbed::image_t& msg, const std::string& channel, int64_t) { OnCamera(msg, channel); });
   process_.AddWallTimer(
       1.0 / options_.si_hz, [this] { SendSpatialInput(); }, "hl2ss/si");
+  // The depth stream's inputs (checked in depth_stream.cc) and its 5 Hz frames.
+  const auto refused = [this](const std::string& channel, const std::optional<Refusal>& r) {
+    if (r) process_.Reject(channel + "/" + r->key, r->reason);
+  };
+  process_.Subscribe<orbed::iiwa_status_t>(
+      options_.iiwa_status_channel,
+      [this, refused](const orbed::iiwa_status_t& msg, const std::string& channel, int64_t) {
+        refused(channel, depth_->OnJoints(msg));
+      });
+  process_.Subscribe<orbed::robot_state_t>(
+      options_.robot_state_channel,
+      [this, refused](const orbed::robot_state_t& msg, const std::string& channel, int64_t) {
+        refused(channel, depth_->OnRobotState(msg));
+      });
+  process_.Subscribe<orbed::hmd_pose_t>(
+      options_.truth_channel,
+      [this, refused](const orbed::hmd_pose_t& msg, const std::string& channel, int64_t) {
+        refused(channel, depth_->OnTruth(msg, MonotonicMicros()));
+      });
+  if (server_.port(PortKind::kRmDepthLongThrow) != 0)
+    process_.AddWallTimer(
+        1.0 / kLongThrowHz,
+        [this] {
+          if (depth_->Tick(MonotonicMicros())) process_.CountDrop("rm_depth/busy");
+        },
+        "hl2ss/rm_depth");
   if (server_.port(PortKind::kUmq) != 0)
     process_.AddWallTimer(
         1.0,
@@ -93,7 +120,10 @@ Hl2ssProcess::Hl2ssProcess(const CommonFlags& flags, const Hl2ssOptions& options
           if (unity_scene_.revision() != 0) PublishHolograms();  // nothing placed yet: nothing to say
         },
         "hl2ss/holograms");
-  process_.AddWallPoll(options_.poll_period_s, [this] { server_.Poll(MonotonicMicros(), handlers_); });
+  process_.AddWallPoll(options_.poll_period_s, [this] {
+    SendDepth();
+    server_.Poll(MonotonicMicros(), handlers_);
+  });
 
   std::ostringstream ports;
   for (PortKind kind :
@@ -109,6 +139,7 @@ void Hl2ssProcess::OnPose(const orbed::hmd_pose_t& msg, const std::string& chann
   if (!problem.empty()) return process_.Reject(channel + "/field", problem);
   pose_ = msg;
   pose_received_us_ = MonotonicMicros();
+  depth_->OnEstimate(FromPose(msg.X_WH));
 }
 
 void Hl2ssProcess::OnGaze(const orbed::gaze_ray_t& msg, const std::string& channel) {
@@ -185,6 +216,15 @@ void Hl2ssProcess::OnCamera(const orbed::image_t& msg, const std::string& channe
   }
 }
 
+// A frame the depth worker finished: to the clients due (one render, one packet per mode).
+void Hl2ssProcess::SendDepth() {
+  std::optional<DepthPackets> frame = depth_->TakeReady();
+  if (!frame) return;
+  if (!frame->error.empty()) return process_.SetLastError(frame->error);
+  for (int client : frame->mode0) server_.Send(client, frame->packet0, handlers_.on_event);
+  for (int client : frame->mode1) server_.Send(client, frame->packet1, handlers_.on_event);
+}
+
 bool Hl2ssProcess::OnUmqBytes(int client, const uint8_t* data, size_t size, std::vector<uint8_t>* reply) {
   UmqSession& session = umq_sessions_.try_emplace(client, &unity_scene_).first->second;
   const bool keep = session.Consume(data, size, reply);
@@ -208,12 +248,8 @@ Decision Hl2ssProcess::OnConfigured(int client, PortKind port, const StreamConfi
     return d;
   };
   if (port == PortKind::kSi) return d;
-  if (port == PortKind::kRmDepthLongThrow) {
-    if (!options_.rm_depth_available)
-      return refuse("rm_depth/not_available",
-                    "the research-mode depth stream is not built into this orbed-hl2ss");
-    return d;
-  }
+  if (port == PortKind::kRmDepthLongThrow)
+    return depth_->Configure(client, std::get<RmDepthLongThrowConfig>(config));
   if (port != PortKind::kPv) return refuse(PortName(port) + "/unexpected", "no stream on this port");
   const PvConfig& c = std::get<PvConfig>(config);
   if (c.start) {
@@ -258,6 +294,7 @@ void Hl2ssProcess::OnEvent(const ServerEvent& event) {
         ORBED_LOG(kInfo) << "hl2ss: PV subsystem closed";
       }
       if (it != pv_clients_.end()) pv_clients_.erase(it);
+      depth_->Disconnected(event.client);
       const auto umq = umq_sessions_.find(event.client);
       if (umq != umq_sessions_.end()) {
         umq->second.OnDisconnect();
@@ -284,8 +321,9 @@ int RunHl2ss(int argc, const char* const* argv, std::ostream& out, std::ostream&
       "orbed-hl2ss: the emulated headset served as hl2ss serves a HoloLens 2, for unmodified hl2ss\n"
       "clients (viewer/hl2ss.py, hl2ss_lnm.py): remote configuration on 3809, the front camera (PV,\n"
       "RAW NV12 with the pose) on 3810 from HMD_CAMERA, spatial input (head pose, eye-gaze ray) on\n"
-      "3812 from HMD_POSE and GAZE_RAY; research-mode depth on 3805 is refused; the Unity message\n"
-      "queue on 3816 (holograms a client places, published on HOLOGRAMS). docs/hl2ss.md."};
+      "3812 from HMD_POSE and GAZE_RAY; research-mode depth long throw on 3805 (5 Hz, rendered from\n"
+      "HMD_POSE_TRUTH, the scene and the real arm); the Unity message queue on 3816 (holograms a\n"
+      "client places, published on HOLOGRAMS). docs/hl2ss.md."};
   CommonFlags common("orbed-hl2ss");
   AddCommonFlags(&app, &common);
   Hl2ssOptions options;
@@ -339,6 +377,22 @@ int RunHl2ss(int argc, const char* const* argv, std::ostream& out, std::ostream&
   app.add_option("--gaze-channel", options.gaze_channel, "gaze_ray_t channel (the eye-gaze ray)")
       ->capture_default_str();
   app.add_option("--camera-channel", options.camera_channel, "image_t channel (the front camera)")
+      ->capture_default_str();
+  app.add_option(
+      "--urdf", options.rm_depth.urdf_path,
+      "Robot URDF the depth camera sees (default: sim/models/iiwa7.urdf under $ORBED_SOURCE_DIR, else "
+      "the source tree)");
+  app.add_option("--scene", options.rm_depth.scene_path,
+                 "Scene YAML whose objects the depth camera sees (default: sim/models/scenes/trocar_or.yaml, "
+                 "found like --urdf; none: the robot alone)");
+  app.add_option("--truth-channel", options.truth_channel,
+                 "hmd_pose_t channel of the true head (where the depth camera renders from)")
+      ->capture_default_str();
+  app.add_option("--iiwa-status-channel", options.iiwa_status_channel,
+                 "iiwa_status_t channel (the real arm's joints, for the depth camera)")
+      ->capture_default_str();
+  app.add_option("--robot-state-channel", options.robot_state_channel,
+                 "robot_state_t channel (the real arm's base X_WR, for the depth camera)")
       ->capture_default_str();
   app.add_option("--holograms-channel", options.holograms_channel,
                  "hologram_scene_t channel the Unity message queue's scene is published on")

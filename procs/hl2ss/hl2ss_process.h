@@ -17,8 +17,10 @@
 ///   SI  3812  spatial input at si_hz (30 Hz): the latest HMD_POSE's X_WH (the estimate) and
 ///             GAZE_RAY's ray in D, stamped with that HMD_POSE's utime; a pose or ray older than
 ///             stale_s is not valid; hands not tracked
-///   RM depth long throw 3805: configurations parsed and checked; refused until a depth source
-///             is attached (Hl2ssOptions::rm_depth_available)
+///   RM depth long throw 3805: 320×288 depth + AB at 5 Hz (depth_stream.h): the room (the scene's
+///             objects, the real robot at IIWA_STATUS's joints and ROBOT_STATE's base) rendered
+///             from HMD_POSE_TRUTH's head on a worker thread, PNG, stamped with that pose's utime;
+///             mode 1 posed with HMD_POSE's rig node, mode 2 the calibration
 ///   UMQ 3816  the Unity plugin's message queue (unity_scene.h): the remote Unity scene a client
 ///             builds (primitives, poses, colours) is published on HOLOGRAMS after each command
 ///             outside a display list that changed it, and every second, for orbed-hmd to draw in
@@ -38,13 +40,17 @@
 #include <array>
 #include <iosfwd>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 
 #include <orbed/gaze_ray_t.hpp>
 #include <orbed/hmd_pose_t.hpp>
+#include <orbed/iiwa_status_t.hpp>
 #include <orbed/image_t.hpp>
+#include <orbed/robot_state_t.hpp>
 
+#include "procs/hl2ss/depth_stream.h"
 #include "procs/hl2ss/emulated_device.h"
 #include "procs/hl2ss/hl2ss_server.h"
 #include "procs/hl2ss/streams.h"
@@ -68,7 +74,11 @@ struct Hl2ssOptions {
   PvEncoderFactory pv_encoder = RawOnlyPvEncoderFactory();
   /// The PV mode-2 answer for a format (the calibration); empty function: mode 2 refused.
   std::function<std::vector<uint8_t>(const PvConfig&)> pv_calibration;
-  bool rm_depth_available{false};
+  /// The depth stream's robot, scene and camera (depth_stream.h), and its inputs.
+  DepthStreamOptions rm_depth;
+  std::string truth_channel{"HMD_POSE_TRUTH"};
+  std::string iiwa_status_channel{"IIWA_STATUS"};
+  std::string robot_state_channel{"ROBOT_STATE"};
 };
 
 class Hl2ssProcess {
@@ -89,6 +99,7 @@ class Hl2ssProcess {
   void OnEvent(const ServerEvent& event);
   bool OnUmqBytes(int client, const uint8_t* data, size_t size, std::vector<uint8_t>* reply);
   void PublishHolograms();
+  void SendDepth();
 
   Process process_;
   Hl2ssOptions options_;
@@ -109,6 +120,7 @@ class Hl2ssProcess {
   UnityScene unity_scene_;
   std::map<int, UmqSession> umq_sessions_;
   int64_t published_revision_{-1};
+  std::unique_ptr<DepthStream> depth_;  // constructed after the server (its port) and device (time base)
 };
 
 /// orbed-hl2ss's command line (--help). Exit 0; 2 on bad arguments; 1 when it cannot start (a
