@@ -25,8 +25,9 @@ std::optional<Refusal> Refuse(const std::string& key, const std::string& reason)
 
 DepthStream::DepthStream(const DepthStreamOptions& options, const TimeBase& time_base)
     : options_(options), time_base_(time_base) {
-  const std::string urdf =
-      options_.urdf_path.empty() ? SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath) : options_.urdf_path;
+  const std::string urdf = options_.urdf_path.empty()
+                               ? SourceTreePath(sim::RobotModel::kDefaultUrdfRelativePath)
+                               : options_.urdf_path;
   const std::optional<sim::Scene> scene = sim::LoadSceneFlag(options_.scene_path);
   robot_ = std::make_unique<sim::RobotModel>(scene ? sim::LoadRobotForScene(urdf, *scene)
                                                    : sim::RobotModel::LoadFile(urdf));
@@ -120,7 +121,8 @@ std::optional<DepthPackets> DepthStream::TakeReady() {
 
 bool DepthStream::WaitReady(double timeout_s) {
   std::unique_lock<std::mutex> lock(mutex_);
-  return ready_cv_.wait_for(lock, std::chrono::duration<double>(timeout_s), [this] { return ready_.has_value(); });
+  return ready_cv_.wait_for(lock, std::chrono::duration<double>(timeout_s),
+                            [this] { return ready_.has_value(); });
 }
 
 int64_t DepthStream::frames_rendered() const {

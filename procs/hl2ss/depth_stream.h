@@ -56,10 +56,10 @@ struct DepthStreamOptions {
 
 /// One finished frame: the packet for mode-0 and for mode-1 clients, and who is due.
 struct DepthPackets {
-  uint64_t stamp{0};                  ///< hl2ss ticks
-  std::vector<int> mode0, mode1;      ///< the clients due
+  uint64_t stamp{0};              ///< hl2ss ticks
+  std::vector<int> mode0, mode1;  ///< the clients due
   std::vector<uint8_t> packet0, packet1;
-  std::string error;                  ///< non-empty: the frame failed (nothing to send)
+  std::string error;  ///< non-empty: the frame failed (nothing to send)
 };
 
 class DepthStream {

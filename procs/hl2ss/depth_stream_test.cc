@@ -55,13 +55,15 @@ class DepthStreamTest : public ::testing::Test {
   // A head whose depth camera is 1.5 m from the base's axis, looking at it.
   Eigen::Isometry3d HeadLookingAtBase() const {
     const Eigen::Vector3d axis = X_WR_ * Eigen::Vector3d(0, 0, 0.075);
-    return geometry::LookAt(axis + Eigen::Vector3d(-1.5, 0, 0.2), axis) * LongThrowOptions::DefaultX_HZ().inverse();
+    return geometry::LookAt(axis + Eigen::Vector3d(-1.5, 0, 0.2), axis) *
+           LongThrowOptions::DefaultX_HZ().inverse();
   }
   // The depth picture of a packet (hl2ss.py's decoding: PNG then the u64 sensor ticks).
   static cv::Mat Depth(const std::vector<uint8_t>& packet, bool mode1) {
     const uint32_t size = GetU32(packet.data() + 8);
     EXPECT_EQ(packet.size(), kHeaderBytes + size + (mode1 ? kPoseBytes : 0));
-    const cv::Mat png(1, static_cast<int>(size - 8), CV_8UC1, const_cast<uint8_t*>(packet.data() + kHeaderBytes));
+    const cv::Mat png(1, static_cast<int>(size - 8), CV_8UC1,
+                      const_cast<uint8_t*>(packet.data() + kHeaderBytes));
     const cv::Mat bgra = cv::imdecode(png, cv::IMREAD_UNCHANGED);
     return cv::Mat(kLongThrowHeight, kLongThrowWidth, CV_16UC1, const_cast<uint8_t*>(bgra.data)).clone();
   }
@@ -140,7 +142,8 @@ TEST_F(DepthStreamTest, OneRenderPerFrameForEveryClientDue) {
   // The principal pixel looks at the base's axis 1.5 m away horizontally: the base's surface
   // 0.1 m before it, along a ray pitched by atan(0.2 / 1.5).
   const double expected_mm = 1000.0 * (std::hypot(1.5, 0.2) - 0.1 / std::cos(std::atan2(0.2, 1.5)));
-  EXPECT_NEAR(depth.at<uint16_t>(144, 160), expected_mm, 3.0);  // the 24-gon's flat face: within 1 mm + rounding
+  EXPECT_NEAR(depth.at<uint16_t>(144, 160), expected_mm,
+              3.0);  // the 24-gon's flat face: within 1 mm + rounding
   f = Frame(3000);
   EXPECT_EQ(f.mode0, std::vector<int>{2});
   EXPECT_EQ(stream_.frames_rendered(), 3);

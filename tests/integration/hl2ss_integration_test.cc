@@ -12,7 +12,7 @@
 //     colour-conversion rounding, the trailer says its intrinsics and size, the pose is
 //     frames.h's CameraPoseForClient(X_WC);
 //   - refused as this server does not serve them yet: a PV stream before start_subsystem_pv (as
-//     the device), the H.265 profile, PV calibration, the depth stream;
+//     the device), the H.265 profile, PV calibration;
 //   - hostile clients: a garbage PV configuration is refused ("pv/mode"), a PV client that never
 //     reads is dropped ("pv/backlog", "pv/stalled"), an unknown RC command refused ("rc/unknown"),
 //     while the SI and PV clients above keep receiving; all counted on PROCESS_STATUS.
@@ -20,17 +20,26 @@
 // u32 answer each): a cube created, posed, coloured and shown is published on HOLOGRAMS at Unity's
 // (x, y, z) = W's (x, z, y) (frames.h by hand: z_D = −z_U, W = (x_D, −z_D, y_D)); removing it
 // empties the scene; a command declaring 4 GiB closes the connection, counted as "umq/size".
+// And the research-mode depth camera (3805; hl2ss.py's rx_rm_depth_longthrow and its mode-2
+// layout, hl2ss_3dcv's unprojection): the test publishes a robot at known joints and base
+// (IIWA_STATUS, ROBOT_STATE), a true head looking at its base (HMD_POSE_TRUTH) and a different
+// estimate (HMD_POSE); every depth pixel whose ray (the mode-2 uv2xy table, extrinsics and the
+// true rig node) meets the base's cylinder is that distance within 2 mm, a pixel that sees
+// nothing is 0, the mode-1 pose is the estimate's rig node, the stamps are HMD_POSE_TRUTH's; a
+// configuration with mode 3 and a ROBOT_STATE with a NaN are refused and counted.
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
 #include <sys/time.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstring>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <thread>
 
 #include <gtest/gtest.h>
@@ -40,8 +49,11 @@
 #include <orbed/gaze_ray_t.hpp>
 #include <orbed/hmd_pose_t.hpp>
 #include <orbed/hologram_scene_t.hpp>
+#include <orbed/iiwa_status_t.hpp>
 #include <orbed/image_t.hpp>
+#include <orbed/robot_state_t.hpp>
 
+#include "geometry/camera_model.h"
 #include "lcmtypes/contract/conversions.h"
 #include "procs/hl2ss/frames.h"
 #include "tests/integration/testbed_util.h"
@@ -300,9 +312,6 @@ TEST(Hl2ss, AnHl2ssClientSeesTheHeadsetAndHostileClientsAreRefused) {
     Socket calibration(3810);
     calibration.Send({0x02, 0x00, 0x05, 0xd0, 0x02, 0x1e});  // download_calibration_pv(1280, 720, 30)
     EXPECT_TRUE(calibration.ClosedByServer());
-    Socket depth(3805);
-    depth.Send({0x01, 0x01, 0x05, 0x00, 0x00, 0x00});  // rx_rm_depth_longthrow's defaults
-    EXPECT_TRUE(depth.ClosedByServer());
   }
   Socket si(3812);
 
@@ -415,8 +424,7 @@ TEST(Hl2ss, AnHl2ssClientSeesTheHeadsetAndHostileClientsAreRefused) {
         const orbed::process_status_t& s = beats.back().status;
         return CountOf(s, "pv/mode", false) == 1 && CountOf(s, "rc/unknown", false) == 1 &&
                CountOf(s, "pv/subsystem_closed", false) == 1 && CountOf(s, "pv/profile", false) == 1 &&
-               CountOf(s, "pv/mode2", false) == 1 && CountOf(s, "rm_depth/not_available", false) == 1 &&
-               CountOf(s, "pv/backlog", true) >= 10;
+               CountOf(s, "pv/mode2", false) == 1 && CountOf(s, "pv/backlog", true) >= 10;
       },
       10));
   for (int i = 0; i < 5; ++i) ASSERT_TRUE(ReadPacket(&pv, true).ok);
@@ -500,6 +508,219 @@ TEST(Hl2ss, HologramsAClientPlacesArePublished) {
       10));
   umq.Send(Command(17, {}));  // remove all: the first client is still served
   EXPECT_EQ(umq.Read(4).size(), 4u);
+}
+
+// ---- research-mode depth, long throw ------------------------------------------------------------
+constexpr int kDepthW = 320, kDepthH = 288, kDepthPixels = kDepthW * kDepthH;
+constexpr double kBaseRadius = 0.1;   // iiwa_link_0's collision cylinder (sim/models/iiwa7.urdf)
+constexpr double kBaseHeight = 0.15;  // z_R from 0 to 0.15
+
+struct DepthScene {
+  Eigen::Isometry3d X_WR{Eigen::Isometry3d::Identity()};
+  Eigen::Isometry3d X_WH_true{Eigen::Isometry3d::Identity()};
+  Eigen::Isometry3d X_WH_est{Eigen::Isometry3d::Identity()};
+  std::vector<double> q{0.7, 0.0, 0.3, -0.5, 0.2, 0.4, 0.1};  // upright to the elbow: the base in view
+  DepthScene() {
+    X_WR.translation() = Eigen::Vector3d(1.0, 0.5, 0.0);
+    X_WR.linear() = Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    const Eigen::Vector3d axis = X_WR * Eigen::Vector3d(0, 0, 0.075);
+    X_WH_true = geometry::LookAt(axis + Eigen::Vector3d(-1.1, -0.6, 0.3), axis);
+    X_WH_est = X_WH_true;
+    X_WH_est.translation() += Eigen::Vector3d(0.02, -0.01, 0.015);
+    X_WH_est.linear() =
+        Eigen::AngleAxisd(0.01, Eigen::Vector3d::UnitZ()).toRotationMatrix() * X_WH_est.linear();
+  }
+  // Where the ray p_W + t·d_W (d_W unit) first meets the base's side between its rims (margin in),
+  // with the cosine of its incidence: a quadratic in R.
+  std::optional<std::pair<double, double>> BaseSide(const Eigen::Vector3d& p_W, const Eigen::Vector3d& d_W,
+                                                    double margin_m) const {
+    const Eigen::Vector3d p = X_WR.inverse() * p_W, d = X_WR.linear().transpose() * d_W;
+    const double a = d.x() * d.x() + d.y() * d.y(), b = 2 * (p.x() * d.x() + p.y() * d.y());
+    const double c = p.x() * p.x() + p.y() * p.y() - kBaseRadius * kBaseRadius, disc = b * b - 4 * a * c;
+    if (a < 1e-12 || disc < 0) return std::nullopt;
+    const double t = (-b - std::sqrt(disc)) / (2 * a), z = p.z() + t * d.z();
+    if (t <= 0 || z < margin_m || z > kBaseHeight - margin_m) return std::nullopt;
+    const Eigen::Vector3d hit = p + t * d;
+    return std::make_pair(t, -Eigen::Vector3d(hit.x(), hit.y(), 0).normalized().dot(d));
+  }
+};
+
+void PublishDepthInputs(std::atomic<bool>* stop, const DepthScene* scene, std::mutex* mutex,
+                        std::vector<int64_t>* truth_utimes) {
+  lcm::LCM lcm;
+  const auto start = std::chrono::steady_clock::now();
+  for (int64_t tick = 0; !*stop; ++tick) {  // 60 Hz, as orbed-hmd's poses (the sim's 200 Hz need not be)
+    std::this_thread::sleep_until(start + std::chrono::microseconds(tick * 1'000'000 / 60));
+    const int64_t utime = NowMicros();
+    orbed::iiwa_status_t status{};
+    status.utime = utime;
+    status.num_joints = 7;
+    for (auto* v :
+         {&status.joint_position_measured, &status.joint_velocity_estimated, &status.joint_position_commanded,
+          &status.joint_position_ipo, &status.joint_torque_measured, &status.joint_torque_commanded,
+          &status.joint_torque_external})
+      v->assign(7, 0.0);
+    status.joint_position_measured = scene->q;
+    lcm.publish("IIWA_STATUS", &status);
+    orbed::robot_state_t state{};
+    state.utime = utime;
+    state.robot_name = "iiwa";
+    state.X_WR = ToPose(scene->X_WR);
+    state.X_RF = state.X_RT = ToPose(Eigen::Isometry3d::Identity());
+    lcm.publish("ROBOT_STATE", &state);
+    orbed::hmd_pose_t pose{};
+    pose.utime = utime;
+    pose.seq = tick;
+    pose.hmd_name = "hmd";
+    pose.tracking_state = orbed::hmd_pose_t::TRACKING;
+    pose.X_WH = pose.X_WC = ToPose(scene->X_WH_true);
+    {
+      std::lock_guard<std::mutex> lock(*mutex);
+      truth_utimes->push_back(utime);
+    }
+    lcm.publish("HMD_POSE_TRUTH", &pose);
+    pose.X_WH = pose.X_WC = ToPose(scene->X_WH_est);
+    lcm.publish("HMD_POSE", &pose);
+  }
+}
+
+TEST(Hl2ss, DepthOnTheRobotBaseIsTheDistanceAlongThePixelsRay) {
+  BusWatcher bus;
+  bus.Start();
+  RunningProcess server({BinPath("orbed-hl2ss"), "--scene", "none"});  // the robot alone in the room
+  const DepthScene scene;
+  std::mutex mutex;
+  std::vector<int64_t> truth_utimes;
+  std::atomic<bool> stop{false};
+  std::thread headset(PublishDepthInputs, &stop, &scene, &mutex, &truth_utimes);
+  struct Stopper {
+    std::atomic<bool>* stop;
+    std::thread* t;
+    ~Stopper() {
+      *stop = true;
+      t->join();
+    }
+  } stopper{&stop, &headset};
+
+  uint64_t offset = 0;
+  {
+    Socket rc(3809);
+    ASSERT_TRUE(rc.ok());
+    rc.Send({0x01});
+    offset = Le<uint64_t>(rc.Read(8).data());
+  }
+  // Mode 2 (download_calibration_rm_depth_longthrow): uv2x, uv2y, extrinsics, scale, mapx, mapy, K.
+  std::vector<float> calibration((4 * kDepthPixels + 16 + 1 + 4));
+  {
+    Socket c(3805);
+    c.Send({0x02});
+    const std::vector<uint8_t> bytes = c.Read(calibration.size() * 4);
+    ASSERT_EQ(bytes.size(), calibration.size() * 4);
+    std::memcpy(calibration.data(), bytes.data(), bytes.size());
+    EXPECT_TRUE(c.ClosedByServer());
+  }
+  const float* uv2x = calibration.data();
+  const float* uv2y = uv2x + kDepthPixels;
+  Eigen::Matrix4d E;  // [p_Z 1] = [p_N 1] · E
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) E(r, c) = calibration[2 * kDepthPixels + 4 * r + c];
+  const double scale = calibration[2 * kDepthPixels + 16];
+  EXPECT_EQ(scale, 1000.0);
+  // The rig node of a head X_WH as the device reports it (frames.h's conventions by hand: N has
+  // the device's camera axes, x right, y up, z backward), row-vector form: [p_D 1] = [p_N 1] · M.
+  const auto rig_node_matrix = [](const Eigen::Isometry3d& X_WH) {
+    const Eigen::Isometry3d X_DN = hl2ss::X_WD().inverse() * X_WH * hl2ss::X_CCh();
+    return Eigen::Matrix4d(X_DN.matrix().transpose());
+  };
+  // Where the sensor truly is, as the client computes it: camera-to-world = E⁻¹ · M(truth).
+  const Eigen::Matrix4d Z_to_D = E.inverse() * rig_node_matrix(scene.X_WH_true);
+  const Eigen::Vector3d p_WZ = hl2ss::X_WD() * Eigen::Vector3d(Z_to_D.block<1, 3>(3, 0).transpose());
+  const auto ray_W = [&](int u, int v) {  // the pixel's unit ray in W
+    const int i = v * kDepthW + u;
+    const Eigen::Vector3d d_Z = Eigen::Vector3d(uv2x[i], uv2y[i], 1.0).normalized();
+    return Eigen::Vector3d(hl2ss::R_WD() * (Z_to_D.block<3, 3>(0, 0).transpose() * d_Z));
+  };
+
+  Socket depth(3805);
+  depth.Send({0x01, 0x01, 0x00, 0x00, 0x00, 0x00});  // mode 1, divisor 1, PNG filter 0
+  const auto utime_of = [offset](uint64_t ticks) {
+    return static_cast<int64_t>((ticks + offset - kUnixEpochFiletime) / 10);
+  };
+  int frames = 0, checked = 0;
+  double worst_mm = 0;
+  for (uint64_t previous = 0; frames < 3;) {
+    const Packet p = ReadPacket(&depth, true);
+    ASSERT_TRUE(p.ok);
+    EXPECT_GT(p.timestamp, previous);
+    previous = p.timestamp;
+    ASSERT_GT(p.payload.size(), 8u);
+    EXPECT_EQ(Le<uint64_t>(p.payload.data() + p.payload.size() - 8), p.timestamp);
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      EXPECT_NE(std::find(truth_utimes.begin(), truth_utimes.end(), utime_of(p.timestamp)),
+                truth_utimes.end())
+          << "the stamp is an HMD_POSE_TRUTH's utime";
+    }
+    // The mode-1 pose: the estimate's rig node.
+    Eigen::Matrix4d M;
+    for (int r = 0; r < 4; ++r)
+      for (int c = 0; c < 4; ++c) M(r, c) = p.pose[4 * r + c];
+    EXPECT_LT((M - rig_node_matrix(scene.X_WH_est)).cwiseAbs().maxCoeff(), 1e-5);
+    // hl2ss.py: cv2.imdecode(payload[:-8], IMREAD_UNCHANGED) viewed as u16 rows: depth, then AB.
+    const cv::Mat png(1, static_cast<int>(p.payload.size() - 8), CV_8UC1,
+                      const_cast<uint8_t*>(p.payload.data()));
+    const cv::Mat bgra = cv::imdecode(png, cv::IMREAD_UNCHANGED);
+    ASSERT_EQ(bgra.type(), CV_8UC4);
+    ASSERT_EQ(bgra.rows, kDepthH);
+    ASSERT_EQ(bgra.cols, kDepthW);
+    const cv::Mat both(2 * kDepthH, kDepthW, CV_16UC1, bgra.data);
+    const cv::Mat depth_mm = both.rowRange(0, kDepthH), ab = both.rowRange(kDepthH, 2 * kDepthH);
+    if (cv::countNonZero(depth_mm) == 0) continue;  // before the robot's state arrived
+    ++frames;
+    for (int v = 0; v < kDepthH; ++v) {
+      for (int u = 0; u < kDepthW; ++u) {
+        const Eigen::Vector3d d_W = ray_W(u, v);
+        const auto hit = scene.BaseSide(p_WZ, d_W, 0.01);
+        if (!hit || hit->second < 0.7) continue;  // off the silhouette: the 24-gon within ~1 mm
+        const double error_mm = std::abs(depth_mm.at<uint16_t>(v, u) - 1000.0 * hit->first);
+        worst_mm = std::max(worst_mm, error_mm);
+        EXPECT_LT(error_mm, 2.0) << "pixel " << u << "," << v;
+        const double r_m = depth_mm.at<uint16_t>(v, u) / 1000.0;
+        EXPECT_NEAR(ab.at<uint16_t>(v, u), 1e4 / (r_m * r_m), 1.0 + 2e4 * 5e-4 / (r_m * r_m * r_m));
+        ++checked;
+      }
+    }
+    // Above the arm, at the picture's top corners, nothing is in range.
+    for (const auto& [u, v] : {std::pair{0, 0}, std::pair{kDepthW - 1, 0}}) {
+      EXPECT_FALSE(scene.BaseSide(p_WZ, ray_W(u, v), 0.0));
+      EXPECT_EQ(depth_mm.at<uint16_t>(v, u), 0);
+      EXPECT_EQ(ab.at<uint16_t>(v, u), 0);
+    }
+  }
+  EXPECT_GT(checked, 3 * 300);
+  std::printf("depth: %d base pixels in 3 frames, worst error %.2f mm\n", checked, worst_mm);
+
+  // A configuration with mode 3 and a ROBOT_STATE with a NaN: refused and counted; the depth
+  // client keeps receiving.
+  Socket bad(3805);
+  bad.Send({0x03});
+  EXPECT_TRUE(bad.ClosedByServer());
+  {
+    lcm::LCM lcm;
+    orbed::robot_state_t state{};
+    state.X_WR = ToPose(scene.X_WR);
+    state.X_WR.position_m[1] = NAN;
+    lcm.publish("ROBOT_STATE", &state);
+  }
+  EXPECT_TRUE(WaitFor(
+      [&] {
+        const auto beats = bus.Heartbeats("orbed-hl2ss");
+        if (beats.empty()) return false;
+        const orbed::process_status_t& s = beats.back().status;
+        return CountOf(s, "rm_depth/mode", false) == 1 && CountOf(s, "ROBOT_STATE/pose", false) == 1;
+      },
+      10));
+  ASSERT_TRUE(ReadPacket(&depth, true).ok);
 }
 
 }  // namespace
