@@ -5,8 +5,9 @@
 //            it), HMD_POSE and HMD_POSE_TRUTH 60 Hz (a head walking around the robot), IIWA_STATUS
 //            and ROBOT_STATE 200 Hz (as orbed-iiwa-sim; joint 1 turning slowly, so the depth
 //            camera's room is posed anew for every frame);
-//   clients: the PV stream at 1280×720 30 Hz, RAW for S seconds, then H.264 main (hl2ss_lnm's
-//            default bitrate) for S seconds; the long-throw depth stream (mode 1, 5 Hz) throughout.
+//   clients: the long-throw depth stream (mode 1, 5 Hz) throughout: alone for S seconds, then
+//            beside the PV stream at 1280×720 30 Hz, RAW for S seconds, then H.264 main
+//            (hl2ss_lnm's default bitrate) for S seconds.
 // Prints per phase orbed-hl2ss's CPU share of one core (/proc/PID/stat, all its threads) and per
 // stream the latency from capture (the message's utime, recovered from the packet's stamp and RC's
 // UTC offset) to the client's receipt of the whole packet, p50 / p99 [ms].
@@ -141,7 +142,7 @@ std::vector<uint8_t> MrcStart() {  // 0x04|3, then '<BBBBBBBfffII' as hl2ss_lnm.
 
 struct Latencies {
   std::mutex mutex;
-  std::vector<double> ms[2];  // per phase
+  std::vector<double> ms[3];  // per phase
   int phase{0};
   void Add(double v) {
     std::lock_guard<std::mutex> lock(mutex);
@@ -208,10 +209,10 @@ int main(int argc, char** argv) {
         orbed::iiwa_status_t status{};
         status.utime = utime;
         status.num_joints = robot.num_joints();
-        for (auto* v : {&status.joint_position_measured, &status.joint_velocity_estimated,
-                        &status.joint_position_commanded, &status.joint_position_ipo,
-                        &status.joint_torque_measured, &status.joint_torque_commanded,
-                        &status.joint_torque_external})
+        for (auto* v :
+             {&status.joint_position_measured, &status.joint_velocity_estimated,
+              &status.joint_position_commanded, &status.joint_position_ipo, &status.joint_torque_measured,
+              &status.joint_torque_commanded, &status.joint_torque_external})
           v->assign(robot.num_joints(), 0.0);
         for (int j = 0; j < robot.num_joints(); ++j) status.joint_position_measured[j] = q(j);
         lcm.publish("IIWA_STATUS", &status);
@@ -276,16 +277,24 @@ int main(int argc, char** argv) {
     }
   });
 
-  const char* names[2] = {"PV RAW NV12 1280x720 30 Hz", "PV H.264 main 1280x720 30 Hz"};
-  double cpu_share[2] = {NAN, NAN}, wall[2] = {0, 0};
-  bool served[2] = {false, false};
-  for (int phase = 0; phase < 2; ++phase) {
+  const char* names[3] = {"depth alone", "PV RAW NV12 1280x720 30 Hz", "PV H.264 main 1280x720 30 Hz"};
+  double cpu_share[3] = {NAN, NAN, NAN}, wall[3] = {0, 0, 0};
+  bool served[3] = {true, false, false};
+  for (int phase = 0; phase < 3; ++phase) {
     {
       std::lock_guard<std::mutex> a(depth_latency.mutex), b(pv_latency.mutex);
       depth_latency.phase = pv_latency.phase = phase;
     }
+    if (phase == 0) {
+      const Clock::time_point t0 = Clock::now();
+      const double cpu0 = ProcessCpuSeconds(server);
+      std::this_thread::sleep_for(std::chrono::duration<double>(seconds));
+      wall[0] = std::chrono::duration<double>(Clock::now() - t0).count();
+      cpu_share[0] = 100.0 * (ProcessCpuSeconds(server) - cpu0) / wall[0];
+      continue;
+    }
     Socket pv(3810);
-    pv.Send(phase == 0 ? PvConfig(0xFF, 1280 * 720 * 30 * 12) : PvConfig(1, 1280 * 720 * 30 * 12 / 75));
+    pv.Send(phase == 1 ? PvConfig(0xFF, 1280 * 720 * 30 * 12) : PvConfig(1, 1280 * 720 * 30 * 12 / 75));
     std::vector<uint8_t> buffer;
     uint64_t stamp = 0;
     // The first packet starts the phase's clock (the encoder opened, the queues filled).
@@ -307,16 +316,20 @@ int main(int argc, char** argv) {
   waitpid(server, nullptr, 0);
 
   std::printf("hl2ss_process_bench: orbed-hl2ss at the device's rates, %.0f s per phase\n", seconds);
-  std::printf("%-30s %-30s %7s %9s %9s %9s\n", "phase", "stream", "packets", "p50 [ms]", "p99 [ms]", "CPU [%]");
-  for (int phase = 0; phase < 2; ++phase) {
+  std::printf("%-30s %-30s %7s %9s %9s %9s\n", "phase", "stream", "packets", "p50 [ms]", "p99 [ms]",
+              "CPU [%]");
+  for (int phase = 0; phase < 3; ++phase) {
     if (!served[phase]) {
       std::printf("%-30s refused by this orbed-hl2ss\n", names[phase]);
       continue;
     }
-    std::printf("%-30s %-30s %7zu %9.1f %9.1f %9.1f\n", names[phase], "PV", pv_latency.ms[phase].size(),
-                Percentile(pv_latency.ms[phase], 0.5), Percentile(pv_latency.ms[phase], 0.99), cpu_share[phase]);
-    std::printf("%-30s %-30s %7zu %9.1f %9.1f\n", "", "depth 320x288 5 Hz (mode 1)", depth_latency.ms[phase].size(),
-                Percentile(depth_latency.ms[phase], 0.5), Percentile(depth_latency.ms[phase], 0.99));
+    if (phase > 0)
+      std::printf("%-30s %-30s %7zu %9.1f %9.1f\n", names[phase], "PV", pv_latency.ms[phase].size(),
+                  Percentile(pv_latency.ms[phase], 0.5), Percentile(pv_latency.ms[phase], 0.99));
+    std::printf("%-30s %-30s %7zu %9.1f %9.1f %9.1f\n", phase > 0 ? "" : names[phase],
+                "depth 320x288 5 Hz (mode 1)", depth_latency.ms[phase].size(),
+                Percentile(depth_latency.ms[phase], 0.5), Percentile(depth_latency.ms[phase], 0.99),
+                cpu_share[phase]);
   }
   return 0;
 }
