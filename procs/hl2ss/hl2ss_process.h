@@ -34,8 +34,9 @@
 /// frames a slow client misses are counted as drops "<port>/backlog", a client dropped for it as
 /// "<port>/stalled". Connections are logged.
 ///
-/// Threading: everything on the Process::Run thread; the sockets are polled by a timer every
-/// poll_period_s without blocking.
+/// Threading: everything on the Process::Run thread, but for the depth camera's render and PNG
+/// (DepthStream's worker, which hands its packets back to be sent); the sockets are polled by a
+/// timer every poll_period_s without blocking, and finished depth frames are taken there.
 
 #include <array>
 #include <iosfwd>
