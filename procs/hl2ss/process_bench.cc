@@ -10,7 +10,8 @@
 //            (hl2ss_lnm's default bitrate) for S seconds.
 // Prints per phase orbed-hl2ss's CPU share of one core (/proc/PID/stat, all its threads) and per
 // stream the latency from capture (the message's utime, recovered from the packet's stamp and RC's
-// UTC offset) to the client's receipt of the whole packet, p50 / p99 [ms].
+// UTC offset) to the client's receipt of the whole packet, p50 / p99 [ms], and the drops its last
+// PROCESS_STATUS counted (rm_depth/busy: a depth frame replaced before the worker started it).
 //   hl2ss_process_bench ORBED_HL2SS [S (default 10)]
 // A benchmark, not a test: pacing sleeps until each stream's next message.
 #include <arpa/inet.h>
@@ -39,6 +40,7 @@
 #include <orbed/hmd_pose_t.hpp>
 #include <orbed/iiwa_status_t.hpp>
 #include <orbed/image_t.hpp>
+#include <orbed/process_status_t.hpp>
 #include <orbed/robot_state_t.hpp>
 
 #include "base/source_paths.h"
@@ -190,8 +192,20 @@ int main(int argc, char** argv) {
   }
 
   std::atomic<bool> stop{false};
+  std::mutex status_mutex;
+  orbed::process_status_t last_status{};
+  struct OnStatus {
+    std::mutex* mutex;
+    orbed::process_status_t* last;
+    void Handle(const lcm::ReceiveBuffer*, const std::string&, const orbed::process_status_t* m) {
+      if (m->name != "orbed-hl2ss") return;
+      std::lock_guard<std::mutex> lock(*mutex);
+      *last = *m;
+    }
+  } on_status{&status_mutex, &last_status};
   std::thread bus([&] {
     lcm::LCM lcm;
+    lcm.subscribe("PROCESS_STATUS", &OnStatus::Handle, &on_status);
     const Clock::time_point t0 = Clock::now();
     int64_t n_robot = 0, n_pose = 0, n_camera = 0;
     while (!stop) {
@@ -199,7 +213,7 @@ int main(int argc, char** argv) {
         return t0 + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(n / hz));
       };
       const Clock::time_point next = std::min({at(n_robot, 200), at(n_pose, 60), at(n_camera, 30)});
-      std::this_thread::sleep_until(next);
+      while (Clock::now() < next) lcm.handleTimeout(1);  // the heartbeats while waiting
       const double t_s = std::chrono::duration<double>(Clock::now() - t0).count();
       const int64_t utime = NowMicros();
       if (next == at(n_robot, 200)) {
@@ -331,5 +345,11 @@ int main(int argc, char** argv) {
                 Percentile(depth_latency.ms[phase], 0.5), Percentile(depth_latency.ms[phase], 0.99),
                 cpu_share[phase]);
   }
+  std::lock_guard<std::mutex> lock(status_mutex);
+  std::printf("orbed-hl2ss's drops:");
+  for (size_t i = 0; i < last_status.drop_reason.size(); ++i)
+    std::printf(" %s %lld", last_status.drop_reason[i].c_str(),
+                static_cast<long long>(last_status.drop_count[i]));
+  std::printf("%s\n", last_status.drop_reason.empty() ? " none" : "");
   return 0;
 }
