@@ -66,9 +66,14 @@ std::optional<Refusal> DepthStream::OnRobotState(const orbed::robot_state_t& msg
 std::optional<Refusal> DepthStream::OnTruth(const orbed::hmd_pose_t& msg, int64_t now_us) {
   const std::string error = CheckWorldPose(msg.X_WH, "X_WH");
   if (!error.empty()) return Refuse("field", error);
-  truth_ = msg;
-  truth_received_us_ = now_us;
+  truths_[msg.utime] = Truth{FromPose(msg.X_WH), now_us};
+  if (truths_.size() > kKeptPoses) truths_.erase(truths_.begin());
   return std::nullopt;
+}
+
+void DepthStream::OnEstimate(const Eigen::Isometry3d& X_WH, int64_t utime) {
+  estimates_[utime] = X_WH;
+  if (estimates_.size() > kKeptPoses) estimates_.erase(estimates_.begin());
 }
 
 Decision DepthStream::Configure(int client, const RmDepthLongThrowConfig& config) {
@@ -85,8 +90,9 @@ Decision DepthStream::Configure(int client, const RmDepthLongThrowConfig& config
 }
 
 bool DepthStream::Tick(int64_t now_us) {
-  if (clients_.empty() || !truth_) return false;
-  if (now_us - truth_received_us_ > static_cast<int64_t>(options_.stale_s * 1e6)) return false;
+  if (clients_.empty() || truths_.empty()) return false;
+  if (now_us - truths_.rbegin()->second.received_us > static_cast<int64_t>(options_.stale_s * 1e6))
+    return false;
   Job job;
   for (auto& [id, c] : clients_) {
     if (c.ticks++ % c.divisor != 0) continue;
@@ -98,10 +104,17 @@ bool DepthStream::Tick(int64_t now_us) {
     job.q_rad = *q_rad_;
     job.X_WR = *X_WR_;
   }
-  job.X_WH_true = FromPose(truth_->X_WH);
-  // The device's belief: the latest HMD_POSE, else (none yet) the truth.
-  job.X_WH_estimate = X_WH_estimate_ ? *X_WH_estimate_ : job.X_WH_true;
-  job.stamp = time_base_.TicksOf(truth_->utime);
+  // The newest truth whose estimate has come; else the newest with the newest estimate (else itself).
+  auto truth = truths_.rbegin();
+  while (truth != truths_.rend() && !estimates_.count(truth->first)) ++truth;
+  if (truth != truths_.rend()) {
+    job.X_WH_estimate = estimates_.at(truth->first);
+  } else {
+    truth = truths_.rbegin();
+    job.X_WH_estimate = estimates_.empty() ? truth->second.X_WH : estimates_.rbegin()->second;
+  }
+  job.X_WH_true = truth->second.X_WH;
+  job.stamp = time_base_.TicksOf(truth->first);
   bool replaced = false;
   {
     std::lock_guard<std::mutex> lock(mutex_);

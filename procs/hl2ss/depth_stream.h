@@ -3,13 +3,16 @@
 /// The research-mode long-throw depth stream of orbed-hl2ss (port 3805): the depth camera of
 /// rm_depth.h rendered from the real room (the scene's objects and the real robot at its IIWA_STATUS
 /// joints and ROBOT_STATE base, as orbed-hmd draws it) seen from where the head truly is
-/// (HMD_POSE_TRUTH), posed in mode 1 with the rig node of the head the device believes in (the
-/// latest HMD_POSE: RigNodePoseForClient), the calibration in mode 2 (PackLongThrowCalibration).
+/// (HMD_POSE_TRUTH), posed in mode 1 with the rig node of the head the device believes in at that
+/// moment (the HMD_POSE of the same utime: RigNodePoseForClient), the calibration in mode 2
+/// (PackLongThrowCalibration).
 ///
 /// Pacing: the owner calls Tick() at kLongThrowHz (5 Hz); each mode-0/1 client gets every
 /// divisor-th frame made since it connected. A frame is rendered once, whatever the number of
 /// clients due, and only when one is due and the true head pose is at most stale_s old. It is
-/// stamped with that HMD_POSE_TRUTH's utime in hl2ss ticks (the packet and the payload's
+/// rendered from the newest of the last kKeptPoses HMD_POSE_TRUTH whose HMD_POSE (same utime, as
+/// orbed-hmd publishes the pair) has come, else from the newest with the newest HMD_POSE (else the
+/// truth itself), and stamped with that utime in hl2ss ticks (the packet and the payload's
 /// trailing sensor ticks alike).
 ///
 /// Threading: render + PNG (~4 ms p50, ~15 ms p99) run on a worker thread the DepthStream owns.
@@ -75,8 +78,8 @@ class DepthStream {
   std::optional<Refusal> OnRobotState(const orbed::robot_state_t& msg);
   /// HMD_POSE_TRUTH; `now_us` a monotonic clock [µs] for staleness.
   std::optional<Refusal> OnTruth(const orbed::hmd_pose_t& msg, int64_t now_us);
-  /// The checked HMD_POSE's X_WH (the owner checks HMD_POSE for its other streams).
-  void OnEstimate(const Eigen::Isometry3d& X_WH) { X_WH_estimate_ = X_WH; }
+  /// The checked HMD_POSE's X_WH at its utime (the owner checks HMD_POSE for its other streams).
+  void OnEstimate(const Eigen::Isometry3d& X_WH, int64_t utime);
 
   /// A configured client of port 3805: served (modes 0, 1) or answered with the calibration and
   /// closed (mode 2).
@@ -119,9 +122,13 @@ class DepthStream {
   std::map<int, Client> clients_;
   std::optional<Eigen::VectorXd> q_rad_;
   std::optional<Eigen::Isometry3d> X_WR_;
-  std::optional<orbed::hmd_pose_t> truth_;
-  int64_t truth_received_us_{0};
-  std::optional<Eigen::Isometry3d> X_WH_estimate_;
+  static constexpr size_t kKeptPoses = 8;  // of each: 130 ms at 60 Hz
+  struct Truth {
+    Eigen::Isometry3d X_WH;
+    int64_t received_us;
+  };
+  std::map<int64_t, Truth> truths_;                 // by utime, the newest kKeptPoses
+  std::map<int64_t, Eigen::Isometry3d> estimates_;  // by utime, the newest kKeptPoses
 
   // The worker's own (after construction only it touches them).
   std::unique_ptr<render::RoomMesh> room_;

@@ -119,7 +119,7 @@ TEST_F(DepthStreamTest, OneRenderPerFrameForEveryClientDue) {
   X_WH_est.translation() += Eigen::Vector3d(0.01, -0.02, 0.03);
   const int64_t utime = 3'000'000;
   ASSERT_FALSE(stream_.OnTruth(Head(X_WH_true, utime), 0));
-  stream_.OnEstimate(X_WH_est);
+  stream_.OnEstimate(X_WH_est, utime);
   ASSERT_FALSE(stream_.OnJoints(Joints(7)));
 
   DepthPackets f = Frame(1000);
@@ -148,11 +148,27 @@ TEST_F(DepthStreamTest, OneRenderPerFrameForEveryClientDue) {
   EXPECT_EQ(f.mode0, std::vector<int>{2});
   EXPECT_EQ(stream_.frames_rendered(), 3);
 
+  // A newer truth whose estimate has not come: the frame is the older pair's (stamp and pose).
+  Eigen::Isometry3d X_WH_later = X_WH_true;
+  X_WH_later.translation().x() += 0.05;
+  ASSERT_FALSE(stream_.OnTruth(Head(X_WH_later, utime + 16'667), 3000));
+  f = Frame(4000);
+  EXPECT_EQ(f.stamp, 20'000'000u);
+  EXPECT_EQ(std::memcmp(f.packet1.data() + f.packet1.size() - kPoseBytes, pose.data(), kPoseBytes), 0);
+  Eigen::Isometry3d X_WH_later_est = X_WH_est;
+  X_WH_later_est.translation().x() += 0.05;
+  stream_.OnEstimate(X_WH_later_est, utime + 16'667);  // its estimate comes: the newer pair
+  f = Frame(5000);
+  EXPECT_EQ(f.stamp, 20'166'670u);
+  const std::array<float, 16> later =
+      PoseMatrixRowMajor(RigNodePoseForClient(X_WH_later_est, LongThrowOptions{}));
+  EXPECT_EQ(std::memcmp(f.packet1.data() + f.packet1.size() - kPoseBytes, later.data(), kPoseBytes), 0);
+
   stream_.Disconnected(1);
   stream_.Disconnected(2);
-  EXPECT_FALSE(stream_.Tick(4000));
+  EXPECT_FALSE(stream_.Tick(6000));
   EXPECT_FALSE(stream_.TakeReady());
-  EXPECT_EQ(stream_.frames_rendered(), 3);
+  EXPECT_EQ(stream_.frames_rendered(), 5);
 }
 
 TEST_F(DepthStreamTest, AStaleHeadRendersNothing) {

@@ -139,7 +139,7 @@ void Hl2ssProcess::OnPose(const orbed::hmd_pose_t& msg, const std::string& chann
   if (!problem.empty()) return process_.Reject(channel + "/field", problem);
   pose_ = msg;
   pose_received_us_ = MonotonicMicros();
-  depth_->OnEstimate(FromPose(msg.X_WH));
+  depth_->OnEstimate(FromPose(msg.X_WH), msg.utime);
 }
 
 void Hl2ssProcess::OnGaze(const orbed::gaze_ray_t& msg, const std::string& channel) {
