@@ -17,10 +17,13 @@
 #include "lcmtypes/contract/requests.h"
 #include "lcmtypes/contract/validation.h"
 #include "procs/hl2ss/frames.h"
+#include "procs/hl2ss/rm_depth.h"
 #include "runtime/flags.h"
 
 namespace orbed::hl2ss {
 namespace {
+
+constexpr int kMaxCameraSide = 4096;  // PvEncoder's limit: refused before the picture is decoded
 
 int64_t MonotonicMicros() {
   return std::chrono::duration_cast<std::chrono::microseconds>(
@@ -28,20 +31,27 @@ int64_t MonotonicMicros() {
       .count();
 }
 
-// "" or why an image cannot be served; on success *bgr holds its picture.
-std::string DecodeImage(const orbed::image_t& img, cv::Mat* bgr) {
+// "" or why an HMD_CAMERA message cannot be served (checked before its picture is decoded).
+std::string CheckCameraImage(const orbed::image_t& img) {
   std::string problem = CheckImage(img);
   if (problem.empty() && (!std::isfinite(img.cx_px) || !std::isfinite(img.cy_px)))
     problem = "image: cx_px, cy_px must be finite";
   if (!problem.empty()) return problem;
   if (img.width % 2 || img.height % 2) return "image: odd size (NV12 needs even sides)";
+  if (img.width > kMaxCameraSide || img.height > kMaxCameraSide)
+    return "image: larger than " + std::to_string(kMaxCameraSide) + " pixels a side";
+  if (img.pixel_format != orbed::image_t::FORMAT_JPEG && img.pixel_format != orbed::image_t::FORMAT_BGR8)
+    return "image: pixel format " + std::to_string(img.pixel_format) + " (JPEG and BGR8 are served)";
+  return "";
+}
+
+// "" or why a checked image's data do not decode; on success *bgr holds its picture.
+std::string DecodeImage(const orbed::image_t& img, cv::Mat* bgr) {
   if (img.pixel_format == orbed::image_t::FORMAT_JPEG) {
     *bgr = cv::imdecode(img.data, cv::IMREAD_COLOR);
-  } else if (img.pixel_format == orbed::image_t::FORMAT_BGR8) {
+  } else {
     *bgr = cv::Mat(img.height, img.width, CV_8UC3, const_cast<uint8_t*>(img.data.data()), img.row_stride)
                .clone();
-  } else {
-    return "image: pixel format " + std::to_string(img.pixel_format) + " (JPEG and BGR8 are served)";
   }
   if (bgr->empty() || bgr->cols != img.width || bgr->rows != img.height)
     return "image: data do not decode to its size";
@@ -122,6 +132,7 @@ Hl2ssProcess::Hl2ssProcess(const CommonFlags& flags, const Hl2ssOptions& options
         "hl2ss/holograms");
   process_.AddWallPoll(options_.poll_period_s, [this] {
     SendDepth();
+    SendEncodedPv();
     server_.Poll(MonotonicMicros(), handlers_);
   });
 
@@ -170,49 +181,46 @@ void Hl2ssProcess::SendSpatialInput() {
 }
 
 void Hl2ssProcess::OnCamera(const orbed::image_t& msg, const std::string& channel) {
-  const auto clients = server_.Serving(PortKind::kPv);
-  if (clients.empty()) return;
-  std::vector<int> due;
-  for (const auto& [client, config] : clients) {
+  const std::string problem = CheckCameraImage(msg);
+  if (!problem.empty()) return process_.Reject(channel + "/image", problem);
+  geometry::Intrinsics K;
+  K.width_px = msg.width;
+  K.height_px = msg.height;
+  K.fx_px = msg.fx_px;
+  K.fy_px = msg.fy_px;
+  K.cx_px = msg.cx_px;
+  K.cy_px = msg.cy_px;
+  camera_K_ = K;  // for mode 2, also while nobody streams
+  std::vector<PvEncoderWorker*> due;
+  for (const auto& [client, config] : server_.Serving(PortKind::kPv)) {
     const auto it = pv_clients_.find(client);
-    if (it != pv_clients_.end() && it->second.pacer.Next()) due.push_back(client);
+    if (it != pv_clients_.end() && it->second.pacer.Next()) due.push_back(it->second.worker.get());
   }
   if (due.empty()) return;
-  cv::Mat bgr;
-  const std::string problem = DecodeImage(msg, &bgr);
-  if (!problem.empty()) return process_.Reject(channel + "/image", problem);
+  PvJob job;
+  const std::string undecodable = DecodeImage(msg, &job.bgr);
+  if (!undecodable.empty()) return process_.Reject(channel + "/image", undecodable);
+  job.K = K;
+  job.metadata = PvCaptureMetadataFromSettings(device_.pv_settings());
+  job.timestamp = device_.time_base().TicksOf(msg.utime);
   const std::array<float, 16> pose = PoseMatrixRowMajor(CameraPoseForClient(FromPose(msg.X_WC)));
-  const uint64_t stamp = device_.time_base().TicksOf(msg.utime);
-  std::map<std::pair<int, int>, cv::Mat> resized;  // by (width, height): one resize per size
-  for (const auto& [client, config] : clients) {
-    if (std::find(due.begin(), due.end(), client) == due.end()) continue;
-    const PvConfig& c = std::get<PvConfig>(*config);
-    const std::pair<int, int> size{c.width, c.height};
-    if (!resized.count(size)) {
-      if (c.width == bgr.cols && c.height == bgr.rows) {
-        resized[size] = bgr;
-      } else {
-        cv::resize(bgr, resized[size], cv::Size(c.width, c.height), 0, 0, cv::INTER_LINEAR);
-      }
-    }
-    PvFrameInfo info;
-    info.timestamp = stamp;
-    info.width = c.width;
-    info.height = c.height;
-    const double sx = static_cast<double>(c.width) / bgr.cols, sy = static_cast<double>(c.height) / bgr.rows;
-    info.fx_px = msg.fx_px * sx;
-    info.fy_px = msg.fy_px * sy;
-    info.cx_px = (msg.cx_px + 0.5) * sx - 0.5;  // pixel centres at integers
-    info.cy_px = (msg.cy_px + 0.5) * sy - 0.5;
-    info.settings = &device_.pv_settings();
-    std::vector<uint8_t> payload;
-    try {
-      payload = pv_clients_.at(client).payload(resized[size], info);
-    } catch (const std::exception& e) {
-      process_.SetLastError(std::string("pv payload: ") + e.what());
+  for (PvEncoderWorker* worker : due) {
+    PvJob mine = job;  // the picture is shared, read-only
+    if (pv_clients_.at(worker->client()).mode1) mine.pose = pose;
+    if (!worker->Offer(std::move(mine))) process_.CountDrop("pv/encoder_busy");
+  }
+}
+
+void Hl2ssProcess::SendEncodedPv() {
+  for (PvResult& r : pv_hand_back_.TakeAll()) {
+    if (!pv_clients_.count(r.client)) continue;  // left while this was queued
+    if (!r.error.empty()) {
+      process_.CountDrop("pv/encode_failed");
+      process_.SetLastError("pv encoder: " + r.error);
       continue;
     }
-    server_.Send(client, PackPacket(stamp, payload, c.mode == kMode1 ? &pose : nullptr), handlers_.on_event);
+    server_.Send(r.client, PackPacket(r.timestamp, r.payload, r.pose ? &*r.pose : nullptr),
+                 handlers_.on_event);
   }
 }
 
@@ -223,6 +231,13 @@ void Hl2ssProcess::SendDepth() {
   if (!frame->error.empty()) return process_.SetLastError(frame->error);
   for (int client : frame->mode0) server_.Send(client, frame->packet0, handlers_.on_event);
   for (int client : frame->mode1) server_.Send(client, frame->packet1, handlers_.on_event);
+}
+
+void Hl2ssProcess::RemovePvClient(int client) {
+  const auto it = pv_clients_.find(client);
+  if (it == pv_clients_.end()) return;
+  pv_clients_.erase(it);          // joins its worker: at most one picture's encode
+  pv_hand_back_.Discard(client);  // what it finished meanwhile
 }
 
 bool Hl2ssProcess::OnUmqBytes(int client, const uint8_t* data, size_t size, std::vector<uint8_t>* reply) {
@@ -267,17 +282,31 @@ Decision Hl2ssProcess::OnConfigured(int client, PortKind port, const StreamConfi
   if (!device_.pv_open())
     return refuse("pv/subsystem_closed",
                   "the PV subsystem is not open (a client opens it first: start_subsystem_pv)");
+  if (auto format_refusal = CheckPvClientFormat(c))
+    return refuse(format_refusal->key, format_refusal->reason);
   if (c.mode == kMode2) {
-    if (!options_.pv_calibration)
-      return refuse("pv/mode2", "PV calibration (mode 2) is not built into this orbed-hl2ss");
+    if (!camera_K_)
+      return refuse("pv/no_camera", "no HMD_CAMERA picture yet: the calibration is the camera's intrinsics");
+    if (!pose_) return refuse("pv/no_pose", "no HMD_POSE yet: the calibration places the camera on the head");
     d.kind = Decision::kReplyAndClose;
-    d.reply = options_.pv_calibration(c);
+    d.reply = PvCalibrationFor(*camera_K_, c.width, c.height, FromPose(pose_->X_WH), FromPose(pose_->X_WC),
+                               options_.rm_depth.camera.X_HN);  // the rig node the depth camera is on
     return d;
   }
-  std::string refusal;
-  PvPayloadFn payload = options_.pv_encoder(c, &refusal);
-  if (!payload) return refuse("pv/profile", refusal);
-  pv_clients_.insert_or_assign(client, PvClient{std::move(payload), PvPacer(c), c.stop});
+  PvRefusal refusal;
+  const std::optional<PvEncoderConfig> encoder_config =
+      PvEncoderConfigFromClient(c, options_.pv_encoder_threads, &refusal);
+  if (!encoder_config) return refuse(refusal.key, refusal.reason);
+  std::string error;
+  std::shared_ptr<PvEncoder> encoder = PvEncoder::Create(*encoder_config, &error);
+  if (!encoder) return refuse("pv/encoder", error);
+  PvEncodeFn encode = [encoder](const PvJob& job, std::vector<uint8_t>* payload, std::string* why) {
+    return encoder->Encode(job.bgr, job.K, job.metadata, payload, why);
+  };
+  RemovePvClient(client);
+  pv_clients_.emplace(client,
+                      PvClient{std::make_unique<PvEncoderWorker>(client, std::move(encode), &pv_hand_back_),
+                               PvPacer(c), c.mode == kMode1, c.stop});
   return d;
 }
 
@@ -293,7 +322,7 @@ void Hl2ssProcess::OnEvent(const ServerEvent& event) {
         device_.ClosePv();
         ORBED_LOG(kInfo) << "hl2ss: PV subsystem closed";
       }
-      if (it != pv_clients_.end()) pv_clients_.erase(it);
+      RemovePvClient(event.client);
       depth_->Disconnected(event.client);
       const auto umq = umq_sessions_.find(event.client);
       if (umq != umq_sessions_.end()) {
@@ -320,10 +349,10 @@ int RunHl2ss(int argc, const char* const* argv, std::ostream& out, std::ostream&
   CLI::App app{
       "orbed-hl2ss: the emulated headset served as hl2ss serves a HoloLens 2, for unmodified hl2ss\n"
       "clients (viewer/hl2ss.py, hl2ss_lnm.py): remote configuration on 3809, the front camera (PV,\n"
-      "RAW NV12 with the pose) on 3810 from HMD_CAMERA, spatial input (head pose, eye-gaze ray) on\n"
-      "3812 from HMD_POSE and GAZE_RAY; research-mode depth long throw on 3805 (5 Hz, rendered from\n"
-      "HMD_POSE_TRUTH, the scene and the real arm); the Unity message queue on 3816 (holograms a\n"
-      "client places, published on HOLOGRAMS). docs/hl2ss.md."};
+      "RAW NV12, H.264 or H.265 with the pose; its calibration) on 3810 from HMD_CAMERA, spatial\n"
+      "input (head pose, eye-gaze ray) on 3812 from HMD_POSE and GAZE_RAY; research-mode depth long\n"
+      "throw on 3805 (5 Hz, rendered from HMD_POSE_TRUTH, the scene and the real arm); the Unity\n"
+      "message queue on 3816 (holograms a client places, published on HOLOGRAMS). docs/hl2ss.md."};
   CommonFlags common("orbed-hl2ss");
   AddCommonFlags(&app, &common);
   Hl2ssOptions options;
@@ -363,6 +392,10 @@ int RunHl2ss(int argc, const char* const* argv, std::ostream& out, std::ostream&
   app.add_option("--config-timeout-s", options.server.config_timeout_s,
                  "Seconds a client has to send its configuration (or finish an RC command)")
       ->check(orbed::NumberIn(0.1, 600.0))
+      ->capture_default_str();
+  app.add_option("--pv-encoder-threads", options.pv_encoder_threads,
+                 "libavcodec threads of each PV client's encoder (each client has its own encoder thread)")
+      ->check(orbed::NumberIn(1, 8))
       ->capture_default_str();
   app.add_option("--si-hz", options.si_hz, "Spatial-input rate [Hz]")
       ->check(orbed::NumberIn(1.0, 120.0))

@@ -7,13 +7,18 @@
 ///   RC  3809  remote configuration (emulated_device.h): application version, UTC offset, PV
 ///             subsystem status, current time, the PV settings; rig-node poses answered "not
 ///             located"; mapping camera points refused
-///   PV  3810  the front camera: each HMD_CAMERA (JPEG, 30 Hz) decoded, resized to the client's
-///             size (the device's video sizes, 15 or 30 fps, divisor), its payload from the
-///             client's PvPayloadFn (streams.h; RAW = NV12 + metadata trailer), stamped with
-///             HMD_CAMERA's utime and, in mode 1, posed with its X_WC (the SLAM estimate) in D.
-///             The subsystem must be opened first (the START bit), as on the device. Mode 2
-///             (calibration) and the H.26x profiles are refused until their libraries are attached
-///             (Hl2ssOptions::pv_encoder, pv_calibration).
+///   PV  3810  the front camera (pv_stream.h, pv_encoder.h): each HMD_CAMERA (JPEG, 30 Hz) decoded
+///             once, then encoded for each client at its size (the device's video sizes, 15 or
+///             30 fps, divisor) and profile (RAW NV12, H.264 base/main/high, H.265 main) with its
+///             bitrate and GOP, the 80-byte trailer (intrinsics, the RC settings' exposure, ISO and
+///             white balance), stamped with HMD_CAMERA's utime and, in mode 1, posed with its X_WC
+///             (the SLAM estimate) in D. Encoding runs on one thread per client (pv_worker.h):
+///             the newest picture wins, one still waiting when the next arrives is dropped
+///             ("pv/encoder_busy"); payloads come back through a queue drained by the poll, so
+///             only this thread sends. Mode 2 answers the calibration: the latest HMD_CAMERA's
+///             intrinsics at the requested size and the camera on the rig node N from the latest
+///             HMD_POSE (refused "pv/no_camera", "pv/no_pose" until they arrived). The subsystem
+///             must be opened first (the START bit), as on the device.
 ///   SI  3812  spatial input at si_hz (30 Hz): the latest HMD_POSE's X_WH (the estimate) and
 ///             GAZE_RAY's ray in D, stamped with that HMD_POSE's utime; a pose or ray older than
 ///             stale_s is not valid; hands not tracked
@@ -34,9 +39,10 @@
 /// frames a slow client misses are counted as drops "<port>/backlog", a client dropped for it as
 /// "<port>/stalled". Connections are logged.
 ///
-/// Threading: everything on the Process::Run thread, but for the depth camera's render and PNG
-/// (DepthStream's worker, which hands its packets back to be sent); the sockets are polled by a
-/// timer every poll_period_s without blocking, and finished depth frames are taken there.
+/// Threading: everything on the Process::Run thread, except the PV encoders (one thread per PV
+/// client, at most --max-clients, joined when the client leaves) and the depth camera's render and
+/// PNG (DepthStream's worker); both hand their packets back to the process thread, which polls the
+/// sockets by a timer every poll_period_s without blocking and sends them there.
 
 #include <array>
 #include <iosfwd>
@@ -51,9 +57,12 @@
 #include <orbed/image_t.hpp>
 #include <orbed/robot_state_t.hpp>
 
+#include "geometry/camera_model.h"
 #include "procs/hl2ss/depth_stream.h"
 #include "procs/hl2ss/emulated_device.h"
 #include "procs/hl2ss/hl2ss_server.h"
+#include "procs/hl2ss/pv_stream.h"
+#include "procs/hl2ss/pv_worker.h"
 #include "procs/hl2ss/streams.h"
 #include "procs/hl2ss/unity_scene.h"
 #include "runtime/process.h"
@@ -71,15 +80,8 @@ struct Hl2ssOptions {
   double stale_s{0.5};  ///< an HMD_POSE or GAZE_RAY older than this is not reported valid
   double poll_period_s{0.002};
   std::array<uint16_t, 4> app_version{1, 0, 0, 0};
-  /// Makes each PV client's payload function (the seam for the video encoder).
-  PvEncoderFactory pv_encoder = RawOnlyPvEncoderFactory();
-  /// The PV mode-2 answer for a format (the calibration); empty function: mode 2 refused.
-  std::function<std::vector<uint8_t>(const PvConfig&)> pv_calibration;
-  /// The depth stream's robot, scene and camera (depth_stream.h), and its inputs.
-  DepthStreamOptions rm_depth;
-  std::string truth_channel{"HMD_POSE_TRUTH"};
-  std::string iiwa_status_channel{"IIWA_STATUS"};
-  std::string robot_state_channel{"ROBOT_STATE"};
+#include "geometry/camera_model.h"
+#include "procs/hl2ss/depth_stream.h"
 };
 
 class Hl2ssProcess {
@@ -98,6 +100,8 @@ class Hl2ssProcess {
   void SendSpatialInput();
   Decision OnConfigured(int client, PortKind port, const StreamConfig& config);
   void OnEvent(const ServerEvent& event);
+  void SendEncodedPv();
+  void RemovePvClient(int client);
   bool OnUmqBytes(int client, const uint8_t* data, size_t size, std::vector<uint8_t>* reply);
   void PublishHolograms();
   void SendDepth();
@@ -108,11 +112,14 @@ class Hl2ssProcess {
   EmulatedDevice device_;
   ServerHandlers handlers_;
   struct PvClient {
-    PvPayloadFn payload;
+    std::unique_ptr<PvEncoderWorker> worker;
     PvPacer pacer;
+    bool mode1{true};
     bool stop_after{false};  // the STOP bit: close the subsystem when this client leaves
   };
+  PvHandBack pv_hand_back_;  // before pv_clients_: outlives the workers that push into it
   std::map<int, PvClient> pv_clients_;
+  std::optional<geometry::Intrinsics> camera_K_;  // the latest HMD_CAMERA's
   std::optional<orbed::hmd_pose_t> pose_;
   int64_t pose_received_us_{0};
   std::optional<GazeSample> gaze_;

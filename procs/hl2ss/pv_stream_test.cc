@@ -1,0 +1,137 @@
+// The PV stream's choices: the client's bytes as an encoder configuration (hl2ss_lnm's defaults,
+// the GOP option key 10, every refusal's key), the trailer fields from RC settings in the
+// client's units converted by hand, the pacer's frames listed by hand, and the mode-2
+// calibration's extrinsics against a rig node and camera placed by hand.
+#include "procs/hl2ss/pv_stream.h"
+
+#include <cstring>
+
+#include <gtest/gtest.h>
+
+#include "procs/hl2ss/frames.h"
+
+namespace orbed::hl2ss {
+namespace {
+
+PvConfig Client(uint16_t w, uint16_t h, uint8_t profile) {
+  PvConfig c;
+  c.mode = kMode1;
+  c.width = w;
+  c.height = h;
+  c.framerate = 30;
+  c.divisor = 1;
+  c.profile = profile;
+  c.bitrate = w * h * 30u * 12u / 150u;  // hl2ss_lnm's H.265 default
+  return c;
+}
+
+TEST(PvStream, ClientConfigurationBecomesTheEncoders) {
+  PvRefusal refusal;
+  PvConfig c = Client(1920, 1080, kProfileH265Main);
+  c.divisor = 2;
+  c.options = {{kEncoderOptionGopSize, 15}, {16, 1}};  // GOP 15; low latency (accepted, not honoured)
+  const auto e = PvEncoderConfigFromClient(c, 1, &refusal);
+  ASSERT_TRUE(e) << refusal.reason;
+  EXPECT_EQ(e->format.width_px, 1920);
+  EXPECT_EQ(e->format.height_px, 1080);
+  EXPECT_EQ(e->format.framerate_hz, 30);
+  EXPECT_EQ(e->profile, VideoProfile::kH265Main);
+  EXPECT_EQ(e->divisor, 2);
+  EXPECT_EQ(e->bitrate_bps, 1920u * 1080 * 30 * 12 / 150);
+  EXPECT_EQ(e->gop_frames, 15);
+
+  c.options.clear();  // no GOP option: one IDR a second at the client's frame rate
+  c.framerate = 15;
+  EXPECT_EQ(PvEncoderConfigFromClient(c, 1, &refusal)->gop_frames, 15);
+  c.options = {{kEncoderOptionGopSize, 0}};  // 0: "encoder chooses" -> the same default
+  EXPECT_EQ(PvEncoderConfigFromClient(c, 1, &refusal)->gop_frames, 15);
+
+  EXPECT_EQ(PvEncoderConfigFromClient(Client(424, 240, kProfileH264Base), 1, &refusal)->profile,
+            VideoProfile::kH264Base);
+  EXPECT_EQ(PvEncoderConfigFromClient(Client(1280, 720, kProfileRaw), 1, &refusal)->profile, VideoProfile::kRaw);
+}
+
+TEST(PvStream, EachRefusalHasItsKey) {
+  const auto key_of = [](const PvConfig& c) {
+    PvRefusal refusal;
+    EXPECT_FALSE(PvEncoderConfigFromClient(c, 1, &refusal));
+    EXPECT_FALSE(refusal.reason.empty());
+    return refusal.key;
+  };
+  EXPECT_EQ(key_of(Client(1280, 720, 7)), "pv/profile");
+  EXPECT_EQ(key_of(Client(2272, 1278, kProfileH264Main)), "pv/size");  // parsed, not offered here
+  EXPECT_EQ(key_of(Client(896, 504, kProfileRaw)), "pv/size");
+  PvConfig c = Client(1280, 720, kProfileH264Main);
+  c.framerate = 60;
+  EXPECT_EQ(key_of(c), "pv/framerate");
+  c = Client(1280, 720, kProfileH264Main);
+  c.bitrate = kMaxBitrateBps + 1;
+  EXPECT_EQ(key_of(c), "pv/bitrate");
+  c = Client(1280, 720, kProfileH264Main);
+  c.options = {{kEncoderOptionGopSize, kMaxGopFrames + 1}};
+  EXPECT_EQ(key_of(c), "pv/gop");
+}
+
+TEST(PvStream, TrailerFieldsFromTheSettingsTheClientSet) {
+  PvSettings s;  // as the device starts: automatic exposure and ISO, no white-balance value
+  const PvCaptureMetadata defaults;
+  PvCaptureMetadata m = PvCaptureMetadataFromSettings(s);
+  EXPECT_EQ(m.exposure_time_hns, defaults.exposure_time_hns);
+  EXPECT_EQ(m.iso_speed, defaults.iso_speed);
+  EXPECT_EQ(m.white_balance_k, defaults.white_balance_k);
+  s.exposure = {0, 1000};    // manual, 1000 × 10 µs = 10 ms = 100 000 ticks of 100 ns
+  s.iso_speed = {0, 400};    // manual, ISO 400
+  s.white_balance_value = 200;  // × 25 K = 5000 K
+  m = PvCaptureMetadataFromSettings(s);
+  EXPECT_EQ(m.exposure_time_hns, 100000u);
+  EXPECT_EQ(m.iso_speed, 400u);
+  EXPECT_EQ(m.white_balance_k, 5000u);
+  EXPECT_EQ(m.focus_state, defaults.focus_state);
+}
+
+TEST(PvStream, PacerHalvesFor15FpsThenAppliesTheDivisor) {
+  PvConfig c;
+  c.framerate = 15;
+  c.divisor = 2;
+  PvPacer pacer(c);
+  std::vector<int> sent;
+  for (int i = 0; i < 12; ++i)
+    if (pacer.Next()) sent.push_back(i);
+  EXPECT_EQ(sent, (std::vector<int>{0, 4, 8}));
+}
+
+TEST(PvStream, CalibrationIsTheCameraOnTheRigNodeAtTheRequestedSize) {
+  // K at 1280×720 asked at 1920×1080: ×1.5 about pixel edges.
+  geometry::Intrinsics K;
+  K.fx_px = 1000;
+  K.fy_px = 1002;
+  K.cx_px = 639.5;
+  K.cy_px = 359.5;
+  // A head turned 90° about W's z at (1, 2, 1.6); the camera 8 cm ahead of it, 2 cm up (H: y down).
+  Eigen::Isometry3d X_WH = Eigen::Isometry3d::Identity();
+  X_WH.linear() = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  X_WH.translation() = Eigen::Vector3d(1, 2, 1.6);
+  Eigen::Isometry3d X_HC = Eigen::Isometry3d::Identity();
+  X_HC.translation() = Eigen::Vector3d(0, -0.02, 0.08);
+  const Eigen::Isometry3d X_HN = X_CCh();  // the rig node: the head with the device's axes
+  const std::vector<uint8_t> bytes = PvCalibrationFor(K, 1920, 1080, X_WH, X_WH * X_HC, X_HN);
+  ASSERT_EQ(bytes.size(), 52u * 4);
+  std::vector<float> f(52);
+  std::memcpy(f.data(), bytes.data(), bytes.size());
+  EXPECT_FLOAT_EQ(f[0], 1500.0f);
+  EXPECT_FLOAT_EQ(f[1], 1503.0f);
+  EXPECT_FLOAT_EQ(f[2], 959.5f);  // (639.5 + 0.5)·1.5 − 0.5
+  EXPECT_FLOAT_EQ(f[3], 539.5f);
+  // Extrinsics (row-vector, N → Ĉ): N is H flipped (y up, z back), Ĉ is C flipped the same way, so
+  // Ĉ is N translated by X_HC's offset in N: p_Ĉ = p_N − (0, 0.02, −0.08).
+  Eigen::Matrix4d E;
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) E(r, c) = f[25 + 4 * r + c];
+  const Eigen::RowVector4d p_Ch = Eigen::RowVector4d(0.1, 0.2, 0.3, 1) * E;
+  EXPECT_NEAR(p_Ch[0], 0.1, 1e-6);
+  EXPECT_NEAR(p_Ch[1], 0.2 - 0.02, 1e-6);
+  EXPECT_NEAR(p_Ch[2], 0.3 + 0.08, 1e-6);
+}
+
+}  // namespace
+}  // namespace orbed::hl2ss
