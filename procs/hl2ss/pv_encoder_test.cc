@@ -10,6 +10,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "procs/hl2ss/frames.h"
+#include "procs/hl2ss/pv_client_decoder.h"
 
 extern "C" {
 #include <libavcodec/avcodec.h>
@@ -41,83 +42,6 @@ double Psnr(const cv::Mat& a, const cv::Mat& b) {
   const double m = (per[0] + per[1] + per[2]) / 3;
   return m <= 0 ? 99.0 : 10.0 * std::log10(255.0 * 255.0 / m);
 }
-
-// The client's decoder (hl2ss.py _codec_h264 / _codec_hevc): drop the first 6 bytes of an H.264
-// payload, append an access unit delimiter, parse, decode, keep the first picture.
-class ClientDecoder {
- public:
-  explicit ClientDecoder(bool hevc) : hevc_(hevc) {
-    const AVCodec* codec = avcodec_find_decoder(hevc ? AV_CODEC_ID_HEVC : AV_CODEC_ID_H264);
-    ctx_ = avcodec_alloc_context3(codec);
-    EXPECT_EQ(avcodec_open2(ctx_, codec, nullptr), 0);
-    parser_ = av_parser_init(codec->id);
-    packet_ = av_packet_alloc();
-    frame_ = av_frame_alloc();
-  }
-  ~ClientDecoder() {
-    av_frame_free(&frame_);
-    av_packet_free(&packet_);
-    av_parser_close(parser_);
-    avcodec_free_context(&ctx_);
-  }
-  // The BGR picture of one payload's image part, empty when none came out.
-  cv::Mat Decode(const std::vector<std::uint8_t>& image) {
-    static const std::uint8_t kAud264[] = {0x00, 0x00, 0x00, 0x01, 0x09, 0x10};
-    static const std::uint8_t kAud265[] = {0x00, 0x00, 0x00, 0x01, 0x46, 0x01, 0x03};
-    std::vector<std::uint8_t> in(image.begin() + (hevc_ ? 0 : 6), image.end());
-    if (hevc_) {
-      in.insert(in.end(), std::begin(kAud265), std::end(kAud265));
-    } else {
-      in.insert(in.end(), std::begin(kAud264), std::end(kAud264));
-    }
-    in.resize(in.size() + AV_INPUT_BUFFER_PADDING_SIZE, 0);
-    const std::uint8_t* data = in.data();
-    int left = static_cast<int>(in.size() - AV_INPUT_BUFFER_PADDING_SIZE);
-    while (left > 0) {
-      std::uint8_t* out = nullptr;
-      int out_size = 0;
-      const int used =
-          av_parser_parse2(parser_, ctx_, &out, &out_size, data, left, AV_NOPTS_VALUE, AV_NOPTS_VALUE, 0);
-      if (used < 0) return {};
-      data += used;
-      left -= used;
-      if (out_size == 0) continue;
-      packet_->data = out;
-      packet_->size = out_size;
-      if (avcodec_send_packet(ctx_, packet_) < 0) return {};
-      if (avcodec_receive_frame(ctx_, frame_) == 0) return ToBgr();
-    }
-    return {};
-  }
-  int profile() const { return ctx_->profile; }
-  bool last_was_key() const { return key_; }
-
- private:
-  cv::Mat ToBgr() {
-    key_ = frame_->key_frame != 0;
-    const int w = frame_->width, h = frame_->height;
-    EXPECT_EQ(frame_->format, AV_PIX_FMT_YUV420P);
-    cv::Mat i420(h * 3 / 2, w, CV_8UC1);
-    std::uint8_t* dst = i420.ptr<std::uint8_t>(0);
-    for (int r = 0; r < h; ++r) std::memcpy(dst + r * w, frame_->data[0] + r * frame_->linesize[0], w);
-    dst += w * h;
-    for (int p = 1; p <= 2; ++p) {
-      for (int r = 0; r < h / 2; ++r)
-        std::memcpy(dst + r * (w / 2), frame_->data[p] + r * frame_->linesize[p], w / 2);
-      dst += (w / 2) * (h / 2);
-    }
-    cv::Mat bgr;
-    cv::cvtColor(i420, bgr, cv::COLOR_YUV2BGR_I420);
-    av_frame_unref(frame_);
-    return bgr;
-  }
-  bool hevc_;
-  bool key_{false};
-  AVCodecContext* ctx_{nullptr};
-  AVCodecParserContext* parser_{nullptr};
-  AVPacket* packet_{nullptr};
-  AVFrame* frame_{nullptr};
-};
 
 // NAL unit types in an Annex-B stream (after each 00 00 01 start code).
 std::vector<int> NalTypes(const std::vector<std::uint8_t>& s, bool hevc) {
@@ -284,7 +208,7 @@ void ExpectDecodes(VideoProfile profile, int w, int h, double min_psnr_db) {
   std::string error;
   auto enc = PvEncoder::Create(Config(w, h, profile), &error);
   ASSERT_TRUE(enc) << error;
-  ClientDecoder dec(hevc);
+  PvClientDecoder dec(hevc);
   double worst = 99;
   for (int i = 0; i < 4; ++i) {
     const cv::Mat bgr = TestPicture(1280, 720, 8 * i);
@@ -363,7 +287,7 @@ TEST(PvVideo, TwoThreadsStillReturnEachPicturesUnit) {
     c.threads = 2;
     auto enc = PvEncoder::Create(c, &error);
     ASSERT_TRUE(enc) << error;
-    ClientDecoder dec(profile == VideoProfile::kH265Main);
+    PvClientDecoder dec(profile == VideoProfile::kH265Main);
     for (int i = 0; i < 3; ++i) {
       std::vector<std::uint8_t> payload;
       ASSERT_TRUE(enc->Encode(TestPicture(1280, 720, 5 * i), geometry::Intrinsics::HoloLensPv(), {}, &payload,

@@ -12,7 +12,8 @@ std::optional<PvRefusal> CheckPvClientFormat(const PvConfig& client) {
   return PvRefusal{size_known ? "pv/framerate" : "pv/size", *why};
 }
 
-std::optional<PvEncoderConfig> PvEncoderConfigFromClient(const PvConfig& client, int threads, PvRefusal* refusal) {
+std::optional<PvEncoderConfig> PvEncoderConfigFromClient(const PvConfig& client, int threads,
+                                                         PvRefusal* refusal) {
   const auto refuse = [refusal](const std::string& key, const std::string& reason) {
     *refusal = PvRefusal{key, reason};
     return std::nullopt;

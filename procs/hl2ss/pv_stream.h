@@ -54,7 +54,8 @@ std::optional<PvRefusal> CheckPvClientFormat(const PvConfig& client);
 
 /// The encoder configuration for a mode-0/1 client, or the refusal (see the file comment).
 /// `threads`: the encoder threads (the emulation's choice).
-std::optional<PvEncoderConfig> PvEncoderConfigFromClient(const PvConfig& client, int threads, PvRefusal* refusal);
+std::optional<PvEncoderConfig> PvEncoderConfigFromClient(const PvConfig& client, int threads,
+                                                         PvRefusal* refusal);
 
 /// The trailer's capture fields from the RC settings (see the file comment).
 PvCaptureMetadata PvCaptureMetadataFromSettings(const PvSettings& settings);
@@ -63,7 +64,8 @@ PvCaptureMetadata PvCaptureMetadataFromSettings(const PvSettings& settings);
 /// divisor-th of those. Call once per camera frame; true = send this one.
 class PvPacer {
  public:
-  explicit PvPacer(const PvConfig& config) : skip_(config.framerate == 15 ? 2 : 1), divisor_(config.divisor) {}
+  explicit PvPacer(const PvConfig& config)
+      : skip_(config.framerate == 15 ? 2 : 1), divisor_(config.divisor) {}
   bool Next() {
     const bool camera_due = (count_++ % skip_) == 0;
     if (!camera_due) return false;

@@ -48,7 +48,8 @@ TEST(PvStream, ClientConfigurationBecomesTheEncoders) {
 
   EXPECT_EQ(PvEncoderConfigFromClient(Client(424, 240, kProfileH264Base), 1, &refusal)->profile,
             VideoProfile::kH264Base);
-  EXPECT_EQ(PvEncoderConfigFromClient(Client(1280, 720, kProfileRaw), 1, &refusal)->profile, VideoProfile::kRaw);
+  EXPECT_EQ(PvEncoderConfigFromClient(Client(1280, 720, kProfileRaw), 1, &refusal)->profile,
+            VideoProfile::kRaw);
 }
 
 TEST(PvStream, EachRefusalHasItsKey) {
@@ -79,8 +80,8 @@ TEST(PvStream, TrailerFieldsFromTheSettingsTheClientSet) {
   EXPECT_EQ(m.exposure_time_hns, defaults.exposure_time_hns);
   EXPECT_EQ(m.iso_speed, defaults.iso_speed);
   EXPECT_EQ(m.white_balance_k, defaults.white_balance_k);
-  s.exposure = {0, 1000};    // manual, 1000 × 10 µs = 10 ms = 100 000 ticks of 100 ns
-  s.iso_speed = {0, 400};    // manual, ISO 400
+  s.exposure = {0, 1000};       // manual, 1000 × 10 µs = 10 ms = 100 000 ticks of 100 ns
+  s.iso_speed = {0, 400};       // manual, ISO 400
   s.white_balance_value = 200;  // × 25 K = 5000 K
   m = PvCaptureMetadataFromSettings(s);
   EXPECT_EQ(m.exposure_time_hns, 100000u);

@@ -23,7 +23,8 @@ std::vector<PvResult> PvHandBack::TakeAll() {
 
 void PvHandBack::Discard(int client) {
   std::lock_guard<std::mutex> lock(mutex_);
-  queue_.erase(std::remove_if(queue_.begin(), queue_.end(), [client](const PvResult& r) { return r.client == client; }),
+  queue_.erase(std::remove_if(queue_.begin(), queue_.end(),
+                              [client](const PvResult& r) { return r.client == client; }),
                queue_.end());
 }
 

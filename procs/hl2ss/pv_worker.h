@@ -42,10 +42,10 @@ namespace orbed::hl2ss {
 
 /// One picture to encode for one client.
 struct PvJob {
-  cv::Mat bgr;                  ///< shared, read-only: the camera picture at its own size
-  geometry::Intrinsics K;       ///< of `bgr`
-  PvCaptureMetadata metadata;   ///< the trailer's capture fields
-  std::uint64_t timestamp{0};   ///< hl2ss ticks, for the packet
+  cv::Mat bgr;                                ///< shared, read-only: the camera picture at its own size
+  geometry::Intrinsics K;                     ///< of `bgr`
+  PvCaptureMetadata metadata;                 ///< the trailer's capture fields
+  std::uint64_t timestamp{0};                 ///< hl2ss ticks, for the packet
   std::optional<std::array<float, 16>> pose;  ///< the mode-1 pose (frames.h), nullopt in mode 0
 };
 
@@ -59,7 +59,8 @@ struct PvResult {
 };
 
 /// Encodes one job into *payload; false and *error on failure. Runs on a worker thread.
-using PvEncodeFn = std::function<bool(const PvJob& job, std::vector<std::uint8_t>* payload, std::string* error)>;
+using PvEncodeFn =
+    std::function<bool(const PvJob& job, std::vector<std::uint8_t>* payload, std::string* error)>;
 
 /// The thread-safe queue of finished payloads, drained by the process thread.
 class PvHandBack {

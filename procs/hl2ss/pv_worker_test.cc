@@ -140,9 +140,7 @@ TEST(PvWorker, StoppingWaitsForTheEncodeInProgressOnlyAndDropsTheWaitingPicture)
 TEST(PvWorker, AnIdleWorkerStopsAtOnceAndDiscardKeepsOtherClients) {
   HeldEncoder encoder;
   WatchedHandBack back;
-  {
-    PvEncoderWorker idle(1, encoder.Fn(), &back.queue);
-  }  // joined without ever encoding
+  { PvEncoderWorker idle(1, encoder.Fn(), &back.queue); }  // joined without ever encoding
   EXPECT_TRUE(encoder.started().empty());
   back.queue.Push(PvResult{1, 10, {}, std::nullopt, ""});
   back.queue.Push(PvResult{2, 11, {}, std::nullopt, ""});
