@@ -55,7 +55,8 @@ cv::Mat PvClientDecoder::Decode(const std::vector<std::uint8_t>& image) {
   while (left > 0) {
     std::uint8_t* out = nullptr;
     int out_size = 0;
-    const int used = av_parser_parse2(parser_, ctx_, &out, &out_size, data, left, AV_NOPTS_VALUE, AV_NOPTS_VALUE, 0);
+    const int used =
+        av_parser_parse2(parser_, ctx_, &out, &out_size, data, left, AV_NOPTS_VALUE, AV_NOPTS_VALUE, 0);
     if (used < 0) return {};
     data += used;
     left -= used;
@@ -80,7 +81,8 @@ cv::Mat PvClientDecoder::ToBgr() {
   for (int r = 0; r < h; ++r) std::memcpy(dst + r * w, frame_->data[0] + r * frame_->linesize[0], w);
   dst += w * h;
   for (int p = 1; p <= 2; ++p) {
-    for (int r = 0; r < h / 2; ++r) std::memcpy(dst + r * (w / 2), frame_->data[p] + r * frame_->linesize[p], w / 2);
+    for (int r = 0; r < h / 2; ++r)
+      std::memcpy(dst + r * (w / 2), frame_->data[p] + r * frame_->linesize[p], w / 2);
     dst += (w / 2) * (h / 2);
   }
   cv::Mat bgr;
