@@ -74,10 +74,12 @@ std::optional<VideoProfile> VideoProfileFromByte(std::uint8_t byte) {
 const std::vector<PvFormat>& SupportedPvFormats() {
   static const std::vector<PvFormat> formats = [] {
     std::vector<PvFormat> f;
-    for (const auto& [w, h] : std::vector<std::pair<int, int>>{{1920, 1080},
+    for (const auto& [w, h] : std::vector<std::pair<int, int>>{{2272, 1278},
+                                                               {1920, 1080},
                                                                {1280, 720},
                                                                {1128, 636},
                                                                {960, 540},
+                                                               {896, 504},
                                                                {760, 428},
                                                                {640, 360},
                                                                {500, 282},
@@ -107,8 +109,9 @@ std::optional<std::string> CheckPvFormat(const PvFormat& format) {
         << format.framerate_hz;
   } else {
     why << "PV size " << format.width_px << "x" << format.height_px
-        << " is not a video mode of the device (1920x1080, 1952x1100, 1504x846, 1280x720, 1128x636, 960x540, "
-           "760x428, 640x360, 500x282, 424x240)";
+        << " is not a video mode of the device (2272x1278, 1952x1100, 1920x1080, 1504x846, 1280x720, "
+           "1128x636, "
+           "960x540, 896x504, 760x428, 640x360, 500x282, 424x240)";
   }
   return why.str();
 }

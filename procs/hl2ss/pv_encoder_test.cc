@@ -81,7 +81,9 @@ TEST(PvFormat, DeviceModesAcceptedOthersRefusedWithReason) {
   const auto size = CheckPvFormat({800, 600, 30});
   ASSERT_TRUE(size);
   EXPECT_NE(size->find("not a video mode"), std::string::npos) << *size;
-  EXPECT_EQ(SupportedPvFormats().size(), 23u);
+  EXPECT_FALSE(CheckPvFormat({2272, 1278, 30}));
+  EXPECT_FALSE(CheckPvFormat({896, 504, 15}));
+  EXPECT_EQ(SupportedPvFormats().size(), 27u);  // 10 sizes × 2 rates, 1952×1100 × 3, 1504×846 × 4
 }
 
 TEST(PvFormat, ConfigChecks) {

@@ -3,9 +3,10 @@
 /// What the PV port (3810) serves a client, from its parsed configuration (protocol.h PvConfig)
 /// and the emulated device's state, without sockets, threads or bus:
 ///   - PvEncoderConfigFromClient: the client's bytes as a pv_encoder.h configuration, or a refusal
-///     with its counted key: "pv/profile" (a profile byte pv_encoder does not know), "pv/size" (a
-///     size the parser knows but the emulated camera does not offer: 2272×1278, 896×504),
-///     "pv/framerate", "pv/bitrate" (above kMaxBitrateBps), "pv/gop" (a GOP above 600 pictures).
+///     with its counted key: "pv/profile" (a profile byte pv_encoder does not know), "pv/size" and
+///     "pv/framerate" (a mode pv_encoder.h SupportedPvFormats does not list), "pv/bitrate" (above
+///     kMaxBitrateBps), "pv/gop" (a GOP above 600 pictures). The parser (protocol.h) refuses most
+///     of these first under the same keys; these checks keep pv_encoder's the one definition.
 ///     The GOP is the client's CODECAPI_AVEncMPVGOPSize encoder option (hl2ss.py
 ///     H26xEncoderProperty key 10); absent or 0 (the Media Foundation encoder's "choose"), it is
 ///     the frame rate, hl2ss_lnm's default: one IDR a second. Other encoder options and the level

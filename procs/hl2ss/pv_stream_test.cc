@@ -60,8 +60,11 @@ TEST(PvStream, EachRefusalHasItsKey) {
     return refusal.key;
   };
   EXPECT_EQ(key_of(Client(1280, 720, 7)), "pv/profile");
-  EXPECT_EQ(key_of(Client(2272, 1278, kProfileH264Main)), "pv/size");  // parsed, not offered here
-  EXPECT_EQ(key_of(Client(896, 504, kProfileRaw)), "pv/size");
+  EXPECT_EQ(key_of(Client(1000, 1000, kProfileH264Main)), "pv/size");
+  PvRefusal refusal;  // every size the parser knows is served
+  for (const PvFormatSize& s : PvVideoSizes())
+    EXPECT_TRUE(PvEncoderConfigFromClient(Client(s.width, s.height, kProfileRaw), 1, &refusal))
+        << s.width << "x" << s.height << ": " << refusal.reason;
   PvConfig c = Client(1280, 720, kProfileH264Main);
   c.framerate = 60;
   EXPECT_EQ(key_of(c), "pv/framerate");

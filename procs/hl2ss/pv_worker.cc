@@ -32,19 +32,24 @@ PvEncoderWorker::PvEncoderWorker(int client, PvEncodeFn encode, PvHandBack* out)
     : client_(client), encode_(std::move(encode)), out_(out), thread_([this] { Loop(); }) {}
 
 PvEncoderWorker::~PvEncoderWorker() {
+  RequestStop();
+  thread_.join();
+}
+
+void PvEncoderWorker::RequestStop() {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     stop_ = true;
     mailbox_.reset();
   }
   wake_.notify_one();
-  thread_.join();
 }
 
 bool PvEncoderWorker::Offer(PvJob job) {
   bool replaced = false;
   {
     std::lock_guard<std::mutex> lock(mutex_);
+    if (stop_) return true;  // stopping: nothing is encoded any more, and nothing was waiting
     replaced = mailbox_.has_value();
     mailbox_ = std::move(job);
   }

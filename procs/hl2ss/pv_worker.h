@@ -12,8 +12,9 @@
 ///   - the worker takes the job, runs the encode function on it (outside any lock) and pushes the
 ///     result, tagged with the client, into the PvHandBack;
 ///   - the process thread drains the PvHandBack (TakeAll) in its poll and sends.
-/// Stopping (the destructor): the waiting job is discarded, the thread is told to stop and joined;
-/// it returns after the encode in progress, so the caller blocks at most one picture's encode.
+/// Stopping (RequestStop, then the destructor): the waiting job is discarded, the thread is told to
+/// stop and joined; it returns after the encode in progress, so the caller blocks at most one
+/// picture's encode.
 /// Results the worker pushed before it stopped stay in the PvHandBack: the caller removes them
 /// with Discard(client) after the join.
 ///
@@ -84,7 +85,7 @@ class PvEncoderWorker {
  public:
   /// Starts the thread. `out` must outlive the worker.
   PvEncoderWorker(int client, PvEncodeFn encode, PvHandBack* out);
-  /// Discards a waiting job, stops the thread and joins it (after the encode in progress).
+  /// RequestStop(), then joins the thread (after the encode in progress).
   ~PvEncoderWorker();
   PvEncoderWorker(const PvEncoderWorker&) = delete;
   PvEncoderWorker& operator=(const PvEncoderWorker&) = delete;
@@ -92,6 +93,10 @@ class PvEncoderWorker {
   /// Puts `job` in the mailbox. Returns false when it replaced a job still waiting there (that
   /// one is dropped: count it).
   bool Offer(PvJob job);
+
+  /// Discards a waiting job and tells the thread to stop after the encode in progress, without
+  /// waiting for it. Later offers are discarded.
+  void RequestStop();
 
   int client() const { return client_; }
 

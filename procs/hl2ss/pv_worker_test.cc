@@ -121,16 +121,18 @@ TEST(PvWorker, StoppingWaitsForTheEncodeInProgressOnlyAndDropsTheWaitingPicture)
   worker->Offer(Job(1));
   ASSERT_TRUE(encoder.WaitStarted(1));
   worker->Offer(Job(2));  // waiting when the client leaves
+  worker->RequestStop();  // what the destructor does first, here before 1 is released
+  EXPECT_TRUE(worker->Offer(Job(3))) << "discarded, not counted as replacing anything";
   std::promise<void> stopped;
+  std::future<void> done = stopped.get_future();
   std::thread stopper([&] {
     worker.reset();  // the process thread's part: blocks until the encode of 1 returns
     stopped.set_value();
   });
-  std::future<void> done = stopped.get_future();
   encoder.Release();
   ASSERT_EQ(done.wait_for(kTimeout), std::future_status::ready);
   stopper.join();
-  EXPECT_EQ(encoder.started(), std::vector<std::uint64_t>{1}) << "2 was never encoded";
+  EXPECT_EQ(encoder.started(), std::vector<std::uint64_t>{1}) << "2 and 3 were never encoded";
   // What the worker handed back before it stopped is discarded by the caller.
   ASSERT_TRUE(back.WaitPushes(1));
   back.queue.Discard(3);
