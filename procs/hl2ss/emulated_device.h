@@ -32,8 +32,9 @@ struct PvSettings {
   std::array<uint32_t, 5> focus{};  ///< mode, auto range, distance, value, driver fallback
   uint32_t temporal_denoising{0};
   uint32_t white_balance_preset{0};
-  uint32_t white_balance_value{0};         ///< [25 K]
-  std::array<uint32_t, 2> exposure{1, 0};  ///< mode (1 auto), value [10 µs]
+  uint32_t white_balance_value{0};  ///< [25 K]
+  std::array<uint32_t, 2> exposure{1,
+                                   0};  ///< mode (1 auto), value [µs] (the device sets TimeSpan(10 × value))
   uint32_t exposure_priority_video{0};
   std::array<uint32_t, 2> iso_speed{1, 0};  ///< mode (1 auto), value
   uint32_t backlight_compensation{0};

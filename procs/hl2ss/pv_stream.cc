@@ -47,7 +47,7 @@ std::optional<PvEncoderConfig> PvEncoderConfigFromClient(const PvConfig& client,
 
 PvCaptureMetadata PvCaptureMetadataFromSettings(const PvSettings& s) {
   PvCaptureMetadata m;
-  if (s.exposure[0] == 0) m.exposure_time_hns = static_cast<std::uint64_t>(s.exposure[1]) * 100;
+  if (s.exposure[0] == 0) m.exposure_time_hns = static_cast<std::uint64_t>(s.exposure[1]) * 10;
   if (s.iso_speed[0] == 0) m.iso_speed = s.iso_speed[1];
   if (s.white_balance_value != 0) m.white_balance_k = s.white_balance_value * 25;
   return m;

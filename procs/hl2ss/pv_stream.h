@@ -13,9 +13,9 @@
 ///     byte are accepted and not honoured (pv_encoder.h).
 ///   - PvCaptureMetadataFromSettings: the trailer's capture fields from the RC settings the client
 ///     set (emulated_device.h PvSettings): exposure time when exposure is manual (mode 0; value in
-///     10 µs → ×100 ticks of 100 ns), ISO speed when manual (mode 0), white balance when a value
-///     was set (units of 25 K); every other field, and those not set, pv_encoder.h's documented
-///     PvCaptureMetadata defaults.
+///     µs → ×10 ticks of 100 ns, as the device server's TimeSpan(10 × value)), ISO speed when manual (mode
+///     0), white balance when a value was set (units of 25 K); every other field, and those not set,
+///     pv_encoder.h's documented PvCaptureMetadata defaults.
 ///   - PvPacer: which 30 Hz camera frames a client gets (15 fps: every second one; then every
 ///     divisor-th of those).
 ///   - PvCalibrationFor: the mode-2 answer: pv_encoder.h PackPvCalibration with K the camera's

@@ -83,7 +83,7 @@ TEST(PvStream, TrailerFieldsFromTheSettingsTheClientSet) {
   EXPECT_EQ(m.exposure_time_hns, defaults.exposure_time_hns);
   EXPECT_EQ(m.iso_speed, defaults.iso_speed);
   EXPECT_EQ(m.white_balance_k, defaults.white_balance_k);
-  s.exposure = {0, 1000};       // manual, 1000 × 10 µs = 10 ms = 100 000 ticks of 100 ns
+  s.exposure = {0, 10000};      // manual, 10 000 µs (the device: TimeSpan(10 × value)) = 100 000 ticks
   s.iso_speed = {0, 400};       // manual, ISO 400
   s.white_balance_value = 200;  // × 25 K = 5000 K
   m = PvCaptureMetadataFromSettings(s);

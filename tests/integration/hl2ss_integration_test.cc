@@ -10,8 +10,9 @@
 //     UTC offset = the utime as a FILETIME) in D (frames.h), its eye ray one of GAZE_RAY's;
 //   - PV H.264 main mode 1 at 1280×720 (hl2ss_lnm's default bitrate and GOP option): every payload,
 //     decoded as the client decodes it (libavcodec; the first 6 bytes dropped), is the HMD_CAMERA
-//     picture of its stamp within encoder noise (PSNR > 30 dB against the JPEG-decoded picture
-//     the server had), the first one a key frame; its pose is frames.h's CameraPoseForClient(X_WC);
+//     picture of its stamp within encoder noise (PSNR > 40 dB against the JPEG-decoded picture
+//     the server had), the first one a key frame; its trailer carries the exposure and ISO set over
+//     RC before; its pose is frames.h's CameraPoseForClient(X_WC);
 //   - PV H.265 main (the client's default profile) mode 0 at 424×240: every payload decodes to a
 //     424×240 picture near the HMD_CAMERA picture resized;
 //   - PV RAW mode 1 at 1280×720: the NV12 decodes to the HMD_CAMERA picture of its stamp within
@@ -349,6 +350,9 @@ TEST(Hl2ss, AnHl2ssClientSeesTheHeadsetAndHostileClientsAreRefused) {
     start.Send(MrcStart());
     EXPECT_TRUE(start.ClosedByServer());
     Socket rc(3809);
+    // set_pv_exposure(Manual, 10000 µs), set_pv_iso_speed(Manual, 400): '<BII' each, no answer;
+    // the status query after them is answered once they are applied.
+    rc.Send({0x08, 0, 0, 0, 0, 0x10, 0x27, 0, 0, 0x0A, 0, 0, 0, 0, 0x90, 0x01, 0, 0});
     rc.Send({0x03});
     EXPECT_EQ(rc.Read(1), std::vector<uint8_t>{1}) << "the PV subsystem is open";
   }
@@ -432,6 +436,11 @@ TEST(Hl2ss, AnHl2ssClientSeesTheHeadsetAndHostileClientsAreRefused) {
       const uint8_t* trailer = p.payload.data() + p.payload.size() - 80;
       EXPECT_FLOAT_EQ(Le<float>(trailer), 1000.0f);
       EXPECT_EQ(Le<uint16_t>(trailer + 76), kWidth);
+      // The RC settings: the device's TimeSpan(10 × 10000 µs) in 100 ns ticks, ISO 400; white
+      // balance not set: the emulated camera's 4500 K.
+      EXPECT_EQ(Le<uint64_t>(trailer + 16), 100000u);
+      EXPECT_EQ(Le<uint32_t>(trailer + 48), 400u);
+      EXPECT_EQ(Le<uint32_t>(trailer + 52), 4500u);
       std::pair<int, orbed::pose_t> frame;
       ASSERT_TRUE(frame_of(p.timestamp, &frame)) << "no HMD_CAMERA at the stamp";
       const cv::Mat decoded = decoder.Decode({p.payload.begin(), p.payload.end() - 80});
