@@ -14,7 +14,7 @@
 //     the server had), the first one a key frame; its trailer carries the exposure and ISO set over
 //     RC before; its pose is frames.h's CameraPoseForClient(X_WC);
 //   - PV H.265 main (the client's default profile) mode 0 at 424×240: every payload decodes to a
-//     424×240 picture near the HMD_CAMERA picture resized;
+//     424×240 picture, the HMD_CAMERA picture of its stamp resized (PSNR > 40 dB);
 //   - PV RAW mode 1 at 1280×720: the NV12 decodes to the HMD_CAMERA picture of its stamp within
 //     colour-conversion rounding, the trailer says its intrinsics and size, the pose as above;
 //   - refused: a PV stream before start_subsystem_pv (as the device), an unknown profile byte
@@ -26,9 +26,10 @@
 // square tile facing the camera at a known p_W off the optical axis, a known X_WC and off-centre
 // K): refused ("pv/no_camera") before any HMD_CAMERA; then, at 1920×1080, the intrinsics and the
 // mode-1 pose project p_W with hl2ss_3dcv's math (row vectors, the projection matrix with −fx,
-// pv_fix_calibration) within 1 px of the tile's drawn centroid (its body-id mask's, scaled to
-// 1920×1080), and so do the mode-2 extrinsics from the rig node N (docs/hl2ss.md: the head with
-// the device's axes) placed by the HMD_POSE the test sent.
+// pv_fix_calibration) within 0.25 px (1 px asked) of the tile's drawn centroid (its body-id mask's,
+// scaled to 1920×1080), and so do the mode-2 extrinsics from the rig node N (docs/hl2ss.md: the
+// head with the device's axes) placed by the HMD_POSE the test sent. The calibration is no longer
+// refused, nor are the H.264/H.265 profiles.
 // And the Unity message queue (3816; hl2ss_rus.py's command layouts: id u32 | size u32 | data, one
 // u32 answer each): a cube created, posed, coloured and shown is published on HOLOGRAMS at Unity's
 // (x, y, z) = W's (x, z, y) (frames.h by hand: z_D = −z_U, W = (x_D, −z_D, y_D)); removing it
