@@ -80,8 +80,12 @@ struct Hl2ssOptions {
   double stale_s{0.5};  ///< an HMD_POSE or GAZE_RAY older than this is not reported valid
   double poll_period_s{0.002};
   std::array<uint16_t, 4> app_version{1, 0, 0, 0};
-#include "geometry/camera_model.h"
-#include "procs/hl2ss/depth_stream.h"
+  int pv_encoder_threads{1};  ///< libavcodec threads per PV client's encoder (1 … 8)
+  /// The depth stream's robot, scene and camera (depth_stream.h), and its inputs.
+  DepthStreamOptions rm_depth;
+  std::string truth_channel{"HMD_POSE_TRUTH"};
+  std::string iiwa_status_channel{"IIWA_STATUS"};
+  std::string robot_state_channel{"ROBOT_STATE"};
 };
 
 class Hl2ssProcess {
