@@ -1,7 +1,8 @@
-// A hologram placed by an hl2ss client shows in the headset's AR view: the real orbed-hl2ss and the
-// real orbed-hmd over real LCM and real TCP in a private network namespace (ctest wraps this binary
-// in scripts/netns-exec), with no robot on the bus (AR_VIEW then holds the camera frame and the
-// client's holograms only).
+// A hologram placed by an hl2ss client shows in the headset's AR view and over its reflective
+// display's frame: the real orbed-hl2ss and the real orbed-hmd (one display) over real LCM and real
+// TCP in a private network namespace (ctest wraps this binary in scripts/netns-exec), with no robot
+// on the bus (AR_VIEW then holds the camera frame and the client's holograms only, the display its
+// frozen frame and the holograms).
 //
 // The client is the test's own, written from hl2ss_rus.py's layouts on the Unity message queue
 // (3816): commands back to back, each `id (u32) | size (u32) | data`, little-endian, one u32 answer
@@ -16,10 +17,12 @@
 //   3. from the first AR_VIEW that differs from its camera frame on, three AR_VIEWs in a row: the
 //      centroid of the differing pixels is within kMaxCentroidErrorPx of where the AR_VIEW's own
 //      camera model (its intrinsics and X_WC) projects the sphere's centre, their number within
-//      [0.85, 1.1] of the silhouette's area π (f r / z)², and the pixel there is red;
+//      [0.85, 1.1] of the silhouette's area π (f r / z)², and the pixel there is red; likewise in
+//      the first REFLECTIVE_VIEW that differs from the one before placement (the same frame, captured
+//      at the walk's first waypoint), with that frame's camera model;
 //   4. the client removes it (command 16; answer 1): from the first AR_VIEW with no differing pixel
 //      on, three in a row equal their camera frames byte for byte (the same encoder on the same
-//      pixels);
+//      pixels), and REFLECTIVE_VIEW is the one before placement again, byte for byte;
 //   5. neither process refused anything (PROCESS_STATUS).
 // Time: about 1.3 s (of it up to 1 s for both heartbeats after the removal). Measured: centroids
 // 0.25-0.4 px from the projection, 97 % of the disk differing.
@@ -49,6 +52,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <orbed/image_t.hpp>
+#include <orbed/reflective_view_t.hpp>
 
 #include "lcmtypes/contract/conversions.h"
 #include "runtime/flags.h"
@@ -136,6 +140,7 @@ class Pictures {
     if (!lcm_.good()) throw std::runtime_error("LCM not available");
     lcm_.subscribe("HMD_CAMERA", &Pictures::OnCamera, this);
     lcm_.subscribe("AR_VIEW", &Pictures::OnArView, this);
+    lcm_.subscribe("REFLECTIVE_VIEW", &Pictures::OnReflective, this);
     thread_ = std::thread([this] {
       while (!stop_) lcm_.handleTimeout(20);
     });
@@ -163,6 +168,11 @@ class Pictures {
     std::lock_guard<std::mutex> lock(mutex_);
     pairs_.clear();
   }
+  // The picture of the latest REFLECTIVE_VIEW of display 0, if one came.
+  std::optional<orbed::image_t> reflective() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return reflective_;
+  }
   int unpaired() const {
     std::lock_guard<std::mutex> lock(mutex_);
     return unpaired_;
@@ -184,8 +194,14 @@ class Pictures {
     if (pairs_.size() < 30) pairs_.push_back({*m, it->second});
   }
 
+  void OnReflective(const lcm::ReceiveBuffer*, const std::string&, const orbed::reflective_view_t* m) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (m->display_id == 0) reflective_ = m->image;
+  }
+
   lcm::LCM lcm_;
   mutable std::mutex mutex_;
+  std::optional<orbed::image_t> reflective_;
   std::map<int64_t, orbed::image_t> cameras_;
   std::deque<Pair> pairs_;
   int unpaired_{0};
@@ -195,18 +211,19 @@ class Pictures {
 
 cv::Mat Decode(const std::vector<uint8_t>& jpeg) { return cv::imdecode(jpeg, cv::IMREAD_COLOR); }
 
-// Where an AR_VIEW and its camera frame differ by more than kDiffThreshold in some channel.
+// Where a picture with holograms and the same picture without (an AR_VIEW and its camera frame) differ by
+// more than kDiffThreshold in some channel.
 struct Difference {
   int pixels{0};
   Eigen::Vector2d centroid_px{Eigen::Vector2d::Zero()};
 };
 
-Difference Differ(const Pair& pair) {
-  const cv::Mat ar = Decode(pair.ar.data), camera = Decode(pair.camera.data);
-  EXPECT_FALSE(ar.empty() || camera.empty());
-  if (ar.empty() || camera.empty() || ar.size() != camera.size()) return {};
+Difference Differ(const orbed::image_t& drawn, const orbed::image_t& base) {
+  const cv::Mat a = Decode(drawn.data), b = Decode(base.data);
+  EXPECT_FALSE(a.empty() || b.empty());
+  if (a.empty() || b.empty() || a.size() != b.size()) return {};
   cv::Mat diff, channels[3];
-  cv::absdiff(ar, camera, diff);
+  cv::absdiff(a, b, diff);
   cv::split(diff, channels);
   const cv::Mat mask = cv::max(channels[0], cv::max(channels[1], channels[2])) > kDiffThreshold;
   const cv::Moments m = cv::moments(mask, true);
@@ -227,13 +244,38 @@ Eigen::Vector2d Project(const orbed::image_t& view, const Eigen::Vector3d& p_C) 
 }
 
 // The inputs `name` had refused by its last heartbeat, if that came after `since`; else -1.
+// The sphere of diameter kSphereDiameterM at p_W drawn in `view`, where `diff` says it differs from the
+// picture without it: the centroid at the projection of its centre, the area of its silhouette, red.
+void ExpectSphereAt(const orbed::image_t& view, const Difference& diff, const Eigen::Vector3d& p_W,
+                    const std::string& label) {
+  const Eigen::Vector3d p_C = InCamera(view, p_W);
+  const Eigen::Vector2d uv = Project(view, p_C);
+  const double radius_px = view.fx_px * kSphereDiameterM / 2 / p_C.z();
+  const double area_px = M_PI * radius_px * radius_px;
+  ASSERT_GT(uv.x() - radius_px, 0) << label;  // the sphere wholly in view
+  ASSERT_LT(uv.x() + radius_px, view.width) << label;
+  ASSERT_GT(uv.y() - radius_px, 0) << label;
+  ASSERT_LT(uv.y() + radius_px, view.height) << label;
+  std::printf("%s: %d pixels differ (disk %.0f), centroid (%.2f, %.2f), projected (%.2f, %.2f)\n",
+              label.c_str(), diff.pixels, area_px, diff.centroid_px.x(), diff.centroid_px.y(), uv.x(),
+              uv.y());
+  EXPECT_GT(diff.pixels, 0.85 * area_px) << label;
+  EXPECT_LT(diff.pixels, 1.1 * area_px) << label;
+  EXPECT_LT((diff.centroid_px - uv).norm(), kMaxCentroidErrorPx)
+      << label << " drawn at " << diff.centroid_px.transpose() << ", projected " << uv.transpose();
+  const cv::Mat bgr = Decode(view.data);
+  const cv::Vec3b at =
+      bgr.at<cv::Vec3b>(static_cast<int>(std::lround(uv.y())), static_cast<int>(std::lround(uv.x())));
+  EXPECT_GT(int{at[2]} - int{at[1]}, 60) << label << ": red over the room, BGR " << at;
+}
+
 int64_t Rejected(const BusWatcher& bus, const std::string& name,
                  std::chrono::steady_clock::time_point since) {
   const auto beats = bus.Heartbeats(name);
   return beats.empty() || beats.back().received < since ? -1 : beats.back().status.rejected_inputs;
 }
 
-TEST(Hl2ssHolograms, ASpherePlacedThroughTheMessageQueueShowsInArViewAtItsPixel) {
+TEST(Hl2ssHolograms, ASpherePlacedThroughTheMessageQueueShowsInArViewAndOnTheDisplayAtItsPixel) {
   // The walk: 3 cm/s past the foot end (the shipped walk's names, which config/hmd.yaml's displays
   // and alignment use), looking at the robot's middle; AR_VIEW at 10 Hz.
   const std::string config = MakeTempDir("hl2ss_holograms") + "/slow_walk.yaml";
@@ -249,7 +291,7 @@ TEST(Hl2ssHolograms, ASpherePlacedThroughTheMessageQueueShowsInArViewAtItsPixel)
   bus.Start();
   Pictures pictures;
   RunningProcess hl2ss({BinPath("orbed-hl2ss"), "--name", "hl2ss"});
-  RunningProcess hmd({BinPath("orbed-hmd"), "--name", "hmd", "--displays", "0", "--config", config});
+  RunningProcess hmd({BinPath("orbed-hmd"), "--name", "hmd", "--displays", "1", "--config", config});
   const auto next = [&] {
     hl2ss.running();  // drain their output
     hmd.running();
@@ -259,7 +301,11 @@ TEST(Hl2ssHolograms, ASpherePlacedThroughTheMessageQueueShowsInArViewAtItsPixel)
   // 1. Nothing placed: an AR_VIEW is its camera frame.
   const std::optional<Pair> before = next();
   ASSERT_TRUE(before) << "no AR_VIEW with its HMD_CAMERA within 20 s";
-  EXPECT_EQ(Differ(*before).pixels, 0);
+  EXPECT_EQ(Differ(before->ar, before->camera).pixels, 0);
+  // The reflective display's frame, frozen since it captured it at the walk's first waypoint.
+  std::optional<orbed::image_t> mirror_before;
+  ASSERT_TRUE(WaitFor([&] { return (mirror_before = pictures.reflective()).has_value(); }, 20))
+      << "no REFLECTIVE_VIEW within 20 s";
 
   // 2. A red sphere a metre ahead of that AR_VIEW's camera.
   const Eigen::Vector3d p_W = FromPose(before->ar.X_WC) * Eigen::Vector3d(0, 0, kAheadM);
@@ -285,7 +331,7 @@ TEST(Hl2ssHolograms, ASpherePlacedThroughTheMessageQueueShowsInArViewAtItsPixel)
   ASSERT_TRUE(WaitFor(
       [&] {
         pair = next();
-        diff = pair ? Differ(*pair) : Difference{};
+        diff = pair ? Differ(pair->ar, pair->camera) : Difference{};
         return diff.pixels > 0;
       },
       20))
@@ -294,28 +340,23 @@ TEST(Hl2ssHolograms, ASpherePlacedThroughTheMessageQueueShowsInArViewAtItsPixel)
     if (i > 0) {
       pair = next();
       ASSERT_TRUE(pair);
-      diff = Differ(*pair);
+      diff = Differ(pair->ar, pair->camera);
     }
-    const orbed::image_t& view = pair->ar;
-    const Eigen::Vector3d p_C = InCamera(view, p_W);
-    const Eigen::Vector2d uv = Project(view, p_C);
-    const double radius_px = view.fx_px * kSphereDiameterM / 2 / p_C.z();
-    const double area_px = M_PI * radius_px * radius_px;
-    ASSERT_GT(uv.x() - radius_px, 0);  // the sphere wholly in view
-    ASSERT_LT(uv.x() + radius_px, view.width);
-    ASSERT_GT(uv.y() - radius_px, 0);
-    ASSERT_LT(uv.y() + radius_px, view.height);
-    std::printf("AR_VIEW %d: %d pixels differ (disk %.0f), centroid (%.2f, %.2f), projected (%.2f, %.2f)\n",
-                i, diff.pixels, area_px, diff.centroid_px.x(), diff.centroid_px.y(), uv.x(), uv.y());
-    EXPECT_GT(diff.pixels, 0.85 * area_px);
-    EXPECT_LT(diff.pixels, 1.1 * area_px);
-    EXPECT_LT((diff.centroid_px - uv).norm(), kMaxCentroidErrorPx)
-        << "drawn at " << diff.centroid_px.transpose() << ", projected " << uv.transpose();
-    const cv::Mat ar = Decode(view.data);
-    const cv::Vec3b at =
-        ar.at<cv::Vec3b>(static_cast<int>(std::lround(uv.y())), static_cast<int>(std::lround(uv.x())));
-    EXPECT_GT(int{at[2]} - int{at[1]}, 60) << "red over the room: BGR " << at;
+    ExpectSphereAt(pair->ar, diff, p_W, "AR_VIEW " + std::to_string(i));
   }
+
+  // And over the reflective display's frame: its first REFLECTIVE_VIEW that differs from the frame
+  // before, where that frame's own camera model projects the centre.
+  std::optional<orbed::image_t> mirror;
+  ASSERT_TRUE(WaitFor(
+      [&] {
+        mirror = pictures.reflective();
+        return mirror && mirror->data != mirror_before->data;
+      },
+      20))
+      << "the sphere never showed over the reflective display's frame";
+  EXPECT_EQ(mirror->utime, mirror_before->utime) << "the same frame";
+  ExpectSphereAt(*mirror, Differ(*mirror, *mirror_before), p_W, "REFLECTIVE_VIEW");
 
   // 4. Removed: from the first AR_VIEW without it, three in a row are their camera frames.
   client.Add(16, {key});
@@ -324,7 +365,7 @@ TEST(Hl2ssHolograms, ASpherePlacedThroughTheMessageQueueShowsInArViewAtItsPixel)
   ASSERT_TRUE(WaitFor(
       [&] {
         pair = next();
-        return pair && Differ(*pair).pixels == 0;
+        return pair && Differ(pair->ar, pair->camera).pixels == 0;
       },
       20))
       << "the sphere stayed in AR_VIEW";
@@ -333,6 +374,14 @@ TEST(Hl2ssHolograms, ASpherePlacedThroughTheMessageQueueShowsInArViewAtItsPixel)
     ASSERT_TRUE(pair);
     EXPECT_EQ(pair->ar.data, pair->camera.data) << "AR_VIEW " << i << " after the removal";
   }
+
+  ASSERT_TRUE(WaitFor(
+      [&] {
+        mirror = pictures.reflective();
+        return mirror && mirror->data == mirror_before->data;
+      },
+      20))
+      << "the sphere stayed over the reflective display's frame";
 
   // 5. Nothing refused on the way: each process's first heartbeat after the removal.
   const auto removed_at = std::chrono::steady_clock::now();
