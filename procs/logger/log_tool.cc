@@ -236,8 +236,10 @@ int RunLogTool(int argc, const char* const* argv, std::ostream& out, std::ostrea
       ->excludes(csv_flag);
   export_cmd->add_option("--urdf", urdf_path,
                          "--mcap: the robot of /scene and /tf (default: the shipped iiwa 7)");
-  export_cmd->add_option("--scene", scene_path,
-                         "--mcap: the scene of /scene (default: the shipped OR; none: no scene)");
+  export_cmd->add_option(
+      "--scene", scene_path,
+      "--mcap: the scene of /scene (default: the run's, from provenance.json beside the log, else "
+      "the shipped OR; none: no scene)");
   export_cmd->add_option("--from-s", from_s, "from this many seconds after the first event")
       ->check(orbed::NonNegativeNumber());
   export_cmd->add_option("--to-s", to_s, "to this many seconds after the first event")

@@ -17,6 +17,7 @@
 #include <orbed/to_json.hpp>
 
 #include "base/format.h"
+#include "base/source_paths.h"
 #include "lcmtypes/bounded_decode.h"
 #include "lcmtypes/contract/channels.h"
 #include "lcmtypes/contract/conversions.h"
@@ -288,6 +289,20 @@ std::map<std::string, std::string> ProvenanceEntries(const std::string& path, st
   return entries;
 }
 
+// The scene the run was launched with (the provenance record's "arguments"."scene", a path in the
+// source tree or absolute), or "" when the record names none or cannot be read.
+std::string SceneOfRun(const std::string& provenance_path) {
+  std::string problem;
+  const std::map<std::string, std::string> entries = ProvenanceEntries(provenance_path, &problem);
+  const auto arguments = entries.find("arguments");
+  if (!problem.empty() || arguments == entries.end()) return "";
+  const json parsed = json::parse(arguments->second, nullptr, false);
+  if (!parsed.is_object() || !parsed.contains("scene") || !parsed["scene"].is_string()) return "";
+  const std::string scene = parsed["scene"].get<std::string>();
+  if (scene.empty() || std::filesystem::path(scene).is_absolute()) return scene;
+  return SourceTreePath(scene);
+}
+
 // Frames records onto a pipe into the node writer (procs/logger/mcap/mcap_writer.mjs says the frame).
 class PipeSink : public RecordSink {
  public:
@@ -352,7 +367,11 @@ class PipeSink : public RecordSink {
 
 McapExportResult WriteMcapRecords(const MappedLog& log, const McapExportOptions& options, RecordSink* sink) {
   const sim::RobotModel model = sim::RobotModel::LoadFlag(options.urdf_path);
-  const std::optional<sim::Scene> scene = sim::LoadSceneFlag(options.scene_path);
+  // The run's own scene when none is given (a study's patients each have theirs).
+  const std::string scene_path = options.scene_path.empty() && !options.provenance_path.empty()
+                                     ? SceneOfRun(options.provenance_path)
+                                     : options.scene_path;
+  const std::optional<sim::Scene> scene = sim::LoadSceneFlag(scene_path);
   return WriteMcapRecords(log.data(), log.size(), options, model, scene ? &*scene : nullptr, sink);
 }
 

@@ -43,12 +43,14 @@
 namespace orbed::logger {
 
 struct McapExportOptions {
-  std::string out_path;               ///< the MCAP file (replaced when the export succeeds)
-  double from_s = 0, to_s = 1e18;     ///< seconds after the log's first event
-  std::regex channels{".*"};          ///< whole LCM channel name must match
-  std::string provenance_path;        ///< "" = none
-  std::string log_name;               ///< for the metadata
-  std::string urdf_path, scene_path;  ///< the Foxglove channels' robot and scene ("" = shipped)
+  std::string out_path;            ///< the MCAP file (replaced when the export succeeds)
+  double from_s = 0, to_s = 1e18;  ///< seconds after the log's first event
+  std::regex channels{".*"};       ///< whole LCM channel name must match
+  std::string provenance_path;     ///< "" = none
+  std::string log_name;            ///< for the metadata
+  /// The Foxglove channels' robot and scene: "" = the shipped robot, and the scene the run was
+  /// launched with (the provenance record's arguments) or else the shipped OR.
+  std::string urdf_path, scene_path;
   double tf_hz = 30.0, scene_period_s = 1.0;
 };
 

@@ -197,10 +197,19 @@ TEST(McapExport, ReadBackByMcapCoreIndexedReader) {
     expect["X_WR"] = PoseJson(RobotState(0, 7).X_WR);
     expect["X_WV"] = PoseJson(reg.X_WV_mean);
   }
+  // The run's scene, named by its provenance record (as scripts/orbed records launch arguments):
+  // /scene draws it, not the shipped OR.
+  const std::string scene_path = (dir / "run_scene.yaml").string();
+  std::ofstream(scene_path)
+      << "name: run_scene\nrobot:\n  base_pose: {position_m: [0.25, -0.55, 0.75], rpy_deg: [0, "
+         "0, 90]}\n  tool_length_m: 0.25\ntrocar:\n  position_m: [0.1, 0.0, 1.0]\n  "
+         "insertion_direction: [0.0, 0.0, -1.0]\nobjects:\n  - name: only_in_this_run\n    shape: box\n"
+         "    size_m: [1.0, 1.0, 0.5]\n    pose: {position_m: [0.0, 0.0, 0.25]}\n";
   const json provenance = {{"format", "orbed.provenance/1"},
                            {"commit", "0123abc"},
                            {"command", {"scripts/orbed", "run"}},
-                           {"started_utc", "2026-12-05T03:00:00Z"}};
+                           {"started_utc", "2026-12-05T03:00:00Z"},
+                           {"arguments", {{"scene", scene_path}}}};
   std::ofstream(dir / "provenance.json") << provenance.dump(2);
 
   std::ostringstream out, err;
@@ -226,6 +235,7 @@ TEST(McapExport, ReadBackByMcapCoreIndexedReader) {
   expect["registration_request_id"] = "9007199254740993";
   expect["X_WH_on_second_tf"] = true;
   expect["provenance"] = provenance;
+  expect["scene_object"] = "only_in_this_run";
   expect["jpeg_path"] = jpeg_path;
   expect["log_times_ns"] = {{"/hmd/camera", std::to_string(kT0 + 8000) + "000"},
                             {"IIWA_STATUS", std::to_string(kT0 + 2000) + "000"}};

@@ -15,7 +15,8 @@
 //     Schema reader takes (an object's "properties" an object, one "type" per property, no arrays of
 //     arrays); every message validates against its schema, but for the nulls above; the Foxglove
 //     channels' messages validate against @foxglove/schemas' own JSON schemas too;
-//   - the provenance record is the metadata "provenance".
+//   - the provenance record is the metadata "provenance", and /scene draws the scene its arguments
+//     name.
 import { test } from "node:test";
 import assert from "node:assert/strict";
 import { open, readFile } from "node:fs/promises";
@@ -150,6 +151,11 @@ test("the exported MCAP file, read back by @mcap/core", async () => {
       const registration = bySequence["/registration"].get(0).value.X_WV_mean.position;
       assert.deepEqual([registration.x, registration.y, registration.z], expected.X_WV.position_m);
       assert.ok(bySequence["/scene"].get(1).value.entities.some((e) => e.id.startsWith("virtual_robot/")));
+    }
+    if (expected.scene_object) {  // the run's own scene (its provenance record's), not the shipped OR
+      const entities = bySequence["/scene"].get(0).value.entities;
+      assert.ok(entities.some((e) => e.id === `scene/${expected.scene_object}`), "the run's scene on /scene");
+      assert.ok(!entities.some((e) => e.id === "scene/floor"), "not the shipped OR's");
     }
     const jpeg = await readFile(expected.jpeg_path);
     const image = bySequence["/hmd/camera"].get(0).value;
