@@ -89,8 +89,8 @@ TEST(Holograms, UnitysPrimitivesAtUnitysSizes) {
   }
   // Plane: 10 m square in x_G z_G facing +y_G; quad: 1 m square in x_G y_G facing +z_G.
   for (const auto& [kind, half, normal_G] :
-       {std::tuple{HS::KIND_PLANE, 5.0, Eigen::Vector3d::UnitY().eval()},
-        std::tuple{HS::KIND_QUAD, 0.5, Eigen::Vector3d::UnitZ().eval()}}) {
+       {std::tuple{int8_t{HS::KIND_PLANE}, 5.0, Eigen::Vector3d::UnitY().eval()},
+        std::tuple{int8_t{HS::KIND_QUAD}, 0.5, Eigen::Vector3d::UnitZ().eval()}}) {
     render::Mesh mesh;
     TessellateHolograms(One(kind, X_WG, {1, 1, 1}), {}, &mesh);
     ASSERT_EQ(mesh.triangles.size(), 2u);
