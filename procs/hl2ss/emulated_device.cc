@@ -1,5 +1,7 @@
 #include "procs/hl2ss/emulated_device.h"
 
+#include "procs/hl2ss/frames.h"
+
 namespace orbed::hl2ss {
 
 RcOutcome EmulatedDevice::HandleRc(const RcCommand& c, int64_t now_us) {
@@ -18,13 +20,34 @@ RcOutcome EmulatedDevice::HandleRc(const RcCommand& c, int64_t now_us) {
       PutU64(&out.reply, c.u[0] == 0 ? time_base_.TicksOf(now_us) : TimeBase::FiletimeOf(now_us));
       break;
     case RcCommandId::kRmGetRigNodeWorldPoses:
-      out.reply.assign(static_cast<size_t>(c.u[0]) * kPoseBytes, 0);
+      out.reply.reserve(c.q.size() * kPoseBytes);
+      for (uint64_t ticks : c.q) {
+        const std::optional<Eigen::Isometry3d> X_WH = history_.Find(time_base_.UtimeOf(ticks));
+        const std::array<float, 16> pose =
+            X_WH ? PoseMatrixRowMajor(RigNodePoseForClient(*X_WH, depth_camera_)) : std::array<float, 16>{};
+        for (float v : pose) PutF32(&out.reply, v);
+      }
       break;
-    case RcCommandId::kRmMapCameraPoints:
-      out.refused = true;
-      out.key = "rc/map_points";
-      out.reason = "mapping research-mode camera points is not emulated";
+    case RcCommandId::kRmMapCameraPoints: {
+      if (c.u[0] != static_cast<uint32_t>(kPortRmDepthLongThrow)) {
+        out.refused = true;
+        out.key = "rc/map_points_sensor";
+        out.reason = "mapping points of the research-mode camera on port " + std::to_string(c.u[0]) +
+                     ": only the long-throw depth camera (" + std::to_string(kPortRmDepthLongThrow) +
+                     ") is emulated";
+        break;
+      }
+      const geometry::Intrinsics& K = depth_camera_.intrinsics;
+      out.reply.reserve(c.f.size() * 4);
+      for (size_t i = 0; i + 1 < c.f.size(); i += 2) {
+        const Eigen::Vector2d in(c.f[i], c.f[i + 1]);
+        const Eigen::Vector2d mapped =
+            c.u[1] == 0 ? LongThrowImagePointToUnitPlane(K, in) : LongThrowUnitPlaneToImagePoint(K, in);
+        PutF32(&out.reply, static_cast<float>(mapped.x()));
+        PutF32(&out.reply, static_cast<float>(mapped.y()));
+      }
       break;
+    }
     case RcCommandId::kSetMarkerState:
       marker_ = c.u[0] != 0;
       break;

@@ -64,7 +64,7 @@ Hl2ssProcess::Hl2ssProcess(const CommonFlags& flags, const Hl2ssOptions& options
     : process_(flags),
       options_(options),
       server_(options.server),
-      device_(TimeBase{NowMicros()}, options.app_version),
+      device_(TimeBase{NowMicros()}, options.app_version, options.rm_depth.camera),
       unity_scene_(options.unity_limits),
       depth_(std::make_unique<DepthStream>(options.rm_depth, device_.time_base())) {
   handlers_.on_configured = [this](int client, PortKind port, const StreamConfig& config) {
@@ -150,6 +150,7 @@ void Hl2ssProcess::OnPose(const orbed::hmd_pose_t& msg, const std::string& chann
   if (!problem.empty()) return process_.Reject(channel + "/field", problem);
   pose_ = msg;
   pose_received_us_ = MonotonicMicros();
+  device_.RecordPose(msg.utime, FromPose(msg.X_WH), msg.tracking_state != orbed::hmd_pose_t::LOST);
   depth_->OnEstimate(FromPose(msg.X_WH), msg.utime);
 }
 

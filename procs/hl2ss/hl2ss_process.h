@@ -5,8 +5,9 @@
 /// (docs/hl2ss.md). One TCP port per stream (hl2ss_server.h; loopback by default):
 ///
 ///   RC  3809  remote configuration (emulated_device.h): application version, UTC offset, PV
-///             subsystem status, current time, the PV settings; rig-node poses answered "not
-///             located"; mapping camera points refused
+///             subsystem status, current time, the PV settings; rig-node world poses at the
+///             client's timestamps from the last 10 s of HMD_POSE (the depth camera's rig node);
+///             the long-throw camera's points mapped (other sensors refused)
 ///   PV  3810  the front camera (pv_stream.h, pv_encoder.h): each HMD_CAMERA (JPEG, 30 Hz) decoded
 ///             once, then encoded for each client at its size (the device's video sizes, 15 or
 ///             30 fps, divisor) and profile (RAW NV12, H.264 base/main/high, H.265 main) with its

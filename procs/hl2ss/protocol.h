@@ -54,6 +54,8 @@ struct TimeBase {
   }
   /// What TS_GET_UTC_OFFSET answers: FILETIME(UTC) − ticks, constant for this emulator.
   uint64_t UtcOffset() const { return kFiletimeOfUnixEpoch + static_cast<uint64_t>(qpc_origin_us) * 10; }
+  /// The utime [µs since the Unix epoch] of a tick count: the inverse of TicksOf (to the µs below).
+  int64_t UtimeOf(uint64_t ticks) const { return qpc_origin_us + static_cast<int64_t>(ticks / 10); }
   /// The FILETIME of `utime_us` (TS_GET_CURRENT_TIME with source UTC).
   static uint64_t FiletimeOf(int64_t utime_us) {
     return kFiletimeOfUnixEpoch + static_cast<uint64_t>(utime_us) * 10;

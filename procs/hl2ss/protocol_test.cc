@@ -1,11 +1,9 @@
 // The hl2ss protocol parsers and framing against bytes computed by hand from hl2ss.py's struct
-// formats (little-endian; e.g. rx_pv's '<BHHBBBBI' + '<B' + '<QQ' per option), and the emulated
-// device's remote-configuration answers.
+// formats (little-endian; e.g. rx_pv's '<BHHBBBBI' + '<B' + '<QQ' per option). The emulated
+// device's remote-configuration answers: emulated_device_test.cc.
 #include "procs/hl2ss/protocol.h"
 
 #include <gtest/gtest.h>
-
-#include "procs/hl2ss/emulated_device.h"
 
 namespace orbed::hl2ss {
 namespace {
@@ -248,49 +246,6 @@ TEST(RcCommand, UnknownOutOfRangeAndHugeCountsAreRefusedBeforeTheirBytes) {
   EXPECT_EQ(key("19"
                 "0000000000000080"),
             "rc/si_sampling_delay");  // INT64_MIN
-}
-
-TEST(EmulatedDevice, AnswersWhatTheClientWaitsFor) {
-  EmulatedDevice device(TimeBase{1'700'000'000'000'000}, {1, 2, 3, 4});
-  const auto answer = [&](const std::string& hex, int64_t now_us = 0) {
-    const std::vector<uint8_t> b = Hex(hex);
-    const Parsed<RcCommand> p = ParseRcCommand(b.data(), b.size());
-    EXPECT_EQ(p.status, ParseStatus::kDone) << hex;
-    return device.HandleRc(p.value, now_us);
-  };
-  EXPECT_EQ(answer("00").reply, Hex("0100"
-                                    "0200"
-                                    "0300"
-                                    "0400"));
-  EXPECT_EQ(GetU64(answer("01").reply.data()), 133'444'736'000'000'000ULL);
-  EXPECT_EQ(answer("03").reply, Hex("00"));
-  device.OpenPv(MrcVideoOptions{});
-  EXPECT_EQ(answer("03").reply, Hex("01"));
-  EXPECT_EQ(GetU64(answer("18"
-                          "00000000",
-                          1'700'000'002'000'000)
-                       .reply.data()),
-            20'000'000u);
-  EXPECT_EQ(GetU64(answer("18"
-                          "01000000",
-                          0)
-                       .reply.data()),
-            kFiletimeOfUnixEpoch);
-  EXPECT_EQ(answer("17"
-                   "03000000"
-                   "010000000000000002000000000000000300000000000000")
-                .reply,
-            std::vector<uint8_t>(3 * 64, 0));
-  EXPECT_TRUE(answer("08"
-                     "00000000"
-                     "e8030000")
-                  .reply.empty());
-  EXPECT_EQ(device.pv_settings().exposure, (std::array<uint32_t, 2>{0, 1000}));
-  EXPECT_TRUE(answer("16"
-                     "dd0e0000"
-                     "00000000"
-                     "00000000")
-                  .refused);
 }
 
 }  // namespace

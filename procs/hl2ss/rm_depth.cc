@@ -22,16 +22,6 @@ void PutF32(std::uint8_t* p, float f) {
   for (int i = 0; i < 4; ++i) p[i] = static_cast<std::uint8_t>(v >> (8 * i));
 }
 
-// The emulated sensor's own mapping functions, in its API's pixel convention (integer image
-// coordinates at pixel corners), as the server's calibration code calls them.
-Eigen::Vector2d MapImagePointToCameraUnitPlane(const geometry::Intrinsics& K, double u_corner,
-                                               double v_corner) {
-  return {(u_corner - 0.5 - K.cx_px) / K.fx_px, (v_corner - 0.5 - K.cy_px) / K.fy_px};
-}
-Eigen::Vector2d MapCameraSpaceToImagePoint(const geometry::Intrinsics& K, double x, double y) {
-  return {K.fx_px * x + K.cx_px + 0.5, K.fy_px * y + K.cy_px + 0.5};
-}
-
 }  // namespace
 
 geometry::Intrinsics LongThrowIntrinsics() {
@@ -43,6 +33,15 @@ geometry::Intrinsics LongThrowIntrinsics() {
   K.cx_px = 0.5 * (kLongThrowWidth - 1);
   K.cy_px = 0.5 * (kLongThrowHeight - 1);
   return K;
+}
+
+Eigen::Vector2d LongThrowImagePointToUnitPlane(const geometry::Intrinsics& K,
+                                               const Eigen::Vector2d& uv_corner) {
+  return {(uv_corner.x() - 0.5 - K.cx_px) / K.fx_px, (uv_corner.y() - 0.5 - K.cy_px) / K.fy_px};
+}
+
+Eigen::Vector2d LongThrowUnitPlaneToImagePoint(const geometry::Intrinsics& K, const Eigen::Vector2d& xy) {
+  return {K.fx_px * xy.x() + K.cx_px + 0.5, K.fy_px * xy.y() + K.cy_px + 0.5};
 }
 
 Eigen::Isometry3d LongThrowOptions::DefaultX_HZ() {
@@ -131,7 +130,7 @@ std::vector<std::uint8_t> PackLongThrowCalibration(const LongThrowOptions& optio
   float min_y = min_x, max_y = -min_x;
   for (int v = 0; v < H; ++v) {
     for (int u = 0; u < W; ++u) {
-      const Eigen::Vector2d xy = MapImagePointToCameraUnitPlane(K, u + 0.5, v + 0.5);
+      const Eigen::Vector2d xy = LongThrowImagePointToUnitPlane(K, {u + 0.5, v + 0.5});
       const float x = static_cast<float>(xy.x()), y = static_cast<float>(xy.y());
       uv2x[v * W + u] = x;
       uv2y[v * W + u] = y;
@@ -145,7 +144,7 @@ std::vector<std::uint8_t> PackLongThrowCalibration(const LongThrowOptions& optio
   const float step_x = (max_x - min_x) / span_u, step_y = (max_y - min_y) / span_v;
   for (int v = 0; v < H; ++v) {
     for (int u = 0; u < W; ++u) {
-      const Eigen::Vector2d uv = MapCameraSpaceToImagePoint(K, step_x * u + min_x, step_y * v + min_y);
+      const Eigen::Vector2d uv = LongThrowUnitPlaneToImagePoint(K, {step_x * u + min_x, step_y * v + min_y});
       mapx[v * W + u] = static_cast<float>(uv.x());
       mapy[v * W + u] = static_cast<float>(uv.y());
     }

@@ -63,6 +63,14 @@ inline constexpr float kLongThrowScale = 1000.0f;  ///< depth units per metre (m
 /// The emulated sensor's pinhole (see the file comment).
 geometry::Intrinsics LongThrowIntrinsics();
 
+/// The sensor's own mapping functions, in its API's pixel convention (integer image coordinates at
+/// pixel corners, so pixel (u, v)'s centre is (u + ½, v + ½)), for a camera with intrinsics K
+/// (pixel centres at integers): an image point to the unit plane z = 1 of Z, and back. The mode-2
+/// uv2xy table and undistort map, and RC's map-camera-points answers, all come from these two.
+Eigen::Vector2d LongThrowImagePointToUnitPlane(const geometry::Intrinsics& K,
+                                               const Eigen::Vector2d& uv_corner);
+Eigen::Vector2d LongThrowUnitPlaneToImagePoint(const geometry::Intrinsics& K, const Eigen::Vector2d& xy);
+
 struct LongThrowOptions {
   geometry::Intrinsics intrinsics{LongThrowIntrinsics()};
   Eigen::Isometry3d X_HZ{DefaultX_HZ()};  ///< the depth camera on the head
