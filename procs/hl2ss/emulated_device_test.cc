@@ -87,14 +87,15 @@ TEST(EmulatedDevice, RigNodeWorldPosesFromThePoseHistory) {
   device.RecordPose(kOrigin + 1'016'667, X_WH2, true);
   device.RecordPose(kOrigin + 1'033'334, X_WH2, false);  // tracking lost
 
-  std::vector<uint8_t> command = Hex("17"
-                                     "06000000");
-  for (uint64_t ticks : {10'000'000ULL,    // that sample's utime exactly
-                         10'080'000ULL,    // 8 ms after it, 8.667 ms before the next: the first
-                         10'100'000ULL,    // 10 ms after it: the second is nearer
-                         10'333'340ULL,    // the lost sample: not located
-                         20'000'000ULL,    // 0.97 s after the newest: none within a period
-                         0ULL})            // before the history
+  std::vector<uint8_t> command =
+      Hex("17"
+          "06000000");
+  for (uint64_t ticks : {10'000'000ULL,  // that sample's utime exactly
+                         10'080'000ULL,  // 8 ms after it, 8.667 ms before the next: the first
+                         10'100'000ULL,  // 10 ms after it: the second is nearer
+                         10'333'340ULL,  // the lost sample: not located
+                         20'000'000ULL,  // 0.97 s after the newest: none within a period
+                         0ULL})          // before the history
     PutU64(&command, ticks);
   const std::vector<float> f = Floats(Answer(&device, command).reply);
   ASSERT_EQ(f.size(), 6u * 16u);
@@ -112,8 +113,9 @@ TEST(EmulatedDevice, TheRigNodeIsTheDepthCamerasConfiguredOne) {
   options.X_HN = Eigen::Isometry3d::Identity();  // a rig node on the head frame itself
   EmulatedDevice device(TimeBase{kOrigin}, {1, 0, 0, 0}, options);
   device.RecordPose(kOrigin, Eigen::Isometry3d::Identity(), true);
-  std::vector<uint8_t> command = Hex("17"
-                                     "01000000");
+  std::vector<uint8_t> command =
+      Hex("17"
+          "01000000");
   PutU64(&command, 0);
   // X_DN = X_WD⁻¹ = R_DW, whose columns (1 0 0), (0 0 −1), (0 1 0) are the rows sent.
   EXPECT_EQ(Floats(Answer(&device, command).reply),
@@ -129,10 +131,11 @@ TEST(EmulatedDevice, MapsLongThrowPointsAsItsUv2xyTable) {
 
   // Image to unit plane: pixel (u, v)'s centre is (u + ½, v + ½) in the sensor's convention, and
   // the image centre (160, 144) the principal ray.
-  std::vector<uint8_t> command = Hex("16"
-                                     "dd0e0000"   // port 3805
-                                     "00000000"   // ImagePointToCameraUnitPlane
-                                     "02000000");  // 2 points
+  std::vector<uint8_t> command =
+      Hex("16"
+          "dd0e0000"    // port 3805
+          "00000000"    // ImagePointToCameraUnitPlane
+          "02000000");  // 2 points
   for (float c : {u + 0.5f, v + 0.5f, 160.0f, 144.0f}) PutF32(&command, c);
   const std::vector<float> xy = Floats(Answer(&device, command).reply);
   ASSERT_EQ(xy.size(), 4u);
@@ -146,10 +149,11 @@ TEST(EmulatedDevice, MapsLongThrowPointsAsItsUv2xyTable) {
   EXPECT_NEAR(xy[1], (203 - 143.5) / fx, 1e-6);
 
   // And back: the unit-plane point to the image point it came from.
-  command = Hex("16"
-                "dd0e0000"
-                "01000000"  // CameraSpaceToImagePoint
-                "01000000");
+  command =
+      Hex("16"
+          "dd0e0000"
+          "01000000"  // CameraSpaceToImagePoint
+          "01000000");
   PutF32(&command, xy[0]);
   PutF32(&command, xy[1]);
   const std::vector<float> uv = Floats(Answer(&device, command).reply);

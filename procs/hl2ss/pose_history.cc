@@ -26,8 +26,8 @@ std::optional<Eigen::Isometry3d> PoseHistory::Find(int64_t utime) const {
   const auto after = std::lower_bound(samples_.begin(), samples_.end(), utime,
                                       [](const PoseSample& s, int64_t t) { return s.utime < t; });
   auto nearest = after;
-  if (after == samples_.end() ||
-      (after != samples_.begin() && Distance(utime, std::prev(after)->utime) <= Distance(after->utime, utime)))
+  if (after == samples_.end() || (after != samples_.begin() &&
+                                  Distance(utime, std::prev(after)->utime) <= Distance(after->utime, utime)))
     nearest = std::prev(after);
   if (Distance(nearest->utime, utime) > static_cast<uint64_t>(match_window_us_) || !nearest->located)
     return std::nullopt;

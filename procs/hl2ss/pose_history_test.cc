@@ -23,8 +23,8 @@ TEST(PoseHistory, ExactOrNearestWithinTheWindow) {
   EXPECT_EQ(XOf(h.Find(1499)), 2);
   EXPECT_EQ(XOf(h.Find(1500)), 2);  // halfway: the earlier
   EXPECT_EQ(XOf(h.Find(1501)), 3);
-  EXPECT_EQ(XOf(h.Find(900)), 0);   // 100 before the oldest: inside the window
-  EXPECT_FALSE(h.Find(899));        // 101 before
+  EXPECT_EQ(XOf(h.Find(900)), 0);  // 100 before the oldest: inside the window
+  EXPECT_FALSE(h.Find(899));       // 101 before
   EXPECT_EQ(XOf(h.Find(1900)), 4);
   EXPECT_FALSE(h.Find(1901));
   EXPECT_FALSE(h.Find(INT64_MIN));

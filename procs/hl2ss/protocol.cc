@@ -76,29 +76,45 @@ std::vector<uint8_t> PackPacket(uint64_t timestamp, const std::vector<uint8_t>& 
 }
 
 // ---------------------------------------------------------------------------------------------
-const std::vector<PvFormatSize>& PvVideoSizes() {
-  static const std::vector<PvFormatSize> kSizes = {{2272, 1278}, {1952, 1100}, {1920, 1080}, {1504, 846},
-                                                   {1280, 720},  {1128, 636},  {960, 540},   {896, 504},
-                                                   {760, 428},   {640, 360},   {500, 282},   {424, 240}};
-  return kSizes;
+const std::vector<PvVideoMode>& PvVideoModes() {
+  static const std::vector<PvVideoMode> kModes = [] {
+    std::vector<PvVideoMode> m;
+    for (const auto& [w, h] : std::vector<std::pair<int, int>>{{2272, 1278},
+                                                               {1952, 1100},
+                                                               {1920, 1080},
+                                                               {1280, 720},
+                                                               {1128, 636},
+                                                               {960, 540},
+                                                               {896, 504},
+                                                               {760, 428},
+                                                               {640, 360},
+                                                               {500, 282},
+                                                               {424, 240}})
+      for (int hz : {15, 30}) m.push_back({w, h, hz});
+    for (int hz : {5, 15, 30}) m.push_back({1504, 846, hz});
+    return m;
+  }();
+  return kModes;
 }
 
 namespace {
 
-// The video format (u16 width, u16 height, u8 framerate) at p; "" or why it is refused.
+// "" or why the video format is refused (and *key its class).
 std::string CheckVideoFormat(uint16_t width, uint16_t height, uint8_t framerate, std::string* key) {
-  bool known = false;
-  for (const PvFormatSize& s : PvVideoSizes()) known = known || (s.width == width && s.height == height);
-  if (!known) {
+  bool size_known = false;
+  for (const PvVideoMode& m : PvVideoModes()) {
+    if (m.width != width || m.height != height) continue;
+    if (m.framerate == framerate) return "";
+    size_known = true;
+  }
+  if (!size_known) {
     *key = "pv/size";
     return "video size " + std::to_string(width) + "x" + std::to_string(height) +
            " is not one the camera offers";
   }
-  if (framerate != 15 && framerate != 30) {
-    *key = "pv/framerate";
-    return "framerate " + std::to_string(framerate) + " (the camera offers 15 and 30)";
-  }
-  return "";
+  *key = "pv/framerate";
+  return "framerate " + std::to_string(framerate) + " at " + std::to_string(width) + "x" +
+         std::to_string(height) + " is not a mode the emulated camera serves (protocol.h PvVideoModes)";
 }
 
 bool KnownLevel(uint8_t level) {

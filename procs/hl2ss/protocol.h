@@ -109,13 +109,17 @@ inline constexpr uint8_t kLevelDefault = 0xFF;
 /// The encoder options a client may send (u8 count of u64 key/value pairs).
 inline constexpr int kMaxEncoderOptions = 255;
 
-/// The PV video formats the device offers (Microsoft's locatable-camera table for HoloLens 2)
-/// that this emulator serves, each at 15 or 30 frames per second (the emulated camera runs at
-/// 30 Hz, so 60 is refused).
-struct PvFormatSize {
-  int width, height;
+/// The PV video modes served: the HoloLens 2 PV camera's own (Microsoft's locatable-camera table)
+/// at the rates the emulated camera, which runs at kPvCameraHz, can deliver (those dividing it):
+/// 2272×1278, 1952×1100, 1920×1080, 1280×720, 1128×636, 960×540, 896×504, 760×428, 640×360,
+/// 500×282 and 424×240 at 15 and 30 Hz; 1504×846 at 5, 15 and 30 Hz. The device's 60 Hz modes
+/// (1952×1100, 1504×846) are refused. The one list of PV modes: the parser checks a client's
+/// against it, and pv_encoder.h SupportedPvFormats is made from it.
+struct PvVideoMode {
+  int width, height, framerate;
 };
-const std::vector<PvFormatSize>& PvVideoSizes();
+inline constexpr int kPvCameraHz = 30;
+const std::vector<PvVideoMode>& PvVideoModes();
 
 /// Mixed-reality-capture options sent with the START bit (hl2ss.py _create_configuration_for_mrc_video,
 /// '<BBBBBBBfffII').

@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "procs/hl2ss/frames.h"
+#include "procs/hl2ss/protocol.h"
 
 extern "C" {
 #include <libavcodec/avcodec.h>
@@ -74,21 +75,7 @@ std::optional<VideoProfile> VideoProfileFromByte(std::uint8_t byte) {
 const std::vector<PvFormat>& SupportedPvFormats() {
   static const std::vector<PvFormat> formats = [] {
     std::vector<PvFormat> f;
-    for (const auto& [w, h] : std::vector<std::pair<int, int>>{{2272, 1278},
-                                                               {1920, 1080},
-                                                               {1280, 720},
-                                                               {1128, 636},
-                                                               {960, 540},
-                                                               {896, 504},
-                                                               {760, 428},
-                                                               {640, 360},
-                                                               {500, 282},
-                                                               {424, 240}}) {
-      f.push_back({w, h, 15});
-      f.push_back({w, h, 30});
-    }
-    for (int hz : {15, 30, 60}) f.push_back({1952, 1100, hz});
-    for (int hz : {5, 15, 30, 60}) f.push_back({1504, 846, hz});
+    for (const PvVideoMode& m : PvVideoModes()) f.push_back({m.width, m.height, m.framerate});
     return f;
   }();
   return formats;
@@ -108,10 +95,17 @@ std::optional<std::string> CheckPvFormat(const PvFormat& format) {
     why << "PV " << format.width_px << "x" << format.height_px << " runs at " << rates.str() << " Hz, not "
         << format.framerate_hz;
   } else {
-    why << "PV size " << format.width_px << "x" << format.height_px
-        << " is not a video mode of the device (2272x1278, 1952x1100, 1920x1080, 1504x846, 1280x720, "
-           "1128x636, "
-           "960x540, 896x504, 760x428, 640x360, 500x282, 424x240)";
+    why << "PV size " << format.width_px << "x" << format.height_px << " is not a video mode of the device (";
+    const char* separator = "";
+    for (size_t i = 0; i < SupportedPvFormats().size(); ++i) {
+      const PvFormat& f = SupportedPvFormats()[i];
+      if (i > 0 && f.width_px == SupportedPvFormats()[i - 1].width_px &&
+          f.height_px == SupportedPvFormats()[i - 1].height_px)
+        continue;
+      why << separator << f.width_px << "x" << f.height_px;
+      separator = ", ";
+    }
+    why << ")";
   }
   return why.str();
 }

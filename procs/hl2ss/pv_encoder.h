@@ -70,10 +70,9 @@ struct PvFormat {
   int framerate_hz{30};
 };
 
-/// The modes accepted: the HoloLens 2 PV camera's video modes (Microsoft's locatable-camera table;
-/// the client's raw stride is (width + 63) & ~63 for every one): 2272×1278, 1920×1080, 1280×720,
-/// 1128×636, 960×540, 896×504, 760×428, 640×360, 500×282 and 424×240 at 15 and 30 Hz; 1952×1100
-/// at 15, 30, 60 Hz; 1504×846 at 5, 15, 30, 60 Hz. The same sizes as protocol.h PvVideoSizes.
+/// The modes accepted: protocol.h PvVideoModes (the device's modes the 30 Hz emulated camera can
+/// serve), the one list the client's configuration is parsed against too. The client's raw stride
+/// is (width + 63) & ~63 for every one.
 const std::vector<PvFormat>& SupportedPvFormats();
 
 /// nullopt when `format` is a supported mode, else why not (names the accepted sizes or rates).

@@ -16,8 +16,8 @@
 ///     µs → ×10 ticks of 100 ns, as the device server's TimeSpan(10 × value)), ISO speed when manual (mode
 ///     0), white balance when a value was set (units of 25 K); every other field, and those not set,
 ///     pv_encoder.h's documented PvCaptureMetadata defaults.
-///   - PvPacer: which 30 Hz camera frames a client gets (15 fps: every second one; then every
-///     divisor-th of those).
+///   - PvPacer: which 30 Hz camera frames a client gets (a mode's rate divides 30, protocol.h
+///     PvVideoModes: 15 fps every second one, 5 fps every sixth; then every divisor-th of those).
 ///   - PvCalibrationFor: the mode-2 answer: pv_encoder.h PackPvCalibration with K the camera's
 ///     (HMD_CAMERA's) scaled to the requested size and X_NC = X_HN⁻¹ · X_HC, X_HC = X_WH⁻¹ · X_WC
 ///     from one HMD_POSE (the estimate), N the rig node of rm_depth.h (LongThrowOptions::X_HN).
@@ -61,12 +61,15 @@ std::optional<PvEncoderConfig> PvEncoderConfigFromClient(const PvConfig& client,
 /// The trailer's capture fields from the RC settings (see the file comment).
 PvCaptureMetadata PvCaptureMetadataFromSettings(const PvSettings& settings);
 
-/// Which HMD_CAMERA frames (30 Hz) a PV client gets: at 15 fps every second one, then every
-/// divisor-th of those. Call once per camera frame; true = send this one.
+/// Which HMD_CAMERA frames (kPvCameraHz) a PV client gets: every (30 / framerate)-th, then every
+/// divisor-th of those. Call once per camera frame; true = send this one. A framerate that does
+/// not divide 30 (never parsed) counts as 30.
 class PvPacer {
  public:
   explicit PvPacer(const PvConfig& config)
-      : skip_(config.framerate == 15 ? 2 : 1), divisor_(config.divisor) {}
+      : skip_(config.framerate > 0 && kPvCameraHz % config.framerate == 0 ? kPvCameraHz / config.framerate
+                                                                          : 1),
+        divisor_(config.divisor < 1 ? 1 : config.divisor) {}
   bool Next() {
     const bool camera_due = (count_++ % skip_) == 0;
     if (!camera_due) return false;

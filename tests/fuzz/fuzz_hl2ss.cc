@@ -32,9 +32,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       const PvConfig& c = p.value;
       if (c.mode == kMode3) break;
       bool known = false;
-      for (const PvFormatSize& s : PvVideoSizes())
-        known = known || (s.width == c.width && s.height == c.height);
-      Check(known && (c.framerate == 15 || c.framerate == 30));
+      for (const PvVideoMode& m : PvVideoModes())
+        known = known || (m.width == c.width && m.height == c.height && m.framerate == c.framerate);
+      Check(known);
       if (c.mode != kMode2) Check(c.divisor >= 1 && c.bitrate > 0 && c.options.size() <= kMaxEncoderOptions);
       break;
     }
