@@ -214,12 +214,19 @@ void Hl2ssProcess::OnCamera(const orbed::image_t& msg, const std::string& channe
 
 void Hl2ssProcess::SendEncodedPv() {
   for (PvResult& r : pv_hand_back_.TakeAll()) {
-    if (!pv_clients_.count(r.client)) continue;  // left while this was queued
+    const auto it = pv_clients_.find(r.client);
+    if (it == pv_clients_.end()) continue;  // left while this was queued
     if (!r.error.empty()) {
       process_.CountDrop("pv/encode_failed");
       process_.SetLastError("pv encoder: " + r.error);
       continue;
     }
+    // After a lost packet, pictures encoded before the key frame asked for cannot be decoded.
+    if (it->second.awaiting_key_frame && !r.key_frame) {
+      process_.CountDrop("pv/before_key_frame");
+      continue;
+    }
+    it->second.awaiting_key_frame = false;
     server_.Send(r.client, PackPacket(r.timestamp, r.payload, r.pose ? &*r.pose : nullptr),
                  handlers_.on_event);
   }
@@ -302,12 +309,13 @@ Decision Hl2ssProcess::OnConfigured(int client, PortKind port, const StreamConfi
   std::shared_ptr<PvEncoder> encoder = PvEncoder::Create(*encoder_config, &error);
   if (!encoder) return refuse("pv/encoder", error);
   PvEncodeFn encode = [encoder](const PvJob& job, std::vector<uint8_t>* payload, std::string* why) {
+    if (job.key_frame) encoder->ForceKeyFrame();
     return encoder->Encode(job.bgr, job.K, job.metadata, payload, why);
   };
   RemovePvClient(client);
   pv_clients_.emplace(client,
                       PvClient{std::make_unique<PvEncoderWorker>(client, std::move(encode), &pv_hand_back_),
-                               PvPacer(c), c.mode == kMode1, c.stop});
+                               PvPacer(c), c.mode == kMode1, c.stop, c.profile != kProfileRaw});
   return d;
 }
 
@@ -336,9 +344,17 @@ void Hl2ssProcess::OnEvent(const ServerEvent& event) {
     case ServerEvent::kRefused:
       process_.Reject(event.key, event.peer + ": " + event.detail);
       break;
-    case ServerEvent::kDropped:
+    case ServerEvent::kDropped: {
       process_.CountDrop(event.key);
+      // A video client that lost a packet decodes nothing more until an IDR: ask its encoder for
+      // one, and send it nothing before.
+      const auto it = pv_clients_.find(event.client);
+      if (event.port == PortKind::kPv && it != pv_clients_.end() && it->second.video) {
+        it->second.worker->RequestKeyFrame();
+        it->second.awaiting_key_frame = true;
+      }
       break;
+    }
     case ServerEvent::kStalled:
       process_.CountDrop(event.key);
       ORBED_LOG(kWarn) << "hl2ss: " << who << " dropped: " << event.detail;

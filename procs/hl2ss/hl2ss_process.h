@@ -16,7 +16,10 @@
 ///             (the SLAM estimate) in D. Encoding runs on one thread per client (pv_worker.h):
 ///             the newest picture wins, one still waiting when the next arrives is dropped
 ///             ("pv/encoder_busy"); payloads come back through a queue drained by the poll, so
-///             only this thread sends. Mode 2 answers the calibration: the latest HMD_CAMERA's
+///             only this thread sends. When an H.264/H.265 packet finds the client's queue full
+///             ("pv/backlog"), its worker is asked for a key frame and the pictures encoded before
+///             it are not sent ("pv/before_key_frame"): the client's next picture is an IDR, the
+///             first it can decode after the loss. Mode 2 answers the calibration: the latest HMD_CAMERA's
 ///             intrinsics at the requested size and the camera on the rig node N from the latest
 ///             HMD_POSE (refused "pv/no_camera", "pv/no_pose" until they arrived). The subsystem
 ///             must be opened first (the START bit), as on the device.
@@ -120,7 +123,9 @@ class Hl2ssProcess {
     std::unique_ptr<PvEncoderWorker> worker;
     PvPacer pacer;
     bool mode1{true};
-    bool stop_after{false};  // the STOP bit: close the subsystem when this client leaves
+    bool stop_after{false};          // the STOP bit: close the subsystem when this client leaves
+    bool video{false};               // H.264 / H.265 (not raw): a lost packet needs a key frame
+    bool awaiting_key_frame{false};  // a packet was dropped: send nothing until the key frame asked for
   };
   PvHandBack pv_hand_back_;  // before pv_clients_: outlives the workers that push into it
   std::map<int, PvClient> pv_clients_;

@@ -261,13 +261,16 @@ std::unique_ptr<PvEncoder> PvEncoder::Create(const PvEncoderConfig& config, std:
   ctx->colorspace = AVCOL_SPC_SMPTE170M;
   av_opt_set(ctx->priv_data, "preset", "ultrafast", 0);
   av_opt_set(ctx->priv_data, "tune", "zerolatency", 0);
+  av_opt_set(ctx->priv_data, "forced-idr", "1", 0);  // a picture asked to be I is an IDR (ForceKeyFrame)
   if (hevc) {
     ctx->profile = FF_PROFILE_HEVC_MAIN;
     // One frame in flight (frame-threads=1: each picture's unit comes back at once); the threads
     // work within the picture (wavefront rows). SAO back on (the fastest preset turns it off):
-    // libx265 3.5 leaks its filter's buffers, ~115 kB an encoder, when SAO is off.
-    const std::string params = "log-level=error:repeat-headers=1:aud=0:sao=1:frame-threads=1:pools=" +
-                               std::to_string(config.threads);
+    // libx265 3.5 leaks its filter's buffers, ~115 kB an encoder, when SAO is off. Closed GOPs:
+    // each key frame (the GOP's, a forced one) an IDR, not a CRA.
+    const std::string params =
+        "log-level=error:repeat-headers=1:aud=0:sao=1:open-gop=0:frame-threads=1:pools=" +
+        std::to_string(config.threads);
     av_opt_set(ctx->priv_data, "x265-params", params.c_str(), 0);
   } else {
     // x264 signals the lowest profile its tools fit, and the ultrafast preset's fit baseline: the
@@ -357,8 +360,10 @@ bool PvEncoder::EncodeVideo(const cv::Mat& bgr, std::vector<std::uint8_t>* paylo
     }
   }
   frame->pts = frames_;
-  // The first picture of a connection is an IDR with the parameter sets; later ones follow the GOP.
-  frame->pict_type = frames_ == 0 ? AV_PICTURE_TYPE_I : AV_PICTURE_TYPE_NONE;
+  // The first picture of a connection is an IDR with the parameter sets, and so is one forced
+  // (ForceKeyFrame); the others follow the GOP.
+  frame->pict_type = frames_ == 0 || key_frame_next_ ? AV_PICTURE_TYPE_I : AV_PICTURE_TYPE_NONE;
+  key_frame_next_ = false;
   int sent = avcodec_send_frame(ctx, frame);
   if (sent < 0) {
     *error = "encoder refused the picture: " + AvError(sent);

@@ -24,6 +24,9 @@
 /// the parameter sets (SPS and PPS, and the VPS for H.265) in band; every later IDR, one per GOP
 /// (the client's CODECAPI_AVEncMPVGOPSize, default = the frame rate: one a second), carries them
 /// again. No B-frames: each call returns the access unit of the picture it was given.
+/// ForceKeyFrame makes the next picture an IDR (with its parameter sets) whatever the GOP, for a
+/// client that lost a packet: H.264 and H.265 cannot be decoded past a lost picture until the next
+/// IDR; the GOP counts on from it.
 ///
 /// Profiles: the client's VideoProfile byte: 0 H.264 baseline, 1 main, 2 high, 3 H.265 main (the
 /// client's default), 255 raw. The level byte and the other encoder options are not honoured
@@ -152,6 +155,10 @@ class PvEncoder {
   bool Encode(const cv::Mat& bgr, const geometry::Intrinsics& K_picture, const PvCaptureMetadata& metadata,
               std::vector<std::uint8_t>* payload, std::string* error);
 
+  /// The next picture encoded is an IDR carrying the parameter sets (see the file comment). No
+  /// effect for raw, whose pictures are all independent.
+  void ForceKeyFrame() { key_frame_next_ = true; }
+
   const PvEncoderConfig& config() const { return config_; }
   std::int64_t frames() const { return frames_; }  ///< pictures encoded so far
 
@@ -164,6 +171,7 @@ class PvEncoder {
   std::unique_ptr<Codec> codec_;  // null for raw
   cv::Mat resized_, i420_;
   std::int64_t frames_{0};
+  bool key_frame_next_{false};
 };
 
 }  // namespace orbed::hl2ss

@@ -283,6 +283,43 @@ TEST(PvVideo, EachConnectionStartsWithAnIdrAndTheGopRepeatsIt) {
   EXPECT_EQ(enc->frames(), 7);
 }
 
+// After a lost packet the client's decoder needs an IDR: a forced one decodes on a fresh decoder
+// (one that saw nothing before, as a decoder past the loss), where the P picture before it does not.
+TEST(PvVideo, AForcedKeyFrameDecodesOnAFreshDecoder) {
+  for (VideoProfile profile : {VideoProfile::kH264Main, VideoProfile::kH265Main}) {
+    const bool hevc = profile == VideoProfile::kH265Main;
+    std::string error;
+    auto enc = PvEncoder::Create(Config(640, 360, profile), &error);  // GOP 30: no IDR but the first
+    ASSERT_TRUE(enc) << error;
+    std::vector<std::vector<std::uint8_t>> images;
+    for (int i = 0; i < 6; ++i) {
+      if (i == 4) enc->ForceKeyFrame();
+      std::vector<std::uint8_t> payload;
+      const cv::Mat bgr = TestPicture(1280, 720, 6 * i);
+      ASSERT_TRUE(enc->Encode(bgr, geometry::Intrinsics::HoloLensPv(), {}, &payload, &error)) << error;
+      images.push_back(ImagePart(payload));
+      const std::vector<int> nals = NalTypes(images.back(), hevc);
+      const bool idr = hevc ? Has(nals, 19) || Has(nals, 20) : Has(nals, 5);
+      const bool sps = hevc ? Has(nals, 32) && Has(nals, 33) && Has(nals, 34) : Has(nals, 7) && Has(nals, 8);
+      EXPECT_EQ(idr, i == 0 || i == 4) << static_cast<int>(profile) << " picture " << i;
+      EXPECT_EQ(sps, i == 0 || i == 4) << static_cast<int>(profile) << " picture " << i;
+      if (i != 4) continue;
+      PvClientDecoder fresh(hevc);
+      const cv::Mat decoded = fresh.Decode(images.back());
+      ASSERT_FALSE(decoded.empty()) << static_cast<int>(profile);
+      EXPECT_TRUE(fresh.last_was_key());
+      cv::Mat expected;
+      cv::resize(bgr, expected, cv::Size(640, 360), 0, 0, cv::INTER_AREA);
+      EXPECT_GT(Psnr(decoded, expected), 30.0) << static_cast<int>(profile);
+    }
+    PvClientDecoder fresh(hevc);  // the P picture before the forced IDR: nothing to decode from
+    EXPECT_TRUE(fresh.Decode(images[3]).empty()) << static_cast<int>(profile);
+    PvClientDecoder after(hevc);  // and the P picture after it decodes once the IDR was seen
+    ASSERT_FALSE(after.Decode(images[4]).empty());
+    EXPECT_FALSE(after.Decode(images[5]).empty()) << static_cast<int>(profile);
+  }
+}
+
 TEST(PvVideo, TwoThreadsStillReturnEachPicturesUnit) {
   for (VideoProfile profile : {VideoProfile::kH264High, VideoProfile::kH265Main}) {
     std::string error;

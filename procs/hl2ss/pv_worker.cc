@@ -57,6 +57,11 @@ bool PvEncoderWorker::Offer(PvJob job) {
   return !replaced;
 }
 
+void PvEncoderWorker::RequestKeyFrame() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  key_frame_next_ = true;
+}
+
 void PvEncoderWorker::Loop() {
   for (;;) {
     PvJob job;
@@ -66,11 +71,14 @@ void PvEncoderWorker::Loop() {
       if (stop_) return;
       job = std::move(*mailbox_);
       mailbox_.reset();
+      job.key_frame = job.key_frame || key_frame_next_;
+      key_frame_next_ = false;
     }
     PvResult result;
     result.client = client_;
     result.timestamp = job.timestamp;
     result.pose = job.pose;
+    result.key_frame = job.key_frame;
     try {
       if (!encode_(job, &result.payload, &result.error)) {
         result.payload.clear();

@@ -11,7 +11,10 @@
 ///     Offer() says so, for the caller to count the drop;
 ///   - the worker takes the job, runs the encode function on it (outside any lock) and pushes the
 ///     result, tagged with the client, into the PvHandBack;
-///   - the process thread drains the PvHandBack (TakeAll) in its poll and sends.
+///   - the process thread drains the PvHandBack (TakeAll) in its poll and sends;
+///   - RequestKeyFrame() marks the next job the worker takes (the one waiting, or the next offered)
+///     `key_frame`, for the encode function to make an IDR of; a request is consumed only by a
+///     job taken, so a replaced job does not lose it.
 /// Stopping (RequestStop, then the destructor): the waiting job is discarded, the thread is told to
 /// stop and joined; it returns after the encode in progress, so the caller blocks at most one
 /// picture's encode.
@@ -48,6 +51,7 @@ struct PvJob {
   PvCaptureMetadata metadata;                 ///< the trailer's capture fields
   std::uint64_t timestamp{0};                 ///< hl2ss ticks, for the packet
   std::optional<std::array<float, 16>> pose;  ///< the mode-1 pose (frames.h), nullopt in mode 0
+  bool key_frame{false};                      ///< encode as a key frame (set by RequestKeyFrame)
 };
 
 /// What a worker hands back: the packet's parts, or why the encode failed.
@@ -56,7 +60,8 @@ struct PvResult {
   std::uint64_t timestamp{0};
   std::vector<std::uint8_t> payload;
   std::optional<std::array<float, 16>> pose;
-  std::string error;  ///< non-empty: no payload
+  bool key_frame{false};  ///< the job asked for a key frame
+  std::string error;      ///< non-empty: no payload
 };
 
 /// Encodes one job into *payload; false and *error on failure. Runs on a worker thread.
@@ -98,6 +103,9 @@ class PvEncoderWorker {
   /// waiting for it. Later offers are discarded.
   void RequestStop();
 
+  /// The next job taken is marked key_frame (see the file comment).
+  void RequestKeyFrame();
+
   int client() const { return client_; }
 
  private:
@@ -110,6 +118,7 @@ class PvEncoderWorker {
   std::condition_variable wake_;
   std::optional<PvJob> mailbox_;
   bool stop_{false};
+  bool key_frame_next_{false};
   std::thread thread_;  // last: started after the members it uses
 };
 

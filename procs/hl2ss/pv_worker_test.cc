@@ -23,6 +23,7 @@ class HeldEncoder {
     return [this](const PvJob& job, std::vector<std::uint8_t>* payload, std::string* error) {
       std::unique_lock<std::mutex> lock(mutex_);
       started_.push_back(job.timestamp);
+      key_frames_.push_back(job.key_frame);
       changed_.notify_all();
       const size_t me = started_.size();
       changed_.wait(lock, [&] { return released_ >= me; });
@@ -49,12 +50,17 @@ class HeldEncoder {
     std::lock_guard<std::mutex> lock(mutex_);
     return started_;
   }
+  std::vector<bool> key_frames() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return key_frames_;
+  }
   static constexpr std::uint64_t kFail = 200, kThrow = 201;
 
  private:
   std::mutex mutex_;
   std::condition_variable changed_;
   std::vector<std::uint64_t> started_;
+  std::vector<bool> key_frames_;
   size_t released_{0};
 };
 
@@ -114,6 +120,32 @@ TEST(PvWorker, EncodesTheLatestPictureAndCountsTheReplacedOne) {
   EXPECT_TRUE(back.queue.TakeAll().empty()) << "taken once";
 }
 
+TEST(PvWorker, AKeyFrameRequestGoesToTheNextJobTakenEvenWhenTheWaitingOneIsReplaced) {
+  HeldEncoder encoder;
+  WatchedHandBack back;
+  PvEncoderWorker worker(3, encoder.Fn(), &back.queue);
+  EXPECT_TRUE(worker.Offer(Job(1)));
+  ASSERT_TRUE(encoder.WaitStarted(1));
+  worker.RequestKeyFrame();  // while 1 is being encoded: for the next job taken
+  EXPECT_TRUE(worker.Offer(Job(2)));
+  EXPECT_FALSE(worker.Offer(Job(3))) << "2 replaced: the request stays";
+  encoder.Release();
+  ASSERT_TRUE(encoder.WaitStarted(2));
+  encoder.Release();
+  ASSERT_TRUE(back.WaitPushes(2));
+  EXPECT_TRUE(worker.Offer(Job(4)));  // the request was consumed by 3
+  ASSERT_TRUE(encoder.WaitStarted(3));
+  encoder.Release();
+  ASSERT_TRUE(back.WaitPushes(3));
+  EXPECT_EQ(encoder.started(), (std::vector<std::uint64_t>{1, 3, 4}));
+  EXPECT_EQ(encoder.key_frames(), (std::vector<bool>{false, true, false}));
+  const std::vector<PvResult> results = back.queue.TakeAll();
+  ASSERT_EQ(results.size(), 3u);
+  EXPECT_FALSE(results[0].key_frame);
+  EXPECT_TRUE(results[1].key_frame) << "the result says so, for the sender";
+  EXPECT_FALSE(results[2].key_frame);
+}
+
 TEST(PvWorker, StoppingWaitsForTheEncodeInProgressOnlyAndDropsTheWaitingPicture) {
   HeldEncoder encoder;
   WatchedHandBack back;
@@ -144,8 +176,8 @@ TEST(PvWorker, AnIdleWorkerStopsAtOnceAndDiscardKeepsOtherClients) {
   WatchedHandBack back;
   { PvEncoderWorker idle(1, encoder.Fn(), &back.queue); }  // joined without ever encoding
   EXPECT_TRUE(encoder.started().empty());
-  back.queue.Push(PvResult{1, 10, {}, std::nullopt, ""});
-  back.queue.Push(PvResult{2, 11, {}, std::nullopt, ""});
+  back.queue.Push(PvResult{1, 10, {}, std::nullopt, false, ""});
+  back.queue.Push(PvResult{2, 11, {}, std::nullopt, false, ""});
   back.queue.Discard(1);
   const std::vector<PvResult> left = back.queue.TakeAll();
   ASSERT_EQ(left.size(), 1u);
