@@ -371,6 +371,8 @@ TEST(Hl2ss, AnHl2ssClientSeesTheHeadsetAndHostileClientsAreRefused) {
   // SI: 15 packets (half a second), each the HMD_POSE of its stamp.
   const Eigen::Matrix3d R_DW = hl2ss::R_WD().transpose();
   int si_checked = 0, eye_checked = 0;
+  uint64_t si_stamp = 0;  // the last checked packet's, with its head
+  Eigen::Isometry3d si_X_WH = Eigen::Isometry3d::Identity();
   for (int i = 0; i < 15; ++i) {
     const Packet p = ReadPacket(&si, false);
     ASSERT_TRUE(p.ok);
@@ -396,6 +398,8 @@ TEST(Hl2ss, AnHl2ssClientSeesTheHeadsetAndHostileClientsAreRefused) {
     EXPECT_LT((f3(16) - R_DW * X_WH.linear().col(2)).norm(), 1e-6);   // forward: H's +z
     EXPECT_LT((f3(28) - R_DW * -X_WH.linear().col(1)).norm(), 1e-6);  // up: H's −y
     ++si_checked;
+    si_stamp = p.timestamp;
+    si_X_WH = X_WH;
     if (valid & 2) {
       bool found = false;
       for (const orbed::gaze_ray_t& g : gazes)
@@ -407,6 +411,25 @@ TEST(Hl2ss, AnHl2ssClientSeesTheHeadsetAndHostileClientsAreRefused) {
   }
   EXPECT_GE(si_checked, 10);
   EXPECT_GE(eye_checked, 5);
+
+  {  // RC rig-node world poses ('<BI' + count × u64): at that SI stamp, the rig node (the head
+     // with the device's axes) of its HMD_POSE; an hour later, not located (16 zeros).
+    Socket rc(3809);
+    std::vector<uint8_t> command = {0x17, 2, 0, 0, 0};
+    const uint64_t an_hour_later = si_stamp + 36'000'000'000u;
+    for (const uint64_t ticks : {si_stamp, an_hour_later})
+      for (int b = 0; b < 8; ++b) command.push_back(static_cast<uint8_t>(ticks >> (8 * b)));
+    rc.Send(command);
+    const std::vector<uint8_t> poses = rc.Read(2 * 64);
+    ASSERT_EQ(poses.size(), 2u * 64u);
+    Eigen::Isometry3d X_HN = Eigen::Isometry3d::Identity();
+    X_HN.linear() = Eigen::Vector3d(1, -1, -1).asDiagonal();
+    const Eigen::Matrix4d M = (hl2ss::X_WD().inverse() * si_X_WH * X_HN).matrix().transpose();
+    for (int k = 0; k < 16; ++k) {
+      EXPECT_NEAR(Le<float>(poses.data() + 4 * k), M(k / 4, k % 4), 1e-5) << k;
+      EXPECT_EQ(Le<float>(poses.data() + 64 + 4 * k), 0.0f) << k;
+    }
+  }
 
   std::vector<cv::Mat> pictures;
   for (int k = 0; k < 6; ++k) pictures.push_back(Picture(k));
