@@ -222,11 +222,10 @@ void Hl2ssProcess::SendEncodedPv() {
       continue;
     }
     // After a lost packet, pictures encoded before the key frame asked for cannot be decoded.
-    if (it->second.awaiting_key_frame && !r.key_frame) {
+    if (!it->second.gate.Pass(r.key_frame)) {
       process_.CountDrop("pv/before_key_frame");
       continue;
     }
-    it->second.awaiting_key_frame = false;
     server_.Send(r.client, PackPacket(r.timestamp, r.payload, r.pose ? &*r.pose : nullptr),
                  handlers_.on_event);
   }
@@ -313,9 +312,9 @@ Decision Hl2ssProcess::OnConfigured(int client, PortKind port, const StreamConfi
     return encoder->Encode(job.bgr, job.K, job.metadata, payload, why);
   };
   RemovePvClient(client);
-  pv_clients_.emplace(client,
-                      PvClient{std::make_unique<PvEncoderWorker>(client, std::move(encode), &pv_hand_back_),
-                               PvPacer(c), c.mode == kMode1, c.stop, c.profile != kProfileRaw});
+  pv_clients_.emplace(
+      client, PvClient{std::make_unique<PvEncoderWorker>(client, std::move(encode), &pv_hand_back_),
+                       PvPacer(c), c.mode == kMode1, c.stop, PvKeyFrameGate(c.profile != kProfileRaw)});
   return d;
 }
 
@@ -349,10 +348,8 @@ void Hl2ssProcess::OnEvent(const ServerEvent& event) {
       // A video client that lost a packet decodes nothing more until an IDR: ask its encoder for
       // one, and send it nothing before.
       const auto it = pv_clients_.find(event.client);
-      if (event.port == PortKind::kPv && it != pv_clients_.end() && it->second.video) {
+      if (event.port == PortKind::kPv && it != pv_clients_.end() && it->second.gate.OnDropped())
         it->second.worker->RequestKeyFrame();
-        it->second.awaiting_key_frame = true;
-      }
       break;
     }
     case ServerEvent::kStalled:

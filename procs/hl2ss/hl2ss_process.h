@@ -123,9 +123,8 @@ class Hl2ssProcess {
     std::unique_ptr<PvEncoderWorker> worker;
     PvPacer pacer;
     bool mode1{true};
-    bool stop_after{false};          // the STOP bit: close the subsystem when this client leaves
-    bool video{false};               // H.264 / H.265 (not raw): a lost packet needs a key frame
-    bool awaiting_key_frame{false};  // a packet was dropped: send nothing until the key frame asked for
+    bool stop_after{false};  // the STOP bit: close the subsystem when this client leaves
+    PvKeyFrameGate gate;     // a lost packet: nothing sent until the key frame asked for
   };
   PvHandBack pv_hand_back_;  // before pv_clients_: outlives the workers that push into it
   std::map<int, PvClient> pv_clients_;

@@ -18,6 +18,9 @@
 ///     pv_encoder.h's documented PvCaptureMetadata defaults.
 ///   - PvPacer: which 30 Hz camera frames a client gets (a mode's rate divides 30, protocol.h
 ///     PvVideoModes: 15 fps every second one, 5 fps every sixth; then every divisor-th of those).
+///   - PvKeyFrameGate: after a packet to an H.264/H.265 client is lost (its send queue full), the
+///     client decodes nothing until an IDR: its encoder is asked for one and the pictures finished
+///     before it are withheld, so the next picture sent is that IDR. Raw clients are not gated.
 ///   - PvCalibrationFor: the mode-2 answer: pv_encoder.h PackPvCalibration with K the camera's
 ///     (HMD_CAMERA's) scaled to the requested size and X_NC = X_HN⁻¹ · X_HC, X_HC = X_WH⁻¹ · X_WC
 ///     from one HMD_POSE (the estimate), N the rig node of rm_depth.h (LongThrowOptions::X_HN).
@@ -78,6 +81,28 @@ class PvPacer {
 
  private:
   std::int64_t skip_, divisor_, count_{0}, sent_{0};
+};
+
+/// See the file comment. One per PV client, used by the process thread.
+class PvKeyFrameGate {
+ public:
+  explicit PvKeyFrameGate(bool video) : video_(video) {}
+  /// A packet to the client was dropped. True: ask its encoder for a key frame.
+  bool OnDropped() {
+    awaiting_ = video_;
+    return video_;
+  }
+  /// Whether to send a finished picture (`key_frame`: encoded as the key frame asked for); false:
+  /// withhold it (the client could not decode it).
+  bool Pass(bool key_frame) {
+    if (awaiting_ && !key_frame) return false;
+    awaiting_ = false;
+    return true;
+  }
+
+ private:
+  bool video_;
+  bool awaiting_{false};
 };
 
 /// The mode-2 bytes for a client asking `width_px` × `height_px`: K_camera (the camera's, at its

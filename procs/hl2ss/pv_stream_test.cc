@@ -146,6 +146,19 @@ TEST(PvStream, PacerTakesEvery30OverFpsThenAppliesTheDivisor) {
   EXPECT_EQ(sent, (std::vector<int>{0, 6, 12}));
 }
 
+TEST(PvStream, AfterALossOnlyTheKeyFrameAskedForAndWhatFollowsAreSent) {
+  PvKeyFrameGate video(true);
+  EXPECT_TRUE(video.Pass(false)) << "no loss yet: every picture";
+  EXPECT_TRUE(video.OnDropped()) << "ask the encoder for a key frame";
+  EXPECT_FALSE(video.Pass(false)) << "encoded before the request: undecodable after the loss";
+  EXPECT_FALSE(video.Pass(false));
+  EXPECT_TRUE(video.Pass(true)) << "the key frame";
+  EXPECT_TRUE(video.Pass(false)) << "and the pictures after it";
+  PvKeyFrameGate raw(false);
+  EXPECT_FALSE(raw.OnDropped()) << "raw pictures are independent";
+  EXPECT_TRUE(raw.Pass(false));
+}
+
 TEST(PvStream, CalibrationIsTheCameraOnTheRigNodeAtTheRequestedSize) {
   // K at 1280×720 asked at 1920×1080: ×1.5 about pixel edges.
   geometry::Intrinsics K;
