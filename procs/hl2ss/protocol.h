@@ -138,7 +138,7 @@ struct PvConfig {
   bool stop{false};      ///< STOP bit: close the subsystem after
   MrcVideoOptions mrc;   ///< with `start`
   uint16_t width{0}, height{0};
-  uint8_t framerate{0};  ///< frames per second asked for (15 or 30)
+  uint8_t framerate{0};  ///< frames per second asked for (a PvVideoModes rate of the size)
   uint8_t divisor{1};    ///< send every divisor-th frame (≥ 1); modes 0 and 1
   uint8_t profile{kProfileRaw};
   uint8_t level{kLevelDefault};

@@ -1,7 +1,7 @@
 // libFuzzer: what an hl2ss client sends to orbed-hl2ss (procs/hl2ss/protocol.h). The first byte picks
 // the port (PV, RM depth long throw, SI, RC); the rest is the client's bytes. Whatever they are, each
 // parser ends without crashing and uses no more than it was given; a configuration it accepts is in
-// range (a video size the camera offers at 15 or 30 fps, divisor >= 1, PNG filter <= 6); the RC
+// range (a video mode of protocol.h PvVideoModes, divisor >= 1, PNG filter <= 6); the RC
 // command stream is parsed command after command as the server does, each accepted command answered
 // by the emulated device without crashing, until more bytes are needed or one is refused.
 #include <cstdlib>
