@@ -917,6 +917,21 @@ TEST(Hl2ss, DepthOnTheRobotBaseIsTheDistanceAlongThePixelsRay) {
   }
   const float* uv2x = calibration.data();
   const float* uv2y = uv2x + kDepthPixels;
+  {  // RC map camera points ('<BIII' + points): pixel (250, 31)'s centre, (250.5, 31.5) in the
+     // sensor's corner convention, goes to its uv2xy entry.
+    Socket rc(3809);
+    std::vector<uint8_t> command = {0x16, 0xDD, 0x0E, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0};  // 3805, op 0, 1 point
+    for (const float f : {250.5f, 31.5f}) {
+      uint32_t bits;
+      std::memcpy(&bits, &f, 4);
+      for (int b = 0; b < 4; ++b) command.push_back(static_cast<uint8_t>(bits >> (8 * b)));
+    }
+    rc.Send(command);
+    const std::vector<uint8_t> xy = rc.Read(8);
+    ASSERT_EQ(xy.size(), 8u);
+    EXPECT_EQ(Le<float>(xy.data()), uv2x[31 * kDepthW + 250]);
+    EXPECT_EQ(Le<float>(xy.data() + 4), uv2y[31 * kDepthW + 250]);
+  }
   Eigen::Matrix4d E;  // [p_Z 1] = [p_N 1] · E
   for (int r = 0; r < 4; ++r)
     for (int c = 0; c < 4; ++c) E(r, c) = calibration[2 * kDepthPixels + 4 * r + c];
