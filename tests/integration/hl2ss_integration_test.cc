@@ -21,7 +21,12 @@
 //     ("pv/profile"), a size the camera does not offer (1000×1000, "pv/size");
 //   - hostile clients: a garbage PV configuration is refused ("pv/mode"), a PV client that never
 //     reads is dropped ("pv/backlog", "pv/stalled"), an unknown RC command refused ("rc/unknown"),
-//     while the SI and PV clients above keep receiving; all counted on PROCESS_STATUS.
+//     while the SI and PV clients above keep receiving; all counted on PROCESS_STATUS;
+//   - RC: the rig node's world pose at an SI packet's stamp is that HMD_POSE's rig node; an hour
+//     later, not located (zeros).
+// A lost H.264 packet: a client (GOP 600, 150 Mbit/s) stops reading until PROCESS_STATUS counts a
+// "pv/backlog" drop, then reads on: every picture it receives is an IDR or carries the frame_num
+// after the previous one's (its slice headers read by hand: decodable in order), and an IDR comes.
 // The PV calibration (mode 2), with a picture the test renders itself (render::Renderer: a 6 cm
 // square tile facing the camera at a known p_W off the optical axis, a known X_WC and off-centre
 // K): refused ("pv/no_camera") before any HMD_CAMERA; then, at 1920×1080, the intrinsics and the
@@ -40,7 +45,8 @@
 // estimate (HMD_POSE); every depth pixel whose ray (the mode-2 uv2xy table, extrinsics and the
 // true rig node) meets the base's cylinder is that distance within 2 mm, a pixel that sees
 // nothing is 0, the mode-1 pose is the estimate's rig node, the stamps are HMD_POSE_TRUTH's; a
-// configuration with mode 3 and a ROBOT_STATE with a NaN are refused and counted.
+// configuration with mode 3 and a ROBOT_STATE with a NaN are refused and counted; RC maps a depth
+// pixel's centre to its uv2xy entry.
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
@@ -560,6 +566,142 @@ TEST(Hl2ss, AnHl2ssClientSeesTheHeadsetAndHostileClientsAreRefused) {
       },
       10));
   for (int i = 0; i < 5; ++i) ASSERT_TRUE(ReadPacket(&pv, true).ok);
+}
+
+// ---- a lost H.264 packet: the next picture the client gets is an IDR ------------------------------
+// Just enough of an H.264 stream's syntax (ITU-T H.264 7.3.2.1.1 and 7.3.3) to tell whether the
+// pictures received can be decoded in order: with no B-frames every picture is a reference, so each
+// is an IDR or has the frame_num after the previous one's (modulo MaxFrameNum).
+class Rbsp {
+ public:
+  explicit Rbsp(const std::vector<uint8_t>& nal) {  // without emulation-prevention bytes
+    for (size_t i = 0; i < nal.size(); ++i) {
+      if (i >= 2 && nal[i] == 3 && nal[i - 1] == 0 && nal[i - 2] == 0) continue;
+      b_.push_back(nal[i]);
+    }
+  }
+  uint32_t Bits(int n) {
+    uint32_t v = 0;
+    for (int i = 0; i < n; ++i, ++at_)
+      v = (v << 1) | (at_ / 8 < b_.size() ? (b_[at_ / 8] >> (7 - at_ % 8)) & 1 : 0);
+    return v;
+  }
+  uint32_t Ue() {
+    int zeros = 0;
+    while (zeros < 31 && Bits(1) == 0) ++zeros;
+    return (1u << zeros) - 1 + Bits(zeros);
+  }
+
+ private:
+  std::vector<uint8_t> b_;
+  size_t at_{8};  // past the NAL header byte
+};
+
+struct H264Picture {
+  bool idr{false};
+  int frame_num{-1};
+};
+
+// The picture of one PV payload (its image part: the device's 6-byte delimiter, then Annex B);
+// `log2_max_frame_num` is read from an SPS when the payload carries one.
+H264Picture ParseH264Payload(const std::vector<uint8_t>& payload, int* log2_max_frame_num) {
+  std::vector<std::vector<uint8_t>> nals;
+  for (size_t i = 0; i + 3 <= payload.size(); ++i) {
+    if (payload[i] == 0 && payload[i + 1] == 0 && payload[i + 2] == 1) {
+      nals.emplace_back();
+      i += 2;
+    } else if (!nals.empty()) {
+      nals.back().push_back(payload[i]);
+    }
+  }
+  H264Picture picture;
+  for (const std::vector<uint8_t>& nal : nals) {
+    if (nal.empty()) continue;
+    const int type = nal[0] & 0x1F;
+    Rbsp r(nal);
+    if (type == 7) {
+      const uint32_t profile = r.Bits(8);
+      r.Bits(16);  // constraint flags, level
+      r.Ue();      // seq_parameter_set_id
+      if (profile == 100 || profile == 110 || profile == 122 || profile == 244) {
+        if (r.Ue() == 3) r.Bits(1);  // chroma_format_idc, separate_colour_plane_flag
+        r.Ue();                      // bit depths
+        r.Ue();
+        r.Bits(1);  // qpprime_y_zero_transform_bypass_flag
+        EXPECT_EQ(r.Bits(1), 0u) << "no scaling matrices";
+      }
+      *log2_max_frame_num = static_cast<int>(r.Ue()) + 4;
+    } else if ((type == 1 || type == 5) && picture.frame_num < 0) {
+      r.Ue();  // first_mb_in_slice
+      r.Ue();  // slice_type
+      r.Ue();  // pic_parameter_set_id
+      picture.idr = type == 5;
+      picture.frame_num = static_cast<int>(r.Bits(*log2_max_frame_num));
+    }
+  }
+  return picture;
+}
+
+TEST(Hl2ss, AnH264ClientThatLostAPacketGetsAnIdrNext) {
+  BusWatcher bus;
+  bus.Start();
+  RunningProcess server({BinPath("orbed-hl2ss"), "--max-drops", "100000"});
+  Sent sent;
+  std::atomic<bool> stop{false};
+  std::thread headset(Publish, &stop, &sent);
+  struct Stopper {
+    std::atomic<bool>* stop;
+    std::thread* t;
+    ~Stopper() {
+      *stop = true;
+      t->join();
+    }
+  } stopper{&stop, &headset};
+  {
+    Socket start(3810);
+    start.Send(MrcStart());
+    EXPECT_TRUE(start.ClosedByServer());
+  }
+  // Mode 0, H.264 main, a GOP of 600 (20 s): no IDR but the first unless one is forced; 150 Mbit/s
+  // (large pictures, so that the socket's buffers fill within a fraction of a second).
+  Socket pv(3810, 4096);
+  std::vector<uint8_t> config = PvConfig(0x00, kWidth, kHeight, kH264Main, {{10, 600}});
+  const uint32_t bitrate = 150'000'000;
+  std::memcpy(config.data() + 9, &bitrate, 4);  // after mode, width, height, rate, divisor, profile, level
+  pv.Send(config);
+  int log2_max_frame_num = 0;
+  const Packet first = ReadPacket(&pv, false);
+  ASSERT_TRUE(first.ok);
+  H264Picture previous =
+      ParseH264Payload({first.payload.begin() + 6, first.payload.end()}, &log2_max_frame_num);
+  ASSERT_TRUE(previous.idr);
+  ASSERT_GT(log2_max_frame_num, 0);
+  // Read nothing until the server says a packet for this client found its queue full.
+  ASSERT_TRUE(WaitFor(
+      [&] {
+        const auto beats = bus.Heartbeats("orbed-hl2ss");
+        return !beats.empty() && CountOf(beats.back().status, "pv/backlog", true) >= 1;
+      },
+      20));
+  // Then every picture received decodes from those before it, and one is an IDR (the forced one).
+  int idrs = 0, after_idr = 0;
+  for (int i = 0; i < 600 && after_idr < 10; ++i) {
+    const Packet p = ReadPacket(&pv, false);
+    ASSERT_TRUE(p.ok) << i;
+    const H264Picture picture =
+        ParseH264Payload({p.payload.begin() + 6, p.payload.end() - 80}, &log2_max_frame_num);
+    ASSERT_GE(picture.frame_num, 0) << i;
+    if (picture.idr) {
+      ++idrs;
+      EXPECT_EQ(picture.frame_num, 0);
+    } else {
+      EXPECT_EQ(picture.frame_num, (previous.frame_num + 1) % (1 << log2_max_frame_num))
+          << "picture " << i << " cannot be decoded: the one before it was lost";
+    }
+    if (idrs > 0) ++after_idr;
+    previous = picture;
+  }
+  EXPECT_GE(idrs, 1) << "a key frame after the loss";
 }
 
 // ---- PV calibration against a picture the test renders ------------------------------------------
