@@ -58,6 +58,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <functional>
 #include <map>
 #include <mutex>
 #include <optional>
@@ -160,6 +161,21 @@ Packet ReadPacket(Socket* s, bool mode1) {
   p.ok = true;
   return p;
 }
+
+// The headset the test plays, on its own thread until the test ends (stopped and joined then).
+class Headset {
+ public:
+  explicit Headset(const std::function<void(std::atomic<bool>*)>& publish)
+      : thread_([this, publish] { publish(&stop_); }) {}
+  ~Headset() {
+    stop_ = true;
+    thread_.join();
+  }
+
+ private:
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
 
 // ---- the headset the test plays ------------------------------------------------------------------
 struct Sent {
@@ -318,16 +334,7 @@ TEST(Hl2ss, AnHl2ssClientSeesTheHeadsetAndHostileClientsAreRefused) {
   RunningProcess server(
       {BinPath("orbed-hl2ss"), "--app-version", "1.2.3.4", "--max-drops", "10", "--max-queue-mb", "8"});
   Sent sent;
-  std::atomic<bool> stop{false};
-  std::thread headset(Publish, &stop, &sent);
-  struct Stopper {
-    std::atomic<bool>* stop;
-    std::thread* t;
-    ~Stopper() {
-      *stop = true;
-      t->join();
-    }
-  } stopper{&stop, &headset};
+  const Headset headset([&](std::atomic<bool>* stop) { Publish(stop, &sent); });
 
   // RC: version, UTC offset, PV subsystem status.
   uint64_t offset = 0;
@@ -647,16 +654,7 @@ TEST(Hl2ss, AnH264ClientThatLostAPacketGetsAnIdrNext) {
   bus.Start();
   RunningProcess server({BinPath("orbed-hl2ss"), "--max-drops", "100000"});
   Sent sent;
-  std::atomic<bool> stop{false};
-  std::thread headset(Publish, &stop, &sent);
-  struct Stopper {
-    std::atomic<bool>* stop;
-    std::thread* t;
-    ~Stopper() {
-      *stop = true;
-      t->join();
-    }
-  } stopper{&stop, &headset};
+  const Headset headset([&](std::atomic<bool>* stop) { Publish(stop, &sent); });
   {
     Socket start(3810);
     start.Send(MrcStart());
@@ -802,16 +800,7 @@ TEST(Hl2ss, PvCalibrationProjectsAPointWhereTheRendererDrewIt) {
     EXPECT_TRUE(early.ClosedByServer()) << "no HMD_CAMERA yet: no intrinsics to answer";
   }
   const CubeScene scene = RenderCube();
-  std::atomic<bool> stop{false};
-  std::thread headset(PublishCube, &scene, &stop);
-  struct Stopper {
-    std::atomic<bool>* stop;
-    std::thread* t;
-    ~Stopper() {
-      *stop = true;
-      t->join();
-    }
-  } stopper{&stop, &headset};
+  const Headset headset([&](std::atomic<bool>* stop) { PublishCube(&scene, stop); });
 
   // One mode-1 frame (so the server has both messages), then the calibration.
   Packet frame;
@@ -1029,16 +1018,8 @@ TEST(Hl2ss, DepthOnTheRobotBaseIsTheDistanceAlongThePixelsRay) {
   const DepthScene scene;
   std::mutex mutex;
   std::vector<int64_t> truth_utimes;
-  std::atomic<bool> stop{false};
-  std::thread headset(PublishDepthInputs, &stop, &scene, &mutex, &truth_utimes);
-  struct Stopper {
-    std::atomic<bool>* stop;
-    std::thread* t;
-    ~Stopper() {
-      *stop = true;
-      t->join();
-    }
-  } stopper{&stop, &headset};
+  const Headset headset(
+      [&](std::atomic<bool>* stop) { PublishDepthInputs(stop, &scene, &mutex, &truth_utimes); });
 
   uint64_t offset = 0;
   {
