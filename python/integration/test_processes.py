@@ -143,6 +143,15 @@ def test_a_log_read_in_python_equals_orbed_log_csv_export_cell_for_cell(sim, pro
     assert trial_columns.index("annotation_landmark[2]") < trial_columns.index("annotation_side[0]")
 
 
+def first_difference(channel, python, cpp):
+    """Where two CSV texts part: the line numbers and the two lines, for a failure message."""
+    a, b = python.split(b"\n"), cpp.split(b"\n")
+    for i, (x, y) in enumerate(zip(a, b)):
+        if x != y:
+            return f"{channel}: {len(a)} lines in Python, {len(b)} in C++; line {i}:\n  {x[:400]}\n  {y[:400]}"
+    return f"{channel}: {len(a)} lines in Python, {len(b)} in C++, equal up to the shorter"
+
+
 def test_a_viraal_run_started_from_python_and_its_folder_and_log(tmp_path):
     folder = runs.run("run", "--run-id", "pinned", "--arg", "trials=1", env=dict(os.environ, ORBED_LOGS_DIR=str(tmp_path)),
                       output=subprocess.DEVNULL, timeout_s=600)
@@ -156,5 +165,6 @@ def test_a_viraal_run_started_from_python_and_its_folder_and_log(tmp_path):
     text = log.export(run.logs[0], text=True)
     assert len(text.frames) >= 15 and text.damage == []
     for channel, frame in text.frames.items():
-        assert log.csv_text(frame).encode() == (out / (log.csv_file_stem(channel) + ".csv")).read_bytes(), channel
+        python, cpp = log.csv_text(frame).encode(), (out / (log.csv_file_stem(channel) + ".csv")).read_bytes()
+        assert python == cpp, first_difference(channel, python, cpp)
     assert sorted(p.name for p in out.iterdir()) == sorted(log.csv_file_stem(c) + ".csv" for c in text.frames)

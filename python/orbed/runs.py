@@ -98,10 +98,15 @@ class Started:
 
 def start(verb, *args, env=None, output=None):
     """Starts `scripts/orbed VERB ARGS...` (verb: run, study or sweep) without waiting. env: the
-    environment (default this one); output: where its output goes (default this process's)."""
+    environment (default this one); output: where its output goes (default this process's). The
+    run gets a network namespace of its own, as from a shell, also when this process is inside
+    one (`scripts/orbed join`, a test's namespace): it never shares a bus with what runs here."""
     if verb not in VERBS:
         raise ValueError(f"verb {verb!r}: one of {VERBS}")
-    return Started(verb, [str(a) for a in args], dict(os.environ if env is None else env), output)
+    env = dict(os.environ if env is None else env)
+    for inside in ("ORBED_IN_NETNS", "ORBED_NETNS_PIDFILE"):  # scripts/netns-exec would reuse this one
+        env.pop(inside, None)
+    return Started(verb, [str(a) for a in args], env, output)
 
 
 def run(verb, *args, env=None, output=None, timeout_s=None):
