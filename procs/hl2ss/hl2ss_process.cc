@@ -18,6 +18,7 @@
 #include "lcmtypes/contract/validation.h"
 #include "procs/hl2ss/frames.h"
 #include "procs/hl2ss/rm_depth.h"
+#include "render/image_message.h"
 #include "runtime/flags.h"
 
 namespace orbed::hl2ss {
@@ -42,19 +43,6 @@ std::string CheckCameraImage(const orbed::image_t& img) {
     return "image: larger than " + std::to_string(kMaxCameraSide) + " pixels a side";
   if (img.pixel_format != orbed::image_t::FORMAT_JPEG && img.pixel_format != orbed::image_t::FORMAT_BGR8)
     return "image: pixel format " + std::to_string(img.pixel_format) + " (JPEG and BGR8 are served)";
-  return "";
-}
-
-// "" or why a checked image's data do not decode; on success *bgr holds its picture.
-std::string DecodeImage(const orbed::image_t& img, cv::Mat* bgr) {
-  if (img.pixel_format == orbed::image_t::FORMAT_JPEG) {
-    *bgr = cv::imdecode(img.data, cv::IMREAD_COLOR);
-  } else {
-    *bgr = cv::Mat(img.height, img.width, CV_8UC3, const_cast<uint8_t*>(img.data.data()), img.row_stride)
-               .clone();
-  }
-  if (bgr->empty() || bgr->cols != img.width || bgr->rows != img.height)
-    return "image: data do not decode to its size";
   return "";
 }
 
@@ -199,7 +187,7 @@ void Hl2ssProcess::OnCamera(const orbed::image_t& msg, const std::string& channe
   }
   if (due.empty()) return;
   PvJob job;
-  const std::string undecodable = DecodeImage(msg, &job.bgr);
+  const std::string undecodable = render::DecodeImageMessage(msg, &job.bgr);
   if (!undecodable.empty()) return process_.Reject(channel + "/image", undecodable);
   job.K = K;
   job.metadata = PvCaptureMetadataFromSettings(device_.pv_settings());

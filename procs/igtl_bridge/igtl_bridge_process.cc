@@ -22,6 +22,7 @@
 #include "lcmtypes/contract/requests.h"
 #include "lcmtypes/contract/session_control.h"
 #include "lcmtypes/contract/validation.h"
+#include "render/image_message.h"
 #include "runtime/flags.h"
 #include "sim/guidance_messages.h"
 
@@ -31,18 +32,7 @@ namespace {
 // "" or why an image_t cannot be shown (CheckImage, then the decoding); on success *bgr holds it.
 std::string DecodeImage(const orbed::image_t& img, cv::Mat* bgr) {
   const std::string problem = CheckImage(img);
-  if (!problem.empty()) return problem;
-  if (img.pixel_format == orbed::image_t::FORMAT_JPEG) {
-    *bgr = cv::imdecode(img.data, cv::IMREAD_COLOR);
-  } else if (img.pixel_format == orbed::image_t::FORMAT_BGR8) {
-    *bgr = cv::Mat(img.height, img.width, CV_8UC3, const_cast<uint8_t*>(img.data.data()), img.row_stride)
-               .clone();
-  } else {
-    return "pixel format " + std::to_string(img.pixel_format) + " (JPEG and BGR8 are shown)";
-  }
-  if (bgr->empty() || bgr->cols != img.width || bgr->rows != img.height)
-    return "the data do not decode to its size";
-  return "";
+  return problem.empty() ? render::DecodeImageMessage(img, bgr) : problem;
 }
 
 int StatusCode(int8_t state) {
