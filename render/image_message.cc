@@ -21,7 +21,8 @@ std::optional<cv::Size> JpegDeclaredSize(const std::vector<std::uint8_t>& b) {
     }
     if (marker == 0xD9 || marker == 0xDA || i + 3 >= n) return std::nullopt;  // no frame header first
     const size_t length = (size_t{b[i + 2]} << 8) | b[i + 3];
-    const bool frame_header = marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 && marker != 0xCC;
+    const bool frame_header =
+        marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 && marker != 0xCC;
     if (frame_header) {
       if (length < 7 || i + 8 >= n) return std::nullopt;
       const int height = (b[i + 5] << 8) | b[i + 6], width = (b[i + 7] << 8) | b[i + 8];
@@ -38,8 +39,9 @@ std::string DecodeImageMessage(const orbed::image_t& img, cv::Mat* bgr) {
     const std::optional<cv::Size> declared = JpegDeclaredSize(img.data);
     if (!declared) return "image: data are not a JPEG with a frame header";
     if (declared->width != img.width || declared->height != img.height)
-      return "image: the JPEG declares " + std::to_string(declared->width) + "x" + std::to_string(declared->height) +
-             ", the message " + std::to_string(img.width) + "x" + std::to_string(img.height);
+      return "image: the JPEG declares " + std::to_string(declared->width) + "x" +
+             std::to_string(declared->height) + ", the message " + std::to_string(img.width) + "x" +
+             std::to_string(img.height);
     try {
       *bgr = cv::imdecode(img.data, cv::IMREAD_COLOR);
     } catch (const cv::Exception&) {

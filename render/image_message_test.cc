@@ -57,7 +57,8 @@ TEST(ImageMessage, AJpegDeclaringAnotherSizeIsRefusedBeforeDecoding) {
   }
   ASSERT_EQ(JpegDeclaredSize(bomb), cv::Size(60000, 60000));
   cv::Mat bgr;
-  EXPECT_EQ(DecodeImageMessage(Message(64, 48, bomb), &bgr), "image: the JPEG declares 60000x60000, the message 64x48");
+  EXPECT_EQ(DecodeImageMessage(Message(64, 48, bomb), &bgr),
+            "image: the JPEG declares 60000x60000, the message 64x48");
   EXPECT_TRUE(bgr.empty());
   EXPECT_NE(DecodeImageMessage(Message(64, 48, {9, 9, 9}), &bgr), "");
   std::vector<std::uint8_t> truncated = Jpeg(64, 48);
